@@ -1,0 +1,113 @@
+#include "analysis/Access.h"
+
+namespace sphc {
+
+std::vector<std::string> positionProps(int dim) {
+  std::vector<std::string> p = {"x", "y", "z"};
+  p.resize(dim);
+  return p;
+}
+
+std::set<std::string> pairQuantityClosure(const std::set<std::string>& used) {
+  // Dependencies between pair quantities, as the generated code computes them.
+  static const std::map<std::string, std::vector<std::string>> deps = {
+      {"RIJ", {"R2IJ"}},          {"R2IJ", {"XIJ"}},
+      {"WIJ", {"RIJ", "HIJ"}},    {"WI", {"RIJ"}},
+      {"WJ", {"RIJ"}},            {"DWIJ", {"XIJ", "RIJ", "HIJ"}},
+      {"DWI", {"XIJ", "RIJ"}},    {"DWJ", {"XIJ", "RIJ"}},
+      {"EPS", {"HIJ"}},           {"RHOIJ1", {"RHOIJ"}}};
+  std::set<std::string> out = used;
+  // XIJ, R2IJ and HIJ are always computed: the neighbour test needs them.
+  out.insert("XIJ");
+  out.insert("R2IJ");
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    for (const auto& q : std::set<std::string>(out)) {
+      auto it = deps.find(q);
+      if (it == deps.end()) continue;
+      for (const auto& d : it->second) changed |= out.insert(d).second;
+    }
+  }
+  return out;
+}
+
+static void addBodyAccesses(std::vector<Access>& out, const BodyFacts& f, int dest,
+                            const std::vector<int>& sources, Access proto) {
+  for (const auto& r : f.dReads) {
+    Access a = proto;
+    a.array = dest;
+    a.prop = r.prop;
+    a.loc = r.loc;
+    out.push_back(a);
+  }
+  for (const auto& w : f.dWrites) {
+    Access a = proto;
+    a.array = dest;
+    a.prop = w.prop;
+    a.loc = w.loc;
+    a.write = true;
+    out.push_back(a);
+  }
+  for (int s : sources)
+    for (const auto& r : f.sReads) {
+      Access a = proto;
+      a.array = s;
+      a.prop = r.prop;
+      a.loc = r.loc;
+      a.viaSource = true;
+      out.push_back(a);
+    }
+}
+
+std::vector<Access> equationAccesses(const Plan& plan, const PlanEquation& eq) {
+  std::vector<Access> out;
+  if (eq.declIndex < 0) return out;
+  const PlanEquationDecl& pd = plan.equationDecls[eq.declIndex];
+  for (const auto& [kind, bodyIdx] : pd.methods) {
+    const BodyFacts& f = plan.bodies[bodyIdx].facts;
+    Access proto;
+    proto.equation = eq.id;
+    proto.method = kind;
+    addBodyAccesses(out, f, eq.dest, kind == ast::Method::Loop ? eq.sources : std::vector<int>{},
+                    proto);
+    if (kind != ast::Method::Loop) continue;
+    // What the generated neighbour loop reads for this body.
+    std::set<std::string> q = pairQuantityClosure(f.pairQuantities);
+    std::vector<std::string> implicitProps = positionProps(plan.dim);
+    implicitProps.push_back("h");
+    if (q.count("VIJ")) {
+      std::vector<std::string> vel = {"u", "v", "w"};
+      vel.resize(plan.dim);
+      implicitProps.insert(implicitProps.end(), vel.begin(), vel.end());
+    }
+    if (q.count("RHOIJ")) implicitProps.push_back("rho");
+    std::vector<int> arrays = eq.sources;
+    arrays.push_back(eq.dest);
+    for (int a : arrays)
+      for (const auto& p : implicitProps) {
+        Access acc = proto;
+        acc.array = a;
+        acc.prop = p;
+        acc.loc = eq.loc;
+        acc.implicit = true;
+        acc.viaSource = a != eq.dest;
+        out.push_back(acc);
+      }
+  }
+  return out;
+}
+
+std::vector<Access> stepperAccesses(const Plan& plan, int a) {
+  std::vector<Access> out;
+  const PlanArray& arr = plan.arrays[a];
+  if (arr.stepper < 0) return out;
+  for (const auto& [name, bodyIdx] : plan.steppers[arr.stepper].methods) {
+    Access proto;
+    proto.stepperMethod = name;
+    addBodyAccesses(out, plan.bodies[bodyIdx].facts, a, {}, proto);
+  }
+  return out;
+}
+
+}  // namespace sphc

@@ -1,0 +1,28 @@
+// The analysis passes, one per file, each `bool pass(Plan&, DiagnosticEngine&)` returning
+// false when it reported errors. The driver runs them in this order.
+#pragma once
+
+#include "frontend/Diagnostics.h"
+#include "sema/Plan.h"
+
+namespace sphc {
+
+// analysis/Pruning.cpp: marks equations whose results never reach integrated state (what
+// steppers read), output, the adaptive time step or a convergence test as not live.
+bool pruneEquations(Plan& plan, DiagnosticEngine& diags);
+// analysis/Properties.cpp: the exact property set of every array; errors for reads that
+// nothing sets, warnings for writes nothing reads and declarations nothing uses.
+bool inferProperties(Plan& plan, DiagnosticEngine& diags);
+// analysis/Hazards.cpp: within one group, a loop reading a source property that an equation
+// of the same group writes is an error (the result would depend on evaluation order).
+bool checkHazards(Plan& plan, DiagnosticEngine& diags);
+// analysis/PairQuantities.cpp: which pair quantities each (group, dest, source) loop computes.
+bool selectPairQuantities(Plan& plan, DiagnosticEngine& diags);
+
+// What the adaptive time step reads of a stepped, moving array (h, cs, velocities for the
+// CFL limit; accelerations for the force limit).
+std::vector<std::string> adaptiveDtProps(const Plan& plan);
+// Arrays the adaptive time step looks at: those whose stepper moves them (writes x).
+bool movesParticles(const Plan& plan, int array);
+
+}  // namespace sphc

@@ -1,0 +1,123 @@
+#include "analysis/Access.h"
+#include "analysis/Passes.h"
+
+#include <map>
+#include <set>
+
+namespace sphc {
+
+namespace {
+
+bool isConstant(const PlanArray& a, const std::string& name) {
+  return std::find(a.constants.begin(), a.constants.end(), name) != a.constants.end();
+}
+
+}  // namespace
+
+bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
+  unsigned errorsBefore = diags.errorCount();
+  // Every live access, grouped by array.
+  std::vector<std::vector<Access>> byArray(plan.arrays.size());
+  for (const auto& eq : plan.equations)
+    if (eq.live)
+      for (auto& acc : equationAccesses(plan, eq)) byArray[acc.array].push_back(acc);
+  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a)
+    for (auto& acc : stepperAccesses(plan, a)) byArray[a].push_back(acc);
+
+  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) {
+    PlanArray& arr = plan.arrays[a];
+    std::vector<Access>& accs = byArray[a];
+    std::map<std::string, const Access*> firstRead, firstWrite;
+    std::vector<std::string> order;  // first-appearance order of undeclared properties
+    auto note = [&](const std::string& p) {
+      if (!arr.find(p) && std::find(order.begin(), order.end(), p) == order.end())
+        order.push_back(p);
+    };
+    for (const auto& acc : accs) {
+      if (isConstant(arr, acc.prop)) continue;
+      auto& slot = acc.write ? firstWrite[acc.prop] : firstRead[acc.prop];
+      if (!slot) slot = &acc;
+      note(acc.prop);
+    }
+    std::set<std::string> readByOthers;  // output, neighbour search, time step
+    for (const auto& p : arr.outputProps) {
+      readByOthers.insert(p);
+      note(p);
+    }
+    if (movesParticles(plan, a))
+      for (const auto& p : adaptiveDtProps(plan)) {
+        readByOthers.insert(p);
+        note(p);
+      }
+
+    // The final property list: positions, declared properties that something uses (in
+    // declaration order), then the rest in order of first use.
+    std::vector<PlanProperty> props;
+    std::set<std::string> positions;
+    for (const auto& p : positionProps(plan.dim)) positions.insert(p);
+    for (const char* p : {"x", "y", "z"}) {
+      bool used = positions.count(p) || firstRead.count(p) || firstWrite.count(p) ||
+                  readByOthers.count(p);
+      if (!used) continue;
+      PlanProperty pp;
+      pp.name = p;
+      props.push_back(pp);
+    }
+    auto isPosition = [](const std::string& p) { return p == "x" || p == "y" || p == "z"; };
+    for (const auto& d : arr.props) {
+      bool used = firstRead.count(d.name) || firstWrite.count(d.name) ||
+                  readByOthers.count(d.name);
+      if (!used) {
+        diags.warning(d.declLoc, "property '" + d.name + "' of array '" + arr.name +
+                                     "' is declared but nothing uses it; it is not allocated");
+        continue;
+      }
+      props.push_back(d);
+    }
+    for (const auto& p : order) {
+      if (isPosition(p)) continue;
+      PlanProperty pp;
+      pp.name = p;
+      props.push_back(pp);
+    }
+    for (auto& p : props) {
+      p.read = firstRead.count(p.name) || readByOthers.count(p.name) || positions.count(p.name);
+      p.written = firstWrite.count(p.name) != 0;
+      p.output = std::find(arr.outputProps.begin(), arr.outputProps.end(), p.name) !=
+                 arr.outputProps.end();
+      bool set = p.written || p.declared || isPosition(p.name);
+      if (p.read && !set) {
+        auto it = firstRead.find(p.name);
+        if (it != firstRead.end()) {
+          const Access& r = *it->second;
+          std::string who = r.equation >= 0 ? "equation '" + plan.equations[r.equation].name +
+                                                   "'"
+                                             : "the stepper of '" + arr.name + "'";
+          diags.error(r.loc, "property '" + p.name + "' of array '" + arr.name + "' is read" +
+                                 (r.implicit ? " (by the neighbour loop of " + who + ")"
+                                             : " by " + who) +
+                                 " but nothing sets it");
+        } else {
+          diags.error(p.output ? plan.scene->name.loc : arr.loc,
+                      "property '" + p.name + "' of array '" + arr.name + "' is " +
+                          (p.output ? "output" : "needed by the adaptive time step") +
+                          " but nothing sets it");
+        }
+        diags.note(arr.loc, "give it an initial value in array '" + arr.name +
+                                "': property " + p.name + " = ...;");
+      }
+      if (p.written && !p.read && !p.output) {
+        const Access& w = *firstWrite[p.name];
+        std::string who = w.equation >= 0 ? "equation '" + plan.equations[w.equation].name +
+                                                 "'"
+                                           : "the stepper of '" + arr.name + "'";
+        diags.warning(w.loc, "property '" + p.name + "' of array '" + arr.name +
+                                 "' is written by " + who + " but never read");
+      }
+    }
+    arr.props = std::move(props);
+  }
+  return diags.errorCount() == errorsBefore;
+}
+
+}  // namespace sphc

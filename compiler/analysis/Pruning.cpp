@@ -1,0 +1,89 @@
+#include "analysis/Access.h"
+#include "analysis/Passes.h"
+
+#include <set>
+
+namespace sphc {
+
+std::vector<std::string> adaptiveDtProps(const Plan& plan) {
+  std::vector<std::string> props;
+  if (!plan.adaptiveDt) return props;
+  props = {"h"};
+  std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
+  vel.resize(plan.dim);
+  acc.resize(plan.dim);
+  if (plan.cfl || !plan.forceFactor) {
+    props.push_back("cs");
+    props.insert(props.end(), vel.begin(), vel.end());
+  }
+  if (plan.forceFactor) props.insert(props.end(), acc.begin(), acc.end());
+  return props;
+}
+
+bool movesParticles(const Plan& plan, int array) {
+  for (const auto& a : stepperAccesses(plan, array))
+    if (a.write && a.prop == "x") return true;
+  return false;
+}
+
+bool pruneEquations(Plan& plan, DiagnosticEngine&) {
+  using Key = std::pair<int, std::string>;
+  std::set<Key> live;
+  // Roots: what steppers read, what is output, what the adaptive time step reads.
+  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) {
+    for (const auto& acc : stepperAccesses(plan, a))
+      if (!acc.write) live.insert({a, acc.prop});
+    for (const auto& p : plan.arrays[a].outputProps) live.insert({a, p});
+    if (movesParticles(plan, a))
+      for (const auto& p : adaptiveDtProps(plan)) live.insert({a, p});
+  }
+  std::vector<std::vector<Access>> accesses;
+  for (const auto& eq : plan.equations) accesses.push_back(equationAccesses(plan, eq));
+  std::vector<bool> isLive(plan.equations.size(), false);
+  // An equation with a convergence test steers its group: it is always live.
+  for (const auto& eq : plan.equations)
+    if (eq.declIndex >= 0 &&
+        plan.equationDecls[eq.declIndex].methods.count(ast::Method::Converged))
+      isLive[eq.id] = true;
+  auto addReads = [&](int e) {
+    for (const auto& acc : accesses[e])
+      if (!acc.write) live.insert({acc.array, acc.prop});
+  };
+  for (size_t e = 0; e < plan.equations.size(); ++e)
+    if (isLive[e]) addReads(static_cast<int>(e));
+  // Fixpoint: an equation that writes something live is live, and so is what it reads.
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t e = 0; e < plan.equations.size(); ++e) {
+      if (isLive[e]) continue;
+      const PlanEquation& eq = plan.equations[e];
+      bool writesLive = false;
+      for (const auto& acc : accesses[e])
+        writesLive |= acc.write && live.count({acc.array, acc.prop});
+      if (eq.declIndex >= 0) {
+        const auto& pd = plan.equationDecls[eq.declIndex];
+        if (!pd.reduceTarget.empty()) writesLive |= live.count({eq.dest, pd.reduceTarget}) != 0;
+      }
+      if (!writesLive) continue;
+      isLive[e] = changed = true;
+      addReads(static_cast<int>(e));
+    }
+  }
+  for (auto& eq : plan.equations) {
+    eq.live = isLive[eq.id];
+    if (eq.live) continue;
+    std::set<std::string> writes;
+    for (const auto& acc : accesses[eq.id])
+      if (acc.write) writes.insert(acc.prop);
+    std::string w;
+    for (const auto& p : writes) w += (w.empty() ? "" : ", ") + p;
+    eq.pruneReason = "it writes " + (w.empty() ? std::string("nothing") : w) + " of '" +
+                     plan.arrays[eq.dest].name +
+                     "', which no stepper, output, time-step limit or convergence test uses";
+    plan.notes.push_back("pruned " + eq.name + "(dest = " + plan.arrays[eq.dest].name +
+                         "): " + eq.pruneReason);
+  }
+  return true;
+}
+
+}  // namespace sphc

@@ -1,0 +1,77 @@
+// Equation and stepper bodies, parsed and checked by Clang (libTooling) as C99 functions that
+// sphc synthesises, with #line directives so every Clang diagnostic points into the .sph file.
+// The result is what the analysis passes need: which d_/s_ properties a body reads and writes,
+// which pair quantities it uses, and whether it uses t and dt. The rest of sphc never sees
+// Clang: this header is the whole interface.
+#pragma once
+
+#include "frontend/Diagnostics.h"
+
+#include "llvm/Support/SMLoc.h"
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace sphc {
+
+enum class BodyKind {
+  Initialize,   // equation: per destination particle
+  Loop,         // equation: per (destination, neighbour) pair; s_* and pair quantities visible
+  PostLoop,     // equation: per destination particle
+  Reduce,       // equation: per destination particle, `return` a double
+  Converged,    // equation: once, `return` an int (>0 converged, <0 not, 0 no opinion)
+  StepperInit,  // stepper initialize: per particle
+  StepperStage  // stepper stageN: per particle
+};
+
+// How a property is stored, for typing `d_NAME` / `s_NAME` in the synthesised function.
+// Properties not listed are double scalars.
+struct PropShape {
+  std::string type = "double";  // double, int, uint
+  int stride = 1;
+};
+
+struct BodySource {
+  std::string text;                  // raw text between the braces
+  llvm::SMLoc start;                 // location of text[0] in the .sph buffer
+  BodyKind kind = BodyKind::Initialize;
+  std::string label;                 // for messages: "equation TaitEOS, method initialize"
+  std::vector<std::string> scalars;  // double constants visible by name (params, consts)
+  std::map<std::string, PropShape> props;  // known property shapes (by property name)
+};
+
+struct PropAccess {
+  std::string prop;                  // without the d_/s_ prefix
+  llvm::SMLoc loc;                   // first occurrence in the body
+};
+
+struct BodyFacts {
+  bool ok = false;                   // false: errors were reported for this body
+  std::vector<PropAccess> dReads;    // d_ properties read (incl. read in `+=`)
+  std::vector<PropAccess> dWrites;   // d_ properties written (=, +=, ++, ...)
+  std::vector<PropAccess> sReads;    // s_ properties read
+  std::set<std::string> pairQuantities;  // XIJ, VIJ, R2IJ, RIJ, HIJ, WIJ, WI, WJ, DWIJ, DWI,
+                                         // DWJ, RHOIJ, RHOIJ1, EPS (only in Loop bodies)
+  bool usesT = false, usesDt = false;
+  std::set<std::string> scalarsUsed;     // which of BodySource::scalars appear
+};
+
+// The identifiers every body may use, besides d_/s_ properties and the scalars it is given.
+const std::vector<std::string>& pairQuantityNames();
+const std::vector<std::string>& allowedMathFunctions();
+
+class BodyAnalyzer {
+ public:
+  explicit BodyAnalyzer(DiagnosticEngine& diags) : diags_(diags) {}
+  // Analyses all bodies in one Clang invocation; facts[i] belongs to bodies[i]. Errors
+  // (Clang's and sphc's portability rules) are reported through the DiagnosticEngine at
+  // .sph locations.
+  std::vector<BodyFacts> analyze(const std::vector<BodySource>& bodies);
+
+ private:
+  DiagnosticEngine& diags_;
+};
+
+}  // namespace sphc

@@ -1,0 +1,182 @@
+#include "driver/Build.h"
+
+#include "llvm/ADT/SmallString.h"
+#include "llvm/ADT/StringExtras.h"
+#include "llvm/Support/FileSystem.h"
+#include "llvm/Support/MemoryBuffer.h"
+#include "llvm/Support/Path.h"
+#include "llvm/Support/Program.h"
+#include "llvm/Support/SHA1.h"
+#include "llvm/Support/raw_ostream.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <map>
+
+namespace sphc {
+
+namespace fs = llvm::sys::fs;
+namespace path = llvm::sys::path;
+
+Install locateInstall(const char* argv0) {
+  static int anchor;
+  std::string exe = fs::getMainExecutable(argv0, &anchor);
+  llvm::SmallString<256> prefix(exe);
+  path::remove_filename(prefix);  // bin/
+  path::remove_filename(prefix);  // <prefix>
+  Install in;
+  in.prefix = std::string(prefix);
+  auto join = [&](std::initializer_list<const char*> parts) {
+    llvm::SmallString<256> p(prefix);
+    for (const char* s : parts) path::append(p, s);
+    return std::string(p);
+  };
+  in.includeDir = join({"include"});
+  in.libDir = join({"lib"});
+  in.stdlibDir = join({"share", "sphc", "stdlib"});
+  in.buildInfo = join({"share", "sphc", "buildinfo.txt"});
+  return in;
+}
+
+std::string cacheDirectory() {
+  if (const char* d = std::getenv("SPHC_CACHE_DIR")) return d;
+  if (const char* x = std::getenv("XDG_CACHE_HOME")) return std::string(x) + "/sphc";
+  if (const char* h = std::getenv("HOME")) return std::string(h) + "/.cache/sphc";
+  return ".sphc-cache";
+}
+
+namespace {
+
+std::map<std::string, std::string> readBuildInfo(const std::string& file, std::string& err) {
+  std::map<std::string, std::string> info;
+  auto buf = llvm::MemoryBuffer::getFile(file);
+  if (!buf) {
+    err = "cannot read '" + file + "': " + buf.getError().message() +
+          " (is sphc installed or run from its build tree?)";
+    return info;
+  }
+  llvm::SmallVector<llvm::StringRef, 8> lines;
+  (*buf)->getBuffer().split(lines, '\n', -1, false);
+  for (auto l : lines) {
+    auto [k, v] = l.split('=');
+    info[k.trim().str()] = v.trim().str();
+  }
+  return info;
+}
+
+void addFileToHash(llvm::SHA1& h, const std::string& file) {
+  if (auto buf = llvm::MemoryBuffer::getFile(file)) h.update((*buf)->getBuffer());
+  h.update(file);
+}
+
+}  // namespace
+
+BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
+  auto start = std::chrono::steady_clock::now();
+  BuildResult res;
+  std::string err;
+  auto info = readBuildInfo(install.buildInfo, err);
+  if (!err.empty()) {
+    res.message = err;
+    return res;
+  }
+  std::string cxx = req.cxx.empty() ? info["cxx"] : req.cxx;
+  std::string flags = req.cxxflags.empty() ? info["cxxflags"] : req.cxxflags;
+  std::string libs = info["libs"];
+  std::string runtimeLib = install.libDir + "/libsphc_runtime.a";
+
+  // The key: generated code, compiler, flags, libraries, the runtime library and headers.
+  llvm::SHA1 sha;
+  sha.update(req.cpp);
+  sha.update(cxx + "\n" + flags + "\n" + libs);
+  addFileToHash(sha, runtimeLib);
+  std::error_code ec;
+  std::vector<std::string> headers;
+  for (fs::directory_iterator it(install.includeDir + "/sphc", ec), end; it != end && !ec;
+       it.increment(ec))
+    headers.push_back(it->path());
+  std::sort(headers.begin(), headers.end());
+  for (const auto& hdr : headers) addFileToHash(sha, hdr);
+  std::string key = llvm::toHex(sha.final()).substr(0, 24);
+
+  llvm::SmallString<256> dir(cacheDirectory());
+  path::append(dir, key);
+  std::string cachedExe = std::string(dir) + "/scene";
+  auto finish = [&](bool ok) {
+    res.ok = ok;
+    res.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return res;
+  };
+  auto deliver = [&]() {
+    fs::remove(req.output);
+    if (auto e = fs::copy_file(cachedExe, req.output)) {
+      res.message = "cannot write '" + req.output + "': " + e.message();
+      return finish(false);
+    }
+    fs::setPermissions(req.output, fs::all_read | fs::all_exe | fs::owner_write);
+    return finish(true);
+  };
+  if (req.useCache && fs::can_execute(cachedExe)) {
+    res.cached = true;
+    return deliver();
+  }
+  if (auto e = fs::create_directories(dir)) {
+    res.message = "cannot create the cache directory '" + std::string(dir) + "': " + e.message();
+    return finish(false);
+  }
+  std::string cppFile = std::string(dir) + "/scene.cpp";
+  std::string logFile = std::string(dir) + "/build.log";
+  {
+    llvm::raw_fd_ostream os(cppFile, ec);
+    if (ec) {
+      res.message = "cannot write '" + cppFile + "': " + ec.message();
+      return finish(false);
+    }
+    os << req.cpp;
+  }
+  std::string tmpExe = cachedExe + ".tmp";
+  std::vector<std::string> args;
+  auto cxxPath = llvm::sys::findProgramByName(cxx);
+  if (!cxxPath) {
+    res.message = "cannot find the C++ compiler '" + cxx + "' (set it with --cxx)";
+    return finish(false);
+  }
+  args.push_back(*cxxPath);
+  llvm::SmallVector<llvm::StringRef, 16> parts;
+  llvm::StringRef(flags).split(parts, ' ', -1, false);
+  for (auto p : parts) args.push_back(p.str());
+  args.push_back("-I" + install.includeDir);
+  args.push_back(cppFile);
+  args.push_back(runtimeLib);
+  parts.clear();
+  llvm::StringRef(libs).split(parts, ' ', -1, false);
+  for (auto p : parts) args.push_back(p.str());
+  args.push_back("-o");
+  args.push_back(tmpExe);
+  if (req.verbose) {
+    for (const auto& a : args) llvm::errs() << a << " ";
+    llvm::errs() << "\n";
+  }
+  std::vector<llvm::StringRef> argRefs(args.begin(), args.end());
+  llvm::Optional<llvm::StringRef> redirects[] = {llvm::None, llvm::StringRef(logFile),
+                                                 llvm::StringRef(logFile)};
+  std::string execErr;
+  int rc = llvm::sys::ExecuteAndWait(args[0], argRefs, llvm::None, redirects, 0, 0, &execErr);
+  if (rc != 0) {
+    std::string log;
+    if (auto buf = llvm::MemoryBuffer::getFile(logFile)) log = (*buf)->getBuffer().str();
+    if (log.size() > 4000) log = log.substr(0, 4000) + "\n...";
+    res.message = "the generated C++ did not compile (" +
+                  (execErr.empty() ? "exit code " + std::to_string(rc) : execErr) +
+                  "); generated code: " + cppFile + ", log: " + logFile + "\n" + log;
+    return finish(false);
+  }
+  if (auto e = fs::rename(tmpExe, cachedExe)) {
+    res.message = "cannot move the built executable into the cache: " + e.message();
+    return finish(false);
+  }
+  return deliver();
+}
+
+}  // namespace sphc

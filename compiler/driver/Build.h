@@ -1,0 +1,40 @@
+// Building generated C++ into an executable, with a content-hash cache: an unchanged scene
+// (same generated code, compiler, flags and runtime) is not compiled again.
+#pragma once
+
+#include <string>
+
+namespace sphc {
+
+// Where sphc's own files are: found relative to the sphc executable (<prefix>/bin/sphc).
+struct Install {
+  std::string prefix;
+  std::string includeDir;   // <prefix>/include       (holds sphc/*.h)
+  std::string libDir;       // <prefix>/lib           (libsphc_runtime.a)
+  std::string stdlibDir;    // <prefix>/share/sphc/stdlib
+  std::string buildInfo;    // <prefix>/share/sphc/buildinfo.txt
+};
+Install locateInstall(const char* argv0);
+
+struct BuildRequest {
+  std::string cpp;          // the generated code
+  std::string output;       // executable to write
+  std::string cxx;          // override of the C++ compiler ("" = from buildinfo)
+  std::string cxxflags;     // override of the flags ("" = from buildinfo)
+  bool useCache = true;
+  bool verbose = false;
+};
+
+struct BuildResult {
+  bool ok = false;
+  bool cached = false;
+  std::string message;      // on failure: what went wrong, with the log's location
+  double seconds = 0.0;
+};
+
+BuildResult buildExecutable(const Install& install, const BuildRequest& req);
+
+// The cache directory: $SPHC_CACHE_DIR, else $XDG_CACHE_HOME/sphc, else ~/.cache/sphc.
+std::string cacheDirectory();
+
+}  // namespace sphc

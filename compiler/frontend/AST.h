@@ -1,0 +1,194 @@
+// The AST of a .sph file: what the parser read, with source locations, and no meaning
+// attached (Sema resolves names and binds parameters). Bodies of equations and steppers are
+// kept as raw text; Clang parses them in body/BodyAnalysis.
+#pragma once
+
+#include "llvm/Support/SMLoc.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace sphc::ast {
+
+struct Ident {
+  std::string name;
+  llvm::SMLoc loc;
+};
+
+// Declarative-layer expressions (params, initial values, equation arguments, scene settings).
+struct Expr;
+using ExprPtr = std::shared_ptr<const Expr>;
+struct Expr {
+  enum Kind { Number, Name, Unary, Binary, Call, Ternary };
+  Kind kind = Number;
+  llvm::SMLoc loc;
+  double number = 0.0;        // Number
+  std::string text;           // Number: literal as written; Name: identifier; Call: callee
+  std::string op;             // Unary: "-", "+", "!"; Binary: + - * / % < <= > >= == != && ||
+  std::vector<ExprPtr> args;  // Unary: 1, Binary: 2, Call: n, Ternary: cond, then, else
+};
+
+// `name = expr` or `name = [a, b]` in an argument list (equation instances, geometry, group
+// options, adaptive_dt).
+struct KwArg {
+  Ident name;
+  ExprPtr value;               // set unless isList
+  bool isList = false;
+  std::vector<Ident> list;     // `[fluid, boundary]`
+};
+
+// Raw C text of a method body: the characters between `{` and the matching `}`.
+struct Body {
+  std::string text;
+  llvm::SMLoc start;           // the first character of `text` (just after `{`)
+};
+
+struct ImportDecl {
+  std::vector<Ident> path;     // import a.b;  -> {a, b}
+  llvm::SMLoc loc;
+};
+
+struct ParamDecl {
+  Ident name;
+  ExprPtr value;
+};
+
+struct PropertyDecl {
+  Ident name;
+  std::string type = "double";  // "double", "int", "uint"
+  int stride = 1;
+  ExprPtr init;                 // may be null: 0
+  llvm::SMLoc loc;              // the `property` keyword
+};
+
+struct ConstDecl {
+  Ident name;
+  int size = 1;
+  ExprPtr init;                 // may be null: 0
+};
+
+struct GeometryDecl {
+  Ident builder;                // block, tank, disk, sphere, cylinder, line
+  std::vector<KwArg> args;
+};
+
+struct LoadDecl {
+  std::string path;             // as written (relative to the .sph file)
+  llvm::SMLoc loc;
+};
+
+struct ArrayDecl {
+  Ident name;
+  std::vector<GeometryDecl> geometry;
+  std::vector<LoadDecl> loads;
+  std::vector<PropertyDecl> properties;
+  std::vector<ConstDecl> constants;
+};
+
+struct EqParam {
+  Ident name;
+  ExprPtr defaultValue;         // may be null: required argument
+};
+
+struct EqConst {
+  Ident name;
+  ExprPtr value;
+};
+
+struct Method {
+  enum Kind { Initialize, Loop, PostLoop, Reduce, Converged };
+  Kind kind = Initialize;
+  llvm::SMLoc loc;              // the method keyword
+  std::string reduceOp;         // Reduce: "sum", "max", "min"
+  Ident reduceTarget;           // Reduce: the array constant receiving the result
+  Body body;
+};
+
+struct EquationDecl {
+  Ident name;
+  std::vector<EqParam> params;
+  std::vector<EqConst> consts;
+  std::vector<Method> methods;
+};
+
+struct StepperMethod {
+  Ident name;                   // "initialize", "stage1", "stage2", ...
+  Body body;
+};
+
+struct StepperDecl {
+  Ident name;
+  std::vector<StepperMethod> methods;
+};
+
+struct IntegratorDecl {
+  Ident name;
+  std::vector<Ident> steps;     // initialize, stageN, compute_accelerations, update_domain
+};
+
+struct EquationInstance {
+  Ident equation;
+  std::vector<KwArg> args;      // dest = a, sources = [b, c], param = expr
+};
+
+struct GroupDecl;
+// One entry of an `equations { }` or `group { }` list: exactly one of the two is set.
+struct GroupItem {
+  std::shared_ptr<GroupDecl> group;
+  std::shared_ptr<EquationInstance> equation;
+};
+
+struct GroupDecl {
+  llvm::SMLoc loc;              // the `group` keyword
+  std::vector<KwArg> options;   // real, iterate, min_iterations, max_iterations
+  std::vector<GroupItem> items;
+};
+
+struct OutputDecl {
+  llvm::SMLoc loc;
+  ExprPtr every;                // `output every T`, or null
+  std::vector<ExprPtr> at;      // `output at [t1, t2]`
+  struct Item {
+    Ident array;
+    std::vector<Ident> props;
+  };
+  std::vector<Item> items;
+};
+
+struct SceneSetting {
+  Ident key;                    // dim, kernel, tf, dt, integrator, ...
+  ExprPtr value;                // identifiers (CubicSpline, PECIntegrator) are Name exprs
+};
+
+struct SceneStepper {
+  Ident array;
+  Ident stepper;
+};
+
+struct SceneDecl {
+  Ident name;
+  std::vector<SceneSetting> settings;
+  std::vector<SceneStepper> steppers;
+  bool hasAdaptiveDt = false;
+  llvm::SMLoc adaptiveDtLoc;
+  std::vector<KwArg> adaptiveDt;
+  std::vector<OutputDecl> outputs;
+  llvm::SMLoc equationsLoc;
+  std::vector<GroupItem> equations;
+};
+
+// One parsed file. Sema merges a scene's module with the modules it imports.
+struct Module {
+  std::string filename;         // as given on the command line or resolved for an import
+  unsigned bufferId = 0;        // in the DiagnosticEngine's SourceMgr
+  std::vector<ImportDecl> imports;
+  std::vector<ParamDecl> params;
+  std::vector<ArrayDecl> arrays;
+  std::vector<EquationDecl> equations;
+  std::vector<StepperDecl> steppers;
+  std::vector<IntegratorDecl> integrators;
+  std::vector<SceneDecl> scenes;
+};
+
+}  // namespace sphc::ast

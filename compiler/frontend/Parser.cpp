@@ -1,0 +1,732 @@
+#include "frontend/Parser.h"
+
+#include "llvm/ADT/STLExtras.h"
+#include "llvm/ADT/ScopeExit.h"
+#include "llvm/ADT/StringExtras.h"
+#include "llvm/Support/MemoryBuffer.h"
+
+#include <cstdlib>
+
+namespace sphc {
+
+using ast::ExprPtr;
+
+namespace {
+
+constexpr llvm::StringLiteral kTopLevelKeywords[] = {
+    "import", "param", "array", "equation", "stepper", "integrator", "scene"};
+
+// `stage` followed by one or more digits.
+bool isStageName(llvm::StringRef word) {
+  return word.consume_front("stage") && !word.empty() && llvm::all_of(word, llvm::isDigit);
+}
+
+bool isStepperMethod(llvm::StringRef word) { return word == "initialize" || isStageName(word); }
+
+bool isIntegratorStatement(llvm::StringRef word) {
+  return isStepperMethod(word) || word == "compute_accelerations" || word == "update_domain";
+}
+
+// Binary operators by C precedence, loosest first; 0 for any other token.
+int binaryPrecedence(Token::Kind kind) {
+  switch (kind) {
+    case Token::OrOr: return 1;
+    case Token::AndAnd: return 2;
+    case Token::EqEq: case Token::NotEq: return 3;
+    case Token::Less: case Token::LessEq: case Token::Greater: case Token::GreaterEq: return 4;
+    case Token::Plus: case Token::Minus: return 5;
+    case Token::Star: case Token::Slash: case Token::Percent: return 6;
+    default: return 0;
+  }
+}
+
+std::shared_ptr<ast::Expr> makeExpr(ast::Expr::Kind kind, const Token& tok) {
+  auto e = std::make_shared<ast::Expr>();
+  e->kind = kind;
+  e->loc = tok.loc;
+  return e;
+}
+
+ast::Ident identOf(const Token& tok) { return ast::Ident{tok.text.str(), tok.loc}; }
+
+std::string quoted(llvm::StringRef s) { return "'" + s.str() + "'"; }
+
+}  // namespace
+
+Parser::Parser(DiagnosticEngine& diags, llvm::SourceMgr& sm, unsigned bufferId)
+    : diags_(diags),
+      bufferId_(bufferId),
+      filename_(sm.getMemoryBuffer(bufferId)->getBufferIdentifier().str()),
+      errorsAtStart_(diags.errorCount()),
+      lex_(diags, sm.getMemoryBuffer(bufferId)->getBuffer()) {}
+
+// ---------------------------------------------------------------------------------------------
+// Tokens, errors and recovery
+
+void Parser::advance() {
+  prevEnd_ = cur().endLoc();
+  lex_.advance();
+}
+
+bool Parser::consumeIf(Token::Kind kind) {
+  if (!cur().is(kind)) return false;
+  advance();
+  return true;
+}
+
+bool Parser::expect(Token::Kind kind, const llvm::Twine& context) {
+  if (consumeIf(kind)) return true;
+  llvm::SMLoc loc = kind == Token::Semi && prevEnd_.isValid() ? prevEnd_ : cur().loc;
+  return error(loc, "expected " + describe(kind) + " " + context);
+}
+
+bool Parser::parseIdent(ast::Ident& out, const llvm::Twine& expected) {
+  if (!cur().is(Token::Identifier)) return error(cur().loc, expected);
+  out = identOf(cur());
+  advance();
+  return true;
+}
+
+bool Parser::parseBody(ast::Body& out, llvm::StringRef method, const std::string& owner) {
+  if (!cur().is(Token::LBrace))
+    return error(cur().loc, "expected '{' to start the body of " + quoted(method) + " in " + owner);
+  out = lex_.lexBody(method);
+  prevEnd_ = llvm::SMLoc::getFromPointer(out.start.getPointer() + out.text.size() + 1);
+  return true;
+}
+
+bool Parser::report(llvm::SMLoc loc, const llvm::Twine& msg) {
+  bool consequence = cur().is(Token::Error) || (cur().is(Token::Eof) && lex_.hitEofByError());
+  bool show = !panic_ && !stopped_ && !consequence;
+  panic_ = true;
+  if (!show) return false;
+  diags_.error(loc, msg);
+  checkErrorLimit();
+  return true;
+}
+
+bool Parser::error(llvm::SMLoc loc, const llvm::Twine& msg) {
+  report(loc, msg);
+  return false;
+}
+
+void Parser::checkErrorLimit() {
+  if (stopped_ || diags_.errorCount() - errorsAtStart_ < kMaxErrors) return;
+  stopped_ = true;
+  diags_.note(llvm::SMLoc(), "too many errors in " + filename_ + "; stopping");
+  lex_.stop();
+}
+
+bool Parser::atTopLevelItem() {
+  if (!cur().is(Token::Identifier)) return false;
+  return llvm::is_contained(kTopLevelKeywords, cur().text) &&
+         lex_.peek().is(Token::Identifier);
+}
+
+void Parser::skipToTopLevelItem() {
+  lex_.setSuppressed(true);
+  while (!cur().is(Token::Eof) && !atTopLevelItem()) {
+    if (cur().is(Token::LBrace))
+      lex_.lexBody("");
+    else
+      advance();
+  }
+  lex_.setSuppressed(false);
+}
+
+void Parser::skipStatement() {
+  // A statement ends at `;` or with a `{ ... }` (skipped whole, its text may be C); a `}` or
+  // a top-level keyword ends the enclosing block.
+  lex_.setSuppressed(true);
+  while (!cur().is(Token::Eof) && !cur().is(Token::RBrace) && !atTopLevelItem()) {
+    if (cur().is(Token::LBrace)) {
+      lex_.lexBody("");
+      panic_ = false;
+      break;
+    }
+    if (cur().is(Token::Semi)) {
+      lex_.setSuppressed(false);
+      advance();
+      panic_ = false;
+      return;
+    }
+    advance();
+  }
+  lex_.setSuppressed(false);
+  if (cur().is(Token::RBrace)) panic_ = false;
+}
+
+bool Parser::parseBlock(const std::string& what, llvm::function_ref<bool()> parseItem,
+                        bool sceneStepper) {
+  llvm::SMLoc open = cur().loc;
+  if (!expect(Token::LBrace, "to start the body of " + what)) return false;
+  while (!cur().is(Token::RBrace)) {
+    if (cur().is(Token::Eof)) {
+      if (report(cur().loc, "unexpected end of file in " + what + ": missing '}'"))
+        diags_.note(open, "to match this '{'");
+      return false;
+    }
+    if (atTopLevelItem() && !(sceneStepper && atWord("stepper"))) {
+      if (report(cur().loc, "expected '}' at the end of " + what + " before " +
+                                quoted(cur().text)))
+        diags_.note(open, "to match this '{'");
+      return false;
+    }
+    if (!parseItem()) skipStatement();
+  }
+  advance();
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Declarations
+
+std::unique_ptr<ast::Module> Parser::parseModule() {
+  auto mod = std::make_unique<ast::Module>();
+  mod->filename = filename_;
+  mod->bufferId = bufferId_;
+  while (!cur().is(Token::Eof)) {
+    panic_ = false;
+    checkErrorLimit();
+    if (!parseItem(*mod)) skipToTopLevelItem();
+  }
+  return mod;
+}
+
+bool Parser::parseItem(ast::Module& mod) {
+  if (atWord("import")) return parseImport(mod);
+  if (atWord("param")) return parseParam(mod);
+  if (atWord("array")) return parseArray(mod);
+  if (atWord("equation")) return parseEquation(mod);
+  if (atWord("stepper")) return parseStepper(mod);
+  if (atWord("integrator")) return parseIntegrator(mod);
+  if (atWord("scene")) return parseScene(mod);
+  const char* expected = "import, param, array, equation, stepper, integrator or scene";
+  if (cur().is(Token::Identifier))
+    return error(cur().loc, "unknown declaration " + quoted(cur().text) + ": expected " + expected);
+  return error(cur().loc, "expected a declaration (" + llvm::Twine(expected) + "), found " +
+                              describe(cur()));
+}
+
+bool Parser::parseImport(ast::Module& mod) {
+  ast::ImportDecl imp;
+  imp.loc = cur().loc;
+  advance();
+  do {
+    ast::Ident part;
+    if (!parseIdent(part, "expected a module name after 'import'")) return false;
+    imp.path.push_back(std::move(part));
+  } while (consumeIf(Token::Dot));
+  mod.imports.push_back(std::move(imp));
+  return expect(Token::Semi, "after import");
+}
+
+bool Parser::parseParam(ast::Module& mod) {
+  advance();
+  ast::ParamDecl param;
+  if (!parseIdent(param.name, "expected a parameter name after 'param'") ||
+      !expect(Token::Assign, "after parameter name " + quoted(param.name.name)))
+    return false;
+  param.value = parseExpr();
+  if (!param.value) return false;
+  mod.params.push_back(std::move(param));
+  return expect(Token::Semi, "after parameter declaration");
+}
+
+bool Parser::parseArray(ast::Module& mod) {
+  advance();
+  ast::ArrayDecl array;
+  if (!parseIdent(array.name, "expected an array name after 'array'")) return false;
+  bool ok = parseBlock("array " + quoted(array.name.name), [&] { return parseArrayItem(array); });
+  mod.arrays.push_back(std::move(array));
+  return ok;
+}
+
+bool Parser::parseArrayItem(ast::ArrayDecl& array) {
+  if (atWord("geometry")) return parseGeometry(array);
+  if (atWord("load")) return parseLoad(array);
+  if (atWord("property")) return parseProperty(array);
+  if (atWord("const")) return parseArrayConst(array);
+  const char* expected = "'geometry', 'load', 'property' or 'const'";
+  if (cur().is(Token::Identifier))
+    return error(cur().loc, "unknown item " + quoted(cur().text) + " in array " +
+                                quoted(array.name.name) + ": expected " + expected);
+  return error(cur().loc, "expected " + llvm::Twine(expected) + " in array " +
+                              quoted(array.name.name) + ", found " + describe(cur()));
+}
+
+bool Parser::parseGeometry(ast::ArrayDecl& array) {
+  advance();
+  ast::GeometryDecl geom;
+  if (!parseIdent(geom.builder, "expected a geometry builder after 'geometry' (block, tank, "
+                                "disk, sphere, cylinder or line)") ||
+      !expect(Token::LParen, "after geometry builder " + quoted(geom.builder.name)) ||
+      !parseKwArgs(geom.args))
+    return false;
+  array.geometry.push_back(std::move(geom));
+  return expect(Token::Semi, "after geometry declaration");
+}
+
+bool Parser::parseLoad(ast::ArrayDecl& array) {
+  ast::LoadDecl load;
+  load.loc = cur().loc;
+  advance();
+  if (!cur().is(Token::String))
+    return error(cur().loc, "expected a file name string after 'load', found " + describe(cur()));
+  load.path = cur().value;
+  advance();
+  array.loads.push_back(std::move(load));
+  return expect(Token::Semi, "after load declaration");
+}
+
+bool Parser::parseProperty(ast::ArrayDecl& array) {
+  ast::PropertyDecl prop;
+  prop.loc = cur().loc;
+  advance();
+  // `property TYPE NAME` or `property TYPE[N] NAME`: the word before the name is a type.
+  if (cur().is(Token::Identifier) &&
+      (lex_.peek().is(Token::Identifier) || lex_.peek().is(Token::LBracket))) {
+    llvm::StringRef type = cur().text;
+    if (type != "double" && type != "int" && type != "uint")
+      return error(cur().loc, "unknown property type " + quoted(type) +
+                                  ": expected double, int or uint");
+    prop.type = type.str();
+    advance();
+    if (consumeIf(Token::LBracket)) {
+      std::optional<int> stride = parseBracketedSize("stride");
+      if (!stride) return false;
+      prop.stride = *stride;
+    }
+  }
+  if (!parseIdent(prop.name, "expected a property name after 'property'")) return false;
+  if (consumeIf(Token::Assign) && !(prop.init = parseExpr())) return false;
+  array.properties.push_back(std::move(prop));
+  return expect(Token::Semi, "after property declaration");
+}
+
+bool Parser::parseArrayConst(ast::ArrayDecl& array) {
+  advance();
+  ast::ConstDecl c;
+  if (!parseIdent(c.name, "expected a constant name after 'const'")) return false;
+  if (consumeIf(Token::LBracket)) {
+    std::optional<int> size = parseBracketedSize("size");
+    if (!size) return false;
+    c.size = *size;
+  }
+  if (consumeIf(Token::Assign) && !(c.init = parseExpr())) return false;
+  array.constants.push_back(std::move(c));
+  return expect(Token::Semi, "after constant declaration");
+}
+
+std::optional<int> Parser::parseBracketedSize(const llvm::Twine& what) {
+  unsigned value = 0;
+  if (!cur().is(Token::Number) || cur().text.getAsInteger(10, value) || value < 1 ||
+      value > 1u << 20) {
+    error(cur().loc, "expected a positive integer " + what + " in '[ ]', found " + describe(cur()));
+    return std::nullopt;
+  }
+  advance();
+  if (!expect(Token::RBracket, "after the " + what)) return std::nullopt;
+  return static_cast<int>(value);
+}
+
+bool Parser::parseEquation(ast::Module& mod) {
+  advance();
+  ast::EquationDecl eq;
+  if (!parseIdent(eq.name, "expected an equation name after 'equation'")) return false;
+  std::string what = "equation " + quoted(eq.name.name);
+  if (!expect(Token::LParen, "after the name of " + what) || !parseEquationParams(eq))
+    return false;
+  bool ok = parseBlock(what, [&] { return parseEquationItem(eq); });
+  mod.equations.push_back(std::move(eq));
+  return ok;
+}
+
+bool Parser::parseEquationParams(ast::EquationDecl& eq) {
+  if (consumeIf(Token::RParen)) return true;
+  do {
+    ast::EqParam param;
+    if (!parseIdent(param.name, "expected a parameter name in equation " + quoted(eq.name.name)))
+      return false;
+    if (consumeIf(Token::Assign) && !(param.defaultValue = parseExpr())) return false;
+    eq.params.push_back(std::move(param));
+  } while (consumeIf(Token::Comma));
+  return expect(Token::RParen, "after the parameters of equation " + quoted(eq.name.name));
+}
+
+bool Parser::parseEquationItem(ast::EquationDecl& eq) {
+  static constexpr std::pair<llvm::StringLiteral, ast::Method::Kind> kMethods[] = {
+      {"initialize", ast::Method::Initialize},
+      {"loop", ast::Method::Loop},
+      {"post_loop", ast::Method::PostLoop},
+      {"converged", ast::Method::Converged}};
+  std::string owner = "equation " + quoted(eq.name.name);
+  if (atWord("const")) return parseEquationConst(eq);
+  if (atWord("reduce")) return parseReduce(eq);
+  for (const auto& [name, kind] : kMethods) {
+    if (!atWord(name)) continue;
+    ast::Method method;
+    method.kind = kind;
+    method.loc = cur().loc;
+    advance();
+    if (!parseBody(method.body, name, owner)) return false;
+    eq.methods.push_back(std::move(method));
+    return true;
+  }
+  if (cur().is(Token::Identifier))
+    return error(cur().loc, "unknown method " + quoted(cur().text) + " in " + owner +
+                                ": expected initialize, loop, post_loop, reduce or converged");
+  return error(cur().loc, "expected a method or 'const' in " + owner + ", found " +
+                              describe(cur()));
+}
+
+bool Parser::parseEquationConst(ast::EquationDecl& eq) {
+  advance();
+  ast::EqConst c;
+  if (!parseIdent(c.name, "expected a constant name after 'const'") ||
+      !expect(Token::Assign, "after constant " + quoted(c.name.name)) ||
+      !(c.value = parseExpr()))
+    return false;
+  eq.consts.push_back(std::move(c));
+  return expect(Token::Semi, "after constant declaration");
+}
+
+bool Parser::parseReduce(ast::EquationDecl& eq) {
+  ast::Method method;
+  method.kind = ast::Method::Reduce;
+  method.loc = cur().loc;
+  advance();
+  if (atWord("sum") || atWord("max") || atWord("min")) {
+    method.reduceOp = cur().text.str();
+    advance();
+  } else if (cur().is(Token::Identifier) && lex_.peek().is(Token::Identifier)) {
+    return error(cur().loc, "unknown reduction operator " + quoted(cur().text) +
+                                ": expected sum, max or min");
+  } else {
+    return error(cur().loc, "expected a reduction operator after 'reduce': sum, max or min");
+  }
+  if (!parseIdent(method.reduceTarget, "expected the array constant receiving the result after "
+                                       "'reduce " + method.reduceOp + "'") ||
+      !parseBody(method.body, "reduce", "equation " + quoted(eq.name.name)))
+    return false;
+  eq.methods.push_back(std::move(method));
+  return true;
+}
+
+bool Parser::parseStepper(ast::Module& mod) {
+  advance();
+  ast::StepperDecl stepper;
+  if (!parseIdent(stepper.name, "expected a stepper name after 'stepper'")) return false;
+  std::string what = "stepper " + quoted(stepper.name.name);
+  bool ok = parseBlock(what, [&] {
+    if (cur().is(Token::Identifier) && isStepperMethod(cur().text)) {
+      ast::StepperMethod method;
+      method.name = identOf(cur());
+      advance();
+      if (!parseBody(method.body, method.name.name, what)) return false;
+      stepper.methods.push_back(std::move(method));
+      return true;
+    }
+    if (cur().is(Token::Identifier))
+      return error(cur().loc, quoted(cur().text) +
+                                  " is not a stepper method: expected initialize or stageN");
+    return error(cur().loc, "expected a stepper method (initialize or stageN), found " +
+                                describe(cur()));
+  });
+  mod.steppers.push_back(std::move(stepper));
+  return ok;
+}
+
+bool Parser::parseIntegrator(ast::Module& mod) {
+  advance();
+  ast::IntegratorDecl integrator;
+  if (!parseIdent(integrator.name, "expected an integrator name after 'integrator'")) return false;
+  const char* expected = "initialize, stageN, compute_accelerations or update_domain";
+  bool ok = parseBlock("integrator " + quoted(integrator.name.name), [&] {
+    if (cur().is(Token::Identifier) && isIntegratorStatement(cur().text)) {
+      integrator.steps.push_back(identOf(cur()));
+      advance();
+      return expect(Token::Semi, "after integrator statement");
+    }
+    if (cur().is(Token::Identifier))
+      return error(cur().loc, quoted(cur().text) + " is not an integrator statement: expected " +
+                                  expected);
+    return error(cur().loc, "expected an integrator statement (" + llvm::Twine(expected) +
+                                "), found " + describe(cur()));
+  });
+  mod.integrators.push_back(std::move(integrator));
+  return ok;
+}
+
+bool Parser::parseScene(ast::Module& mod) {
+  advance();
+  ast::SceneDecl scene;
+  if (!parseIdent(scene.name, "expected a scene name after 'scene'")) return false;
+  bool ok = parseBlock(
+      "scene " + quoted(scene.name.name), [&] { return parseSceneItem(scene); },
+      /*sceneStepper=*/true);
+  mod.scenes.push_back(std::move(scene));
+  return ok;
+}
+
+bool Parser::parseSceneItem(ast::SceneDecl& scene) {
+  if (!cur().is(Token::Identifier))
+    return error(cur().loc, "expected a scene item ('name = value;', stepper, adaptive_dt, "
+                            "output or equations), found " + describe(cur()));
+  // The scene's keywords are contextual: `output = 3;` is a setting named output.
+  if (lex_.peek().is(Token::Assign)) return parseSceneSetting(scene);
+  if (atWord("stepper")) return parseSceneStepper(scene);
+  if (atWord("adaptive_dt")) return parseAdaptiveDt(scene);
+  if (atWord("output")) return parseOutput(scene);
+  if (atWord("equations")) {
+    scene.equationsLoc = cur().loc;
+    advance();
+    return parseBlock("equations", [&] { return parseGroupItem(scene.equations, 0); });
+  }
+  return error(lex_.peek().loc, "expected '=' after scene setting " + quoted(cur().text));
+}
+
+bool Parser::parseSceneSetting(ast::SceneDecl& scene) {
+  ast::SceneSetting setting;
+  setting.key = identOf(cur());
+  advance();
+  advance();  // '='
+  if (!(setting.value = parseExpr())) return false;
+  scene.settings.push_back(std::move(setting));
+  return expect(Token::Semi, "after scene setting " + quoted(scene.settings.back().key.name));
+}
+
+bool Parser::parseSceneStepper(ast::SceneDecl& scene) {
+  advance();
+  ast::SceneStepper st;
+  if (!parseIdent(st.array, "expected an array name after 'stepper'") ||
+      !expect(Token::Assign, "after 'stepper " + st.array.name + "'") ||
+      !parseIdent(st.stepper, "expected a stepper name after 'stepper " + st.array.name + " ='"))
+    return false;
+  scene.steppers.push_back(std::move(st));
+  return expect(Token::Semi, "after scene stepper");
+}
+
+bool Parser::parseAdaptiveDt(ast::SceneDecl& scene) {
+  scene.hasAdaptiveDt = true;
+  scene.adaptiveDtLoc = cur().loc;
+  advance();
+  if (!expect(Token::LParen, "after 'adaptive_dt'") || !parseKwArgs(scene.adaptiveDt))
+    return false;
+  return expect(Token::Semi, "after 'adaptive_dt(...)'");
+}
+
+bool Parser::parseOutput(ast::SceneDecl& scene) {
+  ast::OutputDecl out;
+  out.loc = cur().loc;
+  advance();
+  if (atWord("every")) {
+    advance();
+    if (!(out.every = parseExpr())) return false;
+  } else if (atWord("at")) {
+    advance();
+    if (!expect(Token::LBracket, "after 'output at'")) return false;
+    do {
+      ExprPtr t = parseExpr();
+      if (!t) return false;
+      out.at.push_back(std::move(t));
+    } while (consumeIf(Token::Comma));
+    if (!consumeIf(Token::RBracket))
+      return error(cur().loc, "expected ',' or ']' in the output times, found " + describe(cur()));
+  } else {
+    return error(cur().loc, "expected 'every' or 'at' after 'output', found " + describe(cur()));
+  }
+  bool ok = parseBlock("output", [&] { return parseOutputItem(out); });
+  scene.outputs.push_back(std::move(out));
+  return ok;
+}
+
+bool Parser::parseOutputItem(ast::OutputDecl& out) {
+  ast::OutputDecl::Item item;
+  if (!parseIdent(item.array, "expected an array name in output, as in 'fluid(x, y);'") ||
+      !expect(Token::LParen, "after array " + quoted(item.array.name) + " in output"))
+    return false;
+  do {
+    ast::Ident prop;
+    if (!parseIdent(prop, "expected a property name in the output of " + quoted(item.array.name)))
+      return false;
+    item.props.push_back(std::move(prop));
+  } while (consumeIf(Token::Comma));
+  if (!consumeIf(Token::RParen))
+    return error(cur().loc, "expected ',' or ')' in the output of " + quoted(item.array.name) +
+                                ", found " + describe(cur()));
+  out.items.push_back(std::move(item));
+  return expect(Token::Semi, "after output item");
+}
+
+bool Parser::parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth) {
+  if (atWord("group") && (lex_.peek().is(Token::LParen) || lex_.peek().is(Token::LBrace))) {
+    if (depth >= kMaxNesting)
+      return error(cur().loc, "groups nested too deeply (more than " +
+                                  llvm::Twine(kMaxNesting) + " levels)");
+    auto group = std::make_shared<ast::GroupDecl>();
+    group->loc = cur().loc;
+    advance();
+    if (consumeIf(Token::LParen) && !parseKwArgs(group->options)) return false;
+    items.push_back(ast::GroupItem{group, nullptr});
+    return parseBlock("group", [&] { return parseGroupItem(group->items, depth + 1); });
+  }
+  if (!cur().is(Token::Identifier))
+    return error(cur().loc, "expected an equation instance 'Name(arg = value, ...);' or a group, "
+                            "found " + describe(cur()));
+  auto inst = std::make_shared<ast::EquationInstance>();
+  inst->equation = identOf(cur());
+  advance();
+  if (!expect(Token::LParen, "after equation " + quoted(inst->equation.name)) ||
+      !parseKwArgs(inst->args))
+    return false;
+  items.push_back(ast::GroupItem{nullptr, inst});
+  return expect(Token::Semi, "after equation instance " + quoted(inst->equation.name));
+}
+
+bool Parser::parseKwArgs(std::vector<ast::KwArg>& args) {
+  if (consumeIf(Token::RParen)) return true;
+  do {
+    if (!cur().is(Token::Identifier))
+      return error(cur().loc, "expected an argument 'name = value', found " + describe(cur()));
+    if (!lex_.peek().is(Token::Assign))
+      return error(lex_.peek().loc, "expected '=' after argument name " + quoted(cur().text));
+    ast::KwArg arg;
+    arg.name = identOf(cur());
+    advance();
+    advance();  // '='
+    if (consumeIf(Token::LBracket)) {
+      arg.isList = true;
+      if (!parseNameList(arg.list, "the list of " + quoted(arg.name.name))) return false;
+    } else if (!(arg.value = parseExpr())) {
+      return false;
+    }
+    args.push_back(std::move(arg));
+  } while (consumeIf(Token::Comma));
+  if (!consumeIf(Token::RParen))
+    return error(cur().loc, "expected ',' or ')' after argument " + quoted(args.back().name.name) +
+                                ", found " + describe(cur()));
+  return true;
+}
+
+bool Parser::parseNameList(std::vector<ast::Ident>& names, const llvm::Twine& what) {
+  if (consumeIf(Token::RBracket)) return true;
+  do {
+    ast::Ident name;
+    if (!parseIdent(name, "expected an array name in " + what)) return false;
+    names.push_back(std::move(name));
+  } while (consumeIf(Token::Comma));
+  if (!consumeIf(Token::RBracket))
+    return error(cur().loc, "expected ',' or ']' in " + what + ", found " + describe(cur()));
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Expressions
+
+bool Parser::enterNesting() {
+  if (exprDepth_ >= kMaxNesting)
+    return error(cur().loc, "expression nested too deeply (more than " +
+                                llvm::Twine(kMaxNesting) + " levels)");
+  ++exprDepth_;
+  return true;
+}
+
+ExprPtr Parser::parseExpr() {
+  if (!enterNesting()) return nullptr;
+  auto leave = llvm::make_scope_exit([&] { leaveNesting(); });
+  ExprPtr cond = parseBinary(1);
+  if (!cond || !cur().is(Token::Question)) return cond;
+  auto e = makeExpr(ast::Expr::Ternary, cur());
+  advance();
+  ExprPtr then = parseExpr();
+  if (!then || !expect(Token::Colon, "in conditional expression")) return nullptr;
+  ExprPtr otherwise = parseExpr();
+  if (!otherwise) return nullptr;
+  e->args = {cond, then, otherwise};
+  return e;
+}
+
+ExprPtr Parser::parseBinary(int minPrecedence) {
+  ExprPtr lhs = parseUnary();
+  while (lhs) {
+    int prec = binaryPrecedence(cur().kind);
+    if (prec == 0 || prec < minPrecedence) break;
+    auto e = makeExpr(ast::Expr::Binary, cur());
+    e->op = cur().text.str();
+    advance();
+    ExprPtr rhs = parseBinary(prec + 1);
+    if (!rhs) return nullptr;
+    e->args = {lhs, rhs};
+    lhs = e;
+  }
+  return lhs;
+}
+
+ExprPtr Parser::parseUnary() {
+  if (!cur().is(Token::Minus) && !cur().is(Token::Plus) && !cur().is(Token::Not))
+    return parsePrimary();
+  if (!enterNesting()) return nullptr;
+  auto leave = llvm::make_scope_exit([&] { leaveNesting(); });
+  auto e = makeExpr(ast::Expr::Unary, cur());
+  e->op = cur().text.str();
+  advance();
+  ExprPtr operand = parseUnary();
+  if (!operand) return nullptr;
+  e->args = {operand};
+  return e;
+}
+
+ExprPtr Parser::parsePrimary() {
+  switch (cur().kind) {
+    case Token::Number: {
+      auto e = makeExpr(ast::Expr::Number, cur());
+      e->text = cur().text.str();
+      e->number = std::strtod(e->text.c_str(), nullptr);
+      advance();
+      return e;
+    }
+    case Token::Identifier: {
+      if (lex_.peek().is(Token::LParen)) return parseCall();
+      auto e = makeExpr(ast::Expr::Name, cur());
+      e->text = cur().text.str();
+      advance();
+      return e;
+    }
+    case Token::LParen:
+      return parseParenthesised();
+    default:
+      error(cur().loc, "expected an expression, found " + describe(cur()));
+      return nullptr;
+  }
+}
+
+ExprPtr Parser::parseParenthesised() {
+  llvm::SMLoc open = cur().loc;
+  advance();
+  ExprPtr e = parseExpr();
+  if (!e) return nullptr;
+  if (consumeIf(Token::RParen)) return e;
+  if (report(cur().loc, "expected ')', found " + describe(cur())))
+    diags_.note(open, "to match this '('");
+  return nullptr;
+}
+
+ExprPtr Parser::parseCall() {
+  auto e = makeExpr(ast::Expr::Call, cur());
+  e->text = cur().text.str();
+  advance();
+  advance();  // '('
+  if (consumeIf(Token::RParen)) return e;
+  do {
+    ExprPtr arg = parseExpr();
+    if (!arg) return nullptr;
+    e->args.push_back(std::move(arg));
+  } while (consumeIf(Token::Comma));
+  if (consumeIf(Token::RParen)) return e;
+  error(cur().loc, "expected ',' or ')' in the arguments of " + quoted(e->text) + ", found " +
+                       describe(cur()));
+  return nullptr;
+}
+
+}  // namespace sphc

@@ -1,0 +1,121 @@
+// The Plan: a scene after semantic analysis. Sema builds it from the AST (names resolved,
+// equations instantiated with their arguments); the analysis passes annotate it (body facts,
+// liveness, exact property sets, pair quantities); the code generators read it.
+#pragma once
+
+#include "body/BodyAnalysis.h"
+#include "frontend/AST.h"
+
+#include "llvm/Support/SMLoc.h"
+#include "llvm/Support/raw_ostream.h"
+
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace sphc {
+
+class DiagnosticEngine;
+
+// A property of an array as the solver will allocate it.
+struct PlanProperty {
+  std::string name;
+  std::string type = "double";     // double, int, uint
+  int stride = 1;
+  ast::ExprPtr init;               // initial value (null: 0 or set by geometry)
+  llvm::SMLoc declLoc;             // `property` declaration, if any
+  bool declared = false;
+  bool written = false;            // by a live equation or stepper
+  bool read = false;               // by a live equation, stepper, output or neighbour search
+  bool output = false;
+};
+
+struct PlanArray {
+  std::string name;
+  llvm::SMLoc loc;
+  const ast::ArrayDecl* decl = nullptr;
+  std::vector<PlanProperty> props;       // filled by the properties pass; x, y, z first
+  std::vector<std::string> constants;    // declared consts and reduce targets
+  int stepper = -1;                      // index into Plan::steppers
+  std::vector<std::string> outputProps;  // as listed in the scene's output
+  const PlanProperty* find(const std::string& p) const;
+  PlanProperty* find(const std::string& p);
+};
+
+// A body after analysis: its source and what Clang found in it.
+struct PlanBody {
+  BodySource source;
+  BodyFacts facts;
+};
+
+// An equation declaration used by the scene, with its bodies analysed once.
+struct PlanEquationDecl {
+  const ast::EquationDecl* decl = nullptr;
+  std::map<ast::Method::Kind, int> methods;  // kind -> index into Plan::bodies
+  std::string reduceOp, reduceTarget;
+};
+
+// One use of an equation: `Name(dest = a, sources = [b, c], p = expr)`.
+struct PlanEquation {
+  int id = 0;
+  int declIndex = -1;                         // into Plan::equationDecls
+  std::string name;                           // equation name
+  llvm::SMLoc loc;                            // the instance in the scene
+  int dest = -1;                              // array index
+  std::vector<int> sources;                   // array indices
+  // Parameter and const values in evaluation order (params first, then consts).
+  std::vector<std::pair<std::string, ast::ExprPtr>> values;
+  bool live = true;
+  std::string pruneReason;
+};
+
+struct PlanGroup {
+  llvm::SMLoc loc;
+  bool real = true;
+  bool iterate = false;
+  int minIterations = 1, maxIterations = 1;
+  std::vector<int> equations;                 // direct members, in order
+  std::vector<std::unique_ptr<PlanGroup>> subgroups;
+  // Order of members: entry >= 0 is equations[entry]; entry < 0 is subgroups[-entry - 1].
+  std::vector<int> order;
+  // Pair quantities needed per (dest, source) loop: filled by the pair-quantity pass.
+  std::map<std::pair<int, int>, std::set<std::string>> pairQuantities;
+};
+
+struct PlanStepper {
+  const ast::StepperDecl* decl = nullptr;
+  std::map<std::string, int> methods;         // "initialize", "stage1", ... -> body index
+};
+
+struct Plan {
+  std::string sceneName;
+  std::string mainFile;
+  const ast::SceneDecl* scene = nullptr;
+  int dim = 2;
+  std::string kernel = "CubicSpline";
+  double kernelRadiusScale = 2.0;
+  ast::ExprPtr tf, dt;
+  bool adaptiveDt = false;
+  ast::ExprPtr cfl, forceFactor;
+  ast::ExprPtr outputEvery;
+  std::vector<ast::ExprPtr> outputAt;
+  std::vector<std::string> integratorSteps;   // initialize, stage1, compute_accelerations, ...
+  std::string integratorName;
+  std::vector<const ast::ParamDecl*> params;  // in order
+  std::vector<PlanArray> arrays;
+  std::vector<PlanEquationDecl> equationDecls;
+  std::vector<PlanEquation> equations;
+  std::vector<PlanStepper> steppers;
+  std::vector<PlanBody> bodies;
+  PlanGroup root;                             // the scene's equations { } as a group
+  std::vector<std::string> notes;             // what the passes decided, for --report
+
+  int arrayIndex(const std::string& name) const;
+};
+
+// Prints the plan (used by --dump-after and --report).
+void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report);
+
+}  // namespace sphc

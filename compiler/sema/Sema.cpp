@@ -1,0 +1,746 @@
+#include "sema/Sema.h"
+
+#include "frontend/Parser.h"
+#include "sema/Geometry.h"
+
+#include "llvm/ADT/StringExtras.h"
+#include "llvm/Support/FileSystem.h"
+#include "llvm/Support/MemoryBuffer.h"
+#include "llvm/Support/Path.h"
+
+#include <map>
+#include <set>
+
+namespace sphc {
+
+// ---------------------------------------------------------------------------------------
+// Imports
+// ---------------------------------------------------------------------------------------
+
+namespace {
+
+std::string joinImport(const ast::ImportDecl& imp) {
+  std::string s;
+  for (const auto& p : imp.path) {
+    if (!s.empty()) s += ".";
+    s += p.name;
+  }
+  return s;
+}
+
+// Reads and parses one file; null if it cannot be read.
+std::unique_ptr<ast::Module> parseFile(const std::string& path, DiagnosticEngine& diags,
+                                       llvm::SMLoc importLoc) {
+  auto buf = llvm::MemoryBuffer::getFile(path, /*IsText=*/true);
+  if (!buf) {
+    if (importLoc.isValid())
+      diags.error(importLoc, "cannot read '" + path + "': " + buf.getError().message());
+    else
+      diags.error("cannot read '" + path + "': " + buf.getError().message());
+    return nullptr;
+  }
+  unsigned id = diags.sourceMgr().AddNewSourceBuffer(std::move(*buf), importLoc);
+  Parser parser(diags, diags.sourceMgr(), id);
+  auto mod = parser.parseModule();
+  if (mod) {
+    mod->filename = path;
+    mod->bufferId = id;
+  }
+  return mod;
+}
+
+}  // namespace
+
+std::vector<std::unique_ptr<ast::Module>> loadModules(const std::string& mainFile,
+                                                      const std::vector<std::string>& includeDirs,
+                                                      const std::string& stdlibDir,
+                                                      DiagnosticEngine& diags) {
+  std::vector<std::unique_ptr<ast::Module>> modules;
+  auto main = parseFile(mainFile, diags, llvm::SMLoc());
+  if (!main) return modules;
+  modules.push_back(std::move(main));
+  std::set<std::string> loaded;  // canonical paths
+  {
+    llvm::SmallString<256> real;
+    if (!llvm::sys::fs::real_path(mainFile, real)) loaded.insert(std::string(real));
+  }
+  // Breadth-first over imports; each file once.
+  for (size_t m = 0; m < modules.size(); ++m) {
+    std::string dir = std::string(llvm::sys::path::parent_path(modules[m]->filename));
+    std::vector<ast::ImportDecl> imports = modules[m]->imports;
+    for (const auto& imp : imports) {
+      llvm::SmallString<128> rel;
+      for (size_t i = 0; i < imp.path.size(); ++i) {
+        if (i + 1 < imp.path.size())
+          llvm::sys::path::append(rel, imp.path[i].name);
+        else
+          llvm::sys::path::append(rel, imp.path[i].name + ".sph");
+      }
+      std::vector<std::string> candidates;
+      candidates.push_back(dir.empty() ? std::string(rel) : (dir + "/" + std::string(rel)));
+      for (const auto& inc : includeDirs) candidates.push_back(inc + "/" + std::string(rel));
+      if (!stdlibDir.empty()) candidates.push_back(stdlibDir + "/" + std::string(rel));
+      std::string found;
+      for (const auto& c : candidates)
+        if (llvm::sys::fs::is_regular_file(c)) {
+          found = c;
+          break;
+        }
+      if (found.empty()) {
+        llvm::SMLoc loc = imp.path.empty() ? imp.loc : imp.path.front().loc;
+        diags.error(loc, "cannot find module '" + joinImport(imp) + "' (looked for '" +
+                             std::string(rel) + "' next to this file, in -I directories and " +
+                             "in the stdlib)");
+        continue;
+      }
+      llvm::SmallString<256> real;
+      std::string key = llvm::sys::fs::real_path(found, real) ? found : std::string(real);
+      if (!loaded.insert(key).second) continue;
+      auto mod = parseFile(found, diags, imp.loc);
+      if (mod) modules.push_back(std::move(mod));
+    }
+  }
+  return modules;
+}
+
+// ---------------------------------------------------------------------------------------
+// Expressions
+// ---------------------------------------------------------------------------------------
+
+int mathFunctionArity(const std::string& name) {
+  static const std::map<std::string, int> arity = {
+      {"sqrt", 1},  {"exp", 1},   {"log", 1},   {"log10", 1}, {"sin", 1},  {"cos", 1},
+      {"tan", 1},   {"asin", 1},  {"acos", 1},  {"atan", 1},  {"sinh", 1}, {"cosh", 1},
+      {"tanh", 1},  {"fabs", 1},  {"abs", 1},   {"floor", 1}, {"ceil", 1}, {"round", 1},
+      {"cbrt", 1},  {"pow", 2},   {"atan2", 2}, {"fmin", 2},  {"fmax", 2}, {"min", 2},
+      {"max", 2},   {"fmod", 2},  {"hypot", 2}};
+  auto it = arity.find(name);
+  return it == arity.end() ? -1 : it->second;
+}
+
+bool checkExpr(const ast::Expr& e, const std::function<bool(const std::string&)>& isKnown,
+               const std::string& what, DiagnosticEngine& diags) {
+  bool ok = true;
+  switch (e.kind) {
+    case ast::Expr::Number:
+      break;
+    case ast::Expr::Name:
+      if (e.text == "pi" || e.text == "e" || e.text == "true" || e.text == "false") break;
+      if (!isKnown(e.text)) {
+        diags.error(e.loc, "unknown name '" + e.text + "' in " + what);
+        ok = false;
+      }
+      break;
+    case ast::Expr::Call: {
+      int n = mathFunctionArity(e.text);
+      if (n < 0) {
+        diags.error(e.loc, "unknown function '" + e.text + "' in " + what +
+                               ": expressions may call math functions only (sqrt, pow, exp, "
+                               "log, sin, cos, tan, atan2, fabs, fmin, fmax, floor, ceil, ...)");
+        ok = false;
+      } else if (static_cast<int>(e.args.size()) != n) {
+        diags.error(e.loc, "'" + e.text + "' takes " + llvm::Twine(n) + " argument" +
+                               (n == 1 ? "" : "s") + ", not " + llvm::Twine(e.args.size()));
+        ok = false;
+      }
+      for (const auto& a : e.args) ok &= checkExpr(*a, isKnown, what, diags);
+      break;
+    }
+    default:
+      for (const auto& a : e.args) ok &= checkExpr(*a, isKnown, what, diags);
+  }
+  return ok;
+}
+
+// ---------------------------------------------------------------------------------------
+// Plan building
+// ---------------------------------------------------------------------------------------
+
+namespace {
+
+const std::vector<std::string>& kernelNames() {
+  static const std::vector<std::string> k = {"CubicSpline", "QuinticSpline", "WendlandQuintic",
+                                             "Gaussian"};
+  return k;
+}
+
+double kernelRadius(const std::string& k) {
+  return (k == "QuinticSpline" || k == "Gaussian") ? 3.0 : 2.0;
+}
+
+std::string joinNames(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+  return s;
+}
+
+class SemaImpl {
+ public:
+  SemaImpl(const std::vector<std::unique_ptr<ast::Module>>& modules, DiagnosticEngine& diags)
+      : modules_(modules), diags_(diags) {}
+
+  std::unique_ptr<Plan> run();
+
+ private:
+  template <class Decl>
+  void collect(std::map<std::string, const Decl*>& table, const Decl& d, const char* kind) {
+    auto [it, inserted] = table.emplace(d.name.name, &d);
+    if (!inserted) {
+      diags_.error(d.name.loc, std::string("redefinition of ") + kind + " '" + d.name.name + "'");
+      diags_.note(it->second->name.loc, "previous definition is here");
+    }
+  }
+  bool isParam(const std::string& n) const { return paramIndex_.count(n) != 0; }
+  bool checkSceneExpr(const ast::ExprPtr& e, const std::string& what) {
+    return e && checkExpr(*e, [this](const std::string& n) { return isParam(n); }, what, diags_);
+  }
+  void buildArrays();
+  void checkGeometry(const ast::GeometryDecl& g, const std::string& array);
+  void buildScene();
+  void buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g, int depth);
+  void instantiate(const ast::EquationInstance& inst, PlanGroup& g);
+  int useEquationDecl(const ast::EquationDecl* decl);
+  int useStepper(const ast::StepperDecl* decl);
+  std::map<std::string, PropShape> propShapes() const;
+  int arrayFromName(const ast::Ident& id, const std::string& role);
+
+  const std::vector<std::unique_ptr<ast::Module>>& modules_;
+  DiagnosticEngine& diags_;
+  std::unique_ptr<Plan> plan_;
+  std::map<std::string, size_t> paramIndex_;
+  std::map<std::string, const ast::ArrayDecl*> arrays_;
+  std::map<std::string, const ast::EquationDecl*> equations_;
+  std::map<std::string, const ast::StepperDecl*> steppers_;
+  std::map<std::string, const ast::IntegratorDecl*> integrators_;
+  std::map<const ast::EquationDecl*, int> usedEquations_;
+  std::map<const ast::StepperDecl*, int> usedSteppers_;
+};
+
+std::unique_ptr<Plan> SemaImpl::run() {
+  plan_ = std::make_unique<Plan>();
+  const ast::Module& main = *modules_.front();
+  plan_->mainFile = main.filename;
+
+  // Global tables over all modules: the main file and what it imports share one namespace.
+  for (const auto& m : modules_) {
+    for (const auto& p : m->params) {
+      if (paramIndex_.count(p.name.name)) {
+        diags_.error(p.name.loc, "redefinition of parameter '" + p.name.name + "'");
+        diags_.note(plan_->params[paramIndex_[p.name.name]]->name.loc,
+                    "previous definition is here");
+        continue;
+      }
+      // A parameter's default may use the parameters declared before it.
+      checkSceneExpr(p.value, "the value of parameter '" + p.name.name +
+                                  "' (it may use parameters declared before it)");
+      paramIndex_[p.name.name] = plan_->params.size();
+      plan_->params.push_back(&p);
+    }
+    for (const auto& a : m->arrays) collect(arrays_, a, "array");
+    for (const auto& e : m->equations) collect(equations_, e, "equation");
+    for (const auto& s : m->steppers) collect(steppers_, s, "stepper");
+    for (const auto& i : m->integrators) collect(integrators_, i, "integrator");
+  }
+  for (size_t m = 1; m < modules_.size(); ++m)
+    for (const auto& s : modules_[m]->scenes) {
+      diags_.error(s.name.loc, "scene '" + s.name.name + "' in an imported module: a module "
+                               "meant for import holds no scene");
+    }
+  if (main.scenes.empty()) {
+    diags_.error(diags_.sourceMgr().getMemoryBuffer(main.bufferId)->getBufferStart() ?
+                     llvm::SMLoc::getFromPointer(
+                         diags_.sourceMgr().getMemoryBuffer(main.bufferId)->getBufferStart()) :
+                     llvm::SMLoc(),
+                 "no scene in '" + main.filename + "': add `scene NAME { ... }`");
+    return nullptr;
+  }
+  if (main.scenes.size() > 1) {
+    diags_.error(main.scenes[1].name.loc, "a file holds one scene; '" +
+                                              main.scenes[1].name.name + "' is the second");
+    diags_.note(main.scenes[0].name.loc, "first scene is here");
+  }
+  plan_->scene = &main.scenes.front();
+  plan_->sceneName = plan_->scene->name.name;
+
+  buildArrays();
+  buildScene();
+  if (diags_.hasErrors()) return nullptr;
+  return std::move(plan_);
+}
+
+void SemaImpl::buildArrays() {
+  // Arrays are instantiated in declaration order, main module first.
+  for (const auto& m : modules_)
+    for (const auto& a : m->arrays) {
+      if (arrays_[a.name.name] != &a) continue;  // a redefinition, already reported
+      PlanArray pa;
+      pa.name = a.name.name;
+      pa.loc = a.name.loc;
+      pa.decl = &a;
+      std::set<std::string> seen = {"x", "y", "z"};
+      for (const auto& g : a.geometry) checkGeometry(g, pa.name);
+      if (a.geometry.empty() && a.loads.empty())
+        diags_.warning(a.name.loc, "array '" + pa.name + "' has no geometry and no load: it "
+                                   "starts with no particles");
+      for (const auto& p : a.properties) {
+        if (p.name.name == "x" || p.name.name == "y" || p.name.name == "z") {
+          diags_.error(p.name.loc, "'" + p.name.name + "' is a position: it is set by the "
+                                   "array's geometry or load, not by a property declaration");
+          continue;
+        }
+        if (p.init)
+          checkExpr(*p.init,
+                    [&](const std::string& n) { return isParam(n) || seen.count(n); },
+                    "the initial value of '" + p.name.name +
+                        "' (it may use x, y, z, params and properties declared before it)",
+                    diags_);
+        if (!seen.insert(p.name.name).second) {
+          diags_.error(p.name.loc, "property '" + p.name.name + "' of array '" + pa.name +
+                                       "' is declared twice");
+          continue;
+        }
+        PlanProperty prop;
+        prop.name = p.name.name;
+        prop.type = p.type;
+        prop.stride = p.stride;
+        prop.init = p.init;
+        prop.declLoc = p.name.loc;
+        prop.declared = true;
+        pa.props.push_back(prop);
+      }
+      for (const auto& c : a.constants) {
+        if (c.init) checkSceneExpr(c.init, "constant '" + c.name.name + "'");
+        pa.constants.push_back(c.name.name);
+      }
+      plan_->arrays.push_back(std::move(pa));
+    }
+}
+
+void SemaImpl::checkGeometry(const ast::GeometryDecl& g, const std::string& array) {
+  const GeometryBuilder* b = findGeometryBuilder(g.builder.name);
+  if (!b) {
+    std::vector<std::string> names;
+    for (const auto& gb : geometryBuilders()) names.push_back(gb.name);
+    diags_.error(g.builder.loc, "unknown geometry '" + g.builder.name + "'; geometries are: " +
+                                    joinNames(names));
+    return;
+  }
+  std::set<std::string> given;
+  for (const auto& kw : g.args) {
+    bool known = false;
+    for (const auto& a : b->args) known |= a.name == kw.name.name;
+    if (!known) {
+      std::vector<std::string> names;
+      for (const auto& a : b->args) names.push_back(a.name);
+      diags_.error(kw.name.loc, "geometry '" + b->name + "' has no argument '" + kw.name.name +
+                                    "'; arguments are: " + joinNames(names));
+      continue;
+    }
+    if (!given.insert(kw.name.name).second)
+      diags_.error(kw.name.loc, "argument '" + kw.name.name + "' is given twice");
+    if (kw.isList)
+      diags_.error(kw.name.loc, "geometry argument '" + kw.name.name + "' takes a number");
+    else
+      checkSceneExpr(kw.value, "geometry of array '" + array + "'");
+  }
+  for (const auto& a : b->args)
+    if (!a.defaultValue && !given.count(a.name))
+      diags_.error(g.builder.loc, "geometry '" + b->name + "' needs argument '" + a.name + "'");
+}
+
+int SemaImpl::arrayFromName(const ast::Ident& id, const std::string& role) {
+  int idx = plan_->arrayIndex(id.name);
+  if (idx < 0) {
+    std::vector<std::string> names;
+    for (const auto& a : plan_->arrays) names.push_back(a.name);
+    diags_.error(id.loc, "unknown array '" + id.name + "' as " + role +
+                             (names.empty() ? std::string(": no arrays are declared")
+                                            : "; arrays are: " + joinNames(names)));
+  }
+  return idx;
+}
+
+std::map<std::string, PropShape> SemaImpl::propShapes() const {
+  std::map<std::string, PropShape> shapes;
+  for (const auto& a : plan_->arrays)
+    for (const auto& p : a.props) shapes[p.name] = PropShape{p.type, p.stride};
+  return shapes;
+}
+
+int SemaImpl::useEquationDecl(const ast::EquationDecl* decl) {
+  auto it = usedEquations_.find(decl);
+  if (it != usedEquations_.end()) return it->second;
+  PlanEquationDecl pd;
+  pd.decl = decl;
+  std::vector<std::string> scalars;
+  for (const auto& p : decl->params) scalars.push_back(p.name.name);
+  for (const auto& c : decl->consts) scalars.push_back(c.name.name);
+  for (const auto& m : decl->methods) {
+    if (pd.methods.count(m.kind)) {
+      diags_.error(m.loc, "equation '" + decl->name.name + "' defines this method twice");
+      continue;
+    }
+    static const char* names[] = {"initialize", "loop", "post_loop", "reduce", "converged"};
+    static const BodyKind kinds[] = {BodyKind::Initialize, BodyKind::Loop, BodyKind::PostLoop,
+                                     BodyKind::Reduce, BodyKind::Converged};
+    PlanBody body;
+    body.source.text = m.body.text;
+    body.source.start = m.body.start;
+    body.source.kind = kinds[m.kind];
+    body.source.label = "equation " + decl->name.name + ", method " + names[m.kind];
+    body.source.scalars = scalars;
+    body.source.props = propShapes();
+    pd.methods[m.kind] = static_cast<int>(plan_->bodies.size());
+    plan_->bodies.push_back(std::move(body));
+    if (m.kind == ast::Method::Reduce) {
+      pd.reduceOp = m.reduceOp;
+      pd.reduceTarget = m.reduceTarget.name;
+    }
+  }
+  int idx = static_cast<int>(plan_->equationDecls.size());
+  plan_->equationDecls.push_back(pd);
+  usedEquations_[decl] = idx;
+  return idx;
+}
+
+int SemaImpl::useStepper(const ast::StepperDecl* decl) {
+  auto it = usedSteppers_.find(decl);
+  if (it != usedSteppers_.end()) return it->second;
+  PlanStepper ps;
+  ps.decl = decl;
+  for (const auto& m : decl->methods) {
+    if (ps.methods.count(m.name.name)) {
+      diags_.error(m.name.loc, "stepper '" + decl->name.name + "' defines '" + m.name.name +
+                                   "' twice");
+      continue;
+    }
+    PlanBody body;
+    body.source.text = m.body.text;
+    body.source.start = m.body.start;
+    body.source.kind =
+        m.name.name == "initialize" ? BodyKind::StepperInit : BodyKind::StepperStage;
+    body.source.label = "stepper " + decl->name.name + ", " + m.name.name;
+    body.source.props = propShapes();
+    ps.methods[m.name.name] = static_cast<int>(plan_->bodies.size());
+    plan_->bodies.push_back(std::move(body));
+  }
+  int idx = static_cast<int>(plan_->steppers.size());
+  plan_->steppers.push_back(ps);
+  usedSteppers_[decl] = idx;
+  return idx;
+}
+
+void SemaImpl::buildScene() {
+  const ast::SceneDecl& s = *plan_->scene;
+  std::set<std::string> seen;
+  static const std::vector<std::string> known = {"dim", "kernel", "tf", "dt", "integrator"};
+  for (const auto& set : s.settings) {
+    const std::string& k = set.key.name;
+    if (!seen.insert(k).second) {
+      diags_.error(set.key.loc, "scene setting '" + k + "' is given twice");
+      continue;
+    }
+    const ast::Expr& v = *set.value;
+    if (k == "dim") {
+      if (v.kind != ast::Expr::Number || (v.number != 1 && v.number != 2 && v.number != 3))
+        diags_.error(v.loc, "dim must be 1, 2 or 3");
+      else
+        plan_->dim = static_cast<int>(v.number);
+    } else if (k == "kernel") {
+      const auto& ks = kernelNames();
+      if (v.kind != ast::Expr::Name || std::find(ks.begin(), ks.end(), v.text) == ks.end())
+        diags_.error(v.loc, "unknown kernel" +
+                                (v.kind == ast::Expr::Name ? " '" + v.text + "'" : "") +
+                                "; kernels are: " + joinNames(ks));
+      else {
+        plan_->kernel = v.text;
+        plan_->kernelRadiusScale = kernelRadius(v.text);
+      }
+    } else if (k == "tf") {
+      if (checkSceneExpr(set.value, "tf")) plan_->tf = set.value;
+    } else if (k == "dt") {
+      if (checkSceneExpr(set.value, "dt")) plan_->dt = set.value;
+    } else if (k == "integrator") {
+      auto it = v.kind == ast::Expr::Name ? integrators_.find(v.text) : integrators_.end();
+      if (it == integrators_.end()) {
+        std::vector<std::string> names;
+        for (const auto& [n, d] : integrators_) names.push_back(n);
+        diags_.error(v.loc, "unknown integrator" +
+                                (v.kind == ast::Expr::Name ? " '" + v.text + "'" : "") +
+                                (names.empty() ? std::string("; none is declared (import "
+                                                             "integrators;)")
+                                               : "; integrators are: " + joinNames(names)));
+      } else {
+        plan_->integratorName = v.text;
+        for (const auto& st : it->second->steps) plan_->integratorSteps.push_back(st.name);
+      }
+    } else {
+      diags_.error(set.key.loc, "unknown scene setting '" + k + "'; settings are: " +
+                                    joinNames(known) +
+                                    ", and stepper, adaptive_dt, output, equations");
+    }
+  }
+  if (!plan_->tf) diags_.error(s.name.loc, "scene '" + s.name.name + "' has no final time: "
+                                            "add `tf = ...;`");
+  if (!plan_->dt) diags_.error(s.name.loc, "scene '" + s.name.name + "' has no time step: "
+                                            "add `dt = ...;` (the fixed or initial step)");
+
+  for (const auto& st : s.steppers) {
+    int a = arrayFromName(st.array, "the array of a stepper");
+    auto it = steppers_.find(st.stepper.name);
+    if (it == steppers_.end()) {
+      std::vector<std::string> names;
+      for (const auto& [n, d] : steppers_) names.push_back(n);
+      diags_.error(st.stepper.loc, "unknown stepper '" + st.stepper.name + "'" +
+                                       (names.empty() ? std::string("")
+                                                      : "; steppers are: " + joinNames(names)));
+      continue;
+    }
+    if (a < 0) continue;
+    if (plan_->arrays[a].stepper >= 0) {
+      diags_.error(st.array.loc, "array '" + st.array.name + "' already has a stepper");
+      continue;
+    }
+    plan_->arrays[a].stepper = useStepper(it->second);
+  }
+  bool anyStepper = false;
+  for (const auto& a : plan_->arrays) anyStepper |= a.stepper >= 0;
+  if (anyStepper && plan_->integratorName.empty())
+    diags_.error(s.name.loc, "scene '" + s.name.name + "' has steppers but no integrator: add "
+                             "`integrator = PECIntegrator;` (import integrators;)");
+  // Integrator stages must exist in the steppers that are used.
+  for (const auto& step : plan_->integratorSteps)
+    if (step.rfind("stage", 0) == 0)
+      for (const auto& a : plan_->arrays)
+        if (a.stepper >= 0 && !plan_->steppers[a.stepper].methods.count(step))
+          diags_.error(plan_->steppers[a.stepper].decl->name.loc,
+                       "stepper '" + plan_->steppers[a.stepper].decl->name.name +
+                           "' (used for array '" + a.name + "') has no '" + step +
+                           "', which integrator '" + plan_->integratorName + "' calls");
+
+  if (s.hasAdaptiveDt) {
+    plan_->adaptiveDt = true;
+    for (const auto& kw : s.adaptiveDt) {
+      if (kw.isList) {
+        diags_.error(kw.name.loc, "adaptive_dt arguments are numbers");
+        continue;
+      }
+      if (!checkSceneExpr(kw.value, "adaptive_dt")) continue;
+      if (kw.name.name == "cfl")
+        plan_->cfl = kw.value;
+      else if (kw.name.name == "force")
+        plan_->forceFactor = kw.value;
+      else
+        diags_.error(kw.name.loc, "unknown adaptive_dt argument '" + kw.name.name +
+                                      "'; arguments are: cfl, force");
+    }
+  }
+
+  for (const auto& out : s.outputs) {
+    if (out.every) {
+      if (plan_->outputEvery)
+        diags_.error(out.loc, "output interval given twice");
+      else if (checkSceneExpr(out.every, "the output interval"))
+        plan_->outputEvery = out.every;
+    }
+    for (const auto& t : out.at)
+      if (checkSceneExpr(t, "an output time")) plan_->outputAt.push_back(t);
+    for (const auto& item : out.items) {
+      int a = arrayFromName(item.array, "an output");
+      if (a < 0) continue;
+      for (const auto& p : item.props) plan_->arrays[a].outputProps.push_back(p.name);
+    }
+  }
+
+  plan_->root.loc = s.equationsLoc;
+  buildGroup(s.equations, plan_->root, 0);
+}
+
+void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g, int depth) {
+  for (const auto& item : items) {
+    if (item.equation) {
+      instantiate(*item.equation, g);
+      continue;
+    }
+    const ast::GroupDecl& gd = *item.group;
+    auto sub = std::make_unique<PlanGroup>();
+    sub->loc = gd.loc;
+    bool hasMin = false, hasMax = false;
+    for (const auto& kw : gd.options) {
+      const std::string& k = kw.name.name;
+      auto boolValue = [&](bool& out) {
+        const ast::Expr* v = kw.isList ? nullptr : kw.value.get();
+        if (v && v->kind == ast::Expr::Name && (v->text == "true" || v->text == "false"))
+          out = v->text == "true";
+        else if (v && v->kind == ast::Expr::Number && (v->number == 0 || v->number == 1))
+          out = v->number != 0;
+        else
+          diags_.error(kw.name.loc, "group option '" + k + "' takes true or false");
+      };
+      auto intValue = [&](int& out) {
+        const ast::Expr* v = kw.isList ? nullptr : kw.value.get();
+        if (v && v->kind == ast::Expr::Number && v->number >= 1 &&
+            v->number == static_cast<int>(v->number))
+          out = static_cast<int>(v->number);
+        else
+          diags_.error(kw.name.loc, "group option '" + k + "' takes a positive integer");
+      };
+      if (k == "real")
+        boolValue(sub->real);
+      else if (k == "iterate")
+        boolValue(sub->iterate);
+      else if (k == "min_iterations") {
+        intValue(sub->minIterations);
+        hasMin = true;
+      } else if (k == "max_iterations") {
+        intValue(sub->maxIterations);
+        hasMax = true;
+      } else
+        diags_.error(kw.name.loc, "unknown group option '" + k +
+                                      "'; options are: real, iterate, min_iterations, "
+                                      "max_iterations");
+    }
+    if ((hasMin || hasMax) && !sub->iterate)
+      diags_.error(gd.loc, "min_iterations/max_iterations need `iterate = true`");
+    if (sub->iterate && !hasMax) sub->maxIterations = 100;
+    if (sub->minIterations > sub->maxIterations)
+      diags_.error(gd.loc, "min_iterations is larger than max_iterations");
+    buildGroup(gd.items, *sub, depth + 1);
+    g.order.push_back(-static_cast<int>(g.subgroups.size()) - 1);
+    g.subgroups.push_back(std::move(sub));
+  }
+}
+
+void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
+  auto it = equations_.find(inst.equation.name);
+  if (it == equations_.end()) {
+    diags_.error(inst.equation.loc, "unknown equation '" + inst.equation.name +
+                                        "' (is its module imported?)");
+    return;
+  }
+  const ast::EquationDecl* decl = it->second;
+  PlanEquation eq;
+  eq.name = decl->name.name;
+  eq.loc = inst.equation.loc;
+  bool hasLoop = false;
+  for (const auto& m : decl->methods) hasLoop |= m.kind == ast::Method::Loop;
+  std::map<std::string, ast::ExprPtr> given;
+  bool sawDest = false, sawSources = false;
+  for (const auto& kw : inst.args) {
+    const std::string& k = kw.name.name;
+    if (k == "dest") {
+      sawDest = true;
+      if (kw.isList || kw.value->kind != ast::Expr::Name) {
+        diags_.error(kw.name.loc, "dest takes one array name: dest = fluid");
+        continue;
+      }
+      eq.dest = arrayFromName(ast::Ident{kw.value->text, kw.value->loc}, "dest");
+    } else if (k == "sources") {
+      sawSources = true;
+      std::vector<ast::Ident> names = kw.list;
+      if (!kw.isList) {
+        if (kw.value->kind != ast::Expr::Name) {
+          diags_.error(kw.name.loc, "sources takes array names: sources = [fluid, boundary]");
+          continue;
+        }
+        names.push_back(ast::Ident{kw.value->text, kw.value->loc});
+      }
+      for (const auto& n : names) {
+        int a = arrayFromName(n, "a source");
+        if (a < 0) continue;
+        if (std::find(eq.sources.begin(), eq.sources.end(), a) != eq.sources.end())
+          diags_.error(n.loc, "array '" + n.name + "' is listed twice in sources");
+        else
+          eq.sources.push_back(a);
+      }
+    } else {
+      bool isParamName = false;
+      for (const auto& p : decl->params) isParamName |= p.name.name == k;
+      if (!isParamName) {
+        std::vector<std::string> names;
+        for (const auto& p : decl->params) names.push_back(p.name.name);
+        diags_.error(kw.name.loc, "equation '" + decl->name.name + "' has no parameter '" + k +
+                                      "'" + (names.empty() ? std::string("")
+                                                           : "; parameters are: " +
+                                                                 joinNames(names)) +
+                                      " (and dest, sources)");
+        diags_.note(decl->name.loc, "equation '" + decl->name.name + "' is declared here");
+        continue;
+      }
+      if (kw.isList) {
+        diags_.error(kw.name.loc, "parameter '" + k + "' takes a number, not a list");
+        continue;
+      }
+      if (given.count(k)) {
+        diags_.error(kw.name.loc, "parameter '" + k + "' is given twice");
+        continue;
+      }
+      checkSceneExpr(kw.value, "argument '" + k + "' of " + decl->name.name);
+      given[k] = kw.value;
+    }
+  }
+  if (!sawDest) diags_.error(inst.equation.loc, "equation '" + decl->name.name +
+                                                    "' needs a destination: dest = ARRAY");
+  if (hasLoop && (!sawSources || eq.sources.empty()) && sawDest)
+    diags_.error(inst.equation.loc, "equation '" + decl->name.name + "' has a loop and needs "
+                                    "sources: sources = [ARRAY, ...]");
+  if (!hasLoop && !eq.sources.empty())
+    diags_.warning(inst.equation.loc, "equation '" + decl->name.name + "' has no loop: its "
+                                      "sources are not used");
+  for (const auto& p : decl->params) {
+    auto git = given.find(p.name.name);
+    ast::ExprPtr v = git != given.end() ? git->second : p.defaultValue;
+    if (!v) {
+      diags_.error(inst.equation.loc, "missing argument '" + p.name.name + "' of equation '" +
+                                          decl->name.name + "'");
+      diags_.note(p.name.loc, "parameter declared here without a default");
+      continue;
+    }
+    if (git == given.end()) {
+      // A default may use the equation's earlier parameters only.
+      std::set<std::string> earlier;
+      for (const auto& q : decl->params) {
+        if (&q == &p) break;
+        earlier.insert(q.name.name);
+      }
+      checkExpr(*v, [&](const std::string& n) { return earlier.count(n) != 0; },
+                "the default of '" + p.name.name + "'", diags_);
+    }
+    eq.values.emplace_back(p.name.name, v);
+  }
+  {
+    std::set<std::string> visible;
+    for (const auto& p : decl->params) visible.insert(p.name.name);
+    for (const auto& c : decl->consts) {
+      if (c.value)
+        checkExpr(*c.value, [&](const std::string& n) { return visible.count(n) != 0; },
+                  "const '" + c.name.name + "' of equation '" + decl->name.name +
+                      "' (it may use the equation's parameters and earlier consts)",
+                  diags_);
+      visible.insert(c.name.name);
+      eq.values.emplace_back(c.name.name, c.value);
+    }
+  }
+  if (eq.dest < 0) return;
+  eq.declIndex = useEquationDecl(decl);
+  const auto& pd = plan_->equationDecls[eq.declIndex];
+  if (!pd.reduceTarget.empty()) {
+    auto& consts = plan_->arrays[eq.dest].constants;
+    if (std::find(consts.begin(), consts.end(), pd.reduceTarget) == consts.end())
+      consts.push_back(pd.reduceTarget);
+  }
+  eq.id = static_cast<int>(plan_->equations.size());
+  g.equations.push_back(eq.id);
+  g.order.push_back(static_cast<int>(g.equations.size()) - 1);
+  plan_->equations.push_back(std::move(eq));
+}
+
+}  // namespace
+
+std::unique_ptr<Plan> buildPlan(const std::vector<std::unique_ptr<ast::Module>>& modules,
+                                DiagnosticEngine& diags) {
+  if (modules.empty()) return nullptr;
+  return SemaImpl(modules, diags).run();
+}
+
+}  // namespace sphc

@@ -1,0 +1,275 @@
+// sphc runtime: SPH smoothing kernels (header only).
+//
+// Every kernel is a radial function W(r, h) = sigma_d / h^d * f(q), q = r / h, with compact
+// support q < radius_scale. Each is a class template on the dimension so that generated code
+// names the exact type (e.g. `sphc::CubicSpline<2>`) and the hot loop inlines it: all members
+// are static and inline, with no virtual calls and no allocation.
+//
+// Interface of every kernel K = Kernel<Dim>:
+//   K::radius_scale           support radius in units of h (W = 0 for r >= radius_scale * h)
+//   K::name                   "CubicSpline", ...
+//   K::w(rij, h)              W(r_ij, h)
+//   K::dwdq(rij, h)           dW/dq = sigma_d / h^d * f'(q): the derivative with respect to q,
+//                             normalisation included. Hence
+//                                 grad_i W = dwdq(rij, h) / (h * rij) * xij
+//   K::gradient(xij, rij, h, grad)
+//                             grad_i W, the gradient with respect to x_i, where
+//                             xij = x_i - x_j and rij = |xij|; it is zero for rij < 1e-12
+//                             (the gradient of a radial kernel vanishes at r = 0, and this
+//                             avoids 0/0).
+//
+// Kernels and normalisations sigma_d for d = 1, 2, 3:
+//   CubicSpline     (Monaghan 1992, 2005), support 2h
+//                   f = 1 - 3/2 q^2 + 3/4 q^3 (q < 1), 1/4 (2 - q)^3 (1 <= q < 2)
+//                   sigma = 2/3, 10/(7 pi), 1/pi
+//   QuinticSpline   (Morris et al. 1997), support 3h
+//                   f = (3-q)^5 - 6 (2-q)^5 + 15 (1-q)^5, each term only where its base > 0
+//                   sigma = 1/120, 7/(478 pi), 1/(120 pi)
+//                   (the 3D value 3/(359 pi) found in some texts does not integrate to one:
+//                   the exact integral of f over R^3 is 120 pi.)
+//   WendlandQuintic (Wendland C2, Dehnen & Aly 2012), support 2h
+//                   d = 2, 3: f = (1 - q/2)^4 (2q + 1), sigma = 7/(4 pi), 21/(16 pi)
+//                   d = 1:    the C2 Wendland function of 1D, f = (1 - q/2)^3 (1.5q + 1),
+//                             sigma = 5/8 (the 2D/3D function is not positive definite in 1D;
+//                             PySPH offers this one as a separate 1D-only kernel).
+//   Gaussian        truncated at 3h: f = exp(-q^2), sigma = 1/pi^(d/2).
+//                   The truncation is not renormalised (as in PySPH): the integral over the
+//                   support is erf(3) in 1D, 1 - e^-9 in 2D, erf(3) - 6/sqrt(pi) e^-9 in 3D,
+//                   i.e. 1 - O(1e-4).
+#pragma once
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace sphc {
+
+namespace detail {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInvSqrtPi = 0.56418958354775628695;     // 1 / sqrt(pi)
+constexpr double kInvPi32 = 0.17958712212516656169;       // 1 / pi^(3/2)
+
+template <int Dim>
+inline double inv_h_pow(double h) {
+  static_assert(Dim >= 1 && Dim <= 3, "sphc kernels: Dim must be 1, 2 or 3");
+  const double ih = 1.0 / h;
+  if constexpr (Dim == 1) {
+    return ih;
+  } else if constexpr (Dim == 2) {
+    return ih * ih;
+  } else {
+    return ih * ih * ih;
+  }
+}
+
+// The part common to all kernels: W, dW/dq and the gradient from a shape `S` providing
+// `S::sigma` (normalisation for the dimension), `S::radius_scale`, `S::f(q)` and `S::df(q)`.
+// f and df must return 0 for q >= radius_scale.
+template <class S, int Dim>
+struct RadialKernel {
+  static constexpr int dim = Dim;
+  static constexpr double radius_scale = S::radius_scale;
+
+  static inline double w(double rij, double h) {
+    return S::sigma * inv_h_pow<Dim>(h) * S::f(rij / h);
+  }
+  static inline double dwdq(double rij, double h) {
+    return S::sigma * inv_h_pow<Dim>(h) * S::df(rij / h);
+  }
+  static inline void gradient(const double xij[3], double rij, double h, double grad[3]) {
+    // dW/dx_i = dW/dq * dq/dr * dr/dx_i = dwdq * (1/h) * xij / rij.
+    const double s = rij > 1e-12 ? dwdq(rij, h) / (h * rij) : 0.0;
+    grad[0] = s * xij[0];
+    grad[1] = s * xij[1];
+    grad[2] = s * xij[2];
+  }
+};
+
+template <int Dim>
+struct CubicShape {
+  static constexpr double radius_scale = 2.0;
+  static constexpr double sigma =
+      Dim == 1 ? 2.0 / 3.0 : Dim == 2 ? 10.0 / (7.0 * kPi) : 1.0 / kPi;
+  static inline double f(double q) {
+    if (q < 1.0) return 1.0 - 1.5 * q * q * (1.0 - 0.5 * q);
+    if (q < 2.0) {
+      const double t = 2.0 - q;
+      return 0.25 * t * t * t;
+    }
+    return 0.0;
+  }
+  static inline double df(double q) {
+    if (q < 1.0) return q * (2.25 * q - 3.0);  // -3q + 9/4 q^2
+    if (q < 2.0) {
+      const double t = 2.0 - q;
+      return -0.75 * t * t;
+    }
+    return 0.0;
+  }
+};
+
+template <int Dim>
+struct QuinticShape {
+  static constexpr double radius_scale = 3.0;
+  static constexpr double sigma =
+      Dim == 1 ? 1.0 / 120.0 : Dim == 2 ? 7.0 / (478.0 * kPi) : 1.0 / (120.0 * kPi);
+  static inline double f(double q) {
+    if (q >= 3.0) return 0.0;
+    const double t3 = 3.0 - q, t2 = 2.0 - q, t1 = 1.0 - q;
+    double v = t3 * t3 * t3 * t3 * t3;
+    if (q < 2.0) v -= 6.0 * t2 * t2 * t2 * t2 * t2;
+    if (q < 1.0) v += 15.0 * t1 * t1 * t1 * t1 * t1;
+    return v;
+  }
+  static inline double df(double q) {
+    if (q >= 3.0) return 0.0;
+    const double t3 = 3.0 - q, t2 = 2.0 - q, t1 = 1.0 - q;
+    double v = -5.0 * t3 * t3 * t3 * t3;
+    if (q < 2.0) v += 30.0 * t2 * t2 * t2 * t2;
+    if (q < 1.0) v -= 75.0 * t1 * t1 * t1 * t1;
+    return v;
+  }
+};
+
+// Wendland C2 for d = 2, 3: (1 - q/2)^4 (2q + 1).
+template <int Dim>
+struct WendlandC2Shape {
+  static constexpr double radius_scale = 2.0;
+  static constexpr double sigma = Dim == 2 ? 7.0 / (4.0 * kPi) : 21.0 / (16.0 * kPi);
+  static inline double f(double q) {
+    if (q >= 2.0) return 0.0;
+    const double t = 1.0 - 0.5 * q, t2 = t * t;
+    return t2 * t2 * (2.0 * q + 1.0);
+  }
+  static inline double df(double q) {
+    // d/dq [t^4 (2q+1)] = -2 t^3 (2q+1) + 2 t^4 = -5 q t^3
+    if (q >= 2.0) return 0.0;
+    const double t = 1.0 - 0.5 * q;
+    return -5.0 * q * t * t * t;
+  }
+};
+
+// Wendland C2 for d = 1: (1 - q/2)^3 (1.5q + 1).
+template <>
+struct WendlandC2Shape<1> {
+  static constexpr double radius_scale = 2.0;
+  static constexpr double sigma = 5.0 / 8.0;
+  static inline double f(double q) {
+    if (q >= 2.0) return 0.0;
+    const double t = 1.0 - 0.5 * q;
+    return t * t * t * (1.5 * q + 1.0);
+  }
+  static inline double df(double q) {
+    // d/dq [t^3 (1.5q+1)] = -1.5 t^2 (1.5q+1) + 1.5 t^3 = -3 q t^2
+    if (q >= 2.0) return 0.0;
+    const double t = 1.0 - 0.5 * q;
+    return -3.0 * q * t * t;
+  }
+};
+
+template <int Dim>
+struct GaussianShape {
+  static constexpr double radius_scale = 3.0;
+  static constexpr double sigma = Dim == 1 ? kInvSqrtPi : Dim == 2 ? 1.0 / kPi : kInvPi32;
+  static inline double f(double q) { return q < 3.0 ? std::exp(-q * q) : 0.0; }
+  static inline double df(double q) { return q < 3.0 ? -2.0 * q * std::exp(-q * q) : 0.0; }
+};
+
+}  // namespace detail
+
+template <int Dim>
+struct CubicSpline : detail::RadialKernel<detail::CubicShape<Dim>, Dim> {
+  static constexpr const char* name = "CubicSpline";
+};
+
+template <int Dim>
+struct QuinticSpline : detail::RadialKernel<detail::QuinticShape<Dim>, Dim> {
+  static constexpr const char* name = "QuinticSpline";
+};
+
+template <int Dim>
+struct WendlandQuintic : detail::RadialKernel<detail::WendlandC2Shape<Dim>, Dim> {
+  static constexpr const char* name = "WendlandQuintic";
+};
+
+template <int Dim>
+struct Gaussian : detail::RadialKernel<detail::GaussianShape<Dim>, Dim> {
+  static constexpr const char* name = "Gaussian";
+};
+
+// ---- Run-time selection (tests and tools; generated code names the kernel type) ----------
+
+enum class KernelKind { CubicSpline, QuinticSpline, WendlandQuintic, Gaussian };
+
+inline const char* kernel_name(KernelKind k) {
+  switch (k) {
+    case KernelKind::CubicSpline: return "CubicSpline";
+    case KernelKind::QuinticSpline: return "QuinticSpline";
+    case KernelKind::WendlandQuintic: return "WendlandQuintic";
+    case KernelKind::Gaussian: return "Gaussian";
+  }
+  return "?";
+}
+
+// The kind named `name` (as in kernel_name); false if there is none.
+inline bool parse_kernel_kind(const std::string& name, KernelKind& out) {
+  for (KernelKind k : {KernelKind::CubicSpline, KernelKind::QuinticSpline,
+                       KernelKind::WendlandQuintic, KernelKind::Gaussian}) {
+    if (name == kernel_name(k)) {
+      out = k;
+      return true;
+    }
+  }
+  return false;
+}
+
+// A kernel chosen at run time: a switch per call, so not for the hot loop.
+struct AnyKernel {
+  KernelKind kind = KernelKind::CubicSpline;
+  int dim = 2;
+
+  double w(double rij, double h) const {
+    return visit([&](auto k) { return decltype(k)::w(rij, h); });
+  }
+  double dwdq(double rij, double h) const {
+    return visit([&](auto k) { return decltype(k)::dwdq(rij, h); });
+  }
+  void gradient(const double xij[3], double rij, double h, double grad[3]) const {
+    visit([&](auto k) {
+      decltype(k)::gradient(xij, rij, h, grad);
+      return 0.0;
+    });
+  }
+  double radius_scale() const {
+    return visit([](auto k) { return decltype(k)::radius_scale; });
+  }
+  const char* name() const { return kernel_name(kind); }
+
+  // Calls fn(K<dim>{}) for the selected kernel type; throws std::invalid_argument for a
+  // dimension other than 1, 2, 3.
+  template <class Fn>
+  double visit(Fn&& fn) const {
+    switch (kind) {
+      case KernelKind::CubicSpline: return visit_dim<CubicSpline>(fn);
+      case KernelKind::QuinticSpline: return visit_dim<QuinticSpline>(fn);
+      case KernelKind::WendlandQuintic: return visit_dim<WendlandQuintic>(fn);
+      case KernelKind::Gaussian: return visit_dim<Gaussian>(fn);
+    }
+    throw std::invalid_argument("sphc::AnyKernel: unknown kernel kind");
+  }
+
+ private:
+  template <template <int> class K, class Fn>
+  double visit_dim(Fn& fn) const {
+    switch (dim) {
+      case 1: return fn(K<1>{});
+      case 2: return fn(K<2>{});
+      case 3: return fn(K<3>{});
+    }
+    throw std::invalid_argument(std::string("sphc::AnyKernel: dimension must be 1, 2 or 3 (got ") +
+                                std::to_string(dim) + ")");
+  }
+};
+
+}  // namespace sphc

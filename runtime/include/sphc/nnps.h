@@ -1,0 +1,173 @@
+// sphc runtime: neighbour search with a cell list.
+//
+// All arrays of a scene share one SearchDomain (bounding box and cell size); each source array
+// gets its own CellList built on it every time step. The generated loop asks for candidates
+// of a destination point and applies the neighbour criterion itself:
+//
+//     j is a neighbour of i  <=>  r_ij < radius_scale * max(h_i, h_j)
+//
+// This works with fixed and variable h. Because the cell size is radius_scale * (max h over
+// all arrays), every neighbour lies at most one cell away along each axis, so the 3^dim cells
+// around the point's cell hold every neighbour (candidates are a superset of neighbours).
+//
+// Robustness: cell coordinates are clamped to the grid, so a point outside the domain (a
+// particle that moved since the domain was made, or a query point anywhere) lands in the
+// nearest border cell; NaN coordinates land in cell 0. Clamping never moves two points
+// further apart in cell units, so the 3^dim stencil stays sufficient for such points too
+// (only efficiency suffers if many particles pile up in border cells).
+//
+// Storage: particle indices sorted by cell (stable counting sort, so ascending index within a
+// cell) in one contiguous vector, with cell start offsets. When the grid has at most
+// 8 n + 1024 cells it is dense (cell = linear index; the three cells of a row along x are
+// contiguous, so a stencil is 3^(dim-1) contiguous ranges). Otherwise (sparse domains) only
+// occupied cells are numbered, through an open-addressing hash of the cell coordinates, so
+// memory stays O(n). Both build in O(n) and reuse their buffers between builds.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "sphc/particle_array.h"
+
+namespace sphc {
+
+struct SearchDomain {
+  int dim = 2;
+  double lo[3] = {0.0, 0.0, 0.0};
+  double hi[3] = {0.0, 0.0, 0.0};
+  double cell_size = 1.0;
+};
+
+// Bounding box over the x, y, z of all particles of all arrays (a missing y or z is 0; axes
+// beyond `dim` are [0, 0]; non-finite coordinates are ignored), padded by 1e-6 * cell_size,
+// and cell_size = radius_scale * max h over all arrays (property "h"; 1.0 when there is no
+// positive finite h, e.g. no particles). Throws std::invalid_argument for dim not in 1..3,
+// radius_scale <= 0, or a non-empty array without "x" or "h".
+SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays, int dim,
+                                double radius_scale);
+
+class CellList {
+ public:
+  // Auto picks dense or hashed storage by the number of cells; Dense and Hash force one (for
+  // tests and benchmarks; Dense still falls back to Hash beyond 2^31 cells).
+  enum class Mode { Auto, Dense, Hash };
+
+  // Sorts particles 0..n-1 into cells. y and z may be nullptr (treated as 0). Throws
+  // std::invalid_argument if dom.dim is not 1..3 or n >= 2^32 - 1.
+  void build(const SearchDomain& dom, const double* x, const double* y, const double* z,
+             std::size_t n);
+
+  // Calls f(std::uint32_t j) for every particle j in the 3^dim cells around the cell of
+  // (xi, yi, zi). Deterministic order: cells by z, then y, then x, ascending; within a cell by
+  // ascending j. Valid (calls nothing) before the first build.
+  template <class F>
+  inline void for_each_candidate(double xi, double yi, double zi, F&& f) const;
+
+  std::size_t size() const { return n_; }
+
+  // Convenience for tests and tools, not for the hot loop: out = the indices j (in candidate
+  // order) with |x_i - x_j| < radius_scale * max(hi, h[j]), distance over x, y, z (nullptr y
+  // or z read as 0). A query at a particle's own position includes that particle.
+  void neighbors(double xi, double yi, double zi, double hi, const double* x, const double* y,
+                 const double* z, const double* h, double radius_scale,
+                 std::vector<std::uint32_t>& out) const;
+
+  void set_mode(Mode m) { mode_ = m; }
+  bool is_dense() const { return dense_; }
+  // Dense: all cells of the grid; hashed: occupied cells.
+  std::size_t num_cells() const { return start_.size() - 1; }
+  const int* cells_per_axis() const { return ncell_; }
+
+ private:
+  static constexpr std::uint32_t kNoCell = 0xffffffffu;
+  static constexpr std::uint64_t kEmptyKey = ~std::uint64_t{0};  // never a packed key
+  static constexpr int kCellBits = 21;                           // 3 * 21 bits in a key
+  static constexpr int kMaxCellsPerAxis = 1 << kCellBits;
+
+  // Cell coordinate along an axis: NaN and values below the grid give 0, values beyond it
+  // give the last cell; for values in range truncation is floor.
+  static inline int axis_cell(double v, double cmax) {
+    v = v >= 0.0 ? v : 0.0;
+    v = v <= cmax ? v : cmax;
+    return static_cast<int>(v);
+  }
+  inline void cell_coords(double x, double y, double z, int c[3]) const {
+    c[0] = axis_cell((x - lo_[0]) * inv_cell_, cmax_[0]);
+    c[1] = axis_cell((y - lo_[1]) * inv_cell_, cmax_[1]);
+    c[2] = axis_cell((z - lo_[2]) * inv_cell_, cmax_[2]);
+  }
+  static inline std::uint64_t pack(int cx, int cy, int cz) {
+    return static_cast<std::uint64_t>(cx) | (static_cast<std::uint64_t>(cy) << kCellBits) |
+           (static_cast<std::uint64_t>(cz) << (2 * kCellBits));
+  }
+  inline std::size_t slot_of(std::uint64_t key) const {
+    // Fibonacci hashing: the top bits of key * 2^64/phi.
+    return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> hash_shift_);
+  }
+  // Hashed storage: the cell number of a packed key, kNoCell if unoccupied.
+  inline std::uint32_t find_cell(std::uint64_t key) const {
+    const std::size_t mask = keys_.size() - 1;
+    for (std::size_t s = slot_of(key);; s = (s + 1) & mask) {
+      const std::uint64_t k = keys_[s];
+      if (k == key) return slot_cell_[s];
+      if (k == kEmptyKey) return kNoCell;
+    }
+  }
+  std::uint32_t insert_cell(std::uint64_t key, std::uint32_t& next_cell);
+
+  Mode mode_ = Mode::Auto;
+  bool dense_ = true;
+  std::size_t n_ = 0;
+  double lo_[3] = {0.0, 0.0, 0.0};
+  double inv_cell_ = 0.0;
+  double cmax_[3] = {0.0, 0.0, 0.0};  // ncell_ - 1, as doubles for clamping
+  int ncell_[3] = {1, 1, 1};
+  // Cell c holds order_[start_[c] .. start_[c + 1]).
+  std::vector<std::uint32_t> start_ = {0, 0};
+  std::vector<std::uint32_t> order_;
+  std::vector<std::uint32_t> cell_of_;  // build scratch: cell of each particle
+  // Hashed storage: open addressing with linear probing, size a power of two >= 2 n.
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::uint32_t> slot_cell_;
+  int hash_shift_ = 64;
+};
+
+template <class F>
+inline void CellList::for_each_candidate(double xi, double yi, double zi, F&& f) const {
+  int c[3];
+  cell_coords(xi, yi, zi, c);
+  // Stencil bounds, clipped to the grid (axes beyond dim have one cell, so they give 0..0).
+  int lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = c[a] > 0 ? c[a] - 1 : 0;
+    hi[a] = c[a] + 1 < ncell_[a] ? c[a] + 1 : c[a];
+  }
+  const std::uint32_t* order = order_.data();
+  const std::uint32_t* start = start_.data();
+  if (dense_) {
+    for (int cz = lo[2]; cz <= hi[2]; ++cz) {
+      for (int cy = lo[1]; cy <= hi[1]; ++cy) {
+        // Cells lo[0]..hi[0] of a row are consecutive: one contiguous range of order_.
+        const std::size_t row =
+            (static_cast<std::size_t>(cz) * ncell_[1] + static_cast<std::size_t>(cy)) *
+            ncell_[0];
+        const std::uint32_t end = start[row + hi[0] + 1];
+        for (std::uint32_t k = start[row + lo[0]]; k < end; ++k) f(order[k]);
+      }
+    }
+  } else {
+    for (int cz = lo[2]; cz <= hi[2]; ++cz) {
+      for (int cy = lo[1]; cy <= hi[1]; ++cy) {
+        for (int cx = lo[0]; cx <= hi[0]; ++cx) {
+          const std::uint32_t cell = find_cell(pack(cx, cy, cz));
+          if (cell == kNoCell) continue;
+          const std::uint32_t end = start[cell + 1];
+          for (std::uint32_t k = start[cell]; k < end; ++k) f(order[k]);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace sphc

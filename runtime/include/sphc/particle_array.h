@@ -1,0 +1,70 @@
+// sphc runtime: particle arrays (structure of arrays).
+//
+// A ParticleArray holds n particles and a list of named properties. Each property is a
+// contiguous vector of doubles, int32 or uint32 values with a stride (1 for a scalar, 9 for a
+// 3x3 tensor): value k of particle i is at [i * stride + k]. Per-array constants are small
+// double vectors (PySPH's `constants`). Generated code looks properties up once per call and
+// then works on raw pointers.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace sphc {
+
+enum class PropType : std::uint8_t { F64, I32, U32 };
+
+const char* prop_type_name(PropType t);
+
+struct Property {
+  std::string name;
+  PropType type = PropType::F64;
+  int stride = 1;
+  std::vector<double> f64;
+  std::vector<std::int32_t> i32;
+  std::vector<std::uint32_t> u32;
+};
+
+struct Constant {
+  std::string name;
+  std::vector<double> values;
+};
+
+struct ParticleArray {
+  std::string name;
+  std::size_t n = 0;
+  std::vector<Property> props;
+  std::vector<Constant> constants;
+
+  // Adds a property (sized to n, filled with `init`) and returns its index; if a property of
+  // that name exists, returns its index unchanged (type and stride must match, else throws
+  // std::invalid_argument naming the array and property).
+  int add_property(const std::string& name, PropType type = PropType::F64, int stride = 1,
+                   double init = 0.0);
+  // Index of a property, -1 if absent.
+  int find(const std::string& name) const;
+  // Resizes every property to n particles (new entries are 0).
+  void resize(std::size_t n);
+
+  double* f64(int idx) { return props[idx].f64.data(); }
+  std::int32_t* i32(int idx) { return props[idx].i32.data(); }
+  std::uint32_t* u32(int idx) { return props[idx].u32.data(); }
+  const double* f64(int idx) const { return props[idx].f64.data(); }
+  // By name; throws std::out_of_range naming the array and property if absent or not F64.
+  double* f64(const std::string& name);
+  const double* f64(const std::string& name) const;
+
+  // Adds a constant with `size` values set to `init` (returns index; existing: its index).
+  int add_constant(const std::string& name, int size = 1, double init = 0.0);
+  int find_constant(const std::string& name) const;
+  double* constant(int idx) { return constants[idx].values.data(); }
+  double* constant(const std::string& name);  // throws std::out_of_range if absent
+
+  // Appends particle `i` of `src` (same property names) to this array; properties missing in
+  // src are 0. Used by inlets and by loading.
+  void append_from(const ParticleArray& src, std::size_t i);
+};
+
+}  // namespace sphc

@@ -1,0 +1,52 @@
+// sphc runtime: the run loop and command line of every generated solver.
+//
+// The generated `main` fills a SceneProgram and returns run_main(argc, argv, prog). run_main
+// owns the command line (see --help), the time loop, output (HDF5 files plus an XDMF index),
+// the progress line and the blow-up diagnosis.
+//
+// Exit codes: 0 success, 1 error (an exception from the scene or from output), 2 bad usage,
+// 3 the simulation blew up (a non-finite value, or the adaptive time step collapsed).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "sphc/particle_array.h"
+
+namespace sphc {
+
+struct ParamInfo {
+  std::string name;
+  double value = 0.0;  // default; NaN: computed at set-up from other parameters (see help)
+  std::string help;
+};
+
+// Times a scene computes from its parameters; the command line may override them.
+struct SceneTimes {
+  double tf = 1.0;                 // final time
+  double dt = 1e-4;                // fixed time step, or the initial one with adaptive_dt
+  double output_every = 0.0;       // sim-time interval; 0 = no periodic output
+  std::vector<double> output_at;   // extra output times
+};
+
+struct SceneProgram {
+  std::string name;  // scene name (used for output names)
+  int dim = 2;
+  std::vector<ParamInfo> params;  // defaults, in order; --set overrides by name
+  // Called once with the final parameter values (same order as params). Builds arrays, sets
+  // the scene's tf, dt and output times (they may depend on params).
+  std::function<void(const std::vector<double>& params, SceneTimes& times)> setup;
+  std::function<std::vector<ParticleArray*>()> arrays;
+  std::function<void(double t, double dt)> compute_initial;  // may be empty
+  std::function<void(double t, double dt)> step;             // one time step from t to t+dt
+  std::function<double()> adaptive_dt;                       // empty = fixed dt
+  // Array name -> properties written (empty list = all); empty = every array, all properties.
+  std::vector<std::pair<std::string, std::vector<std::string>>> output;
+};
+
+// Runs the scene as the command line asks; returns the process exit code.
+int run_main(int argc, char** argv, SceneProgram& prog);
+
+}  // namespace sphc

@@ -1,0 +1,63 @@
+#include "sphc/load.h"
+
+#include "sphc/hdf5_io.h"
+
+#include <stdexcept>
+
+namespace sphc {
+
+namespace {
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+}  // namespace
+
+ParticleArray load_particles(const std::string& dir, const std::string& path,
+                             const std::string& array) {
+  std::string full = (!path.empty() && path[0] == '/') || dir.empty() ? path : dir + "/" + path;
+  if (endsWith(full, ".csv")) return read_particles_csv(full, array);
+  if (endsWith(full, ".h5") || endsWith(full, ".hdf5")) return read_particles_hdf5(full, array);
+  throw std::runtime_error("cannot load '" + full + "' for array '" + array +
+                           "': expected a .h5, .hdf5 or .csv file");
+}
+
+Points positions_of(const ParticleArray& a) {
+  Points p;
+  const char* axes[3] = {"x", "y", "z"};
+  std::vector<double>* out[3] = {&p.x, &p.y, &p.z};
+  for (int k = 0; k < 3; ++k) {
+    int i = a.find(axes[k]);
+    if (i >= 0)
+      *out[k] = a.props[i].f64;
+    else if (k == 0)
+      throw std::runtime_error("loaded array '" + a.name + "' has no 'x' column");
+    else
+      out[k]->assign(a.n, 0.0);
+  }
+  return p;
+}
+
+void apply_loaded(ParticleArray& a, std::size_t total, const std::vector<ParticleArray>& loaded) {
+  std::size_t count = 0;
+  for (const auto& l : loaded) count += l.n;
+  std::size_t offset = total - count;
+  for (const auto& l : loaded) {
+    for (const auto& src : l.props) {
+      int i = a.find(src.name);
+      if (i < 0) continue;  // the scene does not use this property
+      Property& dst = a.props[i];
+      if (dst.type != src.type || dst.stride != src.stride)
+        throw std::runtime_error("property '" + src.name + "' of loaded array '" + a.name +
+                                 "' has another type or stride in the file than in the scene");
+      std::size_t s = static_cast<std::size_t>(dst.stride);
+      for (std::size_t j = 0; j < l.n * s; ++j) {
+        if (dst.type == PropType::F64) dst.f64[offset * s + j] = src.f64[j];
+        if (dst.type == PropType::I32) dst.i32[offset * s + j] = src.i32[j];
+        if (dst.type == PropType::U32) dst.u32[offset * s + j] = src.u32[j];
+      }
+    }
+    offset += l.n;
+  }
+}
+
+}  // namespace sphc

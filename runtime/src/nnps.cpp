@@ -1,0 +1,192 @@
+// sphc runtime: cell-list neighbour search (non-inline parts). See nnps.h.
+#include "sphc/nnps.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace sphc {
+
+namespace {
+
+void check_dim(int dim, const char* who) {
+  if (dim < 1 || dim > 3) {
+    throw std::invalid_argument(std::string(who) + ": dim must be 1, 2 or 3 (got " +
+                                std::to_string(dim) + ")");
+  }
+}
+
+}  // namespace
+
+SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays, int dim,
+                                double radius_scale) {
+  check_dim(dim, "sphc::make_search_domain");
+  if (!(radius_scale > 0.0) || !std::isfinite(radius_scale)) {
+    throw std::invalid_argument("sphc::make_search_domain: radius_scale must be > 0 (got " +
+                                std::to_string(radius_scale) + ")");
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  double lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
+  double hmax = 0.0;
+  static const char* const kAxis[3] = {"x", "y", "z"};
+
+  for (const ParticleArray* pa : arrays) {
+    if (pa == nullptr || pa->n == 0) continue;
+    for (const char* need : {"x", "h"}) {
+      const int idx = pa->find(need);
+      if (idx < 0 || pa->props[idx].type != PropType::F64) {
+        throw std::invalid_argument("sphc::make_search_domain: array '" + pa->name +
+                                    "' has no double property '" + need + "'");
+      }
+    }
+    for (int a = 0; a < dim; ++a) {
+      const int idx = pa->find(kAxis[a]);
+      if (idx < 0 || pa->props[idx].type != PropType::F64) {
+        // A missing y or z reads as 0.
+        lo[a] = std::min(lo[a], 0.0);
+        hi[a] = std::max(hi[a], 0.0);
+        continue;
+      }
+      const Property& p = pa->props[idx];
+      for (std::size_t i = 0; i < pa->n; ++i) {
+        const double v = p.f64[i * p.stride];
+        if (!std::isfinite(v)) continue;
+        lo[a] = std::min(lo[a], v);
+        hi[a] = std::max(hi[a], v);
+      }
+    }
+    const Property& h = pa->props[pa->find("h")];
+    for (std::size_t i = 0; i < pa->n; ++i) {
+      const double v = h.f64[i * h.stride];
+      if (std::isfinite(v) && v > hmax) hmax = v;
+    }
+  }
+
+  SearchDomain dom;
+  dom.dim = dim;
+  dom.cell_size = hmax > 0.0 ? radius_scale * hmax : 1.0;
+  const double pad = 1e-6 * dom.cell_size;
+  for (int a = 0; a < 3; ++a) {
+    if (a < dim && lo[a] <= hi[a]) {
+      dom.lo[a] = lo[a] - pad;
+      dom.hi[a] = hi[a] + pad;
+    } else {
+      dom.lo[a] = dom.hi[a] = 0.0;  // axis unused, or no finite coordinate at all
+    }
+  }
+  return dom;
+}
+
+std::uint32_t CellList::insert_cell(std::uint64_t key, std::uint32_t& next_cell) {
+  const std::size_t mask = keys_.size() - 1;
+  for (std::size_t s = slot_of(key);; s = (s + 1) & mask) {
+    if (keys_[s] == key) return slot_cell_[s];
+    if (keys_[s] == kEmptyKey) {
+      keys_[s] = key;
+      slot_cell_[s] = next_cell;
+      return next_cell++;
+    }
+  }
+}
+
+void CellList::build(const SearchDomain& dom, const double* x, const double* y,
+                     const double* z, std::size_t n) {
+  check_dim(dom.dim, "sphc::CellList::build");
+  if (n >= kNoCell) {
+    throw std::invalid_argument("sphc::CellList::build: too many particles (" +
+                                std::to_string(n) + ")");
+  }
+  n_ = n;
+
+  // Grid geometry. Cells may be made larger than dom.cell_size (never smaller, which keeps
+  // the 3^dim stencil sufficient) so that each axis has at most kMaxCellsPerAxis cells; an
+  // unusable cell size (0, negative, NaN) degrades to one cell per axis.
+  double extent[3] = {0.0, 0.0, 0.0};
+  double max_extent = 0.0;
+  for (int a = 0; a < dom.dim; ++a) {
+    const double e = dom.hi[a] - dom.lo[a];
+    extent[a] = std::isfinite(e) && e > 0.0 ? e : 0.0;
+    max_extent = std::max(max_extent, extent[a]);
+  }
+  double cell = dom.cell_size;
+  if (!(cell > 0.0) || !std::isfinite(cell)) cell = max_extent > 0.0 ? max_extent : 1.0;
+  cell = std::max(cell, max_extent / (kMaxCellsPerAxis - 1));
+  inv_cell_ = 1.0 / cell;
+  double total_cells = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    const bool used = a < dom.dim && std::isfinite(dom.lo[a]);
+    lo_[a] = used ? dom.lo[a] : 0.0;
+    ncell_[a] = used ? static_cast<int>(std::min<double>(std::floor(extent[a] * inv_cell_) + 1.0,
+                                                         kMaxCellsPerAxis))
+                     : 1;
+    cmax_[a] = ncell_[a] - 1;
+    total_cells *= ncell_[a];
+  }
+
+  constexpr double kMaxDense = 2147483648.0;  // dense cell numbers must fit in uint32
+  switch (mode_) {
+    case Mode::Auto:
+      dense_ = total_cells <= 8.0 * static_cast<double>(n) + 1024.0 && total_cells < kMaxDense;
+      break;
+    case Mode::Dense: dense_ = total_cells < kMaxDense; break;
+    case Mode::Hash: dense_ = false; break;
+  }
+
+  // Cell of every particle.
+  cell_of_.resize(n);
+  std::size_t num_cells = 0;
+  if (dense_) {
+    num_cells = static_cast<std::size_t>(total_cells);
+    for (std::size_t i = 0; i < n; ++i) {
+      int c[3];
+      cell_coords(x[i], y ? y[i] : 0.0, z ? z[i] : 0.0, c);
+      cell_of_[i] = static_cast<std::uint32_t>(
+          c[0] + static_cast<std::size_t>(ncell_[0]) *
+                     (c[1] + static_cast<std::size_t>(ncell_[1]) * c[2]));
+    }
+  } else {
+    // Occupied cells are numbered in order of first appearance (deterministic).
+    int bits = 4;
+    while ((std::size_t{1} << bits) < 2 * n) ++bits;
+    keys_.assign(std::size_t{1} << bits, kEmptyKey);
+    slot_cell_.resize(keys_.size());
+    hash_shift_ = 64 - bits;
+    std::uint32_t next_cell = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      int c[3];
+      cell_coords(x[i], y ? y[i] : 0.0, z ? z[i] : 0.0, c);
+      cell_of_[i] = insert_cell(pack(c[0], c[1], c[2]), next_cell);
+    }
+    num_cells = next_cell;
+  }
+
+  // Stable counting sort by cell: count, inclusive prefix sum (start_[c] = end of cell c),
+  // then place particles from last to first, decrementing, which leaves start_[c] = begin.
+  start_.assign(num_cells + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++start_[cell_of_[i]];
+  std::uint32_t running = 0;
+  for (std::size_t c = 0; c < num_cells; ++c) {
+    running += start_[c];
+    start_[c] = running;
+  }
+  start_[num_cells] = static_cast<std::uint32_t>(n);
+  order_.resize(n);
+  for (std::size_t i = n; i-- > 0;) order_[--start_[cell_of_[i]]] = static_cast<std::uint32_t>(i);
+}
+
+void CellList::neighbors(double xi, double yi, double zi, double hi, const double* x,
+                         const double* y, const double* z, const double* h, double radius_scale,
+                         std::vector<std::uint32_t>& out) const {
+  out.clear();
+  for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {
+    const double dx = xi - x[j];
+    const double dy = yi - (y ? y[j] : 0.0);
+    const double dz = zi - (z ? z[j] : 0.0);
+    const double rmax = radius_scale * std::max(hi, h[j]);
+    if (dx * dx + dy * dy + dz * dz < rmax * rmax) out.push_back(j);
+  });
+}
+
+}  // namespace sphc

@@ -1,0 +1,150 @@
+// sphc runtime: particle arrays. See particle_array.h.
+#include "sphc/particle_array.h"
+
+#include <stdexcept>
+
+namespace sphc {
+
+namespace {
+
+// Resizes a property's values to n particles; new values are 0.
+void resize_prop(Property& p, std::size_t n) {
+  const std::size_t len = n * static_cast<std::size_t>(p.stride);
+  switch (p.type) {
+    case PropType::F64: p.f64.resize(len, 0.0); break;
+    case PropType::I32: p.i32.resize(len, 0); break;
+    case PropType::U32: p.u32.resize(len, 0u); break;
+  }
+}
+
+}  // namespace
+
+const char* prop_type_name(PropType t) {
+  switch (t) {
+    case PropType::F64: return "double";
+    case PropType::I32: return "int";
+    case PropType::U32: return "unsigned";
+  }
+  return "?";
+}
+
+int ParticleArray::add_property(const std::string& pname, PropType type, int stride,
+                                double init) {
+  const std::string where = "array '" + name + "', property '" + pname + "'";
+  if (stride < 1) {
+    throw std::invalid_argument(where + ": stride must be >= 1 (got " + std::to_string(stride) +
+                                ")");
+  }
+  const int existing = find(pname);
+  if (existing >= 0) {
+    const Property& p = props[existing];
+    if (p.type != type || p.stride != stride) {
+      throw std::invalid_argument(where + " exists as " + prop_type_name(p.type) + "[" +
+                                  std::to_string(p.stride) + "], requested as " +
+                                  prop_type_name(type) + "[" + std::to_string(stride) + "]");
+    }
+    return existing;
+  }
+  Property p;
+  p.name = pname;
+  p.type = type;
+  p.stride = stride;
+  const std::size_t len = n * static_cast<std::size_t>(stride);
+  switch (type) {
+    case PropType::F64: p.f64.assign(len, init); break;
+    case PropType::I32: p.i32.assign(len, static_cast<std::int32_t>(init)); break;
+    case PropType::U32: p.u32.assign(len, static_cast<std::uint32_t>(init)); break;
+  }
+  props.push_back(std::move(p));
+  return static_cast<int>(props.size()) - 1;
+}
+
+int ParticleArray::find(const std::string& pname) const {
+  for (std::size_t k = 0; k < props.size(); ++k) {
+    if (props[k].name == pname) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+void ParticleArray::resize(std::size_t new_n) {
+  for (Property& p : props) resize_prop(p, new_n);
+  n = new_n;
+}
+
+double* ParticleArray::f64(const std::string& pname) {
+  return const_cast<double*>(static_cast<const ParticleArray&>(*this).f64(pname));
+}
+
+const double* ParticleArray::f64(const std::string& pname) const {
+  const int idx = find(pname);
+  if (idx < 0) throw std::out_of_range("array '" + name + "' has no property '" + pname + "'");
+  if (props[idx].type != PropType::F64) {
+    throw std::out_of_range("array '" + name + "', property '" + pname + "' is " +
+                            prop_type_name(props[idx].type) + ", not double");
+  }
+  return props[idx].f64.data();
+}
+
+int ParticleArray::add_constant(const std::string& cname, int size, double init) {
+  const int existing = find_constant(cname);
+  if (existing >= 0) return existing;
+  if (size < 0) {
+    throw std::invalid_argument("array '" + name + "', constant '" + cname +
+                                "': size must be >= 0 (got " + std::to_string(size) + ")");
+  }
+  constants.push_back(Constant{cname, std::vector<double>(static_cast<std::size_t>(size), init)});
+  return static_cast<int>(constants.size()) - 1;
+}
+
+int ParticleArray::find_constant(const std::string& cname) const {
+  for (std::size_t k = 0; k < constants.size(); ++k) {
+    if (constants[k].name == cname) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+double* ParticleArray::constant(const std::string& cname) {
+  const int idx = find_constant(cname);
+  if (idx < 0) throw std::out_of_range("array '" + name + "' has no constant '" + cname + "'");
+  return constants[idx].values.data();
+}
+
+void ParticleArray::append_from(const ParticleArray& src, std::size_t i) {
+  if (i >= src.n) {
+    throw std::out_of_range("append_from: particle " + std::to_string(i) + " of array '" +
+                            src.name + "' (which has " + std::to_string(src.n) + ")");
+  }
+  // Check everything before changing anything, so a failure leaves this array intact.
+  std::vector<int> src_idx(props.size());
+  for (std::size_t k = 0; k < props.size(); ++k) {
+    const Property& p = props[k];
+    src_idx[k] = src.find(p.name);
+    if (src_idx[k] < 0) continue;
+    const Property& q = src.props[src_idx[k]];
+    if (q.type != p.type || q.stride != p.stride) {
+      throw std::invalid_argument("append_from: property '" + p.name + "' is " +
+                                  prop_type_name(p.type) + "[" + std::to_string(p.stride) +
+                                  "] in array '" + name + "' but " + prop_type_name(q.type) +
+                                  "[" + std::to_string(q.stride) + "] in array '" + src.name +
+                                  "'");
+    }
+  }
+  // src may be *this: grow first, then read src by index (never through stale pointers).
+  for (std::size_t k = 0; k < props.size(); ++k) {
+    Property& p = props[k];
+    resize_prop(p, n + 1);
+    if (src_idx[k] < 0) continue;
+    const Property& q = src.props[src_idx[k]];
+    const std::size_t s = static_cast<std::size_t>(p.stride);
+    for (std::size_t c = 0; c < s; ++c) {
+      switch (p.type) {
+        case PropType::F64: p.f64[n * s + c] = q.f64[i * s + c]; break;
+        case PropType::I32: p.i32[n * s + c] = q.i32[i * s + c]; break;
+        case PropType::U32: p.u32[n * s + c] = q.u32[i * s + c]; break;
+      }
+    }
+  }
+  ++n;
+}
+
+}  // namespace sphc

@@ -1,0 +1,567 @@
+// sphc runtime: the run loop and command line of generated solvers (see solver.h).
+#include "sphc/solver.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "sphc/hdf5_io.h"
+
+namespace sphc {
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitError = 1;
+constexpr int kExitUsage = 2;
+constexpr int kExitBlowUp = 3;
+
+constexpr double kTimeSlack = 1e-12;     // relative to tf: "t reached tf", "t reached an output"
+constexpr double kMinDtFraction = 1e-12; // an adaptive dt below this * tf has collapsed
+constexpr long kCheckEvery = 10;         // steps between scans for non-finite values
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string scene_name(const SceneProgram& prog) {
+  return prog.name.empty() ? std::string("scene") : prog.name;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Command line.
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  bool help = false;
+  bool quiet = false;
+  bool no_output = false;
+  bool timing = false;
+  std::optional<double> tf;
+  std::optional<double> dt;
+  std::optional<double> output_every;
+  long max_steps = std::numeric_limits<long>::max();
+  std::string directory;  // empty: <scene>_output
+  std::vector<std::pair<std::string, double>> sets;
+};
+
+double parse_number(const std::string& text, const std::string& what) {
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE ||
+      !std::isfinite(value)) {
+    throw UsageError(fmt::format("{}: '{}' is not a number", what, text));
+  }
+  return value;
+}
+
+double parse_time(const std::string& text, const std::string& option, bool zero_allowed) {
+  const double value = parse_number(text, option);
+  if (value < 0 || (!zero_allowed && value == 0)) {
+    throw UsageError(fmt::format("{}: expected a {} number, got '{}'", option,
+                                 zero_allowed ? "non-negative" : "positive", text));
+  }
+  return value;
+}
+
+long parse_count(const std::string& text, const std::string& option) {
+  char* end = nullptr;
+  errno = 0;
+  const long value = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE || value < 0) {
+    throw UsageError(
+        fmt::format("{}: expected a non-negative whole number, got '{}'", option, text));
+  }
+  return value;
+}
+
+std::string parameter_names(const SceneProgram& prog) {
+  if (prog.params.empty()) return fmt::format("the scene '{}' has no parameters", scene_name(prog));
+  std::string names;
+  for (const ParamInfo& p : prog.params) names += (names.empty() ? "" : ", ") + p.name;
+  return fmt::format("the parameters of scene '{}' are: {}", scene_name(prog), names);
+}
+
+std::pair<std::string, double> parse_set(const std::string& arg, const SceneProgram& prog) {
+  const std::size_t eq = arg.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw UsageError(fmt::format("--set expects NAME=VALUE, got '{}'", arg));
+  }
+  const std::string name = arg.substr(0, eq);
+  const bool known = std::any_of(prog.params.begin(), prog.params.end(),
+                                 [&](const ParamInfo& p) { return p.name == name; });
+  if (!known) {
+    throw UsageError(
+        fmt::format("--set {}: unknown parameter '{}'; {}", arg, name, parameter_names(prog)));
+  }
+  return {name, parse_number(arg.substr(eq + 1), "--set " + name)};
+}
+
+Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
+  Options o;
+  for (int i = 1; i < argc; ++i) {
+    std::string option = argv[i];
+    std::optional<std::string> attached;  // --name=value
+    if (option.rfind("--", 0) == 0 && option.find('=') != std::string::npos) {
+      attached = option.substr(option.find('=') + 1);
+      option.resize(option.find('='));
+    }
+    auto value = [&]() -> std::string {
+      if (attached) return *attached;
+      if (i + 1 >= argc) throw UsageError(fmt::format("{} expects a value", option));
+      return argv[++i];
+    };
+    auto flag = [&](bool& target) {
+      if (attached) throw UsageError(fmt::format("{} takes no value", option));
+      target = true;
+    };
+
+    if (option == "-h" || option == "--help") flag(o.help);
+    else if (option == "--quiet") flag(o.quiet);
+    else if (option == "--no-output") flag(o.no_output);
+    else if (option == "--timing") flag(o.timing);
+    else if (option == "--tf") o.tf = parse_time(value(), option, true);
+    else if (option == "--dt") o.dt = parse_time(value(), option, false);
+    else if (option == "--output-every") o.output_every = parse_time(value(), option, true);
+    else if (option == "--max-steps") o.max_steps = parse_count(value(), option);
+    else if (option == "--set") o.sets.push_back(parse_set(value(), prog));
+    else if (option == "-d" || option == "--directory") {
+      o.directory = value();
+      if (o.directory.empty()) throw UsageError(fmt::format("{} expects a directory", option));
+    } else {
+      throw UsageError(fmt::format("unknown option '{}'", argv[i]));
+    }
+  }
+  return o;
+}
+
+std::string program_name(int argc, char** argv, const SceneProgram& prog) {
+  if (argc > 0 && argv[0] && *argv[0]) return std::filesystem::path(argv[0]).filename().string();
+  return scene_name(prog);
+}
+
+void print_help(const std::string& program, const SceneProgram& prog) {
+  const std::string scene = scene_name(prog);
+  fmt::print(
+      "usage: {0} [options]\n"
+      "\n"
+      "Runs the sphc scene '{1}' ({2}D).\n"
+      "\n"
+      "options:\n"
+      "  --tf T                final time (default: the scene's)\n"
+      "  --dt DT               time step: the fixed one, or the initial one with an adaptive\n"
+      "                        time step (default: the scene's)\n"
+      "  --output-every T      output interval in simulation time, replacing the scene's\n"
+      "                        output times (0: first and last state only)\n"
+      "  --max-steps N         stop after N time steps\n"
+      "  -d, --directory DIR   output directory (default: {1}_output)\n"
+      "  --set NAME=VALUE      set a scene parameter (repeatable)\n"
+      "  --quiet               no progress line and no summary\n"
+      "  --no-output           write no files (benchmarks)\n"
+      "  --timing              print at the end, for the time loop:\n"
+      "                        timing: steps=N particles=P wall_s=W us_per_particle_step=U\n"
+      "  -h, --help            print this help\n"
+      "\n"
+      "Output: DIR/{1}_NNNNNN.h5 (NNNNNN: the step) and DIR/{1}.xdmf (for ParaView).\n"
+      "Exit codes: 0 done, 1 error, 2 bad usage, 3 the simulation blew up.\n",
+      program, scene, prog.dim);
+  if (prog.params.empty()) return;
+  std::size_t width = 0;
+  std::vector<std::string> lefts;
+  for (const ParamInfo& p : prog.params) {
+    // NaN: the default is computed from other parameters at set-up (help says how).
+    lefts.push_back(std::isnan(p.value) ? p.name : fmt::format("{} = {}", p.name, p.value));
+    width = std::max(width, lefts.back().size());
+  }
+  fmt::print("\nparameters (--set NAME=VALUE; defaults shown):\n");
+  for (std::size_t k = 0; k < lefts.size(); ++k) {
+    fmt::print("  {:<{}}  {}\n", lefts[k], width, prog.params[k].help);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Progress line on stderr: in place (\r, at most 4 a second) on a terminal, else a plain line
+// every 10% of tf.
+
+class Progress {
+ public:
+  void start(bool enabled, double tf) {
+    enabled_ = enabled && tf > 0;
+    tty_ = isatty(fileno(stderr)) != 0;
+    tf_ = tf;
+    start_ = Clock::now();
+    last_print_ = start_;
+  }
+
+  void update(double t, long step, double dt, std::size_t particles) {
+    if (!enabled_) return;
+    const double fraction = std::min(t / tf_, 1.0);
+    if (tty_) {
+      if (seconds_since(last_print_) < 0.25) return;
+      const std::string text = line(t, step, dt, particles, fraction);
+      fmt::print(stderr, "\r{:<{}}", text, shown_);
+      shown_ = text.size();
+      last_print_ = Clock::now();
+    } else if (fraction >= next_fraction_) {
+      fmt::print(stderr, "{}\n", line(t, step, dt, particles, fraction));
+      next_fraction_ = (std::floor(fraction * 10.0) + 1.0) / 10.0;
+    }
+    std::fflush(stderr);
+  }
+
+  // Ends an in-place line, before anything else is printed.
+  void break_line() {
+    if (shown_ > 0) fmt::print(stderr, "\n");
+    shown_ = 0;
+  }
+
+ private:
+  std::string line(double t, long step, double dt, std::size_t particles, double fraction) const {
+    // Enough decimals to show four significant digits of tf.
+    const int decimals = std::clamp(3 - static_cast<int>(std::floor(std::log10(tf_))), 4, 12);
+    std::string eta = "?";
+    if (fraction > 0) {
+      const long s = std::lround(seconds_since(start_) * (1.0 - fraction) / fraction);
+      eta = s >= 3600 ? fmt::format("{}h{:02}m", s / 3600, s / 60 % 60)
+                      : fmt::format("{}m{:02}s", s / 60, s % 60);
+    }
+    return fmt::format("t={:.{}f}/{:.{}f}  step {}  dt={:.2g}  particles {}  {:.1f}% ETA {}", t,
+                       decimals, tf_, decimals, step, dt, particles, 100.0 * fraction, eta);
+  }
+
+  bool enabled_ = false;
+  bool tty_ = false;
+  double tf_ = 1.0;
+  Clock::time_point start_;
+  Clock::time_point last_print_;
+  double next_fraction_ = 0.1;
+  std::size_t shown_ = 0;  // length of the in-place line on screen, 0 if none
+};
+
+// ---------------------------------------------------------------------------------------------
+// Output files.
+
+class OutputWriter {
+ public:
+  OutputWriter(const SceneProgram& prog, std::string directory, bool enabled)
+      : prog_(prog), scene_(scene_name(prog)), dir_(std::move(directory)), enabled_(enabled) {
+    if (enabled_) std::filesystem::create_directories(dir_);
+  }
+
+  bool enabled() const { return enabled_; }
+  const std::string& newest() const { return newest_; }
+
+  void write(const std::vector<ParticleArray*>& arrays, const OutputMeta& meta) {
+    if (!enabled_) return;
+    const std::string file = fmt::format("{}_{:06d}.h5", scene_, meta.step);
+    const std::vector<OutputArray> selection = selected(arrays);
+    write_particles_hdf5(in_dir(file), selection, meta);
+    series_.push_back(make_xdmf_entry(file, meta.t, selection));
+    write_xdmf(in_dir(scene_ + ".xdmf"), series_, prog_.dim);
+    newest_ = in_dir(file);
+  }
+
+  // Every property of every array, for inspection; not indexed by the XDMF file.
+  std::string write_blowup(const std::vector<ParticleArray*>& arrays, const OutputMeta& meta) {
+    const std::string path = in_dir(scene_ + "_blowup.h5");
+    std::vector<OutputArray> all;
+    for (const ParticleArray* a : arrays) all.push_back(OutputArray{a, {}});
+    write_particles_hdf5(path, all, meta);
+    return path;
+  }
+
+ private:
+  std::string in_dir(const std::string& file) const {
+    return (std::filesystem::path(dir_) / file).string();
+  }
+
+  std::vector<OutputArray> selected(const std::vector<ParticleArray*>& arrays) const {
+    std::vector<OutputArray> out;
+    if (prog_.output.empty()) {
+      for (const ParticleArray* a : arrays) out.push_back(OutputArray{a, {}});
+      return out;
+    }
+    for (const auto& [name, props] : prog_.output) {
+      auto it = std::find_if(arrays.begin(), arrays.end(),
+                             [&](const ParticleArray* a) { return a->name == name; });
+      if (it == arrays.end()) {
+        throw std::runtime_error(fmt::format("the output names array '{}', which the scene '{}' "
+                                             "does not have", name, scene_));
+      }
+      out.push_back(OutputArray{*it, props});
+    }
+    return out;
+  }
+
+  const SceneProgram& prog_;
+  std::string scene_;
+  std::string dir_;
+  bool enabled_;
+  std::vector<XdmfEntry> series_;
+  std::string newest_;
+};
+
+// When output is due: at multiples of output_every and at the output_at times, at the first
+// step that reaches them (time steps are not shortened to hit output times).
+class OutputSchedule {
+ public:
+  OutputSchedule(const SceneTimes& times, double slack)
+      : every_(times.output_every), at_(times.output_at), slack_(slack) {
+    std::sort(at_.begin(), at_.end());
+    due(0.0);  // t = 0 is always written
+  }
+
+  // True if t reached an output time not reached before.
+  bool due(double t) {
+    bool reached = false;
+    if (every_ > 0) {
+      while (static_cast<double>(next_k_) * every_ <= t + slack_) {
+        reached = true;
+        ++next_k_;
+      }
+    }
+    while (next_at_ < at_.size() && at_[next_at_] <= t + slack_) {
+      reached = true;
+      ++next_at_;
+    }
+    return reached;
+  }
+
+ private:
+  double every_;
+  std::vector<double> at_;
+  double slack_;
+  long next_k_ = 1;
+  std::size_t next_at_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Blow-up diagnosis.
+
+struct NonFinite {
+  const ParticleArray* array;
+  const Property* prop;
+  std::size_t index;  // into prop->f64
+};
+
+std::optional<NonFinite> find_non_finite(const std::vector<ParticleArray*>& arrays) {
+  for (const ParticleArray* a : arrays) {
+    for (const Property& p : a->props) {
+      if (p.type != PropType::F64) continue;
+      for (std::size_t k = 0; k < p.f64.size(); ++k) {
+        if (!std::isfinite(p.f64[k])) return NonFinite{a, &p, k};
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+std::string describe(const NonFinite& bad) {
+  const std::size_t stride = static_cast<std::size_t>(std::max(bad.prop->stride, 1));
+  const std::string component =
+      stride > 1 ? fmt::format("component {} of ", bad.index % stride) : std::string();
+  return fmt::format("{}property '{}' of particle {} in array '{}' is {}", component,
+                     bad.prop->name, bad.index / stride, bad.array->name, bad.prop->f64[bad.index]);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The run.
+
+class Simulation {
+ public:
+  Simulation(SceneProgram& prog, const Options& opt, Progress& progress)
+      : prog_(prog), opt_(opt), progress_(progress) {}
+
+  int run() {
+    if (!prog_.setup || !prog_.step) {
+      throw std::runtime_error("the scene program has no setup or no step function");
+    }
+    SceneTimes times;
+    prog_.setup(parameter_values(), times);
+    apply_overrides(times);
+    arrays_ = prog_.arrays ? prog_.arrays() : std::vector<ParticleArray*>{};
+    const std::string dir =
+        opt_.directory.empty() ? scene_name(prog_) + "_output" : opt_.directory;
+    OutputWriter writer(prog_, dir, !opt_.no_output);
+    writer_ = &writer;
+
+    const double tf = times.tf;
+    const double slack = kTimeSlack * tf;
+    OutputSchedule schedule(times, slack);
+    dt_ = times.dt;
+    if (auto bad = find_non_finite(arrays_)) return blow_up("simulation blew up", describe(*bad));
+    write_output();
+    if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
+
+    const auto loop_start = Clock::now();
+    progress_.start(!opt_.quiet, tf);
+    double particle_steps = 0;
+    while (t_ < tf - slack && step_ < opt_.max_steps) {
+      double dt = times.dt;
+      if (prog_.adaptive_dt) {
+        dt = prog_.adaptive_dt();
+        if (!std::isfinite(dt) || dt < kMinDtFraction * tf) return time_step_failure(dt, tf);
+      }
+      const bool last = t_ + dt >= tf - slack;
+      if (last) dt = tf - t_;
+      prog_.step(t_, dt);
+      ++step_;
+      dt_ = dt;
+      // A fixed step computes t as step * dt, so rounding errors do not accumulate.
+      t_ = last ? tf : prog_.adaptive_dt ? t_ + dt : static_cast<double>(step_) * times.dt;
+      particle_steps += static_cast<double>(particles());
+
+      const bool output_due = schedule.due(t_);
+      if (output_due || step_ % kCheckEvery == 0) {
+        if (auto bad = find_non_finite(arrays_)) return blow_up("simulation blew up", describe(*bad));
+      }
+      if (output_due) write_output();
+      progress_.update(t_, step_, dt_, particles());
+    }
+    if (last_output_step_ != step_) {
+      if (auto bad = find_non_finite(arrays_)) return blow_up("simulation blew up", describe(*bad));
+      write_output();
+    }
+    report(seconds_since(loop_start), particle_steps, tf);
+    return kExitOk;
+  }
+
+ private:
+  std::vector<double> parameter_values() const {
+    std::vector<double> values;
+    for (const ParamInfo& p : prog_.params) values.push_back(p.value);
+    for (const auto& [name, value] : opt_.sets) {
+      for (std::size_t k = 0; k < prog_.params.size(); ++k) {
+        if (prog_.params[k].name == name) values[k] = value;
+      }
+    }
+    return values;
+  }
+
+  void apply_overrides(SceneTimes& times) const {
+    if (opt_.tf) times.tf = *opt_.tf;
+    if (opt_.dt) times.dt = *opt_.dt;
+    if (opt_.output_every) {
+      times.output_every = *opt_.output_every;
+      times.output_at.clear();
+    }
+    auto require = [](bool ok, const char* what, double value) {
+      if (!ok) {
+        throw std::runtime_error(
+            fmt::format("the scene's {} is {} (check the parameters)", what, value));
+      }
+    };
+    require(std::isfinite(times.tf) && times.tf >= 0, "final time tf", times.tf);
+    require(std::isfinite(times.dt) && times.dt > 0, "time step dt", times.dt);
+    require(std::isfinite(times.output_every) && times.output_every >= 0,
+            "output interval", times.output_every);
+  }
+
+  std::size_t particles() const {
+    std::size_t n = 0;
+    for (const ParticleArray* a : arrays_) n += a->n;
+    return n;
+  }
+
+  OutputMeta meta() const { return OutputMeta{t_, step_, dt_, prog_.dim, scene_name(prog_)}; }
+
+  void write_output() {
+    writer_->write(arrays_, meta());
+    last_output_step_ = step_;
+  }
+
+  int time_step_failure(double dt, double tf) {
+    // A non-finite property usually explains a bad time step: name it if there is one.
+    if (auto bad = find_non_finite(arrays_)) return blow_up("simulation blew up", describe(*bad));
+    if (!std::isfinite(dt) || dt <= 0) {
+      return blow_up("simulation blew up", fmt::format("the adaptive time step is {}", dt));
+    }
+    return blow_up("time step collapsed",
+                   fmt::format("the adaptive time step {} is below {} * tf = {}", dt,
+                               kMinDtFraction, kMinDtFraction * tf));
+  }
+
+  int blow_up(const std::string& headline, const std::string& detail) {
+    progress_.break_line();
+    fmt::print(stderr, "error: {} at t={}, step {} (dt={}): {}\n", headline, t_, step_, dt_,
+               detail);
+    if (writer_->enabled()) {
+      try {
+        const std::string path = writer_->write_blowup(arrays_, meta());
+        fmt::print(stderr, "note: the bad state is in '{}'; the last good output is '{}'\n", path,
+                   writer_->newest());
+      } catch (const std::exception& e) {
+        fmt::print(stderr, "note: could not write the bad state: {}\n", e.what());
+      }
+    }
+    return kExitBlowUp;
+  }
+
+  void report(double wall_s, double particle_steps, double tf) {
+    const double us = particle_steps > 0 ? wall_s * 1e6 / particle_steps : 0.0;
+    progress_.break_line();
+    if (!opt_.quiet) {
+      const char* why = step_ >= opt_.max_steps && t_ < tf ? " (--max-steps reached)" : "";
+      fmt::print(stderr, "done: t={} after {} steps{}, {:.3g} s, {:.3g} us/particle/step\n", t_,
+                 step_, why, wall_s, us);
+    }
+    if (opt_.timing) {
+      fmt::print("timing: steps={} particles={} wall_s={:.6g} us_per_particle_step={:.6g}\n",
+                 step_, particles(), wall_s, us);
+      std::fflush(stdout);
+    }
+  }
+
+  SceneProgram& prog_;
+  const Options& opt_;
+  Progress& progress_;
+  OutputWriter* writer_ = nullptr;
+  std::vector<ParticleArray*> arrays_;
+  double t_ = 0.0;
+  double dt_ = 0.0;
+  long step_ = 0;
+  long last_output_step_ = -1;
+};
+
+}  // namespace
+
+int run_main(int argc, char** argv, SceneProgram& prog) {
+  Options opt;
+  try {
+    opt = parse_command_line(argc, argv, prog);
+  } catch (const UsageError& e) {
+    fmt::print(stderr, "error: {}\nrun '{} --help' for the options\n", e.what(),
+               program_name(argc, argv, prog));
+    return kExitUsage;
+  }
+  if (opt.help) {
+    print_help(program_name(argc, argv, prog), prog);
+    return kExitOk;
+  }
+  Progress progress;
+  try {
+    return Simulation(prog, opt, progress).run();
+  } catch (const std::exception& e) {
+    progress.break_line();
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitError;
+  }
+}
+
+}  // namespace sphc

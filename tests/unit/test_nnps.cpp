@@ -1,0 +1,294 @@
+// Unit tests of the cell-list neighbour search (runtime/include/sphc/nnps.h).
+//
+// The reference is brute force with the same criterion and the same floating operations
+// (r^2 < (radius_scale * max(h_i, h_j))^2), so neighbour sets must match exactly.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "sphc/nnps.h"
+#include "sphc/particle_array.h"
+
+namespace {
+
+using sphc::CellList;
+using sphc::ParticleArray;
+using sphc::SearchDomain;
+
+constexpr double kRadiusScale = 2.0;
+
+// n particles uniform in [0, L]^dim (other coordinates 0) with h in [0.5, 1.5] * h0.
+ParticleArray random_array(std::size_t n, int dim, double L, double h0, unsigned seed) {
+  ParticleArray pa;
+  pa.name = "fluid";
+  pa.resize(n);
+  for (const char* p : {"x", "y", "z", "h"}) pa.add_property(p);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> pos(0.0, L), hs(0.5 * h0, 1.5 * h0);
+  for (std::size_t i = 0; i < n; ++i) {
+    pa.f64("x")[i] = pos(rng);
+    pa.f64("y")[i] = dim >= 2 ? pos(rng) : 0.0;
+    pa.f64("z")[i] = dim == 3 ? pos(rng) : 0.0;
+    pa.f64("h")[i] = hs(rng);
+  }
+  return pa;
+}
+
+std::vector<std::uint32_t> brute_force(double xi, double yi, double zi, double hi,
+                                       const ParticleArray& pa) {
+  std::vector<std::uint32_t> out;
+  const double *x = pa.f64("x"), *y = pa.f64("y"), *z = pa.f64("z"), *h = pa.f64("h");
+  for (std::size_t j = 0; j < pa.n; ++j) {
+    const double dx = xi - x[j], dy = yi - y[j], dz = zi - z[j];
+    const double rmax = kRadiusScale * std::max(hi, h[j]);
+    if (dx * dx + dy * dy + dz * dz < rmax * rmax) out.push_back(static_cast<std::uint32_t>(j));
+  }
+  return out;
+}
+
+// Checks every particle of `pa` (and the extra query points) against brute force; returns the
+// number of neighbour pairs found, so tests can check they tested something.
+std::size_t check_against_brute_force(const CellList& cl, const ParticleArray& pa,
+                                      const std::vector<std::array<double, 4>>& extra = {}) {
+  const double *x = pa.f64("x"), *y = pa.f64("y"), *z = pa.f64("z"), *h = pa.f64("h");
+  std::vector<std::array<double, 4>> queries = extra;
+  for (std::size_t i = 0; i < pa.n; ++i) queries.push_back({x[i], y[i], z[i], h[i]});
+  std::size_t pairs = 0;
+  std::vector<std::uint32_t> got;
+  for (const auto& q : queries) {
+    cl.neighbors(q[0], q[1], q[2], q[3], x, y, z, h, kRadiusScale, got);
+    std::vector<std::uint32_t> want = brute_force(q[0], q[1], q[2], q[3], pa);
+    std::sort(got.begin(), got.end());
+    EXPECT_TRUE(std::adjacent_find(got.begin(), got.end()) == got.end())
+        << "a candidate was visited twice";
+    EXPECT_EQ(got, want) << "query (" << q[0] << ", " << q[1] << ", " << q[2] << ")";
+    if (got != want) break;  // one failure is enough to debug
+    pairs += got.size();
+  }
+  return pairs;
+}
+
+SearchDomain domain_of(const ParticleArray& pa, int dim) {
+  return sphc::make_search_domain({&pa}, dim, kRadiusScale);
+}
+
+void build(CellList& cl, const SearchDomain& dom, const ParticleArray& pa) {
+  cl.build(dom, pa.f64("x"), pa.f64("y"), pa.f64("z"), pa.n);
+}
+
+class NnpsModes : public ::testing::TestWithParam<CellList::Mode> {};
+
+TEST_P(NnpsModes, MatchesBruteForceVariableH) {
+  for (int dim : {1, 2, 3}) {
+    SCOPED_TRACE("dim " + std::to_string(dim));
+    const std::size_t n = dim == 1 ? 300 : dim == 2 ? 2000 : 3000;
+    ParticleArray pa = random_array(n, dim, 10.0, dim == 1 ? 0.05 : dim == 2 ? 0.2 : 0.4, 42 + dim);
+    CellList cl;
+    cl.set_mode(GetParam());
+    build(cl, domain_of(pa, dim), pa);
+    EXPECT_EQ(cl.size(), n);
+    if (GetParam() != CellList::Mode::Auto) {
+      EXPECT_EQ(cl.is_dense(), GetParam() == CellList::Mode::Dense);
+    }
+    EXPECT_GT(check_against_brute_force(cl, pa), 2 * n);  // more than self-pairs
+  }
+}
+
+TEST_P(NnpsModes, ParticlesMovedOutsideTheDomain) {
+  // The domain is made once, then particles move (some far outside it) and the list is
+  // rebuilt on the stale domain, as between two domain updates. Query points outside too.
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE("dim " + std::to_string(dim));
+    ParticleArray pa = random_array(1500, dim, 5.0, 0.25, 7 + dim);
+    const SearchDomain dom = domain_of(pa, dim);
+    std::mt19937_64 rng(99);
+    std::uniform_real_distribution<double> shift(-8.0, 8.0);
+    double* x = pa.f64("x");
+    double* y = pa.f64("y");
+    double* z = pa.f64("z");
+    for (std::size_t i = 0; i < pa.n; i += 3) {
+      x[i] += shift(rng);
+      y[i] += shift(rng);
+      if (dim == 3) z[i] += shift(rng);
+    }
+    // A dense pile beyond the upper corner: all of it clamps into one border cell.
+    for (std::size_t i = 1; i < pa.n; i += 50) {
+      x[i] = 30.0 + 0.01 * i;
+      y[i] = 30.0;
+    }
+    CellList cl;
+    cl.set_mode(GetParam());
+    build(cl, dom, pa);
+    std::vector<std::array<double, 4>> extra = {
+        {-100.0, -100.0, 0.0, 0.3}, {100.0, 2.0, 0.0, 0.3}, {2.5, 2.5, 40.0, 0.3},
+        {30.5, 30.0, 0.0, 0.3},     {5.3, 5.3, 0.0, 0.3},
+    };
+    EXPECT_GT(check_against_brute_force(cl, pa, extra), pa.n);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllModes, NnpsModes,
+                         ::testing::Values(CellList::Mode::Auto, CellList::Mode::Dense,
+                                           CellList::Mode::Hash),
+                         [](const ::testing::TestParamInfo<CellList::Mode>& info) {
+                           switch (info.param) {
+                             case CellList::Mode::Auto: return std::string("Auto");
+                             case CellList::Mode::Dense: return std::string("Dense");
+                             case CellList::Mode::Hash: return std::string("Hash");
+                           }
+                           return std::string("Unknown");
+                         });
+
+TEST(Nnps, SparseDomainUsesHash) {
+  // Two clusters 1e4 apart with cells of ~0.5: a dense grid would need ~4e8 cells in 2D.
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE("dim " + std::to_string(dim));
+    ParticleArray a = random_array(800, dim, 2.0, 0.1, 1);
+    ParticleArray b = random_array(800, dim, 2.0, 0.1, 2);
+    for (std::size_t i = 0; i < b.n; ++i) {
+      b.f64("x")[i] += 1e4;
+      b.f64("y")[i] += 1e4;
+    }
+    ParticleArray all = a;
+    for (std::size_t i = 0; i < b.n; ++i) all.append_from(b, i);
+    CellList cl;
+    build(cl, domain_of(all, dim), all);
+    EXPECT_FALSE(cl.is_dense());
+    EXPECT_LE(cl.num_cells(), all.n);
+    EXPECT_GT(check_against_brute_force(cl, all), 2 * all.n);
+  }
+}
+
+TEST(Nnps, TwoArraysShareADomain) {
+  // Sources and destinations in different arrays with different h: the domain's cell size
+  // comes from the larger h, and a query of one array on the other's list is exact.
+  ParticleArray fluid = random_array(1000, 2, 4.0, 0.05, 3);
+  ParticleArray solid = random_array(500, 2, 4.0, 0.2, 4);
+  const SearchDomain dom = sphc::make_search_domain({&fluid, &solid}, 2, kRadiusScale);
+  double hmax = 0.0;
+  for (std::size_t i = 0; i < solid.n; ++i) hmax = std::max(hmax, solid.f64("h")[i]);
+  EXPECT_DOUBLE_EQ(dom.cell_size, kRadiusScale * hmax);
+  CellList cl;
+  build(cl, dom, solid);
+  std::vector<std::array<double, 4>> queries;
+  for (std::size_t i = 0; i < fluid.n; ++i) {
+    queries.push_back({fluid.f64("x")[i], fluid.f64("y")[i], 0.0, fluid.f64("h")[i]});
+  }
+  EXPECT_GT(check_against_brute_force(cl, solid, queries), fluid.n);
+}
+
+TEST(Nnps, EmptyAndSingleParticle) {
+  ParticleArray pa = random_array(0, 2, 1.0, 0.1, 5);
+  CellList unbuilt;
+  int calls = 0;
+  unbuilt.for_each_candidate(0.0, 0.0, 0.0, [&](std::uint32_t) { ++calls; });
+  EXPECT_EQ(calls, 0);
+
+  CellList cl;
+  const SearchDomain dom = domain_of(pa, 2);
+  EXPECT_GT(dom.cell_size, 0.0);
+  build(cl, dom, pa);
+  EXPECT_EQ(cl.size(), 0u);
+  cl.for_each_candidate(0.5, 0.5, 0.0, [&](std::uint32_t) { ++calls; });
+  EXPECT_EQ(calls, 0);
+
+  pa = random_array(1, 2, 1.0, 0.1, 6);
+  build(cl, domain_of(pa, 2), pa);
+  std::vector<std::uint32_t> got;
+  cl.neighbors(pa.f64("x")[0], pa.f64("y")[0], 0.0, 0.1, pa.f64("x"), pa.f64("y"), nullptr,
+               pa.f64("h"), kRadiusScale, got);
+  EXPECT_EQ(got, std::vector<std::uint32_t>{0});
+  cl.neighbors(50.0, 50.0, 0.0, 0.1, pa.f64("x"), pa.f64("y"), nullptr, pa.f64("h"),
+               kRadiusScale, got);
+  EXPECT_TRUE(got.empty());
+}
+
+TEST(Nnps, NonFiniteCoordinatesDoNotCrash) {
+  ParticleArray pa = random_array(200, 3, 2.0, 0.1, 8);
+  const SearchDomain dom = domain_of(pa, 3);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  pa.f64("x")[3] = nan;
+  pa.f64("y")[4] = inf;
+  pa.f64("z")[5] = -inf;
+  pa.f64("x")[6] = 1e300;
+  for (CellList::Mode mode : {CellList::Mode::Dense, CellList::Mode::Hash}) {
+    CellList cl;
+    cl.set_mode(mode);
+    build(cl, dom, pa);
+    EXPECT_EQ(cl.size(), pa.n);
+    // NaN never satisfies the criterion, infinite distances neither: brute force agrees.
+    check_against_brute_force(cl, pa, {{nan, 0.0, 0.0, 0.1}, {inf, -inf, nan, 0.1}});
+  }
+  // make_search_domain ignores the non-finite coordinates.
+  const SearchDomain d2 = domain_of(pa, 3);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_TRUE(std::isfinite(d2.lo[a]));
+    EXPECT_TRUE(std::isfinite(d2.hi[a]));
+  }
+}
+
+TEST(Nnps, DeterministicOrderAndRebuild) {
+  ParticleArray pa = random_array(1000, 2, 3.0, 0.1, 11);
+  const SearchDomain dom = domain_of(pa, 2);
+  CellList a, b;
+  build(a, dom, pa);
+  build(b, dom, pa);
+  build(b, dom, pa);  // rebuilding with the same data gives the same list
+  for (std::size_t i = 0; i < pa.n; i += 17) {
+    std::vector<std::uint32_t> ca, cb;
+    a.for_each_candidate(pa.f64("x")[i], pa.f64("y")[i], 0.0,
+                         [&](std::uint32_t j) { ca.push_back(j); });
+    b.for_each_candidate(pa.f64("x")[i], pa.f64("y")[i], 0.0,
+                         [&](std::uint32_t j) { cb.push_back(j); });
+    EXPECT_EQ(ca, cb);
+  }
+  // Shrinking and growing n between builds.
+  ParticleArray small = random_array(10, 2, 3.0, 0.1, 12);
+  build(b, dom, small);
+  check_against_brute_force(b, small);
+  build(b, dom, pa);
+  check_against_brute_force(b, pa);
+}
+
+TEST(Nnps, SearchDomainAndErrors) {
+  ParticleArray pa = random_array(100, 2, 1.0, 0.1, 13);
+  const SearchDomain dom = domain_of(pa, 2);
+  EXPECT_EQ(dom.dim, 2);
+  const double* x = pa.f64("x");
+  EXPECT_LE(dom.lo[0], *std::min_element(x, x + pa.n));
+  EXPECT_GE(dom.hi[0], *std::max_element(x, x + pa.n));
+  EXPECT_EQ(dom.lo[2], 0.0);
+  EXPECT_EQ(dom.hi[2], 0.0);
+
+  EXPECT_THROW(sphc::make_search_domain({&pa}, 4, 2.0), std::invalid_argument);
+  EXPECT_THROW(sphc::make_search_domain({&pa}, 2, 0.0), std::invalid_argument);
+  ParticleArray no_h;
+  no_h.name = "wall";
+  no_h.resize(3);
+  no_h.add_property("x");
+  try {
+    sphc::make_search_domain({&no_h}, 2, 2.0);
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'wall'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'h'"), std::string::npos) << e.what();
+  }
+  SearchDomain bad = dom;
+  bad.dim = 0;
+  CellList cl;
+  EXPECT_THROW(build(cl, bad, pa), std::invalid_argument);
+  // A degenerate cell size does not crash (one cell per axis at worst).
+  bad = dom;
+  bad.cell_size = 0.0;
+  build(cl, bad, pa);
+  check_against_brute_force(cl, pa);
+}
+
+}  // namespace

@@ -1,0 +1,258 @@
+// The run loop and command line of generated solvers (runtime/src/solver.cpp), driven with a
+// tiny synthetic scene: particles moving at constant speed, x += u * dt.
+#include "sphc/solver.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sphc/hdf5_io.h"
+
+namespace fs = std::filesystem;
+using namespace sphc;
+
+namespace {
+
+fs::path fresh_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const fs::path dir =
+      fs::path("tmp_solver") / (std::string(info->test_suite_name()) + "_" + info->name());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// The scene "mover": params u (speed) and tf; dt = 0.01, output every 0.25.
+struct Mover {
+  ParticleArray fluid;
+  std::vector<double> seen_params;
+  long steps = 0;
+  double last_t_plus_dt = 0;
+  SceneProgram prog;
+
+  Mover() {
+    prog.name = "mover";
+    prog.dim = 2;
+    prog.params = {{"u", 1.0, "speed"}, {"tf", 1.0, "final time"}};
+    prog.setup = [this](const std::vector<double>& params, SceneTimes& times) {
+      seen_params = params;
+      fluid.name = "fluid";
+      fluid.n = 4;
+      for (const char* p : {"x", "y", "z", "u", "rho"}) fluid.add_property(p);
+      for (std::size_t i = 0; i < fluid.n; ++i) {
+        fluid.f64("x")[i] = static_cast<double>(i);
+        fluid.f64("u")[i] = params[0];
+      }
+      times.tf = params[1];
+      times.dt = 0.01;
+      times.output_every = 0.25;
+    };
+    prog.arrays = [this] { return std::vector<ParticleArray*>{&fluid}; };
+    prog.step = [this](double t, double dt) {
+      double* x = fluid.f64("x");
+      const double* u = fluid.f64("u");
+      for (std::size_t i = 0; i < fluid.n; ++i) x[i] += u[i] * dt;
+      ++steps;
+      last_t_plus_dt = t + dt;
+    };
+    prog.output = {{"fluid", {"u"}}};
+  }
+};
+
+int run(SceneProgram& prog, std::vector<std::string> args) {
+  args.insert(args.begin(), "mover");
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  return run_main(static_cast<int>(args.size()), argv.data(), prog);
+}
+
+// Runs with stderr captured into `err`.
+int run_capturing(SceneProgram& prog, std::vector<std::string> args, std::string& err) {
+  ::testing::internal::CaptureStderr();
+  const int code = run(prog, std::move(args));
+  err = ::testing::internal::GetCapturedStderr();
+  return code;
+}
+
+std::vector<std::string> h5_files(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() == ".h5") names.push_back(e.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+double output_time(const fs::path& file) {
+  // The time of an output is visible through its particles: x = i + u t with u = 1.
+  const ParticleArray a = read_particles_hdf5(file.string(), "fluid");
+  return a.f64("x")[0];
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+}  // namespace
+
+TEST(Solver, RunsToTheFinalTimeWithPeriodicOutputs) {
+  const fs::path dir = fresh_dir();
+  Mover m;
+  EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string()}), 0);
+  EXPECT_EQ(m.steps, 100);
+  EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000025.h5",
+                                                     "mover_000050.h5", "mover_000075.h5",
+                                                     "mover_000100.h5"}));
+  const double expected[] = {0, 0.25, 0.5, 0.75, 1.0};
+  const auto files = h5_files(dir);
+  for (std::size_t k = 0; k < files.size(); ++k) EXPECT_NEAR(output_time(dir / files[k]), expected[k], 1e-12);
+  EXPECT_TRUE(fs::exists(dir / "mover.xdmf"));
+  // Written: x, y, z and the requested u only.
+  EXPECT_EQ(read_particles_hdf5((dir / files[0]).string(), "fluid").props.size(), 4u);
+}
+
+TEST(Solver, LastStepIsClippedToEndExactlyAtTf) {
+  const fs::path dir = fresh_dir();
+  Mover m;
+  EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string(), "--tf", "0.105", "--output-every", "0"}), 0);
+  EXPECT_EQ(m.steps, 11);
+  EXPECT_EQ(m.last_t_plus_dt, 0.105);
+  EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000011.h5"}));
+  EXPECT_NEAR(output_time(dir / "mover_000011.h5"), 0.105, 1e-12);
+}
+
+TEST(Solver, OutputAtTimesAreWrittenAtTheFirstStepReachingThem) {
+  const fs::path dir = fresh_dir();
+  Mover m;
+  const auto setup = m.prog.setup;
+  m.prog.setup = [&](const std::vector<double>& params, SceneTimes& times) {
+    setup(params, times);
+    times.output_every = 0;
+    times.output_at = {0.305, 0.3};
+  };
+  EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string()}), 0);
+  EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000030.h5",
+                                                     "mover_000031.h5", "mover_000100.h5"}));
+}
+
+TEST(Solver, SetOverridesReachSetup) {
+  const fs::path dir = fresh_dir();
+  Mover m;
+  EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string(), "--set", "u=2", "--set=tf=0.5"}), 0);
+  EXPECT_EQ(m.seen_params, (std::vector<double>{2.0, 0.5}));
+  EXPECT_EQ(m.steps, 50);
+  EXPECT_NEAR(m.fluid.f64("x")[3], 3.0 + 2.0 * 0.5, 1e-12);
+}
+
+TEST(Solver, BadUsageExitsWithCode2) {
+  const fs::path dir = fresh_dir();
+  Mover m;
+  std::string err;
+  EXPECT_EQ(run_capturing(m.prog, {"-d", dir.string(), "--set", "speed=2"}, err), 2);
+  EXPECT_TRUE(contains(err, "speed")) << err;
+  EXPECT_TRUE(contains(err, "u, tf")) << err;
+  EXPECT_EQ(run_capturing(m.prog, {"--set", "u=fast"}, err), 2);
+  EXPECT_TRUE(contains(err, "fast")) << err;
+  EXPECT_EQ(run_capturing(m.prog, {"--dt", "0"}, err), 2);
+  EXPECT_EQ(run_capturing(m.prog, {"--max-steps"}, err), 2);
+  EXPECT_EQ(run_capturing(m.prog, {"--frobnicate"}, err), 2);
+  EXPECT_TRUE(contains(err, "--frobnicate")) << err;
+  EXPECT_EQ(m.steps, 0);
+}
+
+TEST(Solver, HelpListsOptionsAndParameters) {
+  Mover m;
+  ::testing::internal::CaptureStdout();
+  EXPECT_EQ(run(m.prog, {"--help"}), 0);
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  for (const char* part : {"--tf", "--dt", "--output-every", "--max-steps", "--directory",
+                           "--set", "--quiet", "--no-output", "--timing", "u = 1", "speed",
+                           "tf = 1", "final time"}) {
+    EXPECT_TRUE(contains(out, part)) << part << " missing in:\n" << out;
+  }
+  EXPECT_EQ(m.steps, 0);
+}
+
+TEST(Solver, MaxStepsStopsEarlyAndWritesTheLastState) {
+  const fs::path dir = fresh_dir();
+  Mover m;
+  EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string(), "--max-steps", "7"}), 0);
+  EXPECT_EQ(m.steps, 7);
+  EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000007.h5"}));
+}
+
+TEST(Solver, TimingLineAndNoOutput) {
+  const fs::path dir = fresh_dir() / "never";
+  Mover m;
+  ::testing::internal::CaptureStdout();
+  EXPECT_EQ(run(m.prog, {"--quiet", "--no-output", "--timing", "-d", dir.string()}), 0);
+  const std::string out = ::testing::internal::GetCapturedStdout();
+  EXPECT_TRUE(contains(out, "timing: steps=100 particles=4 wall_s=")) << out;
+  EXPECT_TRUE(contains(out, " us_per_particle_step=")) << out;
+  EXPECT_FALSE(fs::exists(dir));
+}
+
+TEST(Solver, NanBlowUpIsDiagnosedAndKeepsTheLastGoodOutput) {
+  const fs::path dir = fresh_dir();
+  Mover m;
+  const auto step = m.prog.step;
+  m.prog.step = [&](double t, double dt) {
+    step(t, dt);
+    if (m.steps == 37) m.fluid.f64("rho")[2] = std::nan("");
+  };
+  std::string err;
+  EXPECT_EQ(run_capturing(m.prog, {"--quiet", "-d", dir.string()}, err), 3);
+  EXPECT_EQ(m.steps, 40);  // found by the scan every 10 steps
+  EXPECT_TRUE(contains(err, "error: simulation blew up at t=")) << err;
+  EXPECT_TRUE(contains(err, "step 40")) << err;
+  EXPECT_TRUE(contains(err, "property 'rho' of particle 2 in array 'fluid' is nan")) << err;
+  EXPECT_EQ(h5_files(dir),
+            (std::vector<std::string>{"mover_000000.h5", "mover_000025.h5", "mover_blowup.h5"}));
+  EXPECT_TRUE(contains(err, "mover_blowup.h5")) << err;
+  // The XDMF index lists the good outputs only.
+  std::ifstream xdmf(dir / "mover.xdmf");
+  const std::string text((std::istreambuf_iterator<char>(xdmf)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(contains(text, "mover_000025.h5"));
+  EXPECT_FALSE(contains(text, "blowup"));
+}
+
+TEST(Solver, CollapsingAdaptiveTimeStepIsDiagnosed) {
+  const fs::path dir = fresh_dir();
+  Mover m;
+  double dt = 0.01;
+  m.prog.adaptive_dt = [&] { return dt *= 0.1; };
+  std::string err;
+  EXPECT_EQ(run_capturing(m.prog, {"--quiet", "-d", dir.string()}, err), 3);
+  EXPECT_TRUE(contains(err, "time step collapsed")) << err;
+
+  Mover n;
+  n.prog.adaptive_dt = [] { return std::numeric_limits<double>::quiet_NaN(); };
+  EXPECT_EQ(run_capturing(n.prog, {"--quiet", "--no-output"}, err), 3);
+  EXPECT_TRUE(contains(err, "adaptive time step is nan")) << err;
+}
+
+TEST(Solver, AdaptiveTimeStepEndsExactlyAtTf) {
+  const fs::path dir = fresh_dir();
+  Mover m;
+  m.prog.adaptive_dt = [] { return 0.03; };
+  EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string(), "--output-every", "0"}), 0);
+  EXPECT_EQ(m.steps, 34);
+  EXPECT_EQ(m.last_t_plus_dt, 1.0);
+}
+
+TEST(Solver, ExceptionsFromTheSceneExitWithCode1) {
+  Mover m;
+  m.prog.step = [](double, double) { throw std::runtime_error("boom"); };
+  std::string err;
+  EXPECT_EQ(run_capturing(m.prog, {"--quiet", "--no-output"}, err), 1);
+  EXPECT_TRUE(contains(err, "error: boom")) << err;
+}

@@ -1,0 +1,236 @@
+#!/usr/bin/env python3
+"""Validation of the 2D dam break (examples/dambreak.sph) against experiment.
+
+Runs nothing itself: it reads the HDF5 snapshots a run of the dam break wrote into a
+directory (files <scene>_NNNNNN.h5 with root attributes t, step, dt, dim and groups /fluid and
+/boundary holding one dataset per property) and checks
+
+  1. finiteness: no NaN or infinity in any dataset of any snapshot;
+  2. containment: every fluid particle stays in the tank, i.e.
+         -layers*dx - tol <= x <= W + layers*dx + tol   and   y >= -layers*dx - tol,
+     with tol = 0.1 dx: a particle past the outer face of the wall layers has gone through
+     the wall (there is no lid, so y is not bounded above);
+  3. the surge front against the experiment of Koshizuka & Oka (1996)
+     (tests/data/koshizuka_oka_1996_surge.csv), in dimensionless form
+         T = t sqrt(2 g / L),   Z/L = front position / column width L.
+     The front is the largest x among fluid particles that have at least MIN_NEIGHBOURS other
+     fluid particles within 2 dx: this ignores isolated splash droplets thrown ahead of the
+     surge, which an experiment's front tracking would not see either.
+     The experimental curve is interpolated linearly at every snapshot time with T inside the
+     experiment's range (it ends at T = 3.10, Z/L = 3.62, before the surge reaches the far
+     wall at Z/L = 4). Snapshots with T < 1 are shown but not judged: the front has then moved
+     less than 0.5 L from its start at Z/L = 1 and the relative error mostly measures the
+     gate opening of the experiment, not the flow. Each judged snapshot must be within
+     --tol (default 10%) relative error.
+
+Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input.
+With --plot FILE.png (needs matplotlib) it also draws the front against the experiment.
+
+Usage: dambreak_front.py OUTPUT_DIR [--tol 0.10] [--dx DX] [--layers 3] [--plot out.png]
+"""
+
+import argparse
+import glob
+import os
+import re
+import sys
+
+try:
+    import h5py
+    import numpy as np
+except ImportError as exc:  # pragma: no cover - environment problem, not a test failure
+    sys.stderr.write("dambreak_front.py needs numpy and h5py (%s)\n" % exc)
+    sys.exit(2)
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DEFAULT_DATA = os.path.join(HERE, "..", "data", "koshizuka_oka_1996_surge.csv")
+MIN_NEIGHBOURS = 3
+T_JUDGE_MIN = 1.0
+
+
+def load_csv(path):
+    """Reads a CSV with '#' comment lines and a header row; returns {column: array}."""
+    rows, header = [], None
+    with open(path) as f:
+        for line in f:
+            line = line.strip()
+            if not line or line.startswith("#"):
+                continue
+            cells = [c.strip() for c in line.split(",")]
+            if header is None:
+                header = cells
+            else:
+                rows.append([float(c) for c in cells])
+    data = np.array(rows, dtype=float)
+    return {name: data[:, i] for i, name in enumerate(header)}
+
+
+def snapshot_files(directory):
+    """Snapshot files <scene>_NNNNNN.h5 of a directory, in step order."""
+    files = [f for f in glob.glob(os.path.join(directory, "*.h5"))
+             if re.search(r"_\d+\.h5$", os.path.basename(f))]
+    return sorted(files, key=lambda f: int(re.search(r"_(\d+)\.h5$", f).group(1)))
+
+
+def infer_dx(x, y):
+    """Lattice spacing from the initial fluid: median nearest-neighbour distance."""
+    n = len(x)
+    idx = np.arange(0, n, max(1, n // 200))
+    d = []
+    for i in idx:
+        r2 = (x - x[i]) ** 2 + (y - y[i]) ** 2
+        r2[i] = np.inf
+        d.append(np.sqrt(r2.min()))
+    return float(np.median(d))
+
+
+def front_position(x, y, dx):
+    """Largest x of a fluid particle with >= MIN_NEIGHBOURS fluid neighbours within 2 dx."""
+    order = np.argsort(-x)
+    r2max = (2.0 * dx) ** 2
+    for i in order:
+        r2 = (x - x[i]) ** 2 + (y - y[i]) ** 2
+        if np.count_nonzero(r2 < r2max) - 1 >= MIN_NEIGHBOURS:
+            return float(x[i])
+    return float("nan")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("outdir", help="directory with the dam break's HDF5 snapshots")
+    ap.add_argument("--tol", type=float, default=0.10,
+                    help="largest relative error of the front where T >= 1 (default 0.10)")
+    ap.add_argument("--dx", type=float, default=None,
+                    help="particle spacing (default: inferred from the first snapshot)")
+    ap.add_argument("--layers", type=int, default=3, help="wall layers (default 3)")
+    ap.add_argument("--tank", type=float, default=4.0, help="tank width W [m] (default 4)")
+    ap.add_argument("--L", type=float, default=1.0, help="column width L [m] (default 1)")
+    ap.add_argument("--g", type=float, default=9.81, help="gravity [m/s^2] (default 9.81)")
+    ap.add_argument("--data", default=DEFAULT_DATA, help="experimental CSV (T,Z_L)")
+    ap.add_argument("--plot", default=None, help="write a plot of the front to this PNG")
+    args = ap.parse_args()
+
+    files = snapshot_files(args.outdir)
+    if not files:
+        sys.stderr.write("dambreak_front.py: no <scene>_NNNNNN.h5 files in %s\n" % args.outdir)
+        return 2
+
+    exp = load_csv(args.data)
+    t_exp, z_exp = exp["T"], exp["Z_L"]
+    tscale = np.sqrt(2.0 * args.g / args.L)
+
+    failures = []
+    dx = args.dx
+    times, fronts, nfluid = [], [], None
+    for path in files:
+        name = os.path.basename(path)
+        with h5py.File(path, "r") as f:
+            t = float(f.attrs["t"])
+            for gname, group in f.items():
+                if not isinstance(group, h5py.Group):
+                    continue
+                for dname, dset in group.items():
+                    if not isinstance(dset, h5py.Dataset):
+                        continue
+                    a = dset[()]
+                    if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
+                        bad = int(np.count_nonzero(~np.isfinite(a)))
+                        failures.append("%s: /%s/%s has %d non-finite values"
+                                        % (name, gname, dname, bad))
+            if "fluid" not in f:
+                sys.stderr.write("dambreak_front.py: %s has no /fluid group\n" % name)
+                return 2
+            x = np.asarray(f["fluid/x"][()], dtype=float)
+            y = np.asarray(f["fluid/y"][()], dtype=float)
+        if nfluid is None:
+            nfluid = len(x)
+            if dx is None:
+                dx = infer_dx(x, y)
+        elif len(x) != nfluid:
+            failures.append("%s: %d fluid particles, the first snapshot has %d"
+                            % (name, len(x), nfluid))
+
+        ok = np.isfinite(x) & np.isfinite(y)
+        x, y = x[ok], y[ok]
+        tol = 0.1 * dx
+        wall = args.layers * dx
+        out = (x < -wall - tol) | (x > args.tank + wall + tol) | (y < -wall - tol)
+        if np.any(out):
+            i = int(np.argmax(out))
+            failures.append("t = %.4f: %d fluid particles outside the tank, e.g. at (%.4f, %.4f)"
+                            % (t, int(np.count_nonzero(out)), x[i], y[i]))
+        times.append(t)
+        fronts.append(front_position(x, y, dx) if len(x) else float("nan"))
+
+    times = np.array(times)
+    fronts = np.array(fronts) / args.L
+    T = times * tscale
+
+    print("dam break surge front vs Koshizuka & Oka (1996): %d snapshots in %s"
+          % (len(files), args.outdir))
+    print("dx = %.5g, front = max x of fluid particles with >= %d neighbours within 2 dx"
+          % (dx, MIN_NEIGHBOURS))
+    print("judged where %.1f <= T <= %.3f (T = t sqrt(2g/L)); tolerance %.0f%%"
+          % (T_JUDGE_MIN, t_exp.max(), 100 * args.tol))
+    print()
+    print("%8s %8s %10s %10s %9s  %s" % ("t [s]", "T", "Z/L sim", "Z/L exp", "rel.err", ""))
+    judged = 0
+    worst = 0.0
+    for ti, Ti, zi in zip(times, T, fronts):
+        if Ti > t_exp.max():
+            print("%8.4f %8.4f %10.4f %10s %9s" % (ti, Ti, zi, "-", "-"))
+            continue
+        ze = float(np.interp(Ti, t_exp, z_exp))
+        err = (zi - ze) / ze
+        if Ti < T_JUDGE_MIN:
+            mark = "(not judged: T < 1)"
+        elif not np.isfinite(err) or abs(err) > args.tol:
+            mark = "FAIL"
+            failures.append("t = %.4f (T = %.3f): front Z/L = %.4f, experiment %.4f, error %+.1f%%"
+                            % (ti, Ti, zi, ze, 100 * err))
+            judged += 1
+        else:
+            mark = "ok"
+            judged += 1
+        if Ti >= T_JUDGE_MIN and np.isfinite(err):
+            worst = max(worst, abs(err))
+        print("%8.4f %8.4f %10.4f %10.4f %+8.1f%%  %s" % (ti, Ti, zi, ze, 100 * err, mark))
+
+    print()
+    if judged < 5 or T.max() < 0.95 * t_exp.max():
+        failures.append("the snapshots do not cover the experiment: %d judged times, last T = %.3f"
+                        " (need >= 5 and T up to %.3f)" % (judged, T.max(), t_exp.max()))
+
+    if args.plot:
+        try:
+            import matplotlib
+            matplotlib.use("Agg")
+            import matplotlib.pyplot as plt
+            plt.figure(figsize=(6, 4.5))
+            plt.plot(T, fronts, "-", label="sphc (front, >= %d neighbours)" % MIN_NEIGHBOURS)
+            plt.plot(t_exp, z_exp, "o", label="Koshizuka & Oka (1996), experiment")
+            plt.fill_between(t_exp, z_exp * (1 - args.tol), z_exp * (1 + args.tol),
+                             color="gray", alpha=0.2, label="+/- %.0f%%" % (100 * args.tol))
+            plt.xlim(0, max(3.5, t_exp.max() * 1.1))
+            plt.ylim(0.8, 4.2)
+            plt.xlabel(r"$T = t\,\sqrt{2g/L}$")
+            plt.ylabel(r"$Z/L$")
+            plt.legend(loc="upper left")
+            plt.tight_layout()
+            plt.savefig(args.plot, dpi=150)
+            print("plot written to %s" % args.plot)
+        except ImportError:
+            print("--plot: matplotlib is not available, no plot written")
+
+    if failures:
+        print("FAILED (%d problems):" % len(failures))
+        for msg in failures:
+            print("  " + msg)
+        return 1
+    print("PASSED: finite, contained, front within %.0f%% at %d times (worst %.1f%%)"
+          % (100 * args.tol, judged, 100 * worst))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
