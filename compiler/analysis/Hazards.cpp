@@ -34,6 +34,8 @@ void checkGroup(const Plan& plan, const PlanGroup& g, DiagnosticEngine& diags) {
                                  "in which particles are processed");
           diags.note(w.loc, "'" + r.prop + "' is written here; split the group so that this "
                             "write happens in a group before the loop that reads it");
+          diags.note(reader.loc, "the reading equation is used here");
+          if (i != j) diags.note(writer.loc, "the writing equation is used here, in the same group");
           goto nextRead;
         }
       }

@@ -97,6 +97,9 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
                                  (r.implicit ? " (by the neighbour loop of " + who + ")"
                                              : " by " + who) +
                                  " but nothing sets it");
+          if (r.equation >= 0 && !r.implicit)
+            diags.note(plan.equations[r.equation].loc,
+                       "in this use of '" + plan.equations[r.equation].name + "'");
         } else {
           diags.error(p.output ? plan.scene->name.loc : arr.loc,
                       "property '" + p.name + "' of array '" + arr.name + "' is " +

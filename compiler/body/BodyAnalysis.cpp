@@ -5,13 +5,17 @@
 // the facts the analysis passes need (property reads/writes, pair quantities, t/dt, scalars)
 // come from a walk over each function's AST.
 //
-// A body `{ d_arho[d_idx] = 0.0; }` of a loop at eq.sph:3:14 becomes
+// A reduce body `{ return c0 * d_h[d_idx]; }` at eq.sph:5:10, whose equation has the scalar
+// c0, becomes
 //
-//   void __sphc_body_0(const int d_idx, const int s_idx, const double t, const double dt,
-//       const double XIJ[const 3], ..., const double EPS, double *const d_arho) {
-//   #line 3 "eq.sph"
-//                d_arho[d_idx] = 0.0; }
+//   double __sphc_body_1(const int d_idx, const double t, const double dt, const double c0,
+//                        double *const d_h) {
+//   #line 5 "eq.sph"
+//            return c0 * d_h[d_idx]; }
 //
+// (a loop body also gets `const int s_idx`, pair quantities such as `const double
+// DWIJ[const 3]`, and `const double *const s_m` for source properties; only the names a body
+// mentions are declared),
 // so Clang's presumed locations are the .sph positions. Since the body text is copied verbatim,
 // a location inside it maps back to the .sph buffer exactly by its offset from the body's start
 // (O(1), and robust to anything the user writes in the body); the #line directive keeps Clang's
@@ -96,8 +100,8 @@ const char* kindName(BodyKind kind) {
 bool returnsValue(BodyKind kind) { return kind == BodyKind::Reduce || kind == BodyKind::Converged; }
 
 // What a quick lexical scan of a body finds: its identifiers (in order of first appearance,
-// outside comments and literals) and the offsets of preprocessor directives (`#` first on a
-// line), which bodies may not contain.
+// outside comments and literals) and the offsets of preprocessor directives other than
+// #pragma (`#` first on a line), which bodies may not contain.
 struct BodyTokens {
   std::vector<std::string> identifiers;
   std::vector<size_t> directives;
@@ -125,7 +129,11 @@ BodyTokens scanBody(llvm::StringRef text) {
         if (text[i] == '\\') ++i;
       ++i;
     } else if (c == '#' && wasLineStart) {
-      tokens.directives.push_back(i++);
+      // `#pragma` (e.g. a loop hint) is harmless; other directives are not allowed.
+      size_t name = text.find_first_not_of(" \t", i + 1);
+      if (name == llvm::StringRef::npos || !text.substr(name).startswith("pragma"))
+        tokens.directives.push_back(i);
+      ++i;
     } else if (isIdentChar(c)) {
       size_t j = i;
       while (j < text.size() && isIdentChar(text[j])) ++j;
@@ -275,8 +283,9 @@ class Batch {
 };
 
 // The function of a body. Every sphc name the body mentions is a const parameter, so the C type
-// system rejects writes to it; s_ names and pair quantities are declared in every kind of body,
-// so that using them outside 'loop' gets sphc's clear message instead of "undeclared".
+// system rejects writes to it; s_ names and pair quantities are declared in every kind of body
+// that mentions them, so that using them outside 'loop' gets sphc's clear message instead of
+// "undeclared".
 void Batch::synthesise() {
   unit_ = prelude();
   regions_.resize(bodies_.size());
@@ -710,7 +719,6 @@ class BodyAction : public clang::ASTFrontendAction {
 std::vector<BodyFacts> BodyAnalyzer::analyze(const std::vector<BodySource>& bodies) {
   if (bodies.empty()) return {};
   Batch batch(diags_, bodies);
-  if (getenv("TMPDUMP")) llvm::errs() << batch.unit();
 
   // A syntax-only cc1 invocation over the in-memory unit: C99, no headers searched.
   const char* args[] = {"-fsyntax-only", "-x", "c", "-std=c99", "-nostdsysteminc", "-nobuiltininc",

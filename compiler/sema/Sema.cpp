@@ -214,6 +214,7 @@ class SemaImpl {
   std::map<std::string, const ast::IntegratorDecl*> integrators_;
   std::map<const ast::EquationDecl*, int> usedEquations_;
   std::map<const ast::StepperDecl*, int> usedSteppers_;
+  bool integratorGiven_ = false;
 };
 
 std::unique_ptr<Plan> SemaImpl::run() {
@@ -461,6 +462,7 @@ void SemaImpl::buildScene() {
     } else if (k == "dt") {
       if (checkSceneExpr(set.value, "dt")) plan_->dt = set.value;
     } else if (k == "integrator") {
+      integratorGiven_ = true;
       auto it = v.kind == ast::Expr::Name ? integrators_.find(v.text) : integrators_.end();
       if (it == integrators_.end()) {
         std::vector<std::string> names;
@@ -505,7 +507,7 @@ void SemaImpl::buildScene() {
   }
   bool anyStepper = false;
   for (const auto& a : plan_->arrays) anyStepper |= a.stepper >= 0;
-  if (anyStepper && plan_->integratorName.empty())
+  if (anyStepper && !integratorGiven_)
     diags_.error(s.name.loc, "scene '" + s.name.name + "' has steppers but no integrator: add "
                              "`integrator = PECIntegrator;` (import integrators;)");
   // Integrator stages must exist in the steppers that are used.

