@@ -37,6 +37,8 @@
 #include <algorithm>
 #include <cctype>
 #include <memory>
+#include <set>
+#include <utility>
 
 namespace sphc {
 
@@ -164,10 +166,9 @@ std::string quoted(llvm::StringRef s) {
   return out + "\"";
 }
 
-// Declarations every body sees: the allowed math.h functions (double versions) and constants.
-std::string prelude() {
-  std::string out = "/* sphc: equation and stepper bodies, one function each */\n";
-  static const char* constants[][2] = {
+// math.h's constants, as macros of the prelude: {name, value}.
+const std::vector<std::pair<const char*, const char*>>& mathConstants() {
+  static const std::vector<std::pair<const char*, const char*>> constants = {
       {"M_E", "2.71828182845904523536"},    {"M_LOG2E", "1.44269504088896340736"},
       {"M_LOG10E", "0.434294481903251827651"}, {"M_LN2", "0.693147180559945309417"},
       {"M_LN10", "2.30258509299404568402"}, {"M_PI", "3.14159265358979323846"},
@@ -175,7 +176,31 @@ std::string prelude() {
       {"M_1_PI", "0.318309886183790671538"}, {"M_2_PI", "0.636619772367581343076"},
       {"M_2_SQRTPI", "1.12837916709551257390"}, {"M_SQRT2", "1.41421356237309504880"},
       {"M_SQRT1_2", "0.707106781186547524401"}};
-  for (auto& c : constants) out += std::string("#define ") + c[0] + " " + c[1] + "\n";
+  return constants;
+}
+
+// A name that cannot be a parameter of the synthesised function: a C99 keyword or a macro of
+// the prelude. (Sema should not let such a scalar through; if it does, the body's own use of
+// the name is what Clang then reports.)
+bool isReservedInC(const std::string& name) {
+  static const std::set<std::string> keywords = {
+      "auto",     "break",  "case",     "char",   "const",    "continue", "default",
+      "do",       "double", "else",     "enum",   "extern",   "float",    "for",
+      "goto",     "if",     "inline",   "int",    "long",     "register", "restrict",
+      "return",   "short",  "signed",   "sizeof", "static",   "struct",   "switch",
+      "typedef",  "union",  "unsigned", "void",   "volatile", "while",    "_Bool",
+      "_Complex", "_Imaginary"};
+  if (keywords.count(name)) return true;
+  for (const auto& c : mathConstants())
+    if (name == c.first) return true;
+  return false;
+}
+
+// Declarations every body sees: the allowed math.h functions (double versions) and constants.
+std::string prelude() {
+  std::string out = "/* sphc: equation and stepper bodies, one function each */\n";
+  for (const auto& c : mathConstants())
+    out += std::string("#define ") + c.first + " " + c.second + "\n";
   for (const std::string& f : allowedMathFunctions())
     out += "double " + f + (isTwoArgumentMathFunction(f) ? "(double, double);\n" : "(double);\n");
   return out;
@@ -262,8 +287,9 @@ class Batch {
   }
   void reportOutsideLoop(int i, llvm::SMLoc loc, const std::string& name) {
     if (!state[i].reportedOutsideLoop.insert(name).second) return;
-    llvm::StringRef n(name);
-    if (n.startswith("s_"))
+    if (name == "s_idx")
+      error(i, loc, "'s_idx' (the neighbour's index) is only available in 'loop'");
+    else if (llvm::StringRef(name).startswith("s_"))
       error(i, loc, "'" + name + "': s_ properties are only available in 'loop', not in '" +
                         kindName(bodies_[i].kind) + "'");
     else
@@ -328,7 +354,8 @@ void Batch::synthesise() {
     std::set<std::string> declared = {"d_idx", "s_idx", "t", "dt"};
     declared.insert(pairQuantityNames().begin(), pairQuantityNames().end());
     for (const std::string& s : b.scalars)
-      if (!isPropertyName(s) && declared.insert(s).second) param("const double " + s, s);
+      if (!isPropertyName(s) && !isReservedInC(s) && declared.insert(s).second)
+        param("const double " + s, s);
     for (const std::string& p : tokens.identifiers) {
       if (!isPropertyName(p)) continue;
       auto shape = b.props.find(p.substr(2));
@@ -393,7 +420,7 @@ class DiagnosticForwarder : public clang::DiagnosticConsumer {
       llvm::SmallString<128> msg;
       info.FormatDiagnostic(msg);
       clang::PresumedLoc p = sm.getPresumedLoc(info.getLocation());
-      SPHC_INTERNAL("diagnostic in the synthesised body prelude at line " +
+      SPHC_INTERNAL("diagnostic outside the bodies in the synthesised unit, line " +
                     llvm::Twine(p.isValid() ? p.getLine() : 0) + ": " + msg);
     }
     if (replaced(i, info)) return;

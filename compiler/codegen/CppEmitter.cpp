@@ -144,6 +144,7 @@ class Emitter {
   std::ostringstream scene_;  // members of struct Scene
   std::vector<std::string> groupFunctions_;
   std::set<std::string> sourceArrays_;  // arrays that need a cell list
+  std::set<std::string> loopArrays_;    // arrays in a neighbour loop, as dest or source
   int phaseCounter_ = 0;
 };
 
@@ -445,6 +446,8 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
     for (int s : sources) {
       const std::string& S = arr(s).name;
       sourceArrays_.insert(S);
+      loopArrays_.insert(S);
+      loopArrays_.insert(D);
       std::set<std::string> q;
       if (group) {
         auto it = group->pairQuantities.find({d, s});
@@ -653,14 +656,18 @@ void Emitter::emitSteppers() {
 void Emitter::emitStep() {
   scene_ << "  // Rebuilds the neighbour search of every array that is a source.\n";
   scene_ << "  void update_neighbours() {\n";
-  scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
-  bool first = true;
-  for (const auto& a : plan_.arrays) {
-    scene_ << (first ? "" : ", ") << "&" << a.name;
-    first = false;
+  if (!loopArrays_.empty()) {
+    // The search domain spans every array that takes part in a neighbour loop.
+    scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
+    bool first = true;
+    for (const auto& a : plan_.arrays) {
+      if (!loopArrays_.count(a.name)) continue;
+      scene_ << (first ? "" : ", ") << "&" << a.name;
+      first = false;
+    }
+    scene_ << "};\n";
+    scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
   }
-  scene_ << "};\n";
-  scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
   for (const auto& S : sourceArrays_) {
     int s = plan_.arrayIndex(S);
     const char* axes[3] = {"x", "y", "z"};

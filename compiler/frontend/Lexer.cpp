@@ -240,8 +240,10 @@ Token Lexer::lexToken() {
     case '>': return maybePair('=', Token::GreaterEq, Token::Greater);
     default: break;
   }
-  if (c == '&' && pos_ + 1 < end_ && pos_[1] == '&') return maybePair('&', Token::AndAnd, Token::Error);
-  if (c == '|' && pos_ + 1 < end_ && pos_[1] == '|') return maybePair('|', Token::OrOr, Token::Error);
+  if ((c == '&' || c == '|') && pos_ + 1 < end_ && pos_[1] == c) {
+    pos_ += 2;
+    return make(c == '&' ? Token::AndAnd : Token::OrOr, start, pos_);
+  }
 
   // A stray character; a multi-byte UTF-8 sequence counts as one.
   ++pos_;

@@ -1,5 +1,7 @@
 #include "sema/Plan.h"
 
+#include "llvm/Support/Format.h"
+
 namespace sphc {
 
 int Plan::arrayIndex(const std::string& name) const {
@@ -74,7 +76,7 @@ void printGroup(const Plan& plan, const PlanGroup& g, llvm::raw_ostream& os, int
 
 void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
   os << "scene " << plan.sceneName << ": dim " << plan.dim << ", kernel " << plan.kernel
-     << " (radius " << plan.kernelRadiusScale << " h), integrator "
+     << " (radius " << llvm::format("%g", plan.kernelRadiusScale) << " h), integrator "
      << (plan.integratorName.empty() ? "none" : plan.integratorName) << "\n";
   if (!plan.integratorSteps.empty()) {
     os << "time step:";
