@@ -162,6 +162,9 @@ def pysph_all(python, tmp, dx_large, steps, steps_large, repeat):
     cold_dir = os.path.join(tmp, "pysph-cold")
     os.makedirs(cold_dir)
     res["cold"] = pysph_run(python, DEFAULT_DX, 1, cold_dir, home=home)
+    cached_dir = os.path.join(tmp, "pysph-cached")
+    os.makedirs(cached_dir)
+    res["cached"] = pysph_run(python, DEFAULT_DX, 1, cached_dir, home=home)
     for key, dx, n in (("small", DEFAULT_DX, steps), ("large", dx_large, steps_large)):
         best = None
         for i in range(repeat):
@@ -171,7 +174,6 @@ def pysph_all(python, tmp, dx_large, steps, steps_large, repeat):
             if best is None or r["us"] < best["us"]:
                 best = r
         res[key] = best
-    res["cached"] = res["small"]
     return res
 
 
@@ -237,6 +239,7 @@ def main():
     rows = [
         ("compile / set-up, empty cache [s]", s.get("cold"), g(p, "cold", "setup")),
         ("compile / set-up, cached [s]", s.get("cached"), g(p, "cached", "setup")),
+        ("    whole command, cached, 1 step [s]", s.get("cached"), g(p, "cached", "wall")),
     ]
     for label, a, b in rows:
         ratio = b / a if (a and b) else None
@@ -254,7 +257,8 @@ def main():
     print()
     print("sphc compile times are wall times of the whole `sphc` command. PySPH set-up is its")
     print("'Setup took' (code generation, Cython compilation when the cache is empty, particle")
-    print("creation); its per-step figure is 'Run took' / (steps x particles). Lower is better.")
+    print("creation; Python start-up and imports are only in the 'whole command' row); its")
+    print("per-step figure is 'Run took' / (steps x particles). Lower is better.")
     return 0
 
 

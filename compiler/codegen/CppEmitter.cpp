@@ -668,13 +668,21 @@ void Emitter::emitStep() {
     scene_ << "};\n";
     scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
   }
+  if (!sourceArrays_.empty()) {
+    // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
+    // are close in memory; all per-particle state moves with them.
+    scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+  }
   for (const auto& S : sourceArrays_) {
     int s = plan_.arrayIndex(S);
     const char* axes[3] = {"x", "y", "z"};
-    scene_ << "    cells_" << S << ".build(domain";
+    std::string build = "cells_" + S + ".build(domain";
     for (int k = 0; k < 3; ++k)
-      scene_ << ", " << (k < plan_.dim ? propPtr(s, axes[k]) : std::string("nullptr"));
-    scene_ << ", " << S << ".n);\n";
+      build += ", " + (k < plan_.dim ? propPtr(s, axes[k]) : std::string("nullptr"));
+    build += ", " + S + ".n);";
+    scene_ << "    " << build << "\n";
+    scene_ << "    if (reorder) {\n      " << S << ".permute(cells_" << S
+           << ".cell_order());\n      " << build << "\n    }\n";
   }
   scene_ << "  }\n\n";
   scene_ << "  void compute_accelerations(double t, double dt) {\n";
@@ -840,6 +848,10 @@ std::string Emitter::run() {
   out_ << "  sphc::SearchDomain domain;\n";
   for (const auto& S : sourceArrays_) out_ << "  sphc::CellList cells_" << S << ";\n";
   out_ << "  int last_iterations = 0;\n";
+  if (!sourceArrays_.empty()) {
+    out_ << "  static constexpr long REORDER_EVERY = 50;\n";
+    out_ << "  long builds = 0;\n";
+  }
   if (anyLoad) {
     llvm::SmallString<256> dir(plan_.mainFile);
     llvm::sys::fs::make_absolute(dir);

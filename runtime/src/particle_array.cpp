@@ -2,6 +2,7 @@
 #include "sphc/particle_array.h"
 
 #include <stdexcept>
+#include <string>
 
 namespace sphc {
 
@@ -145,6 +146,41 @@ void ParticleArray::append_from(const ParticleArray& src, std::size_t i) {
     }
   }
   ++n;
+}
+
+namespace {
+template <class T>
+void permute_values(std::vector<T>& v, const std::vector<std::uint32_t>& order, int stride,
+                    std::vector<T>& scratch) {
+  const std::size_t s = static_cast<std::size_t>(stride);
+  scratch.resize(v.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+    for (std::size_t k = 0; k < s; ++k) scratch[i * s + k] = v[order[i] * s + k];
+  v.swap(scratch);
+}
+}  // namespace
+
+void ParticleArray::permute(const std::vector<std::uint32_t>& order) {
+  if (order.size() != n)
+    throw std::invalid_argument("permute of array '" + name + "': the order has " +
+                                std::to_string(order.size()) + " entries for " +
+                                std::to_string(n) + " particles");
+  std::vector<char> seen(n, 0);
+  for (std::uint32_t i : order) {
+    if (i >= n || seen[i])
+      throw std::invalid_argument("permute of array '" + name + "': not a permutation");
+    seen[i] = 1;
+  }
+  std::vector<double> f;
+  std::vector<std::int32_t> i32;
+  std::vector<std::uint32_t> u32;
+  for (Property& p : props) {
+    switch (p.type) {
+      case PropType::F64: permute_values(p.f64, order, p.stride, f); break;
+      case PropType::I32: permute_values(p.i32, order, p.stride, i32); break;
+      case PropType::U32: permute_values(p.u32, order, p.stride, u32); break;
+    }
+  }
 }
 
 }  // namespace sphc

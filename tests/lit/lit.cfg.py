@@ -16,6 +16,10 @@ def tool(name):
     return r'(?<![\w%/.-])' + name + r'(?![\w.-])'
 
 config.substitutions.append(('%sphc', os.path.join(config.sphc_bin_dir, 'sphc')))
+# The build tree (tests of `cmake --install`). A lit.site.cfg.py written before
+# sphc_build_dir existed: the build tree is the parent of its bin/.
+config.substitutions.append(('%build_dir', getattr(config, 'sphc_build_dir', None) or
+                             os.path.dirname(config.sphc_bin_dir)))
 config.substitutions.append((tool('FileCheck'), config.filecheck))
 config.substitutions.append((tool('not'), config.not_tool))
 

@@ -1,6 +1,7 @@
 // Unit tests of sphc::ParticleArray (runtime/include/sphc/particle_array.h).
 #include <gtest/gtest.h>
 
+#include <stdexcept>
 #include <string>
 
 #include "sphc/particle_array.h"
@@ -159,3 +160,32 @@ TEST(ParticleArray, AppendFrom) {
 }
 
 }  // namespace
+
+// permute: particle i becomes old particle order[i], in every property, whatever its type
+// and stride; a non-permutation is refused and changes nothing.
+TEST(ParticleArrayPermute, ReordersEveryPropertyByTheGivenOrder) {
+  sphc::ParticleArray a;
+  a.name = "fluid";
+  int x = a.add_property("x");
+  int tag = a.add_property("tag", sphc::PropType::I32);
+  int s = a.add_property("s", sphc::PropType::F64, 2);
+  a.resize(3);
+  for (int i = 0; i < 3; ++i) {
+    a.f64(x)[i] = 10.0 * i;
+    a.i32(tag)[i] = 100 + i;
+    a.f64(s)[2 * i] = i;
+    a.f64(s)[2 * i + 1] = -i;
+  }
+  a.permute({2, 0, 1});
+  EXPECT_EQ(a.f64(x)[0], 20.0);
+  EXPECT_EQ(a.f64(x)[1], 0.0);
+  EXPECT_EQ(a.f64(x)[2], 10.0);
+  EXPECT_EQ(a.i32(tag)[0], 102);
+  EXPECT_EQ(a.i32(tag)[2], 101);
+  EXPECT_EQ(a.f64(s)[0], 2.0);
+  EXPECT_EQ(a.f64(s)[1], -2.0);
+  EXPECT_EQ(a.f64(s)[5], -1.0);
+  EXPECT_THROW(a.permute({0, 0, 1}), std::invalid_argument);
+  EXPECT_THROW(a.permute({0, 1}), std::invalid_argument);
+  EXPECT_EQ(a.f64(x)[0], 20.0);
+}

@@ -73,6 +73,10 @@ class CellList {
                  const double* z, const double* h, double radius_scale,
                  std::vector<std::uint32_t>& out) const;
 
+  // Particle indices in cell order (cell by cell, ascending within a cell): the permutation
+  // that makes neighbours close in memory (see ParticleArray::permute).
+  const std::vector<std::uint32_t>& cell_order() const { return order_; }
+
   void set_mode(Mode m) { mode_ = m; }
   bool is_dense() const { return dense_; }
   // Dense: all cells of the grid; hashed: occupied cells.

@@ -62,6 +62,11 @@ struct ParticleArray {
   double* constant(int idx) { return constants[idx].values.data(); }
   double* constant(const std::string& name);  // throws std::out_of_range if absent
 
+  // Reorders the particles: particle i becomes the old particle order[i], for every property
+  // (order must be a permutation of 0..n-1; throws std::invalid_argument otherwise). Used to
+  // keep neighbours close in memory (the cell order of the neighbour search).
+  void permute(const std::vector<std::uint32_t>& order);
+
   // Appends particle `i` of `src` (same property names) to this array; properties missing in
   // src are 0. Used by inlets and by loading.
   void append_from(const ParticleArray& src, std::size_t i);
