@@ -41,6 +41,7 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
     }
     std::set<std::string> readByOthers;  // output, neighbour search, time step
     for (const auto& p : arr.outputProps) {
+      if (isConstant(arr, p)) continue;  // constants are written with every snapshot
       readByOthers.insert(p);
       note(p);
     }

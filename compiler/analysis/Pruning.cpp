@@ -77,6 +77,8 @@ bool pruneEquations(Plan& plan, DiagnosticEngine&) {
       if (acc.write) writes.insert(acc.prop);
     std::string w;
     for (const auto& p : writes) w += (w.empty() ? "" : ", ") + p;
+    if (eq.declIndex >= 0 && !plan.equationDecls[eq.declIndex].reduceTarget.empty())
+      w += (w.empty() ? "" : ", ") + plan.equationDecls[eq.declIndex].reduceTarget;
     eq.pruneReason = "it writes " + (w.empty() ? std::string("nothing") : w) + " of '" +
                      plan.arrays[eq.dest].name +
                      "', which no stepper, output, time-step limit or convergence test uses";

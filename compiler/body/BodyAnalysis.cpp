@@ -107,6 +107,10 @@ bool returnsValue(BodyKind kind) { return kind == BodyKind::Reduce || kind == Bo
 struct BodyTokens {
   std::vector<std::string> identifiers;
   std::vector<size_t> directives;
+  // The first bracket that does not balance ((), [], {}), and what is wrong with it; Clang
+  // would otherwise read past the end of the body into the next one.
+  size_t unbalancedAt = std::string::npos;
+  std::string unbalanced;
   bool has(const std::string& name) const {
     return std::find(identifiers.begin(), identifiers.end(), name) != identifiers.end();
   }
@@ -114,6 +118,13 @@ struct BodyTokens {
 
 BodyTokens scanBody(llvm::StringRef text) {
   BodyTokens tokens;
+  std::vector<std::pair<char, size_t>> open;  // unclosed brackets
+  auto mismatch = [&](size_t at, const std::string& what) {
+    if (tokens.unbalancedAt == std::string::npos) {
+      tokens.unbalancedAt = at;
+      tokens.unbalanced = what;
+    }
+  };
   bool lineStart = true;  // only blanks so far on this line
   for (size_t i = 0; i < text.size();) {
     char c = text[i];
@@ -136,6 +147,19 @@ BodyTokens scanBody(llvm::StringRef text) {
       if (name == llvm::StringRef::npos || !text.substr(name).startswith("pragma"))
         tokens.directives.push_back(i);
       ++i;
+    } else if (c == '(' || c == '[' || c == '{') {
+      open.push_back({c, i});
+      ++i;
+    } else if (c == ')' || c == ']' || c == '}') {
+      char want = c == ')' ? '(' : c == ']' ? '[' : '{';
+      if (open.empty() || open.back().first != want)
+        mismatch(i, std::string("unexpected '") + c + "'" +
+                        (open.empty() ? std::string("")
+                                      : std::string(": '") + open.back().first +
+                                            "' is still open"));
+      else
+        open.pop_back();
+      ++i;
     } else if (isIdentChar(c)) {
       size_t j = i;
       while (j < text.size() && isIdentChar(text[j])) ++j;
@@ -147,6 +171,9 @@ BodyTokens scanBody(llvm::StringRef text) {
       ++i;
     }
   }
+  if (!open.empty())
+    mismatch(open.back().second, std::string("'") + open.back().first +
+                                     "' is not closed in this body");
   return tokens;
 }
 
@@ -217,6 +244,7 @@ struct BodyState {
   unsigned errors = 0;
   bool checked = false;  // its function reached the AST walk (not after a fatal error)
   bool missingReturnReported = false;
+  bool blanked = false;  // left out of the unit after an error (unbalanced brackets)
   std::set<std::string> reportedOutsideLoop;  // s_/pair-quantity names already reported
 };
 
@@ -277,7 +305,7 @@ class Batch {
 
   // sphc's messages shared by the diagnostic forwarder and the AST walk.
   void reportMissingReturn(int i) {
-    if (state[i].missingReturnReported) return;
+    if (state[i].missingReturnReported || state[i].blanked) return;
     state[i].missingReturnReported = true;
     const BodySource& b = bodies_[i];
     std::string what = b.label.empty() ? std::string("a '") + kindName(b.kind) + "' body"
@@ -338,6 +366,20 @@ void Batch::synthesise() {
                                      : llvm::SMLoc(),
             "preprocessor directives are not allowed in bodies");
       for (size_t k = at; k < text.size() && text[k] != '\n'; ++k) text[k] = ' ';
+    }
+
+    // Unbalanced brackets: reported here, and the body is left out of the unit (blanked,
+    // keeping offsets), since Clang would read on into the next body.
+    if (tokens.unbalancedAt != std::string::npos) {
+      error(static_cast<int>(i), b.start.isValid()
+                                     ? llvm::SMLoc::getFromPointer(b.start.getPointer() +
+                                                                   tokens.unbalancedAt)
+                                     : llvm::SMLoc(),
+            tokens.unbalanced);
+      for (char& ch : text)
+        if (ch != '\n') ch = ' ';
+      tokens = BodyTokens();
+      state[i].blanked = true;
     }
 
     // Only the names the body mentions become parameters (besides indices and time).
@@ -416,6 +458,7 @@ class DiagnosticForwarder : public clang::DiagnosticConsumer {
     }
     const clang::SourceManager& sm = info.getSourceManager();
     int i = batch_.bodyAt(sm, info.getLocation());
+    if (i < 0 && batch_.diags().hasErrors()) return;  // a consequence of an error reported
     if (i < 0) {
       llvm::SmallString<128> msg;
       info.FormatDiagnostic(msg);

@@ -787,8 +787,12 @@ void Emitter::emitMain() {
   for (const auto& a : plan_.arrays) {
     if (anyOutput && a.outputProps.empty()) continue;
     out_ << "  prog.output.push_back({\"" << a.name << "\", {";
-    for (size_t i = 0; i < a.outputProps.size(); ++i)
-      out_ << (i ? ", " : "") << "\"" << a.outputProps[i] << "\"";
+    bool firstProp = true;
+    for (const auto& p : a.outputProps) {
+      if (constIndex(plan_.arrayIndex(a.name), p) >= 0) continue;  // constants: always written
+      out_ << (firstProp ? "" : ", ") << "\"" << p << "\"";
+      firstProp = false;
+    }
     out_ << "}});\n";
   }
   out_ << "  return sphc::run_main(argc, argv, prog);\n}\n";

@@ -2,7 +2,9 @@
 
 #include "sphc/hdf5_io.h"
 
+#include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace sphc {
 
@@ -46,14 +48,38 @@ void apply_loaded(ParticleArray& a, std::size_t total, const std::vector<Particl
       int i = a.find(src.name);
       if (i < 0) continue;  // the scene does not use this property
       Property& dst = a.props[i];
-      if (dst.type != src.type || dst.stride != src.stride)
+      if (dst.stride != src.stride)
         throw std::runtime_error("property '" + src.name + "' of loaded array '" + a.name +
-                                 "' has another type or stride in the file than in the scene");
+                                 "' has stride " + std::to_string(src.stride) +
+                                 " in the file but " + std::to_string(dst.stride) +
+                                 " in the scene");
+      if (dst.type != src.type && src.type != PropType::F64)
+        throw std::runtime_error("property '" + src.name + "' of loaded array '" + a.name +
+                                 "' is " + prop_type_name(src.type) + " in the file but " +
+                                 prop_type_name(dst.type) + " in the scene");
       std::size_t s = static_cast<std::size_t>(dst.stride);
       for (std::size_t j = 0; j < l.n * s; ++j) {
-        if (dst.type == PropType::F64) dst.f64[offset * s + j] = src.f64[j];
-        if (dst.type == PropType::I32) dst.i32[offset * s + j] = src.i32[j];
-        if (dst.type == PropType::U32) dst.u32[offset * s + j] = src.u32[j];
+        const std::size_t k = offset * s + j;
+        if (dst.type == src.type) {
+          if (dst.type == PropType::F64) dst.f64[k] = src.f64[j];
+          if (dst.type == PropType::I32) dst.i32[k] = src.i32[j];
+          if (dst.type == PropType::U32) dst.u32[k] = src.u32[j];
+          continue;
+        }
+        // A CSV column (always read as doubles) into an int or uint property: whole numbers
+        // in range only.
+        const double v = src.f64[j];
+        const bool isU = dst.type == PropType::U32;
+        if (v != std::floor(v) || v < (isU ? 0.0 : -2147483648.0) ||
+            v > (isU ? 4294967295.0 : 2147483647.0))
+          throw std::runtime_error("property '" + src.name + "' of loaded array '" + a.name +
+                                   "' is " + prop_type_name(dst.type) +
+                                   " in the scene, but the file has " + std::to_string(v) +
+                                   " for particle " + std::to_string(j / s));
+        if (isU)
+          dst.u32[k] = static_cast<std::uint32_t>(v);
+        else
+          dst.i32[k] = static_cast<std::int32_t>(v);
       }
     }
     offset += l.n;

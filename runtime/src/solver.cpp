@@ -405,9 +405,11 @@ class Simulation {
     const double slack = kTimeSlack * tf;
     OutputSchedule schedule(times, slack);
     dt_ = times.dt;
+    // As PySPH: the equations run once before the first output, so the t = 0 snapshot holds
+    // computed quantities (pressures, summation densities) and not zeros.
+    if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
     if (auto bad = find_non_finite(arrays_)) return blow_up("simulation blew up", describe(*bad));
     write_output();
-    if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
 
     const auto loop_start = Clock::now();
     progress_.start(!opt_.quiet, tf);

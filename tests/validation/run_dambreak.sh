@@ -1,10 +1,10 @@
 #!/bin/sh
-# Validation of the 2D dam break against the Koshizuka & Oka (1996) experiment, in three
+# Validation of the 2D dam break against experiment (Koshizuka & Oka 1996, Martin & Moyce 1952), in three
 # steps, each of which fails the test when it fails:
 #   1. compile examples/dambreak.sph with sphc,
 #   2. run it to t = 1 s, writing snapshots every 0.02 s,
 #   3. check the snapshots with dambreak_front.py (finite values, particles in the tank,
-#      surge front within 10% of the experiment).
+#      surge front within 10% of the experimental data; see dambreak_front.py).
 #
 # Usage: run_dambreak.sh SPHC SOURCE_DIR EXE OUT_DIR
 #   SPHC        the sphc executable (<build>/bin/sphc)
