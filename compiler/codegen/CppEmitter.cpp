@@ -346,11 +346,18 @@ void Emitter::emitArraySetup(const PlanArray& a) {
 
 void Emitter::emitSetup() {
   scene_ << "  void setup(const std::vector<double>& values, sphc::SceneTimes& times) {\n";
-  for (size_t i = 0; i < plan_.params.size(); ++i) {
-    const auto* p = plan_.params[i];
-    scene_ << "    P." << p->name.name << " = std::isnan(values[" << i << "]) ? "
-           << exprCpp(*p->value, [&](const std::string& n) { return paramRef(n); }) << " : values["
-           << i << "];\n";
+  // Parameters in declaration order: a `param` takes its --set value if given, else its
+  // default (which may use earlier ones); a `let` is always computed.
+  size_t given = 0;
+  for (const auto* p : plan_.params) {
+    std::string value = exprCpp(*p->value, [&](const std::string& n) { return paramRef(n); });
+    if (p->derived) {
+      scene_ << "    P." << p->name.name << " = " << value << ";\n";
+      continue;
+    }
+    scene_ << "    P." << p->name.name << " = std::isnan(values[" << given << "]) ? " << value
+           << " : values[" << given << "];\n";
+    ++given;
   }
   for (const auto& eq : plan_.equations) {
     if (!eq.live) continue;
@@ -762,6 +769,7 @@ void Emitter::emitMain() {
   out_ << "  prog.name = \"" << plan_.sceneName << "\";\n";
   out_ << "  prog.dim = DIM;\n";
   for (const auto* p : plan_.params) {
+    if (p->derived) continue;  // `let`: not overridable
     bool lit = isLiteral(*p->value);
     char buf[64];
     snprintf(buf, sizeof buf, "%.17g", lit ? literalValue(*p->value) : 0.0);

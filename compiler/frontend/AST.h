@@ -52,6 +52,7 @@ struct ImportDecl {
 struct ParamDecl {
   Ident name;
   ExprPtr value;
+  bool derived = false;  // `let`: computed from params, not overridable at run time
 };
 
 struct PropertyDecl {

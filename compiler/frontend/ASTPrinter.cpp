@@ -56,7 +56,7 @@ class Printer {
       at(imp.loc) << "\n";
     }
     for (const auto& p : mod.params) {
-      decl(0, "param", p.name);
+      decl(0, p.derived ? "let" : "param", p.name);
       init(p.value);
       os_ << "\n";
     }

@@ -14,7 +14,7 @@ using ast::ExprPtr;
 namespace {
 
 constexpr llvm::StringLiteral kTopLevelKeywords[] = {
-    "import", "param", "array", "equation", "stepper", "integrator", "scene"};
+    "import", "param", "let", "array", "equation", "stepper", "integrator", "scene"};
 
 // `stage` followed by one or more digits.
 bool isStageName(llvm::StringRef word) {
@@ -195,13 +195,13 @@ std::unique_ptr<ast::Module> Parser::parseModule() {
 
 bool Parser::parseItem(ast::Module& mod) {
   if (atWord("import")) return parseImport(mod);
-  if (atWord("param")) return parseParam(mod);
+  if (atWord("param") || atWord("let")) return parseParam(mod);
   if (atWord("array")) return parseArray(mod);
   if (atWord("equation")) return parseEquation(mod);
   if (atWord("stepper")) return parseStepper(mod);
   if (atWord("integrator")) return parseIntegrator(mod);
   if (atWord("scene")) return parseScene(mod);
-  const char* expected = "import, param, array, equation, stepper, integrator or scene";
+  const char* expected = "import, param, let, array, equation, stepper, integrator or scene";
   if (cur().is(Token::Identifier))
     return error(cur().loc, "unknown declaration " + quoted(cur().text) + ": expected " + expected);
   return error(cur().loc, "expected a declaration (" + llvm::Twine(expected) + "), found " +
@@ -222,9 +222,11 @@ bool Parser::parseImport(ast::Module& mod) {
 }
 
 bool Parser::parseParam(ast::Module& mod) {
-  advance();
   ast::ParamDecl param;
-  if (!parseIdent(param.name, "expected a parameter name after 'param'") ||
+  param.derived = atWord("let");
+  advance();
+  if (!parseIdent(param.name, param.derived ? "expected a name after 'let'"
+                                            : "expected a parameter name after 'param'") ||
       !expect(Token::Assign, "after parameter name " + quoted(param.name.name)))
     return false;
   param.value = parseExpr();

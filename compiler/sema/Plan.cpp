@@ -85,8 +85,17 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
   }
   if (plan.adaptiveDt) os << "adaptive time step: yes\n";
   os << "parameters:";
-  for (const auto* p : plan.params) os << " " << p->name.name;
+  for (const auto* p : plan.params)
+    if (!p->derived) os << " " << p->name.name;
   os << "\n";
+  bool anyDerived = false;
+  for (const auto* p : plan.params) anyDerived |= p->derived;
+  if (anyDerived) {
+    os << "derived (let):";
+    for (const auto* p : plan.params)
+      if (p->derived) os << " " << p->name.name;
+    os << "\n";
+  }
   for (const auto& a : plan.arrays) {
     os << "array " << a.name;
     if (a.stepper >= 0) os << " (stepper " << plan.steppers[a.stepper].decl->name.name << ")";

@@ -226,7 +226,7 @@ std::unique_ptr<Plan> SemaImpl::run() {
   for (const auto& m : modules_) {
     for (const auto& p : m->params) {
       if (paramIndex_.count(p.name.name)) {
-        diags_.error(p.name.loc, "redefinition of parameter '" + p.name.name + "'");
+        diags_.error(p.name.loc, "redefinition of '" + p.name.name + "'");
         diags_.note(plan_->params[paramIndex_[p.name.name]]->name.loc,
                     "previous definition is here");
         continue;
