@@ -722,10 +722,10 @@ void Emitter::emitAdaptiveDt() {
   if (!plan_.adaptiveDt) return;
   auto pn = [&](const std::string& n) { return paramRef(n); };
   std::string cfl = plan_.cfl ? exprCpp(*plan_.cfl, pn) : "0.3";
-  scene_ << "  // The stable time step: CFL (h / (c + |v|)) and force (sqrt(h / |a|)) limits\n"
-            "  // over moving particles.\n";
+  scene_ << "  // The stable time step: CFL (h / (c + |v|)), force (sqrt(h / |a|)) and viscous\n"
+            "  // (h^2 / nu) limits over moving particles.\n";
   scene_ << "  double adaptive_dt() {\n";
-  scene_ << "    double dt_cfl = HUGE_VAL, dt_force = HUGE_VAL;\n";
+  scene_ << "    double dt_cfl = HUGE_VAL, dt_force = HUGE_VAL, h2min = HUGE_VAL;\n";
   std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
     if (!movesParticles(plan_, a)) continue;
@@ -748,6 +748,7 @@ void Emitter::emitAdaptiveDt() {
       scene_ << ");\n";
       scene_ << "        dt_cfl = std::fmin(dt_cfl, h[i] / (cs[i] + vmag));\n";
     }
+    if (plan_.nu) scene_ << "        h2min = std::fmin(h2min, h[i] * h[i]);\n";
     if (plan_.forceFactor) {
       scene_ << "        const double amag = std::sqrt(";
       for (int k = 0; k < plan_.dim; ++k)
@@ -757,8 +758,13 @@ void Emitter::emitAdaptiveDt() {
     }
     scene_ << "      }\n    }\n";
   }
-  scene_ << "    return std::fmin(" << cfl << " * dt_cfl, "
+  scene_ << "    double dt = std::fmin(" << cfl << " * dt_cfl, "
          << (plan_.forceFactor ? exprCpp(*plan_.forceFactor, pn) : "1.0") << " * dt_force);\n";
+  if (plan_.nu)
+    scene_ << "    dt = std::fmin(dt, "
+           << (plan_.viscousFactor ? exprCpp(*plan_.viscousFactor, pn) : "0.125")
+           << " * h2min / " << exprCpp(*plan_.nu, pn) << ");  // viscous limit\n";
+  scene_ << "    return dt;\n";
   scene_ << "  }\n\n";
 }
 

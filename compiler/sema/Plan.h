@@ -99,6 +99,7 @@ struct Plan {
   ast::ExprPtr tf, dt;
   bool adaptiveDt = false;
   ast::ExprPtr cfl, forceFactor;
+  ast::ExprPtr viscousFactor, nu;  // viscous limit: viscousFactor * h^2 / nu (if nu is given)
   ast::ExprPtr outputEvery;
   std::vector<ast::ExprPtr> outputAt;
   std::vector<std::string> integratorSteps;   // initialize, stage1, compute_accelerations, ...

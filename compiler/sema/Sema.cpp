@@ -532,11 +532,19 @@ void SemaImpl::buildScene() {
         plan_->cfl = kw.value;
       else if (kw.name.name == "force")
         plan_->forceFactor = kw.value;
+      else if (kw.name.name == "viscous")
+        plan_->viscousFactor = kw.value;
+      else if (kw.name.name == "nu")
+        plan_->nu = kw.value;
       else
         diags_.error(kw.name.loc, "unknown adaptive_dt argument '" + kw.name.name +
-                                      "'; arguments are: cfl, force");
+                                      "'; arguments are: cfl, force, viscous, nu");
     }
   }
+
+  if (plan_->viscousFactor && !plan_->nu)
+    diags_.error(s.adaptiveDtLoc, "adaptive_dt: the viscous limit needs the kinematic "
+                                  "viscosity: nu = ...");
 
   for (const auto& out : s.outputs) {
     if (out.every) {
