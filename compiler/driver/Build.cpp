@@ -84,6 +84,13 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   std::string flags = req.cxxflags.empty() ? info["cxxflags"] : req.cxxflags;
   std::string libs = info["libs"];
   std::string runtimeLib = install.libDir + "/libsphc_runtime.a";
+  if (req.backend == "openmp") {
+    // The OpenMP runtime library and the compiler's OpenMP flag (compile and link).
+    runtimeLib = install.libDir + "/libsphc_runtime_omp.a";
+    std::string omp = info.count("openmp_flags") ? info["openmp_flags"] : "-fopenmp";
+    flags += " " + omp;
+    libs += " " + omp;
+  }
 
   // The key: generated code, compiler, flags, libraries, the runtime library and headers.
   llvm::SHA1 sha;

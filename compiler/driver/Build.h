@@ -21,6 +21,7 @@ struct BuildRequest {
   std::string output;       // executable to write
   std::string cxx;          // override of the C++ compiler ("" = from buildinfo)
   std::string cxxflags;     // override of the flags ("" = from buildinfo)
+  std::string backend = "serial";  // serial or openmp: which runtime and flags
   bool useCache = true;
   bool verbose = false;
 };

@@ -68,9 +68,14 @@ int main(int argc, char** argv) {
     llvm::errs() << "sphc: " << what << " done at " << llvm::format("%.3f", s) << " s\n";
   };
 
-  if (Backend != "serial") {
-    llvm::errs() << "sphc: error: backend '" << Backend << "' is not available yet; this "
-                 << "version builds --backend=serial only\n";
+  if (Backend == "opencl") {
+    llvm::errs() << "sphc: error: backend 'opencl' is not available yet; this version builds "
+                 << "--backend=serial and --backend=openmp\n";
+    return fail();
+  }
+  if (Backend != "serial" && Backend != "openmp") {
+    llvm::errs() << "sphc: error: unknown backend '" << Backend
+                 << "'; backends are: serial, openmp (opencl: not yet)\n";
     return fail();
   }
   static const char* passes[] = {"parse", "sema",   "bodies", "prune",
@@ -160,6 +165,7 @@ int main(int argc, char** argv) {
   req.output = output;
   req.cxx = Cxx;
   req.cxxflags = CxxFlags;
+  req.backend = Backend;
   req.useCache = !NoCache;
   req.verbose = Verbose;
   BuildResult res = buildExecutable(install, req);

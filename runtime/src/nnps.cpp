@@ -50,14 +50,21 @@ SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays,
         continue;
       }
       const Property& p = pa->props[idx];
+      double l = lo[a], u = hi[a];
+      // The OpenMP build of the runtime (libsphc_runtime_omp) runs these loops in parallel;
+      // min and max do not depend on the order, so the result is the serial one.
+#pragma omp parallel for reduction(min : l) reduction(max : u) schedule(static)
       for (std::size_t i = 0; i < pa->n; ++i) {
         const double v = p.f64[i * p.stride];
         if (!std::isfinite(v)) continue;
-        lo[a] = std::min(lo[a], v);
-        hi[a] = std::max(hi[a], v);
+        l = std::min(l, v);
+        u = std::max(u, v);
       }
+      lo[a] = l;
+      hi[a] = u;
     }
     const Property& h = pa->props[pa->find("h")];
+#pragma omp parallel for reduction(max : hmax) schedule(static)
     for (std::size_t i = 0; i < pa->n; ++i) {
       const double v = h.f64[i * h.stride];
       if (std::isfinite(v) && v > hmax) hmax = v;
@@ -139,6 +146,9 @@ void CellList::build(const SearchDomain& dom, const double* x, const double* y,
   std::size_t num_cells = 0;
   if (dense_) {
     num_cells = static_cast<std::size_t>(total_cells);
+    // Independent per particle: parallel in the OpenMP runtime. The counting sort below
+    // stays serial, so the order (and every result) equals the serial build's.
+#pragma omp parallel for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
       int c[3];
       cell_coords(x[i], y ? y[i] : 0.0, z ? z[i] : 0.0, c);

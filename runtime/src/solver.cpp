@@ -56,6 +56,7 @@ struct Options {
   std::optional<double> dt;
   std::optional<double> output_every;
   long max_steps = std::numeric_limits<long>::max();
+  long threads = 0;  // 0: the backend's default (all cores)
   std::string directory;  // empty: <scene>_output
   std::vector<std::pair<std::string, double>> sets;
 };
@@ -140,6 +141,13 @@ Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
     else if (option == "--dt") o.dt = parse_time(value(), option, false);
     else if (option == "--output-every") o.output_every = parse_time(value(), option, true);
     else if (option == "--max-steps") o.max_steps = parse_count(value(), option);
+    else if (option == "--threads") {
+      o.threads = parse_count(value(), option);
+      if (o.threads < 1) throw UsageError("--threads expects a positive number");
+      if (!prog.set_threads)
+        throw UsageError("--threads: this solver was built with --backend=" + prog.backend +
+                         ", which runs on one thread");
+    }
     else if (option == "--set") o.sets.push_back(parse_set(value(), prog));
     else if (option == "-d" || option == "--directory") {
       o.directory = value();
@@ -170,6 +178,7 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "  --output-every T      output interval in simulation time, replacing the scene's\n"
       "                        output times (0: first and last state only)\n"
       "  --max-steps N         stop after N time steps\n"
+      "  --threads N           threads to use (multi-threaded backends; default: all cores)\n"
       "  -d, --directory DIR   output directory (default: {1}_output)\n"
       "  --set NAME=VALUE      set a scene parameter (repeatable)\n"
       "  --quiet               no progress line and no summary\n"
@@ -392,6 +401,7 @@ class Simulation {
     if (!prog_.setup || !prog_.step) {
       throw std::runtime_error("the scene program has no setup or no step function");
     }
+    threads_ = prog_.set_threads ? prog_.set_threads(static_cast<int>(opt_.threads)) : 1;
     SceneTimes times;
     prog_.setup(parameter_values(), times);
     apply_overrides(times);
@@ -524,8 +534,9 @@ class Simulation {
                  step_, why, wall_s, us);
     }
     if (opt_.timing) {
-      fmt::print("timing: steps={} particles={} wall_s={:.6g} us_per_particle_step={:.6g}\n",
-                 step_, particles(), wall_s, us);
+      fmt::print("timing: steps={} particles={} wall_s={:.6g} us_per_particle_step={:.6g} "
+                 "backend={} threads={}\n",
+                 step_, particles(), wall_s, us, prog_.backend, threads_);
       std::fflush(stdout);
     }
   }
@@ -533,6 +544,7 @@ class Simulation {
   SceneProgram& prog_;
   const Options& opt_;
   Progress& progress_;
+  int threads_ = 1;
   OutputWriter* writer_ = nullptr;
   std::vector<ParticleArray*> arrays_;
   double t_ = 0.0;

@@ -42,6 +42,11 @@ struct SceneProgram {
   std::function<void(double t, double dt)> compute_initial;  // may be empty
   std::function<void(double t, double dt)> step;             // one time step from t to t+dt
   std::function<double()> adaptive_dt;                       // empty = fixed dt
+  // Multi-threaded backends: sets the number of threads (--threads N) and returns the number
+  // in use; empty for a serial solver, which then refuses --threads.
+  std::function<int(int threads)> set_threads;
+  // The backend the solver was built with, for the timing line ("serial", "openmp", ...).
+  std::string backend = "serial";
   // Array name -> properties written (empty list = all); empty = every array, all properties.
   std::vector<std::pair<std::string, std::vector<std::string>>> output;
 };
