@@ -92,14 +92,15 @@ def serial_env(extra=None):
 
 # ---- sphc ---------------------------------------------------------------------------------
 
-def sphc_compile(sphc, tmp):
-    cache = os.path.join(tmp, "sphc-cache")
+def sphc_compile(sphc, tmp, backend="serial"):
+    cache = os.path.join(tmp, "sphc-cache-" + backend)
     os.makedirs(cache)
     env = serial_env({"SPHC_CACHE_DIR": cache})
     src = os.path.join(ROOT, "examples", "dambreak.sph")
-    exe = os.path.join(tmp, "dambreak")
-    cold, _ = run([sphc, src, "-o", exe], env=env)
-    cached, _ = run([sphc, src, "-o", exe + "_cached"], env=env)
+    exe = os.path.join(tmp, "dambreak_" + backend)
+    flags = ["--backend=" + backend]
+    cold, _ = run([sphc, src, "-o", exe] + flags, env=env)
+    cached, _ = run([sphc, src, "-o", exe + "_cached"] + flags, env=env)
     return exe, cold, cached
 
 
@@ -107,13 +108,17 @@ TIMING_RE = re.compile(r"timing: steps=(\d+) particles=(\d+) wall_s=([0-9.eE+-]+
                        r"us_per_particle_step=([0-9.eE+-]+)")
 
 
-def sphc_timing(exe, dx, steps, repeat):
+def sphc_timing(exe, dx, steps, repeat, threads=None):
     best = None
     for _ in range(repeat):
         cmd = [exe, "--max-steps", str(steps), "--no-output", "--timing", "--quiet"]
         if dx != DEFAULT_DX:
             cmd += ["--set", "dx=%r" % dx]
-        _, out = run(cmd, env=serial_env())
+        env = serial_env()
+        if threads:
+            cmd += ["--threads", str(threads)]
+            env["OMP_NUM_THREADS"] = str(threads)
+        _, out = run(cmd, env=env)
         m = TIMING_RE.search(out)
         if not m:
             sys.stderr.write("no 'timing:' line in the output of %s:\n%s\n" % (cmd, out[-2000:]))
@@ -127,12 +132,16 @@ def sphc_timing(exe, dx, steps, repeat):
 
 # ---- PySPH --------------------------------------------------------------------------------
 
-def pysph_run(python, dx, steps, outdir, home=None):
-    """One serial PySPH run; returns set-up time, run time, steps, particles, total wall."""
+def pysph_run(python, dx, steps, outdir, home=None, threads=None):
+    """One PySPH run (serial, or --openmp with `threads`); returns set-up time, run time,
+    steps, particles, total wall."""
     env = serial_env({"HOME": home} if home else None)
     cmd = [python, os.path.abspath(__file__), "--pysph-driver", repr(dx),
            "--max-steps", str(steps), "--tf", "100", "--disable-output",
            "-d", outdir]
+    if threads:
+        cmd.append("--openmp")
+        env["OMP_NUM_THREADS"] = str(threads)
     wall, out = run(cmd, env=env)
     setup = re.search(r"Setup took: ([0-9.eE+-]+) secs", out)
     runt = re.search(r"Run took: ([0-9.eE+-]+) secs", out)
@@ -152,6 +161,16 @@ def pysph_run(python, dx, steps, outdir, home=None):
              particles=int(total.group(1)), wall=wall)
     r["us"] = r["run"] / (r["steps"] * r["particles"]) * 1e6
     return r
+
+
+def pysph_parallel(python, tmp, dx_large, steps, steps_large, threads):
+    res = {}
+    home = os.path.join(tmp, "pysph-home")
+    for key, dx, n in (("small", DEFAULT_DX, steps), ("large", dx_large, steps_large)):
+        d = os.path.join(tmp, "pysph-omp-%s" % key)
+        os.makedirs(d)
+        res[key] = pysph_run(python, dx, n, d, home=home, threads=threads)
+    return res
 
 
 def pysph_all(python, tmp, dx_large, steps, steps_large, repeat):
@@ -199,6 +218,9 @@ def main():
     ap.add_argument("--skip-pysph", action="store_true")
     ap.add_argument("--skip-sphc", action="store_true")
     ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
+    ap.add_argument("--threads", type=int, default=0,
+                    help="also time sphc --backend=openmp and PySPH --openmp with this many "
+                         "threads (default: none)")
     args = ap.parse_args()
 
     tmp = tempfile.mkdtemp(prefix="sphc-bench-")
@@ -217,11 +239,23 @@ def main():
             print("sphc: timing %d steps at dx = %g ..." % (args.steps_large, args.dx_large),
                   flush=True)
             s["large"] = sphc_timing(exe, args.dx_large, args.steps_large, args.repeat)
+            if args.threads:
+                print("sphc: OpenMP build, %d threads ..." % args.threads, flush=True)
+                omp_exe, _, _ = sphc_compile(args.sphc, tmp, "openmp")
+                s["omp_small"] = sphc_timing(omp_exe, DEFAULT_DX, args.steps, args.repeat,
+                                             args.threads)
+                s["omp_large"] = sphc_timing(omp_exe, args.dx_large, args.steps_large,
+                                             args.repeat, args.threads)
         if not args.skip_pysph:
             print("PySPH: dam_break_2d, cold cache, then %d steps at dx = %g and %d at dx = %g ..."
                   % (args.steps, DEFAULT_DX, args.steps_large, args.dx_large), flush=True)
             p = pysph_all(args.pysph_python, tmp, args.dx_large, args.steps,
                           args.steps_large, args.repeat)
+            if args.threads:
+                print("PySPH: --openmp, %d threads ..." % args.threads, flush=True)
+                for k, v in pysph_parallel(args.pysph_python, tmp, args.dx_large, args.steps,
+                                           args.steps_large, args.threads).items():
+                    p["omp_" + k] = v
     finally:
         if args.keep:
             print("kept %s" % tmp)
@@ -254,6 +288,20 @@ def main():
                                                                     s[key]["steps"]),
                                    "-" if b is None else "%d, %d" % (p[key]["particles"],
                                                                     p[key]["steps"])))
+    if args.threads:
+        print()
+        print("parallel, %d threads: sphc --backend=openmp, PySPH --openmp" % args.threads)
+        for key, dx in (("small", DEFAULT_DX), ("large", args.dx_large)):
+            a, b = g(s, "omp_" + key, "us"), g(p, "omp_" + key, "us")
+            ratio = b / a if (a and b) else None
+            print("%-44s %12s %12s %12s" % ("us / particle / step, dx = %g" % dx,
+                                             fmt(a, "%.3f"), fmt(b, "%.3f"),
+                                             fmt(ratio, "%.2fx")))
+            sa, ss = g(s, key, "us"), g(s, "omp_" + key, "us")
+            pa, ps = g(p, key, "us"), g(p, "omp_" + key, "us")
+            print("%-44s %12s %12s" % ("    speed-up over own serial",
+                                       fmt(sa / ss if sa and ss else None, "%.2fx"),
+                                       fmt(pa / ps if pa and ps else None, "%.2fx")))
     print()
     print("sphc compile times are wall times of the whole `sphc` command. PySPH set-up is its")
     print("'Setup took' (code generation, Cython compilation when the cache is empty, particle")
