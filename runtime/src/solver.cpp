@@ -227,9 +227,10 @@ class Progress {
       fmt::print(stderr, "\r{:<{}}", text, shown_);
       shown_ = text.size();
       last_print_ = Clock::now();
-    } else if (fraction >= next_fraction_) {
+    } else if (fraction >= next_fraction_ * (1.0 - 1e-9)) {
+      // Every 10% of tf; the slack lets t = 0.09999999999999999 of tf = 0.1 count as 10%.
       fmt::print(stderr, "{}\n", line(t, step, dt, particles, fraction));
-      next_fraction_ = (std::floor(fraction * 10.0) + 1.0) / 10.0;
+      next_fraction_ = (std::floor(fraction * 10.0 * (1.0 + 1e-9)) + 1.0) / 10.0;
     }
     std::fflush(stderr);
   }
