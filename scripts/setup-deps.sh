@@ -12,6 +12,7 @@ PACKAGES=(
   libhdf5-dev hdf5-tools libfmt-dev libeigen3-dev
   # tests: GoogleTest; Python with numpy and h5py for the validation checks
   libgtest-dev googletest python3 python3-numpy python3-h5py
+  pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo  # --backend=opencl (PoCL: CPU)
 )
 
 missing=()

@@ -99,8 +99,13 @@ std::string bodyFunctionName(const std::string& owner, const std::string& method
 class Emitter {
  public:
   Emitter(const Plan& plan, const DiagnosticEngine& diags, const EmitOptions& opts)
-      : plan_(plan), diags_(diags), openmp_(opts.backend == "openmp") {}
+      : plan_(plan),
+        diags_(diags),
+        openmp_(opts.backend == "openmp"),
+        opencl_(opts.backend == "opencl"),
+        singlePrecision_(opts.precision == "single") {}
   std::string run();
+  const std::string& kernelSource() const { return clText_; }
 
  private:
   // Parameters of a body function, in order, as (C++ declaration, argument kind) pairs.
@@ -109,17 +114,70 @@ class Emitter {
     enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp } kind;
     std::string name;  // property, pair quantity or scalar name
   };
-  std::vector<BodyParam> bodyParams(const PlanBody& b, int destArray) const;
+  // device: OpenCL C types (`real`, `__global` pointers) for a kernel of --backend=opencl.
+  std::vector<BodyParam> bodyParams(const PlanBody& b, int destArray, bool device = false) const;
   void emitBodyFunction(const PlanBody& b, const std::string& name, const std::string& ret,
-                        int destArray);
+                        int destArray, bool device = false);
+  // eqValues + sep + scalar: "eq3.rho0" on the host, "eq3_rho0" (a kernel argument) on the
+  // device.
   std::string callBody(const std::string& fn, const PlanBody& b, int dest, int src,
-                       const std::string& eqValues, const std::string& idx) const;
+                       const std::string& eqValues, const std::string& idx,
+                       const std::string& sep = ".") const;
+  // The body of the neighbour loop for one candidate s_idx: pair quantities, the neighbour
+  // criterion (`skip` leaves the candidate), then every loop body. Shared by the C++ loop
+  // (double, Kernel::w) and the OpenCL kernel (real, kernel_w).
+  // The destination particle's position, h (and velocity) as locals xi, yi, zi, hi (ui...).
+  void emitDestLocals(std::ostream& os, const std::string& indent,
+                      const std::set<std::string>& q, bool device) const;
+  void emitCandidate(std::ostream& os, const std::set<std::string>& q,
+                     const std::vector<const PlanEquation*>& loopers, int d, int s, bool device);
+  // ---- --backend=opencl: kernels into cl_, launches into scene_ ----
+  struct KernelArgs {
+    std::vector<std::string> decls, host;
+    std::map<std::string, size_t> at;
+    // A buffer that one body reads (const) and another writes becomes non-const.
+    void add(const std::string& decl, const std::string& hostExpr, const std::string& key) {
+      auto it = at.find(key);
+      if (it != at.end()) {
+        if (decl.find("const ") == std::string::npos) decls[it->second] = decl;
+        return;
+      }
+      at[key] = decls.size();
+      decls.push_back(decl);
+      host.push_back(hostExpr);
+    }
+  };
+  std::string devType(int a, const std::string& p) const;
+  std::string devBuffer(int a, const std::string& p) const;
+  void addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int src,
+                   const std::string& eqValues) const;
+  void beginKernel(const std::string& name, const KernelArgs& ka, bool guard = true);
+  std::string launch(const std::string& name, const std::string& n, const KernelArgs& ka) const;
+  // The kernels of one destination of phase `name`, and their launches.
+  void emitDestinationDevice(int d, const std::vector<const PlanEquation*>& eqs,
+                             const PlanGroup* group, const std::string& name);
+  void emitLineDirective(llvm::SMLoc l);
+  void resetLineDirective();
   std::string propPtr(int array, const std::string& prop) const;
   void emitParams();
   void emitSetup();
   void emitArraySetup(const PlanArray& a);
   void emitGroup(const PlanGroup& g, const std::string& name);
   void emitPhase(const std::vector<int>& eqs, const std::string& name);
+  // What a phase does for one destination, whatever the backend executes it with.
+  std::vector<const PlanEquation*> destEquations(const std::vector<int>& eqIds, int d) const;
+  std::vector<const PlanEquation*> withMethod(const std::vector<const PlanEquation*>& eqs,
+                                              ast::Method::Kind kind) const;
+  struct NeighbourPass {
+    int s = -1;
+    std::set<std::string> q;       // pair quantities, closed under what they need
+    std::vector<const PlanEquation*> loopers;  // equations with a loop over this source
+    std::set<std::string> sprops;  // source properties the loop bodies read
+    std::set<std::string> need;    // read on both sides: positions, h, velocities, rho
+  };
+  // One pass per source, in order of first use; records the arrays the search needs.
+  std::vector<NeighbourPass> neighbourPasses(const std::vector<const PlanEquation*>& eqs, int d,
+                                             const PlanGroup* group);
   void emitSteppers();
   void emitStep();
   void emitAdaptiveDt();
@@ -151,6 +209,10 @@ class Emitter {
   const Plan& plan_;
   const DiagnosticEngine& diags_;
   bool openmp_ = false;
+  bool opencl_ = false;
+  bool singlePrecision_ = false;
+  std::ostringstream cl_;  // OpenCL C of the kernels (--backend=opencl)
+  std::string clText_;
   std::ostringstream out_;
   std::ostringstream scene_;  // members of struct Scene
   std::vector<std::string> groupFunctions_;
@@ -159,52 +221,77 @@ class Emitter {
   int phaseCounter_ = 0;
 };
 
-std::vector<Emitter::BodyParam> Emitter::bodyParams(const PlanBody& b, int destArray) const {
+std::vector<Emitter::BodyParam> Emitter::bodyParams(const PlanBody& b, int destArray,
+                                                    bool device) const {
   std::vector<BodyParam> ps;
+  const std::string real = device ? "real" : "double";
+  const std::string global = device ? "__global " : "";
   const BodyFacts& f = b.facts;
   bool isLoop = b.source.kind == BodyKind::Loop;
   ps.push_back({"int d_idx", BodyParam::Idx, ""});
   if (isLoop) ps.push_back({"int s_idx", BodyParam::SIdx, ""});
-  ps.push_back({"double t", BodyParam::T, ""});
-  ps.push_back({"double dt", BodyParam::Dt, ""});
+  ps.push_back({real + " t", BodyParam::T, ""});
+  ps.push_back({real + " dt", BodyParam::Dt, ""});
   for (const auto& q : pairQuantityNames())
     if (f.pairQuantities.count(q)) {
       bool vec = q == "XIJ" || q == "VIJ" || q == "DWIJ" || q == "DWI" || q == "DWJ";
-      ps.push_back({std::string(vec ? "const double* " : "double ") + q, BodyParam::Pair, q});
+      ps.push_back({(vec ? "const " + real + "* " : real + " ") + q, BodyParam::Pair, q});
     }
   for (const auto& s : b.source.scalars)
-    if (f.scalarsUsed.count(s)) ps.push_back({"double " + s, BodyParam::Scalar, s});
+    if (f.scalarsUsed.count(s)) ps.push_back({real + " " + s, BodyParam::Scalar, s});
   std::set<std::string> written;
   for (const auto& w : f.dWrites) written.insert(w.prop);
   std::set<std::string> dprops;
   for (const auto& r : f.dReads) dprops.insert(r.prop);
   dprops.insert(written.begin(), written.end());
   for (const auto& p : dprops) {
-    std::string type = "double";
+    std::string type = real;
     if (destArray >= 0)
-      if (const PlanProperty* pp = arr(destArray).find(p)) type = cppType(pp->type);
+      if (const PlanProperty* pp = arr(destArray).find(p))
+        type = device ? devType(destArray, p) : cppType(pp->type);
     bool isConst = destArray >= 0 && constIndex(destArray, p) >= 0;
-    ps.push_back({std::string(written.count(p) || isConst ? "" : "const ") + type + "* d_" + p,
+    ps.push_back({global + (written.count(p) || isConst ? "" : "const ") + type + "* d_" + p,
                   BodyParam::DProp, p});
   }
   std::set<std::string> sprops;
   for (const auto& r : f.sReads) sprops.insert(r.prop);
-  for (const auto& p : sprops) ps.push_back({"const double* s_" + p, BodyParam::SProp, p});
+  for (const auto& p : sprops)
+    ps.push_back({global + "const " + real + "* s_" + p, BodyParam::SProp, p});
   return ps;
 }
 
 void Emitter::emitBodyFunction(const PlanBody& b, const std::string& name,
-                               const std::string& ret, int destArray) {
-  auto params = bodyParams(b, destArray);
-  out_ << "// " << b.source.label << ", from " << loc(b.source.start) << "\n";
-  out_ << "static inline " << ret << " " << name << "(";
-  for (size_t i = 0; i < params.size(); ++i) out_ << (i ? ", " : "") << params[i].decl;
-  out_ << ") {";
+                               const std::string& ret, int destArray, bool device) {
+  auto params = bodyParams(b, destArray, device);
+  std::ostream& os = device ? cl_ : out_;
+  os << "// " << b.source.label << ", from " << loc(b.source.start) << "\n";
+  // OpenCL build errors in the body name the .sph line (the program is built at run time).
+  if (device) emitLineDirective(b.source.start);
+  os << (device ? "inline " : "static inline ") << (device && ret == "double" ? "real" : ret)
+     << " " << name << "(";
+  for (size_t i = 0; i < params.size(); ++i) os << (i ? ", " : "") << params[i].decl;
+  os << ") {";
   // The body exactly as written; its first line continues after the opening brace.
   std::string text = b.source.text;
-  out_ << text;
-  if (text.empty() || text.back() != '\n') out_ << "\n";
-  out_ << "}\n\n";
+  os << text;
+  if (text.empty() || text.back() != '\n') os << "\n";
+  os << "}\n";
+  if (device) resetLineDirective();
+  os << "\n";
+}
+
+void Emitter::emitLineDirective(llvm::SMLoc l) {
+  std::string info = loc(l);  // file.sph:line
+  size_t colon = info.rfind(':');
+  if (colon == std::string::npos) return;
+  cl_ << "#line " << info.substr(colon + 1) << " \"" << info.substr(0, colon) << "\"\n";
+}
+
+void Emitter::resetLineDirective() {
+  // The directive is on line (newlines so far + 1): the next line is one more.
+  std::string text = cl_.str();
+  long line = std::count(text.begin(), text.end(), '\n') + 2;
+  cl_ << "#line " << line << " \"" << plan_.sceneName << ".cl\"\n";
 }
 
 std::string Emitter::propPtr(int a, const std::string& p) const {
@@ -216,7 +303,8 @@ std::string Emitter::propPtr(int a, const std::string& p) const {
 }
 
 std::string Emitter::callBody(const std::string& fn, const PlanBody& b, int dest, int src,
-                              const std::string& eqValues, const std::string& time) const {
+                              const std::string& eqValues, const std::string& time,
+                              const std::string& sep) const {
   std::string s = fn + "(";
   bool first = true;
   for (const auto& p : bodyParams(b, dest)) {
@@ -228,7 +316,7 @@ std::string Emitter::callBody(const std::string& fn, const PlanBody& b, int dest
       case BodyParam::T: s += time; break;
       case BodyParam::Dt: s += "dt"; break;
       case BodyParam::Pair: s += p.name; break;
-      case BodyParam::Scalar: s += eqValues + "." + p.name; break;
+      case BodyParam::Scalar: s += eqValues + sep + p.name; break;
       case BodyParam::DProp: s += "d_" + p.name; break;
       case BodyParam::SProp: s += "s_" + p.name; break;
     }
@@ -398,6 +486,130 @@ void Emitter::emitSetup() {
   scene_ << "  }\n\n";
 }
 
+void Emitter::emitDestLocals(std::ostream& os, const std::string& indent,
+                             const std::set<std::string>& q, bool device) const {
+  const std::string R = device ? "real" : "double";
+  const char* axes[3] = {"x", "y", "z"};
+  const char* vel[3] = {"u", "v", "w"};
+  for (int k = 0; k < 3; ++k)
+    os << indent << "const " << R << " " << axes[k] << "i = "
+       << (k < plan_.dim ? std::string("di_") + axes[k] + "[d_idx]" : "0.0") << ";\n";
+  os << indent << "const " << R << " hi = di_h[d_idx];\n";
+  if (q.count("VIJ"))
+    for (int k = 0; k < plan_.dim; ++k)
+      os << indent << "const " << R << " " << vel[k] << "i = di_" << vel[k] << "[d_idx];\n";
+}
+
+void Emitter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
+                            const std::vector<const PlanEquation*>& loopers, int d, int s,
+                            bool device) {
+  const std::string R = device ? "real" : "double";
+  const std::string W = device ? "kernel_w" : "Kernel::w";
+  const std::string GRAD = device ? "kernel_gradient" : "Kernel::gradient";
+  const std::string SQRT = device ? "sqrt" : "std::sqrt";
+  const std::string skip = device ? "continue;" : "return;";
+  const char* axes[3] = {"x", "y", "z"};
+  std::vector<std::string> vel = {"u", "v", "w"};
+  vel.resize(plan_.dim);
+  os << "            const " << R << " hj = sj_h[s_idx];\n";
+  os << "            const " << R << " XIJ[3] = {";
+  for (int k = 0; k < 3; ++k)
+    os << (k ? ", " : "")
+           << (k < plan_.dim ? std::string(axes[k]) + "i - sj_" + axes[k] + "[s_idx]"
+                             : "0.0");
+  os << "};\n";
+  os << "            const " << R << " R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * "
+            "XIJ[2];\n";
+  os << "            const " << R << " hmax = hi > hj ? hi : hj;\n";
+  os << "            if (R2IJ >= RADIUS2 * hmax * hmax) " << skip << "  // not a neighbour\n";
+  os << "            const " << R << " HIJ = 0.5 * (hi + hj);\n";
+  if (q.count("RIJ")) os << "            const " << R << " RIJ = " << SQRT << "(R2IJ);\n";
+  if (q.count("VIJ")) {
+    os << "            const " << R << " VIJ[3] = {";
+    for (int k = 0; k < 3; ++k)
+      os << (k ? ", " : "")
+             << (k < plan_.dim ? vel[k] + "i - sj_" + vel[k] + "[s_idx]" : "0.0");
+    os << "};\n";
+  }
+  if (q.count("WIJ")) os << "            const " << R << " WIJ = " << W << "(RIJ, HIJ);\n";
+  if (q.count("WI")) os << "            const " << R << " WI = " << W << "(RIJ, hi);\n";
+  if (q.count("WJ")) os << "            const " << R << " WJ = " << W << "(RIJ, hj);\n";
+  if (q.count("DWIJ"))
+    os << "            " << R << " DWIJ[3];\n"
+              "            " << GRAD << "(XIJ, RIJ, HIJ, DWIJ);\n";
+  if (q.count("DWI"))
+    os << "            " << R << " DWI[3];\n"
+              "            " << GRAD << "(XIJ, RIJ, hi, DWI);\n";
+  if (q.count("DWJ"))
+    os << "            " << R << " DWJ[3];\n"
+              "            " << GRAD << "(XIJ, RIJ, hj, DWJ);\n";
+  if (q.count("RHOIJ"))
+    os << "            const " << R << " RHOIJ = 0.5 * (di_rho[d_idx] + sj_rho[s_idx]);\n";
+  if (q.count("RHOIJ1")) os << "            const " << R << " RHOIJ1 = 1.0 / RHOIJ;\n";
+  if (q.count("EPS")) os << "            const " << R << " EPS = 0.01 * HIJ * HIJ;\n";
+  for (const auto* eq : loopers) {
+    const auto& pd = plan_.equationDecls[eq->declIndex];
+    const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Loop)];
+    os << "            " << callBody(bodyFunctionName(eq->name, "loop"), b, d, s,
+                                         eqStruct(*eq), "t", device ? "_" : ".")
+           << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+  }
+}
+
+std::vector<const PlanEquation*> Emitter::destEquations(const std::vector<int>& eqIds,
+                                                        int d) const {
+  std::vector<const PlanEquation*> eqs;
+  for (int e : eqIds)
+    if (plan_.equations[e].live && plan_.equations[e].dest == d)
+      eqs.push_back(&plan_.equations[e]);
+  return eqs;
+}
+
+std::vector<const PlanEquation*> Emitter::withMethod(const std::vector<const PlanEquation*>& eqs,
+                                                     ast::Method::Kind kind) const {
+  std::vector<const PlanEquation*> with;
+  for (const auto* eq : eqs)
+    if (plan_.equationDecls[eq->declIndex].methods.count(kind)) with.push_back(eq);
+  return with;
+}
+
+std::vector<Emitter::NeighbourPass> Emitter::neighbourPasses(
+    const std::vector<const PlanEquation*>& eqs, int d, const PlanGroup* group) {
+  std::vector<int> sources;
+  for (const auto* eq : withMethod(eqs, ast::Method::Loop))
+    for (int s : eq->sources)
+      if (std::find(sources.begin(), sources.end(), s) == sources.end()) sources.push_back(s);
+  std::vector<NeighbourPass> passes;
+  for (int s : sources) {
+    sourceArrays_.insert(arr(s).name);
+    loopArrays_.insert(arr(s).name);
+    loopArrays_.insert(arr(d).name);
+    NeighbourPass pass;
+    pass.s = s;
+    if (group) {
+      auto it = group->pairQuantities.find({d, s});
+      if (it != group->pairQuantities.end()) pass.q = it->second;
+    }
+    pass.q = pairQuantityClosure(pass.q);
+    for (const auto* eq : withMethod(eqs, ast::Method::Loop)) {
+      if (std::find(eq->sources.begin(), eq->sources.end(), s) == eq->sources.end()) continue;
+      pass.loopers.push_back(eq);
+      const PlanBody& b =
+          plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(ast::Method::Loop)];
+      for (const auto& r : b.facts.sReads) pass.sprops.insert(r.prop);
+    }
+    std::vector<std::string> pos = positionProps(plan_.dim);
+    pass.need.insert(pos.begin(), pos.end());
+    pass.need.insert("h");
+    std::vector<std::string> vel = {"u", "v", "w"};
+    vel.resize(plan_.dim);
+    if (pass.q.count("VIJ")) pass.need.insert(vel.begin(), vel.end());
+    if (pass.q.count("RHOIJ")) pass.need.insert("rho");
+    passes.push_back(std::move(pass));
+  }
+  return passes;
+}
+
 // One fused evaluation of a list of equations, as PySPH's Group: per destination, every
 // initialize, one neighbour pass per source with every loop, then post_loop and reduce.
 void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) {
@@ -420,12 +632,14 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
   scene_ << "    (void)t; (void)dt;\n";
   for (int d : dests) {
     const std::string& D = arr(d).name;
-    std::vector<const PlanEquation*> eqs;
-    for (int e : eqIds)
-      if (plan_.equations[e].live && plan_.equations[e].dest == d)
-        eqs.push_back(&plan_.equations[e]);
+    std::vector<const PlanEquation*> eqs = destEquations(eqIds, d);
     scene_ << "    {  // destination " << D << "\n";
     scene_ << "      const int n = static_cast<int>(" << D << ".n);\n";
+    if (opencl_) {
+      emitDestinationDevice(d, eqs, group, name);
+      scene_ << "    }\n";
+      continue;
+    }
     // Pointers of every destination property the bodies use.
     std::set<std::string> dprops;
     for (const auto* eq : eqs)
@@ -439,9 +653,7 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
       scene_ << "      " << type << "* d_" << p << " = " << propPtr(d, p) << ";\n";
     }
     auto perParticle = [&](ast::Method::Kind kind, const char* what) {
-      std::vector<const PlanEquation*> with;
-      for (const auto* eq : eqs)
-        if (plan_.equationDecls[eq->declIndex].methods.count(kind)) with.push_back(eq);
+      std::vector<const PlanEquation*> with = withMethod(eqs, kind);
       if (with.empty()) return;
       scene_ << parallelFor("      ");
       scene_ << "      for (int d_idx = 0; d_idx < n; ++d_idx) {  // " << what << "\n";
@@ -456,112 +668,31 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
     };
     perParticle(ast::Method::Initialize, "initialize");
     // One neighbour pass per source.
-    std::vector<int> sources;
-    for (const auto* eq : eqs)
-      if (plan_.equationDecls[eq->declIndex].methods.count(ast::Method::Loop))
-        for (int s : eq->sources)
-          if (std::find(sources.begin(), sources.end(), s) == sources.end())
-            sources.push_back(s);
-    for (int s : sources) {
+    for (const NeighbourPass& pass : neighbourPasses(eqs, d, group)) {
+      const int s = pass.s;
       const std::string& S = arr(s).name;
-      sourceArrays_.insert(S);
-      loopArrays_.insert(S);
-      loopArrays_.insert(D);
-      std::set<std::string> q;
-      if (group) {
-        auto it = group->pairQuantities.find({d, s});
-        if (it != group->pairQuantities.end()) q = it->second;
-      }
-      q = pairQuantityClosure(q);
-      std::set<std::string> sprops;
-      std::vector<const PlanEquation*> loopers;
-      for (const auto* eq : eqs) {
-        const auto& pd = plan_.equationDecls[eq->declIndex];
-        auto it = pd.methods.find(ast::Method::Loop);
-        if (it == pd.methods.end()) continue;
-        if (std::find(eq->sources.begin(), eq->sources.end(), s) == eq->sources.end()) continue;
-        loopers.push_back(eq);
-        for (const auto& r : plan_.bodies[it->second].facts.sReads) sprops.insert(r.prop);
-      }
+      const std::set<std::string>& q = pass.q;
       scene_ << "      {  // neighbours: " << D << " <- " << S << "\n";
-      std::vector<std::string> pos = positionProps(plan_.dim);
-      std::set<std::string> need(pos.begin(), pos.end());
-      need.insert("h");
-      std::vector<std::string> vel = {"u", "v", "w"};
-      vel.resize(plan_.dim);
-      if (q.count("VIJ")) need.insert(vel.begin(), vel.end());
-      if (q.count("RHOIJ")) need.insert("rho");
-      for (const auto& p : need) {
+      for (const auto& p : pass.need) {
         scene_ << "        const double* di_" << p << " = " << propPtr(d, p) << ";\n";
         scene_ << "        const double* sj_" << p << " = " << propPtr(s, p) << ";\n";
       }
-      for (const auto& p : sprops)
+      for (const auto& p : pass.sprops)
         scene_ << "        const double* s_" << p << " = " << propPtr(s, p) << ";\n";
       scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
       scene_ << parallelFor("        ");
       scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
-      const char* axes[3] = {"x", "y", "z"};
-      for (int k = 0; k < 3; ++k)
-        scene_ << "          const double " << axes[k] << "i = "
-               << (k < plan_.dim ? std::string("di_") + axes[k] + "[d_idx]" : "0.0") << ";\n";
-      scene_ << "          const double hi = di_h[d_idx];\n";
-      if (q.count("VIJ"))
-        for (int k = 0; k < plan_.dim; ++k)
-          scene_ << "          const double " << vel[k] << "i = di_" << vel[k] << "[d_idx];\n";
+      emitDestLocals(scene_, "          ", q, false);
       scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
       scene_ << "            const int s_idx = static_cast<int>(j);\n";
-      scene_ << "            const double hj = sj_h[s_idx];\n";
-      scene_ << "            const double XIJ[3] = {";
-      for (int k = 0; k < 3; ++k)
-        scene_ << (k ? ", " : "")
-               << (k < plan_.dim ? std::string(axes[k]) + "i - sj_" + axes[k] + "[s_idx]"
-                                 : "0.0");
-      scene_ << "};\n";
-      scene_ << "            const double R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * "
-                "XIJ[2];\n";
-      scene_ << "            const double hmax = hi > hj ? hi : hj;\n";
-      scene_ << "            if (R2IJ >= RADIUS2 * hmax * hmax) return;  // not a neighbour\n";
-      scene_ << "            const double HIJ = 0.5 * (hi + hj);\n";
-      if (q.count("RIJ")) scene_ << "            const double RIJ = std::sqrt(R2IJ);\n";
-      if (q.count("VIJ")) {
-        scene_ << "            const double VIJ[3] = {";
-        for (int k = 0; k < 3; ++k)
-          scene_ << (k ? ", " : "")
-                 << (k < plan_.dim ? vel[k] + "i - sj_" + vel[k] + "[s_idx]" : "0.0");
-        scene_ << "};\n";
-      }
-      if (q.count("WIJ")) scene_ << "            const double WIJ = Kernel::w(RIJ, HIJ);\n";
-      if (q.count("WI")) scene_ << "            const double WI = Kernel::w(RIJ, hi);\n";
-      if (q.count("WJ")) scene_ << "            const double WJ = Kernel::w(RIJ, hj);\n";
-      if (q.count("DWIJ"))
-        scene_ << "            double DWIJ[3];\n"
-                  "            Kernel::gradient(XIJ, RIJ, HIJ, DWIJ);\n";
-      if (q.count("DWI"))
-        scene_ << "            double DWI[3];\n"
-                  "            Kernel::gradient(XIJ, RIJ, hi, DWI);\n";
-      if (q.count("DWJ"))
-        scene_ << "            double DWJ[3];\n"
-                  "            Kernel::gradient(XIJ, RIJ, hj, DWJ);\n";
-      if (q.count("RHOIJ"))
-        scene_ << "            const double RHOIJ = 0.5 * (di_rho[d_idx] + sj_rho[s_idx]);\n";
-      if (q.count("RHOIJ1")) scene_ << "            const double RHOIJ1 = 1.0 / RHOIJ;\n";
-      if (q.count("EPS")) scene_ << "            const double EPS = 0.01 * HIJ * HIJ;\n";
-      for (const auto* eq : loopers) {
-        const auto& pd = plan_.equationDecls[eq->declIndex];
-        const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Loop)];
-        scene_ << "            " << callBody(bodyFunctionName(eq->name, "loop"), b, d, s,
-                                             eqStruct(*eq), "t")
-               << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
-      }
+      emitCandidate(scene_, q, pass.loopers, d, s, false);
       scene_ << "          });\n        }\n      }\n";
     }
     perParticle(ast::Method::PostLoop, "post_loop");
     // Reductions over the destination array into its constants.
-    for (const auto* eq : eqs) {
+    for (const auto* eq : withMethod(eqs, ast::Method::Reduce)) {
       const auto& pd = plan_.equationDecls[eq->declIndex];
-      auto it = pd.methods.find(ast::Method::Reduce);
-      if (it == pd.methods.end()) continue;
-      const PlanBody& b = plan_.bodies[it->second];
+      const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
       std::string init = pd.reduceOp == "sum" ? "0.0"
                          : pd.reduceOp == "max" ? "-HUGE_VAL"
                                                 : "HUGE_VAL";
@@ -584,6 +715,145 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
     scene_ << "    }\n";
   }
   scene_ << "  }\n\n";
+}
+
+// ---- --backend=opencl ----------------------------------------------------------------------
+// The same phases as the C++ loops above, as kernels: one work item per destination particle
+// (a gather, as the OpenMP loops), a kernel per group phase, destination and method, and per
+// neighbour pass (destination <- source). Only the buffers and scalars the bodies use are
+// arguments. Host code launches them; particle data stays on the device.
+
+std::string Emitter::devType(int a, const std::string& p) const {
+  if (constIndex(a, p) >= 0) return "real";
+  const PlanProperty* pp = arr(a).find(p);
+  if (pp && pp->type == "int") return "int";
+  if (pp && pp->type == "uint") return "uint";
+  return "real";
+}
+
+std::string Emitter::devBuffer(int a, const std::string& p) const {
+  int c = constIndex(a, p);
+  if (c >= 0) return "dev_" + arr(a).name + ".constant(" + std::to_string(c) + ")";
+  int i = propIndex(a, p);
+  if (i < 0) SPHC_INTERNAL("property '" + p + "' of '" + arr(a).name + "' was not allocated");
+  return "dev_" + arr(a).name + ".prop(" + std::to_string(i) + ")";
+}
+
+void Emitter::addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int src,
+                          const std::string& eqValues) const {
+  for (const auto& p : bodyParams(b, dest, true)) {
+    switch (p.kind) {
+      case BodyParam::Scalar:
+        ka.add("const real " + eqValues + "_" + p.name, eqValues + "." + p.name,
+               eqValues + "." + p.name);
+        break;
+      case BodyParam::DProp: ka.add(p.decl, devBuffer(dest, p.name), "d_" + p.name); break;
+      case BodyParam::SProp:
+        ka.add("__global const real* s_" + p.name, devBuffer(src, p.name), "s_" + p.name);
+        break;
+      default: break;
+    }
+  }
+}
+
+void Emitter::beginKernel(const std::string& name, const KernelArgs& ka, bool guard) {
+  cl_ << "__kernel void " << name << "(const int n, const real t, const real dt";
+  for (const auto& d : ka.decls) cl_ << ",\n    " << d;
+  cl_ << ") {\n";
+  if (guard) cl_ << "  const int d_idx = get_global_id(0);\n  if (d_idx >= n) return;\n";
+}
+
+std::string Emitter::launch(const std::string& name, const std::string& n,
+                            const KernelArgs& ka) const {
+  std::string s = "ocl.run(\"" + name + "\", " + n + ", " + n + ", t, dt";
+  for (const auto& h : ka.host) s += ", " + h;
+  return s + ");";
+}
+
+void Emitter::emitDestinationDevice(int d, const std::vector<const PlanEquation*>& eqs,
+                                    const PlanGroup* group, const std::string& name) {
+  const std::string& D = arr(d).name;
+  auto perParticle = [&](ast::Method::Kind kind, const char* what) {
+    std::vector<const PlanEquation*> with = withMethod(eqs, kind);
+    if (with.empty()) return;
+    KernelArgs ka;
+    for (const auto* eq : with)
+      addBodyArgs(ka, plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(kind)], d,
+                  -1, eqStruct(*eq));
+    std::string k = name + "_" + D + "_" + what;
+    beginKernel(k, ka);
+    for (const auto* eq : with) {
+      const auto& pd = plan_.equationDecls[eq->declIndex];
+      const PlanBody& b = plan_.bodies[pd.methods.at(kind)];
+      cl_ << "  " << callBody(bodyFunctionName(eq->name, what), b, d, -1, eqStruct(*eq), "t", "_")
+          << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+    }
+    cl_ << "}\n\n";
+    scene_ << "      " << launch(k, "n", ka) << "  // " << what << "\n";
+  };
+  perParticle(ast::Method::Initialize, "initialize");
+  for (const NeighbourPass& pass : neighbourPasses(eqs, d, group)) {
+    const int s = pass.s;
+    const std::string& S = arr(s).name;
+    const std::set<std::string>& q = pass.q;
+    KernelArgs ka;
+    for (const auto* eq : pass.loopers)
+      addBodyArgs(ka, plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(
+                          ast::Method::Loop)],
+                  d, s, eqStruct(*eq));
+    for (const auto& p : pass.need) {
+      ka.add("__global const real* di_" + p, devBuffer(d, p), "di_" + p);
+      ka.add("__global const real* sj_" + p, devBuffer(s, p), "sj_" + p);
+    }
+    ka.add("SPHC_CELLS_ARGS(cells)", "cells_" + S, "cells");
+    ka.add("SPHC_GRID_ARGS", "grid", "grid");
+    std::string k = name + "_" + D + "_from_" + S;
+    cl_ << "// neighbours: " << D << " <- " << S << "\n";
+    beginKernel(k, ka);
+    emitDestLocals(cl_, "  ", q, true);
+    // The 3^dim cells around the particle's cell, by z, y, x (the CPU candidate order).
+    const char* axes[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a)
+      cl_ << "  const int c" << axes[a] << " = "
+          << (a < plan_.dim ? std::string("sphc_axis_cell((") + axes[a] + "i - grid_lo" +
+                                  axes[a] + ") * grid_inv, grid_n" + axes[a] + ")"
+                            : std::string("0"))
+          << ";\n";
+    cl_
+        << "  for (int kz = max(cz - 1, 0); kz <= min(cz + 1, grid_nz - 1); ++kz)\n"
+        << "  for (int ky = max(cy - 1, 0); ky <= min(cy + 1, grid_ny - 1); ++ky)\n"
+        << "  for (int kx = max(cx - 1, 0); kx <= min(cx + 1, grid_nx - 1); ++kx) {\n"
+        << "    const int cell = (kz * grid_ny + ky) * grid_nx + kx;\n"
+        << "    for (uint k = cells_start[cell]; k < cells_end[cell]; ++k) {\n"
+        << "            const int s_idx = (int)cells_order[k];\n";
+    emitCandidate(cl_, q, pass.loopers, d, s, true);
+    cl_ << "    }\n  }\n}\n\n";
+    scene_ << "      " << launch(k, "n", ka) << "  // neighbours: " << D << " <- " << S << "\n";
+  }
+  perParticle(ast::Method::PostLoop, "post_loop");
+  // Reductions: per-particle values on the device, partial results there, the last step
+  // on the host, into the host copy of the constant (uploaded again).
+  for (const auto* eq : withMethod(eqs, ast::Method::Reduce)) {
+    const auto& pd = plan_.equationDecls[eq->declIndex];
+    const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
+    KernelArgs ka;
+    addBodyArgs(ka, b, d, -1, eqStruct(*eq));
+    ka.add("__global real* reduce_values", "ocl.scratch(n)", "reduce_values");
+    std::string k = name + "_" + D + "_reduce_" + std::to_string(eq->id);
+    beginKernel(k, ka);
+    cl_ << "  reduce_values[d_idx] = "
+        << callBody(bodyFunctionName(eq->name, "reduce"), b, d, -1, eqStruct(*eq), "t", "_")
+        << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n}\n\n";
+    int c = constIndex(d, pd.reduceTarget);
+    std::string op = pd.reduceOp == "sum" ? "Sum" : pd.reduceOp == "max" ? "Max" : "Min";
+    scene_ << "      {  // reduce " << pd.reduceOp << " into " << D << "." << pd.reduceTarget
+           << ": " << eq->name << ", from " << loc(eq->loc) << "\n";
+    scene_ << "        " << launch(k, "n", ka) << "\n";
+    scene_ << "        " << D << ".constant(" << c << ")[0] = ocl.reduce(ocl.scratch(n), n, "
+           << "sphc::ocl::Op::" << op << ");\n";
+    scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << c << ");\n";
+    scene_ << "      }\n";
+  }
 }
 
 void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
@@ -631,6 +901,12 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
     scene_ << "      {\n        const int d_idx = 0;\n";
     std::set<std::string> dprops;
     for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
+    // OpenCL: the test runs on the host; constants are current there, properties are not.
+    bool needsProps = false;
+    for (const auto& p : dprops) needsProps |= constIndex(eq->dest, p) < 0;
+    if (opencl_ && needsProps)
+      scene_ << "        dev_" << arr(eq->dest).name << ".download(ocl, " << arr(eq->dest).name
+             << ");\n";
     for (const auto& p : dprops)
       scene_ << "        double* d_" << p << " = " << propPtr(eq->dest, p) << ";\n";
     scene_ << "        converged = converged && "
@@ -661,6 +937,16 @@ void Emitter::emitSteppers() {
       const PlanBody& b = plan_.bodies[it->second];
       scene_ << "    {  // " << A.name << ": " << st.decl->name.name << "." << m << "\n";
       scene_ << "      const int n = static_cast<int>(" << A.name << ".n);\n";
+      std::string fn = bodyFunctionName(st.decl->name.name, m);
+      if (opencl_) {
+        KernelArgs ka;
+        addBodyArgs(ka, b, a, -1, "");
+        std::string k = "stepper_" + m + "_" + A.name;
+        beginKernel(k, ka);
+        cl_ << "  " << callBody(fn, b, a, -1, "", "t", "_") << ";\n}\n\n";
+        scene_ << "      " << launch(k, "n", ka) << "\n    }\n";
+        continue;
+      }
       std::set<std::string> dprops;
       for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
       for (const auto& w : b.facts.dWrites) dprops.insert(w.prop);
@@ -669,9 +955,7 @@ void Emitter::emitSteppers() {
                << "* d_" << p << " = " << propPtr(a, p) << ";\n";
       scene_ << parallelFor("      ");
       scene_ << "      for (int d_idx = 0; d_idx < n; ++d_idx)\n";
-      scene_ << "        "
-             << callBody(bodyFunctionName(st.decl->name.name, m), b, a, -1, "", "t")
-             << ";\n    }\n";
+      scene_ << "        " << callBody(fn, b, a, -1, "", "t") << ";\n    }\n";
     }
     scene_ << "  }\n\n";
   }
@@ -680,7 +964,39 @@ void Emitter::emitSteppers() {
 void Emitter::emitStep() {
   scene_ << "  // Rebuilds the neighbour search of every array that is a source.\n";
   scene_ << "  void update_neighbours() {\n";
-  if (!loopArrays_.empty()) {
+  if (opencl_) {
+    // On the device: the search domain from min/max reductions, then a cell table per
+    // source (cell keys, bitonic sort, cell start/end). Positions never leave the device.
+    const char* axes[3] = {"x", "y", "z"};
+    auto buf = [&](int a, int k) {
+      return k < plan_.dim ? devBuffer(a, axes[k]) : std::string("nullptr");
+    };
+    if (!loopArrays_.empty()) {
+      scene_ << "    grid = ocl.make_grid({";
+      bool first = true;
+      for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+        if (!loopArrays_.count(arr(a).name)) continue;
+        scene_ << (first ? "" : ",\n                          ") << "{" << buf(a, 0) << ", "
+               << buf(a, 1) << ", " << buf(a, 2) << ", " << devBuffer(a, "h") << ", "
+               << arr(a).name << ".n}";
+        first = false;
+      }
+      scene_ << "}, DIM, Kernel::radius_scale);\n";
+    }
+    // Every REORDER_EVERY builds the particles are sorted in cell order on the device, as
+    // on the CPU (same grid, same order), so outputs list particles in the same order.
+    if (!sourceArrays_.empty())
+      scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+    for (const auto& S : sourceArrays_) {
+      int s = plan_.arrayIndex(S);
+      std::string build = "cells_" + S + ".build(ocl, grid, " + buf(s, 0) + ", " + buf(s, 1) +
+                          ", " + buf(s, 2) + ", " + S + ".n);";
+      scene_ << "    " << build << "\n";
+      scene_ << "    if (reorder) {\n      dev_" << S << ".permute(ocl, cells_" << S << ", " << S
+             << ");\n      " << build << "\n    }\n";
+    }
+  }
+  if (!loopArrays_.empty() && !opencl_) {
     // The search domain spans every array that takes part in a neighbour loop.
     scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
     bool first = true;
@@ -692,12 +1008,13 @@ void Emitter::emitStep() {
     scene_ << "};\n";
     scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
   }
-  if (!sourceArrays_.empty()) {
+  if (!sourceArrays_.empty() && !opencl_) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
   }
   for (const auto& S : sourceArrays_) {
+    if (opencl_) break;
     int s = plan_.arrayIndex(S);
     const char* axes[3] = {"x", "y", "z"};
     std::string build = "cells_" + S + ".build(domain";
@@ -748,6 +1065,57 @@ void Emitter::emitAdaptiveDt() {
     if (!movesParticles(plan_, a)) continue;
     const std::string& A = arr(a).name;
     scene_ << "    {  // " << A << "\n";
+    bool useCfl = plan_.cfl || !plan_.forceFactor;
+    if (opencl_) {
+      // Per-particle limits on the device, their minima from device partial reductions.
+      KernelArgs ka;
+      std::vector<std::string> props = {"h"};
+      if (useCfl) props.push_back("cs");
+      for (int k = 0; k < plan_.dim; ++k) {
+        if (useCfl) props.push_back(vel[k]);
+        if (plan_.forceFactor) props.push_back(acc[k]);
+      }
+      for (const auto& p : props) ka.add("__global const real* " + p, devBuffer(a, p), p);
+      const char* outs[3] = {"dt_cfl", "dt_force", "h2min"};
+      for (int o = 0; o < 3; ++o)
+        ka.add(std::string("__global real* out_") + outs[o],
+               "ocl.scratch(n, " + std::to_string(o + 1) + ")", outs[o]);
+      std::string k = "adaptive_dt_" + A;
+      beginKernel(k, ka);
+      cl_ << "  const int i = d_idx;\n";
+      auto mag = [&](const std::vector<std::string>& c) {
+        std::string m = "sqrt(";
+        for (int k = 0; k < plan_.dim; ++k) m += (k ? " + " : "") + c[k] + "[i] * " + c[k] + "[i]";
+        return m + ")";
+      };
+      cl_ << "  out_dt_cfl[i] = " << (useCfl ? "h[i] / (cs[i] + " + mag(vel) + ")" : "INFINITY")
+          << ";\n";
+      cl_ << "  out_h2min[i] = h[i] * h[i];\n";
+      if (plan_.forceFactor)
+        cl_ << "  const real amag = " << mag(acc) << ";\n"
+            << "  out_dt_force[i] = amag > 0 ? sqrt(h[i] / amag) : INFINITY;\n";
+      else
+        cl_ << "  out_dt_force[i] = INFINITY;\n";
+      cl_ << "}\n\n";
+      scene_ << "      const int n = static_cast<int>(" << A << ".n);\n";
+      scene_ << "      const double t = 0.0, dt = 0.0;  // (kernel arguments, unused)\n";
+      scene_ << "      " << launch(k, "n", ka) << "\n";
+      // The minima in one round trip: (limit, scratch slot) for the limits the scene uses.
+      std::vector<std::pair<std::string, int>> mins;
+      if (useCfl) mins.push_back({"dt_cfl", 1});
+      if (plan_.forceFactor) mins.push_back({"dt_force", 2});
+      if (plan_.nu) mins.push_back({"h2min", 3});
+      scene_ << "      const std::vector<double> mins = ocl.reduce_all({";
+      for (size_t m = 0; m < mins.size(); ++m)
+        scene_ << (m ? ", " : "") << "{ocl.scratch(n, " << mins[m].second
+               << "), static_cast<std::size_t>(n), sphc::ocl::Op::Min}";
+      scene_ << "});\n";
+      for (size_t m = 0; m < mins.size(); ++m)
+        scene_ << "      " << mins[m].first << " = std::fmin(" << mins[m].first << ", mins[" << m
+               << "]);\n";
+      scene_ << "    }\n";
+      continue;
+    }
     scene_ << "      const double* h = " << propPtr(a, "h") << ";\n";
     if (plan_.cfl || !plan_.forceFactor) {
       scene_ << "      const double* cs = " << propPtr(a, "cs") << ";\n";
@@ -792,7 +1160,9 @@ void Emitter::emitMain() {
   out_ << "  sphc::SceneProgram prog;\n";
   out_ << "  prog.name = \"" << plan_.sceneName << "\";\n";
   out_ << "  prog.dim = DIM;\n";
-  out_ << "  prog.backend = \"" << (openmp_ ? "openmp" : "serial") << "\";\n";
+  out_ << "  prog.backend = \"" << (opencl_ ? "opencl" : openmp_ ? "openmp" : "serial")
+       << "\";\n";
+  if (opencl_) out_ << "  scene.selection = sphc::ocl::take_options(argc, argv);\n";
   if (openmp_)
     out_ << "  prog.set_threads = [](int n) {\n"
             "    if (n > 0) omp_set_num_threads(n);\n"
@@ -807,7 +1177,8 @@ void Emitter::emitMain() {
          << (lit ? std::string("") : "= " + exprText(*p->value)) << "\"});\n";
   }
   out_ << "  prog.setup = [](const std::vector<double>& v, sphc::SceneTimes& times) {\n"
-          "    scene.setup(v, times);\n  };\n";
+          "    scene.setup(v, times);\n"
+       << (opencl_ ? "    scene.to_device();\n" : "") << "  };\n";
   out_ << "  prog.arrays = [] { return std::vector<sphc::ParticleArray*>{";
   bool first = true;
   for (const auto& a : plan_.arrays) {
@@ -815,9 +1186,11 @@ void Emitter::emitMain() {
     first = false;
   }
   out_ << "}; };\n";
-  out_ << "  prog.compute_initial = [](double t, double dt) { scene.compute_accelerations(t, dt); "
-          "};\n";
+  out_ << "  prog.compute_initial = [](double t, double dt) { scene.compute_accelerations(t, dt); };\n";
   out_ << "  prog.step = [](double t, double dt) { scene.step(t, dt); };\n";
+  // OpenCL: particle data stays on the device; the run loop asks for it back only when it
+  // writes output or checks for a blow-up.
+  if (opencl_) out_ << "  prog.to_host = [] { scene.to_host(); };\n";
   if (plan_.adaptiveDt) out_ << "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n";
   bool anyOutput = false;
   for (const auto& a : plan_.arrays) anyOutput |= !a.outputProps.empty();
@@ -838,7 +1211,11 @@ void Emitter::emitMain() {
 std::string Emitter::run() {
   std::string file = llvm::sys::path::filename(plan_.mainFile).str();
   out_ << "// Generated by sphc from " << file << ": do not edit; edit the .sph and recompile.\n";
-  out_ << "// Backend: " << (openmp_ ? "openmp (loops over particles in parallel)" : "serial")
+  out_ << "// Backend: "
+       << (opencl_ ? std::string("opencl (kernels in SCENE_CL, ") +
+                         (singlePrecision_ ? "single" : "double") + " precision)"
+           : openmp_ ? "openmp (loops over particles in parallel)"
+                     : "serial")
        << ".\n";
   out_ << "// Scene '" << plan_.sceneName << "': dim " << plan_.dim << ", kernel "
        << plan_.kernel << ", integrator "
@@ -851,12 +1228,15 @@ std::string Emitter::run() {
   if (anyLoad) out_ << "#include \"sphc/load.h\"\n";
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   if (openmp_) out_ << "\n#include <omp.h>\n";
+  if (opencl_) out_ << "\n#include \"sphc/opencl.h\"\n";
   out_ << "\n";
   out_ << "namespace {\n\n";
   out_ << "constexpr int DIM = " << plan_.dim << ";\n";
   out_ << "using Kernel = sphc::" << plan_.kernel << "<DIM>;\n";
   out_ << "constexpr double RADIUS2 = Kernel::radius_scale * Kernel::radius_scale;\n\n";
   out_ << "// ---- Equation and stepper bodies, as written in the .sph files ----\n\n";
+  // OpenCL: line 1 of the kernel source is this directive, so lines are the source's own.
+  if (opencl_) cl_ << "#line 2 \"" << plan_.sceneName << ".cl\"\n";
   // Bodies of live equations (each declaration once) and of steppers.
   std::set<int> emittedDecls;
   for (const auto& eq : plan_.equations) {
@@ -864,9 +1244,11 @@ std::string Emitter::run() {
     const auto& pd = plan_.equationDecls[eq.declIndex];
     static const char* names[] = {"initialize", "loop", "post_loop", "reduce", "converged"};
     static const char* rets[] = {"void", "void", "void", "double", "int"};
+    // OpenCL: every body runs on the device but `converged`, which the host evaluates from
+    // the host copy of the constants.
     for (const auto& [kind, b] : pd.methods)
       emitBodyFunction(plan_.bodies[b], bodyFunctionName(eq.name, names[kind]), rets[kind],
-                       eq.dest);
+                       eq.dest, opencl_ && kind != ast::Method::Converged);
   }
   std::set<int> emittedSteppers;
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
@@ -874,7 +1256,7 @@ std::string Emitter::run() {
     if (s < 0 || !emittedSteppers.insert(s).second) continue;
     for (const auto& [m, b] : plan_.steppers[s].methods)
       emitBodyFunction(plan_.bodies[b], bodyFunctionName(plan_.steppers[s].decl->name.name, m),
-                       "void", a);
+                       "void", a, opencl_);
   }
 
   emitParams();
@@ -883,6 +1265,13 @@ std::string Emitter::run() {
   emitSteppers();
   emitStep();
   emitAdaptiveDt();
+  if (opencl_) {
+    clText_ = cl_.str();
+    out_ << "// ---- OpenCL C of the kernels, built at start-up with the runtime's ----\n\n";
+    out_ << "constexpr bool DOUBLE_PRECISION = " << (singlePrecision_ ? "false" : "true")
+         << ";\n";
+    out_ << "const char* const SCENE_CL = R\"SPHC_CL(" << clText_ << ")SPHC_CL\";\n\n";
+  }
 
   out_ << "// ---- The scene ----\n\n";
   out_ << "struct Scene {\n";
@@ -890,8 +1279,16 @@ std::string Emitter::run() {
   for (const auto& a : plan_.arrays)
     if (!a.decl->loads.empty())
       out_ << "  std::vector<sphc::ParticleArray> loaded_" << a.name << ";\n";
-  out_ << "  sphc::SearchDomain domain;\n";
-  for (const auto& S : sourceArrays_) out_ << "  sphc::CellList cells_" << S << ";\n";
+  if (opencl_) {
+    out_ << "  sphc::ocl::Selection selection;  // --platform, --device\n";
+    out_ << "  sphc::ocl::Context ocl;\n";
+    for (const auto& a : plan_.arrays) out_ << "  sphc::ocl::DeviceArray dev_" << a.name << ";\n";
+    out_ << "  sphc::ocl::Grid grid;\n";
+    for (const auto& S : sourceArrays_) out_ << "  sphc::ocl::CellTable cells_" << S << ";\n";
+  } else {
+    out_ << "  sphc::SearchDomain domain;\n";
+    for (const auto& S : sourceArrays_) out_ << "  sphc::CellList cells_" << S << ";\n";
+  }
   out_ << "  int last_iterations = 0;\n";
   if (!sourceArrays_.empty()) {
     out_ << "  static constexpr long REORDER_EVERY = 50;\n";
@@ -903,6 +1300,19 @@ std::string Emitter::run() {
     out_ << "  std::string source_dir = \"" << llvm::sys::path::parent_path(dir).str()
          << "\";  // where the .sph file is\n";
   }
+  if (opencl_) {
+    // Data movement: everything up after set-up; properties back for output and checks.
+    scene_ << "  void to_device() {\n";
+    scene_ << "    ocl.init(selection, DOUBLE_PRECISION, sphc::ocl::kernel_function_source(\""
+           << plan_.kernel << "\", DIM) + SCENE_CL, \"" << plan_.sceneName << "\");\n";
+    for (const auto& a : plan_.arrays)
+      scene_ << "    dev_" << a.name << ".upload(ocl, " << a.name << ");\n";
+    scene_ << "  }\n\n";
+    scene_ << "  void to_host() {\n";
+    for (const auto& a : plan_.arrays)
+      scene_ << "    dev_" << a.name << ".download(ocl, " << a.name << ");\n";
+    scene_ << "  }\n\n";
+  }
   out_ << "\n" << scene_.str() << "};\n\n}  // namespace\n\n";
   emitMain();
   return out_.str();
@@ -912,6 +1322,13 @@ std::string Emitter::run() {
 
 std::string emitCpp(const Plan& plan, const DiagnosticEngine& diags, const EmitOptions& opts) {
   return Emitter(plan, diags, opts).run();
+}
+
+std::string emitOpenCL(const Plan& plan, const DiagnosticEngine& diags, EmitOptions opts) {
+  opts.backend = "opencl";
+  Emitter e(plan, diags, opts);
+  e.run();
+  return e.kernelSource();
 }
 
 }  // namespace sphc

@@ -1,7 +1,9 @@
 // The serial C++ code generator: a Plan to one readable C++ file that includes the runtime
 // headers and defines `main`. Every equation and stepper body becomes an inline function
 // holding the body as written (with `// from file.sph:line` provenance); each group becomes
-// a function per destination with one fused neighbour pass per source.
+// a function per destination with one fused neighbour pass per source. --backend=opencl
+// shares all of it but the execution of phases, steppers, neighbour search and adaptive dt:
+// those become OpenCL C kernels (the same bodies, typed `real`) launched from the host code.
 #pragma once
 
 #include "frontend/Diagnostics.h"
@@ -12,9 +14,12 @@
 namespace sphc {
 
 struct EmitOptions {
-  std::string backend = "serial";
+  std::string backend = "serial";  // serial, openmp or opencl
+  std::string precision = "double";  // opencl: the device's `real` (double or single)
 };
 
 std::string emitCpp(const Plan& plan, const DiagnosticEngine& diags, const EmitOptions& opts);
+// --backend=opencl: the OpenCL C of the scene's kernels alone (what --emit=opencl prints).
+std::string emitOpenCL(const Plan& plan, const DiagnosticEngine& diags, EmitOptions opts);
 
 }  // namespace sphc

@@ -5,6 +5,7 @@
 #include "llvm/Support/FileSystem.h"
 #include "llvm/Support/MemoryBuffer.h"
 #include "llvm/Support/Path.h"
+#include "llvm/Support/Process.h"
 #include "llvm/Support/Program.h"
 #include "llvm/Support/SHA1.h"
 #include "llvm/Support/raw_ostream.h"
@@ -90,6 +91,12 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
     std::string omp = info.count("openmp_flags") ? info["openmp_flags"] : "-fopenmp";
     flags += " " + omp;
     libs += " " + omp;
+  } else if (req.backend == "opencl") {
+    // The OpenCL runtime library and the ICD loader (kernels are built when the solver runs).
+    runtimeLib = install.libDir + "/libsphc_runtime_ocl.a";
+    flags += " " + (info.count("opencl_flags") ? info["opencl_flags"]
+                                                : std::string("-DCL_TARGET_OPENCL_VERSION=120"));
+    libs += " " + info["opencl_libs"];
   }
 
   // The key: generated code, compiler, flags, libraries, the runtime library and headers.
@@ -132,8 +139,12 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
     res.message = "cannot create the cache directory '" + std::string(dir) + "': " + e.message();
     return finish(false);
   }
-  std::string cppFile = std::string(dir) + "/scene.cpp";
-  std::string logFile = std::string(dir) + "/build.log";
+  // Per-process names: two sphc runs building the same scene at once (parallel tests, make -j)
+  // must not write each other's files. The finished executable is renamed into place, which
+  // is atomic, so a reader sees either no cached build or a whole one.
+  const std::string pid = std::to_string(llvm::sys::Process::getProcessId());
+  std::string cppFile = std::string(dir) + "/scene." + pid + ".cpp";
+  std::string logFile = std::string(dir) + "/build." + pid + ".log";
   {
     llvm::raw_fd_ostream os(cppFile, ec);
     if (ec) {
@@ -142,7 +153,7 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
     }
     os << req.cpp;
   }
-  std::string tmpExe = cachedExe + ".tmp";
+  std::string tmpExe = cachedExe + "." + pid + ".tmp";
   std::vector<std::string> args;
   auto cxxPath = llvm::sys::findProgramByName(cxx);
   if (!cxxPath) {
@@ -183,7 +194,30 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
     res.message = "cannot move the built executable into the cache: " + e.message();
     return finish(false);
   }
+  // Kept beside the executable for people who want to read what was built.
+  fs::rename(cppFile, std::string(dir) + "/scene.cpp");
+  fs::remove(logFile);
   return deliver();
+}
+
+bool openclAvailable(const Install& install, std::string& why) {
+  std::string err;
+  auto info = readBuildInfo(install.buildInfo, err);
+  if (!err.empty()) {
+    why = err;
+    return false;
+  }
+  if (info["opencl_libs"].empty()) {
+    why = "CMake did not find OpenCL when sphc was built (install an OpenCL loader and "
+          "headers, e.g. ocl-icd-opencl-dev opencl-headers, plus a driver such as "
+          "pocl-opencl-icd, and reconfigure)";
+    return false;
+  }
+  if (!fs::exists(install.libDir + "/libsphc_runtime_ocl.a")) {
+    why = "the OpenCL runtime library '" + install.libDir + "/libsphc_runtime_ocl.a' is missing";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace sphc

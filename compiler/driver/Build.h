@@ -21,7 +21,7 @@ struct BuildRequest {
   std::string output;       // executable to write
   std::string cxx;          // override of the C++ compiler ("" = from buildinfo)
   std::string cxxflags;     // override of the flags ("" = from buildinfo)
-  std::string backend = "serial";  // serial or openmp: which runtime and flags
+  std::string backend = "serial";  // serial, openmp or opencl: which runtime and flags
   bool useCache = true;
   bool verbose = false;
 };
@@ -34,6 +34,10 @@ struct BuildResult {
 };
 
 BuildResult buildExecutable(const Install& install, const BuildRequest& req);
+
+// Whether solvers of --backend=opencl can be built (CMake found OpenCL: buildinfo.txt has a
+// non-empty opencl_libs and lib/libsphc_runtime_ocl.a exists); else false and why.
+bool openclAvailable(const Install& install, std::string& why);
 
 // The cache directory: $SPHC_CACHE_DIR, else $XDG_CACHE_HOME/sphc, else ~/.cache/sphc.
 std::string cacheDirectory();

@@ -28,9 +28,14 @@ static cl::opt<std::string> OutputFile("o", cl::desc("Executable to write (defau
                                        cl::value_desc("file"), cl::cat(SphcCat));
 static cl::opt<std::string> Backend("backend", cl::desc("serial (default), openmp or opencl"),
                                     cl::init("serial"), cl::cat(SphcCat));
+static cl::opt<std::string> Precision("precision",
+                                      cl::desc("--backend=opencl: floating point on the device, "
+                                               "double (default; needs fp64) or single"),
+                                      cl::init("double"), cl::cat(SphcCat));
 static cl::opt<std::string> Emit("emit",
                                  cl::desc("What to produce: exe (default), cpp (the generated "
-                                          "C++ on stdout), plan, ast"),
+                                          "C++ on stdout), opencl (the OpenCL C kernels of "
+                                          "--backend=opencl), plan, ast"),
                                  cl::init("exe"), cl::cat(SphcCat));
 static cl::opt<std::string> DumpAfter("dump-after",
                                       cl::desc("Print the state after a pass and stop: parse, "
@@ -68,14 +73,19 @@ int main(int argc, char** argv) {
     llvm::errs() << "sphc: " << what << " done at " << llvm::format("%.3f", s) << " s\n";
   };
 
-  if (Backend == "opencl") {
-    llvm::errs() << "sphc: error: backend 'opencl' is not available yet; this version builds "
-                 << "--backend=serial and --backend=openmp\n";
+  if (Backend != "serial" && Backend != "openmp" && Backend != "opencl") {
+    llvm::errs() << "sphc: error: unknown backend '" << Backend
+                 << "'; backends are: serial, openmp, opencl\n";
     return fail();
   }
-  if (Backend != "serial" && Backend != "openmp") {
-    llvm::errs() << "sphc: error: unknown backend '" << Backend
-                 << "'; backends are: serial, openmp (opencl: not yet)\n";
+  if (Precision != "double" && Precision != "single") {
+    llvm::errs() << "sphc: error: unknown --precision '" << Precision
+                 << "'; it is double or single\n";
+    return fail();
+  }
+  if (Precision != "double" && Backend != "opencl") {
+    llvm::errs() << "sphc: error: --precision=" << Precision
+                 << " is for --backend=opencl; the C++ backends compute in double\n";
     return fail();
   }
   static const char* passes[] = {"parse", "sema",   "bodies", "prune",
@@ -87,13 +97,23 @@ int main(int argc, char** argv) {
                     "hazards, pairs\n";
     return fail();
   }
-  if (Emit != "exe" && Emit != "cpp" && Emit != "plan" && Emit != "ast") {
+  if (Emit != "exe" && Emit != "cpp" && Emit != "opencl" && Emit != "plan" && Emit != "ast") {
     llvm::errs() << "sphc: error: unknown --emit kind '" << Emit
-                 << "'; kinds are: exe, cpp, plan, ast\n";
+                 << "'; kinds are: exe, cpp, opencl, plan, ast\n";
     return fail();
   }
 
   Install install = locateInstall(argv[0]);
+  // A solver of --backend=opencl needs the OpenCL runtime, built only where CMake found
+  // OpenCL; say so before any work (--emit=cpp/opencl do not need it).
+  if (Backend == "opencl" && Emit == "exe") {
+    std::string why;
+    if (!openclAvailable(install, why)) {
+      llvm::errs() << "sphc: error: --backend=opencl is not available in this build: " << why
+                   << "\n";
+      return fail();
+    }
+  }
   llvm::SourceMgr sm;
   DiagnosticEngine diags(sm);
   diags.setWarningsAsErrors(WarningsAsErrors);
@@ -150,7 +170,12 @@ int main(int argc, char** argv) {
   }
 
   // --- code generation and build ------------------------------------------------------
-  std::string cpp = emitCpp(*plan, diags, EmitOptions{Backend});
+  EmitOptions emitOpts{Backend, Precision};
+  if (Emit == "opencl") {
+    llvm::outs() << emitOpenCL(*plan, diags, emitOpts);
+    return 0;
+  }
+  std::string cpp = emitCpp(*plan, diags, emitOpts);
   log("emit");
   if (Emit == "cpp") {
     llvm::outs() << cpp;

@@ -29,6 +29,7 @@ constexpr int kExitBlowUp = 3;
 constexpr double kTimeSlack = 1e-12;     // relative to tf: "t reached tf", "t reached an output"
 constexpr double kMinDtFraction = 1e-12; // an adaptive dt below this * tf has collapsed
 constexpr long kCheckEvery = 10;         // steps between scans for non-finite values
+constexpr long kCheckEveryDevice = 100;  // the same where each scan copies data off a device
 
 using Clock = std::chrono::steady_clock;
 
@@ -419,9 +420,10 @@ class Simulation {
     // As PySPH: the equations run once before the first output, so the t = 0 snapshot holds
     // computed quantities (pressures, summation densities) and not zeros.
     if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
-    if (auto bad = find_non_finite(arrays_)) return blow_up("simulation blew up", describe(*bad));
+    if (auto bad = check_finite()) return blow_up("simulation blew up", describe(*bad));
     write_output();
 
+    const long check_every = prog_.to_host ? kCheckEveryDevice : kCheckEvery;
     const auto loop_start = Clock::now();
     progress_.start(!opt_.quiet, tf);
     double particle_steps = 0;
@@ -441,14 +443,14 @@ class Simulation {
       particle_steps += static_cast<double>(particles());
 
       const bool output_due = schedule.due(t_);
-      if (output_due || step_ % kCheckEvery == 0) {
-        if (auto bad = find_non_finite(arrays_)) return blow_up("simulation blew up", describe(*bad));
+      if (output_due || step_ % check_every == 0) {
+        if (auto bad = check_finite()) return blow_up("simulation blew up", describe(*bad));
       }
       if (output_due) write_output();
       progress_.update(t_, step_, dt_, particles());
     }
     if (last_output_step_ != step_) {
-      if (auto bad = find_non_finite(arrays_)) return blow_up("simulation blew up", describe(*bad));
+      if (auto bad = check_finite()) return blow_up("simulation blew up", describe(*bad));
       write_output();
     }
     report(seconds_since(loop_start), particle_steps, tf);
@@ -486,6 +488,12 @@ class Simulation {
             "output interval", times.output_every);
   }
 
+  // Brings device data to the host (device backends) and looks for NaN or Inf in it.
+  std::optional<NonFinite> check_finite() {
+    if (prog_.to_host) prog_.to_host();
+    return find_non_finite(arrays_);
+  }
+
   std::size_t particles() const {
     std::size_t n = 0;
     for (const ParticleArray* a : arrays_) n += a->n;
@@ -501,7 +509,7 @@ class Simulation {
 
   int time_step_failure(double dt, double tf) {
     // A non-finite property usually explains a bad time step: name it if there is one.
-    if (auto bad = find_non_finite(arrays_)) return blow_up("simulation blew up", describe(*bad));
+    if (auto bad = check_finite()) return blow_up("simulation blew up", describe(*bad));
     if (!std::isfinite(dt) || dt <= 0) {
       return blow_up("simulation blew up", fmt::format("the adaptive time step is {}", dt));
     }

@@ -27,3 +27,16 @@ config.substitutions.append((tool('not'), config.not_tool))
 for var in ('PATH', 'HOME', 'TMPDIR'):
     if var in os.environ:
         config.environment[var] = os.environ[var]
+
+# `REQUIRES: opencl`: the build found OpenCL (buildinfo.txt has a non-empty opencl_libs, and
+# libsphc_runtime_ocl.a was built), so --backend=opencl solvers can be built and run.
+_build_dir = getattr(config, 'sphc_build_dir', None) or os.path.dirname(config.sphc_bin_dir)
+_buildinfo = os.path.join(_build_dir, 'share', 'sphc', 'buildinfo.txt')
+if os.path.exists(_buildinfo):
+    with open(_buildinfo) as f:
+        _info = dict(l.rstrip('\n').split('=', 1) for l in f if '=' in l)
+    if _info.get('opencl_libs', '').strip():
+        config.available_features.add('opencl')
+# Helper scripts of the tests (tests/lit/Inputs), e.g. %h5close A.h5 B.h5 --rtol R.
+config.substitutions.append(('%h5close', 'python3 ' + os.path.join(
+    config.sphc_src_root, 'tests', 'lit', 'Inputs', 'h5close.py')))

@@ -42,6 +42,9 @@ struct SceneProgram {
   std::function<void(double t, double dt)> compute_initial;  // may be empty
   std::function<void(double t, double dt)> step;             // one time step from t to t+dt
   std::function<double()> adaptive_dt;                       // empty = fixed dt
+  // Device backends: copies the device's particle data into the host arrays. The run loop
+  // calls it only before it reads them (output, blow-up checks); empty = data lives on the host.
+  std::function<void()> to_host;
   // Multi-threaded backends: sets the number of threads (--threads N) and returns the number
   // in use; empty for a serial solver, which then refuses --threads.
   std::function<int(int threads)> set_threads;

@@ -1,0 +1,173 @@
+// sphc runtime: support for solvers of --backend=opencl (built as libsphc_runtime_ocl.a, only
+// when CMake found OpenCL).
+//
+// A generated OpenCL solver keeps every particle property in a device buffer (one per
+// property and per array constant, `real` = double or float as chosen by sphc --precision).
+// Host data (sphc::ParticleArray) stays double: DeviceArray converts at upload and download.
+// Context owns the platform/device choice, the program (the scene's kernels plus the runtime
+// kernels below, built once with the build log on failure), kernel launches and reductions.
+// CellTable is the device neighbour search: a cell key per particle on a dense grid over the
+// search domain (the domain from min/max reductions on the device), a counting sort by cell
+// (atomic counts, scan, scatter, then each cell's few indices sorted, so the order is
+// deterministic), and cell start/end tables; interaction kernels loop over the 3^dim
+// cells around a particle and apply r_ij < radius_scale * max(h_i, h_j) themselves.
+#pragma once
+
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 120
+#endif
+#include <CL/cl.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sphc/particle_array.h"
+
+namespace sphc {
+namespace ocl {
+
+// The name of an OpenCL error code (e.g. "CL_OUT_OF_RESOURCES").
+const char* error_name(cl_int err);
+// Throws std::runtime_error("OpenCL: <what> failed: <error name>") unless err is CL_SUCCESS.
+void check(cl_int err, const char* what);
+
+// Removes `--platform N`, `--device N` and `--list-devices` from the command line (so that
+// run_main does not see them); --list-devices prints every platform and device and exits.
+// SPHC_OPENCL_PLATFORM / SPHC_OPENCL_DEVICE in the environment give defaults.
+struct Selection {
+  int platform = -1;  // -1: the first platform with a device that fits
+  int device = -1;
+};
+Selection take_options(int& argc, char** argv);
+
+// The uniform grid of the device neighbour search (dense, cells of side `cell`).
+struct Grid {
+  double lo[3] = {0.0, 0.0, 0.0};
+  double inv_cell = 1.0;
+  int ncell[3] = {1, 1, 1};
+  std::size_t cells() const { return static_cast<std::size_t>(ncell[0]) * ncell[1] * ncell[2]; }
+};
+
+enum class Op { Sum, Min, Max };
+
+class Context;
+
+// The cell table of one source array: particles sorted by cell (a counting sort on the
+// device: order = particle indices cell by cell, ascending within a cell, as CellList's),
+// start/end per cell of the dense grid.
+struct CellTable {
+  cl_mem keys = nullptr, order = nullptr, start = nullptr, end = nullptr;
+  cl_mem count = nullptr, partial = nullptr;  // scratch of the counting sort
+  std::size_t padded = 0, cells = 0;          // capacity of keys/order, of the cell tables
+  static constexpr std::size_t kScanItems = 256;
+  void build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem z, std::size_t n);
+  void release();
+  ~CellTable() { release(); }
+};
+
+// Device copies of the properties and constants of one ParticleArray.
+struct DeviceArray {
+  std::vector<cl_mem> props;
+  std::vector<cl_mem> constants;
+  std::size_t n = 0;
+  cl_mem prop(int i) const { return props[i]; }
+  cl_mem constant(int i) const { return constants[i]; }
+  // Allocates (first call or resize) and copies every property and constant to the device.
+  void upload(Context& ctx, const ParticleArray& a);
+  void upload_constant(Context& ctx, const ParticleArray& a, int c);
+  // Copies every property (not the constants: the host copy is the reference) back.
+  void download(Context& ctx, ParticleArray& a);
+  // Reorders the particles on the device into the cell order of `cells` (built on this
+  // array): ParticleArray::permute(cell_order) of the CPU backends.
+  void permute(Context& ctx, const CellTable& cells, const ParticleArray& a);
+  void release();
+  ~DeviceArray() { release(); }
+};
+
+// Per-array extents for the search domain: device buffers of x, y, z (nullptr beyond dim), h.
+struct Extent {
+  cl_mem x = nullptr, y = nullptr, z = nullptr, h = nullptr;
+  std::size_t n = 0;
+};
+
+class Context {
+ public:
+  // Picks the platform and device (sel, else the first device that fits; double precision
+  // needs fp64), creates the context and queue, and builds `scene_source` (OpenCL C, which may
+  // use the `real` type and the runtime helpers) together with the runtime kernels. On a build
+  // failure the exception holds the compiler log; `#line` directives in the scene source make
+  // it name the .sph lines of the bodies.
+  void init(const Selection& sel, bool double_precision, const std::string& scene_source,
+            const std::string& scene_name);
+  ~Context();
+
+  bool double_precision() const { return dp_; }
+  std::size_t real_size() const { return dp_ ? sizeof(double) : sizeof(float); }
+  const std::string& device_name() const { return device_name_; }
+  cl_command_queue queue() const { return queue_; }
+
+  cl_mem alloc(std::size_t bytes);
+  // A scratch buffer of at least n reals, kept between calls (slot: several at once).
+  cl_mem scratch(std::size_t n, int slot = 0);
+  cl_kernel kernel(const std::string& name);
+
+  // Sets the arguments in order (cl_mem, int, unsigned, double as real, Grid: 7 arguments,
+  // const CellTable&: order, start, end) and runs the kernel on n work items (none if n = 0).
+  template <class... A>
+  void run(const std::string& name, std::size_t n, const A&... args) {
+    if (n == 0) return;
+    cl_kernel k = kernel(name);
+    cl_uint i = 0;
+    (set_arg(k, i, args), ...);
+    launch(k, n, name);
+  }
+  // op over v[0..n) (reals on the device): partial results on the device, finished here.
+  // Min and Max ignore NaN (as fmin/fmax); finite_only also ignores infinities.
+  double reduce(cl_mem v, std::size_t n, Op op, bool finite_only = false);
+  // Several reductions with one wait for the device (as reduce, in order).
+  struct Reduction {
+    cl_mem v;
+    std::size_t n;
+    Op op;
+    bool finite_only = false;
+  };
+  std::vector<double> reduce_all(const std::vector<Reduction>& rs);
+  // The search domain over every array in a neighbour loop (as sphc::make_search_domain:
+  // bounding box of finite coordinates, cell = radius_scale * max h), from device data.
+  Grid make_grid(const std::vector<Extent>& arrays, int dim, double radius_scale);
+  void finish();
+  // Copies n reals from the device into doubles (blocking).
+  void read_reals(cl_mem m, double* out, std::size_t n);
+
+  void set_arg(cl_kernel k, cl_uint& i, cl_mem m);
+  void set_arg(cl_kernel k, cl_uint& i, int v);
+  void set_arg(cl_kernel k, cl_uint& i, unsigned v);
+  void set_arg(cl_kernel k, cl_uint& i, double v);
+  void set_arg(cl_kernel k, cl_uint& i, const Grid& g);
+  void set_arg(cl_kernel k, cl_uint& i, const CellTable& c);
+  // SPHC_OPENCL_PROFILE=1 in the environment: every launch waits for its kernel, and the
+  // time per kernel name is printed to stderr at exit.
+  void launch(cl_kernel k, std::size_t n, const std::string& name = "");
+
+ private:
+  bool dp_ = true;
+  std::string device_name_;
+  cl_context context_ = nullptr;
+  cl_command_queue queue_ = nullptr;
+  cl_program program_ = nullptr;
+  std::map<std::string, cl_kernel> kernels_;
+  std::map<int, std::pair<cl_mem, std::size_t>> scratch_;
+  std::vector<double> host_partial_;
+  bool profile_ = false;
+  std::map<std::string, std::pair<double, long>> profile_times_;
+};
+
+// OpenCL C of the kernel functions `kernel_w(r, h)` and `kernel_gradient(xij, r, h, grad)` and
+// RADIUS_SCALE for one smoothing kernel of sphc/kernels.h ("CubicSpline", ...) and dimension.
+std::string kernel_function_source(const std::string& kernel, int dim);
+
+}  // namespace ocl
+}  // namespace sphc

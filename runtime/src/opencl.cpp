@@ -1,0 +1,777 @@
+#include "sphc/opencl.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+
+namespace sphc {
+namespace ocl {
+
+namespace {
+
+// Runtime kernels: cell keys, bitonic sort, cell ranges, reductions. `real` is defined by
+// the prefix in Context::init.
+const char* kRuntimeSource = R"CLC(
+#define SPHC_GRID_ARGS const real grid_lox, const real grid_loy, const real grid_loz, \
+    const real grid_inv, const int grid_nx, const int grid_ny, const int grid_nz
+#define SPHC_CELLS_ARGS(S) __global const uint* S##_order, __global const uint* S##_start, \
+    __global const uint* S##_end
+
+// Cell coordinate along an axis: NaN and values below the grid give 0, beyond it the last
+// cell (as sphc::CellList).
+inline int sphc_axis_cell(real v, int ncell) {
+  const real cmax = (real)(ncell - 1);
+  v = v >= (real)0 ? v : (real)0;
+  v = v <= cmax ? v : cmax;
+  return (int)v;
+}
+
+__kernel void sphc_cell_keys(const uint n, __global const real* x, __global const real* y,
+                             __global const real* z, const int has_y, const int has_z,
+                             SPHC_GRID_ARGS, __global uint* keys, __global uint* count) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  const int cx = sphc_axis_cell((x[i] - grid_lox) * grid_inv, grid_nx);
+  const int cy = has_y ? sphc_axis_cell((y[i] - grid_loy) * grid_inv, grid_ny) : 0;
+  const int cz = has_z ? sphc_axis_cell((z[i] - grid_loz) * grid_inv, grid_nz) : 0;
+  const uint key = (uint)((cz * grid_ny + cy) * grid_nx + cx);
+  keys[i] = key;
+  atomic_inc(&count[key]);
+}
+
+// Exclusive scan of count[0..cells) into start (and end = start + count), in three kernels:
+// G work items sum chunks, one scans the G sums, G write their chunks.
+__kernel void sphc_scan_chunks(__global const uint* count, const uint cells,
+                               __global uint* partial) {
+  const uint g = get_global_id(0), G = get_global_size(0);
+  const uint chunk = (cells + G - 1) / G;
+  uint sum = 0;
+  for (uint c = g * chunk; c < min(cells, (g + 1) * chunk); ++c) sum += count[c];
+  partial[g] = sum;
+}
+__kernel void sphc_scan_partials(__global uint* partial, const uint G) {
+  if (get_global_id(0) != 0) return;
+  uint acc = 0;
+  for (uint g = 0; g < G; ++g) {
+    const uint v = partial[g];
+    partial[g] = acc;
+    acc += v;
+  }
+}
+__kernel void sphc_scan_apply(__global uint* count, const uint cells,
+                              __global const uint* partial, __global uint* start,
+                              __global uint* end) {
+  const uint g = get_global_id(0), G = get_global_size(0);
+  const uint chunk = (cells + G - 1) / G;
+  uint acc = partial[g];
+  for (uint c = g * chunk; c < min(cells, (g + 1) * chunk); ++c) {
+    start[c] = acc;
+    acc += count[c];
+    end[c] = acc;
+    count[c] = 0;  // the cursor of sphc_scatter
+  }
+}
+__kernel void sphc_scatter(const uint n, __global const uint* keys, __global const uint* start,
+                           __global uint* cursor, __global uint* order) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  const uint key = keys[i];
+  order[start[key] + atomic_inc(&cursor[key])] = i;
+}
+// The scatter's order within a cell depends on timing: sort each cell by index (cells hold a
+// few particles), so the order is deterministic and the CPU's (ascending index).
+__kernel void sphc_sort_cells(const uint cells, __global const uint* start,
+                              __global const uint* end, __global uint* order) {
+  const uint c = get_global_id(0);
+  if (c >= cells) return;
+  const uint b = start[c], e = end[c];
+  for (uint k = b + 1; k < e; ++k) {
+    const uint v = order[k];
+    uint m = k;
+    while (m > b && order[m - 1] > v) {
+      order[m] = order[m - 1];
+      --m;
+    }
+    order[m] = v;
+  }
+}
+
+__kernel void sphc_fill_uint(__global uint* v, const uint value, const uint count) {
+  const uint i = get_global_id(0);
+  if (i < count) v[i] = value;
+}
+
+// Particle i of dst = particle order[i] of src (every value of a stride), for 4- and 8-byte
+// values (ParticleArray::permute on the device).
+__kernel void sphc_gather4(__global uint* dst, __global const uint* src,
+                           __global const uint* order, const uint n, const uint stride) {
+  const uint i = get_global_id(0);
+  if (i >= n * stride) return;
+  dst[i] = src[order[i / stride] * stride + i % stride];
+}
+__kernel void sphc_gather8(__global ulong* dst, __global const ulong* src,
+                           __global const uint* order, const uint n, const uint stride) {
+  const uint i = get_global_id(0);
+  if (i >= n * stride) return;
+  dst[i] = src[order[i / stride] * stride + i % stride];
+}
+
+// Partial extents for the search domain, one pass: work item g writes min/max of the finite
+// x, y, z (axes beyond dim: +inf/-inf) and the max of finite h over v[g], v[g + G], ...
+__kernel void sphc_extent(const uint n, const int dim, __global const real* x,
+                          __global const real* y, __global const real* z,
+                          __global const real* h, const uint offset,
+                          __global real* partial) {
+  const uint g = get_global_id(0), G = get_global_size(0);
+  real lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  real hmax = -INFINITY;
+  for (uint i = g; i < n; i += G) {
+    const real v[3] = {x[i], dim > 1 ? y[i] : (real)0, dim > 2 ? z[i] : (real)0};
+    for (int a = 0; a < dim; ++a)
+      if (isfinite(v[a])) {
+        lo[a] = fmin(lo[a], v[a]);
+        hi[a] = fmax(hi[a], v[a]);
+      }
+    if (isfinite(h[i])) hmax = fmax(hmax, h[i]);
+  }
+  partial += offset + 7 * g;
+  for (int a = 0; a < 3; ++a) {
+    partial[2 * a] = lo[a];
+    partial[2 * a + 1] = hi[a];
+  }
+  partial[6] = hmax;
+}
+
+// Partial reductions: work item g combines v[g], v[g + G], ... (G work items).
+__kernel void sphc_reduce(__global const real* v, const uint n, const int op,
+                          const int finite_only, const uint offset, __global real* partial) {
+  const uint g = get_global_id(0), G = get_global_size(0);
+  real acc = op == 0 ? (real)0 : op == 1 ? (real)INFINITY : (real)(-INFINITY);
+  for (uint i = g; i < n; i += G) {
+    const real x = v[i];
+    if (finite_only && !isfinite(x)) continue;
+    acc = op == 0 ? acc + x : op == 1 ? fmin(acc, x) : fmax(acc, x);
+  }
+  partial[offset + g] = acc;
+}
+)CLC";
+
+constexpr std::size_t kReduceItems = 256;
+
+// A string property of a platform or device (get: clGetPlatformInfo or clGetDeviceInfo).
+template <class Get, class Obj, class Info>
+std::string info_string(Get get, Obj obj, Info what) {
+  std::size_t size = 0;
+  get(obj, what, 0, nullptr, &size);
+  std::string s(size, '\0');
+  get(obj, what, size, s.data(), nullptr);
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  return s;
+}
+
+bool has_fp64(cl_device_id d) {
+  cl_device_fp_config cfg = 0;
+  clGetDeviceInfo(d, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof cfg, &cfg, nullptr);
+  return cfg != 0;
+}
+
+struct Found {
+  int platform, device;
+  cl_platform_id pid;
+  cl_device_id did;
+  std::string platform_name, device_name;
+  bool fp64;
+};
+
+std::vector<Found> find_devices() {
+  std::vector<Found> all;
+  cl_uint np = 0;
+  if (clGetPlatformIDs(0, nullptr, &np) != CL_SUCCESS || np == 0) return all;
+  std::vector<cl_platform_id> ps(np);
+  clGetPlatformIDs(np, ps.data(), nullptr);
+  for (cl_uint p = 0; p < np; ++p) {
+    cl_uint nd = 0;
+    if (clGetDeviceIDs(ps[p], CL_DEVICE_TYPE_ALL, 0, nullptr, &nd) != CL_SUCCESS) continue;
+    std::vector<cl_device_id> ds(nd);
+    clGetDeviceIDs(ps[p], CL_DEVICE_TYPE_ALL, nd, ds.data(), nullptr);
+    for (cl_uint d = 0; d < nd; ++d)
+      all.push_back({static_cast<int>(p), static_cast<int>(d), ps[p], ds[d],
+                     info_string(clGetPlatformInfo, ps[p], CL_PLATFORM_NAME),
+                     info_string(clGetDeviceInfo, ds[d], CL_DEVICE_NAME), has_fp64(ds[d])});
+  }
+  return all;
+}
+
+std::string describe(const std::vector<Found>& all) {
+  if (all.empty())
+    return "  (no OpenCL platform found: is an ICD installed, e.g. pocl-opencl-icd, and "
+           "listed in /etc/OpenCL/vendors?)\n";
+  std::string s;
+  for (const auto& f : all)
+    s += "  --platform " + std::to_string(f.platform) + " --device " + std::to_string(f.device) +
+         ": " + f.device_name + " (" + f.platform_name + "; fp64: " + (f.fp64 ? "yes" : "no") +
+         ")\n";
+  return s;
+}
+
+int env_int(const char* name) {
+  const char* v = std::getenv(name);
+  return v && *v ? std::atoi(v) : -1;
+}
+
+}  // namespace
+
+const char* error_name(cl_int err) {
+  switch (err) {
+#define SPHC_CL_ERR(e) \
+  case e:              \
+    return #e;
+    SPHC_CL_ERR(CL_SUCCESS)
+    SPHC_CL_ERR(CL_DEVICE_NOT_FOUND)
+    SPHC_CL_ERR(CL_DEVICE_NOT_AVAILABLE)
+    SPHC_CL_ERR(CL_COMPILER_NOT_AVAILABLE)
+    SPHC_CL_ERR(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    SPHC_CL_ERR(CL_OUT_OF_RESOURCES)
+    SPHC_CL_ERR(CL_OUT_OF_HOST_MEMORY)
+    SPHC_CL_ERR(CL_BUILD_PROGRAM_FAILURE)
+    SPHC_CL_ERR(CL_INVALID_VALUE)
+    SPHC_CL_ERR(CL_INVALID_PLATFORM)
+    SPHC_CL_ERR(CL_INVALID_DEVICE)
+    SPHC_CL_ERR(CL_INVALID_CONTEXT)
+    SPHC_CL_ERR(CL_INVALID_COMMAND_QUEUE)
+    SPHC_CL_ERR(CL_INVALID_MEM_OBJECT)
+    SPHC_CL_ERR(CL_INVALID_PROGRAM)
+    SPHC_CL_ERR(CL_INVALID_PROGRAM_EXECUTABLE)
+    SPHC_CL_ERR(CL_INVALID_KERNEL_NAME)
+    SPHC_CL_ERR(CL_INVALID_KERNEL)
+    SPHC_CL_ERR(CL_INVALID_ARG_INDEX)
+    SPHC_CL_ERR(CL_INVALID_ARG_VALUE)
+    SPHC_CL_ERR(CL_INVALID_ARG_SIZE)
+    SPHC_CL_ERR(CL_INVALID_KERNEL_ARGS)
+    SPHC_CL_ERR(CL_INVALID_WORK_GROUP_SIZE)
+    SPHC_CL_ERR(CL_INVALID_WORK_ITEM_SIZE)
+    SPHC_CL_ERR(CL_INVALID_GLOBAL_WORK_SIZE)
+    SPHC_CL_ERR(CL_INVALID_BUFFER_SIZE)
+    SPHC_CL_ERR(CL_INVALID_BUILD_OPTIONS)
+#undef SPHC_CL_ERR
+  }
+  return "unknown OpenCL error";
+}
+
+void check(cl_int err, const char* what) {
+  if (err != CL_SUCCESS)
+    throw std::runtime_error(std::string("OpenCL: ") + what + " failed: " + error_name(err) + " (" +
+                             std::to_string(err) + ")");
+}
+
+Selection take_options(int& argc, char** argv) {
+  Selection sel{env_int("SPHC_OPENCL_PLATFORM"), env_int("SPHC_OPENCL_DEVICE")};
+  int out = 1;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto number = [&](int& into) {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "error: %s needs a number\n", a.c_str());
+        std::exit(2);
+      }
+      char* end = nullptr;
+      long v = std::strtol(argv[++i], &end, 10);
+      if (*end || v < 0) {
+        std::fprintf(stderr, "error: %s takes a non-negative integer, not '%s'\n", a.c_str(),
+                     argv[i]);
+        std::exit(2);
+      }
+      into = static_cast<int>(v);
+    };
+    if (a == "--platform") {
+      number(sel.platform);
+    } else if (a == "--device") {
+      number(sel.device);
+    } else if (a == "--list-devices") {
+      std::printf("OpenCL devices:\n%s", describe(find_devices()).c_str());
+      std::exit(0);
+    } else {
+      if (a == "--help" || a == "-h")
+        std::printf(
+            "OpenCL options (this solver was built with --backend=opencl):\n"
+            "  --platform N      use OpenCL platform N (default: the first with a device that "
+            "fits)\n"
+            "  --device N        use device N of the platform\n"
+            "  --list-devices    list the platforms and devices found, and exit\n"
+            "  (SPHC_OPENCL_PLATFORM, SPHC_OPENCL_DEVICE: defaults; SPHC_OPENCL_PROFILE=1: time "
+            "per kernel)\n\n");
+      argv[out++] = argv[i];
+    }
+  }
+  argc = out;
+  argv[argc] = nullptr;
+  return sel;
+}
+
+void Context::init(const Selection& sel, bool double_precision, const std::string& scene_source,
+                   const std::string& scene_name) {
+  dp_ = double_precision;
+  const char* prof = std::getenv("SPHC_OPENCL_PROFILE");
+  profile_ = prof && *prof && std::string(prof) != "0";
+  auto all = find_devices();
+  const Found* pick = nullptr;
+  std::string why;
+  for (const auto& f : all) {
+    if (sel.platform >= 0 && f.platform != sel.platform) continue;
+    if (sel.device >= 0 && f.device != sel.device) continue;
+    if (dp_ && !f.fp64) {
+      why = "device '" + f.device_name + "' (--platform " + std::to_string(f.platform) +
+            " --device " + std::to_string(f.device) +
+            ") does not support double precision (no fp64); rebuild the scene with sphc "
+            "--precision=single or choose another device. ";
+      continue;
+    }
+    pick = &f;
+    break;
+  }
+  if (!pick)
+    throw std::runtime_error(
+        "OpenCL: no device fits (" + std::string(dp_ ? "double" : "single") + " precision" +
+        (sel.platform >= 0 ? ", --platform " + std::to_string(sel.platform) : std::string()) +
+        (sel.device >= 0 ? ", --device " + std::to_string(sel.device) : std::string()) + "). " +
+        why + "Found:\n" + describe(all));
+  device_name_ = pick->device_name;
+  cl_int err = CL_SUCCESS;
+  cl_context_properties props[] = {CL_CONTEXT_PLATFORM,
+                                   reinterpret_cast<cl_context_properties>(pick->pid), 0};
+  context_ = clCreateContext(props, 1, &pick->did, nullptr, nullptr, &err);
+  check(err, "clCreateContext");
+  queue_ = clCreateCommandQueue(context_, pick->did, 0, &err);
+  check(err, "clCreateCommandQueue");
+
+  std::string source = std::string(dp_ ? "#pragma OPENCL EXTENSION cl_khr_fp64 : enable\n"
+                                         "typedef double real;\n"
+                                       // Single: the bodies' `double` locals are float too.
+                                       : "typedef float real;\n#define double float\n") +
+                       "#line 1 \"sphc-runtime.cl\"\n" + kRuntimeSource + scene_source;
+  const char* src = source.c_str();
+  program_ = clCreateProgramWithSource(context_, 1, &src, nullptr, &err);
+  check(err, "clCreateProgramWithSource");
+  // Single precision: literals are float.
+  const char* options = dp_ ? "" : "-cl-single-precision-constant";
+  err = clBuildProgram(program_, 1, &pick->did, options, nullptr, nullptr);
+  if (err != CL_SUCCESS) {
+    std::size_t size = 0;
+    clGetProgramBuildInfo(program_, pick->did, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
+    std::string log(size, '\0');
+    clGetProgramBuildInfo(program_, pick->did, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
+    while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
+    if (log.size() > 6000) log = log.substr(0, 6000) + "\n... (log truncated)";
+    throw std::runtime_error("OpenCL: the kernels of scene '" + scene_name +
+                             "' did not build for device '" + device_name_ + "' (" +
+                             error_name(err) + "); lines of the .sph bodies are named as " +
+                             "file.sph:line, other lines are generated code:\n" + log);
+  }
+}
+
+Context::~Context() {
+  for (const auto& [name, t] : profile_times_)
+    std::fprintf(stderr, "opencl profile: %-40s %8ld launches %10.4f s\n", name.c_str(), t.second,
+                 t.first);
+  for (auto& [n, k] : kernels_) clReleaseKernel(k);
+  for (auto& [s, b] : scratch_) clReleaseMemObject(b.first);
+  if (program_) clReleaseProgram(program_);
+  if (queue_) clReleaseCommandQueue(queue_);
+  if (context_) clReleaseContext(context_);
+}
+
+cl_mem Context::alloc(std::size_t bytes) {
+  cl_int err = CL_SUCCESS;
+  cl_mem m = clCreateBuffer(context_, CL_MEM_READ_WRITE, bytes ? bytes : 16, nullptr, &err);
+  check(err, "clCreateBuffer");
+  return m;
+}
+
+cl_mem Context::scratch(std::size_t n, int slot) {
+  auto& s = scratch_[slot];
+  if (s.second < n || !s.first) {
+    if (s.first) clReleaseMemObject(s.first);
+    s.first = alloc(n * real_size());
+    s.second = n;
+  }
+  return s.first;
+}
+
+cl_kernel Context::kernel(const std::string& name) {
+  auto it = kernels_.find(name);
+  if (it != kernels_.end()) return it->second;
+  cl_int err = CL_SUCCESS;
+  cl_kernel k = clCreateKernel(program_, name.c_str(), &err);
+  check(err, ("clCreateKernel(" + name + ")").c_str());
+  return kernels_[name] = k;
+}
+
+void Context::set_arg(cl_kernel k, cl_uint& i, cl_mem m) {
+  check(clSetKernelArg(k, i++, sizeof(cl_mem), &m), "clSetKernelArg (buffer)");
+}
+void Context::set_arg(cl_kernel k, cl_uint& i, int v) {
+  cl_int x = v;
+  check(clSetKernelArg(k, i++, sizeof x, &x), "clSetKernelArg (int)");
+}
+void Context::set_arg(cl_kernel k, cl_uint& i, unsigned v) {
+  cl_uint x = v;
+  check(clSetKernelArg(k, i++, sizeof x, &x), "clSetKernelArg (uint)");
+}
+void Context::set_arg(cl_kernel k, cl_uint& i, double v) {
+  if (dp_) {
+    check(clSetKernelArg(k, i++, sizeof v, &v), "clSetKernelArg (real)");
+  } else {
+    float f = static_cast<float>(v);
+    check(clSetKernelArg(k, i++, sizeof f, &f), "clSetKernelArg (real)");
+  }
+}
+void Context::set_arg(cl_kernel k, cl_uint& i, const Grid& g) {
+  for (double lo : g.lo) set_arg(k, i, lo);
+  set_arg(k, i, g.inv_cell);
+  for (int c : g.ncell) set_arg(k, i, c);
+}
+void Context::set_arg(cl_kernel k, cl_uint& i, const CellTable& c) {
+  set_arg(k, i, c.order);
+  set_arg(k, i, c.start);
+  set_arg(k, i, c.end);
+}
+
+void Context::launch(cl_kernel k, std::size_t n, const std::string& name) {
+  const std::size_t local = 64;
+  std::size_t global = (n + local - 1) / local * local;
+  const auto start =
+      profile_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
+  check(clEnqueueNDRangeKernel(queue_, k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+        name.empty() ? "clEnqueueNDRangeKernel" : ("clEnqueueNDRangeKernel(" + name + ")").c_str());
+  if (profile_) {
+    finish();
+    auto& slot = profile_times_[name];
+    slot.first += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ++slot.second;
+  }
+}
+
+void Context::finish() { check(clFinish(queue_), "clFinish"); }
+
+std::vector<double> Context::reduce_all(const std::vector<Reduction>& rs) {
+  // Every partial reduction first, then one read of all partial results.
+  cl_mem partial = scratch(kReduceItems * (rs.empty() ? 1 : rs.size()), -1);
+  cl_kernel k = kernel("sphc_reduce");
+  for (std::size_t r = 0; r < rs.size(); ++r) {
+    cl_uint i = 0;
+    set_arg(k, i, rs[r].v);
+    set_arg(k, i, static_cast<unsigned>(rs[r].n));
+    set_arg(k, i, static_cast<int>(rs[r].op));
+    set_arg(k, i, rs[r].finite_only ? 1 : 0);
+    set_arg(k, i, static_cast<unsigned>(r * kReduceItems));
+    set_arg(k, i, partial);
+    launch(k, kReduceItems, "sphc_reduce");
+  }
+  host_partial_.resize(kReduceItems * rs.size());
+  read_reals(partial, host_partial_.data(), host_partial_.size());
+  std::vector<double> out;
+  for (std::size_t r = 0; r < rs.size(); ++r) {
+    const Op op = rs[r].op;
+    double acc = op == Op::Sum ? 0.0 : op == Op::Min ? HUGE_VAL : -HUGE_VAL;
+    for (std::size_t j = 0; j < kReduceItems; ++j) {
+      const double x = host_partial_[r * kReduceItems + j];
+      acc = op == Op::Sum ? acc + x : op == Op::Min ? std::fmin(acc, x) : std::fmax(acc, x);
+    }
+    out.push_back(acc);
+  }
+  return out;
+}
+
+double Context::reduce(cl_mem v, std::size_t n, Op op, bool finite_only) {
+  return reduce_all({{v, n, op, finite_only}})[0];
+}
+
+void Context::read_reals(cl_mem m, double* out, std::size_t n) {
+  if (dp_) {
+    check(clEnqueueReadBuffer(queue_, m, CL_TRUE, 0, n * sizeof(double), out, 0, nullptr, nullptr),
+          "clEnqueueReadBuffer (reals)");
+    return;
+  }
+  std::vector<float> f(n);
+  check(
+      clEnqueueReadBuffer(queue_, m, CL_TRUE, 0, n * sizeof(float), f.data(), 0, nullptr, nullptr),
+      "clEnqueueReadBuffer (reals)");
+  for (std::size_t j = 0; j < n; ++j) out[j] = f[j];
+}
+
+Grid Context::make_grid(const std::vector<Extent>& arrays, int dim, double radius_scale) {
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  double hmax = -HUGE_VAL;
+  // One partial-extent kernel per array, one read of all partial results.
+  const std::size_t per = 7 * kReduceItems;
+  cl_mem partial = scratch(per * arrays.size(), -2);
+  for (std::size_t k = 0; k < arrays.size(); ++k) {
+    const Extent& e = arrays[k];
+    cl_kernel kern = kernel("sphc_extent");
+    cl_uint i = 0;
+    set_arg(kern, i, static_cast<unsigned>(e.n));
+    set_arg(kern, i, dim);
+    set_arg(kern, i, e.x);
+    set_arg(kern, i, e.y ? e.y : e.x);
+    set_arg(kern, i, e.z ? e.z : e.x);
+    set_arg(kern, i, e.h);
+    set_arg(kern, i, static_cast<unsigned>(k * per));
+    set_arg(kern, i, partial);
+    launch(kern, kReduceItems, "sphc_extent");
+  }
+  std::vector<double> values(per * arrays.size());
+  read_reals(partial, values.data(), values.size());
+  for (std::size_t j = 0; j < values.size(); j += 7) {
+    for (int a = 0; a < dim; ++a) {
+      lo[a] = std::fmin(lo[a], values[j + 2 * a]);
+      hi[a] = std::fmax(hi[a], values[j + 2 * a + 1]);
+    }
+    hmax = std::fmax(hmax, values[j + 6]);
+  }
+  // The grid of sphc::make_search_domain and CellList::build (dense), so that in double
+  // precision the cell order, hence the particle order after a reorder, is the CPU one.
+  Grid g;
+  double cell = hmax > 0 && std::isfinite(hmax) ? radius_scale * hmax : 1.0;
+  const double pad = 1e-6 * cell;
+  double extent[3] = {0.0, 0.0, 0.0}, max_extent = 0.0;
+  bool used[3] = {false, false, false};
+  for (int a = 0; a < dim; ++a) {
+    if (!(lo[a] <= hi[a])) continue;
+    used[a] = true;
+    g.lo[a] = lo[a] - pad;
+    const double e = (hi[a] + pad) - g.lo[a];
+    extent[a] = std::isfinite(e) && e > 0.0 ? e : 0.0;
+    max_extent = std::fmax(max_extent, extent[a]);
+  }
+  const double kMaxCellsPerAxis = 1 << 21;
+  cell = std::fmax(cell, max_extent / (kMaxCellsPerAxis - 1));
+  // In single precision cell coordinates are rounded: slightly larger cells keep every
+  // neighbour within one cell (the candidates stay a superset of the neighbours).
+  if (!dp_) cell *= 1.0 + 1e-5;
+  g.inv_cell = 1.0 / cell;
+  std::size_t cells = 1;
+  for (int a = 0; a < 3; ++a) {
+    g.ncell[a] = used[a] ? static_cast<int>(std::fmin(std::floor(extent[a] * g.inv_cell) + 1.0,
+                                                      kMaxCellsPerAxis))
+                         : 1;
+    cells *= static_cast<std::size_t>(g.ncell[a]);
+  }
+  if (cells > (std::size_t{1} << 28))
+    throw std::runtime_error(
+        "OpenCL: the search domain needs " + std::to_string(cells) +
+        " cells; the OpenCL backend uses a dense grid only (sparse domains: use --backend=openmp)");
+  return g;
+}
+
+void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem z, std::size_t n) {
+  // A counting sort by cell: keys and counts, a scan into start/end, a scatter, and a sort of
+  // each cell's few indices (deterministic order). Eight launches, O(n + cells) work.
+  if (n > padded || !keys) {
+    if (keys) clReleaseMemObject(keys);
+    if (order) clReleaseMemObject(order);
+    keys = ctx.alloc(n * sizeof(cl_uint));
+    order = ctx.alloc(n * sizeof(cl_uint));
+    padded = n;
+  }
+  if (grid.cells() > cells || !start) {
+    for (cl_mem m : {start, end, count})
+      if (m) clReleaseMemObject(m);
+    cells = grid.cells();
+    start = ctx.alloc(cells * sizeof(cl_uint));
+    end = ctx.alloc(cells * sizeof(cl_uint));
+    count = ctx.alloc(cells * sizeof(cl_uint));
+  }
+  if (!partial) partial = ctx.alloc(kScanItems * sizeof(cl_uint));
+  const unsigned nc = static_cast<unsigned>(grid.cells());
+  const unsigned un = static_cast<unsigned>(n);
+  ctx.run("sphc_fill_uint", nc, count, 0u, nc);
+  ctx.run("sphc_cell_keys", n, un, x, y ? y : x, z ? z : x, y ? 1 : 0, z ? 1 : 0, grid, keys,
+          count);
+  ctx.run("sphc_scan_chunks", kScanItems, count, nc, partial);
+  ctx.run("sphc_scan_partials", 1, partial, static_cast<unsigned>(kScanItems));
+  ctx.run("sphc_scan_apply", kScanItems, count, nc, partial, start, end);
+  ctx.run("sphc_scatter", n, un, keys, start, count, order);
+  ctx.run("sphc_sort_cells", nc, nc, start, end, order);
+}
+
+void CellTable::release() {
+  for (cl_mem* m : {&keys, &order, &start, &end, &count, &partial})
+    if (*m) {
+      clReleaseMemObject(*m);
+      *m = nullptr;
+    }
+}
+
+void DeviceArray::upload(Context& ctx, const ParticleArray& a) {
+  const bool realloc = props.size() != a.props.size() || n != a.n;
+  if (realloc) release();
+  n = a.n;
+  std::vector<float> tmp;
+  for (std::size_t i = 0; i < a.props.size(); ++i) {
+    const Property& p = a.props[i];
+    const std::size_t count = n * static_cast<std::size_t>(p.stride);
+    const void* data = nullptr;
+    std::size_t bytes = 0;
+    if (p.type == PropType::F64) {
+      if (ctx.double_precision()) {
+        data = p.f64.data();
+        bytes = count * sizeof(double);
+      } else {
+        tmp.assign(p.f64.begin(), p.f64.begin() + count);
+        data = tmp.data();
+        bytes = count * sizeof(float);
+      }
+    } else {
+      data = p.type == PropType::I32 ? static_cast<const void*>(p.i32.data()) : p.u32.data();
+      bytes = count * 4;
+    }
+    if (realloc) props.push_back(ctx.alloc(bytes));
+    if (bytes)
+      check(
+          clEnqueueWriteBuffer(ctx.queue(), props[i], CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
+          "clEnqueueWriteBuffer (property)");
+  }
+  if (constants.size() != a.constants.size()) {
+    for (cl_mem m : constants) clReleaseMemObject(m);
+    constants.clear();
+    for (const auto& c : a.constants) constants.push_back(ctx.alloc(c.values.size() * 8));
+  }
+  for (std::size_t c = 0; c < a.constants.size(); ++c) upload_constant(ctx, a, static_cast<int>(c));
+}
+
+void DeviceArray::upload_constant(Context& ctx, const ParticleArray& a, int c) {
+  const auto& v = a.constants[c].values;
+  if (v.empty()) return;
+  std::vector<float> f(v.begin(), v.end());
+  const void* data = ctx.double_precision() ? static_cast<const void*>(v.data()) : f.data();
+  check(clEnqueueWriteBuffer(ctx.queue(), constants[c], CL_TRUE, 0, v.size() * ctx.real_size(),
+                             data, 0, nullptr, nullptr),
+        "clEnqueueWriteBuffer (constant)");
+}
+
+void DeviceArray::download(Context& ctx, ParticleArray& a) {
+  std::vector<float> tmp;
+  for (std::size_t i = 0; i < a.props.size() && i < props.size(); ++i) {
+    Property& p = a.props[i];
+    const std::size_t count = n * static_cast<std::size_t>(p.stride);
+    if (count == 0) continue;
+    void* data = nullptr;
+    std::size_t bytes = count * 4;
+    if (p.type == PropType::F64) {
+      if (ctx.double_precision()) {
+        data = p.f64.data();
+        bytes = count * sizeof(double);
+      } else {
+        tmp.resize(count);
+        data = tmp.data();
+      }
+    } else {
+      data = p.type == PropType::I32 ? static_cast<void*>(p.i32.data()) : p.u32.data();
+    }
+    check(clEnqueueReadBuffer(ctx.queue(), props[i], CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
+          "clEnqueueReadBuffer (property)");
+    if (p.type == PropType::F64 && !ctx.double_precision())
+      for (std::size_t k = 0; k < count; ++k) p.f64[k] = tmp[k];
+  }
+}
+
+void DeviceArray::permute(Context& ctx, const CellTable& cells, const ParticleArray& a) {
+  for (std::size_t i = 0; i < a.props.size() && i < props.size(); ++i) {
+    const Property& p = a.props[i];
+    const bool wide = p.type == PropType::F64 && ctx.double_precision();
+    const std::size_t count = n * static_cast<std::size_t>(p.stride);
+    if (count == 0) continue;
+    cl_mem dst = ctx.alloc(count * (wide ? 8 : 4));
+    ctx.run(wide ? "sphc_gather8" : "sphc_gather4", count, dst, props[i], cells.order,
+            static_cast<unsigned>(n), static_cast<unsigned>(p.stride));
+    clReleaseMemObject(props[i]);
+    props[i] = dst;
+  }
+}
+
+void DeviceArray::release() {
+  for (cl_mem m : props) clReleaseMemObject(m);
+  for (cl_mem m : constants) clReleaseMemObject(m);
+  props.clear();
+  constants.clear();
+}
+
+std::string kernel_function_source(const std::string& kernel, int dim) {
+  // sigma, radius scale, f(q) and df(q) as in sphc/kernels.h.
+  const double pi = 3.14159265358979323846;
+  std::string sigma, f, df, rs;
+  char buf[64];
+  auto num = [&](double v) {
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    std::string s = buf;
+    if (s.find_first_of(".e") == std::string::npos) s += ".0";
+    return s;
+  };
+  if (kernel == "CubicSpline") {
+    rs = "2.0";
+    sigma = num(dim == 1 ? 2.0 / 3.0 : dim == 2 ? 10.0 / (7.0 * pi) : 1.0 / pi);
+    f = "  if (q < 1.0) return 1.0 - 1.5 * q * q * (1.0 - 0.5 * q);\n"
+        "  if (q < 2.0) { const real t = 2.0 - q; return 0.25 * t * t * t; }\n"
+        "  return 0.0;\n";
+    df = "  if (q < 1.0) return q * (2.25 * q - 3.0);\n"
+         "  if (q < 2.0) { const real t = 2.0 - q; return -0.75 * t * t; }\n"
+         "  return 0.0;\n";
+  } else if (kernel == "QuinticSpline") {
+    rs = "3.0";
+    sigma = num(dim == 1 ? 1.0 / 120.0 : dim == 2 ? 7.0 / (478.0 * pi) : 1.0 / (120.0 * pi));
+    f = "  if (q >= 3.0) return 0.0;\n"
+        "  const real t3 = 3.0 - q, t2 = 2.0 - q, t1 = 1.0 - q;\n"
+        "  real v = t3 * t3 * t3 * t3 * t3;\n"
+        "  if (q < 2.0) v -= 6.0 * t2 * t2 * t2 * t2 * t2;\n"
+        "  if (q < 1.0) v += 15.0 * t1 * t1 * t1 * t1 * t1;\n"
+        "  return v;\n";
+    df = "  if (q >= 3.0) return 0.0;\n"
+         "  const real t3 = 3.0 - q, t2 = 2.0 - q, t1 = 1.0 - q;\n"
+         "  real v = -5.0 * t3 * t3 * t3 * t3;\n"
+         "  if (q < 2.0) v += 30.0 * t2 * t2 * t2 * t2;\n"
+         "  if (q < 1.0) v -= 75.0 * t1 * t1 * t1 * t1;\n"
+         "  return v;\n";
+  } else if (kernel == "WendlandQuintic") {
+    rs = "2.0";
+    if (dim == 1) {
+      sigma = num(5.0 / 8.0);
+      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n"
+          "  return t * t * t * (1.5 * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n"
+           "  return -3.0 * q * t * t;\n";
+    } else {
+      sigma = num(dim == 2 ? 7.0 / (4.0 * pi) : 21.0 / (16.0 * pi));
+      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+          "  return t2 * t2 * (2.0 * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n"
+           "  return -5.0 * q * t * t * t;\n";
+    }
+  } else if (kernel == "Gaussian") {
+    rs = "3.0";
+    sigma = num(dim == 1 ? 1.0 / std::sqrt(pi) : dim == 2 ? 1.0 / pi : std::pow(pi, -1.5));
+    f = "  return q < 3.0 ? exp(-q * q) : 0.0;\n";
+    df = "  return q < 3.0 ? -2.0 * q * exp(-q * q) : 0.0;\n";
+  } else {
+    throw std::invalid_argument("sphc::ocl: unknown kernel '" + kernel + "'");
+  }
+  std::string ih = dim == 1 ? "ih" : dim == 2 ? "(ih * ih)" : "(ih * ih * ih)";
+  return "#line 1 \"sphc-kernel.cl\"\n#define RADIUS_SCALE " + rs +
+         "\n#define RADIUS2 (RADIUS_SCALE * RADIUS_SCALE)\n"
+         "inline real kernel_f(real q) {\n" +
+         f + "}\n" + "inline real kernel_df(real q) {\n" + df + "}\n" +
+         "inline real kernel_w(real rij, real h) {\n  const real ih = 1.0 / h;\n  return " + sigma +
+         " * " + ih + " * kernel_f(rij / h);\n}\n" +
+         "inline void kernel_gradient(const real* xij, real rij, real h, real* grad) {\n"
+         "  const real ih = 1.0 / h;\n"
+         "  const real s = rij > 1e-12 ? " +
+         sigma + " * " + ih +
+         " * kernel_df(rij / h) / (h * rij) : 0.0;\n"
+         "  grad[0] = s * xij[0];\n  grad[1] = s * xij[1];\n  grad[2] = s * xij[2];\n}\n";
+}
+
+}  // namespace ocl
+}  // namespace sphc
