@@ -1,0 +1,59 @@
+#!/bin/sh
+# A validation case against an exact or reference solution, in three steps, each of which
+# fails the test when it fails:
+#   1. compile examples/CASE.sph with sphc,
+#   2. run it to the scene's final time, writing its snapshots,
+#   3. check the snapshots with tests/validation/CASE.py (which prints a table and the error
+#      figures, and writes OUT_DIR/CASE.png).
+# Cases: elliptical_drop (exact solution, Monaghan 1994), hydrostatic_tank (hydrostatics,
+# Adami et al. 2012). The dam break has its own script, run_dambreak.sh.
+#
+# Usage: run_case.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [RUN OPTIONS...]
+#   SPHC        the sphc executable (<build>/bin/sphc)
+#   SOURCE_DIR  the sphc source tree (for examples/ and tests/)
+#   CASE        the case: examples/CASE.sph and tests/validation/CASE.py
+#   EXE         the solver to build (<build>/tests/validation/CASE)
+#   OUT_DIR     where the run writes its snapshots (emptied first)
+#   RUN OPTIONS passed to the solver (e.g. --set dx=0.01)
+# The Python interpreter is $SPHC_PYTHON if set, else the first of python3, /usr/bin/python3
+# that has numpy and h5py.
+set -eu
+
+if [ $# -lt 5 ]; then
+  echo "usage: $0 SPHC SOURCE_DIR CASE EXE OUT_DIR [RUN OPTIONS...]" >&2
+  exit 2
+fi
+SPHC=$1
+SRC=$2
+CASE=$3
+EXE=$4
+OUT=$5
+shift 5
+
+PY=""
+for cand in ${SPHC_PYTHON:-} python3 /usr/bin/python3; do
+  if command -v "$cand" >/dev/null 2>&1 && "$cand" -c "import numpy, h5py" >/dev/null 2>&1; then
+    PY=$cand
+    break
+  fi
+done
+if [ -z "$PY" ]; then
+  echo "run_case.sh: no Python with numpy and h5py (set SPHC_PYTHON)" >&2
+  exit 1
+fi
+
+rm -rf "$OUT"
+mkdir -p "$(dirname "$EXE")" "$OUT"
+
+echo "== 1. compile: $SPHC $SRC/examples/$CASE.sph -o $EXE"
+start=$(date +%s)
+"$SPHC" "$SRC/examples/$CASE.sph" -o "$EXE"
+echo "   compiled in $(( $(date +%s) - start )) s"
+
+echo "== 2. run: $EXE --quiet --timing -d $OUT $*"
+start=$(date +%s)
+"$EXE" --quiet --timing -d "$OUT" "$@"
+echo "   ran in $(( $(date +%s) - start )) s"
+
+echo "== 3. check: $CASE.py $OUT"
+"$PY" "$SRC/tests/validation/$CASE.py" "$OUT" --plot "$OUT/$CASE.png"
