@@ -1176,6 +1176,12 @@ void Emitter::emitMain() {
          << (lit ? std::string(buf) : "std::nan(\"\")") << ", \""
          << (lit ? std::string("") : "= " + exprText(*p->value)) << "\"});\n";
   }
+  for (const auto& o : plan_.options) {
+    std::string choices;
+    for (const auto& c : o.choices) choices += (choices.empty() ? "" : ", ") + c;
+    out_ << "  prog.options.push_back({\"" << o.name << "\", \"" << o.value << "\", \"" << choices
+         << "\"});  // sphc -D " << o.name << "=...\n";
+  }
   out_ << "  prog.setup = [](const std::vector<double>& v, sphc::SceneTimes& times) {\n"
           "    scene.setup(v, times);\n"
        << (opencl_ ? "    scene.to_device();\n" : "") << "  };\n";

@@ -7,6 +7,7 @@
 #include "driver/Build.h"
 #include "frontend/ASTPrinter.h"
 #include "frontend/Diagnostics.h"
+#include "sema/Options.h"
 #include "sema/Sema.h"
 
 #include "llvm/Support/CommandLine.h"
@@ -44,6 +45,11 @@ static cl::opt<std::string> DumpAfter("dump-after",
 static cl::opt<bool> Report("report", cl::desc("Print the execution plan the compiler derived "
                                                "(arrays, properties, groups, pruned equations)"),
                             cl::cat(SphcCat));
+static cl::list<std::string> Defines("D",
+                                     cl::desc("Choose a compile-time option of the scene, as in "
+                                              "-D scheme=edac (see `option` in the scene)"),
+                                     cl::value_desc("name=choice"), cl::Prefix,
+                                     cl::cat(SphcCat));
 static cl::list<std::string> IncludeDirs("I", cl::desc("Add a directory to the import path"),
                                          cl::value_desc("dir"), cl::Prefix, cl::cat(SphcCat));
 static cl::opt<std::string> Cxx("cxx", cl::desc("C++ compiler for the generated code"),
@@ -88,13 +94,13 @@ int main(int argc, char** argv) {
                  << " is for --backend=opencl; the C++ backends compute in double\n";
     return fail();
   }
-  static const char* passes[] = {"parse", "sema",   "bodies", "prune",
-                                 "properties", "hazards", "pairs"};
+  static const char* passes[] = {"parse",      "options", "sema",  "bodies",
+                                 "prune",      "properties", "hazards", "pairs"};
   if (!DumpAfter.empty() &&
       std::find(std::begin(passes), std::end(passes), DumpAfter) == std::end(passes)) {
     llvm::errs() << "sphc: error: unknown pass '" << DumpAfter
-                 << "' for --dump-after; passes are: parse, sema, bodies, prune, properties, "
-                    "hazards, pairs\n";
+                 << "' for --dump-after; passes are: parse, options, sema, bodies, prune, "
+                    "properties, hazards, pairs\n";
     return fail();
   }
   if (Emit != "exe" && Emit != "cpp" && Emit != "opencl" && Emit != "plan" && Emit != "ast") {
@@ -130,10 +136,19 @@ int main(int argc, char** argv) {
   }
   if (modules.empty() || diags.hasErrors()) return fail();
 
-  // --- semantic analysis and the analysis passes ----------------------------------------
+  // --- compile-time options, semantic analysis and the analysis passes --------------------
+  std::vector<ChosenOption> options;
+  std::vector<std::string> defines(Defines.begin(), Defines.end());
+  if (!selectOptions(modules, defines, diags, options)) return fail();
+  log("options");
+  if (DumpAfter == "options") {
+    printModule(*modules.front(), llvm::outs(), diags);
+    return 0;
+  }
   auto plan = buildPlan(modules, diags);
   log("sema");
   if (!plan || diags.hasErrors()) return fail();
+  plan->options = options;
   auto dump = [&](const char* pass) {
     if (DumpAfter != pass) return false;
     printPlan(*plan, llvm::outs(), false);

@@ -44,6 +44,37 @@ struct Body {
   llvm::SMLoc start;           // the first character of `text` (just after `{`)
 };
 
+// Compile-time options: `option scheme in [wcsph, edac] = wcsph;` declares one, `sphc -D
+// scheme=edac` chooses a value, and `when scheme == edac { ... }` blocks (in a scene, an
+// `equations`/`group` list or an array) are kept or dropped by the options pass before Sema.
+struct OptionDecl {
+  Ident name;
+  std::vector<Ident> choices;
+  Ident defaultChoice;
+};
+
+// `when NAME == v`, `when NAME != v`, `when NAME in [v, w]`.
+struct WhenCondition {
+  llvm::SMLoc loc;              // the `when` keyword
+  Ident option;
+  std::vector<Ident> values;    // one for == and !=
+  bool negated = false;         // !=
+  bool isIn = false;            // `in [...]`
+};
+
+// `when C1 { ... } else when C2 { ... } else { ... }`: the first branch whose condition holds
+// is kept (a branch without a condition is the `else`). Body is the fragment of the enclosing
+// construct that the branch holds (scene items, group items or array items).
+template <class Body>
+struct When {
+  struct Branch {
+    bool hasCondition = false;
+    WhenCondition condition;
+    Body body;
+  };
+  std::vector<Branch> branches;
+};
+
 struct ImportDecl {
   std::vector<Ident> path;     // import a.b;  -> {a, b}
   llvm::SMLoc loc;
@@ -85,6 +116,8 @@ struct ArrayDecl {
   std::vector<LoadDecl> loads;
   std::vector<PropertyDecl> properties;
   std::vector<ConstDecl> constants;
+  std::vector<std::shared_ptr<When<ArrayDecl>>> whens;  // items of the chosen branch are
+                                                        // added after the others
 };
 
 struct EqParam {
@@ -134,10 +167,12 @@ struct EquationInstance {
 };
 
 struct GroupDecl;
-// One entry of an `equations { }` or `group { }` list: exactly one of the two is set.
+// One entry of an `equations { }` or `group { }` list: exactly one of the three is set. The
+// options pass replaces each `when` by the items of its chosen branch, in place.
 struct GroupItem {
   std::shared_ptr<GroupDecl> group;
   std::shared_ptr<EquationInstance> equation;
+  std::shared_ptr<When<std::vector<GroupItem>>> when;
 };
 
 struct GroupDecl {
@@ -177,6 +212,8 @@ struct SceneDecl {
   std::vector<OutputDecl> outputs;
   llvm::SMLoc equationsLoc;
   std::vector<GroupItem> equations;
+  std::vector<std::shared_ptr<When<SceneDecl>>> whens;  // the chosen branch's items are
+                                                        // added after the others
 };
 
 // One parsed file. Sema merges a scene's module with the modules it imports.
@@ -184,6 +221,7 @@ struct Module {
   std::string filename;         // as given on the command line or resolved for an import
   unsigned bufferId = 0;        // in the DiagnosticEngine's SourceMgr
   std::vector<ImportDecl> imports;
+  std::vector<OptionDecl> options;
   std::vector<ParamDecl> params;
   std::vector<ArrayDecl> arrays;
   std::vector<EquationDecl> equations;

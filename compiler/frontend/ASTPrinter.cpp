@@ -55,6 +55,11 @@ class Printer {
       llvm::interleave(imp.path, os_, [&](const ast::Ident& p) { os_ << p.name; }, ".");
       at(imp.loc) << "\n";
     }
+    for (const auto& o : mod.options) {
+      decl(0, "option", o.name) << " in [";
+      llvm::interleaveComma(o.choices, os_, [&](const ast::Ident& c) { os_ << c.name; });
+      os_ << "] = " << o.defaultChoice.name << "\n";
+    }
     for (const auto& p : mod.params) {
       decl(0, p.derived ? "let" : "param", p.name);
       init(p.value);
@@ -131,17 +136,21 @@ class Printer {
 
   void array(const ast::ArrayDecl& a) {
     decl(0, "array", a.name) << "\n";
+    arrayItems(a, 1);
+  }
+
+  void arrayItems(const ast::ArrayDecl& a, int indent) {
     for (const auto& g : a.geometry) {
-      decl(1, "geometry", g.builder);
+      decl(indent, "geometry", g.builder);
       kwargs(g.args);
       os_ << "\n";
     }
     for (const auto& l : a.loads) {
-      line(1) << "load \"" << l.path << "\"";
+      line(indent) << "load \"" << l.path << "\"";
       at(l.loc) << "\n";
     }
     for (const auto& p : a.properties) {
-      line(1) << "property " << p.type;
+      line(indent) << "property " << p.type;
       if (p.stride != 1) os_ << "[" << p.stride << "]";
       os_ << " " << p.name.name;
       at(p.name.loc);
@@ -149,11 +158,33 @@ class Printer {
       os_ << "\n";
     }
     for (const auto& c : a.constants) {
-      line(1) << "const " << c.name.name;
+      line(indent) << "const " << c.name.name;
       if (c.size != 1) os_ << "[" << c.size << "]";
       at(c.name.loc);
       init(c.init);
       os_ << "\n";
+    }
+    for (const auto& w : a.whens)
+      when(*w, indent, [&](const ast::ArrayDecl& part, int in) { arrayItems(part, in); });
+  }
+
+  // `when` blocks: one line per branch, its body one level deeper.
+  template <class Body, class PrintBody>
+  void when(const ast::When<Body>& w, int indent, PrintBody printBody) {
+    bool first = true;
+    for (const auto& b : w.branches) {
+      if (!b.hasCondition) {
+        line(indent) << "else\n";
+      } else {
+        const auto& c = b.condition;
+        line(indent) << (first ? "" : "else ") << "when " << c.option.name
+                     << (c.isIn ? " in [" : c.negated ? " != " : " == ");
+        llvm::interleaveComma(c.values, os_, [&](const ast::Ident& v) { os_ << v.name; });
+        os_ << (c.isIn ? "]" : "");
+        at(c.loc) << "\n";
+      }
+      first = false;
+      printBody(b.body, indent + 1);
     }
   }
 
@@ -181,31 +212,37 @@ class Printer {
 
   void scene(const ast::SceneDecl& s) {
     decl(0, "scene", s.name) << "\n";
+    sceneItems(s, 1);
+  }
+
+  void sceneItems(const ast::SceneDecl& s, int indent) {
     for (const auto& set : s.settings) {
-      decl(1, "set", set.key);
+      decl(indent, "set", set.key);
       init(set.value);
       os_ << "\n";
     }
     for (const auto& st : s.steppers) {
-      line(1) << "stepper " << st.array.name << " = " << st.stepper.name;
+      line(indent) << "stepper " << st.array.name << " = " << st.stepper.name;
       at(st.array.loc) << "\n";
     }
     if (s.hasAdaptiveDt) {
-      line(1) << "adaptive_dt";
+      line(indent) << "adaptive_dt";
       at(s.adaptiveDtLoc);
       kwargs(s.adaptiveDt);
       os_ << "\n";
     }
-    for (const auto& out : s.outputs) output(out);
+    for (const auto& out : s.outputs) output(out, indent);
     if (s.equationsLoc.isValid()) {
-      line(1) << "equations";
+      line(indent) << "equations";
       at(s.equationsLoc) << "\n";
-      groupItems(s.equations, 2);
+      groupItems(s.equations, indent + 1);
     }
+    for (const auto& w : s.whens)
+      when(*w, indent, [&](const ast::SceneDecl& part, int in) { sceneItems(part, in); });
   }
 
-  void output(const ast::OutputDecl& out) {
-    line(1) << "output";
+  void output(const ast::OutputDecl& out, int indent) {
+    line(indent) << "output";
     at(out.loc);
     if (out.every) {
       os_ << " every ";
@@ -217,7 +254,7 @@ class Printer {
     }
     os_ << "\n";
     for (const auto& item : out.items) {
-      line(2) << item.array.name << "(";
+      line(indent + 1) << item.array.name << "(";
       llvm::interleaveComma(item.props, os_, [&](const ast::Ident& p) { os_ << p.name; });
       os_ << ")";
       at(item.array.loc) << "\n";
@@ -232,6 +269,10 @@ class Printer {
         if (!item.group->options.empty()) kwargs(item.group->options);
         os_ << "\n";
         groupItems(item.group->items, indent + 1);
+      } else if (item.when) {
+        when(*item.when, indent, [&](const std::vector<ast::GroupItem>& part, int in) {
+          groupItems(part, in);
+        });
       } else {
         decl(indent, "instance", item.equation->equation);
         kwargs(item.equation->args);

@@ -14,7 +14,7 @@ using ast::ExprPtr;
 namespace {
 
 constexpr llvm::StringLiteral kTopLevelKeywords[] = {
-    "import", "param", "let", "array", "equation", "stepper", "integrator", "scene"};
+    "import", "option", "param", "let", "array", "equation", "stepper", "integrator", "scene"};
 
 // `stage` followed by one or more digits.
 bool isStageName(llvm::StringRef word) {
@@ -195,13 +195,15 @@ std::unique_ptr<ast::Module> Parser::parseModule() {
 
 bool Parser::parseItem(ast::Module& mod) {
   if (atWord("import")) return parseImport(mod);
+  if (atWord("option")) return parseOption(mod);
   if (atWord("param") || atWord("let")) return parseParam(mod);
   if (atWord("array")) return parseArray(mod);
   if (atWord("equation")) return parseEquation(mod);
   if (atWord("stepper")) return parseStepper(mod);
   if (atWord("integrator")) return parseIntegrator(mod);
   if (atWord("scene")) return parseScene(mod);
-  const char* expected = "import, param, let, array, equation, stepper, integrator or scene";
+  const char* expected =
+      "import, option, param, let, array, equation, stepper, integrator or scene";
   if (cur().is(Token::Identifier))
     return error(cur().loc, "unknown declaration " + quoted(cur().text) + ": expected " + expected);
   return error(cur().loc, "expected a declaration (" + llvm::Twine(expected) + "), found " +
@@ -219,6 +221,93 @@ bool Parser::parseImport(ast::Module& mod) {
   } while (consumeIf(Token::Dot));
   mod.imports.push_back(std::move(imp));
   return expect(Token::Semi, "after import");
+}
+
+// option NAME in [a, b, c] = a;
+bool Parser::parseOption(ast::Module& mod) {
+  advance();
+  ast::OptionDecl opt;
+  if (!parseIdent(opt.name, "expected an option name after 'option'")) return false;
+  if (!atWord("in"))
+    return error(cur().loc, "expected 'in [choice, ...]' after option " + quoted(opt.name.name) +
+                                ", found " + describe(cur()));
+  advance();
+  if (!expect(Token::LBracket, "after 'in'")) return false;
+  if (cur().is(Token::RBracket))
+    return error(cur().loc, "option " + quoted(opt.name.name) + " needs at least one choice");
+  if (!parseNameList(opt.choices, "the choices of option " + quoted(opt.name.name)))
+    return false;
+  if (!expect(Token::Assign, "after the choices of option " + quoted(opt.name.name) +
+                                 " (the default: '= choice')") ||
+      !parseIdent(opt.defaultChoice, "expected the default choice of option " +
+                                         quoted(opt.name.name)))
+    return false;
+  mod.options.push_back(std::move(opt));
+  return expect(Token::Semi, "after option declaration");
+}
+
+// `when` starts a conditional block where it is followed by an option name (so that an
+// equation, setting or property called `when` still parses).
+bool Parser::atWhen() {
+  return atWord("when") && lex_.peek().is(Token::Identifier);
+}
+
+// NAME == v | NAME != v | NAME in [v, w]
+bool Parser::parseWhenCondition(ast::WhenCondition& cond) {
+  cond.loc = cur().loc;
+  advance();
+  if (!parseIdent(cond.option, "expected an option name after 'when'")) return false;
+  if (cur().is(Token::EqEq) || cur().is(Token::NotEq)) {
+    cond.negated = cur().is(Token::NotEq);
+    advance();
+    ast::Ident value;
+    if (!parseIdent(value, "expected a choice of option " + quoted(cond.option.name) +
+                               " after " + (cond.negated ? "'!='" : "'=='")))
+      return false;
+    cond.values.push_back(std::move(value));
+    return true;
+  }
+  if (atWord("in")) {
+    cond.isIn = true;
+    advance();
+    if (!expect(Token::LBracket, "after 'in'")) return false;
+    if (cur().is(Token::RBracket))
+      return error(cur().loc, "expected at least one choice in 'when " + cond.option.name +
+                                  " in [...]'");
+    return parseNameList(cond.values, "the choices of 'when " + cond.option.name + " in'");
+  }
+  return error(cur().loc, "expected '==', '!=' or 'in' after 'when " + cond.option.name +
+                              "', found " + describe(cur()));
+}
+
+template <class Body>
+bool Parser::parseWhen(std::vector<std::shared_ptr<ast::When<Body>>>& out,
+                       const std::string& what, llvm::function_ref<bool(Body&)> parseItem,
+                       bool sceneStepper) {
+  if (whenDepth_ >= kMaxNesting)
+    return error(cur().loc, "'when' blocks nested too deeply (more than " +
+                                llvm::Twine(kMaxNesting) + " levels)");
+  ++whenDepth_;
+  auto leave = llvm::make_scope_exit([&] { --whenDepth_; });
+  auto when = std::make_shared<ast::When<Body>>();
+  out.push_back(when);
+  for (;;) {
+    typename ast::When<Body>::Branch branch;
+    bool hasCondition = atWhen();
+    if (hasCondition) {
+      branch.hasCondition = true;
+      if (!parseWhenCondition(branch.condition)) return false;
+    }
+    auto& b = when->branches.emplace_back(std::move(branch));
+    if (!parseBlock(
+            "'when' in " + what, [&] { return parseItem(b.body); }, sceneStepper))
+      return false;
+    if (!hasCondition || !atWord("else")) return true;
+    advance();  // else
+    if (atWord("when") && !lex_.peek().is(Token::Identifier))
+      return error(lex_.peek().loc, "expected an option name after 'else when', found " +
+                                        describe(lex_.peek()));
+  }
 }
 
 bool Parser::parseParam(ast::Module& mod) {
@@ -249,7 +338,13 @@ bool Parser::parseArrayItem(ast::ArrayDecl& array) {
   if (atWord("load")) return parseLoad(array);
   if (atWord("property")) return parseProperty(array);
   if (atWord("const")) return parseArrayConst(array);
-  const char* expected = "'geometry', 'load', 'property' or 'const'";
+  if (atWhen())
+    return parseWhen<ast::ArrayDecl>(array.whens, "array " + quoted(array.name.name),
+                                     [&](ast::ArrayDecl& part) {
+                                       part.name = array.name;
+                                       return parseArrayItem(part);
+                                     });
+  const char* expected = "'geometry', 'load', 'property', 'const' or 'when'";
   if (cur().is(Token::Identifier))
     return error(cur().loc, "unknown item " + quoted(cur().text) + " in array " +
                                 quoted(array.name.name) + ": expected " + expected);
@@ -474,9 +569,17 @@ bool Parser::parseScene(ast::Module& mod) {
 bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (!cur().is(Token::Identifier))
     return error(cur().loc, "expected a scene item ('name = value;', stepper, adaptive_dt, "
-                            "output or equations), found " + describe(cur()));
+                            "output, equations or when), found " + describe(cur()));
   // The scene's keywords are contextual: `output = 3;` is a setting named output.
   if (lex_.peek().is(Token::Assign)) return parseSceneSetting(scene);
+  if (atWhen())
+    return parseWhen<ast::SceneDecl>(
+        scene.whens, "scene " + quoted(scene.name.name),
+        [&](ast::SceneDecl& part) {
+          part.name = scene.name;
+          return parseSceneItem(part);
+        },
+        /*sceneStepper=*/true);
   if (atWord("stepper")) return parseSceneStepper(scene);
   if (atWord("adaptive_dt")) return parseAdaptiveDt(scene);
   if (atWord("output")) return parseOutput(scene);
@@ -570,8 +673,17 @@ bool Parser::parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth) 
     group->loc = cur().loc;
     advance();
     if (consumeIf(Token::LParen) && !parseKwArgs(group->options)) return false;
-    items.push_back(ast::GroupItem{group, nullptr});
+    items.push_back(ast::GroupItem{group, nullptr, nullptr});
     return parseBlock("group", [&] { return parseGroupItem(group->items, depth + 1); });
+  }
+  if (atWhen()) {
+    std::vector<std::shared_ptr<ast::When<std::vector<ast::GroupItem>>>> whens;
+    bool ok = parseWhen<std::vector<ast::GroupItem>>(
+        whens, "an equations list", [&](std::vector<ast::GroupItem>& part) {
+          return parseGroupItem(part, depth + 1);
+        });
+    if (!whens.empty()) items.push_back(ast::GroupItem{nullptr, nullptr, whens.front()});
+    return ok;
   }
   if (!cur().is(Token::Identifier))
     return error(cur().loc, "expected an equation instance 'Name(arg = value, ...);' or a group, "
@@ -582,7 +694,7 @@ bool Parser::parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth) 
   if (!expect(Token::LParen, "after equation " + quoted(inst->equation.name)) ||
       !parseKwArgs(inst->args))
     return false;
-  items.push_back(ast::GroupItem{nullptr, inst});
+  items.push_back(ast::GroupItem{nullptr, inst, nullptr});
   return expect(Token::Semi, "after equation instance " + quoted(inst->equation.name));
 }
 

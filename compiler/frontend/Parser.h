@@ -61,6 +61,14 @@ class Parser {
   // Declarations.
   bool parseItem(ast::Module& mod);
   bool parseImport(ast::Module& mod);
+  bool parseOption(ast::Module& mod);
+  bool atWhen();
+  bool parseWhenCondition(ast::WhenCondition& cond);
+  // `when C { items } else when C { items } else { items }`; parseItem parses one item of the
+  // enclosing construct into a branch's body.
+  template <class Body>
+  bool parseWhen(std::vector<std::shared_ptr<ast::When<Body>>>& out, const std::string& what,
+                 llvm::function_ref<bool(Body&)> parseItem, bool sceneStepper = false);
   bool parseParam(ast::Module& mod);
   bool parseArray(ast::Module& mod);
   bool parseArrayItem(ast::ArrayDecl& array);
@@ -110,6 +118,7 @@ class Parser {
   bool panic_ = false;        // an error was reported and the parser has not resynchronised
   bool stopped_ = false;      // too many errors
   unsigned exprDepth_ = 0;
+  unsigned whenDepth_ = 0;  // nesting of `when` blocks
 };
 
 }  // namespace sphc

@@ -84,6 +84,12 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
     os << "\n";
   }
   if (plan.adaptiveDt) os << "adaptive time step: yes\n";
+  if (!plan.options.empty()) {
+    os << "options:";
+    for (const auto& o : plan.options)
+      os << " " << o.name << "=" << o.value << (o.fromCommandLine ? " (-D)" : " (default)");
+    os << "\n";
+  }
   os << "parameters:";
   for (const auto* p : plan.params)
     if (!p->derived) os << " " << p->name.name;

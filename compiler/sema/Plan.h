@@ -5,6 +5,7 @@
 
 #include "body/BodyAnalysis.h"
 #include "frontend/AST.h"
+#include "sema/Options.h"
 
 #include "llvm/Support/SMLoc.h"
 #include "llvm/Support/raw_ostream.h"
@@ -112,6 +113,7 @@ struct Plan {
   std::vector<PlanBody> bodies;
   PlanGroup root;                             // the scene's equations { } as a group
   std::vector<std::string> notes;             // what the passes decided, for --report
+  std::vector<ChosenOption> options;          // compile-time options (sema/Options.h)
 
   int arrayIndex(const std::string& name) const;
 };

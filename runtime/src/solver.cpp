@@ -108,6 +108,14 @@ std::pair<std::string, double> parse_set(const std::string& arg, const SceneProg
   const std::string name = arg.substr(0, eq);
   const bool known = std::any_of(prog.params.begin(), prog.params.end(),
                                  [&](const ParamInfo& p) { return p.name == name; });
+  for (const OptionInfo& o : prog.options) {
+    if (o.name == name) {
+      throw UsageError(fmt::format(
+          "--set {}: '{}' is a compile-time option, fixed to '{}' in this executable; build "
+          "another with `sphc SCENE.sph -D {}=CHOICE` (choices: {})",
+          arg, name, o.value, name, o.choices));
+    }
+  }
   if (!known) {
     throw UsageError(
         fmt::format("--set {}: unknown parameter '{}'; {}", arg, name, parameter_names(prog)));
@@ -191,6 +199,11 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "Output: DIR/{1}_NNNNNN.h5 (NNNNNN: the step) and DIR/{1}.xdmf (for ParaView).\n"
       "Exit codes: 0 done, 1 error, 2 bad usage, 3 the simulation blew up.\n",
       program, scene, prog.dim);
+  if (!prog.options.empty()) {
+    fmt::print("\ncompile-time options (sphc -D NAME=CHOICE builds another executable):\n");
+    for (const OptionInfo& o : prog.options)
+      fmt::print("  {} = {}  (choices: {})\n", o.name, o.value, o.choices);
+  }
   if (prog.params.empty()) return;
   std::size_t width = 0;
   std::vector<std::string> lefts;

@@ -23,6 +23,14 @@ struct ParamInfo {
   std::string help;
 };
 
+// A compile-time option of the scene (`option NAME in [...]`, chosen with `sphc -D NAME=...`):
+// fixed in this executable; shown by --help and refused by --set with a hint to rebuild.
+struct OptionInfo {
+  std::string name;
+  std::string value;
+  std::string choices;  // "wcsph, edac, tvf"
+};
+
 // Times a scene computes from its parameters; the command line may override them.
 struct SceneTimes {
   double tf = 1.0;                 // final time
@@ -35,6 +43,7 @@ struct SceneProgram {
   std::string name;  // scene name (used for output names)
   int dim = 2;
   std::vector<ParamInfo> params;  // defaults, in order; --set overrides by name
+  std::vector<OptionInfo> options;  // compile-time options this executable was built with
   // Called once with the final parameter values (same order as params). Builds arrays, sets
   // the scene's tf, dt and output times (they may depend on params).
   std::function<void(const std::vector<double>& params, SceneTimes& times)> setup;
