@@ -197,10 +197,34 @@ class Printer {
       os_ << "\n";
     }
     for (const auto& out : s.outputs) output(out);
+    for (const auto& d : s.domains) domain(d);
     if (s.equationsLoc.isValid()) {
       line(1) << "equations";
       at(s.equationsLoc) << "\n";
       groupItems(s.equations, 2);
+    }
+  }
+
+  void domain(const ast::DomainDecl& d) {
+    line(1) << "domain";
+    at(d.loc) << "\n";
+    for (const auto& item : d.items) {
+      line(2) << (item.kind == ast::DomainItem::Periodic ? "periodic " : "mirror ")
+              << item.axis.name;
+      if (item.lo && item.hi) {
+        os_ << " in [";
+        printExpr(*item.lo, os_);
+        os_ << ", ";
+        printExpr(*item.hi, os_);
+        os_ << "]";
+      } else if (item.lo) {
+        os_ << " >= ";
+        printExpr(*item.lo, os_);
+      } else if (item.hi) {
+        os_ << " <= ";
+        printExpr(*item.hi, os_);
+      }
+      at(item.loc) << "\n";
     }
   }
 
