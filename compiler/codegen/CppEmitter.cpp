@@ -729,11 +729,9 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
     // Ghosts copy the values the phase computed on the real particles, where they carry them.
     if (hasGhosts(d) && !onGhosts) {
       std::set<std::string> written;
-      for (const auto& p : dprops)
-        for (const auto* eq : eqs)
-          for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods)
-            for (const auto& w : plan_.bodies[b].facts.dWrites)
-              if (w.prop == p && constIndex(d, p) < 0) written.insert(p);
+      for (const auto* eq : eqs)
+        for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods)
+          for (const auto& w : plan_.bodies[b].facts.dWrites) written.insert(w.prop);
       std::vector<std::string> refresh;
       for (const auto& p : arr(d).ghostProps)
         if (written.count(p)) refresh.push_back(p);
