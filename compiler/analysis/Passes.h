@@ -18,6 +18,9 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags);
 bool checkHazards(Plan& plan, DiagnosticEngine& diags);
 // analysis/PairQuantities.cpp: which pair quantities each (group, dest, source) loop computes.
 bool selectPairQuantities(Plan& plan, DiagnosticEngine& diags);
+// analysis/Ghosts.cpp: with a periodic or mirror domain, the properties ghost copies of each
+// source array carry (PlanArray::ghostProps).
+bool selectGhostProperties(Plan& plan, DiagnosticEngine& diags);
 
 // What the adaptive time step reads of a stepped, moving array (h, cs, velocities for the
 // CFL limit; accelerations for the force limit).

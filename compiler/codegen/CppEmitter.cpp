@@ -179,6 +179,13 @@ class Emitter {
   std::vector<NeighbourPass> neighbourPasses(const std::vector<const PlanEquation*>& eqs, int d,
                                              const PlanGroup* group);
   void emitSteppers();
+  // Periodic and mirror domains (sphc/domain.h): the box at set-up, wrapping, ghosts.
+  bool hasDomain() const { return plan_.domain.any(); }
+  bool hasGhosts(int a) const { return hasDomain() && !arr(a).ghostProps.empty(); }
+  std::string propIndexList(int a, const std::vector<std::string>& props) const;
+  void emitDomainSetup();
+  void emitUpdateNeighboursWithGhosts();
+  void emitUpdateNeighbours();
   void emitStep();
   void emitAdaptiveDt();
   void emitMain();
@@ -476,6 +483,7 @@ void Emitter::emitSetup() {
     }
   }
   for (const auto& a : plan_.arrays) emitArraySetup(a);
+  if (hasDomain()) emitDomainSetup();
   auto pn = [&](const std::string& n) { return paramRef(n); };
   scene_ << "    times.tf = " << exprCpp(*plan_.tf, pn) << ";\n";
   scene_ << "    times.dt = " << exprCpp(*plan_.dt, pn) << ";\n";
@@ -633,8 +641,12 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
   for (int d : dests) {
     const std::string& D = arr(d).name;
     std::vector<const PlanEquation*> eqs = destEquations(eqIds, d);
+    // Groups with `real = false` run on the ghosts too (they follow the real particles).
+    const bool onGhosts = group && !group->real && hasGhosts(d);
     scene_ << "    {  // destination " << D << "\n";
-    scene_ << "      const int n = static_cast<int>(" << D << ".n);\n";
+    scene_ << "      const int n = static_cast<int>(" << D << ".n"
+           << (onGhosts ? " + ghosts_" + D + ".size()" : std::string("")) << ");"
+           << (onGhosts ? "  // real particles and ghosts (real = false)" : "") << "\n";
     if (opencl_) {
       emitDestinationDevice(d, eqs, group, name);
       scene_ << "    }\n";
@@ -705,12 +717,30 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
       scene_ << parallelFor("        ", std::string("reduction(") +
                                              (pd.reduceOp == "sum" ? "+" : pd.reduceOp) +
                                              " : acc)");
-      scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+      scene_ << "        for (int d_idx = 0; d_idx < "
+             << (onGhosts ? "static_cast<int>(" + D + ".n)" : std::string("n"))
+             << "; ++d_idx) {" << (onGhosts ? "  // real particles only" : "") << "\n";
       scene_ << "          const double v = "
              << callBody(bodyFunctionName(eq->name, "reduce"), b, d, -1, eqStruct(*eq), "t")
              << ";\n          " << combine << ";\n        }\n";
       scene_ << "        " << D << ".constant(" << constIndex(d, pd.reduceTarget)
              << ")[0] = acc;\n      }\n";
+    }
+    // Ghosts copy the values the phase computed on the real particles, where they carry them.
+    if (hasGhosts(d) && !onGhosts) {
+      std::set<std::string> written;
+      for (const auto* eq : eqs)
+        for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods)
+          for (const auto& w : plan_.bodies[b].facts.dWrites) written.insert(w.prop);
+      std::vector<std::string> refresh;
+      for (const auto& p : arr(d).ghostProps)
+        if (written.count(p)) refresh.push_back(p);
+      if (!refresh.empty()) {
+        scene_ << "      // ghosts follow:";
+        for (const auto& p : refresh) scene_ << " " << p;
+        scene_ << "\n      sphc::refresh_ghosts(box, " << D << ", ghosts_" << D << ", "
+               << propIndexList(d, refresh) << ");\n";
+      }
     }
     scene_ << "    }\n";
   }
@@ -961,7 +991,81 @@ void Emitter::emitSteppers() {
   }
 }
 
-void Emitter::emitStep() {
+std::string Emitter::propIndexList(int a, const std::vector<std::string>& props) const {
+  std::string s = "{";
+  for (size_t k = 0; k < props.size(); ++k) {
+    int i = propIndex(a, props[k]);
+    if (i < 0) SPHC_INTERNAL("ghost property '" + props[k] + "' of '" + arr(a).name +
+                             "' was not allocated");
+    s += (k ? ", " : "") + std::to_string(i);
+  }
+  return s + "}";
+}
+
+void Emitter::emitDomainSetup() {
+  const PlanDomain& dom = plan_.domain;
+  auto pn = [&](const std::string& n) { return paramRef(n); };
+  static const char* kAxes[3] = {"x", "y", "z"};
+  scene_ << "    // domain, from " << loc(dom.loc) << "\n";
+  scene_ << "    box.dim = DIM;\n";
+  for (int a = 0; a < 3; ++a)
+    for (int side = 0; side < 2; ++side) {
+      const PlanBoundary& b = side == 0 ? dom.lo[a] : dom.hi[a];
+      if (b.kind == PlanBoundary::Open) continue;
+      const std::string which = side == 0 ? "lo" : "hi";
+      scene_ << "    box." << which << "_kind[" << a << "] = sphc::Boundary::"
+             << (b.kind == PlanBoundary::Periodic ? "Periodic" : "Mirror") << ";  // "
+             << kAxes[a] << ", from " << loc(b.loc) << "\n";
+      scene_ << "    box." << which << "[" << a << "] = " << exprCpp(*b.at, pn) << ";\n";
+    }
+  scene_ << "    sphc::check_domain(box);\n";
+}
+
+// update_neighbours of a scene with a periodic or mirror domain: the search domain of the
+// real particles, the cell-order permutation (of real particles), then the ghosts of every
+// source array, and the cell lists over real particles and ghosts.
+void Emitter::emitUpdateNeighboursWithGhosts() {
+  if (loopArrays_.empty()) return;
+  const char* axes[3] = {"x", "y", "z"};
+  scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
+  bool first = true;
+  for (const auto& a : plan_.arrays) {
+    if (!loopArrays_.count(a.name)) continue;
+    scene_ << (first ? "" : ", ") << "&" << a.name;
+    first = false;
+  }
+  scene_ << "};\n";
+  scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
+  if (sourceArrays_.empty()) return;
+  auto build = [&](const std::string& S, const std::string& count) {
+    int s = plan_.arrayIndex(S);
+    std::string b = "cells_" + S + ".build(domain";
+    for (int k = 0; k < 3; ++k)
+      b += ", " + (k < plan_.dim ? propPtr(s, axes[k]) : std::string("nullptr"));
+    return b + ", " + count + ");";
+  };
+  scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
+  scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
+  for (const auto& S : sourceArrays_)
+    scene_ << "      " << build(S, S + ".n") << "\n      " << S << ".permute(cells_" << S
+           << ".cell_order());\n";
+  scene_ << "    }\n";
+  scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
+  scene_ << "    const double cutoff = domain.cell_size;\n";
+  for (const auto& S : sourceArrays_) {
+    int s = plan_.arrayIndex(S);
+    scene_ << "    sphc::add_ghosts(box, " << S << ", cutoff, ghosts_" << S << ", "
+           << propIndexList(s, arr(s).ghostProps) << ");  //";
+    for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
+    scene_ << "\n";
+  }
+  scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
+  for (const auto& S : sourceArrays_)
+    scene_ << "    " << build(S, S + ".n + ghosts_" + S + ".size()") << "\n";
+}
+
+// update_neighbours and compute_accelerations of a scene without periodic or mirror domain.
+void Emitter::emitUpdateNeighbours() {
   scene_ << "  // Rebuilds the neighbour search of every array that is a source.\n";
   scene_ << "  void update_neighbours() {\n";
   if (opencl_) {
@@ -1028,6 +1132,27 @@ void Emitter::emitStep() {
   scene_ << "  }\n\n";
   scene_ << "  void compute_accelerations(double t, double dt) {\n";
   scene_ << "    update_neighbours();\n    equations(t, dt);\n  }\n\n";
+}
+
+void Emitter::emitStep() {
+  if (hasDomain()) {
+    scene_ << "  // Periodic axes: particles that left the box come back in.\n";
+    scene_ << "  void update_domain() {\n";
+    for (const auto& a : plan_.arrays) scene_ << "    sphc::wrap_periodic(box, " << a.name << ");\n";
+    scene_ << "  }\n\n";
+    scene_ << "  // Rebuilds the neighbour search of every array that is a source, with ghosts.\n";
+    scene_ << "  void update_neighbours() {\n";
+    emitUpdateNeighboursWithGhosts();
+    scene_ << "  }\n\n";
+    scene_ << "  // Ghosts exist during an evaluation only: outside it arrays hold real particles.\n";
+    scene_ << "  void compute_accelerations(double t, double dt) {\n";
+    scene_ << "    update_domain();\n    update_neighbours();\n    equations(t, dt);\n";
+    for (const auto& S : sourceArrays_)
+      scene_ << "    sphc::remove_ghosts(" << S << ", ghosts_" << S << ");\n";
+    scene_ << "  }\n\n";
+  } else {
+    emitUpdateNeighbours();
+  }
   // The integrator's time step; after stage k of m the time is t + k/m dt.
   int stages = 0;
   for (const auto& s : plan_.integratorSteps) stages += s.rfind("stage", 0) == 0;
@@ -1040,7 +1165,8 @@ void Emitter::emitStep() {
     if (s == "compute_accelerations")
       scene_ << "    compute_accelerations(" << time << ", dt);\n";
     else if (s == "update_domain")
-      scene_ << "    // update_domain: no periodic or mirror domain in this scene\n";
+      scene_ << (hasDomain() ? "    update_domain();\n"
+                             : "    // update_domain: no periodic or mirror domain in this scene\n");
     else {
       bool any = false;
       for (const auto& a : plan_.arrays)
@@ -1232,6 +1358,7 @@ std::string Emitter::run() {
   bool anyLoad = false;
   for (const auto& a : plan_.arrays) anyLoad |= !a.decl->loads.empty();
   if (anyLoad) out_ << "#include \"sphc/load.h\"\n";
+  if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   if (openmp_) out_ << "\n#include <omp.h>\n";
   if (opencl_) out_ << "\n#include \"sphc/opencl.h\"\n";
@@ -1294,6 +1421,10 @@ std::string Emitter::run() {
   } else {
     out_ << "  sphc::SearchDomain domain;\n";
     for (const auto& S : sourceArrays_) out_ << "  sphc::CellList cells_" << S << ";\n";
+  }
+  if (hasDomain()) {
+    out_ << "  sphc::Domain box;  // periodic and mirror boundaries\n";
+    for (const auto& S : sourceArrays_) out_ << "  sphc::Ghosts ghosts_" << S << ";\n";
   }
   out_ << "  int last_iterations = 0;\n";
   if (!sourceArrays_.empty()) {

@@ -40,7 +40,8 @@ static cl::opt<std::string> Emit("emit",
                                  cl::init("exe"), cl::cat(SphcCat));
 static cl::opt<std::string> DumpAfter("dump-after",
                                       cl::desc("Print the state after a pass and stop: parse, "
-                                               "sema, bodies, prune, properties, hazards, pairs"),
+                                               "sema, bodies, prune, properties, hazards, pairs, "
+                                               "ghosts"),
                                       cl::value_desc("pass"), cl::cat(SphcCat));
 static cl::opt<bool> Report("report", cl::desc("Print the execution plan the compiler derived "
                                                "(arrays, properties, groups, pruned equations)"),
@@ -94,13 +95,13 @@ int main(int argc, char** argv) {
                  << " is for --backend=opencl; the C++ backends compute in double\n";
     return fail();
   }
-  static const char* passes[] = {"parse",      "options", "sema",  "bodies",
-                                 "prune",      "properties", "hazards", "pairs"};
+  static const char* passes[] = {"parse",      "options", "sema",    "bodies", "prune",
+                                 "properties", "hazards", "pairs",   "ghosts"};
   if (!DumpAfter.empty() &&
       std::find(std::begin(passes), std::end(passes), DumpAfter) == std::end(passes)) {
     llvm::errs() << "sphc: error: unknown pass '" << DumpAfter
                  << "' for --dump-after; passes are: parse, options, sema, bodies, prune, "
-                    "properties, hazards, pairs\n";
+                    "properties, hazards, pairs, ghosts\n";
     return fail();
   }
   if (Emit != "exe" && Emit != "cpp" && Emit != "opencl" && Emit != "plan" && Emit != "ast") {
@@ -155,6 +156,13 @@ int main(int argc, char** argv) {
     return true;
   };
   if (dump("sema")) return 0;
+  // Ghost particles are made on the host; the OpenCL backend keeps particles on the device
+  // and has no ghosts yet.
+  if (Backend == "opencl" && plan->domain.any()) {
+    diags.error(plan->domain.loc, "periodic and mirror domains are not supported with "
+                                  "--backend=opencl yet; use --backend=serial or openmp");
+    return fail();
+  }
 
   {
     std::vector<BodySource> sources;
@@ -175,6 +183,8 @@ int main(int argc, char** argv) {
   if (dump("hazards")) return 0;
   if (!selectPairQuantities(*plan, diags)) return fail();
   if (dump("pairs")) return 0;
+  if (!selectGhostProperties(*plan, diags)) return fail();
+  if (dump("ghosts")) return 0;
   log("analysis");
   if (diags.hasErrors()) return fail();
 

@@ -202,6 +202,22 @@ struct SceneStepper {
   Ident stepper;
 };
 
+// `domain { periodic x in [0, L]; mirror y >= 0; }`: the boundaries of the simulated box.
+// One item per axis and kind; sema checks the axes, intervals and clashes.
+struct DomainItem {
+  enum Kind { Periodic, Mirror };
+  Kind kind = Periodic;
+  llvm::SMLoc loc;              // the `periodic` / `mirror` keyword
+  Ident axis;                   // x, y or z (as written; sema checks)
+  // `in [lo, hi]`: both; `>= lo`: lo only; `<= hi`: hi only.
+  ExprPtr lo, hi;
+};
+
+struct DomainDecl {
+  llvm::SMLoc loc;              // the `domain` keyword
+  std::vector<DomainItem> items;
+};
+
 struct SceneDecl {
   Ident name;
   std::vector<SceneSetting> settings;
@@ -210,6 +226,7 @@ struct SceneDecl {
   llvm::SMLoc adaptiveDtLoc;
   std::vector<KwArg> adaptiveDt;
   std::vector<OutputDecl> outputs;
+  std::vector<DomainDecl> domains;  // sema allows one
   llvm::SMLoc equationsLoc;
   std::vector<GroupItem> equations;
   std::vector<std::shared_ptr<When<SceneDecl>>> whens;  // the chosen branch's items are

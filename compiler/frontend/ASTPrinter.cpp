@@ -232,6 +232,7 @@ class Printer {
       os_ << "\n";
     }
     for (const auto& out : s.outputs) output(out, indent);
+    for (const auto& d : s.domains) domain(d, indent);
     if (s.equationsLoc.isValid()) {
       line(indent) << "equations";
       at(s.equationsLoc) << "\n";
@@ -239,6 +240,29 @@ class Printer {
     }
     for (const auto& w : s.whens)
       when(*w, indent, [&](const ast::SceneDecl& part, int in) { sceneItems(part, in); });
+  }
+
+  void domain(const ast::DomainDecl& d, int indent) {
+    line(indent) << "domain";
+    at(d.loc) << "\n";
+    for (const auto& item : d.items) {
+      line(indent + 1) << (item.kind == ast::DomainItem::Periodic ? "periodic " : "mirror ")
+              << item.axis.name;
+      if (item.lo && item.hi) {
+        os_ << " in [";
+        printExpr(*item.lo, os_);
+        os_ << ", ";
+        printExpr(*item.hi, os_);
+        os_ << "]";
+      } else if (item.lo) {
+        os_ << " >= ";
+        printExpr(*item.lo, os_);
+      } else if (item.hi) {
+        os_ << " <= ";
+        printExpr(*item.hi, os_);
+      }
+      at(item.loc) << "\n";
+    }
   }
 
   void output(const ast::OutputDecl& out, int indent) {

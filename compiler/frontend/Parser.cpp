@@ -569,7 +569,7 @@ bool Parser::parseScene(ast::Module& mod) {
 bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (!cur().is(Token::Identifier))
     return error(cur().loc, "expected a scene item ('name = value;', stepper, adaptive_dt, "
-                            "output, equations or when), found " + describe(cur()));
+                            "output, domain, equations or when), found " + describe(cur()));
   // The scene's keywords are contextual: `output = 3;` is a setting named output.
   if (lex_.peek().is(Token::Assign)) return parseSceneSetting(scene);
   if (atWhen())
@@ -583,6 +583,7 @@ bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (atWord("stepper")) return parseSceneStepper(scene);
   if (atWord("adaptive_dt")) return parseAdaptiveDt(scene);
   if (atWord("output")) return parseOutput(scene);
+  if (atWord("domain")) return parseDomain(scene);
   if (atWord("equations")) {
     scene.equationsLoc = cur().loc;
     advance();
@@ -662,6 +663,52 @@ bool Parser::parseOutputItem(ast::OutputDecl& out) {
                                 ", found " + describe(cur()));
   out.items.push_back(std::move(item));
   return expect(Token::Semi, "after output item");
+}
+
+bool Parser::parseDomain(ast::SceneDecl& scene) {
+  ast::DomainDecl domain;
+  domain.loc = cur().loc;
+  advance();
+  bool ok = parseBlock("domain", [&] { return parseDomainItem(domain); });
+  scene.domains.push_back(std::move(domain));
+  return ok;
+}
+
+// periodic AXIS in [lo, hi];  mirror AXIS in [lo, hi];  mirror AXIS >= lo;  mirror AXIS <= hi;
+bool Parser::parseDomainItem(ast::DomainDecl& domain) {
+  ast::DomainItem item;
+  if (atWord("periodic"))
+    item.kind = ast::DomainItem::Periodic;
+  else if (atWord("mirror"))
+    item.kind = ast::DomainItem::Mirror;
+  else
+    return error(cur().loc, "expected 'periodic' or 'mirror' in domain, found " + describe(cur()));
+  std::string what = item.kind == ast::DomainItem::Periodic ? "periodic" : "mirror";
+  item.loc = cur().loc;
+  advance();
+  if (!parseIdent(item.axis, "expected an axis (x, y or z) after '" + what + "'")) return false;
+  const std::string head = "'" + what + " " + item.axis.name + "'";
+  if (atWord("in")) {
+    advance();
+    if (!expect(Token::LBracket, "after " + head + " in")) return false;
+    if (!(item.lo = parseExpr())) return false;
+    if (!consumeIf(Token::Comma))
+      return error(cur().loc, "expected ',' between the ends of the interval of " + head +
+                                  ", found " + describe(cur()));
+    if (!(item.hi = parseExpr())) return false;
+    if (!consumeIf(Token::RBracket))
+      return error(cur().loc, "expected ']' after the interval of " + head + ", found " +
+                                  describe(cur()));
+  } else if (consumeIf(Token::GreaterEq)) {
+    if (!(item.lo = parseExpr())) return false;
+  } else if (consumeIf(Token::LessEq)) {
+    if (!(item.hi = parseExpr())) return false;
+  } else {
+    return error(cur().loc, "expected 'in [lo, hi]', '>= lo' or '<= hi' after " + head +
+                                ", found " + describe(cur()));
+  }
+  domain.items.push_back(std::move(item));
+  return expect(Token::Semi, "after domain item");
 }
 
 bool Parser::parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth) {

@@ -91,6 +91,8 @@ class Parser {
   bool parseAdaptiveDt(ast::SceneDecl& scene);
   bool parseOutput(ast::SceneDecl& scene);
   bool parseOutputItem(ast::OutputDecl& out);
+  bool parseDomain(ast::SceneDecl& scene);
+  bool parseDomainItem(ast::DomainDecl& domain);
   bool parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth);
   // After `(`: `kwarg, ...)`, consuming the `)`.
   bool parseKwArgs(std::vector<ast::KwArg>& args);

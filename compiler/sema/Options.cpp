@@ -186,6 +186,7 @@ class OptionSelector {
       append(s.settings, part->settings);
       append(s.steppers, part->steppers);
       append(s.outputs, part->outputs);
+      append(s.domains, part->domains);
       if (part->hasAdaptiveDt) {
         if (s.hasAdaptiveDt) {
           diags_.error(part->adaptiveDtLoc, "adaptive_dt is given twice");

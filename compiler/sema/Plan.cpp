@@ -90,6 +90,21 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
       os << " " << o.name << "=" << o.value << (o.fromCommandLine ? " (-D)" : " (default)");
     os << "\n";
   }
+  if (plan.domain.any()) {
+    static const char* kAxes[3] = {"x", "y", "z"};
+    os << "domain:";
+    for (int a = 0; a < 3; ++a) {
+      const PlanBoundary& lo = plan.domain.lo[a];
+      const PlanBoundary& hi = plan.domain.hi[a];
+      if (lo.kind == PlanBoundary::Periodic) {
+        os << " periodic " << kAxes[a] << ";";
+        continue;
+      }
+      if (lo.kind == PlanBoundary::Mirror) os << " mirror " << kAxes[a] << " low;";
+      if (hi.kind == PlanBoundary::Mirror) os << " mirror " << kAxes[a] << " high;";
+    }
+    os << "\n";
+  }
   os << "parameters:";
   for (const auto* p : plan.params)
     if (!p->derived) os << " " << p->name.name;
@@ -112,6 +127,11 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
       if (p.stride != 1) os << "[" << p.stride << "]";
     }
     os << "\n";
+    if (!a.ghostProps.empty()) {
+      os << "    ghosts carry:";
+      for (const auto& p : a.ghostProps) os << " " << p;
+      os << "\n";
+    }
     if (!a.constants.empty()) {
       os << "    constants:";
       for (const auto& c : a.constants) os << " " << c;

@@ -41,6 +41,10 @@ struct PlanArray {
   std::vector<std::string> constants;    // declared consts and reduce targets
   int stepper = -1;                      // index into Plan::steppers
   std::vector<std::string> outputProps;  // as listed in the scene's output
+  // With a periodic or mirror domain: the properties ghost copies of this array's particles
+  // carry (what the source side of a loop reads, and what groups with `real = false` read
+  // on it), filled by the ghost pass; empty when the array is no source.
+  std::vector<std::string> ghostProps;
   const PlanProperty* find(const std::string& p) const;
   PlanProperty* find(const std::string& p);
 };
@@ -85,6 +89,26 @@ struct PlanGroup {
   std::map<std::pair<int, int>, std::set<std::string>> pairQuantities;
 };
 
+// One side (low or high end) of an axis of the scene's `domain { }`.
+struct PlanBoundary {
+  enum Kind { Open, Periodic, Mirror };
+  Kind kind = Open;
+  ast::ExprPtr at;                            // the plane (Periodic: an end of the box)
+  llvm::SMLoc loc;                            // the domain item that set it
+};
+
+// The scene's domain: per axis, its low and high side. Periodic axes have both sides
+// Periodic; a mirror is per side.
+struct PlanDomain {
+  llvm::SMLoc loc;                            // the `domain` keyword
+  PlanBoundary lo[3], hi[3];
+  bool any() const {
+    for (int a = 0; a < 3; ++a)
+      if (lo[a].kind != PlanBoundary::Open || hi[a].kind != PlanBoundary::Open) return true;
+    return false;
+  }
+};
+
 struct PlanStepper {
   const ast::StepperDecl* decl = nullptr;
   std::map<std::string, int> methods;         // "initialize", "stage1", ... -> body index
@@ -111,6 +135,7 @@ struct Plan {
   std::vector<PlanEquation> equations;
   std::vector<PlanStepper> steppers;
   std::vector<PlanBody> bodies;
+  PlanDomain domain;                          // periodic and mirror boundaries
   PlanGroup root;                             // the scene's equations { } as a group
   std::vector<std::string> notes;             // what the passes decided, for --report
   std::vector<ChosenOption> options;          // compile-time options (sema/Options.h)

@@ -8,7 +8,9 @@
 #include "llvm/Support/MemoryBuffer.h"
 #include "llvm/Support/Path.h"
 
+#include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 
 namespace sphc {
@@ -197,6 +199,7 @@ class SemaImpl {
   void buildArrays();
   void checkGeometry(const ast::GeometryDecl& g, const std::string& array);
   void buildScene();
+  void buildDomain(const ast::DomainDecl& d);
   void buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g, int depth);
   void instantiate(const ast::EquationInstance& inst, PlanGroup& g);
   int useEquationDecl(const ast::EquationDecl* decl);
@@ -562,8 +565,115 @@ void SemaImpl::buildScene() {
     }
   }
 
+  for (size_t i = 0; i < s.domains.size(); ++i) {
+    if (i > 0) {
+      diags_.error(s.domains[i].loc, "the scene has a second domain; give all boundaries in one "
+                                     "`domain { ... }`");
+      diags_.note(s.domains[0].loc, "first domain is here");
+      continue;
+    }
+    buildDomain(s.domains[i]);
+  }
+
   plan_->root.loc = s.equationsLoc;
   buildGroup(s.equations, plan_->root, 0);
+}
+
+// The value of an expression made of literals only (numbers, pi, e, arithmetic); nothing if
+// it names a parameter (whose value is known only at run time) or calls a function.
+std::optional<double> literalValue(const ast::Expr& e) {
+  switch (e.kind) {
+    case ast::Expr::Number: return e.number;
+    case ast::Expr::Name:
+      if (e.text == "pi") return M_PI;
+      if (e.text == "e") return M_E;
+      return std::nullopt;
+    case ast::Expr::Unary: {
+      auto v = literalValue(*e.args[0]);
+      if (!v) return std::nullopt;
+      if (e.op == "-") return -*v;
+      if (e.op == "+") return *v;
+      return std::nullopt;
+    }
+    case ast::Expr::Binary: {
+      auto a = literalValue(*e.args[0]), b = literalValue(*e.args[1]);
+      if (!a || !b) return std::nullopt;
+      if (e.op == "+") return *a + *b;
+      if (e.op == "-") return *a - *b;
+      if (e.op == "*") return *a * *b;
+      if (e.op == "/" && *b != 0) return *a / *b;
+      return std::nullopt;
+    }
+    default: return std::nullopt;
+  }
+}
+
+void SemaImpl::buildDomain(const ast::DomainDecl& d) {
+  PlanDomain& dom = plan_->domain;
+  dom.loc = d.loc;
+  static const char* kAxes[3] = {"x", "y", "z"};
+  for (const auto& item : d.items) {
+    const bool periodic = item.kind == ast::DomainItem::Periodic;
+    const std::string what = periodic ? "periodic" : "mirror";
+    int a = -1;
+    for (int k = 0; k < 3; ++k)
+      if (item.axis.name == kAxes[k]) a = k;
+    if (a < 0) {
+      diags_.error(item.axis.loc, "unknown axis '" + item.axis.name + "' in the domain; axes "
+                                  "are x, y and z");
+      continue;
+    }
+    if (a >= plan_->dim) {
+      diags_.error(item.axis.loc, "axis '" + item.axis.name + "' is beyond the scene's " +
+                                      llvm::Twine(plan_->dim) + " dimension" +
+                                      (plan_->dim == 1 ? "" : "s") + " (dim = " +
+                                      llvm::Twine(plan_->dim) + ")");
+      continue;
+    }
+    if (periodic && (!item.lo || !item.hi)) {
+      diags_.error(item.loc, "a periodic axis needs both ends: periodic " + item.axis.name +
+                                 " in [lo, hi]");
+      continue;
+    }
+    bool ok = true;
+    for (const auto* e : {&item.lo, &item.hi})
+      if (*e) ok &= checkSceneExpr(*e, "the domain (it may use params)");
+    if (!ok) continue;
+    if (item.lo && item.hi) {
+      auto lo = literalValue(*item.lo), hi = literalValue(*item.hi);
+      if (lo && hi && !(*lo < *hi)) {
+        diags_.error(item.lo->loc, "empty interval for axis '" + item.axis.name +
+                                       "': the low end must be below the high end");
+        continue;
+      }
+    }
+    // Each side of an axis has one boundary.
+    auto setSide = [&](PlanBoundary& side, const ast::ExprPtr& at, const char* sideName) {
+      if (side.kind != PlanBoundary::Open) {
+        const bool same = (side.kind == PlanBoundary::Periodic) == periodic;
+        diags_.error(item.loc, std::string("the ") + sideName + " side of axis '" +
+                                   item.axis.name + "' " +
+                                   (same ? "is given twice"
+                                         : std::string("is both periodic and a mirror")));
+        diags_.note(side.loc, "first given here");
+        return;
+      }
+      side.kind = periodic ? PlanBoundary::Periodic : PlanBoundary::Mirror;
+      side.at = at;
+      side.loc = item.loc;
+    };
+    if (periodic && (dom.lo[a].kind != PlanBoundary::Open || dom.hi[a].kind != PlanBoundary::Open)) {
+      const PlanBoundary& prev = dom.lo[a].kind != PlanBoundary::Open ? dom.lo[a] : dom.hi[a];
+      const bool same = prev.kind == PlanBoundary::Periodic;
+      diags_.error(item.loc, "axis '" + item.axis.name + "' " +
+                                 (same ? std::string("is periodic twice")
+                                       : std::string("is both periodic and a mirror")));
+      diags_.note(prev.loc, "first given here");
+      continue;
+    }
+    if (item.lo) setSide(dom.lo[a], item.lo, "low");
+    if (item.hi) setSide(dom.hi[a], item.hi, "high");
+  }
 }
 
 void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g, int depth) {
@@ -575,6 +685,7 @@ void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g
     const ast::GroupDecl& gd = *item.group;
     auto sub = std::make_unique<PlanGroup>();
     sub->loc = gd.loc;
+    sub->real = g.real;  // `real = false` applies to the groups inside too
     bool hasMin = false, hasMax = false;
     for (const auto& kw : gd.options) {
       const std::string& k = kw.name.name;

@@ -5,7 +5,8 @@
 #   2. run it to the scene's final time, writing its snapshots,
 #   3. check the snapshots with tests/validation/CASE.py (which prints a table and the error
 #      figures, and writes OUT_DIR/CASE.png).
-# Cases: elliptical_drop (exact solution, Monaghan 1994), hydrostatic_tank (hydrostatics,
+# Cases: elliptical_drop (exact solution, Monaghan 1994), taylor_green (exact solution,
+# periodic), hydrostatic_tank (hydrostatics,
 # Adami et al. 2012). The dam break has its own script, run_dambreak.sh.
 #
 # Usage: run_case.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [RUN OPTIONS...]

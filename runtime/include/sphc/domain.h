@@ -1,0 +1,99 @@
+// sphc runtime: the domain manager (periodic and mirror boundaries, ghost particles).
+//
+// A scene's `domain { periodic x in [0, L]; mirror y >= 0; }` becomes a Domain: per axis, what
+// its low and high side are. Before every acceleration evaluation the generated solver
+//
+//   1. wraps particles that left a periodic box back into it (wrap_periodic: x in [lo, hi));
+//   2. appends to each array that is a neighbour source its ghost particles (add_ghosts):
+//      copies of the real particles within `cutoff` (the largest interaction radius,
+//      radius_scale * max h) of a periodic or mirror side,
+//        - periodic: shifted by the period, to the other side of the box;
+//        - mirror:   reflected through the plane, with the normal velocity component negated;
+//      and, where a particle is near two or three sides (corners, edges), every combination
+//      of those images, so the 3^dim neighbourhood of a real particle near a corner is
+//      complete;
+//   3. builds the cell lists over real particles and ghosts; ghosts are neighbours of every
+//      loop, and destinations only of groups with `real = false`;
+//   4. after the evaluation, removes the ghosts again (remove_ghosts).
+//
+// Storage. Ghosts live after the n real particles in every property's storage: during an
+// evaluation particle n + g (g < ghosts.size()) is ghost g. `ParticleArray::n` stays the
+// number of real particles throughout, so steppers, output, the adaptive time step and the
+// progress line see real particles only; outside an evaluation the storage holds exactly n
+// particles again.
+//
+// Properties. Only the properties listed (by index) are copied to ghosts: what the solver
+// reads of them (the compiler's ghost pass, PlanArray::ghostProps). By name: x, y, z are
+// positions (shifted or reflected); u, v, w are the velocity (a mirror negates the component
+// normal to it); every other property (any type or stride) is copied unchanged. Other
+// properties of ghosts have storage but unspecified values.
+//
+// Requirements: a periodic axis needs hi - lo >= cutoff (one image per side is then
+// enough), and so does an axis with mirrors on both sides; add_ghosts throws
+// std::invalid_argument otherwise. Particles are never moved back through a mirror plane (the
+// ghosts' pressure keeps them inside). Ghosts are found serially in a deterministic order
+// (by real particle, then image), so serial and OpenMP solvers agree bit for bit.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "sphc/nnps.h"
+#include "sphc/particle_array.h"
+
+namespace sphc {
+
+enum class Boundary : std::uint8_t { Open, Periodic, Mirror };
+
+struct Domain {
+  int dim = 2;
+  Boundary lo_kind[3] = {Boundary::Open, Boundary::Open, Boundary::Open};
+  Boundary hi_kind[3] = {Boundary::Open, Boundary::Open, Boundary::Open};
+  double lo[3] = {0.0, 0.0, 0.0};  // the low planes (periodic: the box is [lo, hi))
+  double hi[3] = {0.0, 0.0, 0.0};
+
+  bool periodic(int axis) const { return lo_kind[axis] == Boundary::Periodic; }
+  bool any() const;
+};
+
+// Throws std::invalid_argument (naming the axis) unless: dim is 1..3; axes beyond dim are
+// open; a periodic axis is periodic on both sides; every plane used is finite; lo < hi on an
+// axis with two boundaries.
+void check_domain(const Domain& d);
+
+// Ghost particles of one array: ghost g copies real particle source[g] through image[g].
+// image: 2 bits per axis (bits 2a, 2a+1): 0 = no image along axis a, 1 = the image through
+// the low side (periodic: x + L; mirror: 2 lo - x), 2 = through the high side (x - L;
+// 2 hi - x).
+struct Ghosts {
+  std::vector<std::uint32_t> source;
+  std::vector<std::uint8_t> image;
+  std::size_t size() const { return source.size(); }
+};
+
+// Moves the real particles of `a` that left a periodic box back into [lo, hi) along each
+// periodic axis (by whole periods). Non-finite coordinates are left as they are. Positions
+// missing from the array are skipped.
+void wrap_periodic(const Domain& d, ParticleArray& a);
+
+// Finds the ghosts of the real particles of `a` within `cutoff` of a periodic or mirror side
+// (into `g`, replacing its content), grows the storage of every property of `a` to
+// a.n + g.size() particles and copies the properties `carried` (indices into a.props) to the
+// ghosts. a.n is unchanged. Returns g.size().
+std::size_t add_ghosts(const Domain& d, ParticleArray& a, double cutoff, Ghosts& g,
+                       const std::vector<int>& carried);
+
+// Copies the properties `props` (indices into a.props) from the real particles to their
+// ghosts again (after an evaluation phase changed them on the real particles).
+void refresh_ghosts(const Domain& d, ParticleArray& a, const Ghosts& g,
+                    const std::vector<int>& props);
+
+// Removes the ghosts: the storage of every property back to a.n particles; g emptied.
+void remove_ghosts(ParticleArray& a, Ghosts& g);
+
+// Widens a search domain made from the real particles so that it covers the ghosts too:
+// `cutoff` beyond each periodic or mirror plane.
+void extend_for_ghosts(SearchDomain& s, const Domain& d, double cutoff);
+
+}  // namespace sphc

@@ -1,0 +1,210 @@
+// sphc runtime: the domain manager. See domain.h.
+#include "sphc/domain.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace sphc {
+
+namespace {
+
+const char* const kAxis[3] = {"x", "y", "z"};
+const char* const kVelocity[3] = {"u", "v", "w"};
+
+std::string axis_name(int a) { return std::string("axis ") + kAxis[a]; }
+
+// Storage of property p resized to n particles (new values 0).
+void resize_storage(Property& p, std::size_t n) {
+  const std::size_t len = n * static_cast<std::size_t>(p.stride);
+  switch (p.type) {
+    case PropType::F64: p.f64.resize(len, 0.0); break;
+    case PropType::I32: p.i32.resize(len, 0); break;
+    case PropType::U32: p.u32.resize(len, 0u); break;
+  }
+}
+
+template <class T>
+void copy_values(std::vector<T>& v, std::size_t n, int stride, const Ghosts& g) {
+  const std::size_t s = static_cast<std::size_t>(stride);
+  for (std::size_t k = 0; k < g.size(); ++k)
+    for (std::size_t c = 0; c < s; ++c) v[(n + k) * s + c] = v[g.source[k] * s + c];
+}
+
+int image_along(std::uint8_t image, int axis) { return (image >> (2 * axis)) & 3; }
+
+// The coordinate of the image of v along axis a (code 1: through the low side, 2: high).
+double image_coordinate(const Domain& d, int a, int code, double v) {
+  const bool low = code == 1;
+  const Boundary kind = low ? d.lo_kind[a] : d.hi_kind[a];
+  if (kind == Boundary::Periodic) {
+    const double period = d.hi[a] - d.lo[a];
+    return low ? v + period : v - period;
+  }
+  return low ? 2.0 * d.lo[a] - v : 2.0 * d.hi[a] - v;
+}
+
+void copy_property(const Domain& d, ParticleArray& a, const Ghosts& g, int idx) {
+  if (idx < 0 || static_cast<std::size_t>(idx) >= a.props.size())
+    throw std::out_of_range("ghosts of array '" + a.name + "': no property number " +
+                            std::to_string(idx));
+  Property& p = a.props[idx];
+  const std::size_t n = a.n;
+  int position = -1, velocity = -1;
+  for (int ax = 0; ax < 3; ++ax) {
+    if (p.name == kAxis[ax]) position = ax;
+    if (p.name == kVelocity[ax]) velocity = ax;
+  }
+  if (p.type == PropType::F64 && p.stride == 1 && position >= 0) {
+    double* v = p.f64.data();
+    for (std::size_t k = 0; k < g.size(); ++k) {
+      const int code = image_along(g.image[k], position);
+      const double x = v[g.source[k]];
+      v[n + k] = code ? image_coordinate(d, position, code, x) : x;
+    }
+    return;
+  }
+  if (p.type == PropType::F64 && p.stride == 1 && velocity >= 0) {
+    double* v = p.f64.data();
+    for (std::size_t k = 0; k < g.size(); ++k) {
+      const int code = image_along(g.image[k], velocity);
+      const bool mirrored =
+          code && (code == 1 ? d.lo_kind[velocity] : d.hi_kind[velocity]) == Boundary::Mirror;
+      const double u = v[g.source[k]];
+      v[n + k] = mirrored ? -u : u;
+    }
+    return;
+  }
+  switch (p.type) {
+    case PropType::F64: copy_values(p.f64, n, p.stride, g); break;
+    case PropType::I32: copy_values(p.i32, n, p.stride, g); break;
+    case PropType::U32: copy_values(p.u32, n, p.stride, g); break;
+  }
+}
+
+}  // namespace
+
+bool Domain::any() const {
+  for (int a = 0; a < 3; ++a)
+    if (lo_kind[a] != Boundary::Open || hi_kind[a] != Boundary::Open) return true;
+  return false;
+}
+
+void check_domain(const Domain& d) {
+  if (d.dim < 1 || d.dim > 3)
+    throw std::invalid_argument("domain: dim must be 1, 2 or 3 (got " + std::to_string(d.dim) +
+                                ")");
+  for (int a = 0; a < 3; ++a) {
+    const bool lo = d.lo_kind[a] != Boundary::Open, hi = d.hi_kind[a] != Boundary::Open;
+    if (!lo && !hi) continue;
+    if (a >= d.dim)
+      throw std::invalid_argument("domain: " + axis_name(a) + " is beyond dim = " +
+                                  std::to_string(d.dim));
+    if ((d.lo_kind[a] == Boundary::Periodic) != (d.hi_kind[a] == Boundary::Periodic))
+      throw std::invalid_argument("domain: " + axis_name(a) +
+                                  " is periodic on one side only");
+    if ((lo && !std::isfinite(d.lo[a])) || (hi && !std::isfinite(d.hi[a])))
+      throw std::invalid_argument("domain: a plane of " + axis_name(a) + " is not finite");
+    if (lo && hi && !(d.lo[a] < d.hi[a]))
+      throw std::invalid_argument("domain: " + axis_name(a) + " has the empty interval [" +
+                                  std::to_string(d.lo[a]) + ", " + std::to_string(d.hi[a]) +
+                                  "]");
+  }
+}
+
+void wrap_periodic(const Domain& d, ParticleArray& a) {
+  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
+    if (!d.periodic(ax)) continue;
+    const int idx = a.find(kAxis[ax]);
+    if (idx < 0 || a.props[idx].type != PropType::F64) continue;
+    double* x = a.props[idx].f64.data();
+    const double lo = d.lo[ax], hi = d.hi[ax], period = hi - lo;
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < a.n; ++i) {
+      double v = x[i];
+      if (!std::isfinite(v) || (v >= lo && v < hi)) continue;
+      // Whole periods; the checks after it catch rounding at the ends.
+      v -= std::floor((v - lo) / period) * period;
+      if (v >= hi) v -= period;
+      if (v < lo) v = lo;
+      x[i] = v;
+    }
+  }
+}
+
+std::size_t add_ghosts(const Domain& d, ParticleArray& a, double cutoff, Ghosts& g,
+                       const std::vector<int>& carried) {
+  g.source.clear();
+  g.image.clear();
+  if (!(cutoff >= 0.0) || !std::isfinite(cutoff))
+    throw std::invalid_argument("ghosts of array '" + a.name + "': the cutoff must be finite "
+                                "and >= 0");
+  // Which sides make images, and the coordinates read per axis.
+  bool makes[3][2] = {{false, false}, {false, false}, {false, false}};
+  const double* pos[3] = {nullptr, nullptr, nullptr};
+  bool any = false;
+  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
+    makes[ax][0] = d.lo_kind[ax] != Boundary::Open;
+    makes[ax][1] = d.hi_kind[ax] != Boundary::Open;
+    if (!makes[ax][0] && !makes[ax][1]) continue;
+    any = true;
+    if (makes[ax][0] && makes[ax][1] && d.hi[ax] - d.lo[ax] < cutoff)
+      throw std::invalid_argument(
+          "ghosts of array '" + a.name + "': " + axis_name(ax) + " spans " +
+          std::to_string(d.hi[ax] - d.lo[ax]) + ", less than the interaction radius " +
+          std::to_string(cutoff) + " (radius_scale * max h); enlarge the domain or reduce h");
+    const int idx = a.find(kAxis[ax]);
+    if (idx < 0 || a.props[idx].type != PropType::F64)
+      throw std::invalid_argument("ghosts of array '" + a.name + "': no position " +
+                                  kAxis[ax]);
+    pos[ax] = a.props[idx].f64.data();
+  }
+  if (any) {
+    for (std::size_t i = 0; i < a.n; ++i) {
+      // Per axis the images this particle has: 0 (itself) and 1 / 2 when near a side.
+      int codes[3][3];
+      int count[3] = {1, 1, 1};
+      for (int ax = 0; ax < 3; ++ax) {
+        codes[ax][0] = 0;
+        if (!pos[ax]) continue;
+        const double v = pos[ax][i];
+        if (!std::isfinite(v)) continue;
+        if (makes[ax][0] && v < d.lo[ax] + cutoff) codes[ax][count[ax]++] = 1;
+        if (makes[ax][1] && v > d.hi[ax] - cutoff) codes[ax][count[ax]++] = 2;
+      }
+      // Every combination but the particle itself (corners and edges included).
+      for (int cz = 0; cz < count[2]; ++cz)
+        for (int cy = 0; cy < count[1]; ++cy)
+          for (int cx = 0; cx < count[0]; ++cx) {
+            const int image = codes[0][cx] | (codes[1][cy] << 2) | (codes[2][cz] << 4);
+            if (image == 0) continue;
+            g.source.push_back(static_cast<std::uint32_t>(i));
+            g.image.push_back(static_cast<std::uint8_t>(image));
+          }
+    }
+  }
+  for (Property& p : a.props) resize_storage(p, a.n + g.size());
+  for (int idx : carried) copy_property(d, a, g, idx);
+  return g.size();
+}
+
+void refresh_ghosts(const Domain& d, ParticleArray& a, const Ghosts& g,
+                    const std::vector<int>& props) {
+  for (int idx : props) copy_property(d, a, g, idx);
+}
+
+void remove_ghosts(ParticleArray& a, Ghosts& g) {
+  for (Property& p : a.props) resize_storage(p, a.n);
+  g.source.clear();
+  g.image.clear();
+}
+
+void extend_for_ghosts(SearchDomain& s, const Domain& d, double cutoff) {
+  for (int ax = 0; ax < s.dim && ax < 3; ++ax) {
+    if (d.lo_kind[ax] != Boundary::Open) s.lo[ax] = std::min(s.lo[ax], d.lo[ax] - cutoff);
+    if (d.hi_kind[ax] != Boundary::Open) s.hi[ax] = std::max(s.hi[ax], d.hi[ax] + cutoff);
+  }
+}
+
+}  // namespace sphc
