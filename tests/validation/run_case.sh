@@ -1,18 +1,22 @@
 #!/bin/sh
 # A validation case against an exact or reference solution, in three steps, each of which
 # fails the test when it fails:
-#   1. compile examples/CASE.sph with sphc,
+#   1. compile examples/SCENE.sph with sphc,
 #   2. run it to the scene's final time, writing its snapshots,
-#   3. check the snapshots with tests/validation/CASE.py (which prints a table and the error
-#      figures, and writes OUT_DIR/CASE.png).
+#   3. check the snapshots with tests/validation/CHECK.py (which prints a table and the error
+#      figures, and writes OUT_DIR/SCENE.png).
+# CASE is SCENE:CHECK, or just SCENE when the check script has the scene's name.
 # Cases: elliptical_drop (exact solution, Monaghan 1994), hydrostatic_tank (hydrostatics,
-# Adami et al. 2012). The dam break has its own script, run_dambreak.sh.
+# Adami et al. 2012), hydrostatic_tank_edac:hydrostatic_tank (the same with EDAC),
+# dambreak_edac:dambreak_front (experiments). The WCSPH dam break has its own script,
+# run_dambreak.sh.
 #
 # Usage: run_case.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [RUN OPTIONS...]
 #   SPHC        the sphc executable (<build>/bin/sphc)
 #   SOURCE_DIR  the sphc source tree (for examples/ and tests/)
-#   CASE        the case: examples/CASE.sph and tests/validation/CASE.py
-#   EXE         the solver to build (<build>/tests/validation/CASE)
+#   CASE        SCENE[:CHECK]: examples/SCENE.sph, checked by tests/validation/CHECK.py
+#               (CHECK defaults to SCENE)
+#   EXE         the solver to build (<build>/tests/validation/SCENE)
 #   OUT_DIR     where the run writes its snapshots (emptied first)
 #   RUN OPTIONS passed to the solver (e.g. --set dx=0.01)
 # The Python interpreter is $SPHC_PYTHON if set, else the first of python3, /usr/bin/python3
@@ -29,6 +33,8 @@ CASE=$3
 EXE=$4
 OUT=$5
 shift 5
+SCENE=${CASE%%:*}
+CHECK=${CASE#*:}
 
 PY=""
 for cand in ${SPHC_PYTHON:-} python3 /usr/bin/python3; do
@@ -45,9 +51,9 @@ fi
 rm -rf "$OUT"
 mkdir -p "$(dirname "$EXE")" "$OUT"
 
-echo "== 1. compile: $SPHC $SRC/examples/$CASE.sph -o $EXE"
+echo "== 1. compile: $SPHC $SRC/examples/$SCENE.sph -o $EXE"
 start=$(date +%s)
-"$SPHC" "$SRC/examples/$CASE.sph" -o "$EXE"
+"$SPHC" "$SRC/examples/$SCENE.sph" -o "$EXE"
 echo "   compiled in $(( $(date +%s) - start )) s"
 
 echo "== 2. run: $EXE --quiet --timing -d $OUT $*"
@@ -55,5 +61,5 @@ start=$(date +%s)
 "$EXE" --quiet --timing -d "$OUT" "$@"
 echo "   ran in $(( $(date +%s) - start )) s"
 
-echo "== 3. check: $CASE.py $OUT"
-"$PY" "$SRC/tests/validation/$CASE.py" "$OUT" --plot "$OUT/$CASE.png"
+echo "== 3. check: $CHECK.py $OUT"
+"$PY" "$SRC/tests/validation/$CHECK.py" "$OUT" --plot "$OUT/$SCENE.png"
