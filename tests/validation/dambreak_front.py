@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
-"""Validation of the 2D dam break (examples/dambreak.sph) against experiment.
+"""Validation of the 2D dam break (examples/dambreak.sph, WCSPH, and
+examples/dambreak_edac.sph, EDAC) against experiment.
 
 Runs nothing itself: it reads the HDF5 snapshots a run of the dam break wrote into a
 directory (files <scene>_NNNNNN.h5 with root attributes t, step, dt, dim and groups /fluid and
-/boundary holding one dataset per property) and checks
+/boundary holding one dataset per property; or, for comparisons, PySPH's dam_break_2d output,
+files <name>_NNNNN.hdf5 with /particles/fluid/arrays/x and the time in /solver_data) and checks
 
   1. finiteness: no NaN or infinity in any dataset of any snapshot;
   2. containment: every fluid particle stays in the tank, i.e.
@@ -34,12 +36,18 @@ directory (files <scene>_NNNNNN.h5 with root attributes t, step, dt, dim and gro
        within --tol-mps (default 10%) of Koshizuka & Oka's MPS calculation of the same
          idealised problem.
      The table prints the error against every reference, so the margins stay visible.
+     The same tolerances hold for every scheme (WCSPH, EDAC): they come from the spread of the
+     experiments and from the idealisation the simulations share, not from one scheme.
+
+Positions are measured from the inner face of the left wall, which is x = 0 in sphc's scenes;
+--x0 gives another origin (PySPH's dam_break_2d has its innermost wall layer at x = 0, hence
+its wall face at x0 = dx/2, its fluid column 1.03 m wide at dx = 0.03, and 4 wall layers).
 
 Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input.
 With --plot FILE.png (needs matplotlib) it also draws the front against the experiment.
 
 Usage: dambreak_front.py OUTPUT_DIR [--tol 0.10] [--tol-ko 0.20] [--tol-mps 0.10] [--dx DX] [--layers 3]
-                         [--plot out.png]
+                         [--x0 0] [--label sphc] [--plot out.png]
 """
 
 import argparse
@@ -82,10 +90,27 @@ def load_csv(path):
 
 
 def snapshot_files(directory):
-    """Snapshot files <scene>_NNNNNN.h5 of a directory, in step order."""
-    files = [f for f in glob.glob(os.path.join(directory, "*.h5"))
-             if re.search(r"_\d+\.h5$", os.path.basename(f))]
-    return sorted(files, key=lambda f: int(re.search(r"_(\d+)\.h5$", f).group(1)))
+    """Snapshot files of a directory, in step order: sphc's <scene>_NNNNNN.h5 or, where there
+    are none, PySPH's <name>_NNNNN.hdf5."""
+    for ext in ("h5", "hdf5"):
+        pat = re.compile(r"_(\d+)\.%s$" % ext)
+        files = [f for f in glob.glob(os.path.join(directory, "*." + ext))
+                 if pat.search(os.path.basename(f))]
+        if files:
+            return sorted(files, key=lambda f: int(pat.search(f).group(1)))
+    return []
+
+
+def read_snapshot(f):
+    """(t, {array name: {property: dataset}}) of an open sphc or PySPH snapshot file."""
+    if "particles" in f and "solver_data" in f:  # PySPH
+        t = float(f["solver_data"].attrs["t"])
+        arrays = {name: dict(g["arrays"].items()) for name, g in f["particles"].items()
+                  if isinstance(g, h5py.Group) and "arrays" in g}
+        return t, arrays
+    arrays = {name: {k: d for k, d in g.items() if isinstance(d, h5py.Dataset)}
+              for name, g in f.items() if isinstance(g, h5py.Group)}
+    return float(f.attrs["t"]), arrays
 
 
 def infer_dx(x, y):
@@ -126,6 +151,9 @@ def main():
     ap.add_argument("--dx", type=float, default=None,
                     help="particle spacing (default: inferred from the first snapshot)")
     ap.add_argument("--layers", type=int, default=3, help="wall layers (default 3)")
+    ap.add_argument("--x0", type=float, default=0.0,
+                    help="x of the inner face of the left wall (default 0)")
+    ap.add_argument("--label", default="sphc", help="name of the run in the plot (default sphc)")
     ap.add_argument("--tank", type=float, default=4.0, help="tank width W [m] (default 4)")
     ap.add_argument("--L", type=float, default=1.0, help="column width L [m] (default 1)")
     ap.add_argument("--g", type=float, default=9.81, help="gravity [m/s^2] (default 9.81)")
@@ -158,23 +186,19 @@ def main():
     for path in files:
         name = os.path.basename(path)
         with h5py.File(path, "r") as f:
-            t = float(f.attrs["t"])
-            for gname, group in f.items():
-                if not isinstance(group, h5py.Group):
-                    continue
+            t, arrays = read_snapshot(f)
+            for gname, group in arrays.items():
                 for dname, dset in group.items():
-                    if not isinstance(dset, h5py.Dataset):
-                        continue
                     a = dset[()]
                     if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
                         bad = int(np.count_nonzero(~np.isfinite(a)))
                         failures.append("%s: /%s/%s has %d non-finite values"
                                         % (name, gname, dname, bad))
-            if "fluid" not in f:
-                sys.stderr.write("dambreak_front.py: %s has no /fluid group\n" % name)
+            if "fluid" not in arrays:
+                sys.stderr.write("dambreak_front.py: %s has no fluid array\n" % name)
                 return 2
-            x = np.asarray(f["fluid/x"][()], dtype=float)
-            y = np.asarray(f["fluid/y"][()], dtype=float)
+            x = np.asarray(arrays["fluid"]["x"][()], dtype=float) - args.x0
+            y = np.asarray(arrays["fluid"]["y"][()], dtype=float)
         if nfluid is None:
             nfluid = len(x)
             if dx is None:
@@ -199,8 +223,8 @@ def main():
     fronts = np.array(fronts) / args.L
     T = times * tscale
 
-    print("dam break surge front vs Koshizuka & Oka (1996): %d snapshots in %s"
-          % (len(files), args.outdir))
+    print("dam break surge front vs Koshizuka & Oka (1996): %d snapshots in %s (%s)"
+          % (len(files), args.outdir, args.label))
     print("dx = %.5g, front = max x of fluid particles with >= %d neighbours within 2 dx"
           % (dx, MIN_NEIGHBOURS))
     print("judged where T >= %.1f (T = t sqrt(2g/L)) and the reference Z/L < %.1f;"
@@ -267,7 +291,7 @@ def main():
             matplotlib.use("Agg")
             import matplotlib.pyplot as plt
             plt.figure(figsize=(6, 4.5))
-            plt.plot(T, fronts, "-", label="sphc (front, >= %d neighbours)" % MIN_NEIGHBOURS)
+            plt.plot(T, fronts, "-", label="%s (front, >= %d neighbours)" % (args.label, MIN_NEIGHBOURS))
             for (label, ts, zs), mk in zip(series, "o^v"):
                 plt.plot(ts, zs, mk, label=label + ", experiment")
             plt.plot(t_mps, z_mps, "s", mfc="none", label="Koshizuka & Oka (1996), MPS")
