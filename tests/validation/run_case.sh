@@ -6,7 +6,8 @@
 #   3. check the snapshots with tests/validation/CASE.py (which prints a table and the error
 #      figures, and writes OUT_DIR/CASE.png).
 # Cases: elliptical_drop (exact solution, Monaghan 1994), hydrostatic_tank (hydrostatics,
-# Adami et al. 2012). The dam break has its own script, run_dambreak.sh.
+# Adami et al. 2012), cavity (Ghia et al. 1982). The dam break has its own script,
+# run_dambreak.sh.
 #
 # Usage: run_case.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [RUN OPTIONS...]
 #   SPHC        the sphc executable (<build>/bin/sphc)
