@@ -280,15 +280,20 @@ def main():
             import matplotlib.pyplot as plt
             fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.5))
             line = np.linspace(0.01, 0.99, 99)
-            _, x, y, u, v = snaps[-1]
-            ul = [linear_fit(0.5 * L, yy * L, x, y, [u], h)[0] / U for yy in line]
-            vl = [linear_fit(xx * L, 0.5 * L, x, y, [v], h)[0] / U for xx in line]
-            ax1.plot(ul, line, "b-", label="sphc TVF, nx = %d, t = %.3g" % (nx, tf))
+            # The profiles averaged over the same snapshots as the error figures.
+            ul = np.zeros(len(line))
+            vl = np.zeros(len(line))
+            for (_, x, y, u, v) in avg:
+                ul += [linear_fit(0.5 * L, yy * L, x, y, [u], h)[0] / U for yy in line]
+                vl += [linear_fit(xx * L, 0.5 * L, x, y, [v], h)[0] / U for xx in line]
+            ul /= len(avg)
+            vl /= len(avg)
+            ax1.plot(ul, line, "b-", label="sphc, nx = %d, t = %.3g" % (nx, tf))
             ax1.plot(ref_u[:, 1], ref_u[:, 0], "ko", mfc="none", label="Ghia et al. (1982)")
             ax1.set_xlabel("u / U at x = 0.5")
             ax1.set_ylabel("y / L")
             ax1.legend(fontsize=8)
-            ax2.plot(line, vl, "b-", label="sphc TVF, nx = %d" % nx)
+            ax2.plot(line, vl, "b-", label="sphc, nx = %d" % nx)
             ax2.plot(ref_v[:, 0], ref_v[:, 1], "ko", mfc="none", label="Ghia et al. (1982)")
             ax2.set_xlabel("x / L")
             ax2.set_ylabel("v / U at y = 0.5")
