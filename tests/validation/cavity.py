@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Checks the lid-driven cavity (examples/cavity.sph) against Ghia, Ghia & Shin (1982).
 
-The case (S. Adami, X. Y. Hu, N. A. Adams, J. Comput. Phys. 241 (2013) 292-307, sec. 3):
-a unit square of fluid, no-slip walls, the lid y = 1 moving with speed U = 1, Re = U L / nu
+The case (the lid-driven cavity test of S. Adami, X. Y. Hu, N. A. Adams, J. Comput. Phys. 241
+(2013) 292-307): a unit square of fluid, no-slip walls, the lid y = 1 moving with speed U = 1, Re = U L / nu
 = 100, run from rest to a steady state. The reference: U. Ghia, K. N. Ghia, C. T. Shin,
 J. Comput. Phys. 48 (1982) 387-411, Tables I and II, Re = 100 (tests/data/
 ghia1982_re100_u.csv and _v.csv): u(y) along the vertical centre line x = 0.5 and v(x)
@@ -34,8 +34,9 @@ and the root mean square over them. Tolerances, per resolution (--max-tol, --rms
   Defaults, from these: at nx >= 50 (the paper's resolutions), max 0.04 U and rms 0.02 U,
   twice the 0.02 U of the paper's figure and of PySPH; at nx <= 35 (the CI runs nx = 30,
   coarser than any run of the paper), the same scaled by first order in dx (0.02 U x 50/30
-  = 0.033 U) and doubled: max 0.06 U, rms 0.03 U. Measured with sphc (docs/validation.md):
-  nx = 50: max 0.014 U, rms 0.006 U; nx = 30: max 0.034 U, rms 0.014 U. Runs that must fail
+  = 0.033 U) and doubled: max 0.06 U, rms 0.03 U. Measured with sphc (docs/validation.md),
+  TVF: nx = 30: max 0.034 U, rms 0.014 U; nx = 50: 0.014 U, 0.006 U; nx = 100: 0.0044 U,
+  0.0025 U. GTVF: nx = 30: 0.015 U, 0.008 U; nx = 50: 0.014 U, 0.006 U. Runs that must fail
   do: nx = 30 stopped at t = 3 (not steady: max 0.076 U, and the kinetic-energy check), and
   the cavity without the no-slip wall term (TVFWallNoSlip) (max 0.84 U: the lid drives
   nothing).
