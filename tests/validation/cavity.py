@@ -3,9 +3,9 @@
 
 The case (the lid-driven cavity test of S. Adami, X. Y. Hu, N. A. Adams, J. Comput. Phys. 241
 (2013) 292-307): a unit square of fluid, no-slip walls, the lid y = 1 moving with speed
-U = 1, Re = U L / nu = 100, run from rest to a steady state. The reference: U. Ghia, K. N. Ghia, C. T. Shin,
-J. Comput. Phys. 48 (1982) 387-411, Tables I and II, Re = 100 (tests/data/
-ghia1982_re100_u.csv and _v.csv): u(y) along the vertical centre line x = 0.5 and v(x)
+U = 1, Re = U L / nu = 100, run from rest to a steady state. The reference: U. Ghia,
+K. N. Ghia, C. T. Shin, J. Comput. Phys. 48 (1982) 387-411, Tables I and II, Re = 100
+(tests/data/ghia1982_re100_u.csv and _v.csv): u(y) along the vertical centre line x = 0.5 and v(x)
 along the horizontal centre line y = 0.5, from a 129 x 129 finite-difference solution.
 
 How the SPH velocity is read at a reference point: a weighted least-squares fit of a linear
