@@ -57,6 +57,11 @@ const std::vector<std::string>& allowedMathFunctions() {
   return names;
 }
 
+const std::vector<std::string>& kernelFunctions() {
+  static const std::vector<std::string> names = {"KERNEL_W", "KERNEL_DWDR"};
+  return names;
+}
+
 namespace {
 
 // Names of the synthesised translation unit and of the body functions in it.
@@ -230,6 +235,9 @@ std::string prelude() {
     out += std::string("#define ") + c.first + " " + c.second + "\n";
   for (const std::string& f : allowedMathFunctions())
     out += "double " + f + (isTwoArgumentMathFunction(f) ? "(double, double);\n" : "(double);\n");
+  // The scene's smoothing kernel at any (r, h): KERNEL_W(r, h) = W(r, h), KERNEL_DWDR(r, h) =
+  // dW/dr (the generated code defines them for the scene's kernel and dimension).
+  for (const std::string& f : kernelFunctions()) out += "double " + f + "(double r, double h);\n";
   return out;
 }
 
@@ -653,7 +661,8 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     for (const std::string& f : allowedMathFunctions()) list += (list.empty() ? "" : ", ") + f;
     std::string what = fn ? "call of '" + fn->getName().str() + "'" : std::string("this call");
     error(callee->getBeginLoc(), what + " is not allowed: bodies may call only the math.h "
-                                        "functions " + list);
+                                        "functions " + list +
+                                        " and the kernel's KERNEL_W(r, h), KERNEL_DWDR(r, h)");
     return true;
   }
 
@@ -707,7 +716,10 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   // prelude's declaration of a library builtin such as sqrt redeclares Clang's implicit one.
   bool isAllowedMath(const clang::FunctionDecl* fn) const {
     const auto& allowed = allowedMathFunctions();
-    if (std::find(allowed.begin(), allowed.end(), fn->getName().str()) == allowed.end())
+    const auto& kernel = kernelFunctions();
+    const std::string name = fn->getName().str();
+    if (std::find(allowed.begin(), allowed.end(), name) == allowed.end() &&
+        std::find(kernel.begin(), kernel.end(), name) == kernel.end())
       return false;
     for (const clang::FunctionDecl* d : fn->redecls())
       if (!d->isImplicit() && batch_.bodyAt(sm_, d->getLocation()) < 0) return true;

@@ -61,6 +61,9 @@ struct BodyFacts {
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given.
 const std::vector<std::string>& pairQuantityNames();
 const std::vector<std::string>& allowedMathFunctions();
+// Functions of the scene's smoothing kernel that bodies may call: KERNEL_W(r, h) (the kernel)
+// and KERNEL_DWDR(r, h) (its radial derivative), at any smoothing length h.
+const std::vector<std::string>& kernelFunctions();
 
 class BodyAnalyzer {
  public:

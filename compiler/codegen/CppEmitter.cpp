@@ -2,6 +2,7 @@
 
 #include "analysis/Access.h"
 #include "analysis/Passes.h"
+#include "body/BodyAnalysis.h"
 #include "sema/Geometry.h"
 
 #include "llvm/Support/FileSystem.h"
@@ -116,6 +117,7 @@ class Emitter {
   };
   // device: OpenCL C types (`real`, `__global` pointers) for a kernel of --backend=opencl.
   std::vector<BodyParam> bodyParams(const PlanBody& b, int destArray, bool device = false) const;
+  void emitKernelFunctions();
   void emitBodyFunction(const PlanBody& b, const std::string& name, const std::string& ret,
                         int destArray, bool device = false);
   // eqValues + sep + scalar: "eq3.rho0" on the host, "eq3_rho0" (a kernel argument) on the
@@ -285,6 +287,33 @@ void Emitter::emitBodyFunction(const PlanBody& b, const std::string& name,
   os << "}\n";
   if (device) resetLineDirective();
   os << "\n";
+}
+
+// KERNEL_W(r, h) and KERNEL_DWDR(r, h), the scene's kernel and its radial derivative at any
+// smoothing length, for bodies that call them (e.g. a kernel at h/2); emitted only then.
+void Emitter::emitKernelFunctions() {
+  bool used = false;
+  for (const auto& b : plan_.bodies)
+    for (const std::string& f : kernelFunctions())
+      used |= b.source.text.find(f) != std::string::npos;
+  if (!used) return;
+  out_ << "static inline double KERNEL_W(double r, double h) { return Kernel::w(r, h); }\n"
+          "static inline double KERNEL_DWDR(double r, double h) {\n"
+          "  const double x[3] = {r, 0.0, 0.0};\n"
+          "  double g[3];\n"
+          "  Kernel::gradient(x, r, h, g);\n"
+          "  return r > 0.0 ? g[0] : 0.0;\n"
+          "}\n\n";
+  if (opencl_) {
+    cl_ << "inline real KERNEL_W(real r, real h) { return kernel_w(r, h); }\n"
+           "inline real KERNEL_DWDR(real r, real h) {\n"
+           "  real x[3] = {r, 0.0, 0.0};\n"
+           "  real g[3];\n"
+           "  kernel_gradient(x, r, h, g);\n"
+           "  return r > 0.0 ? g[0] : 0.0;\n"
+           "}\n";
+    resetLineDirective();
+  }
 }
 
 void Emitter::emitLineDirective(llvm::SMLoc l) {
@@ -1370,6 +1399,7 @@ std::string Emitter::run() {
   out_ << "// ---- Equation and stepper bodies, as written in the .sph files ----\n\n";
   // OpenCL: line 1 of the kernel source is this directive, so lines are the source's own.
   if (opencl_) cl_ << "#line 2 \"" << plan_.sceneName << ".cl\"\n";
+  emitKernelFunctions();
   // Bodies of live equations (each declaration once) and of steppers.
   std::set<int> emittedDecls;
   for (const auto& eq : plan_.equations) {

@@ -6,8 +6,8 @@
 #   3. check the snapshots with tests/validation/CASE.py (which prints a table and the error
 #      figures, and writes OUT_DIR/CASE.png).
 # Cases: elliptical_drop (exact solution, Monaghan 1994), taylor_green (exact solution,
-# periodic), hydrostatic_tank (hydrostatics, Adami et al. 2012), the same tank with other
-# schemes (hydrostatic_tank_edac:hydrostatic_tank, ...), dam breaks with other schemes
+# periodic), cavity (Ghia et al. 1982), hydrostatic_tank (hydrostatics, Adami et al. 2012),
+# the same tank with other schemes (hydrostatic_tank_edac:hydrostatic_tank, ...), dam breaks with other schemes
 # against the experiments (dambreak_edac:dambreak_front, ...). The WCSPH dam break has its
 # own script, run_dambreak.sh.
 #
