@@ -8,13 +8,16 @@
 # Cases: elliptical_drop (exact solution, Monaghan 1994), hydrostatic_tank (hydrostatics,
 # Adami et al. 2012). The dam break has its own script, run_dambreak.sh.
 #
-# Usage: run_case.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [RUN OPTIONS...]
+# Usage: run_case.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [RUN OPTIONS...] [-- CHECK OPTIONS...]
 #   SPHC        the sphc executable (<build>/bin/sphc)
 #   SOURCE_DIR  the sphc source tree (for examples/ and tests/)
-#   CASE        the case: examples/CASE.sph and tests/validation/CASE.py
+#   CASE        the case: examples/CASE.sph and tests/validation/CASE.py, or SCENE:CHECK for
+#               examples/SCENE.sph checked by tests/validation/CHECK.py (one check, several
+#               scenes: hydrostatic_tank_iisph:hydrostatic_tank)
 #   EXE         the solver to build (<build>/tests/validation/CASE)
 #   OUT_DIR     where the run writes its snapshots (emptied first)
 #   RUN OPTIONS passed to the solver (e.g. --set dx=0.01)
+#   CHECK OPTIONS passed to the check after the output directory (e.g. --rho-err-tol 1e-4)
 # The Python interpreter is $SPHC_PYTHON if set, else the first of python3, /usr/bin/python3
 # that has numpy and h5py.
 set -eu
@@ -25,10 +28,18 @@ if [ $# -lt 5 ]; then
 fi
 SPHC=$1
 SRC=$2
-CASE=$3
+CASE=${3%%:*}
+CHECK=${3#*:}
 EXE=$4
 OUT=$5
 shift 5
+# Run options up to "--", check options after it.
+RUN_OPTS=""
+while [ $# -gt 0 ] && [ "$1" != "--" ]; do
+  RUN_OPTS="$RUN_OPTS $1"
+  shift
+done
+[ $# -gt 0 ] && shift
 
 PY=""
 for cand in ${SPHC_PYTHON:-} python3 /usr/bin/python3; do
@@ -50,10 +61,11 @@ start=$(date +%s)
 "$SPHC" "$SRC/examples/$CASE.sph" -o "$EXE"
 echo "   compiled in $(( $(date +%s) - start )) s"
 
-echo "== 2. run: $EXE --quiet --timing -d $OUT $*"
+echo "== 2. run: $EXE --quiet --timing -d $OUT$RUN_OPTS"
 start=$(date +%s)
-"$EXE" --quiet --timing -d "$OUT" "$@"
+# shellcheck disable=SC2086  # options are words without spaces
+"$EXE" --quiet --timing -d "$OUT" $RUN_OPTS
 echo "   ran in $(( $(date +%s) - start )) s"
 
-echo "== 3. check: $CASE.py $OUT"
-"$PY" "$SRC/tests/validation/$CASE.py" "$OUT" --plot "$OUT/$CASE.png"
+echo "== 3. check: $CHECK.py $OUT $*"
+"$PY" "$SRC/tests/validation/$CHECK.py" "$OUT" --plot "$OUT/$CASE.png" "$@"
