@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Validation of the 2D dam break (examples/dambreak.sph) against experiment.
+"""Validation of the 2D dam break (examples/dambreak.sph, dambreak_iisph.sph) against experiment.
 
 Runs nothing itself: it reads the HDF5 snapshots a run of the dam break wrote into a
 directory (files <scene>_NNNNNN.h5 with root attributes t, step, dt, dim and groups /fluid and
@@ -34,6 +34,12 @@ directory (files <scene>_NNNNNN.h5 with root attributes t, step, dt, dim and gro
        within --tol-mps (default 10%) of Koshizuka & Oka's MPS calculation of the same
          idealised problem.
      The table prints the error against every reference, so the margins stay visible.
+     Incompressible schemes (examples/dambreak_iisph.sph) solve the idealised problem of the
+     MPS calculation closely (IISPH: within 3.3% of it) and so run ahead of the experiments as
+     that calculation does: the MPS curve itself is up to 13.4% ahead of the nearest
+     experiment and 21.0% ahead of Koshizuka & Oka's (computed from the data files). Their
+     test keeps --tol-mps 10% and widens --tol and --tol-ko to those figures, rounded up:
+     15% and 22%.
 
 Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input.
 With --plot FILE.png (needs matplotlib) it also draws the front against the experiment.
