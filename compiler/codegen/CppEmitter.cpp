@@ -1209,11 +1209,12 @@ void Emitter::emitMain() {
   out_ << "}; };\n";
   out_ << "  prog.compute_initial = [](double t, double dt) { scene.compute_accelerations(t, dt); };\n";
   out_ << "  prog.step = [](double t, double dt) { scene.step(t, dt); };\n";
-  out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   // OpenCL: particle data stays on the device; the run loop asks for it back only when it
   // writes output or checks for a blow-up.
   if (opencl_) out_ << "  prog.to_host = [] { scene.to_host(); };\n";
   if (plan_.adaptiveDt) out_ << "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n";
+  if (!iteratedGroups_.empty())
+    out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   bool anyOutput = false;
   for (const auto& a : plan_.arrays) anyOutput |= !a.outputProps.empty();
   for (const auto& a : plan_.arrays) {

@@ -405,7 +405,8 @@ bool Parser::parseReduce(ast::EquationDecl& eq) {
     return error(cur().loc, "unknown reduction operator " + quoted(cur().text) +
                                 ": expected sum, max, min or mean");
   } else {
-    return error(cur().loc, "expected a reduction operator after 'reduce': sum, max, min or mean");
+    return error(cur().loc,
+                 "expected a reduction operator after 'reduce': sum, max, min or mean");
   }
   if (!parseIdent(method.reduceTarget, "expected the array constant receiving the result after "
                                        "'reduce " + method.reduceOp + "'") ||

@@ -62,7 +62,8 @@ struct SceneProgram {
   std::function<void(double t, double dt)> compute_initial;  // may be empty
   std::function<void(double t, double dt)> step;             // one time step from t to t+dt
   std::function<double()> adaptive_dt;                       // empty = fixed dt
-  // Iterated groups, in source order: their iteration counts so far (may be empty).
+  // Iterated groups (a nested one before the group around it): their iteration counts so
+  // far (may be empty).
   std::function<std::vector<IterationStats>()> iterations;
   // Device backends: copies the device's particle data into the host arrays. The run loop
   // calls it only before it reads them (output, blow-up checks); empty = data lives on the host.
