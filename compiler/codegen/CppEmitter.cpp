@@ -225,6 +225,7 @@ class Emitter {
   std::ostringstream out_;
   std::ostringstream scene_;  // members of struct Scene
   std::vector<std::string> groupFunctions_;
+  std::vector<std::string> iteratedGroups_;  // source locations, in emission order
   std::set<std::string> sourceArrays_;  // arrays that need a cell list
   std::set<std::string> loopArrays_;    // arrays in a neighbour loop, as dest or source
   int phaseCounter_ = 0;
@@ -734,24 +735,47 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
     for (const auto* eq : withMethod(eqs, ast::Method::Reduce)) {
       const auto& pd = plan_.equationDecls[eq->declIndex];
       const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
-      std::string init = pd.reduceOp == "sum" ? "0.0"
+      // mean: the sum, divided by the number of particles (0 for an empty array).
+      const bool sum = pd.reduceOp == "sum" || pd.reduceOp == "mean";
+      std::string init = sum ? "0.0"
                          : pd.reduceOp == "max" ? "-HUGE_VAL"
                                                 : "HUGE_VAL";
-      std::string combine = pd.reduceOp == "sum" ? "acc += v"
+      std::string combine = sum ? "acc += v"
                              : pd.reduceOp == "max" ? "acc = v > acc ? v : acc"
                                                     : "acc = v < acc ? v : acc";
       scene_ << "      {  // reduce " << pd.reduceOp << " into " << D << "." << pd.reduceTarget
              << ": " << eq->name << ", from " << loc(eq->loc) << "\n";
       scene_ << "        double acc = " << init << ";\n";
-      scene_ << parallelFor("        ", std::string("reduction(") +
-                                             (pd.reduceOp == "sum" ? "+" : pd.reduceOp) +
-                                             " : acc)");
-      scene_ << "        for (int d_idx = 0; d_idx < "
-             << (onGhosts ? "static_cast<int>(" + D + ".n)" : std::string("n"))
-             << "; ++d_idx) {" << (onGhosts ? "  // real particles only" : "") << "\n";
-      scene_ << "          const double v = "
-             << callBody(bodyFunctionName(eq->name, "reduce"), b, d, -1, eqStruct(*eq), "t")
-             << ";\n          " << combine << ";\n        }\n";
+      // Reductions see the real particles only (never the ghosts of a non-real group).
+      const std::string nReal =
+          onGhosts ? "static_cast<int>(" + D + ".n)" : std::string("n");
+      const std::string value =
+          callBody(bodyFunctionName(eq->name, "reduce"), b, d, -1, eqStruct(*eq), "t");
+      if (openmp_ && sum) {
+        // A sum in the serial order, so that the result (and an iteration count that a
+        // convergence test derives from it) is bitwise the serial one: the values in
+        // parallel, the sum on one thread (n additions, cheap next to a neighbour pass).
+        const std::string loopHead = "        for (int d_idx = 0; d_idx < " + nReal +
+                                     "; ++d_idx)" +
+                                     (onGhosts ? "  // real particles only" : "") + "\n";
+        scene_ << "        std::vector<double>& values = reduce_scratch;\n";
+        scene_ << "        values.resize(" << nReal << ");\n";
+        scene_ << parallelFor("        ");
+        scene_ << loopHead;
+        scene_ << "          values[d_idx] = " << value << ";\n";
+        scene_ << loopHead << "          acc += values[d_idx];\n";
+        if (pd.reduceOp == "mean")
+          scene_ << "        acc = " << nReal << " > 0 ? acc / " << nReal << " : 0.0;\n";
+      } else {
+        scene_ << parallelFor("        ", std::string("reduction(") +
+                                               (sum ? "+" : pd.reduceOp) + " : acc)");
+        scene_ << "        for (int d_idx = 0; d_idx < " << nReal << "; ++d_idx) {"
+               << (onGhosts ? "  // real particles only" : "") << "\n";
+        scene_ << "          const double v = " << value << ";\n          " << combine
+               << ";\n        }\n";
+        if (pd.reduceOp == "mean")
+          scene_ << "        acc = " << nReal << " > 0 ? acc / " << nReal << " : 0.0;\n";
+      }
       scene_ << "        " << D << ".constant(" << constIndex(d, pd.reduceTarget)
              << ")[0] = acc;\n      }\n";
     }
@@ -904,12 +928,15 @@ void Emitter::emitDestinationDevice(int d, const std::vector<const PlanEquation*
         << callBody(bodyFunctionName(eq->name, "reduce"), b, d, -1, eqStruct(*eq), "t", "_")
         << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n}\n\n";
     int c = constIndex(d, pd.reduceTarget);
-    std::string op = pd.reduceOp == "sum" ? "Sum" : pd.reduceOp == "max" ? "Max" : "Min";
+    std::string op = pd.reduceOp == "sum" || pd.reduceOp == "mean" ? "Sum"
+                     : pd.reduceOp == "max"                         ? "Max"
+                                                                    : "Min";
     scene_ << "      {  // reduce " << pd.reduceOp << " into " << D << "." << pd.reduceTarget
            << ": " << eq->name << ", from " << loc(eq->loc) << "\n";
     scene_ << "        " << launch(k, "n", ka) << "\n";
     scene_ << "        " << D << ".constant(" << c << ")[0] = ocl.reduce(ocl.scratch(n), n, "
-           << "sphc::ocl::Op::" << op << ");\n";
+           << "sphc::ocl::Op::" << op << ")"
+           << (pd.reduceOp == "mean" ? " / (n > 0 ? n : 1)" : "") << ";\n";
     scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << c << ");\n";
     scene_ << "      }\n";
   }
@@ -951,9 +978,12 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
     scene_ << "    (void)t; (void)dt;\n  }\n\n";
     return;
   }
-  scene_ << "    for (int iteration = 1;; ++iteration) {\n";
+  const int statsIndex = static_cast<int>(iteratedGroups_.size());
+  iteratedGroups_.push_back(loc(g.loc));
+  scene_ << "    int iteration = 1;\n    bool converged = true;\n";
+  scene_ << "    for (;; ++iteration) {\n";
   for (const auto& c : calls) scene_ << "      " << c << "(t, dt);\n";
-  scene_ << "      bool converged = true;\n";
+  scene_ << "      converged = true;\n";
   for (const auto* eq : convergers) {
     const auto& pd = plan_.equationDecls[eq->declIndex];
     const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Converged)];
@@ -973,10 +1003,10 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
                        eqStruct(*eq), "t")
            << " > 0;  // " << eq->name << ", from " << loc(eq->loc) << "\n      }\n";
   }
-  scene_ << "      last_iterations = iteration;\n";
   scene_ << "      if (converged && iteration >= " << g.minIterations << ") break;\n";
   scene_ << "      if (iteration >= " << g.maxIterations << ") break;\n";
-  scene_ << "    }\n  }\n\n";
+  scene_ << "    }\n";
+  scene_ << "    iteration_stats[" << statsIndex << "].record(iteration, converged);\n  }\n\n";
   groupFunctions_.push_back(name);
 }
 
@@ -1353,6 +1383,8 @@ void Emitter::emitMain() {
   // writes output or checks for a blow-up.
   if (opencl_) out_ << "  prog.to_host = [] { scene.to_host(); };\n";
   if (plan_.adaptiveDt) out_ << "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n";
+  if (!iteratedGroups_.empty())
+    out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   bool anyOutput = false;
   for (const auto& a : plan_.arrays) anyOutput |= !a.outputProps.empty();
   for (const auto& a : plan_.arrays) {
@@ -1456,7 +1488,12 @@ std::string Emitter::run() {
     out_ << "  sphc::Domain box;  // periodic and mirror boundaries\n";
     for (const auto& S : sourceArrays_) out_ << "  sphc::Ghosts ghosts_" << S << ";\n";
   }
-  out_ << "  int last_iterations = 0;\n";
+  if (openmp_) out_ << "  std::vector<double> reduce_scratch;  // reduce sum/mean, OpenMP\n";
+  // Iterations per evaluation of each iterated group (--timing prints them).
+  out_ << "  std::vector<sphc::IterationStats> iteration_stats{";
+  for (std::size_t k = 0; k < iteratedGroups_.size(); ++k)
+    out_ << (k ? ", " : "") << "sphc::IterationStats{\"" << iteratedGroups_[k] << "\"}";
+  out_ << "};\n";
   if (!sourceArrays_.empty()) {
     out_ << "  static constexpr long REORDER_EVERY = 50;\n";
     out_ << "  long builds = 0;\n";

@@ -134,7 +134,7 @@ struct Method {
   enum Kind { Initialize, Loop, PostLoop, Reduce, Converged };
   Kind kind = Initialize;
   llvm::SMLoc loc;              // the method keyword
-  std::string reduceOp;         // Reduce: "sum", "max", "min"
+  std::string reduceOp;         // Reduce: "sum", "max", "min", "mean"
   Ident reduceTarget;           // Reduce: the array constant receiving the result
   Body body;
 };

@@ -493,14 +493,15 @@ bool Parser::parseReduce(ast::EquationDecl& eq) {
   method.kind = ast::Method::Reduce;
   method.loc = cur().loc;
   advance();
-  if (atWord("sum") || atWord("max") || atWord("min")) {
+  if (atWord("sum") || atWord("max") || atWord("min") || atWord("mean")) {
     method.reduceOp = cur().text.str();
     advance();
   } else if (cur().is(Token::Identifier) && lex_.peek().is(Token::Identifier)) {
     return error(cur().loc, "unknown reduction operator " + quoted(cur().text) +
-                                ": expected sum, max or min");
+                                ": expected sum, max, min or mean");
   } else {
-    return error(cur().loc, "expected a reduction operator after 'reduce': sum, max or min");
+    return error(cur().loc,
+                 "expected a reduction operator after 'reduce': sum, max, min or mean");
   }
   if (!parseIdent(method.reduceTarget, "expected the array constant receiving the result after "
                                        "'reduce " + method.reduceOp + "'") ||

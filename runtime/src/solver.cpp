@@ -194,6 +194,9 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "  --no-output           write no files (benchmarks)\n"
       "  --timing              print at the end, for the time loop:\n"
       "                        timing: steps=N particles=P wall_s=W us_per_particle_step=U\n"
+      "                        and, per iterated group, the iterations of its evaluations:\n"
+      "                        iterations: group=FILE:LINE evaluations=E total=N mean=M\n"
+      "                        min=A max=B unconverged=U\n"
       "  -h, --help            print this help\n"
       "\n"
       "Output: DIR/{1}_NNNNNN.h5 (NNNNNN: the step) and DIR/{1}.xdmf (for ParaView).\n"
@@ -559,6 +562,16 @@ class Simulation {
       fmt::print("timing: steps={} particles={} wall_s={:.6g} us_per_particle_step={:.6g} "
                  "backend={} threads={}\n",
                  step_, particles(), wall_s, us, prog_.backend, threads_);
+      // Counted from the first evaluation, the one before the first step, included.
+      if (prog_.iterations) {
+        for (const IterationStats& s : prog_.iterations()) {
+          fmt::print("iterations: group={} evaluations={} total={} mean={:.4g} min={} max={} "
+                     "unconverged={}\n",
+                     s.where, s.evaluations, s.total,
+                     s.evaluations ? static_cast<double>(s.total) / s.evaluations : 0.0, s.min,
+                     s.max, s.unconverged);
+        }
+      }
       std::fflush(stdout);
     }
   }

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Validation of the 2D dam break (examples/dambreak.sph, WCSPH, and
-examples/dambreak_edac.sph, EDAC) against experiment.
+"""Validation of the 2D dam break (examples/dambreak.sph, WCSPH; dambreak_edac.sph, EDAC;
+dambreak_iisph.sph, IISPH) against experiment.
 
 Runs nothing itself: it reads the HDF5 snapshots a run of the dam break wrote into a
 directory (files <scene>_NNNNNN.h5 with root attributes t, step, dt, dim and groups /fluid and
@@ -36,8 +36,15 @@ files <name>_NNNNN.hdf5 with /particles/fluid/arrays/x and the time in /solver_d
        within --tol-mps (default 10%) of Koshizuka & Oka's MPS calculation of the same
          idealised problem.
      The table prints the error against every reference, so the margins stay visible.
-     The same tolerances hold for every scheme (WCSPH, EDAC): they come from the spread of the
-     experiments and from the idealisation the simulations share, not from one scheme.
+     The same tolerances hold for the weakly compressible schemes (WCSPH, EDAC): they come
+     from the spread of the experiments and from the idealisation the simulations share, not
+     from one scheme.
+     Incompressible schemes (examples/dambreak_iisph.sph) solve the idealised problem of the
+     MPS calculation closely (IISPH: within 3.3% of it) and so run ahead of the experiments as
+     that calculation does: the MPS curve itself is up to 13.4% ahead of the nearest
+     experiment and 21.0% ahead of Koshizuka & Oka's (computed from the data files). Their
+     test keeps --tol-mps 10% and widens --tol and --tol-ko to those figures, rounded up:
+     15% and 22%.
 
 Positions are measured from the inner face of the left wall, which is x = 0 in sphc's scenes;
 --x0 gives another origin (PySPH's dam_break_2d has its innermost wall layer at x = 0, hence

@@ -39,6 +39,26 @@ struct SceneTimes {
   std::vector<double> output_at;   // extra output times
 };
 
+// How many iterations the evaluations of one iterated group took (group (iterate = true)):
+// the generated code records every evaluation; --timing prints the figures.
+struct IterationStats {
+  std::string where;       // the group's source location, file:line
+  long evaluations = 0;    // evaluations of the group (one per compute_accelerations)
+  long total = 0;          // iterations over all evaluations
+  int min = 0, max = 0;    // fewest and most iterations of one evaluation
+  int last = 0;            // iterations of the latest evaluation
+  long unconverged = 0;    // evaluations stopped by max_iterations before converging
+
+  void record(int iterations, bool converged) {
+    min = evaluations == 0 || iterations < min ? iterations : min;
+    max = iterations > max ? iterations : max;
+    last = iterations;
+    total += iterations;
+    ++evaluations;
+    if (!converged) ++unconverged;
+  }
+};
+
 struct SceneProgram {
   std::string name;  // scene name (used for output names)
   int dim = 2;
@@ -51,6 +71,9 @@ struct SceneProgram {
   std::function<void(double t, double dt)> compute_initial;  // may be empty
   std::function<void(double t, double dt)> step;             // one time step from t to t+dt
   std::function<double()> adaptive_dt;                       // empty = fixed dt
+  // Iterated groups (a nested one before the group around it): their iteration counts so
+  // far (may be empty).
+  std::function<std::vector<IterationStats>()> iterations;
   // Device backends: copies the device's particle data into the host arrays. The run loop
   // calls it only before it reads them (output, blow-up checks); empty = data lives on the host.
   std::function<void()> to_host;
