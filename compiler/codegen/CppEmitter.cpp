@@ -216,6 +216,7 @@ class Emitter {
   std::ostringstream out_;
   std::ostringstream scene_;  // members of struct Scene
   std::vector<std::string> groupFunctions_;
+  std::vector<std::string> postStepCalls_;  // top-level groups with post_step = true
   std::set<std::string> sourceArrays_;  // arrays that need a cell list
   std::set<std::string> loopArrays_;    // arrays in a neighbour loop, as dest or source
   int phaseCounter_ = 0;
@@ -875,8 +876,10 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
     }
     flush();
     std::string fn = name + "_" + std::to_string(part++);
-    emitGroup(*g.subgroups[-entry - 1], fn);
-    calls.push_back(fn);
+    const PlanGroup& sub = *g.subgroups[-entry - 1];
+    emitGroup(sub, fn);
+    // A post_step group (top level only) runs after the time step, not with the others.
+    (sub.postStep ? postStepCalls_ : calls).push_back(fn);
   }
   flush();
   std::vector<const PlanEquation*> convergers;
@@ -887,6 +890,13 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
   }
   scene_ << "  // group, from " << loc(g.loc) << "\n";
   scene_ << "  void " << name << "(double t, double dt) {\n";
+  if (g.every) {
+    // `every = N`: only when the number of completed steps is a multiple of N (N < 1: never).
+    auto pn = [&](const std::string& n) { return paramRef(n); };
+    scene_ << "    {\n      const long every = static_cast<long>(std::floor("
+           << exprCpp(*g.every, pn) << " + 0.5));\n"
+           << "      if (every < 1 || step_count % every != 0) return;\n    }\n";
+  }
   if (!g.iterate) {
     for (const auto& c : calls) scene_ << "    " << c << "(t, dt);\n";
     scene_ << "    (void)t; (void)dt;\n  }\n\n";
@@ -1028,6 +1038,13 @@ void Emitter::emitStep() {
   scene_ << "  }\n\n";
   scene_ << "  void compute_accelerations(double t, double dt) {\n";
   scene_ << "    update_neighbours();\n    equations(t, dt);\n  }\n\n";
+  if (!postStepCalls_.empty()) {
+    // Groups with post_step = true: after the integrator's time step, on the new positions.
+    scene_ << "  // groups with post_step = true, after each time step\n";
+    scene_ << "  void post_step(double t, double dt) {\n    update_neighbours();\n";
+    for (const auto& c : postStepCalls_) scene_ << "    " << c << "(t, dt);\n";
+    scene_ << "  }\n\n";
+  }
   // The integrator's time step; after stage k of m the time is t + k/m dt.
   int stages = 0;
   for (const auto& s : plan_.integratorSteps) stages += s.rfind("stage", 0) == 0;
@@ -1049,6 +1066,8 @@ void Emitter::emitStep() {
       if (s.rfind("stage", 0) == 0) ++done;
     }
   }
+  scene_ << "    ++step_count;\n";
+  if (!postStepCalls_.empty()) scene_ << "    post_step(t + dt, dt);\n";
   scene_ << "  }\n\n";
 }
 
@@ -1290,6 +1309,7 @@ std::string Emitter::run() {
     for (const auto& S : sourceArrays_) out_ << "  sphc::CellList cells_" << S << ";\n";
   }
   out_ << "  int last_iterations = 0;\n";
+  out_ << "  long step_count = 0;  // completed time steps (group option `every`)\n";
   if (!sourceArrays_.empty()) {
     out_ << "  static constexpr long REORDER_EVERY = 50;\n";
     out_ << "  long builds = 0;\n";
