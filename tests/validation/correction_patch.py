@@ -14,6 +14,12 @@ Exact results, checked in both snapshots:
     the gradient, so the relative error should be ~1e-14; the tolerance --exact-tol (1e-10,
     relative to |grad rho|) leaves four orders of magnitude and still catches any
     inconsistency in the matrix (a wrong sign or transposition gives O(1) errors).
+  - delta-SPH diffusive term (Marrone et al., Comput. Methods Appl. Mech. Engrg. 200 (2011)
+    1526-1542): delta h c0 sum_b psi_ba . grad W_ab V_b, with the renormalised density
+    gradients in psi, is zero for a linear density at every particle, free surface
+    included; error |arho| in units of delta c0 |grad rho| (the size of one of its terms),
+    tolerance --exact-tol. The Molteni & Colagrossi (2009) term, without the gradients,
+    must not vanish at the free surface (> --fail-min in the same units; Antuono et al. 2012).
   - Shepard filter (Shepard 1968; Colagrossi & Landrini, J. Comput. Phys. 191 (2003)
     448-475): sum_b m_b W_ab / sum_b V_b W_ab reproduces a uniform density ro at every
     particle; tolerance --exact-tol relative to ro.
@@ -59,6 +65,8 @@ def main():
     ap.add_argument("--ro", type=float, default=1000.0)
     ap.add_argument("--gx", type=float, default=0.1)
     ap.add_argument("--gy", type=float, default=0.2)
+    ap.add_argument("--co", type=float, default=10.0)
+    ap.add_argument("--delta", type=float, default=0.1)
     ap.add_argument("--exact-tol", type=float, default=1e-10)
     ap.add_argument("--fail-min", type=float, default=0.01)
     ap.add_argument("--plot", default=None)
@@ -95,6 +103,20 @@ def main():
                 elif not err.max() <= args.exact_tol:
                     failures.append("%s, %s: corrected gradient error %.3g > %.3g"
                                     % (label, name, err.max(), args.exact_tol))
+            scale = args.delta * args.co * np.linalg.norm(G)
+            for name in ("dsph", "mc"):
+                g = f[name]
+                x, y = g["x"][()], g["y"][()]
+                edge = np.minimum(np.minimum(x, 1 - x), np.minimum(y, 1 - y))
+                inner = edge > 2.15 * h
+                e = np.abs(g["arho"][()]) / scale
+                rows.append((label, name, float(e.max()), float(e[inner].max())))
+                if name == "dsph" and not e.max() <= args.exact_tol:
+                    failures.append("%s: delta-SPH term %.3g for a linear density > %.3g"
+                                    % (label, e.max(), args.exact_tol))
+                if name == "mc" and not e.max() > args.fail_min:
+                    failures.append("%s: Molteni-Colagrossi term vanishes too (%.3g): the test "
+                                    "cannot tell the forms apart" % (label, e.max()))
             s = f["shep"]
             x, y = s["x"][()], s["y"][()]
             edge = np.minimum(np.minimum(x, 1 - x), np.minimum(y, 1 - y))
@@ -116,7 +138,8 @@ def main():
     for label, name, e_all, e_in in rows:
         print("%-18s %-10s %14.3e %14.3e" % (label, name, e_all, e_in))
     print("(raw: plain SPH gradient; corr: Bonet-Lok gradient correction; mixed: mixed kernel "
-          "and gradient correction;\n shepard: Shepard filter of a uniform density; summation: "
+          "and gradient correction;\n dsph: delta-SPH term / (delta c0 |grad rho|);\n"
+          " mc: Molteni-Colagrossi term, same units; shepard: Shepard filter of a uniform density; summation: "
           "sum_b m_b W_ab of it)")
 
     if args.plot:
@@ -146,7 +169,7 @@ def main():
         return 1
     print("PASSED: corrected gradients and the Shepard filter exact to %.1e (tolerance %.0e); "
           "the uncorrected forms off by up to %.0f%% (gradient) and %.0f%% (density)"
-          % (max(r[2] for r in rows if r[1] in ("corr", "mixed", "shepard")), args.exact_tol,
+          % (max(r[2] for r in rows if r[1] in ("corr", "mixed", "dsph", "shepard")), args.exact_tol,
              100 * max(r[2] for r in rows if r[1] == "raw"),
              100 * max(r[2] for r in rows if r[1] == "summation")))
     return 0
