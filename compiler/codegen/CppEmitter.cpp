@@ -217,6 +217,7 @@ class Emitter {
   std::ostringstream scene_;  // members of struct Scene
   std::vector<std::string> groupFunctions_;
   std::vector<std::string> postStepCalls_;  // top-level groups with post_step = true
+  std::vector<std::string> postStepDue_;    // their conditions (`every`), as C++
   std::set<std::string> sourceArrays_;  // arrays that need a cell list
   std::set<std::string> loopArrays_;    // arrays in a neighbour loop, as dest or source
   int phaseCounter_ = 0;
@@ -880,6 +881,8 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
     emitGroup(sub, fn);
     // A post_step group (top level only) runs after the time step, not with the others.
     (sub.postStep ? postStepCalls_ : calls).push_back(fn);
+    if (sub.postStep && sub.every) postStepDue_.push_back(fn + "_due()");
+    if (sub.postStep && !sub.every) postStepDue_.push_back("true");
   }
   flush();
   std::vector<const PlanEquation*> convergers;
@@ -889,14 +892,16 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
       convergers.push_back(&eq);
   }
   scene_ << "  // group, from " << loc(g.loc) << "\n";
-  scene_ << "  void " << name << "(double t, double dt) {\n";
   if (g.every) {
     // `every = N`: only when the number of completed steps is a multiple of N (N < 1: never).
     auto pn = [&](const std::string& n) { return paramRef(n); };
-    scene_ << "    {\n      const long every = static_cast<long>(std::floor("
-           << exprCpp(*g.every, pn) << " + 0.5));\n"
-           << "      if (every < 1 || step_count % every != 0) return;\n    }\n";
+    scene_ << "  bool " << name << "_due() const {\n"
+           << "    const long every = static_cast<long>(std::floor(" << exprCpp(*g.every, pn)
+           << " + 0.5));\n"
+           << "    return every >= 1 && step_count % every == 0;\n  }\n\n";
   }
+  scene_ << "  void " << name << "(double t, double dt) {\n";
+  if (g.every) scene_ << "    if (!" << name << "_due()) return;\n";
   if (!g.iterate) {
     for (const auto& c : calls) scene_ << "    " << c << "(t, dt);\n";
     scene_ << "    (void)t; (void)dt;\n  }\n\n";
@@ -1041,7 +1046,11 @@ void Emitter::emitStep() {
   if (!postStepCalls_.empty()) {
     // Groups with post_step = true: after the integrator's time step, on the new positions.
     scene_ << "  // groups with post_step = true, after each time step\n";
-    scene_ << "  void post_step(double t, double dt) {\n    update_neighbours();\n";
+    // No neighbour update when no group is due (a disabled group changes nothing at all).
+    scene_ << "  void post_step(double t, double dt) {\n    if (!(";
+    for (size_t i = 0; i < postStepDue_.size(); ++i)
+      scene_ << (i ? " || " : "") << postStepDue_[i];
+    scene_ << ")) return;\n    update_neighbours();\n";
     for (const auto& c : postStepCalls_) scene_ << "    " << c << "(t, dt);\n";
     scene_ << "  }\n\n";
   }
