@@ -226,6 +226,8 @@ class Emitter {
   std::ostringstream scene_;  // members of struct Scene
   std::vector<std::string> groupFunctions_;
   std::vector<std::string> iteratedGroups_;  // source locations, in emission order
+  std::vector<std::string> postStepCalls_;  // top-level groups with post_step = true
+  std::vector<std::string> postStepDue_;    // their conditions (`every`), as C++
   std::set<std::string> sourceArrays_;  // arrays that need a cell list
   std::set<std::string> loopArrays_;    // arrays in a neighbour loop, as dest or source
   int phaseCounter_ = 0;
@@ -961,8 +963,12 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
     }
     flush();
     std::string fn = name + "_" + std::to_string(part++);
-    emitGroup(*g.subgroups[-entry - 1], fn);
-    calls.push_back(fn);
+    const PlanGroup& sub = *g.subgroups[-entry - 1];
+    emitGroup(sub, fn);
+    // A post_step group (top level only) runs after the time step, not with the others.
+    (sub.postStep ? postStepCalls_ : calls).push_back(fn);
+    if (sub.postStep && sub.every) postStepDue_.push_back(fn + "_due()");
+    if (sub.postStep && !sub.every) postStepDue_.push_back("true");
   }
   flush();
   std::vector<const PlanEquation*> convergers;
@@ -972,7 +978,16 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
       convergers.push_back(&eq);
   }
   scene_ << "  // group, from " << loc(g.loc) << "\n";
+  if (g.every) {
+    // `every = N`: only when the number of completed steps is a multiple of N (N < 1: never).
+    auto pn = [&](const std::string& n) { return paramRef(n); };
+    scene_ << "  bool " << name << "_due() const {\n"
+           << "    const long every = static_cast<long>(std::floor(" << exprCpp(*g.every, pn)
+           << " + 0.5));\n"
+           << "    return every >= 1 && step_count % every == 0;\n  }\n\n";
+  }
   scene_ << "  void " << name << "(double t, double dt) {\n";
+  if (g.every) scene_ << "    if (!" << name << "_due()) return;\n";
   if (!g.iterate) {
     for (const auto& c : calls) scene_ << "    " << c << "(t, dt);\n";
     scene_ << "    (void)t; (void)dt;\n  }\n\n";
@@ -1212,6 +1227,21 @@ void Emitter::emitStep() {
   } else {
     emitUpdateNeighbours();
   }
+  if (!postStepCalls_.empty()) {
+    // Groups with post_step = true: after the integrator's time step, on the new positions.
+    scene_ << "  // groups with post_step = true, after each time step\n";
+    // No neighbour update when no group is due (a disabled group changes nothing at all).
+    scene_ << "  void post_step(double t, double dt) {\n    if (!(";
+    for (size_t i = 0; i < postStepDue_.size(); ++i)
+      scene_ << (i ? " || " : "") << postStepDue_[i];
+    scene_ << ")) return;\n";
+    scene_ << (hasDomain() ? "    update_domain();\n" : "") << "    update_neighbours();\n";
+    for (const auto& c : postStepCalls_) scene_ << "    " << c << "(t, dt);\n";
+    if (hasDomain())
+      for (const auto& S : sourceArrays_)
+        scene_ << "    sphc::remove_ghosts(" << S << ", ghosts_" << S << ");\n";
+    scene_ << "  }\n\n";
+  }
   // The integrator's time step; after stage k of m the time is t + k/m dt.
   int stages = 0;
   for (const auto& s : plan_.integratorSteps) stages += s.rfind("stage", 0) == 0;
@@ -1234,6 +1264,8 @@ void Emitter::emitStep() {
       if (s.rfind("stage", 0) == 0) ++done;
     }
   }
+  scene_ << "    ++step_count;\n";
+  if (!postStepCalls_.empty()) scene_ << "    post_step(t + dt, dt);\n";
   scene_ << "  }\n\n";
 }
 
@@ -1494,6 +1526,7 @@ std::string Emitter::run() {
   for (std::size_t k = 0; k < iteratedGroups_.size(); ++k)
     out_ << (k ? ", " : "") << "sphc::IterationStats{\"" << iteratedGroups_[k] << "\"}";
   out_ << "};\n";
+  out_ << "  long step_count = 0;  // completed time steps (group option `every`)\n";
   if (!sourceArrays_.empty()) {
     out_ << "  static constexpr long REORDER_EVERY = 50;\n";
     out_ << "  long builds = 0;\n";

@@ -1,5 +1,7 @@
 #include "sema/Plan.h"
 
+#include "frontend/ASTPrinter.h"
+
 #include "llvm/Support/Format.h"
 
 namespace sphc {
@@ -36,6 +38,12 @@ void printGroup(const Plan& plan, const PlanGroup& g, llvm::raw_ostream& os, int
   if (!g.real) os << " (real = false)";
   if (g.iterate)
     os << " (iterate, " << g.minIterations << ".." << g.maxIterations << " iterations)";
+  if (g.every) {
+    os << " (every ";
+    printExpr(*g.every, os);
+    os << " steps)";
+  }
+  if (g.postStep) os << " (after each step)";
   os << "\n";
   for (int entry : g.order) {
     if (entry < 0) {

@@ -81,6 +81,12 @@ struct PlanGroup {
   bool real = true;
   bool iterate = false;
   int minIterations = 1, maxIterations = 1;
+  // `every = N` (an expression of params, evaluated at each evaluation): the group runs only
+  // when the number of completed time steps is a multiple of N (never when N < 1); null:
+  // always. `post_step = true` (top-level groups only): the group runs after each time step
+  // instead of in compute_accelerations.
+  ast::ExprPtr every;
+  bool postStep = false;
   std::vector<int> equations;                 // direct members, in order
   std::vector<std::unique_ptr<PlanGroup>> subgroups;
   // Order of members: entry >= 0 is equations[entry]; entry < 0 is subgroups[-entry - 1].

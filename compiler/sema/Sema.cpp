@@ -716,10 +716,21 @@ void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g
       } else if (k == "max_iterations") {
         intValue(sub->maxIterations);
         hasMax = true;
+      } else if (k == "every") {
+        if (kw.isList || !kw.value)
+          diags_.error(kw.name.loc, "group option 'every' takes a number of time steps (an "
+                                    "expression of params)");
+        else if (checkSceneExpr(kw.value, "group option 'every'"))
+          sub->every = kw.value;
+      } else if (k == "post_step") {
+        boolValue(sub->postStep);
+        if (sub->postStep && depth != 0)
+          diags_.error(kw.name.loc, "post_step is an option of a top-level group (one directly "
+                                    "in `equations`), not of a nested group");
       } else
         diags_.error(kw.name.loc, "unknown group option '" + k +
                                       "'; options are: real, iterate, min_iterations, "
-                                      "max_iterations");
+                                      "max_iterations, every, post_step");
     }
     if ((hasMin || hasMax) && !sub->iterate)
       diags_.error(gd.loc, "min_iterations/max_iterations need `iterate = true`");
