@@ -6,6 +6,11 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace sphc {
 
@@ -100,6 +105,17 @@ std::uint32_t CellList::insert_cell(std::uint64_t key, std::uint32_t& next_cell)
 
 void CellList::build(const SearchDomain& dom, const double* x, const double* y,
                      const double* z, std::size_t n) {
+  build_impl(dom, x, y, z, n);
+}
+
+void CellList::build(const SearchDomain& dom, const float* x, const float* y, const float* z,
+                     std::size_t n) {
+  build_impl(dom, x, y, z, n);
+}
+
+template <class T>
+void CellList::build_impl(const SearchDomain& dom, const T* x, const T* y, const T* z,
+                          std::size_t n) {
   check_dim(dom.dim, "sphc::CellList::build");
   if (n >= kNoCell) {
     throw std::invalid_argument("sphc::CellList::build: too many particles (" +
@@ -141,23 +157,24 @@ void CellList::build(const SearchDomain& dom, const double* x, const double* y,
     case Mode::Hash: dense_ = false; break;
   }
 
-  // Cell of every particle.
+  // Cell of every particle (coordinates read as double, whatever T is).
   cell_of_.resize(n);
   std::size_t num_cells = 0;
   if (dense_) {
     num_cells = static_cast<std::size_t>(total_cells);
-    // Independent per particle: parallel in the OpenMP runtime. The counting sort below
-    // stays serial, so the order (and every result) equals the serial build's.
+    // Independent per particle: parallel in the OpenMP runtime.
 #pragma omp parallel for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
       int c[3];
-      cell_coords(x[i], y ? y[i] : 0.0, z ? z[i] : 0.0, c);
+      cell_coords(x[i], y ? static_cast<double>(y[i]) : 0.0, z ? static_cast<double>(z[i]) : 0.0,
+                  c);
       cell_of_[i] = static_cast<std::uint32_t>(
           c[0] + static_cast<std::size_t>(ncell_[0]) *
                      (c[1] + static_cast<std::size_t>(ncell_[1]) * c[2]));
     }
   } else {
-    // Occupied cells are numbered in order of first appearance (deterministic).
+    // Occupied cells are numbered in order of first appearance (deterministic; serial, since
+    // the numbering depends on the order).
     int bits = 4;
     while ((std::size_t{1} << bits) < 2 * n) ++bits;
     keys_.assign(std::size_t{1} << bits, kEmptyKey);
@@ -166,24 +183,122 @@ void CellList::build(const SearchDomain& dom, const double* x, const double* y,
     std::uint32_t next_cell = 0;
     for (std::size_t i = 0; i < n; ++i) {
       int c[3];
-      cell_coords(x[i], y ? y[i] : 0.0, z ? z[i] : 0.0, c);
+      cell_coords(x[i], y ? static_cast<double>(y[i]) : 0.0, z ? static_cast<double>(z[i]) : 0.0,
+                  c);
       cell_of_[i] = insert_cell(pack(c[0], c[1], c[2]), next_cell);
     }
     num_cells = next_cell;
   }
+  counting_sort(num_cells);
+}
 
-  // Stable counting sort by cell: count, inclusive prefix sum (start_[c] = end of cell c),
-  // then place particles from last to first, decrementing, which leaves start_[c] = begin.
-  start_.assign(num_cells + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) ++start_[cell_of_[i]];
-  std::uint32_t running = 0;
-  for (std::size_t c = 0; c < num_cells; ++c) {
-    running += start_[c];
-    start_[c] = running;
+int CellList::sort_threads(std::size_t num_cells) const {
+  if (sort_chunks_ > 0) return sort_chunks_;
+#ifdef _OPENMP
+  // Below this many particles per thread the parallel regions cost more than they save; the
+  // per-thread histograms also cost O(threads * cells), so sparse grids stay serial.
+  int t = omp_in_parallel() ? 1 : omp_get_max_threads();
+  if (n_ < static_cast<std::size_t>(t) * kParallelMinPerThread) t = 1;
+  if (num_cells > 16 * n_ + 4096) t = 1;
+  return std::max(t, 1);
+#else
+  (void)num_cells;
+  return 1;
+#endif
+}
+
+void CellList::counting_sort(std::size_t num_cells) {
+  const std::size_t n = n_;
+  const std::uint32_t* cell_of = cell_of_.data();
+  start_.resize(num_cells + 1);
+  order_.resize(n);
+  const int threads = sort_threads(num_cells);
+  if (threads <= 1) {
+    // Stable counting sort by cell: count, inclusive prefix sum (start_[c] = end of cell c),
+    // then place particles from last to first, decrementing, which leaves start_[c] = begin.
+    std::fill(start_.begin(), start_.end(), 0u);
+    for (std::size_t i = 0; i < n; ++i) ++start_[cell_of[i]];
+    std::uint32_t running = 0;
+    for (std::size_t c = 0; c < num_cells; ++c) {
+      running += start_[c];
+      start_[c] = running;
+    }
+    start_[num_cells] = static_cast<std::uint32_t>(n);
+    for (std::size_t i = n; i-- > 0;) order_[--start_[cell_of[i]]] = static_cast<std::uint32_t>(i);
+    return;
+  }
+
+  // The same sort in parallel, with the same result. Thread t owns the particles of chunk t
+  // (contiguous, ascending) and the cells of cell block t. Pass 1: each thread counts its
+  // chunk's particles per cell in its own histogram. Pass 2: for its cells, a thread turns
+  // the histograms into write offsets: the particles of cell c from chunk t go after those
+  // of chunk 0..t-1, so the order within a cell is ascending by index, as in the serial sort;
+  // the offsets are relative to the cell's begin, whose prefix sum needs pass 3. Pass 4:
+  // each thread places its chunk in ascending order.
+  const std::size_t T = static_cast<std::size_t>(threads);
+  const std::size_t C = num_cells;
+  hist_.resize(T * C);
+  block_sum_.assign(T + 1, 0u);
+  std::uint32_t* hist = hist_.data();
+  std::uint32_t* start = start_.data();
+  std::uint32_t* order = order_.data();
+  std::uint32_t* block_sum = block_sum_.data();
+  auto range = [](std::size_t total, std::size_t parts, std::size_t k) {
+    return std::pair<std::size_t, std::size_t>(total * k / parts, total * (k + 1) / parts);
+  };
+#pragma omp parallel num_threads(threads)
+  {
+#ifdef _OPENMP
+    const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+#else
+    const std::size_t t = 0;
+#endif
+    // (An OpenMP implementation may give fewer threads than asked: then each thread does
+    // the chunks k = t, t + nt, ...)
+#ifdef _OPENMP
+    const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
+#else
+    const std::size_t nt = 1;
+#endif
+    for (std::size_t k = t; k < T; k += nt) {
+      std::uint32_t* h = hist + k * C;
+      std::fill(h, h + C, 0u);
+      const auto [i0, i1] = range(n, T, k);
+      for (std::size_t i = i0; i < i1; ++i) ++h[cell_of[i]];
+    }
+#pragma omp barrier
+    for (std::size_t k = t; k < T; k += nt) {
+      const auto [c0, c1] = range(C, T, k);
+      std::uint32_t sum = 0;
+      for (std::size_t c = c0; c < c1; ++c) {
+        start[c] = sum;  // begin of cell c relative to the block
+        for (std::size_t j = 0; j < T; ++j) {
+          const std::uint32_t count = hist[j * C + c];
+          hist[j * C + c] = sum;  // offset of chunk j's first particle in cell c
+          sum += count;
+        }
+      }
+      block_sum[k + 1] = sum;
+    }
+#pragma omp barrier
+#pragma omp single
+    for (std::size_t k = 0; k < T; ++k) block_sum[k + 1] += block_sum[k];
+    // (implicit barrier)
+    for (std::size_t k = t; k < T; k += nt) {
+      const auto [c0, c1] = range(C, T, k);
+      const std::uint32_t base = block_sum[k];
+      for (std::size_t c = c0; c < c1; ++c) start[c] += base;
+      for (std::size_t j = 0; j < T; ++j)
+        for (std::size_t c = c0; c < c1; ++c) hist[j * C + c] += base;
+    }
+#pragma omp barrier
+    for (std::size_t k = t; k < T; k += nt) {
+      std::uint32_t* h = hist + k * C;
+      const auto [i0, i1] = range(n, T, k);
+      for (std::size_t i = i0; i < i1; ++i) order[h[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+    }
   }
   start_[num_cells] = static_cast<std::uint32_t>(n);
-  order_.resize(n);
-  for (std::size_t i = n; i-- > 0;) order_[--start_[cell_of_[i]]] = static_cast<std::uint32_t>(i);
 }
 
 void CellList::neighbors(double xi, double yi, double zi, double hi, const double* x,
