@@ -29,8 +29,8 @@ static cl::opt<std::string> OutputFile("o", cl::desc("Executable to write (defau
 static cl::opt<std::string> Backend("backend", cl::desc("serial (default), openmp or opencl"),
                                     cl::init("serial"), cl::cat(SphcCat));
 static cl::opt<std::string> Precision("precision",
-                                      cl::desc("--backend=opencl: floating point on the device, "
-                                               "double (default; needs fp64) or single"),
+                                      cl::desc("Floating point the scene computes in: double "
+                                               "(default; on OpenCL it needs fp64) or single"),
                                       cl::init("double"), cl::cat(SphcCat));
 static cl::opt<std::string> Emit("emit",
                                  cl::desc("What to produce: exe (default), cpp (the generated "
@@ -81,11 +81,6 @@ int main(int argc, char** argv) {
   if (Precision != "double" && Precision != "single") {
     llvm::errs() << "sphc: error: unknown --precision '" << Precision
                  << "'; it is double or single\n";
-    return fail();
-  }
-  if (Precision != "double" && Backend != "opencl") {
-    llvm::errs() << "sphc: error: --precision=" << Precision
-                 << " is for --backend=opencl; the C++ backends compute in double\n";
     return fail();
   }
   static const char* passes[] = {"parse", "sema",   "bodies", "prune",

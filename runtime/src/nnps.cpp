@@ -23,6 +23,11 @@ void check_dim(int dim, const char* who) {
   }
 }
 
+// The domain from the bounding box [lo, hi] of the finite coordinates (lo > hi: none) and
+// the largest h.
+SearchDomain finish_domain(const double lo[3], const double hi[3], double hmax, int dim,
+                           double radius_scale);
+
 }  // namespace
 
 SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays, int dim,
@@ -76,6 +81,55 @@ SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays,
     }
   }
 
+  return finish_domain(lo, hi, hmax, dim, radius_scale);
+}
+
+SearchDomain make_search_domain_float(const std::vector<FloatCoords>& arrays, int dim,
+                                      double radius_scale) {
+  check_dim(dim, "sphc::make_search_domain");
+  if (!(radius_scale > 0.0) || !std::isfinite(radius_scale)) {
+    throw std::invalid_argument("sphc::make_search_domain: radius_scale must be > 0 (got " +
+                                std::to_string(radius_scale) + ")");
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  double lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
+  double hmax = 0.0;
+  for (const FloatCoords& c : arrays) {
+    if (c.n == 0) continue;
+    if (c.x == nullptr || c.h == nullptr)
+      throw std::invalid_argument("sphc::make_search_domain: an array has no x or no h");
+    const float* axis[3] = {c.x, c.y, c.z};
+    for (int a = 0; a < dim; ++a) {
+      if (axis[a] == nullptr) {
+        lo[a] = std::min(lo[a], 0.0);
+        hi[a] = std::max(hi[a], 0.0);
+        continue;
+      }
+      const float* v = axis[a];
+      double l = lo[a], u = hi[a];
+#pragma omp parallel for reduction(min : l) reduction(max : u) schedule(static)
+      for (std::size_t i = 0; i < c.n; ++i) {
+        const double w = v[i];
+        if (!std::isfinite(w)) continue;
+        l = std::min(l, w);
+        u = std::max(u, w);
+      }
+      lo[a] = l;
+      hi[a] = u;
+    }
+#pragma omp parallel for reduction(max : hmax) schedule(static)
+    for (std::size_t i = 0; i < c.n; ++i) {
+      const double w = c.h[i];
+      if (std::isfinite(w) && w > hmax) hmax = w;
+    }
+  }
+  return finish_domain(lo, hi, hmax, dim, radius_scale);
+}
+
+namespace {
+
+SearchDomain finish_domain(const double lo[3], const double hi[3], double hmax, int dim,
+                           double radius_scale) {
   SearchDomain dom;
   dom.dim = dim;
   dom.cell_size = hmax > 0.0 ? radius_scale * hmax : 1.0;
@@ -90,6 +144,8 @@ SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays,
   }
   return dom;
 }
+
+}  // namespace
 
 std::uint32_t CellList::insert_cell(std::uint64_t key, std::uint32_t& next_cell) {
   const std::size_t mask = keys_.size() - 1;

@@ -188,6 +188,7 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        timing: steps=N particles=P wall_s=W us_per_particle_step=U\n"
       "                        backend=B threads=T precision=double|single\n"
       "                        [nnps_s=S nnps_share=F: time in the neighbour search]\n"
+      "                        [iterations=I: of iterated groups, in all]\n"
       "  -h, --help            print this help\n"
       "\n"
       "Output: DIR/{1}_NNNNNN.h5 (NNNNNN: the step) and DIR/{1}.xdmf (for ParaView).\n"
@@ -553,6 +554,7 @@ class Simulation {
         const double s = prog_.neighbour_seconds() - nnps_start_;
         nnps = fmt::format(" nnps_s={:.6g} nnps_share={:.4f}", s, wall_s > 0 ? s / wall_s : 0.0);
       }
+      if (prog_.iterations) nnps += fmt::format(" iterations={}", prog_.iterations());
       fmt::print("timing: steps={} particles={} wall_s={:.6g} us_per_particle_step={:.6g} "
                  "backend={} threads={} precision={}{}\n",
                  step_, particles(), wall_s, us, prog_.backend, threads_, prog_.precision, nnps);

@@ -47,6 +47,18 @@ struct SearchDomain {
 SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays, int dim,
                                 double radius_scale);
 
+// The same from float coordinates (--precision=single): x, y, z, h of each array (y, z
+// nullptr where missing, read as 0). The box and h are taken as doubles, exactly.
+struct FloatCoords {
+  const float* x = nullptr;
+  const float* y = nullptr;
+  const float* z = nullptr;
+  const float* h = nullptr;
+  std::size_t n = 0;
+};
+SearchDomain make_search_domain_float(const std::vector<FloatCoords>& arrays, int dim,
+                                      double radius_scale);
+
 class CellList {
  public:
   // Auto picks dense or hashed storage by the number of cells; Dense and Hash force one (for

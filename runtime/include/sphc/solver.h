@@ -56,6 +56,9 @@ struct SceneProgram {
   // Wall seconds spent so far in the neighbour search (search domain, cell lists, reorders
   // into cell order), for the --timing line; empty where not measured.
   std::function<double()> neighbour_seconds;
+  // Iterations run so far by the scene's iterated groups (every evaluation, the one before the
+  // first step included), for the --timing line; empty when the scene iterates no group.
+  std::function<long()> iterations;
   // Array name -> properties written (empty list = all); empty = every array, all properties.
   std::vector<std::pair<std::string, std::vector<std::string>>> output;
 };
