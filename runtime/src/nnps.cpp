@@ -218,16 +218,20 @@ void CellList::build_impl(const SearchDomain& dom, const T* x, const T* y, const
   std::size_t num_cells = 0;
   if (dense_) {
     num_cells = static_cast<std::size_t>(total_cells);
-    // Independent per particle: parallel in the OpenMP runtime.
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      int c[3];
-      cell_coords(x[i], y ? static_cast<double>(y[i]) : 0.0, z ? static_cast<double>(z[i]) : 0.0,
-                  c);
-      cell_of_[i] = static_cast<std::uint32_t>(
-          c[0] + static_cast<std::size_t>(ncell_[0]) *
-                     (c[1] + static_cast<std::size_t>(ncell_[1]) * c[2]));
-    }
+    // Independent per particle: computed by counting_sort, inside its parallel region (one
+    // region and no extra barrier per build).
+    std::uint32_t* cell_of = cell_of_.data();
+    counting_sort(num_cells, [&](std::size_t i0, std::size_t i1) {
+      for (std::size_t i = i0; i < i1; ++i) {
+        int c[3];
+        cell_coords(x[i], y ? static_cast<double>(y[i]) : 0.0,
+                    z ? static_cast<double>(z[i]) : 0.0, c);
+        cell_of[i] = static_cast<std::uint32_t>(
+            c[0] + static_cast<std::size_t>(ncell_[0]) *
+                       (c[1] + static_cast<std::size_t>(ncell_[1]) * c[2]));
+      }
+    });
+    return;
   } else {
     // Occupied cells are numbered in order of first appearance (deterministic; serial, since
     // the numbering depends on the order).
@@ -245,7 +249,7 @@ void CellList::build_impl(const SearchDomain& dom, const T* x, const T* y, const
     }
     num_cells = next_cell;
   }
-  counting_sort(num_cells);
+  counting_sort(num_cells, [](std::size_t, std::size_t) {});
 }
 
 int CellList::sort_threads(std::size_t num_cells) const {
@@ -263,13 +267,15 @@ int CellList::sort_threads(std::size_t num_cells) const {
 #endif
 }
 
-void CellList::counting_sort(std::size_t num_cells) {
+template <class KeyFn>
+void CellList::counting_sort(std::size_t num_cells, KeyFn&& keys) {
   const std::size_t n = n_;
   const std::uint32_t* cell_of = cell_of_.data();
   start_.resize(num_cells + 1);
   order_.resize(n);
   const int threads = sort_threads(num_cells);
   if (threads <= 1) {
+    keys(0, n);
     // Stable counting sort by cell: count, inclusive prefix sum (start_[c] = end of cell c),
     // then place particles from last to first, decrementing, which leaves start_[c] = begin.
     std::fill(start_.begin(), start_.end(), 0u);
@@ -284,21 +290,23 @@ void CellList::counting_sort(std::size_t num_cells) {
     return;
   }
 
-  // The same sort in parallel, with the same result. Thread t owns the particles of chunk t
-  // (contiguous, ascending) and the cells of cell block t. Pass 1: each thread counts its
-  // chunk's particles per cell in its own histogram. Pass 2: for its cells, a thread turns
-  // the histograms into write offsets: the particles of cell c from chunk t go after those
-  // of chunk 0..t-1, so the order within a cell is ascending by index, as in the serial sort;
-  // the offsets are relative to the cell's begin, whose prefix sum needs pass 3. Pass 4:
-  // each thread places its chunk in ascending order.
+  // The same sort in parallel, with the same result, and one barrier. Chunk k of the
+  // particles (contiguous, ascending) belongs to one thread. Pass 1: the thread computes the
+  // cells of its chunk's particles (keys) and counts them per cell in the chunk's histogram.
+  // Pass 2 (after the barrier): from all histograms, the thread computes the write offset of
+  // its chunk in every cell, begin of the cell + the particles of chunks 0..k-1 in it, so the
+  // order within a cell is ascending by index, as in the serial sort, and places its chunk's
+  // particles. Every thread scans the cell counts (O(chunks x cells) each) rather than
+  // sharing the prefix sum, which would take two more barriers: a barrier costs more than
+  // the scan on a busy machine, where a descheduled thread holds up the others.
   const std::size_t T = static_cast<std::size_t>(threads);
   const std::size_t C = num_cells;
   hist_.resize(T * C);
-  block_sum_.assign(T + 1, 0u);
+  offset_.resize(T * C);
   std::uint32_t* hist = hist_.data();
+  std::uint32_t* offsets = offset_.data();
   std::uint32_t* start = start_.data();
   std::uint32_t* order = order_.data();
-  std::uint32_t* block_sum = block_sum_.data();
   auto range = [](std::size_t total, std::size_t parts, std::size_t k) {
     return std::pair<std::size_t, std::size_t>(total * k / parts, total * (k + 1) / parts);
   };
@@ -306,52 +314,36 @@ void CellList::counting_sort(std::size_t num_cells) {
   {
 #ifdef _OPENMP
     const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+    const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
 #else
-    const std::size_t t = 0;
+    const std::size_t t = 0, nt = 1;
 #endif
     // (An OpenMP implementation may give fewer threads than asked: then each thread does
     // the chunks k = t, t + nt, ...)
-#ifdef _OPENMP
-    const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
-#else
-    const std::size_t nt = 1;
-#endif
     for (std::size_t k = t; k < T; k += nt) {
       std::uint32_t* h = hist + k * C;
       std::fill(h, h + C, 0u);
       const auto [i0, i1] = range(n, T, k);
+      keys(i0, i1);
       for (std::size_t i = i0; i < i1; ++i) ++h[cell_of[i]];
     }
 #pragma omp barrier
     for (std::size_t k = t; k < T; k += nt) {
-      const auto [c0, c1] = range(C, T, k);
-      std::uint32_t sum = 0;
-      for (std::size_t c = c0; c < c1; ++c) {
-        start[c] = sum;  // begin of cell c relative to the block
+      std::uint32_t* off = offsets + k * C;
+      std::uint32_t begin = 0;  // of cell c
+      for (std::size_t c = 0; c < C; ++c) {
+        std::uint32_t before = 0, total = 0;
         for (std::size_t j = 0; j < T; ++j) {
           const std::uint32_t count = hist[j * C + c];
-          hist[j * C + c] = sum;  // offset of chunk j's first particle in cell c
-          sum += count;
+          before += j < k ? count : 0u;
+          total += count;
         }
+        off[c] = begin + before;
+        if (k == 0) start[c] = begin;
+        begin += total;
       }
-      block_sum[k + 1] = sum;
-    }
-#pragma omp barrier
-#pragma omp single
-    for (std::size_t k = 0; k < T; ++k) block_sum[k + 1] += block_sum[k];
-    // (implicit barrier)
-    for (std::size_t k = t; k < T; k += nt) {
-      const auto [c0, c1] = range(C, T, k);
-      const std::uint32_t base = block_sum[k];
-      for (std::size_t c = c0; c < c1; ++c) start[c] += base;
-      for (std::size_t j = 0; j < T; ++j)
-        for (std::size_t c = c0; c < c1; ++c) hist[j * C + c] += base;
-    }
-#pragma omp barrier
-    for (std::size_t k = t; k < T; k += nt) {
-      std::uint32_t* h = hist + k * C;
       const auto [i0, i1] = range(n, T, k);
-      for (std::size_t i = i0; i < i1; ++i) order[h[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+      for (std::size_t i = i0; i < i1; ++i) order[off[cell_of[i]]++] = static_cast<std::uint32_t>(i);
     }
   }
   start_[num_cells] = static_cast<std::uint32_t>(n);

@@ -146,8 +146,10 @@ class CellList {
   std::uint32_t insert_cell(std::uint64_t key, std::uint32_t& next_cell);
   template <class T>
   void build_impl(const SearchDomain& dom, const T* x, const T* y, const T* z, std::size_t n);
-  // Stable counting sort of 0..n_-1 by cell_of_ into order_ and start_.
-  void counting_sort(std::size_t num_cells);
+  // Stable counting sort of 0..n_-1 by cell_of_ into order_ and start_; keys(i0, i1) fills
+  // cell_of_[i0..i1) first (inside the parallel region: each thread its own chunk).
+  template <class KeyFn>
+  void counting_sort(std::size_t num_cells, KeyFn&& keys);
   // Chunks (threads) for counting_sort: 1 = the serial sort.
   int sort_threads(std::size_t num_cells) const;
   static constexpr std::size_t kParallelMinPerThread = 4096;
@@ -163,8 +165,8 @@ class CellList {
   std::vector<std::uint32_t> start_ = {0, 0};
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> cell_of_;  // build scratch: cell of each particle
-  std::vector<std::uint32_t> hist_;     // parallel sort scratch: chunks x cells
-  std::vector<std::uint32_t> block_sum_;
+  std::vector<std::uint32_t> hist_;     // parallel sort scratch: chunks x cells, counts
+  std::vector<std::uint32_t> offset_;   // and write offsets
   int sort_chunks_ = 0;
   // Hashed storage: open addressing with linear probing, size a power of two >= 2 n.
   std::vector<std::uint64_t> keys_;
