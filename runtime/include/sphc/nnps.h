@@ -103,6 +103,8 @@ class CellList {
   // Tests: sort in `chunks` chunks with the parallel algorithm whatever the size and thread
   // count (in a runtime without OpenMP the chunks run one after the other); 0 = automatic.
   void set_sort_chunks(int chunks) { sort_chunks_ = chunks; }
+  // Chunks of the last build's sort (1: the serial sort).
+  int last_sort_chunks() const { return last_chunks_; }
   bool is_dense() const { return dense_; }
   // Dense: all cells of the grid; hashed: occupied cells.
   std::size_t num_cells() const { return start_.size() - 1; }
@@ -168,6 +170,7 @@ class CellList {
   std::vector<std::uint32_t> hist_;     // parallel sort scratch: chunks x cells, counts
   std::vector<std::uint32_t> offset_;   // and write offsets
   int sort_chunks_ = 0;
+  int last_chunks_ = 1;
   // Hashed storage: open addressing with linear probing, size a power of two >= 2 n.
   std::vector<std::uint64_t> keys_;
   std::vector<std::uint32_t> slot_cell_;

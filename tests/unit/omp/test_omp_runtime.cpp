@@ -27,7 +27,9 @@ TEST_F(OmpThreads, CellListBuildEqualsSerial) {
   for (int dim : {2, 3}) {
     for (CellList::Mode mode : {CellList::Mode::Dense, CellList::Mode::Hash}) {
       const auto p = sphc_test::clustered_points(60000, dim, 5u);
-      const auto dom = sphc_test::domain_for(dim, 0.21);
+      // Cells per axis: 48 in 2D, 20 in 3D: fewer cells than particles / threads, so the
+      // parallel sort runs (CellList::build picks the serial one otherwise).
+      const auto dom = sphc_test::domain_for(dim, dim == 2 ? 0.21 : 0.5);
       CellList serial;
       serial.set_mode(mode);
       serial.set_sort_chunks(1);
@@ -41,6 +43,7 @@ TEST_F(OmpThreads, CellListBuildEqualsSerial) {
         SCOPED_TRACE(testing::Message() << "dim " << dim << ", dense " << serial.is_dense()
                                         << ", " << threads << " threads");
         sphc_test::expect_same_build(serial, par);
+        EXPECT_EQ(par.last_sort_chunks(), threads);  // the parallel sort ran
       }
     }
   }
