@@ -97,6 +97,61 @@ std::string bodyFunctionName(const std::string& owner, const std::string& method
   return owner + "_" + method;
 }
 
+// A body for --precision=single on the CPU: `double` becomes `float` and every floating
+// literal without a suffix gets `f`, so the body computes in float as it does in OpenCL C
+// (where `#define double float` and -cl-single-precision-constant do the same). Bodies are
+// portable C99 without strings or preprocessor lines, so tokens are identifiers, numbers,
+// comments and punctuation; comments are copied as they are.
+std::string singlePrecisionBody(const std::string& text) {
+  std::string out;
+  auto isIdent = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  size_t i = 0;
+  while (i < text.size()) {
+    char c = text[i];
+    if (c == '/' && i + 1 < text.size() && (text[i + 1] == '/' || text[i + 1] == '*')) {
+      size_t end = text[i + 1] == '/' ? text.find('\n', i) : text.find("*/", i + 2);
+      end = end == std::string::npos ? text.size() : end + (text[i + 1] == '/' ? 0 : 2);
+      out += text.substr(i, end - i);
+      i = end;
+    } else if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
+      size_t end = i;
+      while (end < text.size() && isIdent(text[end])) ++end;
+      std::string word = text.substr(i, end - i);
+      out += word == "double" ? "float" : word;
+      i = end;
+    } else if (std::isdigit(static_cast<unsigned char>(c)) ||
+               (c == '.' && i + 1 < text.size() &&
+                std::isdigit(static_cast<unsigned char>(text[i + 1])))) {
+      // A preprocessing number: digits, letters, '.', and a sign after an exponent letter.
+      size_t end = i;
+      while (end < text.size()) {
+        char d = text[end];
+        if (isIdent(d) || d == '.') {
+          ++end;
+        } else if ((d == '+' || d == '-') && (text[end - 1] == 'e' || text[end - 1] == 'E') &&
+                   !(text[i] == '0' && i + 1 < text.size() &&
+                     (text[i + 1] == 'x' || text[i + 1] == 'X'))) {
+          ++end;
+        } else {
+          break;
+        }
+      }
+      std::string num = text.substr(i, end - i);
+      bool hex = num.size() > 1 && num[0] == '0' && (num[1] == 'x' || num[1] == 'X');
+      bool floating = !hex && num.find_first_of(".eE") != std::string::npos;
+      char last = num.back();
+      bool suffixed = last == 'f' || last == 'F' || last == 'l' || last == 'L';
+      out += num;
+      if (floating && !suffixed) out += "f";
+      i = end;
+    } else {
+      out += c;
+      ++i;
+    }
+  }
+  return out;
+}
+
 class Emitter {
  public:
   Emitter(const Plan& plan, const DiagnosticEngine& diags, const EmitOptions& opts)
@@ -104,7 +159,9 @@ class Emitter {
         diags_(diags),
         openmp_(opts.backend == "openmp"),
         opencl_(opts.backend == "opencl"),
-        singlePrecision_(opts.precision == "single") {}
+        singlePrecision_(opts.precision == "single"),
+        cpuSingle_(singlePrecision_ && !opencl_),
+        real_(cpuSingle_ ? "float" : "double") {}
   std::string run();
   const std::string& kernelSource() const { return clText_; }
 
@@ -160,7 +217,20 @@ class Emitter {
                              const PlanGroup* group, const std::string& name);
   void emitLineDirective(llvm::SMLoc l);
   void resetLineDirective();
+  // The data a scene computes on: host arrays, or their float copies (--precision=single).
   std::string propPtr(int array, const std::string& prop) const;
+  // The host array's own data (set-up writes it).
+  std::string hostPtr(int array, const std::string& prop) const;
+  // The C++ type of a property or constant in the scene's loops (real_ for floating ones).
+  std::string hostType(int array, const std::string& prop) const {
+    if (constIndex(array, prop) >= 0) return real_;
+    const PlanProperty* pp = arr(array).find(prop);
+    return pp && (pp->type == "int" || pp->type == "uint") ? cppType(pp->type) : real_;
+  }
+  // A floating literal of emitted host code ("0.5" or "0.5f").
+  std::string lit(const std::string& v, bool device = false) const {
+    return cpuSingle_ && !device ? v + "f" : v;
+  }
   void emitParams();
   void emitSetup();
   void emitArraySetup(const PlanArray& a);
@@ -188,6 +258,7 @@ class Emitter {
   void emitDomainSetup();
   void emitUpdateNeighboursWithGhosts();
   void emitUpdateNeighbours();
+  void emitTimedNeighbourUpdate();
   void emitStep();
   void emitAdaptiveDt();
   void emitMain();
@@ -220,6 +291,11 @@ class Emitter {
   bool openmp_ = false;
   bool opencl_ = false;
   bool singlePrecision_ = false;
+  // --precision=single on the CPU backends: the scene computes on float copies of the arrays
+  // (sphc::FloatArray f32_<array>), bodies and neighbour search included; the host arrays
+  // (double) serve set-up and, after to_host(), output.
+  bool cpuSingle_ = false;
+  std::string real_ = "double";  // the C++ floating type the scene computes in
   std::ostringstream cl_;  // OpenCL C of the kernels (--backend=opencl)
   std::string clText_;
   std::ostringstream out_;
@@ -236,7 +312,7 @@ class Emitter {
 std::vector<Emitter::BodyParam> Emitter::bodyParams(const PlanBody& b, int destArray,
                                                     bool device) const {
   std::vector<BodyParam> ps;
-  const std::string real = device ? "real" : "double";
+  const std::string real = device ? "real" : real_;
   const std::string global = device ? "__global " : "";
   const BodyFacts& f = b.facts;
   bool isLoop = b.source.kind == BodyKind::Loop;
@@ -260,7 +336,7 @@ std::vector<Emitter::BodyParam> Emitter::bodyParams(const PlanBody& b, int destA
     std::string type = real;
     if (destArray >= 0)
       if (const PlanProperty* pp = arr(destArray).find(p))
-        type = device ? devType(destArray, p) : cppType(pp->type);
+        type = device ? devType(destArray, p) : hostType(destArray, p);
     bool isConst = destArray >= 0 && constIndex(destArray, p) >= 0;
     ps.push_back({global + (written.count(p) || isConst ? "" : "const ") + type + "* d_" + p,
                   BodyParam::DProp, p});
@@ -279,12 +355,13 @@ void Emitter::emitBodyFunction(const PlanBody& b, const std::string& name,
   os << "// " << b.source.label << ", from " << loc(b.source.start) << "\n";
   // OpenCL build errors in the body name the .sph line (the program is built at run time).
   if (device) emitLineDirective(b.source.start);
-  os << (device ? "inline " : "static inline ") << (device && ret == "double" ? "real" : ret)
+  os << (device ? "inline " : "static inline ")
+     << (ret == "double" ? (device ? std::string("real") : real_) : ret)
      << " " << name << "(";
   for (size_t i = 0; i < params.size(); ++i) os << (i ? ", " : "") << params[i].decl;
   os << ") {";
   // The body exactly as written; its first line continues after the opening brace.
-  std::string text = b.source.text;
+  std::string text = cpuSingle_ && !device ? singlePrecisionBody(b.source.text) : b.source.text;
   os << text;
   if (text.empty() || text.back() != '\n') os << "\n";
   os << "}\n";
@@ -334,6 +411,17 @@ void Emitter::resetLineDirective() {
 }
 
 std::string Emitter::propPtr(int a, const std::string& p) const {
+  if (cpuSingle_) {
+    int c = constIndex(a, p);
+    if (c >= 0) return "f32_" + arr(a).name + ".constant(" + std::to_string(c) + ")";
+    int i = propIndex(a, p);
+    if (i >= 0 && arr(a).props[i].type != "int" && arr(a).props[i].type != "uint")
+      return "f32_" + arr(a).name + ".f(" + std::to_string(i) + ")";
+  }
+  return hostPtr(a, p);
+}
+
+std::string Emitter::hostPtr(int a, const std::string& p) const {
   int c = constIndex(a, p);
   if (c >= 0) return arr(a).name + ".constant(" + std::to_string(c) + ")";
   int i = propIndex(a, p);
@@ -460,7 +548,7 @@ void Emitter::emitArraySetup(const PlanArray& a) {
   scene_ << "        const double x = pts.x[i], y = pts.y[i], z = pts.z[i];\n";
   for (const char* c : {"x", "y", "z"})
     if (propIndex(plan_.arrayIndex(A), c) >= 0)
-      scene_ << "        " << propPtr(plan_.arrayIndex(A), c) << "[i] = " << c << ";\n";
+      scene_ << "        " << hostPtr(plan_.arrayIndex(A), c) << "[i] = " << c << ";\n";
   scene_ << "        (void)x; (void)y; (void)z;\n";
   std::set<std::string> locals = {"x", "y", "z"};
   auto initNames = [&](const std::string& n) {
@@ -471,7 +559,7 @@ void Emitter::emitArraySetup(const PlanArray& a) {
     scene_ << "        const double v_" << p->name << " = " << exprCpp(*p->init, initNames)
            << ";  // from " << loc(p->declLoc) << "\n";
     for (int k = 0; k < p->stride; ++k)
-      scene_ << "        " << propPtr(plan_.arrayIndex(A), p->name) << "[i * " << p->stride
+      scene_ << "        " << hostPtr(plan_.arrayIndex(A), p->name) << "[i * " << p->stride
              << " + " << k << "] = static_cast<" << cppType(p->type) << ">(v_" << p->name
              << ");\n";
     locals.insert(p->name);
@@ -528,12 +616,13 @@ void Emitter::emitSetup() {
 
 void Emitter::emitDestLocals(std::ostream& os, const std::string& indent,
                              const std::set<std::string>& q, bool device) const {
-  const std::string R = device ? "real" : "double";
+  const std::string R = device ? "real" : real_;
   const char* axes[3] = {"x", "y", "z"};
   const char* vel[3] = {"u", "v", "w"};
   for (int k = 0; k < 3; ++k)
     os << indent << "const " << R << " " << axes[k] << "i = "
-       << (k < plan_.dim ? std::string("di_") + axes[k] + "[d_idx]" : "0.0") << ";\n";
+       << (k < plan_.dim ? std::string("di_") + axes[k] + "[d_idx]" : lit("0.0", device))
+       << ";\n";
   os << indent << "const " << R << " hi = di_h[d_idx];\n";
   if (q.count("VIJ"))
     for (int k = 0; k < plan_.dim; ++k)
@@ -543,7 +632,8 @@ void Emitter::emitDestLocals(std::ostream& os, const std::string& indent,
 void Emitter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
                             const std::vector<const PlanEquation*>& loopers, int d, int s,
                             bool device) {
-  const std::string R = device ? "real" : "double";
+  const std::string R = device ? "real" : real_;
+  auto L = [&](const char* v) { return lit(v, device); };
   const std::string W = device ? "kernel_w" : "Kernel::w";
   const std::string GRAD = device ? "kernel_gradient" : "Kernel::gradient";
   const std::string SQRT = device ? "sqrt" : "std::sqrt";
@@ -556,19 +646,19 @@ void Emitter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
   for (int k = 0; k < 3; ++k)
     os << (k ? ", " : "")
            << (k < plan_.dim ? std::string(axes[k]) + "i - sj_" + axes[k] + "[s_idx]"
-                             : "0.0");
+                             : L("0.0"));
   os << "};\n";
   os << "            const " << R << " R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * "
             "XIJ[2];\n";
   os << "            const " << R << " hmax = hi > hj ? hi : hj;\n";
   os << "            if (R2IJ >= RADIUS2 * hmax * hmax) " << skip << "  // not a neighbour\n";
-  os << "            const " << R << " HIJ = 0.5 * (hi + hj);\n";
+  os << "            const " << R << " HIJ = " << L("0.5") << " * (hi + hj);\n";
   if (q.count("RIJ")) os << "            const " << R << " RIJ = " << SQRT << "(R2IJ);\n";
   if (q.count("VIJ")) {
     os << "            const " << R << " VIJ[3] = {";
     for (int k = 0; k < 3; ++k)
       os << (k ? ", " : "")
-             << (k < plan_.dim ? vel[k] + "i - sj_" + vel[k] + "[s_idx]" : "0.0");
+             << (k < plan_.dim ? vel[k] + "i - sj_" + vel[k] + "[s_idx]" : L("0.0"));
     os << "};\n";
   }
   if (q.count("WIJ")) os << "            const " << R << " WIJ = " << W << "(RIJ, HIJ);\n";
@@ -584,9 +674,12 @@ void Emitter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
     os << "            " << R << " DWJ[3];\n"
               "            " << GRAD << "(XIJ, RIJ, hj, DWJ);\n";
   if (q.count("RHOIJ"))
-    os << "            const " << R << " RHOIJ = 0.5 * (di_rho[d_idx] + sj_rho[s_idx]);\n";
-  if (q.count("RHOIJ1")) os << "            const " << R << " RHOIJ1 = 1.0 / RHOIJ;\n";
-  if (q.count("EPS")) os << "            const " << R << " EPS = 0.01 * HIJ * HIJ;\n";
+    os << "            const " << R << " RHOIJ = " << L("0.5")
+       << " * (di_rho[d_idx] + sj_rho[s_idx]);\n";
+  if (q.count("RHOIJ1"))
+    os << "            const " << R << " RHOIJ1 = " << L("1.0") << " / RHOIJ;\n";
+  if (q.count("EPS"))
+    os << "            const " << R << " EPS = " << L("0.01") << " * HIJ * HIJ;\n";
   for (const auto* eq : loopers) {
     const auto& pd = plan_.equationDecls[eq->declIndex];
     const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Loop)];
@@ -693,8 +786,8 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
       }
     for (const auto& p : dprops) {
       int c = constIndex(d, p);
-      std::string type = c >= 0 ? "double" : cppType(arr(d).props[propIndex(d, p)].type);
-      scene_ << "      " << type << "* d_" << p << " = " << propPtr(d, p) << ";\n";
+      (void)c;
+      scene_ << "      " << hostType(d, p) << "* d_" << p << " = " << propPtr(d, p) << ";\n";
     }
     auto perParticle = [&](ast::Method::Kind kind, const char* what) {
       std::vector<const PlanEquation*> with = withMethod(eqs, kind);
@@ -718,11 +811,11 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
       const std::set<std::string>& q = pass.q;
       scene_ << "      {  // neighbours: " << D << " <- " << S << "\n";
       for (const auto& p : pass.need) {
-        scene_ << "        const double* di_" << p << " = " << propPtr(d, p) << ";\n";
-        scene_ << "        const double* sj_" << p << " = " << propPtr(s, p) << ";\n";
+        scene_ << "        const " << real_ << "* di_" << p << " = " << propPtr(d, p) << ";\n";
+        scene_ << "        const " << real_ << "* sj_" << p << " = " << propPtr(s, p) << ";\n";
       }
       for (const auto& p : pass.sprops)
-        scene_ << "        const double* s_" << p << " = " << propPtr(s, p) << ";\n";
+        scene_ << "        const " << real_ << "* s_" << p << " = " << propPtr(s, p) << ";\n";
       scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
       scene_ << parallelFor("        ");
       scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
@@ -747,7 +840,7 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
                                                     : "acc = v < acc ? v : acc";
       scene_ << "      {  // reduce " << pd.reduceOp << " into " << D << "." << pd.reduceTarget
              << ": " << eq->name << ", from " << loc(eq->loc) << "\n";
-      scene_ << "        double acc = " << init << ";\n";
+      scene_ << "        " << real_ << " acc = " << init << ";\n";
       // Reductions see the real particles only (never the ghosts of a non-real group).
       const std::string nReal =
           onGhosts ? "static_cast<int>(" + D + ".n)" : std::string("n");
@@ -773,13 +866,12 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
                                                (sum ? "+" : pd.reduceOp) + " : acc)");
         scene_ << "        for (int d_idx = 0; d_idx < " << nReal << "; ++d_idx) {"
                << (onGhosts ? "  // real particles only" : "") << "\n";
-        scene_ << "          const double v = " << value << ";\n          " << combine
+        scene_ << "          const " << real_ << " v = " << value << ";\n          " << combine
                << ";\n        }\n";
         if (pd.reduceOp == "mean")
           scene_ << "        acc = " << nReal << " > 0 ? acc / " << nReal << " : 0.0;\n";
       }
-      scene_ << "        " << D << ".constant(" << constIndex(d, pd.reduceTarget)
-             << ")[0] = acc;\n      }\n";
+      scene_ << "        " << propPtr(d, pd.reduceTarget) << "[0] = acc;\n      }\n";
     }
     // Ghosts copy the values the phase computed on the real particles, where they carry them.
     if (hasGhosts(d) && !onGhosts) {
@@ -1012,7 +1104,8 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
       scene_ << "        dev_" << arr(eq->dest).name << ".download(ocl, " << arr(eq->dest).name
              << ");\n";
     for (const auto& p : dprops)
-      scene_ << "        double* d_" << p << " = " << propPtr(eq->dest, p) << ";\n";
+      scene_ << "        " << hostType(eq->dest, p) << "* d_" << p << " = "
+             << propPtr(eq->dest, p) << ";\n";
     scene_ << "        converged = converged && "
            << callBody(bodyFunctionName(eq->name, "converged"), b, eq->dest, -1,
                        eqStruct(*eq), "t")
@@ -1055,8 +1148,7 @@ void Emitter::emitSteppers() {
       for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
       for (const auto& w : b.facts.dWrites) dprops.insert(w.prop);
       for (const auto& p : dprops)
-        scene_ << "      " << (constIndex(a, p) >= 0 ? "double" : cppType(A.find(p)->type))
-               << "* d_" << p << " = " << propPtr(a, p) << ";\n";
+        scene_ << "      " << hostType(a, p) << "* d_" << p << " = " << propPtr(a, p) << ";\n";
       scene_ << parallelFor("      ");
       scene_ << "      for (int d_idx = 0; d_idx < n; ++d_idx)\n";
       scene_ << "        " << callBody(fn, b, a, -1, "", "t") << ";\n    }\n";
@@ -1174,7 +1266,21 @@ void Emitter::emitUpdateNeighbours() {
              << ");\n      " << build << "\n    }\n";
     }
   }
-  if (!loopArrays_.empty() && !opencl_) {
+  if (!loopArrays_.empty() && cpuSingle_) {
+    // The search domain spans every array that takes part in a neighbour loop (float data).
+    const char* axes[3] = {"x", "y", "z"};
+    scene_ << "    domain = sphc::make_search_domain_float({";
+    bool first = true;
+    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+      if (!loopArrays_.count(arr(a).name)) continue;
+      scene_ << (first ? "" : ",\n                                             ") << "{";
+      for (int k = 0; k < 3; ++k)
+        scene_ << (k < plan_.dim ? propPtr(a, axes[k]) : std::string("nullptr")) << ", ";
+      scene_ << propPtr(a, "h") << ", " << arr(a).name << ".n}";
+      first = false;
+    }
+    scene_ << "}, DIM, Kernel::radius_scale);\n";
+  } else if (!loopArrays_.empty() && !opencl_) {
     // The search domain spans every array that takes part in a neighbour loop.
     scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
     bool first = true;
@@ -1200,12 +1306,28 @@ void Emitter::emitUpdateNeighbours() {
       build += ", " + (k < plan_.dim ? propPtr(s, axes[k]) : std::string("nullptr"));
     build += ", " + S + ".n);";
     scene_ << "    " << build << "\n";
-    scene_ << "    if (reorder) {\n      " << S << ".permute(cells_" << S
-           << ".cell_order());\n      " << build << "\n    }\n";
+    if (cpuSingle_)
+      scene_ << "    if (reorder) {\n      f32_" << S << ".permute(cells_" << S
+             << ".cell_order(), " << S << ");\n      " << build << "\n    }\n";
+    else
+      scene_ << "    if (reorder) {\n      " << S << ".permute(cells_" << S
+             << ".cell_order());\n      " << build << "\n    }\n";
   }
   scene_ << "  }\n\n";
   scene_ << "  void compute_accelerations(double t, double dt) {\n";
-  scene_ << "    update_neighbours();\n    equations(t, dt);\n  }\n\n";
+  emitTimedNeighbourUpdate();
+  scene_ << "    equations(t, dt);\n  }\n\n";
+}
+
+// The call of update_neighbours() in compute_accelerations. CPU backends time it for
+// --timing; the OpenCL launches are asynchronous, so a host timer would measure nothing there.
+void Emitter::emitTimedNeighbourUpdate() {
+  if (opencl_)
+    scene_ << "    update_neighbours();\n";
+  else
+    scene_ << "    const double nnps_t0 = sphc::wall_seconds();\n"
+              "    update_neighbours();\n"
+              "    nnps_seconds += sphc::wall_seconds() - nnps_t0;\n";
 }
 
 void Emitter::emitStep() {
@@ -1220,7 +1342,9 @@ void Emitter::emitStep() {
     scene_ << "  }\n\n";
     scene_ << "  // Ghosts exist during an evaluation only: outside it arrays hold real particles.\n";
     scene_ << "  void compute_accelerations(double t, double dt) {\n";
-    scene_ << "    update_domain();\n    update_neighbours();\n    equations(t, dt);\n";
+    scene_ << "    update_domain();\n";
+    emitTimedNeighbourUpdate();
+    scene_ << "    equations(t, dt);\n";
     for (const auto& S : sourceArrays_)
       scene_ << "    sphc::remove_ghosts(" << S << ", ghosts_" << S << ");\n";
     scene_ << "  }\n\n";
@@ -1333,15 +1457,15 @@ void Emitter::emitAdaptiveDt() {
       scene_ << "    }\n";
       continue;
     }
-    scene_ << "      const double* h = " << propPtr(a, "h") << ";\n";
+    scene_ << "      const " << real_ << "* h = " << propPtr(a, "h") << ";\n";
     if (plan_.cfl || !plan_.forceFactor) {
-      scene_ << "      const double* cs = " << propPtr(a, "cs") << ";\n";
+      scene_ << "      const " << real_ << "* cs = " << propPtr(a, "cs") << ";\n";
       for (int k = 0; k < plan_.dim; ++k)
-        scene_ << "      const double* " << vel[k] << " = " << propPtr(a, vel[k]) << ";\n";
+        scene_ << "      const " << real_ << "* " << vel[k] << " = " << propPtr(a, vel[k]) << ";\n";
     }
     if (plan_.forceFactor)
       for (int k = 0; k < plan_.dim; ++k)
-        scene_ << "      const double* " << acc[k] << " = " << propPtr(a, acc[k]) << ";\n";
+        scene_ << "      const " << real_ << "* " << acc[k] << " = " << propPtr(a, acc[k]) << ";\n";
     scene_ << parallelFor("      ", "reduction(min : dt_cfl, dt_force, h2min)");
     scene_ << "      for (std::size_t i = 0; i < " << A << ".n; ++i) {\n";
     if (plan_.cfl || !plan_.forceFactor) {
@@ -1399,9 +1523,11 @@ void Emitter::emitMain() {
     out_ << "  prog.options.push_back({\"" << o.name << "\", \"" << o.value << "\", \"" << choices
          << "\"});  // sphc -D " << o.name << "=...\n";
   }
+  if (singlePrecision_) out_ << "  prog.precision = \"single\";\n";
   out_ << "  prog.setup = [](const std::vector<double>& v, sphc::SceneTimes& times) {\n"
           "    scene.setup(v, times);\n"
-       << (opencl_ ? "    scene.to_device();\n" : "") << "  };\n";
+       << (opencl_ ? "    scene.to_device();\n" : cpuSingle_ ? "    scene.to_single();\n" : "")
+       << "  };\n";
   out_ << "  prog.arrays = [] { return std::vector<sphc::ParticleArray*>{";
   bool first = true;
   for (const auto& a : plan_.arrays) {
@@ -1413,10 +1539,12 @@ void Emitter::emitMain() {
   out_ << "  prog.step = [](double t, double dt) { scene.step(t, dt); };\n";
   // OpenCL: particle data stays on the device; the run loop asks for it back only when it
   // writes output or checks for a blow-up.
-  if (opencl_) out_ << "  prog.to_host = [] { scene.to_host(); };\n";
+  // --precision=single on the CPU: likewise for the float copies.
+  if (opencl_ || cpuSingle_) out_ << "  prog.to_host = [] { scene.to_host(); };\n";
   if (plan_.adaptiveDt) out_ << "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n";
   if (!iteratedGroups_.empty())
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
+  if (!opencl_) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
   bool anyOutput = false;
   for (const auto& a : plan_.arrays) anyOutput |= !a.outputProps.empty();
   for (const auto& a : plan_.arrays) {
@@ -1441,7 +1569,7 @@ std::string Emitter::run() {
                          (singlePrecision_ ? "single" : "double") + " precision)"
            : openmp_ ? "openmp (loops over particles in parallel)"
                      : "serial")
-       << ".\n";
+       << (cpuSingle_ ? "; single precision (float copies of the arrays)" : "") << ".\n";
   out_ << "// Scene '" << plan_.sceneName << "': dim " << plan_.dim << ", kernel "
        << plan_.kernel << ", integrator "
        << (plan_.integratorName.empty() ? "none" : plan_.integratorName) << ".\n";
@@ -1452,6 +1580,7 @@ std::string Emitter::run() {
   for (const auto& a : plan_.arrays) anyLoad |= !a.decl->loads.empty();
   if (anyLoad) out_ << "#include \"sphc/load.h\"\n";
   if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
+  if (cpuSingle_) out_ << "#include \"sphc/float_arrays.h\"\n";
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   if (openmp_) out_ << "\n#include <omp.h>\n";
   if (opencl_) out_ << "\n#include \"sphc/opencl.h\"\n";
@@ -1459,7 +1588,8 @@ std::string Emitter::run() {
   out_ << "namespace {\n\n";
   out_ << "constexpr int DIM = " << plan_.dim << ";\n";
   out_ << "using Kernel = sphc::" << plan_.kernel << "<DIM>;\n";
-  out_ << "constexpr double RADIUS2 = Kernel::radius_scale * Kernel::radius_scale;\n\n";
+  out_ << "constexpr " << real_
+       << " RADIUS2 = Kernel::radius_scale * Kernel::radius_scale;\n\n";
   out_ << "// ---- Equation and stepper bodies, as written in the .sph files ----\n\n";
   // OpenCL: line 1 of the kernel source is this directive, so lines are the source's own.
   if (opencl_) cl_ << "#line 2 \"" << plan_.sceneName << ".cl\"\n";
@@ -1514,19 +1644,23 @@ std::string Emitter::run() {
     for (const auto& S : sourceArrays_) out_ << "  sphc::ocl::CellTable cells_" << S << ";\n";
   } else {
     out_ << "  sphc::SearchDomain domain;\n";
+    if (cpuSingle_)
+      for (const auto& a : plan_.arrays)
+        out_ << "  sphc::FloatArray f32_" << a.name << ";  // what the scene computes on\n";
     for (const auto& S : sourceArrays_) out_ << "  sphc::CellList cells_" << S << ";\n";
   }
   if (hasDomain()) {
     out_ << "  sphc::Domain box;  // periodic and mirror boundaries\n";
     for (const auto& S : sourceArrays_) out_ << "  sphc::Ghosts ghosts_" << S << ";\n";
   }
-  if (openmp_) out_ << "  std::vector<double> reduce_scratch;  // reduce sum/mean, OpenMP\n";
+  if (openmp_) out_ << "  std::vector<" << real_ << "> reduce_scratch;  // reduce sum/mean, OpenMP\n";
   // Iterations per evaluation of each iterated group (--timing prints them).
   out_ << "  std::vector<sphc::IterationStats> iteration_stats{";
   for (std::size_t k = 0; k < iteratedGroups_.size(); ++k)
     out_ << (k ? ", " : "") << "sphc::IterationStats{\"" << iteratedGroups_[k] << "\"}";
   out_ << "};\n";
   out_ << "  long step_count = 0;  // completed time steps (group option `every`)\n";
+  if (!opencl_) out_ << "  double nnps_seconds = 0.0;  // in update_neighbours, for --timing\n";
   if (!sourceArrays_.empty()) {
     out_ << "  static constexpr long REORDER_EVERY = 50;\n";
     out_ << "  long builds = 0;\n";
@@ -1548,6 +1682,16 @@ std::string Emitter::run() {
     scene_ << "  void to_host() {\n";
     for (const auto& a : plan_.arrays)
       scene_ << "    dev_" << a.name << ".download(ocl, " << a.name << ");\n";
+    scene_ << "  }\n\n";
+  }
+  if (cpuSingle_) {
+    // The float copies: made after set-up; the host doubles updated for output and checks.
+    scene_ << "  void to_single() {\n";
+    for (const auto& a : plan_.arrays) scene_ << "    f32_" << a.name << ".upload(" << a.name << ");\n";
+    scene_ << "  }\n\n";
+    scene_ << "  void to_host() {\n";
+    for (const auto& a : plan_.arrays)
+      scene_ << "    f32_" << a.name << ".download(" << a.name << ");\n";
     scene_ << "  }\n\n";
   }
   out_ << "\n" << scene_.str() << "};\n\n}  // namespace\n\n";

@@ -15,7 +15,7 @@ namespace sphc {
 
 struct EmitOptions {
   std::string backend = "serial";  // serial, openmp or opencl
-  std::string precision = "double";  // opencl: the device's `real` (double or single)
+  std::string precision = "double";  // double or single (float): what the scene computes in
 };
 
 std::string emitCpp(const Plan& plan, const DiagnosticEngine& diags, const EmitOptions& opts);

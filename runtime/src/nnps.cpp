@@ -6,6 +6,11 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace sphc {
 
@@ -17,6 +22,11 @@ void check_dim(int dim, const char* who) {
                                 std::to_string(dim) + ")");
   }
 }
+
+// The domain from the bounding box [lo, hi] of the finite coordinates (lo > hi: none) and
+// the largest h.
+SearchDomain finish_domain(const double lo[3], const double hi[3], double hmax, int dim,
+                           double radius_scale);
 
 }  // namespace
 
@@ -71,6 +81,55 @@ SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays,
     }
   }
 
+  return finish_domain(lo, hi, hmax, dim, radius_scale);
+}
+
+SearchDomain make_search_domain_float(const std::vector<FloatCoords>& arrays, int dim,
+                                      double radius_scale) {
+  check_dim(dim, "sphc::make_search_domain");
+  if (!(radius_scale > 0.0) || !std::isfinite(radius_scale)) {
+    throw std::invalid_argument("sphc::make_search_domain: radius_scale must be > 0 (got " +
+                                std::to_string(radius_scale) + ")");
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  double lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
+  double hmax = 0.0;
+  for (const FloatCoords& c : arrays) {
+    if (c.n == 0) continue;
+    if (c.x == nullptr || c.h == nullptr)
+      throw std::invalid_argument("sphc::make_search_domain: an array has no x or no h");
+    const float* axis[3] = {c.x, c.y, c.z};
+    for (int a = 0; a < dim; ++a) {
+      if (axis[a] == nullptr) {
+        lo[a] = std::min(lo[a], 0.0);
+        hi[a] = std::max(hi[a], 0.0);
+        continue;
+      }
+      const float* v = axis[a];
+      double l = lo[a], u = hi[a];
+#pragma omp parallel for reduction(min : l) reduction(max : u) schedule(static)
+      for (std::size_t i = 0; i < c.n; ++i) {
+        const double w = v[i];
+        if (!std::isfinite(w)) continue;
+        l = std::min(l, w);
+        u = std::max(u, w);
+      }
+      lo[a] = l;
+      hi[a] = u;
+    }
+#pragma omp parallel for reduction(max : hmax) schedule(static)
+    for (std::size_t i = 0; i < c.n; ++i) {
+      const double w = c.h[i];
+      if (std::isfinite(w) && w > hmax) hmax = w;
+    }
+  }
+  return finish_domain(lo, hi, hmax, dim, radius_scale);
+}
+
+namespace {
+
+SearchDomain finish_domain(const double lo[3], const double hi[3], double hmax, int dim,
+                           double radius_scale) {
   SearchDomain dom;
   dom.dim = dim;
   dom.cell_size = hmax > 0.0 ? radius_scale * hmax : 1.0;
@@ -86,6 +145,8 @@ SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays,
   return dom;
 }
 
+}  // namespace
+
 std::uint32_t CellList::insert_cell(std::uint64_t key, std::uint32_t& next_cell) {
   const std::size_t mask = keys_.size() - 1;
   for (std::size_t s = slot_of(key);; s = (s + 1) & mask) {
@@ -100,6 +161,17 @@ std::uint32_t CellList::insert_cell(std::uint64_t key, std::uint32_t& next_cell)
 
 void CellList::build(const SearchDomain& dom, const double* x, const double* y,
                      const double* z, std::size_t n) {
+  build_impl(dom, x, y, z, n);
+}
+
+void CellList::build(const SearchDomain& dom, const float* x, const float* y, const float* z,
+                     std::size_t n) {
+  build_impl(dom, x, y, z, n);
+}
+
+template <class T>
+void CellList::build_impl(const SearchDomain& dom, const T* x, const T* y, const T* z,
+                          std::size_t n) {
   check_dim(dom.dim, "sphc::CellList::build");
   if (n >= kNoCell) {
     throw std::invalid_argument("sphc::CellList::build: too many particles (" +
@@ -141,23 +213,28 @@ void CellList::build(const SearchDomain& dom, const double* x, const double* y,
     case Mode::Hash: dense_ = false; break;
   }
 
-  // Cell of every particle.
+  // Cell of every particle (coordinates read as double, whatever T is).
   cell_of_.resize(n);
   std::size_t num_cells = 0;
   if (dense_) {
     num_cells = static_cast<std::size_t>(total_cells);
-    // Independent per particle: parallel in the OpenMP runtime. The counting sort below
-    // stays serial, so the order (and every result) equals the serial build's.
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      int c[3];
-      cell_coords(x[i], y ? y[i] : 0.0, z ? z[i] : 0.0, c);
-      cell_of_[i] = static_cast<std::uint32_t>(
-          c[0] + static_cast<std::size_t>(ncell_[0]) *
-                     (c[1] + static_cast<std::size_t>(ncell_[1]) * c[2]));
-    }
+    // Independent per particle: computed by counting_sort, inside its parallel region (one
+    // region and no extra barrier per build).
+    std::uint32_t* cell_of = cell_of_.data();
+    counting_sort(num_cells, [&](std::size_t i0, std::size_t i1) {
+      for (std::size_t i = i0; i < i1; ++i) {
+        int c[3];
+        cell_coords(x[i], y ? static_cast<double>(y[i]) : 0.0,
+                    z ? static_cast<double>(z[i]) : 0.0, c);
+        cell_of[i] = static_cast<std::uint32_t>(
+            c[0] + static_cast<std::size_t>(ncell_[0]) *
+                       (c[1] + static_cast<std::size_t>(ncell_[1]) * c[2]));
+      }
+    });
+    return;
   } else {
-    // Occupied cells are numbered in order of first appearance (deterministic).
+    // Occupied cells are numbered in order of first appearance (deterministic; serial, since
+    // the numbering depends on the order).
     int bits = 4;
     while ((std::size_t{1} << bits) < 2 * n) ++bits;
     keys_.assign(std::size_t{1} << bits, kEmptyKey);
@@ -166,24 +243,135 @@ void CellList::build(const SearchDomain& dom, const double* x, const double* y,
     std::uint32_t next_cell = 0;
     for (std::size_t i = 0; i < n; ++i) {
       int c[3];
-      cell_coords(x[i], y ? y[i] : 0.0, z ? z[i] : 0.0, c);
+      cell_coords(x[i], y ? static_cast<double>(y[i]) : 0.0, z ? static_cast<double>(z[i]) : 0.0,
+                  c);
       cell_of_[i] = insert_cell(pack(c[0], c[1], c[2]), next_cell);
     }
     num_cells = next_cell;
   }
+  counting_sort(num_cells, [](std::size_t, std::size_t) {});
+}
 
-  // Stable counting sort by cell: count, inclusive prefix sum (start_[c] = end of cell c),
-  // then place particles from last to first, decrementing, which leaves start_[c] = begin.
-  start_.assign(num_cells + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) ++start_[cell_of_[i]];
-  std::uint32_t running = 0;
-  for (std::size_t c = 0; c < num_cells; ++c) {
-    running += start_[c];
-    start_[c] = running;
+int CellList::sort_threads(std::size_t num_cells) const {
+  if (sort_chunks_ > 0) return sort_chunks_;
+#ifdef _OPENMP
+  // Below this many particles per thread the parallel regions cost more than they save; the
+  // per-thread histograms also cost O(threads * cells), so sparse grids stay serial.
+  // The per-thread histograms cost O(threads x cells) per thread, the per-particle work
+  // O(n / threads): with t threads the parallel sort only pays when cells * t < n (e.g. 3D,
+  // or dense 2D packings; the 2D dam break's grid has ~1.15 cells per particle, where the
+  // serial sort measured as fast as the parallel one on 2 threads). Else the serial sort runs
+  // (with the cell keys still computed in parallel).
+  int t = omp_in_parallel() ? 1 : omp_get_max_threads();
+  if (n_ < static_cast<std::size_t>(t) * kParallelMinPerThread) t = 1;
+  if (num_cells * static_cast<std::size_t>(t) >= n_) t = 1;
+  return std::max(t, 1);
+#else
+  (void)num_cells;
+  return 1;
+#endif
+}
+
+template <class KeyFn>
+void CellList::counting_sort(std::size_t num_cells, KeyFn&& keys) {
+  const std::size_t n = n_;
+  const std::uint32_t* cell_of = cell_of_.data();
+  start_.resize(num_cells + 1);
+  order_.resize(n);
+  const int threads = sort_threads(num_cells);
+  last_chunks_ = threads;
+  if (threads <= 1) {
+    // Keys: independent per particle, in parallel in the OpenMP runtime when worth it.
+#ifdef _OPENMP
+    const int key_threads = omp_in_parallel() || n < 2 * kParallelMinPerThread
+                                ? 1
+                                : omp_get_max_threads();
+#else
+    const int key_threads = 1;
+#endif
+    if (key_threads > 1) {
+#pragma omp parallel num_threads(key_threads)
+      {
+#ifdef _OPENMP
+        const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+        const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
+        keys(n * t / nt, n * (t + 1) / nt);
+#endif
+      }
+    } else {
+      keys(0, n);
+    }
+    // Stable counting sort by cell: count, inclusive prefix sum (start_[c] = end of cell c),
+    // then place particles from last to first, decrementing, which leaves start_[c] = begin.
+    std::fill(start_.begin(), start_.end(), 0u);
+    for (std::size_t i = 0; i < n; ++i) ++start_[cell_of[i]];
+    std::uint32_t running = 0;
+    for (std::size_t c = 0; c < num_cells; ++c) {
+      running += start_[c];
+      start_[c] = running;
+    }
+    start_[num_cells] = static_cast<std::uint32_t>(n);
+    for (std::size_t i = n; i-- > 0;) order_[--start_[cell_of[i]]] = static_cast<std::uint32_t>(i);
+    return;
+  }
+
+  // The same sort in parallel, with the same result, and one barrier. Chunk k of the
+  // particles (contiguous, ascending) belongs to one thread. Pass 1: the thread computes the
+  // cells of its chunk's particles (keys) and counts them per cell in the chunk's histogram.
+  // Pass 2 (after the barrier): from all histograms, the thread computes the write offset of
+  // its chunk in every cell, begin of the cell + the particles of chunks 0..k-1 in it, so the
+  // order within a cell is ascending by index, as in the serial sort, and places its chunk's
+  // particles. Every thread scans the cell counts (O(chunks x cells) each) rather than
+  // sharing the prefix sum, which would take two more barriers: a barrier costs more than
+  // the scan on a busy machine, where a descheduled thread holds up the others.
+  const std::size_t T = static_cast<std::size_t>(threads);
+  const std::size_t C = num_cells;
+  hist_.resize(T * C);
+  offset_.resize(T * C);
+  std::uint32_t* hist = hist_.data();
+  std::uint32_t* offsets = offset_.data();
+  std::uint32_t* start = start_.data();
+  std::uint32_t* order = order_.data();
+  auto range = [](std::size_t total, std::size_t parts, std::size_t k) {
+    return std::pair<std::size_t, std::size_t>(total * k / parts, total * (k + 1) / parts);
+  };
+#pragma omp parallel num_threads(threads)
+  {
+#ifdef _OPENMP
+    const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
+    const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
+#else
+    const std::size_t t = 0, nt = 1;
+#endif
+    // (An OpenMP implementation may give fewer threads than asked: then each thread does
+    // the chunks k = t, t + nt, ...)
+    for (std::size_t k = t; k < T; k += nt) {
+      std::uint32_t* h = hist + k * C;
+      std::fill(h, h + C, 0u);
+      const auto [i0, i1] = range(n, T, k);
+      keys(i0, i1);
+      for (std::size_t i = i0; i < i1; ++i) ++h[cell_of[i]];
+    }
+#pragma omp barrier
+    for (std::size_t k = t; k < T; k += nt) {
+      std::uint32_t* off = offsets + k * C;
+      std::uint32_t begin = 0;  // of cell c
+      for (std::size_t c = 0; c < C; ++c) {
+        std::uint32_t before = 0, total = 0;
+        for (std::size_t j = 0; j < T; ++j) {
+          const std::uint32_t count = hist[j * C + c];
+          before += j < k ? count : 0u;
+          total += count;
+        }
+        off[c] = begin + before;
+        if (k == 0) start[c] = begin;
+        begin += total;
+      }
+      const auto [i0, i1] = range(n, T, k);
+      for (std::size_t i = i0; i < i1; ++i) order[off[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+    }
   }
   start_[num_cells] = static_cast<std::uint32_t>(n);
-  order_.resize(n);
-  for (std::size_t i = n; i-- > 0;) order_[--start_[cell_of_[i]]] = static_cast<std::uint32_t>(i);
 }
 
 void CellList::neighbors(double xi, double yi, double zi, double hi, const double* x,

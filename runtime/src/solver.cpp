@@ -194,6 +194,9 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "  --no-output           write no files (benchmarks)\n"
       "  --timing              print at the end, for the time loop:\n"
       "                        timing: steps=N particles=P wall_s=W us_per_particle_step=U\n"
+      "                        backend=B threads=T precision=double|single\n"
+      "                        [nnps_s=S nnps_share=F: time in the neighbour search]\n"
+      "                        [iterations=I: of iterated groups, in all]\n"
       "                        and, per iterated group, the iterations of its evaluations:\n"
       "                        iterations: group=FILE:LINE evaluations=E total=N mean=M\n"
       "                        min=A max=B unconverged=U\n"
@@ -441,6 +444,7 @@ class Simulation {
 
     const long check_every = prog_.to_host ? kCheckEveryDevice : kCheckEvery;
     const auto loop_start = Clock::now();
+    nnps_start_ = prog_.neighbour_seconds ? prog_.neighbour_seconds() : 0.0;
     progress_.start(!opt_.quiet, tf);
     double particle_steps = 0;
     while (t_ < tf - slack && step_ < opt_.max_steps) {
@@ -559,9 +563,21 @@ class Simulation {
                  step_, why, wall_s, us);
     }
     if (opt_.timing) {
+      // nnps_s: the part of wall_s spent in the neighbour search (when the scene measures
+      // it), nnps_share = nnps_s / wall_s.
+      std::string nnps;
+      if (prog_.neighbour_seconds) {
+        const double s = prog_.neighbour_seconds() - nnps_start_;
+        nnps = fmt::format(" nnps_s={:.6g} nnps_share={:.4f}", s, wall_s > 0 ? s / wall_s : 0.0);
+      }
+      if (prog_.iterations) {
+        long total = 0;
+        for (const IterationStats& s : prog_.iterations()) total += s.total;
+        nnps += fmt::format(" iterations={}", total);
+      }
       fmt::print("timing: steps={} particles={} wall_s={:.6g} us_per_particle_step={:.6g} "
-                 "backend={} threads={}\n",
-                 step_, particles(), wall_s, us, prog_.backend, threads_);
+                 "backend={} threads={} precision={}{}\n",
+                 step_, particles(), wall_s, us, prog_.backend, threads_, prog_.precision, nnps);
       // Counted from the first evaluation, the one before the first step, included.
       if (prog_.iterations) {
         for (const IterationStats& s : prog_.iterations()) {
@@ -580,6 +596,7 @@ class Simulation {
   const Options& opt_;
   Progress& progress_;
   int threads_ = 1;
+  double nnps_start_ = 0.0;  // neighbour_seconds() when the time loop started
   OutputWriter* writer_ = nullptr;
   std::vector<ParticleArray*> arrays_;
   double t_ = 0.0;

@@ -4,7 +4,9 @@
 // calls the templates; one test checks that AnyKernel and the templates agree.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <random>
 #include <string>
 #include <vector>
@@ -269,6 +271,45 @@ TEST(Kernels, NamesAndErrors) {
   EXPECT_FALSE(sphc::parse_kernel_kind("Cubic", parsed));
   EXPECT_THROW((AnyKernel{KernelKind::Gaussian, 4}.w(0.1, 1.0)), std::invalid_argument);
   EXPECT_THROW((AnyKernel{KernelKind::Gaussian, 0}.radius_scale()), std::invalid_argument);
+}
+
+// --precision=single: the kernels called with floats compute in float (the result type is
+// float) and agree with the double kernel within float rounding: a few operations, each
+// rounding by at most u = 2^-24, so 16 u of the kernel's value at 0 is ample; the gradient
+// likewise relative to its largest value on the sampled range. The quintic spline's three
+// fifth powers (3^5 = 243, 6 * 2^5 = 192, 15) cancel to f(0) = 66 and f'(0) = 0, so its
+// rounding is relative to terms ~16 times its result: cancel = 16 there.
+template <class K>
+void expect_float_close(double cancel = 1.0) {
+  static_assert(std::is_same_v<decltype(K::w(0.5f, 1.0f)), float>);
+  const double u = std::ldexp(1.0, -24);
+  const double w0 = K::w(0.0, 1.0);
+  double gmax = 0.0;
+  for (int k = 1; k < 400; ++k) {
+    const double x[3] = {k * 0.0075, 0.0, 0.0};
+    double g[3];
+    K::gradient(x, x[0], 1.0, g);
+    gmax = std::max(gmax, std::fabs(g[0]));
+  }
+  for (int k = 0; k < 400; ++k) {
+    const float r = static_cast<float>(k * 0.0075);
+    EXPECT_NEAR(K::w(r, 1.0f), K::w(static_cast<double>(r), 1.0), 16 * cancel * u * w0) << K::name << " r=" << r;
+    const float xf[3] = {r, 0.0f, 0.0f};
+    const double xd[3] = {r, 0.0, 0.0};
+    float gf[3];
+    double gd[3];
+    K::gradient(xf, r, 1.0f, gf);
+    K::gradient(xd, static_cast<double>(r), 1.0, gd);
+    EXPECT_NEAR(gf[0], gd[0], 16 * cancel * u * gmax) << K::name << " r=" << r;
+  }
+}
+
+TEST(Kernels, FloatCallsComputeInFloatAndAgree) {
+  expect_float_close<sphc::CubicSpline<2>>();
+  expect_float_close<sphc::QuinticSpline<3>>(16.0);
+  expect_float_close<sphc::WendlandQuintic<2>>();
+  expect_float_close<sphc::WendlandQuintic<1>>();
+  expect_float_close<sphc::Gaussian<3>>();
 }
 
 }  // namespace

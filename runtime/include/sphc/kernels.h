@@ -50,10 +50,13 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kInvSqrtPi = 0.56418958354775628695;     // 1 / sqrt(pi)
 constexpr double kInvPi32 = 0.17958712212516656169;       // 1 / pi^(3/2)
 
-template <int Dim>
-inline double inv_h_pow(double h) {
+// The kernels are templates on the floating point type T of their arguments (double, or
+// float for --precision=single): every literal is converted to T, so a float call computes in
+// float, and a double call does the operations of the plain double formulas.
+template <int Dim, class T>
+inline T inv_h_pow(T h) {
   static_assert(Dim >= 1 && Dim <= 3, "sphc kernels: Dim must be 1, 2 or 3");
-  const double ih = 1.0 / h;
+  const T ih = T(1) / h;
   if constexpr (Dim == 1) {
     return ih;
   } else if constexpr (Dim == 2) {
@@ -71,15 +74,18 @@ struct RadialKernel {
   static constexpr int dim = Dim;
   static constexpr double radius_scale = S::radius_scale;
 
-  static inline double w(double rij, double h) {
-    return S::sigma * inv_h_pow<Dim>(h) * S::f(rij / h);
+  template <class T>
+  static inline T w(T rij, T h) {
+    return T(S::sigma) * inv_h_pow<Dim>(h) * S::f(rij / h);
   }
-  static inline double dwdq(double rij, double h) {
-    return S::sigma * inv_h_pow<Dim>(h) * S::df(rij / h);
+  template <class T>
+  static inline T dwdq(T rij, T h) {
+    return T(S::sigma) * inv_h_pow<Dim>(h) * S::df(rij / h);
   }
-  static inline void gradient(const double xij[3], double rij, double h, double grad[3]) {
+  template <class T>
+  static inline void gradient(const T xij[3], T rij, T h, T grad[3]) {
     // dW/dx_i = dW/dq * dq/dr * dr/dx_i = dwdq * (1/h) * xij / rij.
-    const double s = rij > 1e-12 ? dwdq(rij, h) / (h * rij) : 0.0;
+    const T s = rij > T(1e-12) ? dwdq(rij, h) / (h * rij) : T(0);
     grad[0] = s * xij[0];
     grad[1] = s * xij[1];
     grad[2] = s * xij[2];
@@ -91,21 +97,23 @@ struct CubicShape {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma =
       Dim == 1 ? 2.0 / 3.0 : Dim == 2 ? 10.0 / (7.0 * kPi) : 1.0 / kPi;
-  static inline double f(double q) {
-    if (q < 1.0) return 1.0 - 1.5 * q * q * (1.0 - 0.5 * q);
-    if (q < 2.0) {
-      const double t = 2.0 - q;
-      return 0.25 * t * t * t;
+  template <class T>
+  static inline T f(T q) {
+    if (q < T(1)) return T(1) - T(1.5) * q * q * (T(1) - T(0.5) * q);
+    if (q < T(2)) {
+      const T t = T(2) - q;
+      return T(0.25) * t * t * t;
     }
-    return 0.0;
+    return T(0);
   }
-  static inline double df(double q) {
-    if (q < 1.0) return q * (2.25 * q - 3.0);  // -3q + 9/4 q^2
-    if (q < 2.0) {
-      const double t = 2.0 - q;
-      return -0.75 * t * t;
+  template <class T>
+  static inline T df(T q) {
+    if (q < T(1)) return q * (T(2.25) * q - T(3));  // -3q + 9/4 q^2
+    if (q < T(2)) {
+      const T t = T(2) - q;
+      return T(-0.75) * t * t;
     }
-    return 0.0;
+    return T(0);
   }
 };
 
@@ -114,20 +122,22 @@ struct QuinticShape {
   static constexpr double radius_scale = 3.0;
   static constexpr double sigma =
       Dim == 1 ? 1.0 / 120.0 : Dim == 2 ? 7.0 / (478.0 * kPi) : 1.0 / (120.0 * kPi);
-  static inline double f(double q) {
-    if (q >= 3.0) return 0.0;
-    const double t3 = 3.0 - q, t2 = 2.0 - q, t1 = 1.0 - q;
-    double v = t3 * t3 * t3 * t3 * t3;
-    if (q < 2.0) v -= 6.0 * t2 * t2 * t2 * t2 * t2;
-    if (q < 1.0) v += 15.0 * t1 * t1 * t1 * t1 * t1;
+  template <class T>
+  static inline T f(T q) {
+    if (q >= T(3)) return T(0);
+    const T t3 = T(3) - q, t2 = T(2) - q, t1 = T(1) - q;
+    T v = t3 * t3 * t3 * t3 * t3;
+    if (q < T(2)) v -= T(6) * t2 * t2 * t2 * t2 * t2;
+    if (q < T(1)) v += T(15) * t1 * t1 * t1 * t1 * t1;
     return v;
   }
-  static inline double df(double q) {
-    if (q >= 3.0) return 0.0;
-    const double t3 = 3.0 - q, t2 = 2.0 - q, t1 = 1.0 - q;
-    double v = -5.0 * t3 * t3 * t3 * t3;
-    if (q < 2.0) v += 30.0 * t2 * t2 * t2 * t2;
-    if (q < 1.0) v -= 75.0 * t1 * t1 * t1 * t1;
+  template <class T>
+  static inline T df(T q) {
+    if (q >= T(3)) return T(0);
+    const T t3 = T(3) - q, t2 = T(2) - q, t1 = T(1) - q;
+    T v = T(-5) * t3 * t3 * t3 * t3;
+    if (q < T(2)) v += T(30) * t2 * t2 * t2 * t2;
+    if (q < T(1)) v -= T(75) * t1 * t1 * t1 * t1;
     return v;
   }
 };
@@ -137,16 +147,18 @@ template <int Dim>
 struct WendlandC2Shape {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = Dim == 2 ? 7.0 / (4.0 * kPi) : 21.0 / (16.0 * kPi);
-  static inline double f(double q) {
-    if (q >= 2.0) return 0.0;
-    const double t = 1.0 - 0.5 * q, t2 = t * t;
-    return t2 * t2 * (2.0 * q + 1.0);
+  template <class T>
+  static inline T f(T q) {
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q, t2 = t * t;
+    return t2 * t2 * (T(2) * q + T(1));
   }
-  static inline double df(double q) {
+  template <class T>
+  static inline T df(T q) {
     // d/dq [t^4 (2q+1)] = -2 t^3 (2q+1) + 2 t^4 = -5 q t^3
-    if (q >= 2.0) return 0.0;
-    const double t = 1.0 - 0.5 * q;
-    return -5.0 * q * t * t * t;
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q;
+    return T(-5) * q * t * t * t;
   }
 };
 
@@ -155,16 +167,18 @@ template <>
 struct WendlandC2Shape<1> {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = 5.0 / 8.0;
-  static inline double f(double q) {
-    if (q >= 2.0) return 0.0;
-    const double t = 1.0 - 0.5 * q;
-    return t * t * t * (1.5 * q + 1.0);
+  template <class T>
+  static inline T f(T q) {
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q;
+    return t * t * t * (T(1.5) * q + T(1));
   }
-  static inline double df(double q) {
+  template <class T>
+  static inline T df(T q) {
     // d/dq [t^3 (1.5q+1)] = -1.5 t^2 (1.5q+1) + 1.5 t^3 = -3 q t^2
-    if (q >= 2.0) return 0.0;
-    const double t = 1.0 - 0.5 * q;
-    return -3.0 * q * t * t;
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q;
+    return T(-3) * q * t * t;
   }
 };
 
@@ -172,8 +186,10 @@ template <int Dim>
 struct GaussianShape {
   static constexpr double radius_scale = 3.0;
   static constexpr double sigma = Dim == 1 ? kInvSqrtPi : Dim == 2 ? 1.0 / kPi : kInvPi32;
-  static inline double f(double q) { return q < 3.0 ? std::exp(-q * q) : 0.0; }
-  static inline double df(double q) { return q < 3.0 ? -2.0 * q * std::exp(-q * q) : 0.0; }
+  template <class T>
+  static inline T f(T q) { return q < T(3) ? std::exp(-q * q) : T(0); }
+  template <class T>
+  static inline T df(T q) { return q < T(3) ? T(-2) * q * std::exp(-q * q) : T(0); }
 };
 
 }  // namespace detail

@@ -47,6 +47,18 @@ struct SearchDomain {
 SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays, int dim,
                                 double radius_scale);
 
+// The same from float coordinates (--precision=single): x, y, z, h of each array (y, z
+// nullptr where missing, read as 0). The box and h are taken as doubles, exactly.
+struct FloatCoords {
+  const float* x = nullptr;
+  const float* y = nullptr;
+  const float* z = nullptr;
+  const float* h = nullptr;
+  std::size_t n = 0;
+};
+SearchDomain make_search_domain_float(const std::vector<FloatCoords>& arrays, int dim,
+                                      double radius_scale);
+
 class CellList {
  public:
   // Auto picks dense or hashed storage by the number of cells; Dense and Hash force one (for
@@ -54,8 +66,14 @@ class CellList {
   enum class Mode { Auto, Dense, Hash };
 
   // Sorts particles 0..n-1 into cells. y and z may be nullptr (treated as 0). Throws
-  // std::invalid_argument if dom.dim is not 1..3 or n >= 2^32 - 1.
+  // std::invalid_argument if dom.dim is not 1..3 or n >= 2^32 - 1. Float coordinates
+  // (--precision=single) are converted to double for the cell computation.
+  // In the OpenMP runtime the build runs in parallel (cell keys, then a counting sort with a
+  // histogram per thread, see counting_sort) and gives exactly the serial result: the same
+  // order_ and start_, hence the same candidate order.
   void build(const SearchDomain& dom, const double* x, const double* y, const double* z,
+             std::size_t n);
+  void build(const SearchDomain& dom, const float* x, const float* y, const float* z,
              std::size_t n);
 
   // Calls f(std::uint32_t j) for every particle j in the 3^dim cells around the cell of
@@ -77,7 +95,16 @@ class CellList {
   // that makes neighbours close in memory (see ParticleArray::permute).
   const std::vector<std::uint32_t>& cell_order() const { return order_; }
 
+  // Cell c holds cell_order()[cell_start()[c] .. cell_start()[c + 1]) (num_cells() + 1
+  // entries).
+  const std::vector<std::uint32_t>& cell_start() const { return start_; }
+
   void set_mode(Mode m) { mode_ = m; }
+  // Tests: sort in `chunks` chunks with the parallel algorithm whatever the size and thread
+  // count (in a runtime without OpenMP the chunks run one after the other); 0 = automatic.
+  void set_sort_chunks(int chunks) { sort_chunks_ = chunks; }
+  // Chunks of the last build's sort (1: the serial sort).
+  int last_sort_chunks() const { return last_chunks_; }
   bool is_dense() const { return dense_; }
   // Dense: all cells of the grid; hashed: occupied cells.
   std::size_t num_cells() const { return start_.size() - 1; }
@@ -119,6 +146,15 @@ class CellList {
     }
   }
   std::uint32_t insert_cell(std::uint64_t key, std::uint32_t& next_cell);
+  template <class T>
+  void build_impl(const SearchDomain& dom, const T* x, const T* y, const T* z, std::size_t n);
+  // Stable counting sort of 0..n_-1 by cell_of_ into order_ and start_; keys(i0, i1) fills
+  // cell_of_[i0..i1) first (inside the parallel region: each thread its own chunk).
+  template <class KeyFn>
+  void counting_sort(std::size_t num_cells, KeyFn&& keys);
+  // Chunks (threads) for counting_sort: 1 = the serial sort.
+  int sort_threads(std::size_t num_cells) const;
+  static constexpr std::size_t kParallelMinPerThread = 4096;
 
   Mode mode_ = Mode::Auto;
   bool dense_ = true;
@@ -131,6 +167,10 @@ class CellList {
   std::vector<std::uint32_t> start_ = {0, 0};
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> cell_of_;  // build scratch: cell of each particle
+  std::vector<std::uint32_t> hist_;     // parallel sort scratch: chunks x cells, counts
+  std::vector<std::uint32_t> offset_;   // and write offsets
+  int sort_chunks_ = 0;
+  int last_chunks_ = 1;
   // Hashed storage: open addressing with linear probing, size a power of two >= 2 n.
   std::vector<std::uint64_t> keys_;
   std::vector<std::uint32_t> slot_cell_;

@@ -64,12 +64,16 @@ struct ParticleArray {
 
   // Reorders the particles: particle i becomes the old particle order[i], for every property
   // (order must be a permutation of 0..n-1; throws std::invalid_argument otherwise). Used to
-  // keep neighbours close in memory (the cell order of the neighbour search).
+  // keep neighbours close in memory (the cell order of the neighbour search). Parallel in the
+  // OpenMP runtime (each new slot is written by one thread), with the serial result.
   void permute(const std::vector<std::uint32_t>& order);
 
   // Appends particle `i` of `src` (same property names) to this array; properties missing in
   // src are 0. Used by inlets and by loading.
   void append_from(const ParticleArray& src, std::size_t i);
 };
+
+// True if order holds each of 0..n-1 exactly once.
+bool is_permutation_of(const std::vector<std::uint32_t>& order, std::size_t n);
 
 }  // namespace sphc

@@ -8,6 +8,7 @@
 // 3 the simulation blew up (a non-finite value, or the adaptive time step collapsed).
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <string>
 #include <utility>
@@ -82,9 +83,20 @@ struct SceneProgram {
   std::function<int(int threads)> set_threads;
   // The backend the solver was built with, for the timing line ("serial", "openmp", ...).
   std::string backend = "serial";
+  // The floating point type the scene computes in ("double" or "single"), for the timing line.
+  std::string precision = "double";
+  // Wall seconds spent so far in the neighbour search (search domain, cell lists, reorders
+  // into cell order), for the --timing line; empty where not measured.
+  std::function<double()> neighbour_seconds;
   // Array name -> properties written (empty list = all); empty = every array, all properties.
   std::vector<std::pair<std::string, std::vector<std::string>>> output;
 };
+
+// Seconds on a steady clock (for the scene's own timers, e.g. neighbour_seconds).
+inline double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
 
 // Runs the scene as the command line asks; returns the process exit code.
 int run_main(int argc, char** argv, SceneProgram& prog);
