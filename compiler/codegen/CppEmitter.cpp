@@ -1328,18 +1328,9 @@ void Emitter::emitUpdateNeighbours() {
     auto buf = [&](int a, int k) {
       return k < plan_.dim ? devBuffer(a, axes[k]) : std::string("nullptr");
     };
-    if (!loopArrays_.empty()) {
-      scene_ << "    grid = ocl.make_grid({";
-      bool first = true;
-      for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
-        if (!loopArrays_.count(arr(a).name)) continue;
-        scene_ << (first ? "" : ",\n                          ") << "{" << buf(a, 0) << ", "
-               << buf(a, 1) << ", " << buf(a, 2) << ", " << devBuffer(a, "h") << ", "
-               << arr(a).name << ".n}";
-        first = false;
-      }
-      scene_ << "}, DIM, Kernel::radius_scale);\n";
-    }
+    if (!loopArrays_.empty())
+      scene_ << "    grid = ocl.make_grid(" << deviceExtents("                          ")
+             << ", DIM, Kernel::radius_scale);\n";
     // Every REORDER_EVERY builds the particles are sorted in cell order on the device, as
     // on the CPU (same grid, same order), so outputs list particles in the same order.
     if (!sourceArrays_.empty())
