@@ -214,7 +214,11 @@ class Emitter {
   std::string launch(const std::string& name, const std::string& n, const KernelArgs& ka) const;
   // The kernels of one destination of phase `name`, and their launches.
   void emitDestinationDevice(int d, const std::vector<const PlanEquation*>& eqs,
-                             const PlanGroup* group, const std::string& name);
+                             const PlanGroup* group, const std::string& name,
+                             bool onGhosts);
+  // After a phase on the real particles of d: refresh_ghosts of the carried properties it
+  // wrote.
+  void emitGhostRefresh(int d, const std::vector<const PlanEquation*>& eqs, bool onGhosts);
   void emitLineDirective(llvm::SMLoc l);
   void resetLineDirective();
   // The data a scene computes on: host arrays, or their float copies (--precision=single).
@@ -257,6 +261,11 @@ class Emitter {
   std::string propIndexList(int a, const std::vector<std::string>& props) const;
   void emitDomainSetup();
   void emitUpdateNeighboursWithGhosts();
+  void emitUpdateNeighboursWithGhostsDevice();
+  // remove_ghosts of every source array (statements, indented by 4).
+  std::string removeGhosts() const;
+  // The extents of the arrays in neighbour loops, for ocl.search_domain / ocl.make_grid.
+  std::string deviceExtents(const std::string& indent) const;
   void emitUpdateNeighbours();
   void emitTimedNeighbourUpdate();
   void emitStep();
@@ -773,7 +782,8 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
            << (onGhosts ? " + ghosts_" + D + ".size()" : std::string("")) << ");"
            << (onGhosts ? "  // real particles and ghosts (real = false)" : "") << "\n";
     if (opencl_) {
-      emitDestinationDevice(d, eqs, group, name);
+      emitDestinationDevice(d, eqs, group, name, onGhosts);
+      emitGhostRefresh(d, eqs, onGhosts);
       scene_ << "    }\n";
       continue;
     }
@@ -873,25 +883,33 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
       }
       scene_ << "        " << propPtr(d, pd.reduceTarget) << "[0] = acc;\n      }\n";
     }
-    // Ghosts copy the values the phase computed on the real particles, where they carry them.
-    if (hasGhosts(d) && !onGhosts) {
-      std::set<std::string> written;
-      for (const auto* eq : eqs)
-        for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods)
-          for (const auto& w : plan_.bodies[b].facts.dWrites) written.insert(w.prop);
-      std::vector<std::string> refresh;
-      for (const auto& p : arr(d).ghostProps)
-        if (written.count(p)) refresh.push_back(p);
-      if (!refresh.empty()) {
-        scene_ << "      // ghosts follow:";
-        for (const auto& p : refresh) scene_ << " " << p;
-        scene_ << "\n      sphc::refresh_ghosts(box, " << D << ", ghosts_" << D << ", "
-               << propIndexList(d, refresh) << ");\n";
-      }
-    }
+    emitGhostRefresh(d, eqs, onGhosts);
     scene_ << "    }\n";
   }
   scene_ << "  }\n\n";
+}
+
+// Ghosts copy the values a phase computed on the real particles, where they carry them.
+void Emitter::emitGhostRefresh(int d, const std::vector<const PlanEquation*>& eqs,
+                               bool onGhosts) {
+  if (!hasGhosts(d) || onGhosts) return;
+  const std::string& D = arr(d).name;
+  std::set<std::string> written;
+  for (const auto* eq : eqs)
+    for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods)
+      for (const auto& w : plan_.bodies[b].facts.dWrites) written.insert(w.prop);
+  std::vector<std::string> refresh;
+  for (const auto& p : arr(d).ghostProps)
+    if (written.count(p)) refresh.push_back(p);
+  if (refresh.empty()) return;
+  scene_ << "      // ghosts follow:";
+  for (const auto& p : refresh) scene_ << " " << p;
+  if (opencl_)
+    scene_ << "\n      ghosts_" << D << ".refresh(ocl, box, " << D << ", dev_" << D << ", "
+           << propIndexList(d, refresh) << ");\n";
+  else
+    scene_ << "\n      sphc::refresh_ghosts(box, " << D << ", ghosts_" << D << ", "
+           << propIndexList(d, refresh) << ");\n";
 }
 
 // ---- --backend=opencl ----------------------------------------------------------------------
@@ -948,7 +966,8 @@ std::string Emitter::launch(const std::string& name, const std::string& n,
 }
 
 void Emitter::emitDestinationDevice(int d, const std::vector<const PlanEquation*>& eqs,
-                                    const PlanGroup* group, const std::string& name) {
+                                    const PlanGroup* group, const std::string& name,
+                                    bool onGhosts) {
   const std::string& D = arr(d).name;
   auto perParticle = [&](ast::Method::Kind kind, const char* what) {
     std::vector<const PlanEquation*> with = withMethod(eqs, kind);
@@ -1015,7 +1034,9 @@ void Emitter::emitDestinationDevice(int d, const std::vector<const PlanEquation*
     const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
     KernelArgs ka;
     addBodyArgs(ka, b, d, -1, eqStruct(*eq));
-    ka.add("__global real* reduce_values", "ocl.scratch(n)", "reduce_values");
+    // Reductions see the real particles only (never the ghosts of a non-real group).
+    const std::string nReal = onGhosts ? "static_cast<int>(" + D + ".n)" : std::string("n");
+    ka.add("__global real* reduce_values", "ocl.scratch(" + nReal + ")", "reduce_values");
     std::string k = name + "_" + D + "_reduce_" + std::to_string(eq->id);
     beginKernel(k, ka);
     cl_ << "  reduce_values[d_idx] = "
@@ -1027,10 +1048,12 @@ void Emitter::emitDestinationDevice(int d, const std::vector<const PlanEquation*
                                                                     : "Min";
     scene_ << "      {  // reduce " << pd.reduceOp << " into " << D << "." << pd.reduceTarget
            << ": " << eq->name << ", from " << loc(eq->loc) << "\n";
-    scene_ << "        " << launch(k, "n", ka) << "\n";
-    scene_ << "        " << D << ".constant(" << c << ")[0] = ocl.reduce(ocl.scratch(n), n, "
-           << "sphc::ocl::Op::" << op << ")"
-           << (pd.reduceOp == "mean" ? " / (n > 0 ? n : 1)" : "") << ";\n";
+    scene_ << "        " << launch(k, nReal, ka) << (onGhosts ? "  // real particles only" : "")
+           << "\n";
+    scene_ << "        " << D << ".constant(" << c << ")[0] = ocl.reduce(ocl.scratch(" << nReal
+           << "), " << nReal << ", sphc::ocl::Op::" << op << ")"
+           << (pd.reduceOp == "mean" ? " / (" + nReal + " > 0 ? " + nReal + " : 1)" : "")
+           << ";\n";
     scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << c << ");\n";
     scene_ << "      }\n";
   }
@@ -1230,6 +1253,70 @@ void Emitter::emitUpdateNeighboursWithGhosts() {
     scene_ << "    " << build(S, S + ".n + ghosts_" + S + ".size()") << "\n";
 }
 
+std::string Emitter::removeGhosts() const {
+  std::string r;
+  for (const auto& S : sourceArrays_)
+    r += opencl_ ? "    ghosts_" + S + ".remove();\n"
+                 : "    sphc::remove_ghosts(" + S + ", ghosts_" + S + ");\n";
+  return r;
+}
+
+std::string Emitter::deviceExtents(const std::string& indent) const {
+  const char* axes[3] = {"x", "y", "z"};
+  auto buf = [&](int a, int k) {
+    return k < plan_.dim ? devBuffer(a, axes[k]) : std::string("nullptr");
+  };
+  std::string r = "{";
+  bool first = true;
+  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+    if (!loopArrays_.count(arr(a).name)) continue;
+    r += (first ? "" : ",\n" + indent) + "{" + buf(a, 0) + ", " + buf(a, 1) + ", " + buf(a, 2) +
+         ", " + devBuffer(a, "h") + ", " + arr(a).name + ".n}";
+    first = false;
+  }
+  return r + "}";
+}
+
+// The same on the device (--backend=opencl): the search domain of the real particles from
+// device reductions, the cell-order permutation of the real particles on the device, then the
+// ghost list of every source found on the host from its downloaded positions (the CPU's
+// find_ghosts, so the same ghosts in the same order), the ghost slots filled on the device,
+// and the cell tables over real particles and ghosts on the widened grid.
+void Emitter::emitUpdateNeighboursWithGhostsDevice() {
+  if (loopArrays_.empty()) return;
+  const char* axes[3] = {"x", "y", "z"};
+  scene_ << "    sphc::SearchDomain domain = ocl.search_domain(" << deviceExtents("        ")
+         << ", DIM, Kernel::radius_scale);\n";
+  scene_ << "    grid = ocl.grid_of(domain);\n";
+  if (sourceArrays_.empty()) return;
+  auto build = [&](const std::string& S, const std::string& count) {
+    int s = plan_.arrayIndex(S);
+    std::string b = "cells_" + S + ".build(ocl, grid";
+    for (int k = 0; k < 3; ++k)
+      b += ", " + (k < plan_.dim ? devBuffer(s, axes[k]) : std::string("nullptr"));
+    return b + ", " + count + ");";
+  };
+  scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
+  scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
+  for (const auto& S : sourceArrays_)
+    scene_ << "      " << build(S, S + ".n") << "\n      dev_" << S << ".permute(ocl, cells_" << S
+           << ", " << S << ");\n";
+  scene_ << "    }\n";
+  scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
+  scene_ << "    const double cutoff = domain.cell_size;\n";
+  for (const auto& S : sourceArrays_) {
+    int s = plan_.arrayIndex(S);
+    scene_ << "    ghosts_" << S << ".add(ocl, box, " << S << ", dev_" << S << ", cutoff, "
+           << propIndexList(s, arr(s).ghostProps) << ");  //";
+    for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
+    scene_ << "\n";
+  }
+  scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
+  scene_ << "    grid = ocl.grid_of(domain);\n";
+  for (const auto& S : sourceArrays_)
+    scene_ << "    " << build(S, S + ".n + ghosts_" + S + ".size()") << "\n";
+}
+
 // update_neighbours and compute_accelerations of a scene without periodic or mirror domain.
 void Emitter::emitUpdateNeighbours() {
   scene_ << "  // Rebuilds the neighbour search of every array that is a source.\n";
@@ -1241,18 +1328,9 @@ void Emitter::emitUpdateNeighbours() {
     auto buf = [&](int a, int k) {
       return k < plan_.dim ? devBuffer(a, axes[k]) : std::string("nullptr");
     };
-    if (!loopArrays_.empty()) {
-      scene_ << "    grid = ocl.make_grid({";
-      bool first = true;
-      for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
-        if (!loopArrays_.count(arr(a).name)) continue;
-        scene_ << (first ? "" : ",\n                          ") << "{" << buf(a, 0) << ", "
-               << buf(a, 1) << ", " << buf(a, 2) << ", " << devBuffer(a, "h") << ", "
-               << arr(a).name << ".n}";
-        first = false;
-      }
-      scene_ << "}, DIM, Kernel::radius_scale);\n";
-    }
+    if (!loopArrays_.empty())
+      scene_ << "    grid = ocl.make_grid(" << deviceExtents("                          ")
+             << ", DIM, Kernel::radius_scale);\n";
     // Every REORDER_EVERY builds the particles are sorted in cell order on the device, as
     // on the CPU (same grid, same order), so outputs list particles in the same order.
     if (!sourceArrays_.empty())
@@ -1334,19 +1412,26 @@ void Emitter::emitStep() {
   if (hasDomain()) {
     scene_ << "  // Periodic axes: particles that left the box come back in.\n";
     scene_ << "  void update_domain() {\n";
-    for (const auto& a : plan_.arrays) scene_ << "    sphc::wrap_periodic(box, " << a.name << ");\n";
+    for (const auto& a : plan_.arrays)
+      if (opencl_)
+        scene_ << "    sphc::ocl::wrap_periodic(ocl, box, dev_" << a.name << ", " << a.name
+               << ");\n";
+      else
+        scene_ << "    sphc::wrap_periodic(box, " << a.name << ");\n";
     scene_ << "  }\n\n";
     scene_ << "  // Rebuilds the neighbour search of every array that is a source, with ghosts.\n";
     scene_ << "  void update_neighbours() {\n";
-    emitUpdateNeighboursWithGhosts();
+    if (opencl_)
+      emitUpdateNeighboursWithGhostsDevice();
+    else
+      emitUpdateNeighboursWithGhosts();
     scene_ << "  }\n\n";
     scene_ << "  // Ghosts exist during an evaluation only: outside it arrays hold real particles.\n";
     scene_ << "  void compute_accelerations(double t, double dt) {\n";
     scene_ << "    update_domain();\n";
     emitTimedNeighbourUpdate();
     scene_ << "    equations(t, dt);\n";
-    for (const auto& S : sourceArrays_)
-      scene_ << "    sphc::remove_ghosts(" << S << ", ghosts_" << S << ");\n";
+    scene_ << removeGhosts();
     scene_ << "  }\n\n";
   } else {
     emitUpdateNeighbours();
@@ -1361,9 +1446,7 @@ void Emitter::emitStep() {
     scene_ << ")) return;\n";
     scene_ << (hasDomain() ? "    update_domain();\n" : "") << "    update_neighbours();\n";
     for (const auto& c : postStepCalls_) scene_ << "    " << c << "(t, dt);\n";
-    if (hasDomain())
-      for (const auto& S : sourceArrays_)
-        scene_ << "    sphc::remove_ghosts(" << S << ", ghosts_" << S << ");\n";
+    if (hasDomain()) scene_ << removeGhosts();
     scene_ << "  }\n\n";
   }
   // The integrator's time step; after stage k of m the time is t + k/m dt.
@@ -1651,7 +1734,9 @@ std::string Emitter::run() {
   }
   if (hasDomain()) {
     out_ << "  sphc::Domain box;  // periodic and mirror boundaries\n";
-    for (const auto& S : sourceArrays_) out_ << "  sphc::Ghosts ghosts_" << S << ";\n";
+    for (const auto& S : sourceArrays_)
+      out_ << "  " << (opencl_ ? "sphc::ocl::DeviceGhosts" : "sphc::Ghosts") << " ghosts_" << S
+           << ";\n";
   }
   if (openmp_) out_ << "  std::vector<" << real_ << "> reduce_scratch;  // reduce sum/mean, OpenMP\n";
   // Iterations per evaluation of each iterated group (--timing prints them).

@@ -151,13 +151,6 @@ int main(int argc, char** argv) {
     return true;
   };
   if (dump("sema")) return 0;
-  // Ghost particles are made on the host; the OpenCL backend keeps particles on the device
-  // and has no ghosts yet.
-  if (Backend == "opencl" && plan->domain.any()) {
-    diags.error(plan->domain.loc, "periodic and mirror domains are not supported with "
-                                  "--backend=opencl yet; use --backend=serial or openmp");
-    return fail();
-  }
   // Ghosts are copies in the double host arrays; --precision=single on the CPU computes on
   // float copies of them, which have no ghosts yet.
   if (Precision == "single" && Backend != "opencl" && plan->domain.any()) {

@@ -133,16 +133,16 @@ void wrap_periodic(const Domain& d, ParticleArray& a) {
   }
 }
 
-std::size_t add_ghosts(const Domain& d, ParticleArray& a, double cutoff, Ghosts& g,
-                       const std::vector<int>& carried) {
+std::size_t find_ghosts(const Domain& d, const double* const pos[3], std::size_t n,
+                        double cutoff, Ghosts& g, const std::string& array) {
   g.source.clear();
   g.image.clear();
   if (!(cutoff >= 0.0) || !std::isfinite(cutoff))
-    throw std::invalid_argument("ghosts of array '" + a.name + "': the cutoff must be finite "
+    throw std::invalid_argument("ghosts of array '" + array + "': the cutoff must be finite "
                                 "and >= 0");
   // Which sides make images, and the coordinates read per axis.
   bool makes[3][2] = {{false, false}, {false, false}, {false, false}};
-  const double* pos[3] = {nullptr, nullptr, nullptr};
+  const double* axis[3] = {nullptr, nullptr, nullptr};
   bool any = false;
   for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
     makes[ax][0] = d.lo_kind[ax] != Boundary::Open;
@@ -151,39 +151,47 @@ std::size_t add_ghosts(const Domain& d, ParticleArray& a, double cutoff, Ghosts&
     any = true;
     if (makes[ax][0] && makes[ax][1] && d.hi[ax] - d.lo[ax] < cutoff)
       throw std::invalid_argument(
-          "ghosts of array '" + a.name + "': " + axis_name(ax) + " spans " +
+          "ghosts of array '" + array + "': " + axis_name(ax) + " spans " +
           std::to_string(d.hi[ax] - d.lo[ax]) + ", less than the interaction radius " +
           std::to_string(cutoff) + " (radius_scale * max h); enlarge the domain or reduce h");
-    const int idx = a.find(kAxis[ax]);
-    if (idx < 0 || a.props[idx].type != PropType::F64)
-      throw std::invalid_argument("ghosts of array '" + a.name + "': no position " +
-                                  kAxis[ax]);
-    pos[ax] = a.props[idx].f64.data();
+    if (!pos[ax])
+      throw std::invalid_argument("ghosts of array '" + array + "': no position " + kAxis[ax]);
+    axis[ax] = pos[ax];
   }
-  if (any) {
-    for (std::size_t i = 0; i < a.n; ++i) {
-      // Per axis the images this particle has: 0 (itself) and 1 / 2 when near a side.
-      int codes[3][3];
-      int count[3] = {1, 1, 1};
-      for (int ax = 0; ax < 3; ++ax) {
-        codes[ax][0] = 0;
-        if (!pos[ax]) continue;
-        const double v = pos[ax][i];
-        if (!std::isfinite(v)) continue;
-        if (makes[ax][0] && v < d.lo[ax] + cutoff) codes[ax][count[ax]++] = 1;
-        if (makes[ax][1] && v > d.hi[ax] - cutoff) codes[ax][count[ax]++] = 2;
-      }
-      // Every combination but the particle itself (corners and edges included).
-      for (int cz = 0; cz < count[2]; ++cz)
-        for (int cy = 0; cy < count[1]; ++cy)
-          for (int cx = 0; cx < count[0]; ++cx) {
-            const int image = codes[0][cx] | (codes[1][cy] << 2) | (codes[2][cz] << 4);
-            if (image == 0) continue;
-            g.source.push_back(static_cast<std::uint32_t>(i));
-            g.image.push_back(static_cast<std::uint8_t>(image));
-          }
+  if (!any) return 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    // Per axis the images this particle has: 0 (itself) and 1 / 2 when near a side.
+    int codes[3][3];
+    int count[3] = {1, 1, 1};
+    for (int ax = 0; ax < 3; ++ax) {
+      codes[ax][0] = 0;
+      if (!axis[ax]) continue;
+      const double v = axis[ax][i];
+      if (!std::isfinite(v)) continue;
+      if (makes[ax][0] && v < d.lo[ax] + cutoff) codes[ax][count[ax]++] = 1;
+      if (makes[ax][1] && v > d.hi[ax] - cutoff) codes[ax][count[ax]++] = 2;
     }
+    // Every combination but the particle itself (corners and edges included).
+    for (int cz = 0; cz < count[2]; ++cz)
+      for (int cy = 0; cy < count[1]; ++cy)
+        for (int cx = 0; cx < count[0]; ++cx) {
+          const int image = codes[0][cx] | (codes[1][cy] << 2) | (codes[2][cz] << 4);
+          if (image == 0) continue;
+          g.source.push_back(static_cast<std::uint32_t>(i));
+          g.image.push_back(static_cast<std::uint8_t>(image));
+        }
   }
+  return g.size();
+}
+
+std::size_t add_ghosts(const Domain& d, ParticleArray& a, double cutoff, Ghosts& g,
+                       const std::vector<int>& carried) {
+  const double* pos[3] = {nullptr, nullptr, nullptr};
+  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
+    const int idx = a.find(kAxis[ax]);
+    if (idx >= 0 && a.props[idx].type == PropType::F64) pos[ax] = a.props[idx].f64.data();
+  }
+  find_ghosts(d, pos, a.n, cutoff, g, a.name);
   for (Property& p : a.props) resize_storage(p, a.n + g.size());
   for (int idx : carried) copy_property(d, a, g, idx);
   return g.size();

@@ -120,6 +120,49 @@ __kernel void sphc_gather8(__global ulong* dst, __global const ulong* src,
   dst[i] = src[order[i / stride] * stride + i % stride];
 }
 
+// Periodic and mirror domains (sphc/domain.h). sphc_wrap_periodic: sphc::wrap_periodic, with
+// contraction off so that it rounds as the host.
+__kernel void sphc_wrap_periodic(__global real* x, const uint n, const real lo, const real hi) {
+#pragma OPENCL FP_CONTRACT OFF
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  real v = x[i];
+  if (!isfinite(v) || (v >= lo && v < hi)) return;
+  const real period = hi - lo;
+  v -= floor((v - lo) / period) * period;
+  if (v >= hi) v -= period;
+  if (v < lo) v = lo;
+  x[i] = v;
+}
+// Ghost k of v (slot n + k) from its source through its image along `axis`: per side a mode
+// (0: copy, 1: x + t, 2: t - x, 3: -x), as sphc::add_ghosts.
+__kernel void sphc_ghost_real(__global real* v, __global const uint* source,
+                              __global const uchar* image, const uint n, const uint g,
+                              const int axis, const int mode_lo, const real t_lo,
+                              const int mode_hi, const real t_hi) {
+#pragma OPENCL FP_CONTRACT OFF
+  const uint k = get_global_id(0);
+  if (k >= g) return;
+  const real x = v[source[k]];
+  const int code = (image[k] >> (2 * axis)) & 3;
+  const int mode = code == 1 ? mode_lo : code == 2 ? mode_hi : 0;
+  const real t = code == 1 ? t_lo : t_hi;
+  v[n + k] = mode == 1 ? x + t : mode == 2 ? t - x : mode == 3 ? -x : x;
+}
+// Ghost copies of 4- and 8-byte values (every value of a stride).
+__kernel void sphc_ghost_copy4(__global uint* v, __global const uint* source, const uint n,
+                               const uint g, const uint stride) {
+  const uint i = get_global_id(0);
+  if (i >= g * stride) return;
+  v[n * stride + i] = v[source[i / stride] * stride + i % stride];
+}
+__kernel void sphc_ghost_copy8(__global ulong* v, __global const uint* source, const uint n,
+                               const uint g, const uint stride) {
+  const uint i = get_global_id(0);
+  if (i >= g * stride) return;
+  v[n * stride + i] = v[source[i / stride] * stride + i % stride];
+}
+
 // Partial extents for the search domain, one pass: work item g writes min/max of the finite
 // x, y, z (axes beyond dim: +inf/-inf) and the max of finite h over v[g], v[g + G], ...
 __kernel void sphc_extent(const uint n, const int dim, __global const real* x,
@@ -457,6 +500,12 @@ void Context::launch(cl_kernel k, std::size_t n, const std::string& name) {
 
 void Context::finish() { check(clFinish(queue_), "clFinish"); }
 
+void Context::add_profile(const std::string& name, double seconds) {
+  auto& slot = profile_times_[name];
+  slot.first += seconds;
+  ++slot.second;
+}
+
 std::vector<double> Context::reduce_all(const std::vector<Reduction>& rs) {
   // Every partial reduction first, then one read of all partial results.
   cl_mem partial = scratch(kReduceItems * (rs.empty() ? 1 : rs.size()), -1);
@@ -503,7 +552,8 @@ void Context::read_reals(cl_mem m, double* out, std::size_t n) {
   for (std::size_t j = 0; j < n; ++j) out[j] = f[j];
 }
 
-Grid Context::make_grid(const std::vector<Extent>& arrays, int dim, double radius_scale) {
+SearchDomain Context::search_domain(const std::vector<Extent>& arrays, int dim,
+                                    double radius_scale) {
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   double hmax = -HUGE_VAL;
   // One partial-extent kernel per array, one read of all partial results.
@@ -532,21 +582,34 @@ Grid Context::make_grid(const std::vector<Extent>& arrays, int dim, double radiu
     }
     hmax = std::fmax(hmax, values[j + 6]);
   }
-  // The grid of sphc::make_search_domain and CellList::build (dense), so that in double
-  // precision the cell order, hence the particle order after a reorder, is the CPU one.
+  // As sphc::make_search_domain, so that in double precision the grid, hence the cell order
+  // and the particle order after a reorder, is the CPU one.
+  SearchDomain dom;
+  dom.dim = dim;
+  dom.cell_size = hmax > 0 && std::isfinite(hmax) ? radius_scale * hmax : 1.0;
+  const double pad = 1e-6 * dom.cell_size;
+  for (int a = 0; a < 3; ++a) {
+    if (a < dim && lo[a] <= hi[a]) {
+      dom.lo[a] = lo[a] - pad;
+      dom.hi[a] = hi[a] + pad;
+    } else {
+      dom.lo[a] = dom.hi[a] = 0.0;
+    }
+  }
+  return dom;
+}
+
+Grid Context::grid_of(const SearchDomain& dom) const {
+  // The grid of CellList::build (dense).
   Grid g;
-  double cell = hmax > 0 && std::isfinite(hmax) ? radius_scale * hmax : 1.0;
-  const double pad = 1e-6 * cell;
   double extent[3] = {0.0, 0.0, 0.0}, max_extent = 0.0;
-  bool used[3] = {false, false, false};
-  for (int a = 0; a < dim; ++a) {
-    if (!(lo[a] <= hi[a])) continue;
-    used[a] = true;
-    g.lo[a] = lo[a] - pad;
-    const double e = (hi[a] + pad) - g.lo[a];
+  for (int a = 0; a < dom.dim && a < 3; ++a) {
+    const double e = dom.hi[a] - dom.lo[a];
     extent[a] = std::isfinite(e) && e > 0.0 ? e : 0.0;
     max_extent = std::fmax(max_extent, extent[a]);
   }
+  double cell = dom.cell_size;
+  if (!(cell > 0.0) || !std::isfinite(cell)) cell = max_extent > 0.0 ? max_extent : 1.0;
   const double kMaxCellsPerAxis = 1 << 21;
   cell = std::fmax(cell, max_extent / (kMaxCellsPerAxis - 1));
   // In single precision cell coordinates are rounded: slightly larger cells keep every
@@ -555,9 +618,11 @@ Grid Context::make_grid(const std::vector<Extent>& arrays, int dim, double radiu
   g.inv_cell = 1.0 / cell;
   std::size_t cells = 1;
   for (int a = 0; a < 3; ++a) {
-    g.ncell[a] = used[a] ? static_cast<int>(std::fmin(std::floor(extent[a] * g.inv_cell) + 1.0,
+    const bool used = a < dom.dim && std::isfinite(dom.lo[a]);
+    g.lo[a] = used ? dom.lo[a] : 0.0;
+    g.ncell[a] = used ? static_cast<int>(std::fmin(std::floor(extent[a] * g.inv_cell) + 1.0,
                                                       kMaxCellsPerAxis))
-                         : 1;
+                      : 1;
     cells *= static_cast<std::size_t>(g.ncell[a]);
   }
   if (cells > (std::size_t{1} << 28))
@@ -606,9 +671,19 @@ void CellTable::release() {
     }
 }
 
+namespace {
+// Bytes per value of a property on the device.
+std::size_t value_size(const Context& ctx, const Property& p) {
+  return p.type == PropType::F64 ? ctx.real_size() : 4;
+}
+}  // namespace
+
 void DeviceArray::upload(Context& ctx, const ParticleArray& a) {
-  const bool realloc = props.size() != a.props.size() || n != a.n;
-  if (realloc) release();
+  const bool realloc = props.size() != a.props.size() || a.n > capacity || props.empty();
+  if (realloc) {
+    release();
+    capacity = a.n;
+  }
   n = a.n;
   std::vector<float> tmp;
   for (std::size_t i = 0; i < a.props.size(); ++i) {
@@ -629,7 +704,7 @@ void DeviceArray::upload(Context& ctx, const ParticleArray& a) {
       data = p.type == PropType::I32 ? static_cast<const void*>(p.i32.data()) : p.u32.data();
       bytes = count * 4;
     }
-    if (realloc) props.push_back(ctx.alloc(bytes));
+    if (realloc) props.push_back(ctx.alloc(capacity * p.stride * value_size(ctx, p)));
     if (bytes)
       check(
           clEnqueueWriteBuffer(ctx.queue(), props[i], CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
@@ -679,13 +754,30 @@ void DeviceArray::download(Context& ctx, ParticleArray& a) {
   }
 }
 
+void DeviceArray::reserve(Context& ctx, const ParticleArray& a, std::size_t count) {
+  if (count <= capacity) return;
+  const std::size_t cap = std::max(count, capacity + capacity / 4 + 64);
+  for (std::size_t i = 0; i < a.props.size() && i < props.size(); ++i) {
+    const Property& p = a.props[i];
+    const std::size_t per = p.stride * value_size(ctx, p);
+    cl_mem m = ctx.alloc(cap * per);
+    if (capacity * per > 0)
+      check(clEnqueueCopyBuffer(ctx.queue(), props[i], m, 0, 0, capacity * per, 0, nullptr,
+                                nullptr),
+            "clEnqueueCopyBuffer (property)");
+    clReleaseMemObject(props[i]);
+    props[i] = m;
+  }
+  capacity = cap;
+}
+
 void DeviceArray::permute(Context& ctx, const CellTable& cells, const ParticleArray& a) {
   for (std::size_t i = 0; i < a.props.size() && i < props.size(); ++i) {
     const Property& p = a.props[i];
     const bool wide = p.type == PropType::F64 && ctx.double_precision();
     const std::size_t count = n * static_cast<std::size_t>(p.stride);
     if (count == 0) continue;
-    cl_mem dst = ctx.alloc(count * (wide ? 8 : 4));
+    cl_mem dst = ctx.alloc(capacity * static_cast<std::size_t>(p.stride) * (wide ? 8 : 4));
     ctx.run(wide ? "sphc_gather8" : "sphc_gather4", count, dst, props[i], cells.order,
             static_cast<unsigned>(n), static_cast<unsigned>(p.stride));
     clReleaseMemObject(props[i]);
@@ -698,6 +790,120 @@ void DeviceArray::release() {
   for (cl_mem m : constants) clReleaseMemObject(m);
   props.clear();
   constants.clear();
+  capacity = 0;
+}
+
+namespace {
+const char* const kAxisName[3] = {"x", "y", "z"};
+const char* const kVelocityName[3] = {"u", "v", "w"};
+
+// The index of the double property `name` of a, or -1.
+int real_prop(const ParticleArray& a, const char* name) {
+  const int i = a.find(name);
+  return i >= 0 && a.props[i].type == PropType::F64 && a.props[i].stride == 1 ? i : -1;
+}
+}  // namespace
+
+void wrap_periodic(Context& ctx, const Domain& d, DeviceArray& dev, const ParticleArray& a) {
+  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
+    if (!d.periodic(ax)) continue;
+    const int idx = real_prop(a, kAxisName[ax]);
+    if (idx < 0 || static_cast<std::size_t>(idx) >= dev.props.size()) continue;
+    ctx.run("sphc_wrap_periodic", a.n, dev.prop(idx), static_cast<unsigned>(a.n), d.lo[ax],
+            d.hi[ax]);
+  }
+}
+
+std::size_t DeviceGhosts::add(Context& ctx, const Domain& d, const ParticleArray& a,
+                              DeviceArray& dev, double cutoff, const std::vector<int>& carried) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // The real positions of the axes that make images, then the list as on the CPU.
+  const double* p[3] = {nullptr, nullptr, nullptr};
+  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
+    if (d.lo_kind[ax] == Boundary::Open && d.hi_kind[ax] == Boundary::Open) continue;
+    const int idx = real_prop(a, kAxisName[ax]);
+    if (idx < 0) continue;  // find_ghosts names the missing position
+    pos[ax].resize(a.n);
+    if (a.n) ctx.read_reals(dev.prop(idx), pos[ax].data(), a.n);
+    p[ax] = pos[ax].data();
+  }
+  find_ghosts(d, p, a.n, cutoff, list, a.name);
+  const std::size_t g = list.size();
+  dev.reserve(ctx, a, a.n + g);
+  if (g > capacity || !source) {
+    if (source) clReleaseMemObject(source);
+    if (image) clReleaseMemObject(image);
+    capacity = std::max(g, capacity + capacity / 4 + 64);
+    source = ctx.alloc(capacity * sizeof(cl_uint));
+    image = ctx.alloc(capacity);
+  }
+  if (g) {
+    check(clEnqueueWriteBuffer(ctx.queue(), source, CL_TRUE, 0, g * sizeof(cl_uint),
+                               list.source.data(), 0, nullptr, nullptr),
+          "clEnqueueWriteBuffer (ghost sources)");
+    check(clEnqueueWriteBuffer(ctx.queue(), image, CL_TRUE, 0, g, list.image.data(), 0, nullptr,
+                               nullptr),
+          "clEnqueueWriteBuffer (ghost images)");
+  }
+  if (ctx.profiling())
+    ctx.add_profile("host: ghost list (read x, find, write)",
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  refresh(ctx, d, a, dev, carried);
+  return g;
+}
+
+void DeviceGhosts::refresh(Context& ctx, const Domain& d, const ParticleArray& a,
+                           DeviceArray& dev, const std::vector<int>& props) {
+  const std::size_t g = list.size();
+  if (g == 0) return;
+  const unsigned un = static_cast<unsigned>(a.n), ug = static_cast<unsigned>(g);
+  for (int idx : props) {
+    if (idx < 0 || static_cast<std::size_t>(idx) >= a.props.size() ||
+        static_cast<std::size_t>(idx) >= dev.props.size())
+      throw std::out_of_range("ghosts of array '" + a.name + "': no property number " +
+                              std::to_string(idx));
+    const Property& p = a.props[idx];
+    int position = -1, velocity = -1;
+    for (int ax = 0; ax < 3; ++ax) {
+      if (p.name == kAxisName[ax]) position = ax;
+      if (p.name == kVelocityName[ax]) velocity = ax;
+    }
+    if (p.type == PropType::F64 && p.stride == 1 && (position >= 0 || velocity >= 0)) {
+      // Per side: the mode and constant of sphc_ghost_real (see domain.cpp's transforms).
+      const int ax = position >= 0 ? position : velocity;
+      int mode[2] = {0, 0};
+      double t[2] = {0.0, 0.0};
+      for (int side = 0; side < 2; ++side) {
+        const Boundary kind = side == 0 ? d.lo_kind[ax] : d.hi_kind[ax];
+        if (kind == Boundary::Open) continue;
+        if (position >= 0 && kind == Boundary::Periodic) {
+          mode[side] = 1;  // x + L through the low side, x - L through the high side
+          t[side] = side == 0 ? d.hi[ax] - d.lo[ax] : -(d.hi[ax] - d.lo[ax]);
+        } else if (position >= 0) {
+          mode[side] = 2;  // 2 lo - x, 2 hi - x
+          t[side] = 2.0 * (side == 0 ? d.lo[ax] : d.hi[ax]);
+        } else if (kind == Boundary::Mirror) {
+          mode[side] = 3;  // the normal velocity negated
+        }
+      }
+      ctx.run("sphc_ghost_real", g, dev.prop(idx), source, image, un, ug, ax, mode[0], t[0],
+              mode[1], t[1]);
+      continue;
+    }
+    const bool wide = p.type == PropType::F64 && ctx.double_precision();
+    const std::size_t count = g * static_cast<std::size_t>(p.stride);
+    ctx.run(wide ? "sphc_ghost_copy8" : "sphc_ghost_copy4", count, dev.prop(idx), source, un, ug,
+            static_cast<unsigned>(p.stride));
+  }
+}
+
+void DeviceGhosts::release() {
+  for (cl_mem* m : {&source, &image})
+    if (*m) {
+      clReleaseMemObject(*m);
+      *m = nullptr;
+    }
+  capacity = 0;
 }
 
 std::string kernel_function_source(const std::string& kernel, int dim) {

@@ -229,6 +229,40 @@ TEST(Domain, CornersGetEveryCombinationOfImages) {
     for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(got[k][c], expect[k][c]) << k << " " << c;
 }
 
+TEST(Domain, FindGhostsOnRawPositionsIsTheListOfAddGhosts) {
+  // find_ghosts (the OpenCL backend calls it on positions read from the device) and
+  // add_ghosts give the same ghosts in the same order: by particle, then image (x fastest).
+  Domain d;
+  d.dim = 3;
+  d.lo_kind[0] = d.hi_kind[0] = Boundary::Periodic;
+  d.hi[0] = 1.0;
+  d.lo_kind[1] = Boundary::Mirror;  // y >= 0
+  d.lo_kind[2] = d.hi_kind[2] = Boundary::Mirror;
+  d.hi[2] = 1.0;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<std::array<double, 3>> pts(300);
+  for (auto& p : pts) p = {unit(rng), unit(rng), unit(rng)};
+  pts[0] = {0.01, 0.02, 0.03};  // a corner: 2 x 2 x 2 - 1 = 7 ghosts
+  ParticleArray pa = make_array(pts, 0.05);
+  std::vector<double> x(pa.f64("x"), pa.f64("x") + pa.n), y(pa.f64("y"), pa.f64("y") + pa.n),
+      z(pa.f64("z"), pa.f64("z") + pa.n);
+  Ghosts g, raw;
+  sphc::add_ghosts(d, pa, 0.1, g, all_props(pa));
+  const double* pos[3] = {x.data(), y.data(), z.data()};
+  EXPECT_EQ(sphc::find_ghosts(d, pos, x.size(), 0.1, raw, "fluid"), g.size());
+  EXPECT_EQ(raw.source, g.source);
+  EXPECT_EQ(raw.image, g.image);
+  ASSERT_GE(g.size(), 7u);
+  const std::vector<std::uint8_t> corner = {1, 1 << 2, 1 | 1 << 2, 1 << 4, 1 | 1 << 4,
+                                            1 << 2 | 1 << 4, 1 | 1 << 2 | 1 << 4};
+  EXPECT_EQ(std::vector<std::uint8_t>(g.image.begin(), g.image.begin() + 7), corner);
+  for (std::size_t k = 1; k < g.size(); ++k) EXPECT_LE(g.source[k - 1], g.source[k]);
+  // An axis with a side needs its positions.
+  const double* no_z[3] = {x.data(), y.data(), nullptr};
+  EXPECT_THROW(sphc::find_ghosts(d, no_z, x.size(), 0.1, raw, "fluid"), std::invalid_argument);
+}
+
 TEST(Domain, MirroredLatticeIsTheInfiniteLattice) {
   // Periodic in x, mirrors at y = 0 and y = 1: a cell-centred lattice reflects onto itself.
   const int nx = 16;

@@ -37,6 +37,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "sphc/nnps.h"
@@ -77,8 +78,17 @@ struct Ghosts {
 // missing from the array are skipped.
 void wrap_periodic(const Domain& d, ParticleArray& a);
 
+// The one definition of which ghosts exist and in which order (add_ghosts and the OpenCL
+// backend both use it): the ghosts of particles 0..n-1 with coordinates pos[0..2] (nullptr
+// beyond dim; an axis with a periodic or mirror side needs its coordinates) within `cutoff`
+// of a periodic or mirror side, into `g` (replacing its content), by particle, then image
+// (x fastest, then y, then z; each axis: none, low, high). `array` names the array in
+// errors. Returns g.size().
+std::size_t find_ghosts(const Domain& d, const double* const pos[3], std::size_t n,
+                        double cutoff, Ghosts& g, const std::string& array);
+
 // Finds the ghosts of the real particles of `a` within `cutoff` of a periodic or mirror side
-// (into `g`, replacing its content), grows the storage of every property of `a` to
+// (find_ghosts, into `g`, replacing its content), grows the storage of every property of `a` to
 // a.n + g.size() particles and copies the properties `carried` (indices into a.props) to the
 // ghosts. a.n is unchanged. Returns g.size().
 std::size_t add_ghosts(const Domain& d, ParticleArray& a, double cutoff, Ghosts& g,

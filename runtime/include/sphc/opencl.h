@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include "sphc/domain.h"
+#include "sphc/nnps.h"
 #include "sphc/particle_array.h"
 
 namespace sphc {
@@ -68,15 +70,22 @@ struct CellTable {
   ~CellTable() { release(); }
 };
 
-// Device copies of the properties and constants of one ParticleArray.
+// Device copies of the properties and constants of one ParticleArray. Each property buffer
+// holds `capacity` particles (>= n): room for ghosts after the n real particles.
 struct DeviceArray {
   std::vector<cl_mem> props;
   std::vector<cl_mem> constants;
   std::size_t n = 0;
+  std::size_t capacity = 0;
   cl_mem prop(int i) const { return props[i]; }
   cl_mem constant(int i) const { return constants[i]; }
-  // Allocates (first call or resize) and copies every property and constant to the device.
+  // Allocates (first call, other properties or more particles than the capacity) and copies
+  // every property and constant to the device.
   void upload(Context& ctx, const ParticleArray& a);
+  // Grows every property buffer to hold at least `count` particles, keeping its contents
+  // (reallocation and a device copy; the capacity grows by at least a quarter, so a slowly
+  // growing ghost count reallocates rarely).
+  void reserve(Context& ctx, const ParticleArray& a, std::size_t count);
   void upload_constant(Context& ctx, const ParticleArray& a, int c);
   // Copies every property (not the constants: the host copy is the reference) back.
   void download(Context& ctx, ParticleArray& a);
@@ -136,8 +145,15 @@ class Context {
   };
   std::vector<double> reduce_all(const std::vector<Reduction>& rs);
   // The search domain over every array in a neighbour loop (as sphc::make_search_domain:
-  // bounding box of finite coordinates, cell = radius_scale * max h), from device data.
-  Grid make_grid(const std::vector<Extent>& arrays, int dim, double radius_scale);
+  // bounding box of finite coordinates, padded, cell_size = radius_scale * max h), from
+  // device data.
+  SearchDomain search_domain(const std::vector<Extent>& arrays, int dim, double radius_scale);
+  // The dense grid of a search domain (as CellList::build; in single precision the cells are
+  // 1e-5 larger). Refuses more than 2^28 cells.
+  Grid grid_of(const SearchDomain& dom) const;
+  Grid make_grid(const std::vector<Extent>& arrays, int dim, double radius_scale) {
+    return grid_of(search_domain(arrays, dim, radius_scale));
+  }
   void finish();
   // Copies n reals from the device into doubles (blocking).
   void read_reals(cl_mem m, double* out, std::size_t n);
@@ -151,6 +167,9 @@ class Context {
   // SPHC_OPENCL_PROFILE=1 in the environment: every launch waits for its kernel, and the
   // time per kernel name is printed to stderr at exit.
   void launch(cl_kernel k, std::size_t n, const std::string& name = "");
+  bool profiling() const { return profile_; }
+  // Adds host time to the profile printed at exit (under `name`).
+  void add_profile(const std::string& name, double seconds);
 
  private:
   bool dp_ = true;
@@ -163,6 +182,40 @@ class Context {
   std::vector<double> host_partial_;
   bool profile_ = false;
   std::map<std::string, std::pair<double, long>> profile_times_;
+};
+
+// Periodic and mirror domains on the device (sphc/domain.h, the same ghosts in the same
+// order as the CPU backends).
+//
+// wrap_periodic: sphc::wrap_periodic on the device (the same arithmetic, no contraction).
+void wrap_periodic(Context& ctx, const Domain& d, DeviceArray& dev, const ParticleArray& a);
+
+// The ghosts of one source array during an evaluation: particle n + g of every device buffer
+// is ghost g. The list (source particle, image bits) is found on the host by
+// sphc::find_ghosts from the real positions (downloaded: only the axes with a periodic or
+// mirror side), uploaded, and a device kernel per carried property fills the ghost slots
+// with the CPU's transforms (positions shifted or reflected, the normal velocity negated
+// under a mirror, everything else copied). The host ParticleArray never holds ghosts.
+struct DeviceGhosts {
+  Ghosts list;
+  cl_mem source = nullptr, image = nullptr;
+  std::size_t capacity = 0;
+  std::vector<double> pos[3];
+  std::size_t size() const { return list.size(); }
+  // add_ghosts: finds the ghosts of the n real particles, grows dev to n + ghosts and fills
+  // the properties `carried` (indices into a.props). Returns the number of ghosts.
+  std::size_t add(Context& ctx, const Domain& d, const ParticleArray& a, DeviceArray& dev,
+                  double cutoff, const std::vector<int>& carried);
+  // refresh_ghosts: fills the properties `props` of the ghosts from their sources again.
+  void refresh(Context& ctx, const Domain& d, const ParticleArray& a, DeviceArray& dev,
+               const std::vector<int>& props);
+  // remove_ghosts: the count back to 0 (the buffers keep their capacity).
+  void remove() {
+    list.source.clear();
+    list.image.clear();
+  }
+  void release();
+  ~DeviceGhosts() { release(); }
 };
 
 // OpenCL C of the kernel functions `kernel_w(r, h)` and `kernel_gradient(xij, r, h, grad)` and
