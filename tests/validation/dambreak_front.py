@@ -56,9 +56,9 @@ snapshot) unless --depth D gives [0, D]. The front is the same largest x; the fl
 uniform across the channel, so it is the 2D front, and the same references and tolerance
 options apply with the same defaults: the experiments, their spread and the idealisation
 (instant gate, no floor friction) are those of the 2D case. The 3D test
-(validation.dambreak3d) runs at a coarse dx = 0.1 (10 particles along the column, against 33
-in the 2D test), where the front lags the MPS calculation by up to 9.4%; docs/validation.md
-has the figures at finer dx.
+(validation.dambreak3d) runs at dx = 0.0625 (16 particles along the column, against 33 in
+the 2D test), where the front lags the MPS calculation by up to 7.2% (9.4% at dx = 0.1);
+docs/validation.md has the figures.
 
 Positions are measured from the inner face of the left wall, which is x = 0 in sphc's scenes;
 --x0 gives another origin (PySPH's dam_break_2d has its innermost wall layer at x = 0, hence
