@@ -360,11 +360,14 @@ class OutputSchedule {
   // True if t reached an output time not reached before.
   bool due(double t) {
     bool reached = false;
-    if (every_ > 0) {
-      while (static_cast<double>(next_k_) * every_ <= t + slack_) {
-        reached = true;
-        ++next_k_;
-      }
+    if (every_ > 0 && static_cast<double>(next_k_) * every_ <= t + slack_) {
+      // Jump to the first multiple beyond t at once: a step may pass very many output times
+      // (--output-every far below dt), and counting them one by one would not end.
+      reached = true;
+      const double k = std::floor((t + slack_) / every_);
+      next_k_ = std::max(next_k_, static_cast<long>(std::min(k, 9.0e18))) + 1;
+      while (static_cast<double>(next_k_ - 1) * every_ > t + slack_) --next_k_;  // rounding
+      while (static_cast<double>(next_k_) * every_ <= t + slack_) ++next_k_;      // rounding
     }
     while (next_at_ < at_.size() && at_[next_at_] <= t + slack_) {
       reached = true;
