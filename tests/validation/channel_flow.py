@@ -18,8 +18,8 @@ exp(-k^2 pi^2 nu t / d^2), with the sine coefficients of -u_s:
       (2/d) int_0^d y (d - y) sin(k pi y / d) dy = 8 d^2 / (k pi)^3 for odd k, 0 for even k:
       u = F y (d - y) / (2 nu)
           - sum_{k odd} 4 F d^2 / (nu pi^3 k^3) sin(k pi y / d) exp(-k^2 pi^2 nu t / d^2).
-      (Morris et al. write the same series for the velocity counted the other way,
-      F y (y - d) / (2 nu) + sum ..., i.e. -u.)
+      (The form F y (y - d) / (2 nu) + sum_{k odd} ... with the same terms, as it is
+      sometimes quoted, is -u: the velocity counted against the force.)
   Couette: u_s = U y / d;  (2/d) int_0^d (y / d) sin(n pi y / d) dy = 2 (-1)^(n+1) / (n pi):
       u = U y / d + sum_{n >= 1} 2 U (-1)^n / (n pi) sin(n pi y / d) exp(-n^2 pi^2 nu t / d^2).
 
@@ -54,7 +54,8 @@ time):
     (the quintic spline summed over the lattice), so the steady speed is 0.6% too high; with
     EPS = 1e-6 h^2 instead the error is 0.41% (ny = 20) and 0.12% (ny = 40). The rest, a
     slip at the walls, shrinks with dx. Couette, largest at the earliest time (t = 0.0225 s,
-    the steep profile next to the moving plate): ny = 20: 0.47%; ny = 40: 0.24%; < 0.03% at
+    the steep profile next to the moving plate): ny = 20: 0.47%; ny = 40: 0.24%; ny = 80:
+    0.17%; < 0.03% at
     the steady state (a linear profile has no Laplacian: the EPS bias does not act). The
     WCSPH variant: Poiseuille 1.00% / 0.72%, Couette 0.67% / 0.28% (ny = 20 / 40).
   * The tolerances are 1.5 times the largest error measured at ny = 20, the coarsest
