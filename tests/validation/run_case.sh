@@ -22,7 +22,8 @@
 #   RUN OPTIONS passed to the solver (e.g. --set dx=0.01)
 #   CHECK OPTIONS passed to the check after the output directory (e.g. --rho-err-tol 1e-4)
 # The Python interpreter is $SPHC_PYTHON if set, else the first of python3, /usr/bin/python3
-# that has numpy and h5py.
+# that has numpy and h5py. $SPHC_OPTS, if set, is passed to sphc (e.g. "-D scheme=wcsph" for
+# a scene's compile-time option; words without spaces).
 set -eu
 
 if [ $# -lt 5 ]; then
@@ -59,9 +60,10 @@ fi
 rm -rf "$OUT"
 mkdir -p "$(dirname "$EXE")" "$OUT"
 
-echo "== 1. compile: $SPHC $SRC/examples/$CASE.sph -o $EXE"
+echo "== 1. compile: $SPHC $SRC/examples/$CASE.sph ${SPHC_OPTS:+$SPHC_OPTS }-o $EXE"
 start=$(date +%s)
-"$SPHC" "$SRC/examples/$CASE.sph" -o "$EXE"
+# shellcheck disable=SC2086  # options are words without spaces
+"$SPHC" "$SRC/examples/$CASE.sph" ${SPHC_OPTS:-} -o "$EXE"
 echo "   compiled in $(( $(date +%s) - start )) s"
 
 echo "== 2. run: $EXE --quiet --timing -d $OUT$RUN_OPTS"

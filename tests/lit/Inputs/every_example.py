@@ -12,10 +12,12 @@ snapshot at every step; and compares every snapshot with the serial one:
 A new example is covered by being in examples/: nothing to register. A case that a backend
 cannot run yet is named with --skip SCENE[:CHOICE]:BACKEND and reported as skipped, so the
 exclusions are visible in the RUN line of the test that calls this script; likewise
---rtol CASE=R widens the OpenCL tolerance of one case (the test says why).
+--rtol CASE=R widens the OpenCL tolerance of one case, and --scale CASE:NAME=S gives a
+dataset of one case a physical scale (h5close.py --scale; the test says why).
 
 usage: every_example.py --sphc SPHC --examples DIR --out DIR [--opencl] [--steps N]
-                        [--skip CASE:BACKEND ...] [--rtol CASE=R ...] [--only NAME ...]
+                        [--skip CASE:BACKEND ...] [--rtol CASE=R ...]
+                        [--scale CASE:NAME=S ...] [--only NAME ...]
 Prints one line per case and backend ('ok', 'skipped' or what failed) and a closing line
 'N passed, N failed, N skipped'; exits 1 if anything failed.
 """
@@ -61,12 +63,17 @@ def main():
     ap.add_argument('--steps', type=int, default=12)
     ap.add_argument('--skip', action='append', default=[])
     ap.add_argument('--rtol', action='append', default=[])
+    ap.add_argument('--scale', action='append', default=[])
     ap.add_argument('--only', action='append', default=[])
     a = ap.parse_args()
 
     backends = ['openmp'] + (['opencl'] if a.opencl else [])
     skip = set(a.skip)
     rtol = dict(r.split('=', 1) for r in a.rtol)
+    scales = {}
+    for sc in a.scale:
+        c, rest = sc.split(':', 1)
+        scales.setdefault(c, []).extend(['--scale', rest])
     passed = failed = skipped = 0
     examples = sorted(glob.glob(os.path.join(a.examples, '*.sph')))
     if not examples:
@@ -121,7 +128,7 @@ def main():
                         ref = os.path.join(outs['serial'], s)
                         cmp = (['h5diff', ref, mine] if b == 'openmp' else
                                [sys.executable, os.path.join(HERE, 'h5close.py'), ref, mine,
-                                '--rtol', rtol.get(case, '1e-10')])
+                                '--rtol', rtol.get(case, '1e-10')] + scales.get(case, []))
                         r = subprocess.run(cmp, capture_output=True, text=True)
                         if r.returncode != 0:
                             bad.append(s + ': ' + (r.stdout + r.stderr).strip()[-400:])

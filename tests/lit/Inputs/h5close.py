@@ -2,12 +2,14 @@
 """Compares two sphc output files (HDF5) within a relative tolerance, through h5dump (so it
 needs hdf5-tools only, no h5py or numpy).
 
-usage: h5close.py A.h5 B.h5 [--rtol 1e-10] [--sorted] [--verbose]
+usage: h5close.py A.h5 B.h5 [--rtol 1e-10] [--sorted] [--verbose] [--scale NAME=S ...]
 
 Every dataset and attribute of A must exist in B with as many values. Floating point ones
 must satisfy max|a - b| <= rtol * max(max|a|, max|b|): the error is relative to the scale of
 the property (a relative error per value means nothing for values that cross zero, such as
-velocities). Integers and strings must be equal. --sorted compares the sorted values of each
+velocities). --scale NAME=S (NAME as printed, e.g. fluid/arho) makes the scale of that
+dataset at least S: for a property that is exactly zero up to round-off (a patch test), its
+own largest value is round-off and says nothing; S is then its physical scale. Integers and strings must be equal. --sorted compares the sorted values of each
 floating point dataset (for runs whose particle order may differ, e.g. single precision). Exit 0 if they agree, else 1 naming each
 property that does not.
 """
@@ -51,11 +53,15 @@ def read(path):
 
 
 def main(argv):
-    rtol, verbose, ordered, files = 1e-10, False, True, []
+    rtol, verbose, ordered, files, floor = 1e-10, False, True, [], {}
     i = 1
     while i < len(argv):
         if argv[i] == '--rtol':
             rtol = float(argv[i + 1])
+            i += 1
+        elif argv[i] == '--scale':
+            name, value = argv[i + 1].split('=', 1)
+            floor[name] = float(value)
             i += 1
         elif argv[i] == '--verbose':
             verbose = True
@@ -81,7 +87,7 @@ def main(argv):
         fa, fb = [float(x) for x in va], [float(x) for x in vb]
         if not ordered:
             fa, fb = sorted(fa), sorted(fb)
-        scale = max([abs(x) for x in fa + fb] + [0.0])
+        scale = max([abs(x) for x in fa + fb] + [floor.get(name, 0.0)])
         diffs = [abs(x - y) for x, y in zip(fa, fb)]
         err = max(diffs + [0.0])
         rel = err / scale if scale > 0 else err
