@@ -66,6 +66,20 @@ def exact_velocity(x, y, t, re, U=1.0, L=1.0):
     return -f * np.cos(k * x) * np.sin(k * y), f * np.sin(k * x) * np.cos(k * y)
 
 
+def speed_errors(x, y, u, v, t, re, U=1.0, L=1.0):
+    """(decay error, L1 error of the speed) of the particle velocities (u, v) at (x, y, t):
+    max |v| / (U e^{bt}) - 1 and sum | |v| - |v_e| | / sum |v_e| (bench/taylor_green_vs_pysph.py
+    applies the same to PySPH's output)."""
+    ue, ve = exact_velocity(x, y, t, re, U, L)
+    speed = np.hypot(u, v)
+    speed_e = np.hypot(ue, ve)
+    nu = U * L / re
+    amp = U * np.exp(-2.0 * nu * (2.0 * np.pi / L) ** 2 * t)
+    decay_err = float(speed.max() / amp - 1.0)
+    l1 = float(np.sum(np.abs(speed - speed_e)) / np.sum(speed_e))
+    return decay_err, l1
+
+
 def snapshot_files(directory):
     files = [f for f in glob.glob(os.path.join(directory, "*.h5"))
              if re.search(r"_\d+\.h5$", os.path.basename(f))]
@@ -125,13 +139,10 @@ def main():
         if outside:
             failures.append("%s: %d particles outside the periodic box [0, %g)^2"
                             % (name, outside, args.L))
-        ue, ve = exact_velocity(x, y, t, args.re, args.U, args.L)
         speed = np.hypot(u, v)
-        speed_e = np.hypot(ue, ve)
         nu = args.U * args.L / args.re
         amp = args.U * np.exp(-2.0 * nu * (2.0 * np.pi / args.L) ** 2 * t)
-        decay_err = float(speed.max() / amp - 1.0)
-        l1 = float(np.sum(np.abs(speed - speed_e)) / np.sum(speed_e))
+        decay_err, l1 = speed_errors(x, y, u, v, t, args.re, args.U, args.L)
         rows.append((t, float(speed.max()), amp, decay_err, l1))
         last = (t, x, y, speed)
 
