@@ -38,8 +38,8 @@ on the command line (tests/validation/CMakeLists.txt):
   - EDAC (Ramachandran & Puri 2019, with the transport velocity), nx = 50 to t = 1:
     --decay-tol 0.07 --l1-tol 0.05, about 1.5 times the measured -4.84% and 3.45% (the
     errors at t = 2 are -1.32% and 1.78%; PySPH 1.0b1's EDAC: -1.85% and 2.16%), while a
-    viscosity 25% off moves the amplitude at t = 1 by 18% and a WCSPH-like break-up gives
-    errors of 40% and more;
+    viscosity 25% off moves the amplitude at t = 1 by 18% (measured: the scene run at
+    Re = 80 ends at -21.6% and 20.5%) and a WCSPH-like break-up gives errors of 40% and more;
   - TVF (Adami, Hu & Adams 2013), set up as PySPH 1.0b1's example, breaks up from t ~ 0.08
     (as PySPH's does); it is checked at t = 0.07, nx = 50: --l1-tol 0.015 and the default
     1% decay tolerance, against measured 0.66% and +0.07% (the start-up transient peaks at
