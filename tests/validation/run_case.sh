@@ -11,7 +11,8 @@
 # against the experiments (dambreak_edac:dambreak_front, ...). The WCSPH dam break has its
 # own script, run_dambreak.sh.
 #
-# Usage: run_case.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [RUN OPTIONS...] [-- CHECK OPTIONS...]
+# Usage: run_case.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [-D NAME=CHOICE...] [RUN OPTIONS...]
+#                    [-- CHECK OPTIONS...]
 #   SPHC        the sphc executable (<build>/bin/sphc)
 #   SOURCE_DIR  the sphc source tree (for examples/ and tests/)
 #   CASE        the case: examples/CASE.sph and tests/validation/CASE.py, or SCENE:CHECK for
@@ -19,15 +20,17 @@
 #               scenes: hydrostatic_tank_iisph:hydrostatic_tank)
 #   EXE         the solver to build (<build>/tests/validation/CASE)
 #   OUT_DIR     where the run writes its snapshots (emptied first)
+#   -D NAME=CHOICE  a compile-time option of the scene, passed to sphc (e.g. -D scheme=edac:
+#               examples/taylor_green.sph built with EDAC); any number, before the run options
 #   RUN OPTIONS passed to the solver (e.g. --set dx=0.01)
 #   CHECK OPTIONS passed to the check after the output directory (e.g. --rho-err-tol 1e-4)
 # The Python interpreter is $SPHC_PYTHON if set, else the first of python3, /usr/bin/python3
-# that has numpy and h5py. $SPHC_OPTS, if set, is passed to sphc (e.g. "-D scheme=wcsph" for
-# a scene's compile-time option; words without spaces).
+# that has numpy and h5py.
 set -eu
 
 if [ $# -lt 5 ]; then
-  echo "usage: $0 SPHC SOURCE_DIR CASE EXE OUT_DIR [RUN OPTIONS...]" >&2
+  echo "usage: $0 SPHC SOURCE_DIR CASE EXE OUT_DIR [-D NAME=CHOICE...] [RUN OPTIONS...]" \
+       "[-- CHECK OPTIONS...]" >&2
   exit 2
 fi
 SPHC=$1
@@ -37,7 +40,13 @@ CHECK=${3#*:}
 EXE=$4
 OUT=$5
 shift 5
-# Run options up to "--", check options after it.
+# Compile-time options first (-D NAME=CHOICE, for sphc), then run options up to "--", check
+# options after it.
+SPHC_OPTS=""
+while [ $# -gt 1 ] && [ "$1" = "-D" ]; do
+  SPHC_OPTS="$SPHC_OPTS -D $2"
+  shift 2
+done
 RUN_OPTS=""
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do
   RUN_OPTS="$RUN_OPTS $1"
@@ -60,10 +69,10 @@ fi
 rm -rf "$OUT"
 mkdir -p "$(dirname "$EXE")" "$OUT"
 
-echo "== 1. compile: $SPHC $SRC/examples/$CASE.sph ${SPHC_OPTS:+$SPHC_OPTS }-o $EXE"
+echo "== 1. compile: $SPHC $SRC/examples/$CASE.sph$SPHC_OPTS -o $EXE"
 start=$(date +%s)
 # shellcheck disable=SC2086  # options are words without spaces
-"$SPHC" "$SRC/examples/$CASE.sph" ${SPHC_OPTS:-} -o "$EXE"
+"$SPHC" "$SRC/examples/$CASE.sph" $SPHC_OPTS -o "$EXE"
 echo "   compiled in $(( $(date +%s) - start )) s"
 
 echo "== 2. run: $EXE --quiet --timing -d $OUT$RUN_OPTS"
