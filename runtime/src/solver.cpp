@@ -194,7 +194,7 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "  --no-output           write no files (benchmarks)\n"
       "  --timing              print at the end, for the time loop:\n"
       "                        timing: steps=N particles=P wall_s=W us_per_particle_step=U\n"
-      "                        backend=B threads=T precision=double|single\n"
+      "                        backend=B threads=T [omp_wait=W] precision=double|single\n"
       "                        [nnps_s=S nnps_share=F: time in the neighbour search]\n"
       "                        [iterations=I: of iterated groups, in all]\n"
       "                        and, per iterated group, the iterations of its evaluations:\n"
@@ -578,9 +578,17 @@ class Simulation {
         for (const IterationStats& s : prog_.iterations()) total += s.total;
         nnps += fmt::format(" iterations={}", total);
       }
+      // OpenMP: the barrier wait policy in force (prefer_passive_omp_wait).
+      std::string wait;
+      if (prog_.set_threads) {
+        const char* w = std::getenv("OMP_WAIT_POLICY");
+        wait = std::string(" omp_wait=") + (w ? w : std::getenv("GOMP_SPINCOUNT") ? "spincount"
+                                                                                 : "default");
+      }
       fmt::print("timing: steps={} particles={} wall_s={:.6g} us_per_particle_step={:.6g} "
-                 "backend={} threads={} precision={}{}\n",
-                 step_, particles(), wall_s, us, prog_.backend, threads_, prog_.precision, nnps);
+                 "backend={} threads={}{} precision={}{}\n",
+                 step_, particles(), wall_s, us, prog_.backend, threads_, wait, prog_.precision,
+                 nnps);
       // Counted from the first evaluation, the one before the first step, included.
       if (prog_.iterations) {
         for (const IterationStats& s : prog_.iterations()) {
@@ -609,6 +617,12 @@ class Simulation {
 };
 
 }  // namespace
+
+void prefer_passive_omp_wait(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") || std::getenv("GOMP_SPINCOUNT")) return;
+  if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+  execv("/proc/self/exe", argv);  // returns only on failure: go on as we are
+}
 
 int run_main(int argc, char** argv, SceneProgram& prog) {
   Options opt;

@@ -101,4 +101,14 @@ inline double wall_seconds() {
 // Runs the scene as the command line asks; returns the process exit code.
 int run_main(int argc, char** argv, SceneProgram& prog);
 
+// OpenMP solvers call this first thing in main. libgomp reads its wait policy from the
+// environment when it is loaded, before main, and by default spins at every barrier for a
+// long while: whenever another process holds a core, a thread spins on it while the thread
+// it waits for is not running, and a 2-thread run gets tens of times slower than a serial one
+// (measured: 100 against 1.5 us per particle per step on a loaded 2-core machine). Unless
+// the user chose a policy (OMP_WAIT_POLICY or GOMP_SPINCOUNT set), this re-executes the
+// solver once with OMP_WAIT_POLICY=passive (threads sleep at barriers); if that exec fails,
+// the run goes on with libgomp's default. OMP_WAIT_POLICY=active keeps spinning.
+void prefer_passive_omp_wait(char** argv);
+
 }  // namespace sphc
