@@ -1086,12 +1086,23 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
     if (sub.postStep && !sub.every) postStepDue_.push_back("true");
   }
   flush();
+  // The convergence tests of an iterated group: the `converged` of its equations and of those
+  // in its subgroups, at any depth (as PySPH's Group), except inside a nested iterated group,
+  // which tests its own.
   std::vector<const PlanEquation*> convergers;
-  for (int e : g.equations) {
-    const auto& eq = plan_.equations[e];
-    if (eq.live && plan_.equationDecls[eq.declIndex].methods.count(ast::Method::Converged))
-      convergers.push_back(&eq);
-  }
+  std::function<void(const PlanGroup&)> collect = [&](const PlanGroup& grp) {
+    for (int entry : grp.order) {
+      if (entry < 0) {
+        const PlanGroup& sub = *grp.subgroups[-entry - 1];
+        if (!sub.iterate) collect(sub);
+        continue;
+      }
+      const auto& eq = plan_.equations[grp.equations[entry]];
+      if (eq.live && plan_.equationDecls[eq.declIndex].methods.count(ast::Method::Converged))
+        convergers.push_back(&eq);
+    }
+  };
+  collect(g);
   scene_ << "  // group, from " << loc(g.loc) << "\n";
   if (g.every) {
     // `every = N`: only when the number of completed steps is a multiple of N (N < 1: never).
