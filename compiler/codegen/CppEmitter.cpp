@@ -1592,8 +1592,7 @@ void Emitter::emitAdaptiveDt() {
 void Emitter::emitMain() {
   out_ << "int main(int argc, char** argv) {\n";
   if (openmp_)
-    out_ << "  sphc::prefer_passive_omp_wait(argv);  // sleep, not spin, at barriers "
-            "(sphc/solver.h)\n";
+    out_ << "  sphc::choose_omp_wait(argc, argv);  // spin or sleep at barriers (sphc/solver.h)\n";
   out_ << "  static Scene scene;\n";
   out_ << "  sphc::SceneProgram prog;\n";
   out_ << "  prog.name = \"" << plan_.sceneName << "\";\n";

@@ -157,6 +157,14 @@ Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
         throw UsageError("--threads: this solver was built with --backend=" + prog.backend +
                          ", which runs on one thread");
     }
+    else if (option == "--omp-wait") {  // acted on before main (choose_omp_wait)
+      const std::string w = value();
+      if (w != "auto" && w != "passive" && w != "active")
+        throw UsageError("--omp-wait expects auto, passive or active, not '" + w + "'");
+      if (!prog.set_threads)
+        throw UsageError("--omp-wait: this solver was built with --backend=" + prog.backend +
+                         ", which has no OpenMP threads");
+    }
     else if (option == "--set") o.sets.push_back(parse_set(value(), prog));
     else if (option == "-d" || option == "--directory") {
       o.directory = value();
@@ -188,6 +196,11 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        output times (0: first and last state only)\n"
       "  --max-steps N         stop after N time steps\n"
       "  --threads N           threads to use (multi-threaded backends; default: all cores)\n"
+      "  --omp-wait W          OpenMP barrier wait: active (spin: fastest on an idle machine),\n"
+      "                        passive (sleep: far faster when other processes load the\n"
+      "                        cores), auto (default: passive if the 1-minute load average\n"
+      "                        is at least the number of cores at start, else libgomp's\n"
+      "                        default; OMP_WAIT_POLICY or GOMP_SPINCOUNT set: left alone)\n"
       "  -d, --directory DIR   output directory (default: {1}_output)\n"
       "  --set NAME=VALUE      set a scene parameter (repeatable)\n"
       "  --quiet               no progress line and no summary\n"
@@ -578,7 +591,7 @@ class Simulation {
         for (const IterationStats& s : prog_.iterations()) total += s.total;
         nnps += fmt::format(" iterations={}", total);
       }
-      // OpenMP: the barrier wait policy in force (prefer_passive_omp_wait).
+      // OpenMP: the barrier wait policy in force (choose_omp_wait).
       std::string wait;
       if (prog_.set_threads) {
         const char* w = std::getenv("OMP_WAIT_POLICY");
@@ -618,9 +631,29 @@ class Simulation {
 
 }  // namespace
 
-void prefer_passive_omp_wait(char** argv) {
-  if (std::getenv("OMP_WAIT_POLICY") || std::getenv("GOMP_SPINCOUNT")) return;
-  if (setenv("OMP_WAIT_POLICY", "passive", 1) != 0) return;
+void choose_omp_wait(int argc, char** argv) {
+  std::string want = "auto";
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::string(argv[i]) == "--omp-wait") want = argv[i + 1];
+  const char* policy = nullptr;
+  if (want == "passive" || want == "active") {
+    policy = want == "passive" ? "passive" : "active";
+  } else if (want == "auto") {
+    if (std::getenv("OMP_WAIT_POLICY") || std::getenv("GOMP_SPINCOUNT")) return;
+    double load = 0.0;
+    if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
+      if (std::fscanf(f, "%lf", &load) != 1) load = 0.0;
+      std::fclose(f);
+    }
+    const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cores < 1 || load < static_cast<double>(cores)) return;
+    policy = "passive";
+  } else {
+    return;  // run_main reports the bad value
+  }
+  const char* now = std::getenv("OMP_WAIT_POLICY");
+  if (now && std::string(now) == policy) return;  // already so (this is the re-executed run)
+  if (setenv("OMP_WAIT_POLICY", policy, 1) != 0) return;
   execv("/proc/self/exe", argv);  // returns only on failure: go on as we are
 }
 

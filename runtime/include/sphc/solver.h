@@ -101,14 +101,15 @@ inline double wall_seconds() {
 // Runs the scene as the command line asks; returns the process exit code.
 int run_main(int argc, char** argv, SceneProgram& prog);
 
-// OpenMP solvers call this first thing in main. libgomp reads its wait policy from the
-// environment when it is loaded, before main, and by default spins at every barrier for a
-// long while: whenever another process holds a core, a thread spins on it while the thread
-// it waits for is not running, and a 2-thread run gets tens of times slower than a serial one
-// (measured: 100 against 1.5 us per particle per step on a loaded 2-core machine). Unless
-// the user chose a policy (OMP_WAIT_POLICY or GOMP_SPINCOUNT set), this re-executes the
-// solver once with OMP_WAIT_POLICY=passive (threads sleep at barriers); if that exec fails,
-// the run goes on with libgomp's default. OMP_WAIT_POLICY=active keeps spinning.
-void prefer_passive_omp_wait(char** argv);
+// OpenMP solvers call this first thing in main. libgomp reads its barrier wait policy from
+// the environment when it is loaded, before main. Its default spins: the fastest on an idle
+// machine (dam break, 3.4k particles, 2 threads: 0.20 us per particle per step against 0.58
+// sleeping), but when other processes load the cores a thread spins while the one it waits
+// for is not running (measured at load 10 on 2 cores: 100 us spinning, 1.5 sleeping).
+// `--omp-wait active|passive` re-executes the solver once with OMP_WAIT_POLICY set so;
+// `auto` (the default) does so with passive only when the 1-minute load average at start is
+// at least the number of cores, and never when the user set OMP_WAIT_POLICY or
+// GOMP_SPINCOUNT. If the exec fails the run goes on as it is. run_main checks the option.
+void choose_omp_wait(int argc, char** argv);
 
 }  // namespace sphc
