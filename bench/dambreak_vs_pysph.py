@@ -35,6 +35,7 @@ The Python running it must have PySPH (Debian: python3-pysph) unless --skip-pysp
 import argparse
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -69,12 +70,20 @@ def cpu_model():
     return "unknown CPU"
 
 
+def children_cpu():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def run(cmd, env=None, cwd=None):
-    """Runs cmd; returns (wall seconds, combined output). Raises on failure."""
+    """Runs cmd; returns (wall seconds, combined output). Exits on failure. The CPU seconds
+    (user + system) of cmd and its children are in run.cpu afterwards."""
     t0 = time.perf_counter()
+    c0 = children_cpu()
     p = subprocess.run(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE,
                        stderr=subprocess.STDOUT, universal_newlines=True)
     wall = time.perf_counter() - t0
+    run.cpu = children_cpu() - c0
     if p.returncode != 0:
         sys.stderr.write("command failed (exit %d): %s\n%s\n"
                          % (p.returncode, " ".join(cmd), p.stdout[-3000:]))

@@ -41,15 +41,14 @@ import argparse
 import glob
 import os
 import re
-import resource
 import shutil
-import subprocess
 import sys
 import tempfile
-import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "validation"))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from dambreak_vs_pysph import cpu_model, run, serial_env  # noqa: E402  (shared helpers)
 
 
 def pysph_driver(argv):
@@ -65,51 +64,11 @@ def pysph_driver(argv):
     return 0
 
 
-def cpu_model():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return "unknown CPU"
-
-
 def load_average():
     try:
         return "%.2f %.2f %.2f" % os.getloadavg()
     except OSError:
         return "unknown"
-
-
-def children_cpu():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
-
-
-def run(cmd, env=None):
-    """Runs cmd; returns (wall seconds, combined output). Exits on failure. The CPU seconds
-    (user + system) of cmd and its children are in run.cpu afterwards."""
-    t0 = time.perf_counter()
-    c0 = children_cpu()
-    p = subprocess.run(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                       universal_newlines=True)
-    wall = time.perf_counter() - t0
-    run.cpu = children_cpu() - c0
-    if p.returncode != 0:
-        sys.stderr.write("command failed (exit %d): %s\n%s\n"
-                         % (p.returncode, " ".join(cmd), p.stdout[-3000:]))
-        raise SystemExit(1)
-    return wall, p.stdout
-
-
-def serial_env(extra=None):
-    env = dict(os.environ)
-    env["OMP_NUM_THREADS"] = "1"
-    if extra:
-        env.update(extra)
-    return env
 
 
 def last_file(directory, pattern):
