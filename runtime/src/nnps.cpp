@@ -23,11 +23,6 @@ void check_dim(int dim, const char* who) {
   }
 }
 
-// The domain from the bounding box [lo, hi] of the finite coordinates (lo > hi: none) and
-// the largest h.
-SearchDomain finish_domain(const double lo[3], const double hi[3], double hmax, int dim,
-                           double radius_scale);
-
 }  // namespace
 
 SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays, int dim,
@@ -81,7 +76,7 @@ SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays,
     }
   }
 
-  return finish_domain(lo, hi, hmax, dim, radius_scale);
+  return search_domain_of_box(lo, hi, hmax, dim, radius_scale);
 }
 
 SearchDomain make_search_domain_float(const std::vector<FloatCoords>& arrays, int dim,
@@ -123,16 +118,14 @@ SearchDomain make_search_domain_float(const std::vector<FloatCoords>& arrays, in
       if (std::isfinite(w) && w > hmax) hmax = w;
     }
   }
-  return finish_domain(lo, hi, hmax, dim, radius_scale);
+  return search_domain_of_box(lo, hi, hmax, dim, radius_scale);
 }
 
-namespace {
-
-SearchDomain finish_domain(const double lo[3], const double hi[3], double hmax, int dim,
-                           double radius_scale) {
+SearchDomain search_domain_of_box(const double lo[3], const double hi[3], double hmax, int dim,
+                                  double radius_scale) {
   SearchDomain dom;
   dom.dim = dim;
-  dom.cell_size = hmax > 0.0 ? radius_scale * hmax : 1.0;
+  dom.cell_size = hmax > 0.0 && std::isfinite(hmax) ? radius_scale * hmax : 1.0;
   const double pad = 1e-6 * dom.cell_size;
   for (int a = 0; a < 3; ++a) {
     if (a < dim && lo[a] <= hi[a]) {
@@ -144,8 +137,6 @@ SearchDomain finish_domain(const double lo[3], const double hi[3], double hmax, 
   }
   return dom;
 }
-
-}  // namespace
 
 std::uint32_t CellList::insert_cell(std::uint64_t key, std::uint32_t& next_cell) {
   const std::size_t mask = keys_.size() - 1;

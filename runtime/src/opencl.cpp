@@ -584,19 +584,7 @@ SearchDomain Context::search_domain(const std::vector<Extent>& arrays, int dim,
   }
   // As sphc::make_search_domain, so that in double precision the grid, hence the cell order
   // and the particle order after a reorder, is the CPU one.
-  SearchDomain dom;
-  dom.dim = dim;
-  dom.cell_size = hmax > 0 && std::isfinite(hmax) ? radius_scale * hmax : 1.0;
-  const double pad = 1e-6 * dom.cell_size;
-  for (int a = 0; a < 3; ++a) {
-    if (a < dim && lo[a] <= hi[a]) {
-      dom.lo[a] = lo[a] - pad;
-      dom.hi[a] = hi[a] + pad;
-    } else {
-      dom.lo[a] = dom.hi[a] = 0.0;
-    }
-  }
-  return dom;
+  return search_domain_of_box(lo, hi, hmax, dim, radius_scale);
 }
 
 Grid Context::grid_of(const SearchDomain& dom) const {

@@ -59,6 +59,13 @@ struct FloatCoords {
 SearchDomain make_search_domain_float(const std::vector<FloatCoords>& arrays, int dim,
                                       double radius_scale);
 
+// The search domain of a bounding box [lo, hi] of finite coordinates (lo[a] > hi[a]: no
+// coordinate along a) and the largest h (cell 1.0 unless hmax is positive and finite): what
+// the two above end with, and what the OpenCL backend finishes its device reductions with,
+// so that every backend builds the same grid.
+SearchDomain search_domain_of_box(const double lo[3], const double hi[3], double hmax, int dim,
+                                  double radius_scale);
+
 class CellList {
  public:
   // Auto picks dense or hashed storage by the number of cells; Dense and Hash force one (for
