@@ -81,9 +81,7 @@ Usage: channel_flow.py OUTPUT_DIR [--flow poiseuille|couette] [--d 1e-3] [--nu 1
 """
 
 import argparse
-import glob
 import os
-import re
 import sys
 
 try:
@@ -93,27 +91,10 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.stderr.write("channel_flow.py needs numpy and h5py (%s)\n" % exc)
     sys.exit(2)
 
+from snapshots import read_fluid, snapshot_files  # noqa: E402  (tests/validation/snapshots.py)
+
 # In units of d^2 / nu (= 1 s in Morris's set-up).
 CHECK_TIMES = (0.0225, 0.045, 0.1125, 0.225, 0.45)
-
-
-def snapshot_files(directory):
-    """Snapshot files <scene>_NNNNNN.h5 (sphc) or <app>_NNNNN.hdf5 (PySPH), in step order."""
-    files = [f for f in glob.glob(os.path.join(directory, "*.h5")) +
-             glob.glob(os.path.join(directory, "*.hdf5"))
-             if re.search(r"_\d+\.(h5|hdf5)$", os.path.basename(f))]
-    return sorted(files, key=lambda f: int(re.search(r"_(\d+)\.(h5|hdf5)$", f).group(1)))
-
-
-def fluid_group(f):
-    """(t, group of fluid arrays) of a snapshot: sphc's /fluid, or PySPH's
-    /particles/fluid/arrays with the time in /solver_data (for comparisons with PySPH's
-    `pysph run poiseuille` / `couette`). (None, None) when there is no fluid."""
-    if "fluid" in f:
-        return float(f.attrs["t"]), f["fluid"]
-    if "particles" in f and "fluid" in f["particles"]:
-        return float(f["solver_data"].attrs["t"]), f["particles"]["fluid"]["arrays"]
-    return None, None
 
 
 def poiseuille_exact(y, t, d, nu, F, terms=400):
@@ -238,20 +219,10 @@ def main():
     for path in files:
         name = os.path.basename(path)
         with h5py.File(path, "r") as f:
-            t, fl = fluid_group(f)
-            if fl is None:
-                sys.stderr.write("channel_flow.py: %s has no fluid particles\n" % name)
+            got = read_fluid(f, name, ("x", "y", "u", "v", "m"), "channel_flow.py", failures)
+            if got is None:
                 return 2
-            for key in ("x", "y", "u", "v", "m"):
-                if key not in fl:
-                    sys.stderr.write("channel_flow.py: %s has no /fluid/%s\n" % (name, key))
-                    return 2
-            for dname, dset in fl.items():
-                a = dset[()]
-                if a.dtype.kind == "f" and a.ndim and not np.all(np.isfinite(a)):
-                    failures.append("%s: /fluid/%s has %d non-finite values"
-                                    % (name, dname, int(np.count_nonzero(~np.isfinite(a)))))
-            y, u, v, m = (np.asarray(fl[k][()], dtype=float) for k in ("y", "u", "v", "m"))
+            t, (_, y, u, v, m) = got
         if n0 is None:
             n0, mass0 = len(y), float(np.sum(m))
             ny = len(np.unique(np.round(y / d * 1e6)))
