@@ -12,6 +12,8 @@ PACKAGES=(
   libhdf5-dev hdf5-tools libfmt-dev libeigen3-dev
   # tests: GoogleTest; Python with numpy and h5py for the validation checks
   libgtest-dev googletest python3 python3-numpy python3-h5py
+  # the validation checks' plots (PNG, matplotlib's Agg backend; a check without it still runs)
+  python3-matplotlib
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo  # --backend=opencl (PoCL: CPU)
 )
 

@@ -53,14 +53,14 @@ OUTPUT_DIR may also hold PySPH's snapshots (`pysph run cavity -d DIR`, *.hdf5), 
 comparison in docs/validation.md.
 
 Prints the two profiles against the reference, the kinetic energy history and the error
-figures; exits 0 when every check passes, 1 when one fails, 2 on bad input. With
---plot FILE.png (needs matplotlib) it draws the profiles and the reference points.
+figures; exits 0 when every check passes, 1 when one fails, 2 on bad input. It draws the
+profiles and the reference points into OUTPUT_DIR/cavity.png (--plot PATH: elsewhere;
+tests/validation/plots.py).
 
 Usage: cavity.py OUTPUT_DIR [--data DIR] [--L 1] [--U 1] [--avg-time 1.0]
                  [--max-tol T] [--rms-tol T] [--steady-tol 0.02] [--plot out.png]
 """
 
-import argparse
 import os
 import sys
 
@@ -71,7 +71,8 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.stderr.write("cavity.py needs numpy and h5py (%s)\n" % exc)
     sys.exit(2)
 
-from snapshots import read_fluid, snapshot_files  # noqa: E402  (tests/validation/snapshots.py)
+import plots  # noqa: E402  (tests/validation/plots.py)
+from snapshots import argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_DATA = os.path.join(HERE, "..", "data")
@@ -110,8 +111,7 @@ def linear_fit(px, py, x, y, values, h):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("outdir", help="directory with the cavity's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the cavity's HDF5 snapshots")
     ap.add_argument("--data", default=DEFAULT_DATA, help="directory of ghia1982_re100_*.csv")
     ap.add_argument("--L", type=float, default=1.0, help="side of the cavity (default 1)")
     ap.add_argument("--U", type=float, default=1.0, help="lid speed (default 1)")
@@ -126,12 +126,11 @@ def main():
                          "halves of the last --steady-time (default 0.02)")
     ap.add_argument("--steady-time", type=float, default=2.0,
                     help="window of the steadiness check (default 2)")
-    ap.add_argument("--plot", default=None, help="write a plot to this PNG")
+    plots.add_option(ap, "cavity.png")
     args = ap.parse_args()
 
-    files = snapshot_files(args.outdir)
-    if len(files) < 2:
-        sys.stderr.write("cavity.py: need >= 2 <scene>_NNNNNN.h5 files in %s\n" % args.outdir)
+    files = snapshots(args.outdir, "cavity.py")
+    if files is None:
         return 2
     try:
         ref_u = read_table(os.path.join(args.data, "ghia1982_re100_u.csv"))
@@ -245,38 +244,32 @@ def main():
                         "two intervals of %.3g (tolerance %.1f%%)"
                         % (100 * ke_change, half, 100 * args.steady_tol))
 
-    if args.plot:
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-            fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.5))
-            line = np.linspace(0.01, 0.99, 99)
-            # The profiles averaged over the same snapshots as the error figures.
-            ul = np.zeros(len(line))
-            vl = np.zeros(len(line))
-            for (_, x, y, u, v) in avg:
-                ul += [linear_fit(0.5 * L, yy * L, x, y, [u], h)[0] / U for yy in line]
-                vl += [linear_fit(xx * L, 0.5 * L, x, y, [v], h)[0] / U for xx in line]
-            ul /= len(avg)
-            vl /= len(avg)
-            ax1.plot(ul, line, "b-", label="sphc, nx = %d, t = %.3g" % (nx, tf))
-            ax1.plot(ref_u[:, 1], ref_u[:, 0], "ko", mfc="none", label="Ghia et al. (1982)")
-            ax1.set_xlabel("u / U at x = 0.5")
-            ax1.set_ylabel("y / L")
-            ax1.legend(fontsize=8)
-            ax2.plot(line, vl, "b-", label="sphc, nx = %d" % nx)
-            ax2.plot(ref_v[:, 0], ref_v[:, 1], "ko", mfc="none", label="Ghia et al. (1982)")
-            ax2.set_xlabel("x / L")
-            ax2.set_ylabel("v / U at y = 0.5")
-            ax2.legend(fontsize=8)
-            fig.suptitle("Lid-driven cavity, Re = 100: max error %.3f U, rms %.3f U"
-                         % (emax, erms))
-            fig.tight_layout()
-            fig.savefig(args.plot, dpi=150)
-            print("plot written to %s" % args.plot)
-        except ImportError:
-            print("--plot: matplotlib is not available, no plot written")
+    def draw(plt):
+        fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.5))
+        line = np.linspace(0.01, 0.99, 99)
+        # The profiles averaged over the same snapshots as the error figures.
+        ul = np.zeros(len(line))
+        vl = np.zeros(len(line))
+        for (_, x, y, u, v) in avg:
+            ul += [linear_fit(0.5 * L, yy * L, x, y, [u], h)[0] / U for yy in line]
+            vl += [linear_fit(xx * L, 0.5 * L, x, y, [v], h)[0] / U for xx in line]
+        ul /= len(avg)
+        vl /= len(avg)
+        ax1.plot(ul, line, "b-", label="sphc, nx = %d, t = %.3g" % (nx, tf))
+        ax1.plot(ref_u[:, 1], ref_u[:, 0], "ko", mfc="none", label="Ghia et al. (1982)")
+        ax1.set_xlabel("u / U at x = 0.5")
+        ax1.set_ylabel("y / L")
+        ax1.legend(fontsize=8)
+        ax2.plot(line, vl, "b-", label="sphc, nx = %d" % nx)
+        ax2.plot(ref_v[:, 0], ref_v[:, 1], "ko", mfc="none", label="Ghia et al. (1982)")
+        ax2.set_xlabel("x / L")
+        ax2.set_ylabel("v / U at y = 0.5")
+        ax2.legend(fontsize=8)
+        fig.suptitle("Lid-driven cavity, Re = 100: max error %.3f U, rms %.3f U"
+                     % (emax, erms))
+        return fig
+
+    plots.write(args, draw, failures)
 
     if failures:
         print("FAILED (%d problems):" % len(failures))

@@ -73,14 +73,14 @@ units: --d 1 --nu 0.01 --U 1.25e-4, or --F 1e-5 for its poiseuille), for the com
 docs/validation.md.
 
 Prints the table of errors per time (and the profile at the last time); exits 0 when every
-check passes, 1 when one fails, 2 on bad input. With --plot FILE.png (needs matplotlib) it
-draws the binned profiles and the series at the checked times.
+check passes, 1 when one fails, 2 on bad input. It draws the binned profiles and the series
+at the checked times into OUTPUT_DIR/channel_flow.png (--plot PATH: elsewhere;
+tests/validation/plots.py).
 
 Usage: channel_flow.py OUTPUT_DIR [--flow poiseuille|couette] [--d 1e-3] [--nu 1e-6]
                        [--F 1e-4] [--U 1.25e-5] [--tol 0.015] [--plot out.png]
 """
 
-import argparse
 import os
 import sys
 
@@ -91,7 +91,8 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.stderr.write("channel_flow.py needs numpy and h5py (%s)\n" % exc)
     sys.exit(2)
 
-from snapshots import read_fluid, snapshot_files  # noqa: E402  (tests/validation/snapshots.py)
+import plots  # noqa: E402  (tests/validation/plots.py)
+from snapshots import argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
 
 # In units of d^2 / nu (= 1 s in Morris's set-up).
 CHECK_TIMES = (0.0225, 0.045, 0.1125, 0.225, 0.45)
@@ -171,8 +172,7 @@ def self_test(flow, d, nu, F, U, uref):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("outdir", help="directory with the scene's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the scene's HDF5 snapshots")
     ap.add_argument("--flow", choices=("poiseuille", "couette"), default=None,
                     help="the flow (default: from the snapshot names)")
     ap.add_argument("--d", type=float, default=1e-3, help="channel width (default 1e-3 m)")
@@ -184,13 +184,11 @@ def main():
     ap.add_argument("--tol", type=float, default=None,
                     help="largest |u_SPH - u_exact| / u_ref at every checked time "
                          "(default 0.015 for Poiseuille, 0.01 for Couette)")
-    ap.add_argument("--plot", default=None, help="write a plot to this PNG")
+    plots.add_option(ap, "channel_flow.png")
     args = ap.parse_args()
 
-    files = snapshot_files(args.outdir)
-    if len(files) < 2:
-        sys.stderr.write("channel_flow.py: need >= 2 <scene>_NNNNNN.h5 files in %s\n"
-                         % args.outdir)
+    files = snapshots(args.outdir, "channel_flow.py")
+    if files is None:
         return 2
     flow = args.flow
     if flow is None:
@@ -300,28 +298,22 @@ def main():
           % (t, 100 * emax, 100 * esteady, float(np.max(np.abs(ue - us))) / uref))
     print()
 
-    if args.plot:
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-            fig, ax = plt.subplots(figsize=(6, 4.5))
-            yl = np.linspace(0, d, 201)
-            for k, (t, yb, ub, ue, us, emax, erms) in enumerate(rows):
-                col = "C%d" % (k % 10)
-                ax.plot(exact(yl, t) / uref, yl / d, "-", color=col, lw=1)
-                ax.plot(ub / uref, yb / d, "o", color=col, mfc="none", ms=4,
-                        label="t = %.4g s (max err %.2f%%)" % (t, 100 * emax))
-            ax.set_xlabel("u / u_ref")
-            ax.set_ylabel("y / d")
-            ax.set_title("%s start-up, %d rows: sphc (o), series (-)"
-                         % (flow.capitalize(), ny))
-            ax.legend(fontsize=7)
-            fig.tight_layout()
-            fig.savefig(args.plot, dpi=150)
-            print("plot written to %s" % args.plot)
-        except ImportError:
-            print("--plot: matplotlib is not available, no plot written")
+    def draw(plt):
+        fig, ax = plt.subplots(figsize=(6, 4.5))
+        yl = np.linspace(0, d, 201)
+        for k, (t, yb, ub, ue, us, emax, erms) in enumerate(rows):
+            col = "C%d" % (k % 10)
+            ax.plot(exact(yl, t) / uref, yl / d, "-", color=col, lw=1)
+            ax.plot(ub / uref, yb / d, "o", color=col, mfc="none", ms=4,
+                    label="t = %.4g s (max err %.2f%%)" % (t, 100 * emax))
+        ax.set_xlabel("u / u_ref (u_ref = %.3g m/s)" % uref)
+        ax.set_ylabel("y / d")
+        ax.set_title("%s start-up, %d rows: sphc (o), series (-)"
+                     % (flow.capitalize(), ny))
+        ax.legend(fontsize=7)
+        return fig
+
+    plots.write(args, draw, failures)
 
     if failures:
         print("FAILED (%d problems):" % len(failures))

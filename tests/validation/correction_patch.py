@@ -31,16 +31,14 @@ Wendland quintic's sum_b V_b x_ab dW/dx at h = 1.3 dx being 0.974 instead of 1);
 summation density sum_b m_b W_ab is off by more than 10% at the free surface.
 
 Prints a table of max relative errors (all particles; interior = farther than 2.15 h from the
-edge) and exits 0 when every check passes, 1 when one fails, 2 on bad input.
+edge) and exits 0 when every check passes, 1 when one fails, 2 on bad input. It draws the
+error of the plain and the corrected gradient over the perturbed patch into
+OUTPUT_DIR/correction_patch.png (--plot PATH: elsewhere; tests/validation/plots.py).
 
 Usage: correction_patch.py OUTPUT_DIR [--dx 0.05] [--hdx 1.3] [--ro 1000] [--gx 0.1]
                            [--gy 0.2] [--exact-tol 1e-10] [--fail-min 0.01] [--plot out.png]
 """
 
-import argparse
-import glob
-import os
-import re
 import sys
 
 try:
@@ -50,16 +48,12 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.stderr.write("correction_patch.py needs numpy and h5py (%s)\n" % exc)
     sys.exit(2)
 
-
-def snapshot_files(directory):
-    files = [f for f in glob.glob(os.path.join(directory, "*.h5"))
-             if re.search(r"_\d+\.h5$", os.path.basename(f))]
-    return sorted(files, key=lambda f: int(re.search(r"_(\d+)\.h5$", f).group(1)))
+import plots  # noqa: E402  (tests/validation/plots.py)
+from snapshots import argument_parser, snapshots  # noqa: E402  (snapshots.py)
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("outdir")
+    ap = argument_parser(__doc__, "directory with the patch's two HDF5 snapshots")
     ap.add_argument("--dx", type=float, default=0.05)
     ap.add_argument("--hdx", type=float, default=1.3)
     ap.add_argument("--ro", type=float, default=1000.0)
@@ -69,10 +63,12 @@ def main():
     ap.add_argument("--delta", type=float, default=0.1)
     ap.add_argument("--exact-tol", type=float, default=1e-10)
     ap.add_argument("--fail-min", type=float, default=0.01)
-    ap.add_argument("--plot", default=None)
+    plots.add_option(ap, "correction_patch.png")
     args = ap.parse_args()
 
-    files = snapshot_files(args.outdir)
+    files = snapshots(args.outdir, "correction_patch.py")
+    if files is None:
+        return 2
     if len(files) != 2:
         sys.stderr.write("correction_patch.py: expected 2 snapshots in %s, found %d\n"
                          % (args.outdir, len(files)))
@@ -142,25 +138,26 @@ def main():
           " mc: Molteni-Colagrossi term, same units; shepard: Shepard filter of a uniform density; summation: "
           "sum_b m_b W_ab of it)")
 
-    if args.plot:
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-            fig, axes = plt.subplots(1, 2, figsize=(10, 4.5))
-            for ax, name in zip(axes, ("raw", "corr")):
-                x, y, err = plotdata[("perturbed lattice", name)]
-                sc = ax.scatter(x, y, c=np.log10(np.maximum(err, 1e-17)), s=12, cmap="viridis")
-                ax.set_aspect("equal")
-                ax.set_title("%s: log10 |grad rho error| / |grad rho|"
-                             % ("plain SPH" if name == "raw" else "Bonet-Lok corrected"),
-                             fontsize=9)
-                fig.colorbar(sc, ax=ax)
-            fig.tight_layout()
-            fig.savefig(args.plot, dpi=120)
-            print("plot written to %s" % args.plot)
-        except ImportError:
-            print("--plot: matplotlib is not available, no plot written")
+    def draw(plt):
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4.5))
+        for ax, name in zip(axes, ("raw", "corr")):
+            if ("perturbed lattice", name) not in plotdata:  # non-finite: in the failures
+                continue
+            x, y, err = plotdata[("perturbed lattice", name)]
+            sc = ax.scatter(x, y, c=np.log10(np.maximum(err, 1e-17)), s=12, cmap="viridis")
+            ax.set_aspect("equal")
+            ax.set_xlabel("x")
+            ax.set_ylabel("y")
+            ax.set_title("%s: max error %.2g (exact: 0)"
+                         % ("plain SPH gradient" if name == "raw"
+                            else "Bonet-Lok corrected gradient", float(err.max())),
+                         fontsize=9)
+            fig.colorbar(sc, ax=ax, label=r"$\log_{10}$ |grad rho - exact| / |grad rho|")
+        fig.suptitle("correction patch, perturbed lattice, dx = %g, h = %g: "
+                     "rho = ro (1 + %g x + %g y)" % (args.dx, h, args.gx, args.gy), fontsize=10)
+        return fig
+
+    plots.write(args, draw, failures, dpi=120)
 
     if failures:
         print("FAILED (%d problems):" % len(failures))

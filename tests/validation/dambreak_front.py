@@ -64,17 +64,15 @@ Positions are measured from the inner face of the left wall, which is x = 0 in s
 --x0 gives another origin (PySPH's dam_break_2d has its innermost wall layer at x = 0, hence
 its wall face at x0 = dx/2, its fluid column 1.03 m wide at dx = 0.03, and 4 wall layers).
 
-Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input.
-With --plot FILE.png (needs matplotlib) it also draws the front against the experiment.
+Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input. It
+draws the front against the experiments and the MPS calculation into
+OUTPUT_DIR/dambreak_front.png (--plot PATH: elsewhere; tests/validation/plots.py).
 
 Usage: dambreak_front.py OUTPUT_DIR [--tol 0.10] [--tol-ko 0.20] [--tol-mps 0.10] [--dx DX] [--layers 3]
                          [--x0 0] [--dim 2|3] [--depth D] [--label sphc] [--plot out.png]
 """
 
-import argparse
-import glob
 import os
-import re
 import sys
 
 try:
@@ -83,6 +81,10 @@ try:
 except ImportError as exc:  # pragma: no cover - environment problem, not a test failure
     sys.stderr.write("dambreak_front.py needs numpy and h5py (%s)\n" % exc)
     sys.exit(2)
+
+import plots  # noqa: E402  (tests/validation/plots.py)
+from snapshots import (argument_parser, lattice_spacing, particle_arrays,  # noqa: E402
+                       scan_finite, snapshots)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_DATA = os.path.join(HERE, "..", "data", "koshizuka_oka_1996_surge.csv")
@@ -110,50 +112,12 @@ def load_csv(path):
     return {name: data[:, i] for i, name in enumerate(header)}
 
 
-def snapshot_files(directory):
-    """Snapshot files of a directory, in step order: sphc's <scene>_NNNNNN.h5 or, where there
-    are none, PySPH's <name>_NNNNN.hdf5."""
-    for ext in ("h5", "hdf5"):
-        pat = re.compile(r"_(\d+)\.%s$" % ext)
-        files = [f for f in glob.glob(os.path.join(directory, "*." + ext))
-                 if pat.search(os.path.basename(f))]
-        if files:
-            return sorted(files, key=lambda f: int(pat.search(f).group(1)))
-    return []
-
-
-def read_snapshot(f):
-    """(t, dim, {array name: {property: dataset}}) of an open sphc or PySPH snapshot file;
-    dim is None where the file does not say (PySPH's)."""
-    if "particles" in f and "solver_data" in f:  # PySPH
-        t = float(f["solver_data"].attrs["t"])
-        arrays = {name: dict(g["arrays"].items()) for name, g in f["particles"].items()
-                  if isinstance(g, h5py.Group) and "arrays" in g}
-        return t, None, arrays
-    arrays = {name: {k: d for k, d in g.items() if isinstance(d, h5py.Dataset)}
-              for name, g in f.items() if isinstance(g, h5py.Group)}
-    dim = int(f.attrs["dim"]) if "dim" in f.attrs else None
-    return float(f.attrs["t"]), dim, arrays
-
-
 def dist2(pos, i):
     """Squared distances of every particle to particle i; pos is a tuple of coordinate arrays."""
     r2 = np.zeros_like(pos[0])
     for c in pos:
         r2 += (c - c[i]) ** 2
     return r2
-
-
-def infer_dx(pos):
-    """Lattice spacing from the initial fluid: median nearest-neighbour distance."""
-    n = len(pos[0])
-    idx = np.arange(0, n, max(1, n // 200))
-    d = []
-    for i in idx:
-        r2 = dist2(pos, i)
-        r2[i] = np.inf
-        d.append(np.sqrt(r2.min()))
-    return float(np.median(d))
 
 
 def front_position(pos, dx):
@@ -169,8 +133,7 @@ def front_position(pos, dx):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("outdir", help="directory with the dam break's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the dam break's HDF5 snapshots")
     ap.add_argument("--tol", type=float, default=0.10,
                     help="largest relative error against the nearest experimental series "
                          "where T >= 1 (default 0.10)")
@@ -197,12 +160,11 @@ def main():
     ap.add_argument("--data", default=DEFAULT_DATA, help="experimental CSV (T,Z_L)")
     ap.add_argument("--mps", default=DEFAULT_MPS, help="MPS calculation CSV (T,Z_L)")
     ap.add_argument("--mm", default=DEFAULT_MM, help="Martin & Moyce CSV (a_in,T,Z_L)")
-    ap.add_argument("--plot", default=None, help="write a plot of the front to this PNG")
+    plots.add_option(ap, "dambreak_front.png")
     args = ap.parse_args()
 
-    files = snapshot_files(args.outdir)
-    if not files:
-        sys.stderr.write("dambreak_front.py: no <scene>_NNNNNN.h5 files in %s\n" % args.outdir)
+    files = snapshots(args.outdir, "dambreak_front.py", at_least=1)
+    if files is None:
         return 2
 
     exp = load_csv(args.data)
@@ -225,20 +187,14 @@ def main():
     for path in files:
         name = os.path.basename(path)
         with h5py.File(path, "r") as f:
-            t, fdim, arrays = read_snapshot(f)
+            t, fdim, arrays = particle_arrays(f)
             if dim is None:
                 dim = fdim if fdim is not None else 2
             if dim not in (2, 3):
                 sys.stderr.write("dambreak_front.py: %s has dim = %d; a dam break is 2D or 3D\n"
                                  % (name, dim))
                 return 2
-            for gname, group in arrays.items():
-                for dname, dset in group.items():
-                    a = dset[()]
-                    if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
-                        bad = int(np.count_nonzero(~np.isfinite(a)))
-                        failures.append("%s: /%s/%s has %d non-finite values"
-                                        % (name, gname, dname, bad))
+            scan_finite(name, arrays, failures)
             if "fluid" not in arrays:
                 sys.stderr.write("dambreak_front.py: %s has no fluid array\n" % name)
                 return 2
@@ -253,7 +209,7 @@ def main():
         if nfluid is None:
             nfluid = len(pos[0])
             if dx is None:
-                dx = infer_dx(pos)
+                dx = lattice_spacing(pos)
             if dim == 3:
                 if args.depth is not None:
                     channel = (0.0, args.depth)
@@ -347,28 +303,27 @@ def main():
             failures.append("the snapshots do not cover the %s's range: %d judged times, last"
                             " T = %.3f (need >= 5)" % (label, judged[label], T.max()))
 
-    if args.plot:
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-            plt.figure(figsize=(6, 4.5))
-            plt.plot(T, fronts, "-", label="%s (front, >= %d neighbours)" % (args.label, MIN_NEIGHBOURS))
-            for (label, ts, zs), mk in zip(series, "o^v"):
-                plt.plot(ts, zs, mk, label=label + ", experiment")
-            plt.plot(t_mps, z_mps, "s", mfc="none", label="Koshizuka & Oka (1996), MPS")
-            plt.fill_between(t_exp, z_exp * (1 - args.tol), z_exp * (1 + args.tol),
-                             color="gray", alpha=0.2, label="K&O 1996 +/- %.0f%%" % (100 * args.tol))
-            plt.xlim(0, max(3.5, t_exp.max() * 1.1))
-            plt.ylim(0.8, 4.2)
-            plt.xlabel(r"$T = t\,\sqrt{2g/L}$")
-            plt.ylabel(r"$Z/L$")
-            plt.legend(loc="upper left")
-            plt.tight_layout()
-            plt.savefig(args.plot, dpi=150)
-            print("plot written to %s" % args.plot)
-        except ImportError:
-            print("--plot: matplotlib is not available, no plot written")
+    def draw(plt):
+        fig, ax = plt.subplots(figsize=(6.4, 4.8))
+        ax.plot(T, fronts, "-", label="%s (front, >= %d neighbours)"
+                % (args.label, MIN_NEIGHBOURS))
+        for (label, ts, zs), mk in zip(series, "o^v"):
+            ax.plot(ts, zs, mk, label=label + ", experiment")
+        ax.plot(t_mps, z_mps, "s", mfc="none", label="Koshizuka & Oka (1996), MPS")
+        ax.fill_between(t_exp, z_exp * (1 - args.tol), z_exp * (1 + args.tol),
+                        color="gray", alpha=0.2,
+                        label="K&O 1996 +/- %.0f%%" % (100 * args.tol))
+        ax.set_xlim(0, max(3.5, t_exp.max() * 1.1))
+        ax.set_ylim(0.8, 4.2)
+        ax.set_xlabel(r"$T = t\,\sqrt{2g/L}$")
+        ax.set_ylabel(r"surge front $Z/L$")
+        ax.set_title("dam break, %dD, dx = %.4g: worst error %.1f%% vs the nearest experiment, "
+                     "%.1f%% vs MPS" % (dim, dx, 100 * worst["experiments"],
+                                        100 * worst["MPS"]), fontsize=9)
+        ax.legend(loc="upper left", fontsize=8)
+        return fig
+
+    plots.write(args, draw, failures)
 
     if failures:
         print("FAILED (%d problems):" % len(failures))

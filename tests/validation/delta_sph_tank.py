@@ -23,14 +23,14 @@ noise (sphc measures a factor ~5); and error(with) < error(without). A term with
 sign or scale (or switched off) fails: it leaves the noise or makes it grow. Both runs must
 also be finite and keep their particles in the tank.
 
+It draws the pressure of both runs against rho0 g (H - y) into delta_sph_tank.png in the
+directory that holds both (--plot PATH: elsewhere; tests/validation/plots.py).
+
 Usage: delta_sph_tank.py DIR_WITHOUT DIR_WITH [--H 0.5] [--g 9.81] [--rho0 1000]
                          [--ratio 0.5] [--plot out.png]
 """
 
-import argparse
-import glob
 import os
-import re
 import sys
 
 try:
@@ -40,13 +40,8 @@ except ImportError as exc:  # pragma: no cover
     sys.stderr.write("delta_sph_tank.py needs numpy and h5py (%s)\n" % exc)
     sys.exit(2)
 
-
-def last_snapshot(directory):
-    files = [f for f in glob.glob(os.path.join(directory, "*.h5"))
-             if re.search(r"_\d+\.h5$", os.path.basename(f))]
-    if not files:
-        return None
-    return max(files, key=lambda f: int(re.search(r"_(\d+)\.h5$", f).group(1)))
+import plots  # noqa: E402  (tests/validation/plots.py)
+from snapshots import argument_parser, snapshots  # noqa: E402  (snapshots.py)
 
 
 def figures(path, H, g, rho0):
@@ -66,22 +61,20 @@ def figures(path, H, g, rho0):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("without")
-    ap.add_argument("with_")
+    ap = argument_parser(__doc__, "directory of the run without delta-SPH")
+    ap.add_argument("with_", metavar="with", help="directory of the run with delta-SPH")
     ap.add_argument("--H", type=float, default=0.5)
     ap.add_argument("--g", type=float, default=9.81)
     ap.add_argument("--rho0", type=float, default=1000.0)
     ap.add_argument("--ratio", type=float, default=0.5)
-    ap.add_argument("--plot", default=None)
+    plots.add_option(ap, "delta_sph_tank.png")
     args = ap.parse_args()
     runs = []
-    for d in (args.without, args.with_):
-        s = last_snapshot(d)
-        if s is None:
-            sys.stderr.write("delta_sph_tank.py: no snapshots in %s\n" % d)
+    for d in (args.outdir, args.with_):
+        files = snapshots(d, "delta_sph_tank.py", at_least=1)
+        if files is None:
             return 2
-        runs.append(figures(s, args.H, args.g, args.rho0))
+        runs.append(figures(files[-1], args.H, args.g, args.rho0))
     a, b = runs
     print("hydrostatic tank, alpha = 0.1, t = %.3f, %d fluid particles; units of rho0 g H"
           % (a["t"], a["n"]))
@@ -104,26 +97,24 @@ def main():
     if not b["err_rms"] < a["err_rms"]:
         failures.append("error with delta-SPH %.3f%% not below %.3f%% without"
                         % (100 * b["err_rms"], 100 * a["err_rms"]))
-    if args.plot:
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-            fig, axes = plt.subplots(1, 2, figsize=(10, 4.5), sharey=True)
-            pref = args.rho0 * args.g * args.H
-            for ax, r, title in zip(axes, runs, ("without delta-SPH", "delta-SPH, delta = 0.1")):
-                ax.plot(r["p"] / pref, r["y"] / args.H, ".", ms=2)
-                ys = np.linspace(0, 1, 20)
-                ax.plot(1 - ys, ys, "k-", lw=1, label=r"$\rho_0 g (H - y)$")
-                ax.set_title("%s: noise rms %.2f%%" % (title, 100 * r["noise_rms"]), fontsize=9)
-                ax.set_xlabel(r"$p / (\rho_0 g H)$")
-                ax.legend(fontsize=8)
-            axes[0].set_ylabel(r"$y / H$")
-            fig.tight_layout()
-            fig.savefig(args.plot, dpi=120)
-            print("plot written to %s" % args.plot)
-        except ImportError:
-            print("--plot: matplotlib is not available, no plot written")
+    def draw(plt):
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4.5), sharey=True)
+        pref = args.rho0 * args.g * args.H
+        for ax, r, title in zip(axes, runs, ("without delta-SPH", "delta-SPH, delta = 0.1")):
+            ax.plot(r["p"] / pref, r["y"] / args.H, ".", ms=2, label="sphc, t = %.3g s" % r["t"])
+            ys = np.linspace(0, 1, 20)
+            ax.plot(1 - ys, ys, "k-", lw=1, label=r"$\rho_0 g (H - y)$")
+            ax.set_title("%s: noise rms %.2f%%, error rms %.2f%% of $\\rho_0 g H$"
+                         % (title, 100 * r["noise_rms"], 100 * r["err_rms"]), fontsize=9)
+            ax.set_xlabel(r"$p / (\rho_0 g H)$")
+            ax.legend(fontsize=8)
+        axes[0].set_ylabel(r"$y / H$")
+        return fig
+
+    # Both runs are in subdirectories of the test's output directory: the plot goes there.
+    plots.write(args, draw, failures,
+                directory=os.path.commonpath([os.path.abspath(args.outdir),
+                                              os.path.abspath(args.with_)]), dpi=120)
     if failures:
         print("FAILED (%d problems):" % len(failures))
         for m in failures:

@@ -44,17 +44,14 @@ Also checked in every snapshot: all values finite; the number of particles and t
 mass unchanged (mass exactly: particles keep their mass); the density within 5% of rho0
 (Monaghan's c0 = 1400 keeps it within ~1%).
 
-Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input. With
---plot FILE.png (needs matplotlib) it draws the particles and the exact ellipse, and the
-semi-axis against time.
+Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input. It
+draws the particles and the exact ellipse, and the semi-axis against time, into
+OUTPUT_DIR/elliptical_drop.png (--plot PATH: elsewhere; tests/validation/plots.py).
 
 Usage: elliptical_drop.py OUTPUT_DIR [--tol 0.02] [--A0 100] [--plot out.png]
 """
 
-import argparse
-import glob
 import os
-import re
 import sys
 
 try:
@@ -63,6 +60,9 @@ try:
 except ImportError as exc:  # pragma: no cover - environment problem, not a test failure
     sys.stderr.write("elliptical_drop.py needs numpy and h5py (%s)\n" % exc)
     sys.exit(2)
+
+import plots  # noqa: E402  (tests/validation/plots.py)
+from snapshots import argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
 
 
 def rhs(state):
@@ -88,29 +88,19 @@ def exact(t, A0=100.0, nsteps=4000):
     return A, a, 1.0 / a, 0.5 * a * a * (A * A - dA)
 
 
-def snapshot_files(directory):
-    """Snapshot files <scene>_NNNNNN.h5 of a directory, in step order."""
-    files = [f for f in glob.glob(os.path.join(directory, "*.h5"))
-             if re.search(r"_\d+\.h5$", os.path.basename(f))]
-    return sorted(files, key=lambda f: int(re.search(r"_(\d+)\.h5$", f).group(1)))
-
-
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("outdir", help="directory with the elliptical drop's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the elliptical drop's HDF5 snapshots")
     ap.add_argument("--tol", type=float, default=0.02,
                     help="largest relative error of the semi-major axis (default 0.02)")
     ap.add_argument("--rho-tol", type=float, default=0.05,
                     help="largest relative deviation of the density from rho0 (default 0.05)")
     ap.add_argument("--A0", type=float, default=100.0, help="initial strain rate (default 100)")
     ap.add_argument("--rho0", type=float, default=1.0, help="reference density (default 1)")
-    ap.add_argument("--plot", default=None, help="write a plot to this PNG")
+    plots.add_option(ap, "elliptical_drop.png")
     args = ap.parse_args()
 
-    files = snapshot_files(args.outdir)
-    if len(files) < 2:
-        sys.stderr.write("elliptical_drop.py: need >= 2 <scene>_NNNNNN.h5 files in %s\n"
-                         % args.outdir)
+    files = snapshots(args.outdir, "elliptical_drop.py")
+    if files is None:
         return 2
 
     failures = []
@@ -120,22 +110,10 @@ def main():
     for path in files:
         name = os.path.basename(path)
         with h5py.File(path, "r") as f:
-            t = float(f.attrs["t"])
-            if "fluid" not in f:
-                sys.stderr.write("elliptical_drop.py: %s has no /fluid group\n" % name)
+            got = read_fluid(f, name, ("x", "y", "rho", "m"), "elliptical_drop.py", failures)
+            if got is None:
                 return 2
-            g = f["fluid"]
-            for key in ("x", "y", "rho", "m"):
-                if key not in g:
-                    sys.stderr.write("elliptical_drop.py: %s has no /fluid/%s\n" % (name, key))
-                    return 2
-            data = {k: np.asarray(g[k][()], dtype=float) for k in g.keys()
-                    if isinstance(g[k], h5py.Dataset)}
-        for k, a in data.items():
-            if not np.all(np.isfinite(a)):
-                failures.append("%s: /fluid/%s has %d non-finite values"
-                                % (name, k, int(np.count_nonzero(~np.isfinite(a)))))
-        x, y, rho, m = data["x"], data["y"], data["rho"], data["m"]
+            t, (x, y, rho, m) = got
         if n0 is None:
             n0, mass0, y20 = len(x), float(np.sum(m)), float(np.mean(y * y))
             first = (t, x, y)
@@ -181,34 +159,31 @@ def main():
                         "%+.2f%% (tolerance %.1f%%)"
                         % (t, b_mom, b_ex, 100 * err_mom, 100 * args.tol))
 
-    if args.plot:
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-            fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.8))
-            th = np.linspace(0, 2 * np.pi, 400)
-            ax1.plot(first[1], first[2], ".", ms=1, color="0.7", label="t = 0")
-            ax1.plot(last[1], last[2], ".", ms=1.5, label="sphc, t = %.4f" % t)
-            a_ex = 1.0 / b_ex
-            ax1.plot(a_ex * np.cos(th), b_ex * np.sin(th), "k-", lw=1, label="exact ellipse")
-            ax1.set_aspect("equal")
-            ax1.set_xlabel("x")
-            ax1.set_ylabel("y")
-            ax1.legend(loc="upper right", fontsize=8)
-            ts = np.linspace(0, t, 60)
-            ax2.plot(ts, [exact(s, args.A0, 400)[2] for s in ts], "k-", label="exact b")
-            r = np.array(rows)
-            ax2.plot(r[:, 0], r[:, 2], "o", label="sphc, max |y|")
-            ax2.plot(r[:, 0], r[:, 3], "s", mfc="none", label="sphc, second moment")
-            ax2.set_xlabel("t [s]")
-            ax2.set_ylabel("semi-major axis b")
-            ax2.legend(loc="upper left", fontsize=8)
-            fig.tight_layout()
-            fig.savefig(args.plot, dpi=150)
-            print("plot written to %s" % args.plot)
-        except ImportError:
-            print("--plot: matplotlib is not available, no plot written")
+    def draw(plt):
+        fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.8))
+        th = np.linspace(0, 2 * np.pi, 400)
+        ax1.plot(first[1], first[2], ".", ms=1, color="0.7", label="t = 0")
+        ax1.plot(last[1], last[2], ".", ms=1.5, label="sphc, t = %.4f s" % t)
+        a_ex = 1.0 / b_ex
+        ax1.plot(a_ex * np.cos(th), b_ex * np.sin(th), "k-", lw=1, label="exact ellipse")
+        ax1.set_aspect("equal")
+        ax1.set_xlabel("x [m]")
+        ax1.set_ylabel("y [m]")
+        ax1.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3, fontsize=7)
+        ts = np.linspace(0, t, 60)
+        ax2.plot(ts, [exact(s, args.A0, 400)[2] for s in ts], "k-", label="exact b (ODEs)")
+        r = np.array(rows)
+        ax2.plot(r[:, 0], r[:, 2], "o", label="sphc, max |y|")
+        ax2.plot(r[:, 0], r[:, 3], "s", mfc="none", label="sphc, second moment")
+        ax2.set_xlabel("t [s]")
+        ax2.set_ylabel("semi-major axis b [m]")
+        ax2.set_title("at t = %.4f s: error %+.2f%% (max |y|), %+.2f%% (moment); "
+                      "tolerance %.1f%%" % (t, 100 * err_tip, 100 * err_mom, 100 * args.tol),
+                      fontsize=9)
+        ax2.legend(loc="upper left", fontsize=8)
+        return fig
+
+    plots.write(args, draw, failures)
 
     if failures:
         print("FAILED (%d problems):" % len(failures))

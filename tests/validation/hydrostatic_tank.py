@@ -51,17 +51,15 @@ Checks of the last snapshot (the settled state, t = tf):
     unchanged (exactly), no fluid particle below the floor or outside the side walls.
 
 Prints the centre-line profile at t = tf, the history of the largest speed, the error
-figures, and exits 0 when every check passes, 1 when one fails, 2 on bad input. With
---plot FILE.png (needs matplotlib) it draws the pressure profile and the speed history.
+figures, and exits 0 when every check passes, 1 when one fails, 2 on bad input. It draws the
+pressure profile and the speed history into OUTPUT_DIR/hydrostatic_tank.png (--plot PATH:
+elsewhere; tests/validation/plots.py).
 
 Usage: hydrostatic_tank.py OUTPUT_DIR [--H 0.5] [--W 1.0] [--g 9.81] [--rho0 1000]
                            [--p-tol 0.05] [--v-tol 0.005] [--rho-err-tol TOL] [--plot out.png]
 """
 
-import argparse
-import glob
 import os
-import re
 import sys
 
 try:
@@ -71,28 +69,13 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.stderr.write("hydrostatic_tank.py needs numpy and h5py (%s)\n" % exc)
     sys.exit(2)
 
-
-def snapshot_files(directory):
-    """Snapshot files <scene>_NNNNNN.h5 of a directory, in step order."""
-    files = [f for f in glob.glob(os.path.join(directory, "*.h5"))
-             if re.search(r"_\d+\.h5$", os.path.basename(f))]
-    return sorted(files, key=lambda f: int(re.search(r"_(\d+)\.h5$", f).group(1)))
-
-
-def infer_dx(x, y):
-    """Lattice spacing from the initial fluid: median nearest-neighbour distance."""
-    n = len(x)
-    d = []
-    for i in range(0, n, max(1, n // 200)):
-        r2 = (x - x[i]) ** 2 + (y - y[i]) ** 2
-        r2[i] = np.inf
-        d.append(np.sqrt(r2.min()))
-    return float(np.median(d))
+import plots  # noqa: E402  (tests/validation/plots.py)
+from snapshots import (argument_parser, lattice_spacing, read_fluid,  # noqa: E402
+                       snapshots)
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("outdir", help="directory with the tank's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the tank's HDF5 snapshots")
     ap.add_argument("--H", type=float, default=0.5, help="water depth [m] (default 0.5)")
     ap.add_argument("--W", type=float, default=1.0, help="tank width [m] (default 1.0)")
     ap.add_argument("--g", type=float, default=9.81, help="gravity [m/s^2] (default 9.81)")
@@ -105,13 +88,11 @@ def main():
                     help="pressure solver tolerance (relative average density error) of an "
                          "incompressible scheme: check the density error at t = tf against "
                          "2 x this (needs rho and the constant rho_rest in the output)")
-    ap.add_argument("--plot", default=None, help="write a plot to this PNG")
+    plots.add_option(ap, "hydrostatic_tank.png")
     args = ap.parse_args()
 
-    files = snapshot_files(args.outdir)
-    if len(files) < 2:
-        sys.stderr.write("hydrostatic_tank.py: need >= 2 <scene>_NNNNNN.h5 files in %s\n"
-                         % args.outdir)
+    files = snapshots(args.outdir, "hydrostatic_tank.py")
+    if files is None:
         return 2
 
     H, W, g, rho0 = args.H, args.W, args.g, args.rho0
@@ -124,28 +105,12 @@ def main():
     for path in files:
         name = os.path.basename(path)
         with h5py.File(path, "r") as f:
-            t = float(f.attrs["t"])
-            if "fluid" not in f:
-                sys.stderr.write("hydrostatic_tank.py: %s has no /fluid group\n" % name)
+            got = read_fluid(f, name, ("x", "y", "u", "v", "p", "m"), "hydrostatic_tank.py",
+                             failures, scan_all=True)
+            if got is None:
                 return 2
-            for gname, group in f.items():
-                if not isinstance(group, h5py.Group):
-                    continue
-                for dname, dset in group.items():
-                    if not isinstance(dset, h5py.Dataset):
-                        continue
-                    a = dset[()]
-                    if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
-                        failures.append("%s: /%s/%s has %d non-finite values"
-                                        % (name, gname, dname,
-                                           int(np.count_nonzero(~np.isfinite(a)))))
+            t, (x, y, u, v, p, m) = got
             fl = f["fluid"]
-            for key in ("x", "y", "u", "v", "p", "m"):
-                if key not in fl:
-                    sys.stderr.write("hydrostatic_tank.py: %s has no /fluid/%s\n" % (name, key))
-                    return 2
-            x, y, u, v, p, m = (np.asarray(fl[k][()], dtype=float)
-                                for k in ("x", "y", "u", "v", "p", "m"))
             dens = None
             if args.rho_err_tol is not None:
                 consts = fl["constants"].attrs if "constants" in fl else {}
@@ -157,7 +122,7 @@ def main():
                         float(consts["rhoerr"][0]) if "rhoerr" in consts else float("nan"))
         if n0 is None:
             n0, mass0 = len(x), float(np.sum(m))
-            dx = infer_dx(x, y)
+            dx = lattice_spacing((x, y))
         if len(x) != n0:
             failures.append("%s: %d fluid particles, the first snapshot has %d"
                             % (name, len(x), n0))
@@ -231,29 +196,27 @@ def main():
         failures.append("t = %.4f: largest speed %.3f%% of sqrt(g H) (tolerance %.2f%%)"
                         % (t, 100 * vmax, 100 * args.v_tol))
 
-    if args.plot:
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-            fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.5))
-            ax1.plot(pc / pref, yc / H, ".", label="sphc, centre line, t = %.3g s" % t)
-            ys = np.linspace(0, 1, 50)
-            ax1.plot(1 - ys, ys, "k-", lw=1, label=r"$\rho_0 g (H - y)$")
-            ax1.set_xlabel(r"$p / (\rho_0 g H)$")
-            ax1.set_ylabel(r"$y / H$")
-            ax1.legend(loc="upper right", fontsize=8)
-            h = np.array(hist)
-            ax2.semilogy(h[:, 0], np.maximum(h[:, 1], 1e-8), "o-", ms=3)
-            ax2.axhline(args.v_tol, color="r", ls="--", label="tolerance")
-            ax2.set_xlabel("t [s]")
-            ax2.set_ylabel(r"max $|v| / \sqrt{gH}$")
-            ax2.legend(fontsize=8)
-            fig.tight_layout()
-            fig.savefig(args.plot, dpi=150)
-            print("plot written to %s" % args.plot)
-        except ImportError:
-            print("--plot: matplotlib is not available, no plot written")
+    def draw(plt):
+        fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4.5))
+        ax1.plot(pc / pref, yc / H, ".", label="sphc, centre line, t = %.3g s" % t)
+        ys = np.linspace(0, 1, 50)
+        ax1.plot(1 - ys, ys, "k-", lw=1, label=r"$\rho_0 g (H - y)$")
+        ax1.set_xlabel(r"$p / (\rho_0 g H)$")
+        ax1.set_ylabel(r"$y / H$")
+        ax1.set_title("pressure: max error %.2f%% of $\\rho_0 g H$ (tolerance %.1f%%)"
+                      % (100 * perr, 100 * args.p_tol), fontsize=9)
+        ax1.legend(loc="upper right", fontsize=8)
+        h = np.array(hist)
+        ax2.semilogy(h[:, 0], np.maximum(h[:, 1], 1e-8), "o-", ms=3, label="sphc")
+        ax2.axhline(args.v_tol, color="r", ls="--", label="tolerance")
+        ax2.set_xlabel("t [s]")
+        ax2.set_ylabel(r"max $|v| / \sqrt{gH}$")
+        ax2.set_title("spurious speed at t = %.3g s: %.3f%% of $\\sqrt{gH}$"
+                      % (t, 100 * vmax), fontsize=9)
+        ax2.legend(fontsize=8)
+        return fig
+
+    plots.write(args, draw, failures)
 
     if failures:
         print("FAILED (%d problems):" % len(failures))

@@ -1,6 +1,8 @@
-"""Reading sphc (and PySPH) snapshots for the validation checks: the list of snapshot files
-of an output directory in step order, the fluid group of one snapshot, and the checks every
-script makes of it (required datasets present, no non-finite values)."""
+"""Reading sphc (and PySPH) snapshots for the validation checks: the argument parser every
+check starts from, the list of snapshot files of an output directory in step order, the
+particle arrays and the fluid group of one snapshot, and the checks every script makes of it
+(required datasets present, no non-finite values)."""
+import argparse
 import glob
 import os
 import re
@@ -9,12 +11,62 @@ import sys
 import numpy as np
 
 
+def argument_parser(doc, outdir_help):
+    """The parser of a check: described by the first paragraph of its docstring `doc`, with
+    the positional OUTPUT_DIR (`outdir`). The check adds its own options to it."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("outdir", help=outdir_help)
+    return ap
+
+
 def snapshot_files(directory):
-    """Snapshot files <scene>_NNNNNN.h5 (sphc) or <app>_NNNNN.hdf5 (PySPH), in step order."""
-    files = [f for f in glob.glob(os.path.join(directory, "*.h5")) +
-             glob.glob(os.path.join(directory, "*.hdf5"))
-             if re.search(r"_\d+\.(h5|hdf5)$", os.path.basename(f))]
-    return sorted(files, key=lambda f: int(re.search(r"_(\d+)\.(h5|hdf5)$", f).group(1)))
+    """Snapshot files of a directory, in step order: sphc's <scene>_NNNNNN.h5 or, where there
+    are none, PySPH's <app>_NNNNN.hdf5."""
+    for ext in ("h5", "hdf5"):
+        pat = re.compile(r"_(\d+)\.%s$" % ext)
+        files = [f for f in glob.glob(os.path.join(directory, "*." + ext))
+                 if pat.search(os.path.basename(f))]
+        if files:
+            return sorted(files, key=lambda f: int(pat.search(os.path.basename(f)).group(1)))
+    return []
+
+
+def snapshots(directory, who, at_least=2):
+    """snapshot_files(directory), or None after an error on stderr naming `who` (the script)
+    when there are fewer than `at_least`."""
+    files = snapshot_files(directory)
+    if len(files) < at_least:
+        sys.stderr.write("%s: need >= %d <scene>_NNNNNN.h5 files in %s, found %d\n"
+                         % (who, at_least, directory, len(files)))
+        return None
+    return files
+
+
+def particle_arrays(f):
+    """(t, dim, {array name: {property: dataset}}) of an open sphc or PySPH snapshot file;
+    dim is None where the file does not say (PySPH's)."""
+    if "particles" in f and "solver_data" in f:  # PySPH
+        t = float(f["solver_data"].attrs["t"])
+        arrays = {name: {k: d for k, d in g["arrays"].items() if hasattr(d, "dtype")}
+                  for name, g in f["particles"].items()
+                  if not hasattr(g, "dtype") and "arrays" in g}
+        return t, None, arrays
+    arrays = {name: {k: d for k, d in g.items() if hasattr(d, "dtype")}
+              for name, g in f.items() if not hasattr(g, "dtype")}
+    dim = int(f.attrs["dim"]) if "dim" in f.attrs else None
+    return float(f.attrs["t"]), dim, arrays
+
+
+def scan_finite(name, arrays, failures):
+    """Appends to `failures` one line per floating-point dataset of `arrays` ({array name:
+    {property: dataset}}, as particle_arrays gives) with non-finite values; `name` is the
+    snapshot's file name."""
+    for gname, group in arrays.items():
+        for dname, dset in group.items():
+            a = dset[()]
+            if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
+                failures.append("%s: /%s/%s has %d non-finite values"
+                                % (name, gname, dname, int(np.count_nonzero(~np.isfinite(a)))))
 
 
 def fluid_group(f):
@@ -28,10 +80,11 @@ def fluid_group(f):
     return None, None
 
 
-def read_fluid(f, name, keys, who, failures):
+def read_fluid(f, name, keys, who, failures, scan_all=False):
     """(t, [arrays of `keys` as float]) of the open snapshot f (file name `name`), or None
     after an error on stderr naming `who` (the script) when the fluid or one of the keys is
-    missing. Appends to `failures` one line per dataset with non-finite values."""
+    missing. Appends to `failures` one line per dataset with non-finite values: of the fluid,
+    or with scan_all of every particle array (walls too)."""
     t, fl = fluid_group(f)
     if fl is None:
         sys.stderr.write("%s: %s has no fluid particles\n" % (who, name))
@@ -40,9 +93,23 @@ def read_fluid(f, name, keys, who, failures):
         if key not in fl:
             sys.stderr.write("%s: %s has no /fluid/%s\n" % (who, name, key))
             return None
-    for dname, dset in fl.items():
-        a = dset[()]
-        if a.dtype.kind == "f" and a.ndim and not np.all(np.isfinite(a)):
-            failures.append("%s: /fluid/%s has %d non-finite values"
-                            % (name, dname, int(np.count_nonzero(~np.isfinite(a)))))
+    if scan_all:
+        scan_finite(name, particle_arrays(f)[2], failures)
+    else:
+        scan_finite(name, {"fluid": {k: d for k, d in fl.items() if hasattr(d, "dtype")}},
+                    failures)
     return t, [np.asarray(fl[k][()], dtype=float) for k in keys]
+
+
+def lattice_spacing(pos):
+    """The particle spacing of a lattice (the initial fluid): the median nearest-neighbour
+    distance over ~200 of its particles; pos = (x, y) or (x, y, z)."""
+    n = len(pos[0])
+    d = []
+    for i in range(0, n, max(1, n // 200)):
+        r2 = np.zeros_like(pos[0])
+        for c in pos:
+            r2 += (c - c[i]) ** 2
+        r2[i] = np.inf
+        d.append(np.sqrt(r2.min()))
+    return float(np.median(d))

@@ -50,18 +50,16 @@ on the command line (tests/validation/CMakeLists.txt):
 Also checked: all values finite, the particle count and total mass constant (exactly: the
 particles keep their mass), positions inside the periodic box [0, L).
 
-Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input. With
---plot FILE.png (needs matplotlib) it draws the decay of the largest speed against the exact
-one, the L1 error against time, and the particle speeds at the last snapshot.
+Prints a table and exits 0 when every check passes, 1 when one fails, 2 on bad input. It
+draws the decay of the largest speed against the exact one, the L1 error against time, and
+the particle speeds at the last snapshot into OUTPUT_DIR/taylor_green.png (--plot PATH:
+elsewhere; tests/validation/plots.py).
 
 Usage: taylor_green.py OUTPUT_DIR [--re 100] [--decay-tol 0.01] [--l1-tol 0.01] [--plot out.png]
 """
 
-import argparse
-import glob
 import math
 import os
-import re
 import sys
 
 try:
@@ -70,6 +68,9 @@ try:
 except ImportError as exc:  # pragma: no cover - environment problem, not a test failure
     sys.stderr.write("taylor_green.py needs numpy and h5py (%s)\n" % exc)
     sys.exit(2)
+
+import plots  # noqa: E402  (tests/validation/plots.py)
+from snapshots import argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
 
 
 def exact_velocity(x, y, t, re, U=1.0, L=1.0):
@@ -94,15 +95,8 @@ def speed_errors(x, y, u, v, t, re, U=1.0, L=1.0):
     return decay_err, l1
 
 
-def snapshot_files(directory):
-    files = [f for f in glob.glob(os.path.join(directory, "*.h5"))
-             if re.search(r"_\d+\.h5$", os.path.basename(f))]
-    return sorted(files, key=lambda f: int(re.search(r"_(\d+)\.h5$", f).group(1)))
-
-
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("outdir", help="directory with the Taylor-Green HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the Taylor-Green HDF5 snapshots")
     ap.add_argument("--re", type=float, default=100.0, help="Reynolds number (default 100)")
     ap.add_argument("--L", type=float, default=1.0, help="side of the box (default 1)")
     ap.add_argument("--U", type=float, default=1.0, help="velocity scale (default 1)")
@@ -110,13 +104,11 @@ def main():
                     help="largest |decay error| at the last snapshot (default 0.01)")
     ap.add_argument("--l1-tol", type=float, default=0.01,
                     help="largest L1 error of the speed at the last snapshot (default 0.01)")
-    ap.add_argument("--plot", default=None, help="write a plot to this PNG")
+    plots.add_option(ap, "taylor_green.png")
     args = ap.parse_args()
 
-    files = snapshot_files(args.outdir)
-    if len(files) < 2:
-        sys.stderr.write("taylor_green.py: need >= 2 <scene>_NNNNNN.h5 files in %s\n"
-                         % args.outdir)
+    files = snapshots(args.outdir, "taylor_green.py")
+    if files is None:
         return 2
 
     failures = []
@@ -126,22 +118,10 @@ def main():
     for path in files:
         name = os.path.basename(path)
         with h5py.File(path, "r") as f:
-            t = float(f.attrs["t"])
-            if "fluid" not in f:
-                sys.stderr.write("taylor_green.py: %s has no /fluid group\n" % name)
+            got = read_fluid(f, name, ("x", "y", "u", "v", "m"), "taylor_green.py", failures)
+            if got is None:
                 return 2
-            g = f["fluid"]
-            for key in ("x", "y", "u", "v", "m"):
-                if key not in g:
-                    sys.stderr.write("taylor_green.py: %s has no /fluid/%s\n" % (name, key))
-                    return 2
-            data = {k: np.asarray(g[k][()], dtype=float) for k in g.keys()
-                    if isinstance(g[k], h5py.Dataset)}
-        for k, a in data.items():
-            if not np.all(np.isfinite(a)):
-                failures.append("%s: /fluid/%s has %d non-finite values"
-                                % (name, k, int(np.count_nonzero(~np.isfinite(a)))))
-        x, y, u, v, m = (data[k] for k in ("x", "y", "u", "v", "m"))
+            t, (x, y, u, v, m) = got
         if n0 is None:
             n0, mass0 = len(x), math.fsum(m)
         if len(x) != n0:
@@ -181,36 +161,35 @@ def main():
         failures.append("t = %.4f: L1 error of the speed %.2f%% (tolerance %.1f%%)"
                         % (t, 100 * l1, 100 * args.l1_tol))
 
-    if args.plot:
-        try:
-            import matplotlib
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-            r = np.array(rows)
-            fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(14, 4.2))
-            ts = np.linspace(0, r[-1, 0], 200)
-            nu = args.U * args.L / args.re
-            ax1.semilogy(ts, args.U * np.exp(-2.0 * nu * (2 * np.pi / args.L) ** 2 * ts), "k-",
-                         label="exact U exp(-8 pi^2 nu t / L^2)")
-            ax1.semilogy(r[:, 0], r[:, 1], "o", label="sphc, max |v|")
-            ax1.set_xlabel("t")
-            ax1.set_ylabel("max |v|")
-            ax1.legend(fontsize=8)
-            ax2.plot(r[:, 0], 100 * r[:, 4], "o-", label="L1 error of |v|")
-            ax2.plot(r[:, 0], 100 * np.abs(r[:, 3]), "s-", label="|decay error|")
-            ax2.set_xlabel("t")
-            ax2.set_ylabel("error [%]")
-            ax2.legend(fontsize=8)
-            t, x, y, speed = last
-            sc = ax3.scatter(x, y, c=speed, s=2, cmap="viridis")
-            fig.colorbar(sc, ax=ax3, label="|v|")
-            ax3.set_aspect("equal")
-            ax3.set_title("t = %.3f" % t)
-            fig.tight_layout()
-            fig.savefig(args.plot, dpi=150)
-            print("plot written to %s" % args.plot)
-        except ImportError:
-            print("--plot: matplotlib is not available, no plot written")
+    def draw(plt):
+        r = np.array(rows)
+        fig, (ax1, ax2, ax3) = plt.subplots(1, 3, figsize=(14, 4.2))
+        ts = np.linspace(0, r[-1, 0], 200)
+        nu = args.U * args.L / args.re
+        ax1.semilogy(ts, args.U * np.exp(-2.0 * nu * (2 * np.pi / args.L) ** 2 * ts), "k-",
+                     label="exact U exp(-8 pi^2 nu t / L^2)")
+        ax1.semilogy(r[:, 0], r[:, 1], "o", label="sphc, max |v|")
+        ax1.set_xlabel("t")
+        ax1.set_ylabel("max |v|")
+        ax1.set_title("Re = %g: decay error %+.2f%% at t = %.3g (tolerance %.1f%%)"
+                      % (args.re, 100 * decay_err, r[-1, 0], 100 * args.decay_tol),
+                      fontsize=9)
+        ax1.legend(fontsize=8)
+        ax2.plot(r[:, 0], 100 * r[:, 4], "o-", label="L1 error of |v|")
+        ax2.plot(r[:, 0], 100 * np.abs(r[:, 3]), "s-", label="|decay error|")
+        ax2.set_xlabel("t")
+        ax2.set_ylabel("error [%]")
+        ax2.legend(fontsize=8)
+        t, x, y, speed = last
+        sc = ax3.scatter(x, y, c=speed, s=2, cmap="viridis")
+        fig.colorbar(sc, ax=ax3, label="|v|")
+        ax3.set_aspect("equal")
+        ax3.set_xlabel("x")
+        ax3.set_ylabel("y")
+        ax3.set_title("particle speeds at t = %.3f" % t, fontsize=9)
+        return fig
+
+    plots.write(args, draw, failures)
 
     if failures:
         print("FAILED (%d problems):" % len(failures))
