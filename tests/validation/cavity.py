@@ -72,7 +72,8 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.exit(2)
 
 import plots  # noqa: E402  (tests/validation/plots.py)
-from snapshots import argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
+from snapshots import (argument_parser, read_fluid, report_failures,  # noqa: E402
+                       snapshots)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_DATA = os.path.join(HERE, "..", "data")
@@ -111,7 +112,7 @@ def linear_fit(px, py, x, y, values, h):
 
 
 def main():
-    ap = argument_parser(__doc__, "directory with the cavity's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the cavity's HDF5 snapshots", "cavity.png")
     ap.add_argument("--data", default=DEFAULT_DATA, help="directory of ghia1982_re100_*.csv")
     ap.add_argument("--L", type=float, default=1.0, help="side of the cavity (default 1)")
     ap.add_argument("--U", type=float, default=1.0, help="lid speed (default 1)")
@@ -126,7 +127,6 @@ def main():
                          "halves of the last --steady-time (default 0.02)")
     ap.add_argument("--steady-time", type=float, default=2.0,
                     help="window of the steadiness check (default 2)")
-    plots.add_option(ap, "cavity.png")
     args = ap.parse_args()
 
     files = snapshots(args.outdir, "cavity.py")
@@ -271,10 +271,7 @@ def main():
 
     plots.write(args, draw, failures)
 
-    if failures:
-        print("FAILED (%d problems):" % len(failures))
-        for msg in failures:
-            print("  " + msg)
+    if report_failures(failures):
         return 1
     print("PASSED: t = %.3f, centre-line velocities within %.4f U of Ghia et al. (tolerance "
           "%.3f U), rms %.4f U (tolerance %.3f U); steady to %.2f%%; mass conserved, all "

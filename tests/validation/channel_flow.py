@@ -92,7 +92,8 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.exit(2)
 
 import plots  # noqa: E402  (tests/validation/plots.py)
-from snapshots import argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
+from snapshots import (argument_parser, read_fluid, report_failures,  # noqa: E402
+                       snapshots)
 
 # In units of d^2 / nu (= 1 s in Morris's set-up).
 CHECK_TIMES = (0.0225, 0.045, 0.1125, 0.225, 0.45)
@@ -172,7 +173,7 @@ def self_test(flow, d, nu, F, U, uref):
 
 
 def main():
-    ap = argument_parser(__doc__, "directory with the scene's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the scene's HDF5 snapshots", "channel_flow.png")
     ap.add_argument("--flow", choices=("poiseuille", "couette"), default=None,
                     help="the flow (default: from the snapshot names)")
     ap.add_argument("--d", type=float, default=1e-3, help="channel width (default 1e-3 m)")
@@ -184,7 +185,6 @@ def main():
     ap.add_argument("--tol", type=float, default=None,
                     help="largest |u_SPH - u_exact| / u_ref at every checked time "
                          "(default 0.015 for Poiseuille, 0.01 for Couette)")
-    plots.add_option(ap, "channel_flow.png")
     args = ap.parse_args()
 
     files = snapshots(args.outdir, "channel_flow.py")
@@ -315,10 +315,7 @@ def main():
 
     plots.write(args, draw, failures)
 
-    if failures:
-        print("FAILED (%d problems):" % len(failures))
-        for msg in failures[:20]:
-            print("  " + msg)
+    if report_failures(failures, 20):
         return 1
     print("PASSED: %s flow, %d rows, profiles within %.3f%% of u_ref of the series at %d "
           "times up to t = %.4g s (tolerance %.2f%%); mass conserved, all values finite"

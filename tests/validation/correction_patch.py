@@ -49,11 +49,12 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.exit(2)
 
 import plots  # noqa: E402  (tests/validation/plots.py)
-from snapshots import argument_parser, snapshots  # noqa: E402  (snapshots.py)
+from snapshots import argument_parser, report_failures, snapshots  # noqa: E402
 
 
 def main():
-    ap = argument_parser(__doc__, "directory with the patch's two HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the patch's two HDF5 snapshots",
+                         "correction_patch.png")
     ap.add_argument("--dx", type=float, default=0.05)
     ap.add_argument("--hdx", type=float, default=1.3)
     ap.add_argument("--ro", type=float, default=1000.0)
@@ -63,7 +64,6 @@ def main():
     ap.add_argument("--delta", type=float, default=0.1)
     ap.add_argument("--exact-tol", type=float, default=1e-10)
     ap.add_argument("--fail-min", type=float, default=0.01)
-    plots.add_option(ap, "correction_patch.png")
     args = ap.parse_args()
 
     files = snapshots(args.outdir, "correction_patch.py")
@@ -159,10 +159,7 @@ def main():
 
     plots.write(args, draw, failures, dpi=120)
 
-    if failures:
-        print("FAILED (%d problems):" % len(failures))
-        for m in failures:
-            print("  " + m)
+    if report_failures(failures):
         return 1
     print("PASSED: corrected gradients and the Shepard filter exact to %.1e (tolerance %.0e); "
           "the uncorrected forms off by up to %.0f%% (gradient) and %.0f%% (density)"

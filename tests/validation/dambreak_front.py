@@ -84,7 +84,7 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
 
 import plots  # noqa: E402  (tests/validation/plots.py)
 from snapshots import (argument_parser, lattice_spacing, particle_arrays,  # noqa: E402
-                       scan_finite, snapshots)
+                       report_failures, scan_finite, snapshots)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEFAULT_DATA = os.path.join(HERE, "..", "data", "koshizuka_oka_1996_surge.csv")
@@ -133,7 +133,8 @@ def front_position(pos, dx):
 
 
 def main():
-    ap = argument_parser(__doc__, "directory with the dam break's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the dam break's HDF5 snapshots",
+                         "dambreak_front.png")
     ap.add_argument("--tol", type=float, default=0.10,
                     help="largest relative error against the nearest experimental series "
                          "where T >= 1 (default 0.10)")
@@ -160,7 +161,6 @@ def main():
     ap.add_argument("--data", default=DEFAULT_DATA, help="experimental CSV (T,Z_L)")
     ap.add_argument("--mps", default=DEFAULT_MPS, help="MPS calculation CSV (T,Z_L)")
     ap.add_argument("--mm", default=DEFAULT_MM, help="Martin & Moyce CSV (a_in,T,Z_L)")
-    plots.add_option(ap, "dambreak_front.png")
     args = ap.parse_args()
 
     files = snapshots(args.outdir, "dambreak_front.py", at_least=1)
@@ -325,10 +325,7 @@ def main():
 
     plots.write(args, draw, failures)
 
-    if failures:
-        print("FAILED (%d problems):" % len(failures))
-        for msg in failures:
-            print("  " + msg)
+    if report_failures(failures):
         return 1
     print("PASSED: finite, contained; front within %.0f%% of the nearest experiment at %d times"
           " (worst %.1f%%), within %.0f%% of Koshizuka & Oka's experiment (worst %.1f%%), within"

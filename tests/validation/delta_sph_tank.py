@@ -41,7 +41,7 @@ except ImportError as exc:  # pragma: no cover
     sys.exit(2)
 
 import plots  # noqa: E402  (tests/validation/plots.py)
-from snapshots import argument_parser, snapshots  # noqa: E402  (snapshots.py)
+from snapshots import argument_parser, report_failures, snapshots  # noqa: E402
 
 
 def figures(path, H, g, rho0):
@@ -61,13 +61,12 @@ def figures(path, H, g, rho0):
 
 
 def main():
-    ap = argument_parser(__doc__, "directory of the run without delta-SPH")
+    ap = argument_parser(__doc__, "directory of the run without delta-SPH", "delta_sph_tank.png")
     ap.add_argument("with_", metavar="with", help="directory of the run with delta-SPH")
     ap.add_argument("--H", type=float, default=0.5)
     ap.add_argument("--g", type=float, default=9.81)
     ap.add_argument("--rho0", type=float, default=1000.0)
     ap.add_argument("--ratio", type=float, default=0.5)
-    plots.add_option(ap, "delta_sph_tank.png")
     args = ap.parse_args()
     runs = []
     for d in (args.outdir, args.with_):
@@ -115,10 +114,7 @@ def main():
     plots.write(args, draw, failures,
                 directory=os.path.commonpath([os.path.abspath(args.outdir),
                                               os.path.abspath(args.with_)]), dpi=120)
-    if failures:
-        print("FAILED (%d problems):" % len(failures))
-        for m in failures:
-            print("  " + m)
+    if report_failures(failures):
         return 1
     print("PASSED: delta-SPH cuts the pressure noise from %.3f%% to %.3f%% of rho0 g H (a factor "
           "%.1f; required >= %.1f) and the rms error from %.3f%% to %.3f%%"

@@ -62,7 +62,8 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.exit(2)
 
 import plots  # noqa: E402  (tests/validation/plots.py)
-from snapshots import argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
+from snapshots import (argument_parser, read_fluid, report_failures,  # noqa: E402
+                       snapshots)
 
 
 def rhs(state):
@@ -89,14 +90,14 @@ def exact(t, A0=100.0, nsteps=4000):
 
 
 def main():
-    ap = argument_parser(__doc__, "directory with the elliptical drop's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the elliptical drop's HDF5 snapshots",
+                         "elliptical_drop.png")
     ap.add_argument("--tol", type=float, default=0.02,
                     help="largest relative error of the semi-major axis (default 0.02)")
     ap.add_argument("--rho-tol", type=float, default=0.05,
                     help="largest relative deviation of the density from rho0 (default 0.05)")
     ap.add_argument("--A0", type=float, default=100.0, help="initial strain rate (default 100)")
     ap.add_argument("--rho0", type=float, default=1.0, help="reference density (default 1)")
-    plots.add_option(ap, "elliptical_drop.png")
     args = ap.parse_args()
 
     files = snapshots(args.outdir, "elliptical_drop.py")
@@ -185,10 +186,7 @@ def main():
 
     plots.write(args, draw, failures)
 
-    if failures:
-        print("FAILED (%d problems):" % len(failures))
-        for msg in failures:
-            print("  " + msg)
+    if report_failures(failures):
         return 1
     print("PASSED: t = %.5f, semi-major axis error %+.2f%% (max |y|), %+.2f%% (second moment), "
           "tolerance %.1f%%; mass conserved exactly; all values finite"

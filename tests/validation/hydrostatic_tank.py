@@ -71,11 +71,12 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
 
 import plots  # noqa: E402  (tests/validation/plots.py)
 from snapshots import (argument_parser, lattice_spacing, read_fluid,  # noqa: E402
-                       snapshots)
+                       report_failures, snapshots)
 
 
 def main():
-    ap = argument_parser(__doc__, "directory with the tank's HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the tank's HDF5 snapshots",
+                         "hydrostatic_tank.png")
     ap.add_argument("--H", type=float, default=0.5, help="water depth [m] (default 0.5)")
     ap.add_argument("--W", type=float, default=1.0, help="tank width [m] (default 1.0)")
     ap.add_argument("--g", type=float, default=9.81, help="gravity [m/s^2] (default 9.81)")
@@ -88,7 +89,6 @@ def main():
                     help="pressure solver tolerance (relative average density error) of an "
                          "incompressible scheme: check the density error at t = tf against "
                          "2 x this (needs rho and the constant rho_rest in the output)")
-    plots.add_option(ap, "hydrostatic_tank.png")
     args = ap.parse_args()
 
     files = snapshots(args.outdir, "hydrostatic_tank.py")
@@ -218,10 +218,7 @@ def main():
 
     plots.write(args, draw, failures)
 
-    if failures:
-        print("FAILED (%d problems):" % len(failures))
-        for msg in failures:
-            print("  " + msg)
+    if report_failures(failures):
         return 1
     print("PASSED: t = %.4f, centre-line pressure within %.2f%% of rho0 g H (tolerance %.1f%%), "
           "spurious speed %.3f%% of sqrt(g H) (tolerance %.2f%%); mass conserved exactly; all "

@@ -26,6 +26,8 @@ import sys
 import tempfile
 import zlib
 
+from snapshots import report_failures  # tests/validation/snapshots.py
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 CHECK = os.path.join(HERE, "elliptical_drop.py")
 SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -127,10 +129,7 @@ def main():
     if os.path.exists(default):
         failures.append("4. with --plot '' the check wrote %s" % default)
 
-    if failures:
-        print("FAILED (%d problems):" % len(failures))
-        for m in failures:
-            print("  " + m)
+    if report_failures(failures):
         return 1
     print("PASSED: the check writes a valid PNG by default and at --plot PATH, skips the plot "
           "without matplotlib and with --plot '', and passes in every case")

@@ -1,7 +1,7 @@
 """Reading sphc (and PySPH) snapshots for the validation checks: the argument parser every
 check starts from, the list of snapshot files of an output directory in step order, the
-particle arrays and the fluid group of one snapshot, and the checks every script makes of it
-(required datasets present, no non-finite values)."""
+particle arrays and the fluid group of one snapshot, the checks every script makes of it
+(required datasets present, no non-finite values), and the report of the failures."""
 import argparse
 import glob
 import os
@@ -10,12 +10,16 @@ import sys
 
 import numpy as np
 
+import plots  # tests/validation/plots.py
 
-def argument_parser(doc, outdir_help):
+
+def argument_parser(doc, outdir_help, plot_name):
     """The parser of a check: described by the first paragraph of its docstring `doc`, with
-    the positional OUTPUT_DIR (`outdir`). The check adds its own options to it."""
+    the positional OUTPUT_DIR (`outdir`) and --plot PATH, whose default is plot_name in
+    OUTPUT_DIR (plots.py). The check adds its own options to it."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("outdir", help=outdir_help)
+    plots.add_option(ap, plot_name)
     return ap
 
 
@@ -113,3 +117,14 @@ def lattice_spacing(pos):
         r2[i] = np.inf
         d.append(np.sqrt(r2.min()))
     return float(np.median(d))
+
+
+def report_failures(failures, limit=None):
+    """Prints the failures of a check (the first `limit` of them, if given) under a FAILED
+    line; True when there are any (the check then exits 1)."""
+    if not failures:
+        return False
+    print("FAILED (%d problems):" % len(failures))
+    for msg in failures[:limit]:
+        print("  " + msg)
+    return True

@@ -96,7 +96,8 @@ def speed_errors(x, y, u, v, t, re, U=1.0, L=1.0):
 
 
 def main():
-    ap = argument_parser(__doc__, "directory with the Taylor-Green HDF5 snapshots")
+    ap = argument_parser(__doc__, "directory with the Taylor-Green HDF5 snapshots",
+                         "taylor_green.png")
     ap.add_argument("--re", type=float, default=100.0, help="Reynolds number (default 100)")
     ap.add_argument("--L", type=float, default=1.0, help="side of the box (default 1)")
     ap.add_argument("--U", type=float, default=1.0, help="velocity scale (default 1)")
@@ -104,7 +105,6 @@ def main():
                     help="largest |decay error| at the last snapshot (default 0.01)")
     ap.add_argument("--l1-tol", type=float, default=0.01,
                     help="largest L1 error of the speed at the last snapshot (default 0.01)")
-    plots.add_option(ap, "taylor_green.png")
     args = ap.parse_args()
 
     files = snapshots(args.outdir, "taylor_green.py")
@@ -169,23 +169,23 @@ def main():
         ax1.semilogy(ts, args.U * np.exp(-2.0 * nu * (2 * np.pi / args.L) ** 2 * ts), "k-",
                      label="exact U exp(-8 pi^2 nu t / L^2)")
         ax1.semilogy(r[:, 0], r[:, 1], "o", label="sphc, max |v|")
-        ax1.set_xlabel("t")
-        ax1.set_ylabel("max |v|")
+        ax1.set_xlabel("t [L/U]")
+        ax1.set_ylabel("max |v| / U")
         ax1.set_title("Re = %g: decay error %+.2f%% at t = %.3g (tolerance %.1f%%)"
                       % (args.re, 100 * decay_err, r[-1, 0], 100 * args.decay_tol),
                       fontsize=9)
         ax1.legend(fontsize=8)
         ax2.plot(r[:, 0], 100 * r[:, 4], "o-", label="L1 error of |v|")
         ax2.plot(r[:, 0], 100 * np.abs(r[:, 3]), "s-", label="|decay error|")
-        ax2.set_xlabel("t")
+        ax2.set_xlabel("t [L/U]")
         ax2.set_ylabel("error [%]")
         ax2.legend(fontsize=8)
         t, x, y, speed = last
         sc = ax3.scatter(x, y, c=speed, s=2, cmap="viridis")
-        fig.colorbar(sc, ax=ax3, label="|v|")
+        fig.colorbar(sc, ax=ax3, label="|v| / U")
         ax3.set_aspect("equal")
-        ax3.set_xlabel("x")
-        ax3.set_ylabel("y")
+        ax3.set_xlabel("x / L")
+        ax3.set_ylabel("y / L")
         ax3.set_title("particle speeds at t = %.3f" % t, fontsize=9)
         return fig
 
