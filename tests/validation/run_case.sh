@@ -54,20 +54,9 @@ while [ $# -gt 0 ] && [ "$1" != "--" ]; do
 done
 [ $# -gt 0 ] && shift
 
-PY=""
-for cand in ${SPHC_PYTHON:-} python3 /usr/bin/python3; do
-  if command -v "$cand" >/dev/null 2>&1 && "$cand" -c "import numpy, h5py" >/dev/null 2>&1; then
-    PY=$cand
-    break
-  fi
-done
-if [ -z "$PY" ]; then
-  echo "run_case.sh: no Python with numpy and h5py (set SPHC_PYTHON)" >&2
-  exit 1
-fi
-
-rm -rf "$OUT"
-mkdir -p "$(dirname "$EXE")" "$OUT"
+. "$(dirname "$0")/common.sh"
+find_python run_case.sh
+fresh_output "$EXE" "$OUT"
 
 echo "== 1. compile: $SPHC $SRC/examples/$CASE.sph$SPHC_OPTS -o $EXE"
 start=$(date +%s)

@@ -8,19 +8,9 @@ SPHC=$1
 SRC=$2
 EXE=$3
 OUT=$4
-PY=""
-for cand in ${SPHC_PYTHON:-} python3 /usr/bin/python3; do
-  if command -v "$cand" >/dev/null 2>&1 && "$cand" -c "import numpy, h5py" >/dev/null 2>&1; then
-    PY=$cand
-    break
-  fi
-done
-if [ -z "$PY" ]; then
-  echo "run_delta_tank.sh: no Python with numpy and h5py (set SPHC_PYTHON)" >&2
-  exit 1
-fi
-rm -rf "$OUT"
-mkdir -p "$(dirname "$EXE")" "$OUT"
+. "$(dirname "$0")/common.sh"
+find_python run_delta_tank.sh
+fresh_output "$EXE" "$OUT"
 echo "== 1. compile"
 "$SPHC" "$SRC/examples/hydrostatic_tank.sph" -o "$EXE"
 echo "== 2. run without delta-SPH (alpha = 0.1)"
