@@ -211,22 +211,28 @@ def fmt(v, spec="%.2f"):
     return "-" if v is None else spec % v
 
 
-def main():
-    if len(sys.argv) > 1 and sys.argv[1] == "--pysph-driver":
-        return pysph_driver(sys.argv[2:])
-
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def argument_parser(doc):
+    """The options every sphc-against-PySPH benchmark takes."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
-    ap.add_argument("--steps", type=int, default=1000, help="steps at dx = 0.03")
-    ap.add_argument("--steps-large", type=int, default=100, help="steps at ~100k particles")
-    ap.add_argument("--dx-large", type=float, default=0.0047,
-                    help="dx giving ~100k particles (default 0.0047)")
-    ap.add_argument("--repeat", type=int, default=1, help="runs per figure; the best is kept")
     ap.add_argument("--pysph-python", default=sys.executable,
                     help="Python with PySPH (default: this one)")
     ap.add_argument("--skip-pysph", action="store_true")
     ap.add_argument("--skip-sphc", action="store_true")
     ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
+    return ap
+
+
+def main():
+    if len(sys.argv) > 1 and sys.argv[1] == "--pysph-driver":
+        return pysph_driver(sys.argv[2:])
+
+    ap = argument_parser(__doc__)
+    ap.add_argument("--steps", type=int, default=1000, help="steps at dx = 0.03")
+    ap.add_argument("--steps-large", type=int, default=100, help="steps at ~100k particles")
+    ap.add_argument("--dx-large", type=float, default=0.0047,
+                    help="dx giving ~100k particles (default 0.0047)")
+    ap.add_argument("--repeat", type=int, default=1, help="runs per figure; the best is kept")
     ap.add_argument("--threads", type=int, default=0,
                     help="also time sphc --backend=openmp and PySPH --openmp with this many "
                          "threads (default: none)")

@@ -37,7 +37,6 @@ The Python running it needs numpy and h5py, and PySPH (Debian: python3-pysph) un
 --skip-pysph (or pass --pysph-python).
 """
 
-import argparse
 import glob
 import os
 import re
@@ -48,7 +47,8 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "validation"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from dambreak_vs_pysph import cpu_model, run, serial_env  # noqa: E402  (shared helpers)
+from dambreak_vs_pysph import (argument_parser, cpu_model, fmt, run,  # noqa: E402 (shared)
+                               serial_env)
 
 
 def pysph_driver(argv):
@@ -155,23 +155,13 @@ def pysph_all(python, tmp, nx, tf):
 
 # ---- report -------------------------------------------------------------------------------
 
-def fmt(v, spec="%.2f"):
-    return "-" if v is None else spec % v
-
-
 def main():
     if len(sys.argv) > 1 and sys.argv[1] == "--pysph-driver":
         return pysph_driver(sys.argv[2:])
 
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
+    ap = argument_parser(__doc__)
     ap.add_argument("--nx", type=int, default=50, help="particles along a side (default 50)")
     ap.add_argument("--tf", type=float, default=2.0, help="final time (default 2)")
-    ap.add_argument("--pysph-python", default=sys.executable,
-                    help="Python with PySPH (default: this one)")
-    ap.add_argument("--skip-pysph", action="store_true")
-    ap.add_argument("--skip-sphc", action="store_true")
-    ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
     args = ap.parse_args()
 
     load0 = load_average()
