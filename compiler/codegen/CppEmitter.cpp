@@ -875,7 +875,7 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
         const std::string loopHead = "        for (int d_idx = 0; d_idx < " + nReal +
                                      "; ++d_idx)" +
                                      (onGhosts ? "  // real particles only" : "") + "\n";
-        scene_ << "        std::vector<double>& values = reduce_scratch;\n";
+        scene_ << "        std::vector<" << real_ << ">& values = reduce_scratch;\n";
         scene_ << "        values.resize(" << nReal << ");\n";
         scene_ << parallelFor("        ");
         scene_ << loopHead;
