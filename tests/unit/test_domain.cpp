@@ -40,6 +40,30 @@ Domain periodic_box(int dim, double L) {
   return d;
 }
 
+// Periodic in x on [0, 1), a mirror at y = 0 and mirrors at z = 0 and z = 1.
+Domain mixed_box() {
+  Domain d;
+  d.dim = 3;
+  d.lo_kind[0] = d.hi_kind[0] = Boundary::Periodic;
+  d.hi[0] = 1.0;
+  d.lo_kind[1] = Boundary::Mirror;  // y >= 0
+  d.lo_kind[2] = d.hi_kind[2] = Boundary::Mirror;
+  d.hi[2] = 1.0;
+  return d;
+}
+
+// 300 random points of [0, 1)^3 with values of type T (float: exact in double too); point 0
+// in a corner of mixed_box(), 2 x 2 x 2 - 1 = 7 ghosts.
+template <class T>
+std::vector<std::array<double, 3>> random_points(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<T> unit(T(0), T(1));
+  std::vector<std::array<double, 3>> pts(300);
+  for (auto& p : pts) p = {unit(rng), unit(rng), unit(rng)};
+  pts[0] = {T(0.01), T(0.02), T(0.03)};
+  return pts;
+}
+
 ParticleArray make_array(const std::vector<std::array<double, 3>>& pts, double h) {
   ParticleArray pa;
   pa.name = "fluid";
@@ -233,19 +257,8 @@ TEST(Domain, CornersGetEveryCombinationOfImages) {
 TEST(Domain, FindGhostsOnRawPositionsIsTheListOfAddGhosts) {
   // find_ghosts (the OpenCL backend calls it on positions read from the device) and
   // add_ghosts give the same ghosts in the same order: by particle, then image (x fastest).
-  Domain d;
-  d.dim = 3;
-  d.lo_kind[0] = d.hi_kind[0] = Boundary::Periodic;
-  d.hi[0] = 1.0;
-  d.lo_kind[1] = Boundary::Mirror;  // y >= 0
-  d.lo_kind[2] = d.hi_kind[2] = Boundary::Mirror;
-  d.hi[2] = 1.0;
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<std::array<double, 3>> pts(300);
-  for (auto& p : pts) p = {unit(rng), unit(rng), unit(rng)};
-  pts[0] = {0.01, 0.02, 0.03};  // a corner: 2 x 2 x 2 - 1 = 7 ghosts
-  ParticleArray pa = make_array(pts, 0.05);
+  const Domain d = mixed_box();
+  ParticleArray pa = make_array(random_points<double>(7), 0.05);
   std::vector<double> x(pa.f64("x"), pa.f64("x") + pa.n), y(pa.f64("y"), pa.f64("y") + pa.n),
       z(pa.f64("z"), pa.f64("z") + pa.n);
   Ghosts g, raw;
@@ -300,19 +313,10 @@ TEST(Domain, FloatCopyGetsTheGhostsOfTheDoubles) {
   // every ghost value the double one rounded to float (the shifts by 1 and reflections in 0
   // and 1 of a float are exact in double, so rounding once gives float arithmetic's result).
   // Integer properties grow ghosts in the host array; the host doubles stay at n particles.
-  Domain d;
-  d.dim = 3;
-  d.lo_kind[0] = d.hi_kind[0] = Boundary::Periodic;
-  d.hi[0] = 1.0;
-  d.lo_kind[1] = Boundary::Mirror;  // y >= 0
-  d.lo_kind[2] = d.hi_kind[2] = Boundary::Mirror;
-  d.hi[2] = 1.0;
-  std::mt19937 rng(11);
+  const Domain d = mixed_box();
+  ParticleArray pa = make_array(random_points<float>(11), 0.05);
+  std::mt19937 rng(12);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  std::vector<std::array<double, 3>> pts(300);
-  for (auto& p : pts) p = {unit(rng), unit(rng), unit(rng)};
-  pts[0] = {0.01f, 0.02f, 0.03f};  // a corner: 7 ghosts
-  ParticleArray pa = make_array(pts, 0.05);
   const int tag = pa.add_property("tag", sphc::PropType::I32);
   for (std::size_t i = 0; i < pa.n; ++i) pa.i32(tag)[i] = static_cast<std::int32_t>(i);
   for (const char* p : {"u", "v", "w", "m"})
