@@ -260,6 +260,18 @@ class Emitter {
   bool hasGhosts(int a) const { return hasDomain() && !arr(a).ghostProps.empty(); }
   std::string propIndexList(int a, const std::vector<std::string>& props) const;
   void emitDomainSetup();
+  // The data the CPU domain functions work on: "a" (the host array) or, with
+  // --precision=single, "f32_a, a" (its float copy, and the host array for the integers).
+  std::string hostData(int a) const {
+    return (cpuSingle_ ? "f32_" + arr(a).name + ", " : std::string()) + arr(a).name;
+  }
+  // The search domain of every array in a neighbour loop, from its doubles or (single) floats.
+  void emitSearchDomain();
+  // Reorders source S into the cell order of cells_S.
+  std::string permuteInCellOrder(const std::string& S) const {
+    return cpuSingle_ ? "f32_" + S + ".permute(cells_" + S + ".cell_order(), " + S + ");"
+                      : S + ".permute(cells_" + S + ".cell_order());";
+  }
   void emitUpdateNeighboursWithGhosts();
   void emitUpdateNeighboursWithGhostsDevice();
   // remove_ghosts of every source array (statements, indented by 4).
@@ -863,7 +875,7 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
         const std::string loopHead = "        for (int d_idx = 0; d_idx < " + nReal +
                                      "; ++d_idx)" +
                                      (onGhosts ? "  // real particles only" : "") + "\n";
-        scene_ << "        std::vector<double>& values = reduce_scratch;\n";
+        scene_ << "        std::vector<" << real_ << ">& values = reduce_scratch;\n";
         scene_ << "        values.resize(" << nReal << ");\n";
         scene_ << parallelFor("        ");
         scene_ << loopHead;
@@ -908,7 +920,7 @@ void Emitter::emitGhostRefresh(int d, const std::vector<const PlanEquation*>& eq
     scene_ << "\n      ghosts_" << D << ".refresh(ocl, box, " << D << ", dev_" << D << ", "
            << propIndexList(d, refresh) << ");\n";
   else
-    scene_ << "\n      sphc::refresh_ghosts(box, " << D << ", ghosts_" << D << ", "
+    scene_ << "\n      sphc::refresh_ghosts(box, " << hostData(d) << ", ghosts_" << D << ", "
            << propIndexList(d, refresh) << ");\n";
 }
 
@@ -1221,12 +1233,24 @@ void Emitter::emitDomainSetup() {
   scene_ << "    sphc::check_domain(box);\n";
 }
 
-// update_neighbours of a scene with a periodic or mirror domain: the search domain of the
-// real particles, the cell-order permutation (of real particles), then the ghosts of every
-// source array, and the cell lists over real particles and ghosts.
-void Emitter::emitUpdateNeighboursWithGhosts() {
-  if (loopArrays_.empty()) return;
-  const char* axes[3] = {"x", "y", "z"};
+void Emitter::emitSearchDomain() {
+  if (cpuSingle_) {
+    // The search domain spans every array that takes part in a neighbour loop (float data).
+    const char* axes[3] = {"x", "y", "z"};
+    scene_ << "    domain = sphc::make_search_domain_float({";
+    bool first = true;
+    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+      if (!loopArrays_.count(arr(a).name)) continue;
+      scene_ << (first ? "" : ",\n                                             ") << "{";
+      for (int k = 0; k < 3; ++k)
+        scene_ << (k < plan_.dim ? propPtr(a, axes[k]) : std::string("nullptr")) << ", ";
+      scene_ << propPtr(a, "h") << ", " << arr(a).name << ".n}";
+      first = false;
+    }
+    scene_ << "}, DIM, Kernel::radius_scale);\n";
+    return;
+  }
+  // The search domain spans every array that takes part in a neighbour loop.
   scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
   bool first = true;
   for (const auto& a : plan_.arrays) {
@@ -1236,6 +1260,15 @@ void Emitter::emitUpdateNeighboursWithGhosts() {
   }
   scene_ << "};\n";
   scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
+}
+
+// update_neighbours of a scene with a periodic or mirror domain: the search domain of the
+// real particles, the cell-order permutation (of real particles), then the ghosts of every
+// source array, and the cell lists over real particles and ghosts.
+void Emitter::emitUpdateNeighboursWithGhosts() {
+  if (loopArrays_.empty()) return;
+  const char* axes[3] = {"x", "y", "z"};
+  emitSearchDomain();
   if (sourceArrays_.empty()) return;
   auto build = [&](const std::string& S, const std::string& count) {
     int s = plan_.arrayIndex(S);
@@ -1247,14 +1280,13 @@ void Emitter::emitUpdateNeighboursWithGhosts() {
   scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
   scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
   for (const auto& S : sourceArrays_)
-    scene_ << "      " << build(S, S + ".n") << "\n      " << S << ".permute(cells_" << S
-           << ".cell_order());\n";
+    scene_ << "      " << build(S, S + ".n") << "\n      " << permuteInCellOrder(S) << "\n";
   scene_ << "    }\n";
   scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
   scene_ << "    const double cutoff = domain.cell_size;\n";
   for (const auto& S : sourceArrays_) {
     int s = plan_.arrayIndex(S);
-    scene_ << "    sphc::add_ghosts(box, " << S << ", cutoff, ghosts_" << S << ", "
+    scene_ << "    sphc::add_ghosts(box, " << hostData(s) << ", cutoff, ghosts_" << S << ", "
            << propIndexList(s, arr(s).ghostProps) << ");  //";
     for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
     scene_ << "\n";
@@ -1268,7 +1300,8 @@ std::string Emitter::removeGhosts() const {
   std::string r;
   for (const auto& S : sourceArrays_)
     r += opencl_ ? "    ghosts_" + S + ".remove();\n"
-                 : "    sphc::remove_ghosts(" + S + ", ghosts_" + S + ");\n";
+                 : "    sphc::remove_ghosts(" + hostData(plan_.arrayIndex(S)) + ", ghosts_" + S +
+                           ");\n";
   return r;
 }
 
@@ -1355,32 +1388,7 @@ void Emitter::emitUpdateNeighbours() {
              << ");\n      " << build << "\n    }\n";
     }
   }
-  if (!loopArrays_.empty() && cpuSingle_) {
-    // The search domain spans every array that takes part in a neighbour loop (float data).
-    const char* axes[3] = {"x", "y", "z"};
-    scene_ << "    domain = sphc::make_search_domain_float({";
-    bool first = true;
-    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
-      if (!loopArrays_.count(arr(a).name)) continue;
-      scene_ << (first ? "" : ",\n                                             ") << "{";
-      for (int k = 0; k < 3; ++k)
-        scene_ << (k < plan_.dim ? propPtr(a, axes[k]) : std::string("nullptr")) << ", ";
-      scene_ << propPtr(a, "h") << ", " << arr(a).name << ".n}";
-      first = false;
-    }
-    scene_ << "}, DIM, Kernel::radius_scale);\n";
-  } else if (!loopArrays_.empty() && !opencl_) {
-    // The search domain spans every array that takes part in a neighbour loop.
-    scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
-    bool first = true;
-    for (const auto& a : plan_.arrays) {
-      if (!loopArrays_.count(a.name)) continue;
-      scene_ << (first ? "" : ", ") << "&" << a.name;
-      first = false;
-    }
-    scene_ << "};\n";
-    scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
-  }
+  if (!loopArrays_.empty() && !opencl_) emitSearchDomain();
   if (!sourceArrays_.empty() && !opencl_) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
@@ -1395,12 +1403,8 @@ void Emitter::emitUpdateNeighbours() {
       build += ", " + (k < plan_.dim ? propPtr(s, axes[k]) : std::string("nullptr"));
     build += ", " + S + ".n);";
     scene_ << "    " << build << "\n";
-    if (cpuSingle_)
-      scene_ << "    if (reorder) {\n      f32_" << S << ".permute(cells_" << S
-             << ".cell_order(), " << S << ");\n      " << build << "\n    }\n";
-    else
-      scene_ << "    if (reorder) {\n      " << S << ".permute(cells_" << S
-             << ".cell_order());\n      " << build << "\n    }\n";
+    scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build
+           << "\n    }\n";
   }
   scene_ << "  }\n\n";
   scene_ << "  void compute_accelerations(double t, double dt) {\n";
@@ -1428,7 +1432,7 @@ void Emitter::emitStep() {
         scene_ << "    sphc::ocl::wrap_periodic(ocl, box, dev_" << a.name << ", " << a.name
                << ");\n";
       else
-        scene_ << "    sphc::wrap_periodic(box, " << a.name << ");\n";
+        scene_ << "    sphc::wrap_periodic(box, " << hostData(plan_.arrayIndex(a.name)) << ");\n";
     scene_ << "  }\n\n";
     scene_ << "  // Rebuilds the neighbour search of every array that is a source, with ghosts.\n";
     scene_ << "  void update_neighbours() {\n";

@@ -151,13 +151,6 @@ int main(int argc, char** argv) {
     return true;
   };
   if (dump("sema")) return 0;
-  // Ghosts are copies in the double host arrays; --precision=single on the CPU computes on
-  // float copies of them, which have no ghosts yet.
-  if (Precision == "single" && Backend != "opencl" && plan->domain.any()) {
-    diags.error(plan->domain.loc, "periodic and mirror domains are not supported with "
-                                  "--precision=single yet; use --precision=double");
-    return fail();
-  }
 
   {
     std::vector<BodySource> sources;

@@ -15,13 +15,35 @@ const char* const kVelocity[3] = {"u", "v", "w"};
 
 std::string axis_name(int a) { return std::string("axis ") + kAxis[a]; }
 
-// Storage of property p resized to n particles (new values 0).
-void resize_storage(Property& p, std::size_t n) {
-  const std::size_t len = n * static_cast<std::size_t>(p.stride);
-  switch (p.type) {
-    case PropType::F64: p.f64.resize(len, 0.0); break;
-    case PropType::I32: p.i32.resize(len, 0); break;
-    case PropType::U32: p.u32.resize(len, 0u); break;
+// Where the floating values of a property live: the host doubles (HostReals) or the float
+// copy (FloatReals, --precision=single). Integer properties always live in the host array.
+struct HostReals {
+  using Real = double;
+  ParticleArray& a;
+  std::vector<double>& of(std::size_t i) { return a.props[i].f64; }
+};
+struct FloatReals {
+  using Real = float;
+  FloatArray& f;
+  std::vector<float>& of(std::size_t i) {
+    if (i >= f.props.size())
+      throw std::out_of_range("ghosts: the float copy has no property number " +
+                              std::to_string(i) + " (upload() first)");
+    return f.props[i];
+  }
+};
+
+// Storage of every property resized to n particles (new values 0).
+template <class Reals>
+void resize_storage(Reals reals, ParticleArray& a, std::size_t n) {
+  for (std::size_t i = 0; i < a.props.size(); ++i) {
+    Property& p = a.props[i];
+    const std::size_t len = n * static_cast<std::size_t>(p.stride);
+    switch (p.type) {
+      case PropType::F64: reals.of(i).resize(len, 0); break;
+      case PropType::I32: p.i32.resize(len, 0); break;
+      case PropType::U32: p.u32.resize(len, 0u); break;
+    }
   }
 }
 
@@ -34,53 +56,136 @@ void copy_values(std::vector<T>& v, std::size_t n, int stride, const Ghosts& g) 
 
 int image_along(std::uint8_t image, int axis) { return (image >> (2 * axis)) & 3; }
 
-// The coordinate of the image of v along axis a (code 1: through the low side, 2: high).
-double image_coordinate(const Domain& d, int a, int code, double v) {
-  const bool low = code == 1;
-  const Boundary kind = low ? d.lo_kind[a] : d.hi_kind[a];
-  if (kind == Boundary::Periodic) {
-    const double period = d.hi[a] - d.lo[a];
-    return low ? v + period : v - period;
+// v through the transform, in the arithmetic of T (t rounded to T first).
+template <class T>
+T transformed(const GhostTransform& tr, T v) {
+  const T t = static_cast<T>(tr.t);
+  switch (tr.op) {
+    case GhostOp::Shift: return v + t;
+    case GhostOp::Reflect: return t - v;
+    case GhostOp::Negate: return -v;
+    case GhostOp::Copy: break;
   }
-  return low ? 2.0 * d.lo[a] - v : 2.0 * d.hi[a] - v;
+  return v;
 }
 
-void copy_property(const Domain& d, ParticleArray& a, const Ghosts& g, int idx) {
+template <class Reals>
+void copy_property(const Domain& d, Reals reals, ParticleArray& a, const Ghosts& g, int idx) {
+  using Real = typename Reals::Real;
   if (idx < 0 || static_cast<std::size_t>(idx) >= a.props.size())
     throw std::out_of_range("ghosts of array '" + a.name + "': no property number " +
                             std::to_string(idx));
   Property& p = a.props[idx];
   const std::size_t n = a.n;
-  int position = -1, velocity = -1;
-  for (int ax = 0; ax < 3; ++ax) {
-    if (p.name == kAxis[ax]) position = ax;
-    if (p.name == kVelocity[ax]) velocity = ax;
-  }
-  if (p.type == PropType::F64 && p.stride == 1 && position >= 0) {
-    double* v = p.f64.data();
-    for (std::size_t k = 0; k < g.size(); ++k) {
-      const int code = image_along(g.image[k], position);
-      const double x = v[g.source[k]];
-      v[n + k] = code ? image_coordinate(d, position, code, x) : x;
-    }
-    return;
-  }
-  if (p.type == PropType::F64 && p.stride == 1 && velocity >= 0) {
-    double* v = p.f64.data();
-    for (std::size_t k = 0; k < g.size(); ++k) {
-      const int code = image_along(g.image[k], velocity);
-      const bool mirrored =
-          code && (code == 1 ? d.lo_kind[velocity] : d.hi_kind[velocity]) == Boundary::Mirror;
-      const double u = v[g.source[k]];
-      v[n + k] = mirrored ? -u : u;
-    }
+  bool position = false;
+  const int axis = ghost_axis(p, position);
+  if (axis >= 0) {
+    const GhostTransform side[3] = {GhostTransform{}, ghost_transform(d, axis, 0, position),
+                                    ghost_transform(d, axis, 1, position)};
+    Real* v = reals.of(static_cast<std::size_t>(idx)).data();
+    for (std::size_t k = 0; k < g.size(); ++k)
+      v[n + k] = transformed(side[image_along(g.image[k], axis)], v[g.source[k]]);
     return;
   }
   switch (p.type) {
-    case PropType::F64: copy_values(p.f64, n, p.stride, g); break;
+    case PropType::F64: copy_values(reals.of(static_cast<std::size_t>(idx)), n, p.stride, g); break;
     case PropType::I32: copy_values(p.i32, n, p.stride, g); break;
     case PropType::U32: copy_values(p.u32, n, p.stride, g); break;
   }
+}
+
+// wrap_periodic of n coordinates x along axis ax, in the arithmetic of T.
+template <class T>
+void wrap_axis(const Domain& d, int ax, T* x, std::size_t n) {
+  const T lo = static_cast<T>(d.lo[ax]), hi = static_cast<T>(d.hi[ax]), period = hi - lo;
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    T v = x[i];
+    if (!std::isfinite(v) || (v >= lo && v < hi)) continue;
+    // Whole periods; the checks after it catch rounding at the ends.
+    v -= std::floor((v - lo) / period) * period;
+    if (v >= hi) v -= period;
+    if (v < lo) v = lo;
+    x[i] = v;
+  }
+}
+
+template <class Reals>
+void wrap_all(const Domain& d, Reals reals, const ParticleArray& a) {
+  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
+    if (!d.periodic(ax)) continue;
+    const int idx = a.find(kAxis[ax]);
+    if (idx < 0 || a.props[idx].type != PropType::F64) continue;
+    wrap_axis(d, ax, reals.of(static_cast<std::size_t>(idx)).data(), a.n);
+  }
+}
+
+template <class Reals>
+std::size_t add_all(const Domain& d, Reals reals, ParticleArray& a, double cutoff, Ghosts& g,
+                    const std::vector<int>& carried) {
+  using Real = typename Reals::Real;
+  const Real* pos[3] = {nullptr, nullptr, nullptr};
+  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
+    const int idx = a.find(kAxis[ax]);
+    if (idx >= 0 && a.props[idx].type == PropType::F64)
+      pos[ax] = reals.of(static_cast<std::size_t>(idx)).data();
+  }
+  find_ghosts(d, pos, a.n, cutoff, g, a.name);
+  resize_storage(reals, a, a.n + g.size());
+  for (int idx : carried) copy_property(d, reals, a, g, idx);
+  return g.size();
+}
+
+template <class T>
+std::size_t find_ghosts_of(const Domain& d, const T* const pos[3], std::size_t n, double cutoff,
+                           Ghosts& g, const std::string& array) {
+  g.source.clear();
+  g.image.clear();
+  if (!(cutoff >= 0.0) || !std::isfinite(cutoff))
+    throw std::invalid_argument("ghosts of array '" + array + "': the cutoff must be finite "
+                                "and >= 0");
+  // Which sides make images, and the coordinates read per axis.
+  bool makes[3][2] = {{false, false}, {false, false}, {false, false}};
+  const T* axis[3] = {nullptr, nullptr, nullptr};
+  bool any = false;
+  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
+    makes[ax][0] = d.lo_kind[ax] != Boundary::Open;
+    makes[ax][1] = d.hi_kind[ax] != Boundary::Open;
+    if (!makes[ax][0] && !makes[ax][1]) continue;
+    any = true;
+    if (makes[ax][0] && makes[ax][1] && d.hi[ax] - d.lo[ax] < cutoff)
+      throw std::invalid_argument(
+          "ghosts of array '" + array + "': " + axis_name(ax) + " spans " +
+          std::to_string(d.hi[ax] - d.lo[ax]) + ", less than the interaction radius " +
+          std::to_string(cutoff) + " (radius_scale * max h); enlarge the domain or reduce h");
+    if (!pos[ax])
+      throw std::invalid_argument("ghosts of array '" + array + "': no position " + kAxis[ax]);
+    axis[ax] = pos[ax];
+  }
+  if (!any) return 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    // Per axis the images this particle has: 0 (itself) and 1 / 2 when near a side.
+    int codes[3][3];
+    int count[3] = {1, 1, 1};
+    for (int ax = 0; ax < 3; ++ax) {
+      codes[ax][0] = 0;
+      if (!axis[ax]) continue;
+      const double v = axis[ax][i];  // a float widened: compared in double
+      if (!std::isfinite(v)) continue;
+      if (makes[ax][0] && v < d.lo[ax] + cutoff) codes[ax][count[ax]++] = 1;
+      if (makes[ax][1] && v > d.hi[ax] - cutoff) codes[ax][count[ax]++] = 2;
+    }
+    // Every combination but the particle itself (corners and edges included).
+    for (int cz = 0; cz < count[2]; ++cz)
+      for (int cy = 0; cy < count[1]; ++cy)
+        for (int cx = 0; cx < count[0]; ++cx) {
+          const int image = codes[0][cx] | (codes[1][cy] << 2) | (codes[2][cz] << 4);
+          if (image == 0) continue;
+          g.source.push_back(static_cast<std::uint32_t>(i));
+          g.image.push_back(static_cast<std::uint8_t>(image));
+        }
+  }
+  return g.size();
 }
 
 }  // namespace
@@ -113,97 +218,81 @@ void check_domain(const Domain& d) {
   }
 }
 
-void wrap_periodic(const Domain& d, ParticleArray& a) {
-  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
-    if (!d.periodic(ax)) continue;
-    const int idx = a.find(kAxis[ax]);
-    if (idx < 0 || a.props[idx].type != PropType::F64) continue;
-    double* x = a.props[idx].f64.data();
-    const double lo = d.lo[ax], hi = d.hi[ax], period = hi - lo;
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < a.n; ++i) {
-      double v = x[i];
-      if (!std::isfinite(v) || (v >= lo && v < hi)) continue;
-      // Whole periods; the checks after it catch rounding at the ends.
-      v -= std::floor((v - lo) / period) * period;
-      if (v >= hi) v -= period;
-      if (v < lo) v = lo;
-      x[i] = v;
-    }
+GhostTransform ghost_transform(const Domain& d, int axis, int side, bool position) {
+  GhostTransform t;
+  if (axis < 0 || axis >= 3 || side < 0 || side > 1) return t;
+  const Boundary kind = side == 0 ? d.lo_kind[axis] : d.hi_kind[axis];
+  if (kind == Boundary::Open) return t;
+  const double period = d.hi[axis] - d.lo[axis];
+  if (position && kind == Boundary::Periodic) {
+    t.op = GhostOp::Shift;  // x + L through the low side, x - L through the high side
+    t.t = side == 0 ? period : -period;
+  } else if (position) {
+    t.op = GhostOp::Reflect;  // 2 lo - x, 2 hi - x
+    t.t = 2.0 * (side == 0 ? d.lo[axis] : d.hi[axis]);
+  } else if (kind == Boundary::Mirror) {
+    t.op = GhostOp::Negate;  // the velocity component normal to a mirror
   }
+  return t;
+}
+
+int ghost_axis(const Property& p, bool& position) {
+  position = false;
+  if (p.type != PropType::F64 || p.stride != 1) return -1;
+  for (int ax = 0; ax < 3; ++ax) {
+    if (p.name == kAxis[ax]) {
+      position = true;
+      return ax;
+    }
+    if (p.name == kVelocity[ax]) return ax;
+  }
+  return -1;
+}
+
+void wrap_periodic(const Domain& d, ParticleArray& a) { wrap_all(d, HostReals{a}, a); }
+
+void wrap_periodic(const Domain& d, FloatArray& f, const ParticleArray& a) {
+  wrap_all(d, FloatReals{f}, a);
 }
 
 std::size_t find_ghosts(const Domain& d, const double* const pos[3], std::size_t n,
                         double cutoff, Ghosts& g, const std::string& array) {
-  g.source.clear();
-  g.image.clear();
-  if (!(cutoff >= 0.0) || !std::isfinite(cutoff))
-    throw std::invalid_argument("ghosts of array '" + array + "': the cutoff must be finite "
-                                "and >= 0");
-  // Which sides make images, and the coordinates read per axis.
-  bool makes[3][2] = {{false, false}, {false, false}, {false, false}};
-  const double* axis[3] = {nullptr, nullptr, nullptr};
-  bool any = false;
-  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
-    makes[ax][0] = d.lo_kind[ax] != Boundary::Open;
-    makes[ax][1] = d.hi_kind[ax] != Boundary::Open;
-    if (!makes[ax][0] && !makes[ax][1]) continue;
-    any = true;
-    if (makes[ax][0] && makes[ax][1] && d.hi[ax] - d.lo[ax] < cutoff)
-      throw std::invalid_argument(
-          "ghosts of array '" + array + "': " + axis_name(ax) + " spans " +
-          std::to_string(d.hi[ax] - d.lo[ax]) + ", less than the interaction radius " +
-          std::to_string(cutoff) + " (radius_scale * max h); enlarge the domain or reduce h");
-    if (!pos[ax])
-      throw std::invalid_argument("ghosts of array '" + array + "': no position " + kAxis[ax]);
-    axis[ax] = pos[ax];
-  }
-  if (!any) return 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    // Per axis the images this particle has: 0 (itself) and 1 / 2 when near a side.
-    int codes[3][3];
-    int count[3] = {1, 1, 1};
-    for (int ax = 0; ax < 3; ++ax) {
-      codes[ax][0] = 0;
-      if (!axis[ax]) continue;
-      const double v = axis[ax][i];
-      if (!std::isfinite(v)) continue;
-      if (makes[ax][0] && v < d.lo[ax] + cutoff) codes[ax][count[ax]++] = 1;
-      if (makes[ax][1] && v > d.hi[ax] - cutoff) codes[ax][count[ax]++] = 2;
-    }
-    // Every combination but the particle itself (corners and edges included).
-    for (int cz = 0; cz < count[2]; ++cz)
-      for (int cy = 0; cy < count[1]; ++cy)
-        for (int cx = 0; cx < count[0]; ++cx) {
-          const int image = codes[0][cx] | (codes[1][cy] << 2) | (codes[2][cz] << 4);
-          if (image == 0) continue;
-          g.source.push_back(static_cast<std::uint32_t>(i));
-          g.image.push_back(static_cast<std::uint8_t>(image));
-        }
-  }
-  return g.size();
+  return find_ghosts_of(d, pos, n, cutoff, g, array);
+}
+
+std::size_t find_ghosts(const Domain& d, const float* const pos[3], std::size_t n,
+                        double cutoff, Ghosts& g, const std::string& array) {
+  return find_ghosts_of(d, pos, n, cutoff, g, array);
 }
 
 std::size_t add_ghosts(const Domain& d, ParticleArray& a, double cutoff, Ghosts& g,
                        const std::vector<int>& carried) {
-  const double* pos[3] = {nullptr, nullptr, nullptr};
-  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
-    const int idx = a.find(kAxis[ax]);
-    if (idx >= 0 && a.props[idx].type == PropType::F64) pos[ax] = a.props[idx].f64.data();
-  }
-  find_ghosts(d, pos, a.n, cutoff, g, a.name);
-  for (Property& p : a.props) resize_storage(p, a.n + g.size());
-  for (int idx : carried) copy_property(d, a, g, idx);
-  return g.size();
+  return add_all(d, HostReals{a}, a, cutoff, g, carried);
+}
+
+std::size_t add_ghosts(const Domain& d, FloatArray& f, ParticleArray& a, double cutoff, Ghosts& g,
+                       const std::vector<int>& carried) {
+  return add_all(d, FloatReals{f}, a, cutoff, g, carried);
 }
 
 void refresh_ghosts(const Domain& d, ParticleArray& a, const Ghosts& g,
                     const std::vector<int>& props) {
-  for (int idx : props) copy_property(d, a, g, idx);
+  for (int idx : props) copy_property(d, HostReals{a}, a, g, idx);
+}
+
+void refresh_ghosts(const Domain& d, FloatArray& f, ParticleArray& a, const Ghosts& g,
+                    const std::vector<int>& props) {
+  for (int idx : props) copy_property(d, FloatReals{f}, a, g, idx);
 }
 
 void remove_ghosts(ParticleArray& a, Ghosts& g) {
-  for (Property& p : a.props) resize_storage(p, a.n);
+  resize_storage(HostReals{a}, a, a.n);
+  g.source.clear();
+  g.image.clear();
+}
+
+void remove_ghosts(FloatArray& f, ParticleArray& a, Ghosts& g) {
+  resize_storage(FloatReals{f}, a, a.n);
   g.source.clear();
   g.image.clear();
 }

@@ -135,7 +135,7 @@ __kernel void sphc_wrap_periodic(__global real* x, const uint n, const real lo, 
   x[i] = v;
 }
 // Ghost k of v (slot n + k) from its source through its image along `axis`: per side a mode
-// (0: copy, 1: x + t, 2: t - x, 3: -x), as sphc::add_ghosts.
+// (sphc::GhostOp: 0: copy, 1: x + t, 2: t - x, 3: -x), as sphc::add_ghosts.
 __kernel void sphc_ghost_real(__global real* v, __global const uint* source,
                               __global const uchar* image, const uint n, const uint g,
                               const int axis, const int mode_lo, const real t_lo,
@@ -783,7 +783,6 @@ void DeviceArray::release() {
 
 namespace {
 const char* const kAxisName[3] = {"x", "y", "z"};
-const char* const kVelocityName[3] = {"u", "v", "w"};
 
 // The index of the double property `name` of a, or -1.
 int real_prop(const ParticleArray& a, const char* name) {
@@ -851,31 +850,14 @@ void DeviceGhosts::refresh(Context& ctx, const Domain& d, const ParticleArray& a
       throw std::out_of_range("ghosts of array '" + a.name + "': no property number " +
                               std::to_string(idx));
     const Property& p = a.props[idx];
-    int position = -1, velocity = -1;
-    for (int ax = 0; ax < 3; ++ax) {
-      if (p.name == kAxisName[ax]) position = ax;
-      if (p.name == kVelocityName[ax]) velocity = ax;
-    }
-    if (p.type == PropType::F64 && p.stride == 1 && (position >= 0 || velocity >= 0)) {
-      // Per side: the mode and constant of sphc_ghost_real (see domain.cpp's transforms).
-      const int ax = position >= 0 ? position : velocity;
-      int mode[2] = {0, 0};
-      double t[2] = {0.0, 0.0};
-      for (int side = 0; side < 2; ++side) {
-        const Boundary kind = side == 0 ? d.lo_kind[ax] : d.hi_kind[ax];
-        if (kind == Boundary::Open) continue;
-        if (position >= 0 && kind == Boundary::Periodic) {
-          mode[side] = 1;  // x + L through the low side, x - L through the high side
-          t[side] = side == 0 ? d.hi[ax] - d.lo[ax] : -(d.hi[ax] - d.lo[ax]);
-        } else if (position >= 0) {
-          mode[side] = 2;  // 2 lo - x, 2 hi - x
-          t[side] = 2.0 * (side == 0 ? d.lo[ax] : d.hi[ax]);
-        } else if (kind == Boundary::Mirror) {
-          mode[side] = 3;  // the normal velocity negated
-        }
-      }
-      ctx.run("sphc_ghost_real", g, dev.prop(idx), source, image, un, ug, ax, mode[0], t[0],
-              mode[1], t[1]);
+    bool position = false;
+    const int ax = ghost_axis(p, position);
+    if (ax >= 0) {
+      // Per side the op (sphc_ghost_real's mode) and constant of the CPU's transform.
+      const GhostTransform lo = ghost_transform(d, ax, 0, position);
+      const GhostTransform hi = ghost_transform(d, ax, 1, position);
+      ctx.run("sphc_ghost_real", g, dev.prop(idx), source, image, un, ug, ax,
+              static_cast<int>(lo.op), lo.t, static_cast<int>(hi.op), hi.t);
       continue;
     }
     const bool wide = p.type == PropType::F64 && ctx.double_precision();

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "sphc/domain.h"
+#include "sphc/float_arrays.h"
 #include "sphc/nnps.h"
 #include "sphc/particle_array.h"
 
@@ -37,6 +38,30 @@ Domain periodic_box(int dim, double L) {
     d.hi[a] = L;
   }
   return d;
+}
+
+// Periodic in x on [0, 1), a mirror at y = 0 and mirrors at z = 0 and z = 1.
+Domain mixed_box() {
+  Domain d;
+  d.dim = 3;
+  d.lo_kind[0] = d.hi_kind[0] = Boundary::Periodic;
+  d.hi[0] = 1.0;
+  d.lo_kind[1] = Boundary::Mirror;  // y >= 0
+  d.lo_kind[2] = d.hi_kind[2] = Boundary::Mirror;
+  d.hi[2] = 1.0;
+  return d;
+}
+
+// 300 random points of [0, 1)^3 with values of type T (float: exact in double too); point 0
+// in a corner of mixed_box(), 2 x 2 x 2 - 1 = 7 ghosts.
+template <class T>
+std::vector<std::array<double, 3>> random_points(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<T> unit(T(0), T(1));
+  std::vector<std::array<double, 3>> pts(300);
+  for (auto& p : pts) p = {unit(rng), unit(rng), unit(rng)};
+  pts[0] = {T(0.01), T(0.02), T(0.03)};
+  return pts;
 }
 
 ParticleArray make_array(const std::vector<std::array<double, 3>>& pts, double h) {
@@ -232,19 +257,8 @@ TEST(Domain, CornersGetEveryCombinationOfImages) {
 TEST(Domain, FindGhostsOnRawPositionsIsTheListOfAddGhosts) {
   // find_ghosts (the OpenCL backend calls it on positions read from the device) and
   // add_ghosts give the same ghosts in the same order: by particle, then image (x fastest).
-  Domain d;
-  d.dim = 3;
-  d.lo_kind[0] = d.hi_kind[0] = Boundary::Periodic;
-  d.hi[0] = 1.0;
-  d.lo_kind[1] = Boundary::Mirror;  // y >= 0
-  d.lo_kind[2] = d.hi_kind[2] = Boundary::Mirror;
-  d.hi[2] = 1.0;
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::vector<std::array<double, 3>> pts(300);
-  for (auto& p : pts) p = {unit(rng), unit(rng), unit(rng)};
-  pts[0] = {0.01, 0.02, 0.03};  // a corner: 2 x 2 x 2 - 1 = 7 ghosts
-  ParticleArray pa = make_array(pts, 0.05);
+  const Domain d = mixed_box();
+  ParticleArray pa = make_array(random_points<double>(7), 0.05);
   std::vector<double> x(pa.f64("x"), pa.f64("x") + pa.n), y(pa.f64("y"), pa.f64("y") + pa.n),
       z(pa.f64("z"), pa.f64("z") + pa.n);
   Ghosts g, raw;
@@ -291,6 +305,75 @@ TEST(Domain, OnlyCarriedPropertiesAreCopiedAndRefreshWorks) {
   pa.f64("m")[0] = 42.0;
   sphc::refresh_ghosts(d, pa, g, {pa.find("m")});
   EXPECT_EQ(pa.f64("m")[1], 42.0);
+}
+
+TEST(Domain, FloatCopyGetsTheGhostsOfTheDoubles) {
+  // --precision=single: the ghosts of a float copy are those of the double array it was made
+  // from (positions that are floats, so both see the same positions): the same list, and
+  // every ghost value the double one rounded to float (the shifts by 1 and reflections in 0
+  // and 1 of a float are exact in double, so rounding once gives float arithmetic's result).
+  // Integer properties grow ghosts in the host array; the host doubles stay at n particles.
+  const Domain d = mixed_box();
+  ParticleArray pa = make_array(random_points<float>(11), 0.05);
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  const int tag = pa.add_property("tag", sphc::PropType::I32);
+  for (std::size_t i = 0; i < pa.n; ++i) pa.i32(tag)[i] = static_cast<std::int32_t>(i);
+  for (const char* p : {"u", "v", "w", "m"})
+    for (std::size_t i = 0; i < pa.n; ++i) pa.f64(p)[i] = unit(rng);
+  sphc::FloatArray f;
+  f.upload(pa);
+  ParticleArray ref = pa;
+  Ghosts g, gref;
+  const std::size_t n = pa.n;
+  sphc::add_ghosts(d, ref, 0.1, gref, all_props(ref));
+  ASSERT_EQ(sphc::add_ghosts(d, f, pa, 0.1, g, all_props(pa)), gref.size());
+  ASSERT_GE(g.size(), 7u);
+  EXPECT_EQ(g.source, gref.source);
+  EXPECT_EQ(g.image, gref.image);
+  for (std::size_t i = 0; i < pa.props.size(); ++i) {
+    const auto& p = pa.props[i];
+    if (p.type != sphc::PropType::F64) {
+      EXPECT_EQ(p.i32, ref.props[i].i32) << p.name;  // ghosts in the host array
+      continue;
+    }
+    EXPECT_EQ(p.f64.size(), n) << p.name;  // the doubles are left alone
+    ASSERT_EQ(f.props[i].size(), n + g.size()) << p.name;
+    for (std::size_t k = n; k < n + g.size(); ++k)
+      ASSERT_EQ(f.props[i][k], static_cast<float>(ref.props[i].f64[k])) << p.name << " " << k;
+  }
+  // The corner particle's images through y = 0 have v negated, in the float copy too.
+  EXPECT_EQ(f.f(pa.find("v"))[n + 1], -f.f(pa.find("v"))[0]);
+  // Refresh after a phase changed the real particles' values; then back to n particles.
+  f.f(pa.find("m"))[0] = 42.0f;
+  sphc::refresh_ghosts(d, f, pa, g, {pa.find("m")});
+  for (std::size_t k = 0; k < g.size(); ++k)
+    if (g.source[k] == 0) EXPECT_EQ(f.f(pa.find("m"))[n + k], 42.0f);
+  sphc::remove_ghosts(f, pa, g);
+  EXPECT_EQ(g.size(), 0u);
+  for (std::size_t i = 0; i < pa.props.size(); ++i)
+    EXPECT_EQ(pa.props[i].type == sphc::PropType::F64 ? f.props[i].size() : pa.props[i].i32.size(),
+              n)
+        << pa.props[i].name;
+  EXPECT_NO_THROW(f.download(pa));
+}
+
+TEST(Domain, FloatWrapStaysInTheFloatBox) {
+  // Wrapping in float: -1e-9 plus the period rounds to 1.0f, the high end, which belongs to
+  // the next period; the checks after the shift bring it back to the low end.
+  ParticleArray pa = make_array({{-0.25, 0.5, 0}, {1.25, 1.0, 0}, {-1e-9, -2.75, 0}}, 0.1);
+  sphc::FloatArray f;
+  f.upload(pa);
+  sphc::wrap_periodic(periodic_box(2, 1.0), f, pa);
+  const float* x = f.f(pa.find("x"));
+  const float* y = f.f(pa.find("y"));
+  EXPECT_EQ(x[0], 0.75f);
+  EXPECT_EQ(x[1], 0.25f);
+  EXPECT_EQ(y[1], 0.0f);
+  EXPECT_EQ(y[2], 0.25f);
+  EXPECT_GE(x[2], 0.0f);
+  EXPECT_LT(x[2], 1.0f);
+  EXPECT_EQ(pa.f64("x")[0], -0.25);  // the host doubles are left alone
 }
 
 TEST(Domain, RejectsBadDomains) {

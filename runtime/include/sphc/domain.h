@@ -28,6 +28,17 @@
 // normal to it); every other property (any type or stride) is copied unchanged. Other
 // properties of ghosts have storage but unspecified values.
 //
+// Single precision (--precision=single on the CPU backends). The scene computes on the float
+// copy of each array (sphc::FloatArray, float_arrays.h); the overloads taking a FloatArray do
+// the same on it: its floats hold the positions and ghosts, the integer properties of the host
+// array (which have no float copy) grow ghosts as above, and the host doubles are left alone
+// (they hold n particles). The arithmetic is that of the element type: wrapping and the
+// ghost transforms round the planes and periods to float first and then compute in float, as
+// the OpenCL kernels do with `real` = float; ghosts are found by comparing the float positions,
+// widened to double, with the double planes (the OpenCL backend reads its float positions
+// into doubles for find_ghosts), so every backend finds the same ghosts from the same
+// positions.
+//
 // Requirements: a periodic axis needs hi - lo >= cutoff (one image per side is then
 // enough), and so does an axis with mirrors on both sides; add_ghosts throws
 // std::invalid_argument otherwise. Particles are never moved back through a mirror plane (the
@@ -40,6 +51,7 @@
 #include <string>
 #include <vector>
 
+#include "sphc/float_arrays.h"
 #include "sphc/nnps.h"
 #include "sphc/particle_array.h"
 
@@ -73,6 +85,24 @@ struct Ghosts {
   std::size_t size() const { return source.size(); }
 };
 
+// How a ghost's value of a position or velocity component along an axis comes from its
+// source's value v through the image of one side: Shift (periodic position: v + t, t = +-L),
+// Reflect (mirrored position: t - v, t = 2 * plane), Negate (velocity normal to a mirror: -v)
+// or Copy. The one definition: add_ghosts and the OpenCL ghost-fill kernel both use it.
+enum class GhostOp : std::uint8_t { Copy = 0, Shift = 1, Reflect = 2, Negate = 3 };
+struct GhostTransform {
+  GhostOp op = GhostOp::Copy;
+  double t = 0.0;
+};
+// The transform of a position (position = true) or velocity component along `axis` through
+// the image of side 0 (low) or 1 (high).
+GhostTransform ghost_transform(const Domain& d, int axis, int side, bool position);
+
+// What ghosts do with property p: for a double, stride 1 position x, y, z (position = true)
+// or velocity u, v, w (position = false) the axis (0..2) of its transform; -1 for every other
+// property (copied unchanged).
+int ghost_axis(const Property& p, bool& position);
+
 // Moves the real particles of `a` that left a periodic box back into [lo, hi) along each
 // periodic axis (by whole periods). Non-finite coordinates are left as they are. Positions
 // missing from the array are skipped.
@@ -85,6 +115,8 @@ void wrap_periodic(const Domain& d, ParticleArray& a);
 // (x fastest, then y, then z; each axis: none, low, high). `array` names the array in
 // errors. Returns g.size().
 std::size_t find_ghosts(const Domain& d, const double* const pos[3], std::size_t n,
+                        double cutoff, Ghosts& g, const std::string& array);
+std::size_t find_ghosts(const Domain& d, const float* const pos[3], std::size_t n,
                         double cutoff, Ghosts& g, const std::string& array);
 
 // Finds the ghosts of the real particles of `a` within `cutoff` of a periodic or mirror side
@@ -101,6 +133,14 @@ void refresh_ghosts(const Domain& d, ParticleArray& a, const Ghosts& g,
 
 // Removes the ghosts: the storage of every property back to a.n particles; g emptied.
 void remove_ghosts(ParticleArray& a, Ghosts& g);
+
+// The same on the float copy `f` of `a` (--precision=single; see above).
+void wrap_periodic(const Domain& d, FloatArray& f, const ParticleArray& a);
+std::size_t add_ghosts(const Domain& d, FloatArray& f, ParticleArray& a, double cutoff, Ghosts& g,
+                       const std::vector<int>& carried);
+void refresh_ghosts(const Domain& d, FloatArray& f, ParticleArray& a, const Ghosts& g,
+                    const std::vector<int>& props);
+void remove_ghosts(FloatArray& f, ParticleArray& a, Ghosts& g);
 
 // Widens a search domain made from the real particles so that it covers the ghosts too:
 // `cutoff` beyond each periodic or mirror plane.

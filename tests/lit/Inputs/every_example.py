@@ -9,6 +9,13 @@ snapshot at every step; and compares every snapshot with the serial one:
   opencl (double):    within rtol 1e-10 of each property's scale (h5close.py; the reasons it
           is not bitwise and the margin are in tests/lit/backends/opencl-serial-equal.sph).
 
+With --precision single every solver is built with --precision=single (the scene computes on
+float copies of its arrays, periodic and mirror ghosts included) and the serial single run is
+the reference: the OpenMP one must equal it bitwise as above (the float arithmetic is in the
+same order on both). The single runs are not compared with the double ones here (that needs
+a tolerance per scene: tests/lit/backends/single-double.sph, tests/lit/domain/
+single-precision.sph); --opencl is refused with single for the same reason.
+
 A new example is covered by being in examples/: nothing to register. A case that a backend
 cannot run yet is named with --skip SCENE[:CHOICE]:BACKEND and reported as skipped, so the
 exclusions are visible in the RUN line of the test that calls this script; likewise
@@ -16,6 +23,7 @@ exclusions are visible in the RUN line of the test that calls this script; likew
 dataset of one case a physical scale (h5close.py --scale; the test says why).
 
 usage: every_example.py --sphc SPHC --examples DIR --out DIR [--opencl] [--steps N]
+                        [--precision double|single]
                         [--skip CASE:BACKEND ...] [--rtol CASE=R ...]
                         [--scale CASE:NAME=S ...] [--only NAME ...]
 Prints one line per case and backend ('ok', 'skipped' or what failed) and a closing line
@@ -65,7 +73,11 @@ def main():
     ap.add_argument('--rtol', action='append', default=[])
     ap.add_argument('--scale', action='append', default=[])
     ap.add_argument('--only', action='append', default=[])
+    ap.add_argument('--precision', choices=['double', 'single'], default='double')
     a = ap.parse_args()
+    if a.precision == 'single' and a.opencl:
+        ap.error('--opencl compares with a double tolerance: not with --precision single')
+    precision = ['--precision=' + a.precision]
 
     backends = ['openmp'] + (['opencl'] if a.opencl else [])
     skip = set(a.skip)
@@ -90,7 +102,7 @@ def main():
                 exe[b] = os.path.join(a.out, tag + '_' + b)
             # Serial is the reference: without it nothing of this case can be compared.
             outs = {}
-            ok = run([a.sphc, path, '-o', exe['serial']] + flags, log)
+            ok = run([a.sphc, path, '-o', exe['serial']] + flags + precision, log)
             if ok:
                 outs['serial'] = os.path.join(a.out, tag + '_serial_out')
                 ok = run([exe['serial'], '--max-steps', str(a.steps), '--output-every', '1e-12',
@@ -115,7 +127,7 @@ def main():
                 log = []
                 out = os.path.join(a.out, tag + '_' + b + '_out')
                 threads = ['--threads', '2'] if b == 'openmp' else []
-                ok = (run([a.sphc, path, '-o', exe[b], '--backend=' + b] + flags, log) and
+                ok = (run([a.sphc, path, '-o', exe[b], '--backend=' + b] + flags + precision, log) and
                       run([exe[b], '--max-steps', str(a.steps), '--output-every', '1e-12',
                            '-d', out, '--quiet'] + threads, log))
                 bad = []
