@@ -103,6 +103,29 @@ TEST(Geometry, TankCounts) {
   EXPECT_EQ(sphc::tank(1, lo, hi3, 0.25, 2, true).size(), 4u);
 }
 
+// A box whose width is not a whole number of dx (4 m at dx = 0.03 is 133.3 dx): the right
+// wall continues the lattice of the floor, so no seam wider than dx opens in the corner
+// (docs/validation.md, SISPH dam break: water leaked through one of 0.04 m).
+TEST(Geometry, TankWallsOnTheLatticeOfTheBox) {
+  const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {4.0, 4.0, 0.0};
+  const double dx = 0.03;
+  const Points wall = sphc::tank(2, lo, hi, dx, 3, false);
+  // Every x of the wall is on the lattice lo + (k + 1/2) dx.
+  for (std::size_t i = 0; i < wall.size(); ++i) {
+    const double k = wall.x[i] / dx - 0.5;
+    EXPECT_NEAR(k, std::round(k), 1e-9) << "x = " << wall.x[i];
+  }
+  // The right wall's first layer is one dx beyond the floor's last column inside the box.
+  double right_inner = INFINITY, floor_last = -INFINITY;
+  for (std::size_t i = 0; i < wall.size(); ++i) {
+    if (wall.x[i] > hi[0] - 0.5 * dx) right_inner = std::min(right_inner, wall.x[i]);
+    if (wall.y[i] < 0.0 && wall.x[i] < hi[0]) floor_last = std::max(floor_last, wall.x[i]);
+  }
+  EXPECT_NEAR(right_inner - floor_last, dx, 1e-12);
+  EXPECT_NEAR(right_inner, 133.5 * dx, 1e-12);
+  EXPECT_EQ(keys(wall, dx).size(), wall.size());
+}
+
 TEST(Geometry, TankNoDuplicatesAndInnerFace) {
   const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {1.0, 0.6, 0.0};
   const double dx = 0.05;
