@@ -1,6 +1,7 @@
 // The OpenMP runtime (libsphc_runtime_omp): its parallel parts give exactly the serial
 // results, on real threads. CellList::build with 1..4 threads against the serial sort
-// (set_sort_chunks(1)); ParticleArray::permute against a plain loop.
+// (set_sort_chunks(1)); ParticleArray::permute against a plain loop; find_non_finite (the
+// blow-up scan) against a plain loop.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "../cell_list_checks.h"
+#include "../non_finite_checks.h"
 #include "sphc/nnps.h"
 #include "sphc/particle_array.h"
 
@@ -87,6 +89,16 @@ TEST_F(OmpThreads, PermuteEqualsSerialLoop) {
   EXPECT_THROW(pa.permute(out), std::invalid_argument);
   EXPECT_TRUE(sphc::is_permutation_of(order, n));
   EXPECT_FALSE(sphc::is_permutation_of(dup, n));
+}
+
+TEST_F(OmpThreads, FindNonFiniteEqualsSerialLoop) {
+  for (int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+    for (std::size_t n : {5, 20000}) {  // 20000 x 14 values: the parallel scan
+      SCOPED_TRACE(testing::Message() << threads << " threads, " << n << " particles");
+      sphc_test::check_find_non_finite(n, 2, 6);  // fewer cases than the serial test
+    }
+  }
 }
 
 }  // namespace
