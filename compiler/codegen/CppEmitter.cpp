@@ -255,6 +255,20 @@ class Emitter {
   std::vector<NeighbourPass> neighbourPasses(const std::vector<const PlanEquation*>& eqs, int d,
                                              const PlanGroup* group);
   void emitSteppers();
+  // The C++ backends: a function per run of consecutive stepper statements of the integrator
+  // (see stepperRuns), one pass over each array doing all the run's methods per particle.
+  void emitStepperRuns();
+  // Runs of consecutive stepper statements (initialize, stageN) of the integrator's step,
+  // with the index of each statement in plan_.integratorSteps.
+  std::vector<std::vector<size_t>> stepperRuns() const;
+  bool isStepperStatement(const std::string& s) const {
+    return s != "compute_accelerations" && s != "update_domain";
+  }
+  std::string stepperRunName(const std::vector<size_t>& run) const {
+    std::string name = "stepper";
+    for (size_t k : run) name += "_" + plan_.integratorSteps[k];
+    return name;
+  }
   // Periodic and mirror domains (sphc/domain.h): the box at set-up, wrapping, ghosts.
   bool hasDomain() const { return plan_.domain.any(); }
   bool hasGhosts(int a) const { return hasDomain() && !arr(a).ghostProps.empty(); }
@@ -1165,6 +1179,10 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
 }
 
 void Emitter::emitSteppers() {
+  if (!opencl_) {
+    emitStepperRuns();
+    return;
+  }
   std::set<std::string> methods;
   for (const auto& a : plan_.arrays)
     if (a.stepper >= 0)
@@ -1200,6 +1218,85 @@ void Emitter::emitSteppers() {
       scene_ << "        " << callBody(fn, b, a, -1, "", "t") << ";\n    }\n";
     }
     scene_ << "  }\n\n";
+  }
+}
+
+std::vector<std::vector<size_t>> Emitter::stepperRuns() const {
+  std::vector<std::vector<size_t>> runs;
+  bool open = false;
+  for (size_t k = 0; k < plan_.integratorSteps.size(); ++k) {
+    if (!isStepperStatement(plan_.integratorSteps[k])) {
+      open = false;
+      continue;
+    }
+    if (!open) runs.emplace_back();
+    runs.back().push_back(k);
+    open = true;
+  }
+  return runs;
+}
+
+// Steppers are per particle (a body reads and writes its own particle d_idx only, as the
+// parallel loops of the OpenMP backend already require), so running the methods of a run
+// one after the other on each particle, in one pass, gives what running each method on all
+// particles in turn gives, bit for bit, with less memory traffic (PECIntegrator's
+// initialize and stage1 both read and write x, u, rho, ...). The arrays' passes share one
+// parallel region (`omp for nowait`: each array's particles are its own).
+void Emitter::emitStepperRuns() {
+  std::set<std::string> emitted;
+  for (const auto& run : stepperRuns()) {
+    const std::string name = stepperRunName(run);
+    if (!emitted.insert(name).second) continue;
+    struct Part {
+      int a;
+      const PlanStepper* st;
+      std::vector<std::pair<size_t, const PlanBody*>> bodies;  // (position in run, body)
+    };
+    std::vector<Part> parts;
+    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+      const PlanArray& A = arr(a);
+      if (A.stepper < 0) continue;
+      Part part{a, &plan_.steppers[A.stepper], {}};
+      for (size_t k = 0; k < run.size(); ++k) {
+        auto it = part.st->methods.find(plan_.integratorSteps[run[k]]);
+        if (it != part.st->methods.end()) part.bodies.push_back({k, &plan_.bodies[it->second]});
+      }
+      if (!part.bodies.empty()) parts.push_back(part);
+    }
+    if (parts.empty()) continue;
+    scene_ << "  void " << name << "(";
+    for (size_t k = 0; k < run.size(); ++k) scene_ << "double t_" << k << ", ";
+    scene_ << "double dt) {\n   ";
+    for (size_t k = 0; k < run.size(); ++k) scene_ << " (void)t_" << k << ";";
+    scene_ << " (void)dt;\n";
+    if (openmp_) scene_ << "    #pragma omp parallel\n";
+    scene_ << "    {\n";
+    for (const Part& part : parts) {
+      const PlanArray& A = arr(part.a);
+      scene_ << "      {  // " << A.name << ": " << part.st->decl->name.name;
+      for (size_t i = 0; i < part.bodies.size(); ++i)
+        scene_ << (i ? ", " : ".") << plan_.integratorSteps[run[part.bodies[i].first]];
+      scene_ << "\n        const int n = static_cast<int>(" << A.name << ".n);\n";
+      std::set<std::string> dprops;
+      for (const auto& [k, b] : part.bodies) {
+        for (const auto& r : b->facts.dReads) dprops.insert(r.prop);
+        for (const auto& w : b->facts.dWrites) dprops.insert(w.prop);
+      }
+      for (const auto& p : dprops)
+        scene_ << "        " << hostType(part.a, p) << "* d_" << p << " = " << propPtr(part.a, p)
+               << ";\n";
+      if (openmp_) scene_ << "        #pragma omp for schedule(static) nowait\n";
+      scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+      for (const auto& [k, b] : part.bodies) {
+        const std::string m = plan_.integratorSteps[run[k]];
+        scene_ << "          "
+               << callBody(bodyFunctionName(part.st->decl->name.name, m), *b, part.a, -1, "",
+                           "t_" + std::to_string(k))
+               << ";\n";
+      }
+      scene_ << "        }\n      }\n";
+    }
+    scene_ << "    }\n  }\n\n";
   }
 }
 
@@ -1470,9 +1567,42 @@ void Emitter::emitStep() {
   scene_ << "  // integrator " << plan_.integratorName << "\n";
   scene_ << "  void step(double t, double dt) {\n";
   int done = 0;
-  for (const auto& s : plan_.integratorSteps) {
-    std::string time = done == 0 ? "t" : "t + " + std::to_string(done) + ".0 / " +
-                                             std::to_string(stages) + ".0 * dt";
+  auto timeAfter = [&](int stagesDone) {
+    return stagesDone == 0 ? std::string("t")
+                           : "t + " + std::to_string(stagesDone) + ".0 / " +
+                                 std::to_string(stages) + ".0 * dt";
+  };
+  // The C++ backends: a run of stepper statements calls its fused function (emitStepperRuns)
+  // at the run's first statement, with each statement's time.
+  std::map<size_t, std::vector<size_t>> runAt;
+  std::set<size_t> inRun;
+  if (!opencl_) {
+    for (const auto& run : stepperRuns()) {
+      runAt[run.front()] = run;
+      inRun.insert(run.begin(), run.end());
+    }
+  }
+  for (size_t k = 0; k < plan_.integratorSteps.size(); ++k) {
+    const std::string& s = plan_.integratorSteps[k];
+    std::string time = timeAfter(done);
+    if (inRun.count(k)) {
+      auto it = runAt.find(k);
+      if (it != runAt.end()) {
+        bool any = false;  // does an array have one of the run's methods?
+        std::string args;
+        int d = done;
+        for (size_t j : it->second) {
+          const std::string& m = plan_.integratorSteps[j];
+          for (const auto& a : plan_.arrays)
+            any |= a.stepper >= 0 && plan_.steppers[a.stepper].methods.count(m);
+          args += timeAfter(d) + ", ";
+          if (m.rfind("stage", 0) == 0) ++d;
+        }
+        if (any) scene_ << "    " << stepperRunName(it->second) << "(" << args << "dt);\n";
+      }
+      if (s.rfind("stage", 0) == 0) ++done;
+      continue;
+    }
     if (s == "compute_accelerations")
       scene_ << "    compute_accelerations(" << time << ", dt);\n";
     else if (s == "update_domain")

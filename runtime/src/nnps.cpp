@@ -244,21 +244,14 @@ void CellList::build_impl(const SearchDomain& dom, const T* x, const T* y, const
 }
 
 int CellList::sort_threads(std::size_t num_cells) const {
+  (void)num_cells;
   if (sort_chunks_ > 0) return sort_chunks_;
 #ifdef _OPENMP
-  // Below this many particles per thread the parallel regions cost more than they save; the
-  // per-thread histograms also cost O(threads * cells), so sparse grids stay serial.
-  // The per-thread histograms cost O(threads x cells) per thread, the per-particle work
-  // O(n / threads): with t threads the parallel sort only pays when cells * t < n (e.g. 3D,
-  // or dense 2D packings; the 2D dam break's grid has ~1.15 cells per particle, where the
-  // serial sort measured as fast as the parallel one on 2 threads). Else the serial sort runs
-  // (with the cell keys still computed in parallel).
+  // Below this many particles per thread the parallel region costs more than it saves.
   int t = omp_in_parallel() ? 1 : omp_get_max_threads();
   if (n_ < static_cast<std::size_t>(t) * kParallelMinPerThread) t = 1;
-  if (num_cells * static_cast<std::size_t>(t) >= n_) t = 1;
   return std::max(t, 1);
 #else
-  (void)num_cells;
   return 1;
 #endif
 }
@@ -272,26 +265,7 @@ void CellList::counting_sort(std::size_t num_cells, KeyFn&& keys) {
   const int threads = sort_threads(num_cells);
   last_chunks_ = threads;
   if (threads <= 1) {
-    // Keys: independent per particle, in parallel in the OpenMP runtime when worth it.
-#ifdef _OPENMP
-    const int key_threads = omp_in_parallel() || n < 2 * kParallelMinPerThread
-                                ? 1
-                                : omp_get_max_threads();
-#else
-    const int key_threads = 1;
-#endif
-    if (key_threads > 1) {
-#pragma omp parallel num_threads(key_threads)
-      {
-#ifdef _OPENMP
-        const std::size_t t = static_cast<std::size_t>(omp_get_thread_num());
-        const std::size_t nt = static_cast<std::size_t>(omp_get_num_threads());
-        keys(n * t / nt, n * (t + 1) / nt);
-#endif
-      }
-    } else {
-      keys(0, n);
-    }
+    keys(0, n);
     // Stable counting sort by cell: count, inclusive prefix sum (start_[c] = end of cell c),
     // then place particles from last to first, decrementing, which leaves start_[c] = begin.
     std::fill(start_.begin(), start_.end(), 0u);
@@ -306,21 +280,26 @@ void CellList::counting_sort(std::size_t num_cells, KeyFn&& keys) {
     return;
   }
 
-  // The same sort in parallel, with the same result, and one barrier. Chunk k of the
-  // particles (contiguous, ascending) belongs to one thread. Pass 1: the thread computes the
-  // cells of its chunk's particles (keys) and counts them per cell in the chunk's histogram.
-  // Pass 2 (after the barrier): from all histograms, the thread computes the write offset of
-  // its chunk in every cell, begin of the cell + the particles of chunks 0..k-1 in it, so the
-  // order within a cell is ascending by index, as in the serial sort, and places its chunk's
-  // particles. Every thread scans the cell counts (O(chunks x cells) each) rather than
-  // sharing the prefix sum, which would take two more barriers: a barrier costs more than
-  // the scan on a busy machine, where a descheduled thread holds up the others.
+  // The same sort in parallel, with the same result. Chunk k of the particles (contiguous,
+  // ascending) belongs to one thread, and so does range k of the cells.
+  //  1. Chunk k: the cells of its particles (keys), their smallest and largest cell (the
+  //     chunk's window: particles are kept in cell order, so a chunk's cells are mostly a
+  //     narrow range) and the chunk's count per cell of the window.
+  //  2. Cell range k: the number of particles in it (from the windows that overlap it).
+  //  3. Cell range k: its first position (the particles of ranges 0..k-1), then per cell c
+  //     start[c] and, for every chunk j in order, j's first position in c (the particles of
+  //     chunks 0..j-1 in c), in place of j's count: within a cell the order is ascending by
+  //     index, as in the serial sort.
+  //  4. Chunk k: its particles to their positions.
+  // Work per thread O(n / T + C / T + the windows' sizes), C the cells; three barriers.
   const std::size_t T = static_cast<std::size_t>(threads);
   const std::size_t C = num_cells;
-  hist_.resize(T * C);
-  offset_.resize(T * C);
-  std::uint32_t* hist = hist_.data();
-  std::uint32_t* offsets = offset_.data();
+  if (chunk_hist_.size() < T) chunk_hist_.resize(T);
+  chunk_lo_.resize(T);
+  range_count_.resize(T);
+  std::vector<std::uint32_t>* hist = chunk_hist_.data();
+  std::uint32_t* lo = chunk_lo_.data();
+  std::uint32_t* range_count = range_count_.data();
   std::uint32_t* start = start_.data();
   std::uint32_t* order = order_.data();
   auto range = [](std::size_t total, std::size_t parts, std::size_t k) {
@@ -335,31 +314,63 @@ void CellList::counting_sort(std::size_t num_cells, KeyFn&& keys) {
     const std::size_t t = 0, nt = 1;
 #endif
     // (An OpenMP implementation may give fewer threads than asked: then each thread does
-    // the chunks k = t, t + nt, ...)
+    // the chunks and ranges k = t, t + nt, ...)
     for (std::size_t k = t; k < T; k += nt) {
-      std::uint32_t* h = hist + k * C;
-      std::fill(h, h + C, 0u);
       const auto [i0, i1] = range(n, T, k);
       keys(i0, i1);
-      for (std::size_t i = i0; i < i1; ++i) ++h[cell_of[i]];
+      std::uint32_t cmin = 0xffffffffu, cmax = 0;
+      for (std::size_t i = i0; i < i1; ++i) {
+        cmin = std::min(cmin, cell_of[i]);
+        cmax = std::max(cmax, cell_of[i]);
+      }
+      std::vector<std::uint32_t>& h = hist[k];
+      if (i0 == i1) {
+        lo[k] = 0;
+        h.clear();
+        continue;
+      }
+      lo[k] = cmin;
+      h.assign(static_cast<std::size_t>(cmax - cmin) + 1, 0u);
+      std::uint32_t* hk = h.data();
+      for (std::size_t i = i0; i < i1; ++i) ++hk[cell_of[i] - cmin];
     }
 #pragma omp barrier
     for (std::size_t k = t; k < T; k += nt) {
-      std::uint32_t* off = offsets + k * C;
-      std::uint32_t begin = 0;  // of cell c
-      for (std::size_t c = 0; c < C; ++c) {
-        std::uint32_t before = 0, total = 0;
-        for (std::size_t j = 0; j < T; ++j) {
-          const std::uint32_t count = hist[j * C + c];
-          before += j < k ? count : 0u;
-          total += count;
-        }
-        off[c] = begin + before;
-        if (k == 0) start[c] = begin;
-        begin += total;
+      const auto [c0, c1] = range(C, T, k);
+      std::uint32_t count = 0;
+      for (std::size_t j = 0; j < T; ++j) {
+        const std::size_t w0 = std::max<std::size_t>(c0, lo[j]);
+        const std::size_t w1 = std::min<std::size_t>(c1, lo[j] + hist[j].size());
+        const std::uint32_t* hj = hist[j].data();
+        for (std::size_t c = w0; c < w1; ++c) count += hj[c - lo[j]];
       }
+      range_count[k] = count;
+    }
+#pragma omp barrier
+    for (std::size_t k = t; k < T; k += nt) {
+      const auto [c0, c1] = range(C, T, k);
+      std::uint32_t running = 0;
+      for (std::size_t j = 0; j < k; ++j) running += range_count[j];
+      for (std::size_t c = c0; c < c1; ++c) {
+        start[c] = running;
+        for (std::size_t j = 0; j < T; ++j) {
+          const std::size_t w = c - lo[j];  // wraps around below the window
+          if (c >= lo[j] && w < hist[j].size()) {
+            std::uint32_t& e = hist[j][w];
+            const std::uint32_t count = e;
+            e = running;
+            running += count;
+          }
+        }
+      }
+    }
+#pragma omp barrier
+    for (std::size_t k = t; k < T; k += nt) {
       const auto [i0, i1] = range(n, T, k);
-      for (std::size_t i = i0; i < i1; ++i) order[off[cell_of[i]]++] = static_cast<std::uint32_t>(i);
+      std::uint32_t* hk = hist[k].data();
+      const std::uint32_t cmin = lo[k];
+      for (std::size_t i = i0; i < i1; ++i)
+        order[hk[cell_of[i] - cmin]++] = static_cast<std::uint32_t>(i);
     }
   }
   start_[num_cells] = static_cast<std::uint32_t>(n);

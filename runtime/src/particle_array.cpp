@@ -1,6 +1,10 @@
 // sphc runtime: particle arrays. See particle_array.h.
 #include "sphc/particle_array.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -210,6 +214,64 @@ void ParticleArray::permute(const std::vector<std::uint32_t>& order) {
       case PropType::U32: permute_values(p.u32, order, p.stride, u32); break;
     }
   }
+}
+
+namespace {
+
+// Values per block of the non-finite scan, and the fewest values worth a parallel scan.
+constexpr std::size_t kFiniteBlock = 4096;
+constexpr std::size_t kFiniteParallelMin = 65536;
+
+// True if v[0..n) holds a NaN or an infinity (all exponent bits set). No early exit and no
+// branch, so that the compiler vectorises it.
+bool has_non_finite(const double* v, std::size_t n) {
+  constexpr std::uint64_t kExponent = 0x7ff0000000000000ull;
+  std::uint64_t bad = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t bits;
+    std::memcpy(&bits, v + i, sizeof bits);
+    bad |= static_cast<std::uint64_t>((~bits & kExponent) == 0);
+  }
+  return bad != 0;
+}
+
+struct FiniteBlock {
+  const double* v;
+  std::size_t n;
+  std::size_t array, prop, begin;
+};
+
+}  // namespace
+
+std::optional<NonFiniteValue> find_non_finite(const std::vector<ParticleArray*>& arrays) {
+  std::vector<FiniteBlock> blocks;
+  std::size_t total = 0;
+  for (std::size_t a = 0; a < arrays.size(); ++a) {
+    const ParticleArray* pa = arrays[a];
+    if (pa == nullptr) continue;
+    for (std::size_t k = 0; k < pa->props.size(); ++k) {
+      const Property& p = pa->props[k];
+      if (p.type != PropType::F64) continue;
+      const std::size_t size = p.f64.size();
+      for (std::size_t b = 0; b < size; b += kFiniteBlock) {
+        blocks.push_back(FiniteBlock{p.f64.data() + b, std::min(kFiniteBlock, size - b), a, k, b});
+      }
+      total += size;
+    }
+  }
+  // The first block with a bad value: blocks are in scan order, so the smallest index.
+  const long nb = static_cast<long>(blocks.size());
+  long first = std::numeric_limits<long>::max();
+#pragma omp parallel for schedule(static) reduction(min : first) if (total >= kFiniteParallelMin)
+  for (long b = 0; b < nb; ++b) {
+    if (b < first && has_non_finite(blocks[b].v, blocks[b].n)) first = b;
+  }
+  if (first >= nb) return std::nullopt;
+  const FiniteBlock& blk = blocks[static_cast<std::size_t>(first)];
+  for (std::size_t i = 0; i < blk.n; ++i) {
+    if (!std::isfinite(blk.v[i])) return NonFiniteValue{blk.array, blk.prop, blk.begin + i};
+  }
+  return std::nullopt;  // not reached: has_non_finite and isfinite agree
 }
 
 }  // namespace sphc

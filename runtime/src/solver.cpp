@@ -406,16 +406,13 @@ struct NonFinite {
   std::size_t index;  // into prop->f64
 };
 
-std::optional<NonFinite> find_non_finite(const std::vector<ParticleArray*>& arrays) {
-  for (const ParticleArray* a : arrays) {
-    for (const Property& p : a->props) {
-      if (p.type != PropType::F64) continue;
-      for (std::size_t k = 0; k < p.f64.size(); ++k) {
-        if (!std::isfinite(p.f64[k])) return NonFinite{a, &p, k};
-      }
-    }
-  }
-  return std::nullopt;
+// The first non-finite value (sphc::find_non_finite of particle_array.h, parallel in the
+// OpenMP runtime).
+std::optional<NonFinite> first_non_finite(const std::vector<ParticleArray*>& arrays) {
+  const auto bad = sphc::find_non_finite(arrays);
+  if (!bad) return std::nullopt;
+  const ParticleArray* a = arrays[bad->array];
+  return NonFinite{a, &a->props[bad->prop], bad->index};
 }
 
 std::string describe(const NonFinite& bad) {
@@ -527,7 +524,7 @@ class Simulation {
   // Brings device data to the host (device backends) and looks for NaN or Inf in it.
   std::optional<NonFinite> check_finite() {
     if (prog_.to_host) prog_.to_host();
-    return find_non_finite(arrays_);
+    return first_non_finite(arrays_);
   }
 
   std::size_t particles() const {

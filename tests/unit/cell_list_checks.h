@@ -79,4 +79,33 @@ inline void expect_sorted_by_cell(const sphc::CellList& cl) {
   }
 }
 
+// As a simulation keeps its particles: a lattice block (spacing `spacing`, nx x ny points
+// from the origin) in a larger domain (many empty cells: more cells than points, as the 2D
+// dam break's tank), sorted in cell order by a serial build, then each point moved by up to
+// `jitter` (so that chunks of the order cover narrow, slightly overlapping cell ranges).
+inline Points lattice_in_cell_order(std::size_t nx, std::size_t ny, double spacing,
+                                    const sphc::SearchDomain& dom, double jitter,
+                                    unsigned seed) {
+  Points p;
+  for (std::size_t j = 0; j < ny; ++j) {
+    for (std::size_t i = 0; i < nx; ++i) {
+      p.x.push_back((static_cast<double>(i) + 0.5) * spacing);
+      p.y.push_back((static_cast<double>(j) + 0.5) * spacing);
+      p.z.push_back(0.0);
+    }
+  }
+  sphc::CellList cl;
+  cl.set_sort_chunks(1);
+  cl.build(dom, p.x.data(), p.y.data(), nullptr, p.size());
+  Points q;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-jitter, jitter);
+  for (std::uint32_t k : cl.cell_order()) {
+    q.x.push_back(p.x[k] + u(rng));
+    q.y.push_back(p.y[k] + u(rng));
+    q.z.push_back(0.0);
+  }
+  return q;
+}
+
 }  // namespace sphc_test

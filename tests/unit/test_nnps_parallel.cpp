@@ -50,6 +50,31 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{3, CellList::Mode::Hash, 3000}, Case{2, CellList::Mode::Dense, 5},
                       Case{2, CellList::Mode::Dense, 0}));
 
+// Points kept in cell order in a grid with more cells than points (the 2D dam break's case):
+// each chunk's particles occupy a narrow window of cells, most cells are empty.
+TEST(ChunkedSortInCellOrder, EqualsSerialSort) {
+  const auto dom = sphc_test::domain_for(2, 0.13);  // 77 x 77 cells
+  for (double jitter : {0.0, 0.05, 0.4}) {
+    const auto p = sphc_test::lattice_in_cell_order(60, 80, 0.05, dom, jitter, 3u);
+    CellList serial;
+    serial.set_sort_chunks(1);
+    serial.build(dom, p.x.data(), p.y.data(), nullptr, p.size());
+    sphc_test::expect_sorted_by_cell(serial);
+    ASSERT_GT(serial.num_cells(), p.size());
+    for (int chunks : {2, 3, 7, 64}) {
+      CellList par;
+      par.set_sort_chunks(chunks);
+      for (int rep = 0; rep < 2; ++rep) {
+        par.build(dom, p.x.data(), p.y.data(), nullptr, p.size());
+        SCOPED_TRACE(testing::Message() << "jitter " << jitter << ", " << chunks
+                                        << " chunks, build " << rep);
+        EXPECT_EQ(par.last_sort_chunks(), chunks);
+        sphc_test::expect_same_build(serial, par);
+      }
+    }
+  }
+}
+
 TEST(CellListFloat, SameAsDoubleOfTheSameValues) {
   for (int dim : {1, 2, 3}) {
     auto p = sphc_test::clustered_points(4000, dim, 3u);

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "non_finite_checks.h"
 #include "sphc/particle_array.h"
 
 namespace {
@@ -188,4 +189,12 @@ TEST(ParticleArrayPermute, ReordersEveryPropertyByTheGivenOrder) {
   EXPECT_THROW(a.permute({0, 0, 1}), std::invalid_argument);
   EXPECT_THROW(a.permute({0, 1}), std::invalid_argument);
   EXPECT_EQ(a.f64(x)[0], 20.0);
+}
+
+// The run loop's blow-up scan: the first NaN or infinity, as a plain loop finds it.
+TEST(FindNonFinite, FirstBadValueInScanOrder) {
+  for (std::size_t n : {0, 1, 5, 3000, 20000}) {
+    SCOPED_TRACE(testing::Message() << n << " particles");
+    sphc_test::check_find_non_finite(n);
+  }
 }

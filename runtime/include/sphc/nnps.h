@@ -75,9 +75,11 @@ class CellList {
   // Sorts particles 0..n-1 into cells. y and z may be nullptr (treated as 0). Throws
   // std::invalid_argument if dom.dim is not 1..3 or n >= 2^32 - 1. Float coordinates
   // (--precision=single) are converted to double for the cell computation.
-  // In the OpenMP runtime the build runs in parallel (cell keys, then a counting sort with a
-  // histogram per thread, see counting_sort) and gives exactly the serial result: the same
-  // order_ and start_, hence the same candidate order.
+  // In the OpenMP runtime the build runs in parallel from 4096 particles per thread (cell
+  // keys, then a counting sort with a histogram per thread over the cells its particles
+  // occupy, see counting_sort) and gives exactly the serial result: the same order_ and
+  // start_, hence the same candidate order. (Hashed storage numbers the occupied cells
+  // serially.)
   void build(const SearchDomain& dom, const double* x, const double* y, const double* z,
              std::size_t n);
   void build(const SearchDomain& dom, const float* x, const float* y, const float* z,
@@ -174,8 +176,12 @@ class CellList {
   std::vector<std::uint32_t> start_ = {0, 0};
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> cell_of_;  // build scratch: cell of each particle
-  std::vector<std::uint32_t> hist_;     // parallel sort scratch: chunks x cells, counts
-  std::vector<std::uint32_t> offset_;   // and write offsets
+  // Parallel sort scratch, per chunk: the counts, then write positions, of the cells
+  // chunk_lo_[k] .. chunk_lo_[k] + chunk_hist_[k].size() - 1 (the chunk's window); the
+  // particles of each of the chunks' cell ranges.
+  std::vector<std::vector<std::uint32_t>> chunk_hist_;
+  std::vector<std::uint32_t> chunk_lo_;
+  std::vector<std::uint32_t> range_count_;
   int sort_chunks_ = 0;
   int last_chunks_ = 1;
   // Hashed storage: open addressing with linear probing, size a power of two >= 2 n.

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,5 +76,17 @@ struct ParticleArray {
 
 // True if order holds each of 0..n-1 exactly once.
 bool is_permutation_of(const std::vector<std::uint32_t>& order, std::size_t n);
+
+// The first NaN or infinity among the double (F64) properties of the arrays, in the order
+// array, property, value (index into Property::f64, i.e. particle * stride + component);
+// nullopt if every value is finite. The run loop's blow-up check. The OpenMP runtime scans
+// blocks of values in parallel and takes the first bad block (a min reduction), so it finds
+// the same value as the serial scan.
+struct NonFiniteValue {
+  std::size_t array = 0;  // index into `arrays`
+  std::size_t prop = 0;   // index into that array's props
+  std::size_t index = 0;  // into props[prop].f64
+};
+std::optional<NonFiniteValue> find_non_finite(const std::vector<ParticleArray*>& arrays);
 
 }  // namespace sphc

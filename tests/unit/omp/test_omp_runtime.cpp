@@ -1,6 +1,7 @@
 // The OpenMP runtime (libsphc_runtime_omp): its parallel parts give exactly the serial
 // results, on real threads. CellList::build with 1..4 threads against the serial sort
-// (set_sort_chunks(1)); ParticleArray::permute against a plain loop.
+// (set_sort_chunks(1)), also in a grid with more cells than particles; ParticleArray::permute
+// against a plain loop; find_non_finite (the blow-up scan) against a plain loop.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "../cell_list_checks.h"
+#include "../non_finite_checks.h"
 #include "sphc/nnps.h"
 #include "sphc/particle_array.h"
 
@@ -27,8 +29,7 @@ TEST_F(OmpThreads, CellListBuildEqualsSerial) {
   for (int dim : {2, 3}) {
     for (CellList::Mode mode : {CellList::Mode::Dense, CellList::Mode::Hash}) {
       const auto p = sphc_test::clustered_points(60000, dim, 5u);
-      // Cells per axis: 48 in 2D, 20 in 3D: fewer cells than particles / threads, so the
-      // parallel sort runs (CellList::build picks the serial one otherwise).
+      // Cells per axis: 48 in 2D, 20 in 3D (fewer cells than particles).
       const auto dom = sphc_test::domain_for(dim, dim == 2 ? 0.21 : 0.5);
       CellList serial;
       serial.set_mode(mode);
@@ -44,6 +45,30 @@ TEST_F(OmpThreads, CellListBuildEqualsSerial) {
                                         << ", " << threads << " threads");
         sphc_test::expect_same_build(serial, par);
         EXPECT_EQ(par.last_sort_chunks(), threads);  // the parallel sort ran
+      }
+    }
+  }
+}
+
+// More cells than particles, particles in cell order (the 2D dam break at ~100k particles:
+// ~1.2 cells per particle), from 4096 particles per thread: the parallel sort runs.
+TEST_F(OmpThreads, CellListBuildInCellOrderEqualsSerial) {
+  const auto dom = sphc_test::domain_for(2, 0.04);  // 250 x 250 cells
+  for (double jitter : {0.0, 0.02}) {
+    const auto p = sphc_test::lattice_in_cell_order(180, 300, 0.015, dom, jitter, 9u);
+    CellList serial;
+    serial.set_sort_chunks(1);
+    serial.build(dom, p.x.data(), p.y.data(), nullptr, p.size());
+    ASSERT_GT(serial.num_cells(), p.size());
+    for (int threads : {1, 2, 3, 4}) {
+      omp_set_num_threads(threads);
+      CellList par;
+      for (int rep = 0; rep < 2; ++rep) {
+        par.build(dom, p.x.data(), p.y.data(), nullptr, p.size());
+        SCOPED_TRACE(testing::Message() << "jitter " << jitter << ", " << threads
+                                        << " threads, build " << rep);
+        EXPECT_EQ(par.last_sort_chunks(), threads);
+        sphc_test::expect_same_build(serial, par);
       }
     }
   }
@@ -87,6 +112,16 @@ TEST_F(OmpThreads, PermuteEqualsSerialLoop) {
   EXPECT_THROW(pa.permute(out), std::invalid_argument);
   EXPECT_TRUE(sphc::is_permutation_of(order, n));
   EXPECT_FALSE(sphc::is_permutation_of(dup, n));
+}
+
+TEST_F(OmpThreads, FindNonFiniteEqualsSerialLoop) {
+  for (int threads : {1, 2, 3}) {
+    omp_set_num_threads(threads);
+    for (std::size_t n : {5, 20000}) {  // 20000 x 14 values: the parallel scan
+      SCOPED_TRACE(testing::Message() << threads << " threads, " << n << " particles");
+      sphc_test::check_find_non_finite(n, 2, 6);  // fewer cases than the serial test
+    }
+  }
 }
 
 }  // namespace
