@@ -198,9 +198,11 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "  --threads N           threads to use (multi-threaded backends; default: all cores)\n"
       "  --omp-wait W          OpenMP barrier wait: active (spin: fastest on an idle machine),\n"
       "                        passive (sleep: far faster when other processes load the\n"
-      "                        cores), auto (default: passive if the 1-minute load average\n"
-      "                        is at least the number of cores at start, else libgomp's\n"
-      "                        default; OMP_WAIT_POLICY or GOMP_SPINCOUNT set: left alone)\n"
+      "                        cores), auto (default: passive if at start the 1-minute load\n"
+      "                        average is at least the number of cores and the processes\n"
+      "                        running now with this run's threads exceed the cores, else\n"
+      "                        libgomp's default; OMP_WAIT_POLICY or GOMP_SPINCOUNT set:\n"
+      "                        left alone)\n"
       "  -d, --directory DIR   output directory (default: {1}_output)\n"
       "  --set NAME=VALUE      set a scene parameter (repeatable)\n"
       "  --quiet               no progress line and no summary\n"
@@ -628,6 +630,11 @@ class Simulation {
 
 }  // namespace
 
+bool wants_passive_wait(double load1, long others, long threads, long cores) {
+  if (cores < 1) return false;
+  return load1 >= static_cast<double>(cores) && (others < 0 ? 0 : others) + threads > cores;
+}
+
 void choose_omp_wait(int argc, char** argv) {
   std::string want = "auto";
   for (int i = 1; i + 1 < argc; ++i)
@@ -637,13 +644,20 @@ void choose_omp_wait(int argc, char** argv) {
     policy = want == "passive" ? "passive" : "active";
   } else if (want == "auto") {
     if (std::getenv("OMP_WAIT_POLICY") || std::getenv("GOMP_SPINCOUNT")) return;
-    double load = 0.0;
+    // /proc/loadavg: "load1 load5 load15 runnable/total lastpid"; runnable counts this
+    // process.
+    double load = 0.0, load5 = 0.0, load15 = 0.0;
+    long runnable = 0, total = 0;
     if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
-      if (std::fscanf(f, "%lf", &load) != 1) load = 0.0;
+      if (std::fscanf(f, "%lf %lf %lf %ld/%ld", &load, &load5, &load15, &runnable, &total) != 5)
+        load = 0.0;
       std::fclose(f);
     }
     const long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    if (cores < 1 || load < static_cast<double>(cores)) return;
+    long threads = cores;
+    for (int i = 1; i + 1 < argc; ++i)
+      if (std::string(argv[i]) == "--threads") threads = std::atol(argv[i + 1]);
+    if (!wants_passive_wait(load, runnable - 1, threads > 0 ? threads : cores, cores)) return;
     policy = "passive";
   } else {
     return;  // run_main reports the bad value

@@ -256,3 +256,24 @@ TEST(Solver, ExceptionsFromTheSceneExitWithCode1) {
   EXPECT_EQ(run_capturing(m.prog, {"--quiet", "--no-output"}, err), 1);
   EXPECT_TRUE(contains(err, "error: boom")) << err;
 }
+
+// --omp-wait auto: sleep at barriers only when the cores are oversubscribed now and have been
+// loaded for the last minute (sphc/solver.h).
+TEST(Solver, AutoWaitPolicySleepsOnlyOnAnOversubscribedMachine) {
+  // Idle 2-core machine: spin.
+  EXPECT_FALSE(sphc::wants_passive_wait(0.1, 0, 2, 2));
+  // Sustained load and another process running now: sleep.
+  EXPECT_TRUE(sphc::wants_passive_wait(10.0, 8, 2, 2));
+  EXPECT_TRUE(sphc::wants_passive_wait(2.0, 1, 2, 2));
+  // The load average still counts a run that has just ended, but nothing else runs now.
+  EXPECT_FALSE(sphc::wants_passive_wait(2.2, 0, 2, 2));
+  // Something runs now, but the machine was idle over the last minute.
+  EXPECT_FALSE(sphc::wants_passive_wait(0.5, 1, 2, 2));
+  // Enough cores for the others and this run's threads.
+  EXPECT_FALSE(sphc::wants_passive_wait(16.0, 4, 8, 16));
+  EXPECT_TRUE(sphc::wants_passive_wait(16.0, 12, 8, 16));
+  // One thread and three others on 2 cores: oversubscribed too.
+  EXPECT_TRUE(sphc::wants_passive_wait(4.0, 3, 1, 2));
+  // No core count: leave libgomp alone.
+  EXPECT_FALSE(sphc::wants_passive_wait(10.0, 8, 2, 0));
+}

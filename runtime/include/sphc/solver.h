@@ -107,9 +107,18 @@ int run_main(int argc, char** argv, SceneProgram& prog);
 // sleeping), but when other processes load the cores a thread spins while the one it waits
 // for is not running (measured at load 10 on 2 cores: 100 us spinning, 1.5 sleeping).
 // `--omp-wait active|passive` re-executes the solver once with OMP_WAIT_POLICY set so;
-// `auto` (the default) does so with passive only when the 1-minute load average at start is
-// at least the number of cores, and never when the user set OMP_WAIT_POLICY or
-// GOMP_SPINCOUNT. If the exec fails the run goes on as it is. run_main checks the option.
+// `auto` (the default) does so with passive only when the machine is loaded at start
+// (wants_passive_wait), and never when the user set OMP_WAIT_POLICY or GOMP_SPINCOUNT. If the
+// exec fails the run goes on as it is. run_main checks the option.
 void choose_omp_wait(int argc, char** argv);
+
+// The rule of `--omp-wait auto`: sleep at barriers when the cores are oversubscribed, i.e.
+// both the 1-minute load average `load1` is at least `cores` (a sustained load) and the
+// processes runnable right now besides this one (`others`, from /proc/loadavg) plus the
+// `threads` this run starts exceed `cores`. The load average alone lags by a minute: a
+// benchmark that has just finished its serial runs on an idle machine still shows load 2,
+// and spinning would then have been right (dam break, ~100k particles, 2 threads: 0.231 us
+// per particle per step spinning against 0.244-0.252 sleeping).
+bool wants_passive_wait(double load1, long others, long threads, long cores);
 
 }  // namespace sphc
