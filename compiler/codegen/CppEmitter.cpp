@@ -853,7 +853,11 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
       for (const auto& p : pass.sprops)
         scene_ << "        const " << real_ << "* s_" << p << " = " << propPtr(s, p) << ";\n";
       scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
-      scene_ << parallelFor("        ");
+      // Each thread works on its own copies of the array pointers and scalars
+      // (default(firstprivate)): shared, the outlined loop reads them through the
+      // captured frame at every neighbour, ~4% slower than the serial build (dam break,
+      // ~100k particles, 1 thread). The cell list stays shared: a copy would be a waste.
+      scene_ << parallelFor("        ", "default(firstprivate) shared(cells)");
       scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
       emitDestLocals(scene_, "          ", q, false);
       scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
