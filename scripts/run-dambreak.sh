@@ -9,4 +9,8 @@ bash scripts/build.sh
 BUILD=${SPHC_BUILD_DIR:-build}
 "$BUILD/bin/sphc" examples/dambreak.sph -o "$BUILD/dambreak" -v
 "$BUILD/dambreak" -d dambreak_output "$@"
-python3 tests/validation/dambreak_front.py dambreak_output
+# The check's Python: $SPHC_PYTHON, else the first of python3, /usr/bin/python3 with numpy
+# and h5py (Debian's, which setup-deps.sh installs them for).
+. tests/validation/common.sh
+find_python run-dambreak.sh
+"$PY" tests/validation/dambreak_front.py dambreak_output
