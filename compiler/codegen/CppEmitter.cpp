@@ -286,6 +286,10 @@ class Emitter {
     return cpuSingle_ ? "f32_" + S + ".permute(cells_" + S + ".cell_order(), " + S + ");"
                       : S + ".permute(cells_" + S + ".cell_order());";
   }
+  // The statement that builds the cell list of source S over its first `count` particles:
+  // from its position pointers on the CPU (grid `domain`), from its device buffers with
+  // --backend=opencl (grid `grid`).
+  std::string cellListBuild(const std::string& S, const std::string& count) const;
   void emitUpdateNeighboursWithGhosts();
   void emitUpdateNeighboursWithGhostsDevice();
   // remove_ghosts of every source array (statements, indented by 4).
@@ -1366,22 +1370,25 @@ void Emitter::emitSearchDomain() {
 // update_neighbours of a scene with a periodic or mirror domain: the search domain of the
 // real particles, the cell-order permutation (of real particles), then the ghosts of every
 // source array, and the cell lists over real particles and ghosts.
+std::string Emitter::cellListBuild(const std::string& S, const std::string& count) const {
+  const char* axes[3] = {"x", "y", "z"};
+  const int s = plan_.arrayIndex(S);
+  std::string b = "cells_" + S + (opencl_ ? ".build(ocl, grid" : ".build(domain");
+  for (int k = 0; k < 3; ++k)
+    b += ", " + (k >= plan_.dim ? std::string("nullptr")
+                 : opencl_      ? devBuffer(s, axes[k])
+                                : propPtr(s, axes[k]));
+  return b + ", " + count + ");";
+}
+
 void Emitter::emitUpdateNeighboursWithGhosts() {
   if (loopArrays_.empty()) return;
-  const char* axes[3] = {"x", "y", "z"};
   emitSearchDomain();
   if (sourceArrays_.empty()) return;
-  auto build = [&](const std::string& S, const std::string& count) {
-    int s = plan_.arrayIndex(S);
-    std::string b = "cells_" + S + ".build(domain";
-    for (int k = 0; k < 3; ++k)
-      b += ", " + (k < plan_.dim ? propPtr(s, axes[k]) : std::string("nullptr"));
-    return b + ", " + count + ");";
-  };
   scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
   scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
   for (const auto& S : sourceArrays_)
-    scene_ << "      " << build(S, S + ".n") << "\n      " << permuteInCellOrder(S) << "\n";
+    scene_ << "      " << cellListBuild(S, S + ".n") << "\n      " << permuteInCellOrder(S) << "\n";
   scene_ << "    }\n";
   scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
   scene_ << "    const double cutoff = domain.cell_size;\n";
@@ -1394,7 +1401,7 @@ void Emitter::emitUpdateNeighboursWithGhosts() {
   }
   scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
   for (const auto& S : sourceArrays_)
-    scene_ << "    " << build(S, S + ".n + ghosts_" + S + ".size()") << "\n";
+    scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
 }
 
 std::string Emitter::removeGhosts() const {
@@ -1429,23 +1436,15 @@ std::string Emitter::deviceExtents(const std::string& indent) const {
 // and the cell tables over real particles and ghosts on the widened grid.
 void Emitter::emitUpdateNeighboursWithGhostsDevice() {
   if (loopArrays_.empty()) return;
-  const char* axes[3] = {"x", "y", "z"};
   scene_ << "    sphc::SearchDomain domain = ocl.search_domain(" << deviceExtents("        ")
          << ", DIM, Kernel::radius_scale);\n";
   scene_ << "    grid = ocl.grid_of(domain);\n";
   if (sourceArrays_.empty()) return;
-  auto build = [&](const std::string& S, const std::string& count) {
-    int s = plan_.arrayIndex(S);
-    std::string b = "cells_" + S + ".build(ocl, grid";
-    for (int k = 0; k < 3; ++k)
-      b += ", " + (k < plan_.dim ? devBuffer(s, axes[k]) : std::string("nullptr"));
-    return b + ", " + count + ");";
-  };
   scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
   scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
   for (const auto& S : sourceArrays_)
-    scene_ << "      " << build(S, S + ".n") << "\n      dev_" << S << ".permute(ocl, cells_" << S
-           << ", " << S << ");\n";
+    scene_ << "      " << cellListBuild(S, S + ".n") << "\n      dev_" << S
+           << ".permute(ocl, cells_" << S << ", " << S << ");\n";
   scene_ << "    }\n";
   scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
   scene_ << "    const double cutoff = domain.cell_size;\n";
@@ -1459,7 +1458,7 @@ void Emitter::emitUpdateNeighboursWithGhostsDevice() {
   scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
   scene_ << "    grid = ocl.grid_of(domain);\n";
   for (const auto& S : sourceArrays_)
-    scene_ << "    " << build(S, S + ".n + ghosts_" + S + ".size()") << "\n";
+    scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
 }
 
 // update_neighbours and compute_accelerations of a scene without periodic or mirror domain.
@@ -1469,10 +1468,6 @@ void Emitter::emitUpdateNeighbours() {
   if (opencl_) {
     // On the device: the search domain from min/max reductions, then a cell table per
     // source (cell keys, bitonic sort, cell start/end). Positions never leave the device.
-    const char* axes[3] = {"x", "y", "z"};
-    auto buf = [&](int a, int k) {
-      return k < plan_.dim ? devBuffer(a, axes[k]) : std::string("nullptr");
-    };
     if (!loopArrays_.empty())
       scene_ << "    grid = ocl.make_grid(" << deviceExtents("                          ")
              << ", DIM, Kernel::radius_scale);\n";
@@ -1481,9 +1476,7 @@ void Emitter::emitUpdateNeighbours() {
     if (!sourceArrays_.empty())
       scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
     for (const auto& S : sourceArrays_) {
-      int s = plan_.arrayIndex(S);
-      std::string build = "cells_" + S + ".build(ocl, grid, " + buf(s, 0) + ", " + buf(s, 1) +
-                          ", " + buf(s, 2) + ", " + S + ".n);";
+      const std::string build = cellListBuild(S, S + ".n");
       scene_ << "    " << build << "\n";
       scene_ << "    if (reorder) {\n      dev_" << S << ".permute(ocl, cells_" << S << ", " << S
              << ");\n      " << build << "\n    }\n";
@@ -1497,12 +1490,7 @@ void Emitter::emitUpdateNeighbours() {
   }
   for (const auto& S : sourceArrays_) {
     if (opencl_) break;
-    int s = plan_.arrayIndex(S);
-    const char* axes[3] = {"x", "y", "z"};
-    std::string build = "cells_" + S + ".build(domain";
-    for (int k = 0; k < 3; ++k)
-      build += ", " + (k < plan_.dim ? propPtr(s, axes[k]) : std::string("nullptr"));
-    build += ", " + S + ".n);";
+    const std::string build = cellListBuild(S, S + ".n");
     scene_ << "    " << build << "\n";
     scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build
            << "\n    }\n";
