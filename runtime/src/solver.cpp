@@ -402,27 +402,16 @@ class OutputSchedule {
 // ---------------------------------------------------------------------------------------------
 // Blow-up diagnosis.
 
-struct NonFinite {
-  const ParticleArray* array;
-  const Property* prop;
-  std::size_t index;  // into prop->f64
-};
-
-// The first non-finite value (sphc::find_non_finite of particle_array.h, parallel in the
-// OpenMP runtime).
-std::optional<NonFinite> first_non_finite(const std::vector<ParticleArray*>& arrays) {
-  const auto bad = sphc::find_non_finite(arrays);
-  if (!bad) return std::nullopt;
-  const ParticleArray* a = arrays[bad->array];
-  return NonFinite{a, &a->props[bad->prop], bad->index};
-}
-
-std::string describe(const NonFinite& bad) {
-  const std::size_t stride = static_cast<std::size_t>(std::max(bad.prop->stride, 1));
+// What the blow-up message says of the first non-finite value (sphc::find_non_finite of
+// particle_array.h, parallel in the OpenMP runtime).
+std::string describe(const std::vector<ParticleArray*>& arrays, const NonFiniteValue& bad) {
+  const ParticleArray& a = *arrays[bad.array];
+  const Property& prop = a.props[bad.prop];
+  const std::size_t stride = static_cast<std::size_t>(std::max(prop.stride, 1));
   const std::string component =
       stride > 1 ? fmt::format("component {} of ", bad.index % stride) : std::string();
-  return fmt::format("{}property '{}' of particle {} in array '{}' is {}", component,
-                     bad.prop->name, bad.index / stride, bad.array->name, bad.prop->f64[bad.index]);
+  return fmt::format("{}property '{}' of particle {} in array '{}' is {}", component, prop.name,
+                     bad.index / stride, a.name, prop.f64[bad.index]);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -454,7 +443,7 @@ class Simulation {
     // As PySPH: the equations run once before the first output, so the t = 0 snapshot holds
     // computed quantities (pressures, summation densities) and not zeros.
     if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
-    if (auto bad = check_finite()) return blow_up("simulation blew up", describe(*bad));
+    if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
     write_output();
 
     const long check_every = prog_.to_host ? kCheckEveryDevice : kCheckEvery;
@@ -479,13 +468,13 @@ class Simulation {
 
       const bool output_due = schedule.due(t_);
       if (output_due || step_ % check_every == 0) {
-        if (auto bad = check_finite()) return blow_up("simulation blew up", describe(*bad));
+        if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
       }
       if (output_due) write_output();
       progress_.update(t_, step_, dt_, particles());
     }
     if (last_output_step_ != step_) {
-      if (auto bad = check_finite()) return blow_up("simulation blew up", describe(*bad));
+      if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
       write_output();
     }
     report(seconds_since(loop_start), particle_steps, tf);
@@ -523,10 +512,13 @@ class Simulation {
             "output interval", times.output_every);
   }
 
-  // Brings device data to the host (device backends) and looks for NaN or Inf in it.
-  std::optional<NonFinite> check_finite() {
+  // Brings device data to the host (device backends) and looks for NaN or Inf in it: the
+  // blow-up message's description of the first one found, or nullopt.
+  std::optional<std::string> check_finite() {
     if (prog_.to_host) prog_.to_host();
-    return first_non_finite(arrays_);
+    const auto bad = find_non_finite(arrays_);
+    if (!bad) return std::nullopt;
+    return describe(arrays_, *bad);
   }
 
   std::size_t particles() const {
@@ -544,7 +536,7 @@ class Simulation {
 
   int time_step_failure(double dt, double tf) {
     // A non-finite property usually explains a bad time step: name it if there is one.
-    if (auto bad = check_finite()) return blow_up("simulation blew up", describe(*bad));
+    if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
     if (!std::isfinite(dt) || dt <= 0) {
       return blow_up("simulation blew up", fmt::format("the adaptive time step is {}", dt));
     }
