@@ -243,8 +243,7 @@ void CellList::build_impl(const SearchDomain& dom, const T* x, const T* y, const
   counting_sort(num_cells, [](std::size_t, std::size_t) {});
 }
 
-int CellList::sort_threads(std::size_t num_cells) const {
-  (void)num_cells;
+int CellList::sort_threads() const {
   if (sort_chunks_ > 0) return sort_chunks_;
 #ifdef _OPENMP
   // Below this many particles per thread the parallel region costs more than it saves.
@@ -262,7 +261,7 @@ void CellList::counting_sort(std::size_t num_cells, KeyFn&& keys) {
   const std::uint32_t* cell_of = cell_of_.data();
   start_.resize(num_cells + 1);
   order_.resize(n);
-  const int threads = sort_threads(num_cells);
+  const int threads = sort_threads();
   last_chunks_ = threads;
   if (threads <= 1) {
     keys(0, n);

@@ -162,7 +162,7 @@ class CellList {
   template <class KeyFn>
   void counting_sort(std::size_t num_cells, KeyFn&& keys);
   // Chunks (threads) for counting_sort: 1 = the serial sort.
-  int sort_threads(std::size_t num_cells) const;
+  int sort_threads() const;
   static constexpr std::size_t kParallelMinPerThread = 4096;
 
   Mode mode_ = Mode::Auto;
