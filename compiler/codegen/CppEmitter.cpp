@@ -1367,9 +1367,6 @@ void Emitter::emitSearchDomain() {
   scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
 }
 
-// update_neighbours of a scene with a periodic or mirror domain: the search domain of the
-// real particles, the cell-order permutation (of real particles), then the ghosts of every
-// source array, and the cell lists over real particles and ghosts.
 std::string Emitter::cellListBuild(const std::string& S, const std::string& count) const {
   const char* axes[3] = {"x", "y", "z"};
   const int s = plan_.arrayIndex(S);
@@ -1381,6 +1378,9 @@ std::string Emitter::cellListBuild(const std::string& S, const std::string& coun
   return b + ", " + count + ");";
 }
 
+// update_neighbours of a scene with a periodic or mirror domain: the search domain of the
+// real particles, the cell-order permutation (of real particles), then the ghosts of every
+// source array, and the cell lists over real particles and ghosts.
 void Emitter::emitUpdateNeighboursWithGhosts() {
   if (loopArrays_.empty()) return;
   emitSearchDomain();
