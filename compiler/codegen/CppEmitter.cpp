@@ -3,6 +3,7 @@
 #include "analysis/Access.h"
 #include "analysis/Passes.h"
 #include "body/BodyAnalysis.h"
+#include "codegen/Schedule.h"
 #include "sema/Geometry.h"
 
 #include "llvm/Support/FileSystem.h"
@@ -154,14 +155,18 @@ std::string singlePrecisionBody(const std::string& text) {
 
 class Emitter {
  public:
-  Emitter(const Plan& plan, const DiagnosticEngine& diags, const EmitOptions& opts)
-      : plan_(plan),
+  Emitter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
+      : sched_(sched),
+        plan_(*sched.plan),
         diags_(diags),
         openmp_(opts.backend == "openmp"),
         opencl_(opts.backend == "opencl"),
         singlePrecision_(opts.precision == "single"),
         cpuSingle_(singlePrecision_ && !opencl_),
-        real_(cpuSingle_ ? "float" : "double") {}
+        real_(cpuSingle_ ? "float" : "double") {
+    for (int a : sched.cellLists) sourceArrays_.push_back(arr(a).name);
+    for (int a : sched.searchArrays) loopArrays_.insert(arr(a).name);
+  }
   std::string run();
   const std::string& kernelSource() const { return clText_; }
 
@@ -213,12 +218,10 @@ class Emitter {
   void beginKernel(const std::string& name, const KernelArgs& ka, bool guard = true);
   std::string launch(const std::string& name, const std::string& n, const KernelArgs& ka) const;
   // The kernels of one destination of phase `name`, and their launches.
-  void emitDestinationDevice(int d, const std::vector<const PlanEquation*>& eqs,
-                             const PlanGroup* group, const std::string& name,
-                             bool onGhosts);
+  void emitDestinationDevice(const DestinationWork& w, const std::string& name);
   // After a phase on the real particles of d: refresh_ghosts of the carried properties it
   // wrote.
-  void emitGhostRefresh(int d, const std::vector<const PlanEquation*>& eqs, bool onGhosts);
+  void emitGhostRefresh(const DestinationWork& w);
   void emitLineDirective(llvm::SMLoc l);
   void resetLineDirective();
   // The data a scene computes on: host arrays, or their float copies (--precision=single).
@@ -238,37 +241,14 @@ class Emitter {
   void emitParams();
   void emitSetup();
   void emitArraySetup(const PlanArray& a);
-  void emitGroup(const PlanGroup& g, const std::string& name);
-  void emitPhase(const std::vector<int>& eqs, const std::string& name);
-  // What a phase does for one destination, whatever the backend executes it with.
-  std::vector<const PlanEquation*> destEquations(const std::vector<int>& eqIds, int d) const;
-  std::vector<const PlanEquation*> withMethod(const std::vector<const PlanEquation*>& eqs,
-                                              ast::Method::Kind kind) const;
-  struct NeighbourPass {
-    int s = -1;
-    std::set<std::string> q;       // pair quantities, closed under what they need
-    std::vector<const PlanEquation*> loopers;  // equations with a loop over this source
-    std::set<std::string> sprops;  // source properties the loop bodies read
-    std::set<std::string> need;    // read on both sides: positions, h, velocities, rho
-  };
-  // One pass per source, in order of first use; records the arrays the search needs.
-  std::vector<NeighbourPass> neighbourPasses(const std::vector<const PlanEquation*>& eqs, int d,
-                                             const PlanGroup* group);
+  void emitGroup(const ScheduleGroup& g);
+  void emitPhase(const Phase& ph);
+  // The convergence test of an iterated group's equation (inside the iteration loop).
+  void emitConverged(const PlanEquation& eq);
   void emitSteppers();
   // The C++ backends: a function per run of consecutive stepper statements of the integrator
-  // (see stepperRuns), one pass over each array doing all the run's methods per particle.
+  // (Schedule::stepperRuns), one pass over each array doing all the run's methods per particle.
   void emitStepperRuns();
-  // Runs of consecutive stepper statements (initialize, stageN) of the integrator's step,
-  // with the index of each statement in plan_.integratorSteps.
-  std::vector<std::vector<size_t>> stepperRuns() const;
-  bool isStepperStatement(const std::string& s) const {
-    return s != "compute_accelerations" && s != "update_domain";
-  }
-  std::string stepperRunName(const std::vector<size_t>& run) const {
-    std::string name = "stepper";
-    for (size_t k : run) name += "_" + plan_.integratorSteps[k];
-    return name;
-  }
   // Periodic and mirror domains (sphc/domain.h): the box at set-up, wrapping, ghosts.
   bool hasDomain() const { return plan_.domain.any(); }
   bool hasGhosts(int a) const { return hasDomain() && !arr(a).ghostProps.empty(); }
@@ -319,12 +299,14 @@ class Emitter {
   // `#pragma omp parallel for` (with `clauses`) before a loop over particles, for the OpenMP
   // backend; nothing for serial. Loops over destination particles only write their own
   // particle (gather), so they need no atomics and give the serial result bit for bit.
-  std::string parallelFor(const std::string& indent, const std::string& clauses = "") const {
-    if (!openmp_) return "";
+  std::string parallelFor(const std::string& indent, LoopOrder order,
+                          const std::string& clauses = "") const {
+    if (!openmp_ || order != LoopOrder::Parallel) return "";
     return indent + "#pragma omp parallel for schedule(static)" +
            (clauses.empty() ? "" : " " + clauses) + "\n";
   }
 
+  const Schedule& sched_;
   const Plan& plan_;
   const DiagnosticEngine& diags_;
   bool openmp_ = false;
@@ -339,13 +321,8 @@ class Emitter {
   std::string clText_;
   std::ostringstream out_;
   std::ostringstream scene_;  // members of struct Scene
-  std::vector<std::string> groupFunctions_;
-  std::vector<std::string> iteratedGroups_;  // source locations, in emission order
-  std::vector<std::string> postStepCalls_;  // top-level groups with post_step = true
-  std::vector<std::string> postStepDue_;    // their conditions (`every`), as C++
-  std::set<std::string> sourceArrays_;  // arrays that need a cell list
+  std::vector<std::string> sourceArrays_;  // arrays that need a cell list (by name)
   std::set<std::string> loopArrays_;    // arrays in a neighbour loop, as dest or source
-  int phaseCounter_ = 0;
 };
 
 std::vector<Emitter::BodyParam> Emitter::bodyParams(const PlanBody& b, int destArray,
@@ -728,111 +705,35 @@ void Emitter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
   }
 }
 
-std::vector<const PlanEquation*> Emitter::destEquations(const std::vector<int>& eqIds,
-                                                        int d) const {
-  std::vector<const PlanEquation*> eqs;
-  for (int e : eqIds)
-    if (plan_.equations[e].live && plan_.equations[e].dest == d)
-      eqs.push_back(&plan_.equations[e]);
-  return eqs;
-}
-
-std::vector<const PlanEquation*> Emitter::withMethod(const std::vector<const PlanEquation*>& eqs,
-                                                     ast::Method::Kind kind) const {
-  std::vector<const PlanEquation*> with;
-  for (const auto* eq : eqs)
-    if (plan_.equationDecls[eq->declIndex].methods.count(kind)) with.push_back(eq);
-  return with;
-}
-
-std::vector<Emitter::NeighbourPass> Emitter::neighbourPasses(
-    const std::vector<const PlanEquation*>& eqs, int d, const PlanGroup* group) {
-  std::vector<int> sources;
-  for (const auto* eq : withMethod(eqs, ast::Method::Loop))
-    for (int s : eq->sources)
-      if (std::find(sources.begin(), sources.end(), s) == sources.end()) sources.push_back(s);
-  std::vector<NeighbourPass> passes;
-  for (int s : sources) {
-    sourceArrays_.insert(arr(s).name);
-    loopArrays_.insert(arr(s).name);
-    loopArrays_.insert(arr(d).name);
-    NeighbourPass pass;
-    pass.s = s;
-    if (group) {
-      auto it = group->pairQuantities.find({d, s});
-      if (it != group->pairQuantities.end()) pass.q = it->second;
-    }
-    pass.q = pairQuantityClosure(pass.q);
-    for (const auto* eq : withMethod(eqs, ast::Method::Loop)) {
-      if (std::find(eq->sources.begin(), eq->sources.end(), s) == eq->sources.end()) continue;
-      pass.loopers.push_back(eq);
-      const PlanBody& b =
-          plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(ast::Method::Loop)];
-      for (const auto& r : b.facts.sReads) pass.sprops.insert(r.prop);
-    }
-    std::vector<std::string> pos = positionProps(plan_.dim);
-    pass.need.insert(pos.begin(), pos.end());
-    pass.need.insert("h");
-    std::vector<std::string> vel = {"u", "v", "w"};
-    vel.resize(plan_.dim);
-    if (pass.q.count("VIJ")) pass.need.insert(vel.begin(), vel.end());
-    if (pass.q.count("RHOIJ")) pass.need.insert("rho");
-    passes.push_back(std::move(pass));
-  }
-  return passes;
-}
-
 // One fused evaluation of a list of equations, as PySPH's Group: per destination, every
 // initialize, one neighbour pass per source with every loop, then post_loop and reduce.
-void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) {
-  std::vector<int> dests;
-  for (int e : eqIds) {
-    const auto& eq = plan_.equations[e];
-    if (eq.live && std::find(dests.begin(), dests.end(), eq.dest) == dests.end())
-      dests.push_back(eq.dest);
-  }
-  const PlanGroup* group = nullptr;
-  std::function<const PlanGroup*(const PlanGroup&)> findGroup = [&](const PlanGroup& g) {
-    for (int e : g.equations)
-      if (e == eqIds.front()) return &g;
-    for (const auto& sub : g.subgroups)
-      if (auto* r = findGroup(*sub)) return r;
-    return static_cast<const PlanGroup*>(nullptr);
-  };
-  if (!eqIds.empty()) group = findGroup(plan_.root);
+void Emitter::emitPhase(const Phase& ph) {
+  const std::string& name = ph.name;
   scene_ << "  void " << name << "(double t, double dt) {\n";
   scene_ << "    (void)t; (void)dt;\n";
-  for (int d : dests) {
+  for (const DestinationWork& w : ph.destinations) {
+    const int d = w.array;
     const std::string& D = arr(d).name;
-    std::vector<const PlanEquation*> eqs = destEquations(eqIds, d);
     // Groups with `real = false` run on the ghosts too (they follow the real particles).
-    const bool onGhosts = group && !group->real && hasGhosts(d);
+    const bool onGhosts = w.onGhosts;
     scene_ << "    {  // destination " << D << "\n";
     scene_ << "      const int n = static_cast<int>(" << D << ".n"
            << (onGhosts ? " + ghosts_" + D + ".size()" : std::string("")) << ");"
            << (onGhosts ? "  // real particles and ghosts (real = false)" : "") << "\n";
     if (opencl_) {
-      emitDestinationDevice(d, eqs, group, name, onGhosts);
-      emitGhostRefresh(d, eqs, onGhosts);
+      emitDestinationDevice(w, name);
+      emitGhostRefresh(w);
       scene_ << "    }\n";
       continue;
     }
     // Pointers of every destination property the bodies use.
-    std::set<std::string> dprops;
-    for (const auto* eq : eqs)
-      for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods) {
-        for (const auto& r : plan_.bodies[b].facts.dReads) dprops.insert(r.prop);
-        for (const auto& w : plan_.bodies[b].facts.dWrites) dprops.insert(w.prop);
-      }
-    for (const auto& p : dprops) {
-      int c = constIndex(d, p);
-      (void)c;
+    for (const auto& p : w.destProps)
       scene_ << "      " << hostType(d, p) << "* d_" << p << " = " << propPtr(d, p) << ";\n";
-    }
     auto perParticle = [&](ast::Method::Kind kind, const char* what) {
-      std::vector<const PlanEquation*> with = withMethod(eqs, kind);
+      const std::vector<const PlanEquation*>& with =
+          kind == ast::Method::Initialize ? w.initialize : w.postLoop;
       if (with.empty()) return;
-      scene_ << parallelFor("      ");
+      scene_ << parallelFor("      ", w.perParticle);
       scene_ << "      for (int d_idx = 0; d_idx < n; ++d_idx) {  // " << what << "\n";
       for (const auto* eq : with) {
         const auto& pd = plan_.equationDecls[eq->declIndex];
@@ -845,33 +746,34 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
     };
     perParticle(ast::Method::Initialize, "initialize");
     // One neighbour pass per source.
-    for (const NeighbourPass& pass : neighbourPasses(eqs, d, group)) {
-      const int s = pass.s;
+    for (const NeighbourPass& pass : w.passes) {
+      const int s = pass.source;
       const std::string& S = arr(s).name;
-      const std::set<std::string>& q = pass.q;
+      const std::set<std::string>& q = pass.pairQuantities;
       scene_ << "      {  // neighbours: " << D << " <- " << S << "\n";
-      for (const auto& p : pass.need) {
+      for (const auto& p : pass.shared) {
         scene_ << "        const " << real_ << "* di_" << p << " = " << propPtr(d, p) << ";\n";
         scene_ << "        const " << real_ << "* sj_" << p << " = " << propPtr(s, p) << ";\n";
       }
-      for (const auto& p : pass.sprops)
+      for (const auto& p : pass.sourceProps)
         scene_ << "        const " << real_ << "* s_" << p << " = " << propPtr(s, p) << ";\n";
       scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
       // Each thread works on its own copies of the array pointers and scalars
       // (default(firstprivate)): shared, the outlined loop reads them through the
       // captured frame at every neighbour, ~4% slower than the serial build (dam break,
       // ~100k particles, 1 thread). The cell list stays shared: a copy would be a waste.
-      scene_ << parallelFor("        ", "default(firstprivate) shared(cells)");
+      scene_ << parallelFor("        ", pass.order, "default(firstprivate) shared(cells)");
       scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
       emitDestLocals(scene_, "          ", q, false);
       scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
       scene_ << "            const int s_idx = static_cast<int>(j);\n";
-      emitCandidate(scene_, q, pass.loopers, d, s, false);
+      emitCandidate(scene_, q, pass.equations, d, s, false);
       scene_ << "          });\n        }\n      }\n";
     }
     perParticle(ast::Method::PostLoop, "post_loop");
     // Reductions over the destination array into its constants.
-    for (const auto* eq : withMethod(eqs, ast::Method::Reduce)) {
+    for (const Reduction& r : w.reductions) {
+      const PlanEquation* eq = r.equation;
       const auto& pd = plan_.equationDecls[eq->declIndex];
       const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
       // mean: the sum, divided by the number of particles (0 for an empty array).
@@ -890,7 +792,7 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
           onGhosts ? "static_cast<int>(" + D + ".n)" : std::string("n");
       const std::string value =
           callBody(bodyFunctionName(eq->name, "reduce"), b, d, -1, eqStruct(*eq), "t");
-      if (openmp_ && sum) {
+      if (openmp_ && r.combine == LoopOrder::Serial) {
         // A sum in the serial order, so that the result (and an iteration count that a
         // convergence test derives from it) is bitwise the serial one: the values in
         // parallel, the sum on one thread (n additions, cheap next to a neighbour pass).
@@ -899,15 +801,15 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
                                      (onGhosts ? "  // real particles only" : "") + "\n";
         scene_ << "        std::vector<" << real_ << ">& values = reduce_scratch;\n";
         scene_ << "        values.resize(" << nReal << ");\n";
-        scene_ << parallelFor("        ");
+        scene_ << parallelFor("        ", LoopOrder::Parallel);
         scene_ << loopHead;
         scene_ << "          values[d_idx] = " << value << ";\n";
         scene_ << loopHead << "          acc += values[d_idx];\n";
         if (pd.reduceOp == "mean")
           scene_ << "        acc = " << nReal << " > 0 ? acc / " << nReal << " : 0.0;\n";
       } else {
-        scene_ << parallelFor("        ", std::string("reduction(") +
-                                               (sum ? "+" : pd.reduceOp) + " : acc)");
+        scene_ << parallelFor("        ", LoopOrder::Parallel,
+                              std::string("reduction(") + (sum ? "+" : pd.reduceOp) + " : acc)");
         scene_ << "        for (int d_idx = 0; d_idx < " << nReal << "; ++d_idx) {"
                << (onGhosts ? "  // real particles only" : "") << "\n";
         scene_ << "          const " << real_ << " v = " << value << ";\n          " << combine
@@ -917,24 +819,17 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
       }
       scene_ << "        " << propPtr(d, pd.reduceTarget) << "[0] = acc;\n      }\n";
     }
-    emitGhostRefresh(d, eqs, onGhosts);
+    emitGhostRefresh(w);
     scene_ << "    }\n";
   }
   scene_ << "  }\n\n";
 }
 
 // Ghosts copy the values a phase computed on the real particles, where they carry them.
-void Emitter::emitGhostRefresh(int d, const std::vector<const PlanEquation*>& eqs,
-                               bool onGhosts) {
-  if (!hasGhosts(d) || onGhosts) return;
+void Emitter::emitGhostRefresh(const DestinationWork& w) {
+  const int d = w.array;
   const std::string& D = arr(d).name;
-  std::set<std::string> written;
-  for (const auto* eq : eqs)
-    for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods)
-      for (const auto& w : plan_.bodies[b].facts.dWrites) written.insert(w.prop);
-  std::vector<std::string> refresh;
-  for (const auto& p : arr(d).ghostProps)
-    if (written.count(p)) refresh.push_back(p);
+  const std::vector<std::string>& refresh = w.ghostRefresh;
   if (refresh.empty()) return;
   scene_ << "      // ghosts follow:";
   for (const auto& p : refresh) scene_ << " " << p;
@@ -999,12 +894,13 @@ std::string Emitter::launch(const std::string& name, const std::string& n,
   return s + ");";
 }
 
-void Emitter::emitDestinationDevice(int d, const std::vector<const PlanEquation*>& eqs,
-                                    const PlanGroup* group, const std::string& name,
-                                    bool onGhosts) {
+void Emitter::emitDestinationDevice(const DestinationWork& w, const std::string& name) {
+  const int d = w.array;
+  const bool onGhosts = w.onGhosts;
   const std::string& D = arr(d).name;
   auto perParticle = [&](ast::Method::Kind kind, const char* what) {
-    std::vector<const PlanEquation*> with = withMethod(eqs, kind);
+    const std::vector<const PlanEquation*>& with =
+        kind == ast::Method::Initialize ? w.initialize : w.postLoop;
     if (with.empty()) return;
     KernelArgs ka;
     for (const auto* eq : with)
@@ -1022,16 +918,16 @@ void Emitter::emitDestinationDevice(int d, const std::vector<const PlanEquation*
     scene_ << "      " << launch(k, "n", ka) << "  // " << what << "\n";
   };
   perParticle(ast::Method::Initialize, "initialize");
-  for (const NeighbourPass& pass : neighbourPasses(eqs, d, group)) {
-    const int s = pass.s;
+  for (const NeighbourPass& pass : w.passes) {
+    const int s = pass.source;
     const std::string& S = arr(s).name;
-    const std::set<std::string>& q = pass.q;
+    const std::set<std::string>& q = pass.pairQuantities;
     KernelArgs ka;
-    for (const auto* eq : pass.loopers)
+    for (const auto* eq : pass.equations)
       addBodyArgs(ka, plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(
                           ast::Method::Loop)],
                   d, s, eqStruct(*eq));
-    for (const auto& p : pass.need) {
+    for (const auto& p : pass.shared) {
       ka.add("__global const real* di_" + p, devBuffer(d, p), "di_" + p);
       ka.add("__global const real* sj_" + p, devBuffer(s, p), "sj_" + p);
     }
@@ -1056,14 +952,15 @@ void Emitter::emitDestinationDevice(int d, const std::vector<const PlanEquation*
         << "    const int cell = (kz * grid_ny + ky) * grid_nx + kx;\n"
         << "    for (uint k = cells_start[cell]; k < cells_end[cell]; ++k) {\n"
         << "            const int s_idx = (int)cells_order[k];\n";
-    emitCandidate(cl_, q, pass.loopers, d, s, true);
+    emitCandidate(cl_, q, pass.equations, d, s, true);
     cl_ << "    }\n  }\n}\n\n";
     scene_ << "      " << launch(k, "n", ka) << "  // neighbours: " << D << " <- " << S << "\n";
   }
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions: per-particle values on the device, partial results there, the last step
   // on the host, into the host copy of the constant (uploaded again).
-  for (const auto* eq : withMethod(eqs, ast::Method::Reduce)) {
+  for (const Reduction& r : w.reductions) {
+    const PlanEquation* eq = r.equation;
     const auto& pd = plan_.equationDecls[eq->declIndex];
     const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
     KernelArgs ka;
@@ -1093,50 +990,16 @@ void Emitter::emitDestinationDevice(int d, const std::vector<const PlanEquation*
   }
 }
 
-void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
-  // Runs of direct equations become fused phases; subgroups run in place, in order.
-  std::vector<std::string> calls;
-  std::vector<int> run;
-  int part = 0;
-  auto flush = [&] {
-    if (run.empty()) return;
-    std::string fn = name + "_" + std::to_string(part++);
-    emitPhase(run, fn);
-    calls.push_back(fn);
-    run.clear();
-  };
-  for (int entry : g.order) {
-    if (entry >= 0) {
-      run.push_back(g.equations[entry]);
-      continue;
-    }
-    flush();
-    std::string fn = name + "_" + std::to_string(part++);
-    const PlanGroup& sub = *g.subgroups[-entry - 1];
-    emitGroup(sub, fn);
-    // A post_step group (top level only) runs after the time step, not with the others.
-    (sub.postStep ? postStepCalls_ : calls).push_back(fn);
-    if (sub.postStep && sub.every) postStepDue_.push_back(fn + "_due()");
-    if (sub.postStep && !sub.every) postStepDue_.push_back("true");
+void Emitter::emitGroup(const ScheduleGroup& sg) {
+  const PlanGroup& g = *sg.group;
+  const std::string& name = sg.name;
+  // Phases and subgroups first, in order; then the group's own function.
+  for (const auto& m : sg.members) {
+    if (m.isPhase)
+      emitPhase(sg.phases[m.index]);
+    else
+      emitGroup(*sg.subgroups[m.index]);
   }
-  flush();
-  // The convergence tests of an iterated group: the `converged` of its equations and of those
-  // in its subgroups, at any depth (as PySPH's Group), except inside a nested iterated group,
-  // which tests its own.
-  std::vector<const PlanEquation*> convergers;
-  std::function<void(const PlanGroup&)> collect = [&](const PlanGroup& grp) {
-    for (int entry : grp.order) {
-      if (entry < 0) {
-        const PlanGroup& sub = *grp.subgroups[-entry - 1];
-        if (!sub.iterate) collect(sub);
-        continue;
-      }
-      const auto& eq = plan_.equations[grp.equations[entry]];
-      if (eq.live && plan_.equationDecls[eq.declIndex].methods.count(ast::Method::Converged))
-        convergers.push_back(&eq);
-    }
-  };
-  collect(g);
   scene_ << "  // group, from " << loc(g.loc) << "\n";
   if (g.every) {
     // `every = N`: only when the number of completed steps is a multiple of N (N < 1: never).
@@ -1149,99 +1012,66 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
   scene_ << "  void " << name << "(double t, double dt) {\n";
   if (g.every) scene_ << "    if (!" << name << "_due()) return;\n";
   if (!g.iterate) {
-    for (const auto& c : calls) scene_ << "    " << c << "(t, dt);\n";
+    for (const auto& c : sg.calls) scene_ << "    " << c << "(t, dt);\n";
     scene_ << "    (void)t; (void)dt;\n  }\n\n";
     return;
   }
-  const int statsIndex = static_cast<int>(iteratedGroups_.size());
-  iteratedGroups_.push_back(loc(g.loc));
   scene_ << "    int iteration = 1;\n    bool converged = true;\n";
   scene_ << "    for (;; ++iteration) {\n";
-  for (const auto& c : calls) scene_ << "      " << c << "(t, dt);\n";
+  for (const auto& c : sg.calls) scene_ << "      " << c << "(t, dt);\n";
   scene_ << "      converged = true;\n";
-  for (const auto* eq : convergers) {
-    const auto& pd = plan_.equationDecls[eq->declIndex];
-    const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Converged)];
-    scene_ << "      {\n        const int d_idx = 0;\n";
-    std::set<std::string> dprops;
-    for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
-    // OpenCL: the test runs on the host; constants are current there, properties are not.
-    bool needsProps = false;
-    for (const auto& p : dprops) needsProps |= constIndex(eq->dest, p) < 0;
-    if (opencl_ && needsProps)
-      scene_ << "        dev_" << arr(eq->dest).name << ".download(ocl, " << arr(eq->dest).name
-             << ");\n";
-    for (const auto& p : dprops)
-      scene_ << "        " << hostType(eq->dest, p) << "* d_" << p << " = "
-             << propPtr(eq->dest, p) << ";\n";
-    scene_ << "        converged = converged && "
-           << callBody(bodyFunctionName(eq->name, "converged"), b, eq->dest, -1,
-                       eqStruct(*eq), "t")
-           << " > 0;  // " << eq->name << ", from " << loc(eq->loc) << "\n      }\n";
-  }
+  for (const auto* eq : sg.convergers) emitConverged(*eq);
   scene_ << "      if (converged && iteration >= " << g.minIterations << ") break;\n";
   scene_ << "      if (iteration >= " << g.maxIterations << ") break;\n";
   scene_ << "    }\n";
-  scene_ << "    iteration_stats[" << statsIndex << "].record(iteration, converged);\n  }\n\n";
-  groupFunctions_.push_back(name);
+  scene_ << "    iteration_stats[" << sg.statsIndex << "].record(iteration, converged);\n  }\n\n";
 }
 
+// `converged` runs on the host for every backend, on particle 0 of its destination.
+void Emitter::emitConverged(const PlanEquation& eq) {
+  const auto& pd = plan_.equationDecls[eq.declIndex];
+  const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Converged)];
+  scene_ << "      {\n        const int d_idx = 0;\n";
+  std::set<std::string> dprops;
+  for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
+  // OpenCL: the test runs on the host; constants are current there, properties are not.
+  bool needsProps = false;
+  for (const auto& p : dprops) needsProps |= constIndex(eq.dest, p) < 0;
+  if (opencl_ && needsProps)
+    scene_ << "        dev_" << arr(eq.dest).name << ".download(ocl, " << arr(eq.dest).name
+           << ");\n";
+  for (const auto& p : dprops)
+    scene_ << "        " << hostType(eq.dest, p) << "* d_" << p << " = " << propPtr(eq.dest, p)
+           << ";\n";
+  scene_ << "        converged = converged && "
+         << callBody(bodyFunctionName(eq.name, "converged"), b, eq.dest, -1, eqStruct(eq), "t")
+         << " > 0;  // " << eq.name << ", from " << loc(eq.loc) << "\n      }\n";
+}
+
+// --backend=opencl: a kernel per stepper method and array (Schedule::stepperMethods).
 void Emitter::emitSteppers() {
   if (!opencl_) {
     emitStepperRuns();
     return;
   }
-  std::set<std::string> methods;
-  for (const auto& a : plan_.arrays)
-    if (a.stepper >= 0)
-      for (const auto& [m, b] : plan_.steppers[a.stepper].methods) methods.insert(m);
-  for (const auto& m : methods) {
+  for (const auto& [m, arrays] : sched_.stepperMethods) {
     scene_ << "  void stepper_" << m << "(double t, double dt) {\n    (void)t; (void)dt;\n";
-    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+    for (int a : arrays) {
       const PlanArray& A = arr(a);
-      if (A.stepper < 0) continue;
       const PlanStepper& st = plan_.steppers[A.stepper];
-      auto it = st.methods.find(m);
-      if (it == st.methods.end()) continue;
-      const PlanBody& b = plan_.bodies[it->second];
+      const PlanBody& b = plan_.bodies[st.methods.at(m)];
       scene_ << "    {  // " << A.name << ": " << st.decl->name.name << "." << m << "\n";
       scene_ << "      const int n = static_cast<int>(" << A.name << ".n);\n";
       std::string fn = bodyFunctionName(st.decl->name.name, m);
-      if (opencl_) {
-        KernelArgs ka;
-        addBodyArgs(ka, b, a, -1, "");
-        std::string k = "stepper_" + m + "_" + A.name;
-        beginKernel(k, ka);
-        cl_ << "  " << callBody(fn, b, a, -1, "", "t", "_") << ";\n}\n\n";
-        scene_ << "      " << launch(k, "n", ka) << "\n    }\n";
-        continue;
-      }
-      std::set<std::string> dprops;
-      for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
-      for (const auto& w : b.facts.dWrites) dprops.insert(w.prop);
-      for (const auto& p : dprops)
-        scene_ << "      " << hostType(a, p) << "* d_" << p << " = " << propPtr(a, p) << ";\n";
-      scene_ << parallelFor("      ");
-      scene_ << "      for (int d_idx = 0; d_idx < n; ++d_idx)\n";
-      scene_ << "        " << callBody(fn, b, a, -1, "", "t") << ";\n    }\n";
+      KernelArgs ka;
+      addBodyArgs(ka, b, a, -1, "");
+      std::string k = "stepper_" + m + "_" + A.name;
+      beginKernel(k, ka);
+      cl_ << "  " << callBody(fn, b, a, -1, "", "t", "_") << ";\n}\n\n";
+      scene_ << "      " << launch(k, "n", ka) << "\n    }\n";
     }
     scene_ << "  }\n\n";
   }
-}
-
-std::vector<std::vector<size_t>> Emitter::stepperRuns() const {
-  std::vector<std::vector<size_t>> runs;
-  bool open = false;
-  for (size_t k = 0; k < plan_.integratorSteps.size(); ++k) {
-    if (!isStepperStatement(plan_.integratorSteps[k])) {
-      open = false;
-      continue;
-    }
-    if (!open) runs.emplace_back();
-    runs.back().push_back(k);
-    open = true;
-  }
-  return runs;
 }
 
 // Steppers are per particle (a body reads and writes its own particle d_idx only, as the
@@ -1251,55 +1081,31 @@ std::vector<std::vector<size_t>> Emitter::stepperRuns() const {
 // initialize and stage1 both read and write x, u, rho, ...). The arrays' passes share one
 // parallel region (`omp for nowait`: each array's particles are its own).
 void Emitter::emitStepperRuns() {
-  std::set<std::string> emitted;
-  for (const auto& run : stepperRuns()) {
-    const std::string name = stepperRunName(run);
-    if (!emitted.insert(name).second) continue;
-    struct Part {
-      int a;
-      const PlanStepper* st;
-      std::vector<std::pair<size_t, const PlanBody*>> bodies;  // (position in run, body)
-    };
-    std::vector<Part> parts;
-    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
-      const PlanArray& A = arr(a);
-      if (A.stepper < 0) continue;
-      Part part{a, &plan_.steppers[A.stepper], {}};
-      for (size_t k = 0; k < run.size(); ++k) {
-        auto it = part.st->methods.find(plan_.integratorSteps[run[k]]);
-        if (it != part.st->methods.end()) part.bodies.push_back({k, &plan_.bodies[it->second]});
-      }
-      if (!part.bodies.empty()) parts.push_back(part);
-    }
-    if (parts.empty()) continue;
-    scene_ << "  void " << name << "(";
-    for (size_t k = 0; k < run.size(); ++k) scene_ << "double t_" << k << ", ";
+  for (const StepperRun& run : sched_.stepperRuns) {
+    if (run.parts.empty()) continue;
+    const bool parallel = openmp_ && run.order == LoopOrder::Parallel;
+    scene_ << "  void " << run.name << "(";
+    for (size_t k = 0; k < run.methods.size(); ++k) scene_ << "double t_" << k << ", ";
     scene_ << "double dt) {\n   ";
-    for (size_t k = 0; k < run.size(); ++k) scene_ << " (void)t_" << k << ";";
+    for (size_t k = 0; k < run.methods.size(); ++k) scene_ << " (void)t_" << k << ";";
     scene_ << " (void)dt;\n";
-    if (openmp_) scene_ << "    #pragma omp parallel\n";
+    if (parallel) scene_ << "    #pragma omp parallel\n";
     scene_ << "    {\n";
-    for (const Part& part : parts) {
-      const PlanArray& A = arr(part.a);
-      scene_ << "      {  // " << A.name << ": " << part.st->decl->name.name;
+    for (const StepperRun::Part& part : run.parts) {
+      const PlanArray& A = arr(part.array);
+      scene_ << "      {  // " << A.name << ": " << part.stepper->decl->name.name;
       for (size_t i = 0; i < part.bodies.size(); ++i)
-        scene_ << (i ? ", " : ".") << plan_.integratorSteps[run[part.bodies[i].first]];
+        scene_ << (i ? ", " : ".") << run.methods[part.bodies[i].first];
       scene_ << "\n        const int n = static_cast<int>(" << A.name << ".n);\n";
-      std::set<std::string> dprops;
-      for (const auto& [k, b] : part.bodies) {
-        for (const auto& r : b->facts.dReads) dprops.insert(r.prop);
-        for (const auto& w : b->facts.dWrites) dprops.insert(w.prop);
-      }
-      for (const auto& p : dprops)
-        scene_ << "        " << hostType(part.a, p) << "* d_" << p << " = " << propPtr(part.a, p)
-               << ";\n";
-      if (openmp_) scene_ << "        #pragma omp for schedule(static) nowait\n";
+      for (const auto& p : part.destProps)
+        scene_ << "        " << hostType(part.array, p) << "* d_" << p << " = "
+               << propPtr(part.array, p) << ";\n";
+      if (parallel) scene_ << "        #pragma omp for schedule(static) nowait\n";
       scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
       for (const auto& [k, b] : part.bodies) {
-        const std::string m = plan_.integratorSteps[run[k]];
         scene_ << "          "
-               << callBody(bodyFunctionName(part.st->decl->name.name, m), *b, part.a, -1, "",
-                           "t_" + std::to_string(k))
+               << callBody(bodyFunctionName(part.stepper->decl->name.name, run.methods[k]), *b,
+                           part.array, -1, "", "t_" + std::to_string(k))
                << ";\n";
       }
       scene_ << "        }\n      }\n";
@@ -1540,81 +1346,68 @@ void Emitter::emitStep() {
   } else {
     emitUpdateNeighbours();
   }
-  if (!postStepCalls_.empty()) {
+  if (!sched_.postStep.empty()) {
     // Groups with post_step = true: after the integrator's time step, on the new positions.
     scene_ << "  // groups with post_step = true, after each time step\n";
     // No neighbour update when no group is due (a disabled group changes nothing at all).
     scene_ << "  void post_step(double t, double dt) {\n    if (!(";
-    for (size_t i = 0; i < postStepDue_.size(); ++i)
-      scene_ << (i ? " || " : "") << postStepDue_[i];
+    for (size_t i = 0; i < sched_.postStep.size(); ++i)
+      scene_ << (i ? " || " : "")
+             << (sched_.postStep[i].group->every ? sched_.postStep[i].function + "_due()"
+                                                 : std::string("true"));
     scene_ << ")) return;\n";
     scene_ << (hasDomain() ? "    update_domain();\n" : "") << "    update_neighbours();\n";
-    for (const auto& c : postStepCalls_) scene_ << "    " << c << "(t, dt);\n";
+    for (const auto& ps : sched_.postStep) scene_ << "    " << ps.function << "(t, dt);\n";
     if (hasDomain()) scene_ << removeGhosts();
     scene_ << "  }\n\n";
   }
   // The integrator's time step; after stage k of m the time is t + k/m dt.
-  int stages = 0;
-  for (const auto& s : plan_.integratorSteps) stages += s.rfind("stage", 0) == 0;
+  const int stages = sched_.stages;
   scene_ << "  // integrator " << plan_.integratorName << "\n";
   scene_ << "  void step(double t, double dt) {\n";
-  int done = 0;
   auto timeAfter = [&](int stagesDone) {
     return stagesDone == 0 ? std::string("t")
                            : "t + " + std::to_string(stagesDone) + ".0 / " +
                                  std::to_string(stages) + ".0 * dt";
   };
-  // The C++ backends: a run of stepper statements calls its fused function (emitStepperRuns)
-  // at the run's first statement, with each statement's time.
-  std::map<size_t, std::vector<size_t>> runAt;
-  std::set<size_t> inRun;
-  if (!opencl_) {
-    for (const auto& run : stepperRuns()) {
-      runAt[run.front()] = run;
-      inRun.insert(run.begin(), run.end());
-    }
-  }
-  for (size_t k = 0; k < plan_.integratorSteps.size(); ++k) {
-    const std::string& s = plan_.integratorSteps[k];
-    std::string time = timeAfter(done);
-    if (inRun.count(k)) {
-      auto it = runAt.find(k);
-      if (it != runAt.end()) {
-        bool any = false;  // does an array have one of the run's methods?
-        std::string args;
-        int d = done;
-        for (size_t j : it->second) {
-          const std::string& m = plan_.integratorSteps[j];
-          for (const auto& a : plan_.arrays)
-            any |= a.stepper >= 0 && plan_.steppers[a.stepper].methods.count(m);
-          args += timeAfter(d) + ", ";
-          if (m.rfind("stage", 0) == 0) ++d;
-        }
-        if (any) scene_ << "    " << stepperRunName(it->second) << "(" << args << "dt);\n";
-      }
-      if (s.rfind("stage", 0) == 0) ++done;
+  for (const StepStatement& st : sched_.step) {
+    if (st.kind == StepStatement::ComputeAccelerations) {
+      scene_ << "    compute_accelerations(" << timeAfter(st.stagesDone[0]) << ", dt);\n";
       continue;
     }
-    if (s == "compute_accelerations")
-      scene_ << "    compute_accelerations(" << time << ", dt);\n";
-    else if (s == "update_domain")
+    if (st.kind == StepStatement::UpdateDomain) {
       scene_ << (hasDomain() ? "    update_domain();\n"
                              : "    // update_domain: no periodic or mirror domain in this scene\n");
-    else {
+      continue;
+    }
+    const StepperRun& run = sched_.stepperRuns[st.run];
+    if (!opencl_) {
+      // The C++ backends: the run's fused function (emitStepperRuns), with each statement's
+      // time.
+      if (run.parts.empty()) continue;
+      std::string args;
+      for (int d : st.stagesDone) args += timeAfter(d) + ", ";
+      scene_ << "    " << run.name << "(" << args << "dt);\n";
+      continue;
+    }
+    // OpenCL: each statement's kernels in turn, where an array's stepper has the method.
+    for (size_t j = 0; j < run.methods.size(); ++j) {
       bool any = false;
-      for (const auto& a : plan_.arrays)
-        any |= a.stepper >= 0 && plan_.steppers[a.stepper].methods.count(s);
-      if (any) scene_ << "    stepper_" << s << "(" << time << ", dt);\n";
-      if (s.rfind("stage", 0) == 0) ++done;
+      for (const auto& part : run.parts)
+        for (const auto& [k, b] : part.bodies) any |= k == j;
+      if (any)
+        scene_ << "    stepper_" << run.methods[j] << "(" << timeAfter(st.stagesDone[j])
+               << ", dt);\n";
     }
   }
   scene_ << "    ++step_count;\n";
-  if (!postStepCalls_.empty()) scene_ << "    post_step(t + dt, dt);\n";
+  if (!sched_.postStep.empty()) scene_ << "    post_step(t + dt, dt);\n";
   scene_ << "  }\n\n";
 }
 
 void Emitter::emitAdaptiveDt() {
-  if (!plan_.adaptiveDt) return;
+  const AdaptiveDt& ad = sched_.adaptiveDt;
+  if (!ad.enabled) return;
   auto pn = [&](const std::string& n) { return paramRef(n); };
   std::string cfl = plan_.cfl ? exprCpp(*plan_.cfl, pn) : "0.3";
   scene_ << "  // The stable time step: CFL (h / (c + |v|)), force (sqrt(h / |a|)) and viscous\n"
@@ -1622,11 +1415,10 @@ void Emitter::emitAdaptiveDt() {
   scene_ << "  double adaptive_dt() {\n";
   scene_ << "    double dt_cfl = HUGE_VAL, dt_force = HUGE_VAL, h2min = HUGE_VAL;\n";
   std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
-  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
-    if (!movesParticles(plan_, a)) continue;
+  for (int a : ad.arrays) {
     const std::string& A = arr(a).name;
     scene_ << "    {  // " << A << "\n";
-    bool useCfl = plan_.cfl || !plan_.forceFactor;
+    const bool useCfl = ad.cfl;
     if (opencl_) {
       // Per-particle limits on the device, their minima from device partial reductions.
       KernelArgs ka;
@@ -1634,7 +1426,7 @@ void Emitter::emitAdaptiveDt() {
       if (useCfl) props.push_back("cs");
       for (int k = 0; k < plan_.dim; ++k) {
         if (useCfl) props.push_back(vel[k]);
-        if (plan_.forceFactor) props.push_back(acc[k]);
+        if (ad.force) props.push_back(acc[k]);
       }
       for (const auto& p : props) ka.add("__global const real* " + p, devBuffer(a, p), p);
       const char* outs[3] = {"dt_cfl", "dt_force", "h2min"};
@@ -1652,7 +1444,7 @@ void Emitter::emitAdaptiveDt() {
       cl_ << "  out_dt_cfl[i] = " << (useCfl ? "h[i] / (cs[i] + " + mag(vel) + ")" : "INFINITY")
           << ";\n";
       cl_ << "  out_h2min[i] = h[i] * h[i];\n";
-      if (plan_.forceFactor)
+      if (ad.force)
         cl_ << "  const real amag = " << mag(acc) << ";\n"
             << "  out_dt_force[i] = amag > 0 ? sqrt(h[i] / amag) : INFINITY;\n";
       else
@@ -1664,8 +1456,8 @@ void Emitter::emitAdaptiveDt() {
       // The minima in one round trip: (limit, scratch slot) for the limits the scene uses.
       std::vector<std::pair<std::string, int>> mins;
       if (useCfl) mins.push_back({"dt_cfl", 1});
-      if (plan_.forceFactor) mins.push_back({"dt_force", 2});
-      if (plan_.nu) mins.push_back({"h2min", 3});
+      if (ad.force) mins.push_back({"dt_force", 2});
+      if (ad.viscous) mins.push_back({"h2min", 3});
       scene_ << "      const std::vector<double> mins = ocl.reduce_all({";
       for (size_t m = 0; m < mins.size(); ++m)
         scene_ << (m ? ", " : "") << "{ocl.scratch(n, " << mins[m].second
@@ -1678,25 +1470,25 @@ void Emitter::emitAdaptiveDt() {
       continue;
     }
     scene_ << "      const " << real_ << "* h = " << propPtr(a, "h") << ";\n";
-    if (plan_.cfl || !plan_.forceFactor) {
+    if (ad.cfl) {
       scene_ << "      const " << real_ << "* cs = " << propPtr(a, "cs") << ";\n";
       for (int k = 0; k < plan_.dim; ++k)
         scene_ << "      const " << real_ << "* " << vel[k] << " = " << propPtr(a, vel[k]) << ";\n";
     }
-    if (plan_.forceFactor)
+    if (ad.force)
       for (int k = 0; k < plan_.dim; ++k)
         scene_ << "      const " << real_ << "* " << acc[k] << " = " << propPtr(a, acc[k]) << ";\n";
-    scene_ << parallelFor("      ", "reduction(min : dt_cfl, dt_force, h2min)");
+    scene_ << parallelFor("      ", ad.order, "reduction(min : dt_cfl, dt_force, h2min)");
     scene_ << "      for (std::size_t i = 0; i < " << A << ".n; ++i) {\n";
-    if (plan_.cfl || !plan_.forceFactor) {
+    if (ad.cfl) {
       scene_ << "        const double vmag = std::sqrt(";
       for (int k = 0; k < plan_.dim; ++k)
         scene_ << (k ? " + " : "") << vel[k] << "[i] * " << vel[k] << "[i]";
       scene_ << ");\n";
       scene_ << "        dt_cfl = std::fmin(dt_cfl, h[i] / (cs[i] + vmag));\n";
     }
-    if (plan_.nu) scene_ << "        h2min = std::fmin(h2min, h[i] * h[i]);\n";
-    if (plan_.forceFactor) {
+    if (ad.viscous) scene_ << "        h2min = std::fmin(h2min, h[i] * h[i]);\n";
+    if (ad.force) {
       scene_ << "        const double amag = std::sqrt(";
       for (int k = 0; k < plan_.dim; ++k)
         scene_ << (k ? " + " : "") << acc[k] << "[i] * " << acc[k] << "[i]";
@@ -1707,7 +1499,7 @@ void Emitter::emitAdaptiveDt() {
   }
   scene_ << "    double dt = std::fmin(" << cfl << " * dt_cfl, "
          << (plan_.forceFactor ? exprCpp(*plan_.forceFactor, pn) : "1.0") << " * dt_force);\n";
-  if (plan_.nu)
+  if (ad.viscous)
     scene_ << "    dt = std::fmin(dt, "
            << (plan_.viscousFactor ? exprCpp(*plan_.viscousFactor, pn) : "0.125")
            << " * h2min / " << exprCpp(*plan_.nu, pn) << ");  // viscous limit\n";
@@ -1764,7 +1556,7 @@ void Emitter::emitMain() {
   // --precision=single on the CPU: likewise for the float copies.
   if (opencl_ || cpuSingle_) out_ << "  prog.to_host = [] { scene.to_host(); };\n";
   if (plan_.adaptiveDt) out_ << "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n";
-  if (!iteratedGroups_.empty())
+  if (!sched_.iteratedGroups.empty())
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   if (!opencl_) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
   bool anyOutput = false;
@@ -1840,7 +1632,7 @@ std::string Emitter::run() {
 
   emitParams();
   emitSetup();
-  emitGroup(plan_.root, "equations");
+  emitGroup(sched_.equations);
   emitSteppers();
   emitStep();
   emitAdaptiveDt();
@@ -1880,8 +1672,9 @@ std::string Emitter::run() {
   if (openmp_) out_ << "  std::vector<" << real_ << "> reduce_scratch;  // reduce sum/mean, OpenMP\n";
   // Iterations per evaluation of each iterated group (--timing prints them).
   out_ << "  std::vector<sphc::IterationStats> iteration_stats{";
-  for (std::size_t k = 0; k < iteratedGroups_.size(); ++k)
-    out_ << (k ? ", " : "") << "sphc::IterationStats{\"" << iteratedGroups_[k] << "\"}";
+  for (std::size_t k = 0; k < sched_.iteratedGroups.size(); ++k)
+    out_ << (k ? ", " : "") << "sphc::IterationStats{\"" << loc(sched_.iteratedGroups[k])
+         << "\"}";
   out_ << "};\n";
   out_ << "  long step_count = 0;  // completed time steps (group option `every`)\n";
   if (!opencl_) out_ << "  double nnps_seconds = 0.0;  // in update_neighbours, for --timing\n";
@@ -1925,13 +1718,14 @@ std::string Emitter::run() {
 
 }  // namespace
 
-std::string emitCpp(const Plan& plan, const DiagnosticEngine& diags, const EmitOptions& opts) {
-  return Emitter(plan, diags, opts).run();
+std::string emitCpp(const Schedule& sched, const DiagnosticEngine& diags,
+                    const EmitOptions& opts) {
+  return Emitter(sched, diags, opts).run();
 }
 
-std::string emitOpenCL(const Plan& plan, const DiagnosticEngine& diags, EmitOptions opts) {
+std::string emitOpenCL(const Schedule& sched, const DiagnosticEngine& diags, EmitOptions opts) {
   opts.backend = "opencl";
-  Emitter e(plan, diags, opts);
+  Emitter e(sched, diags, opts);
   e.run();
   return e.kernelSource();
 }

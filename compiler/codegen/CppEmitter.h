@@ -6,6 +6,7 @@
 // those become OpenCL C kernels (the same bodies, typed `real`) launched from the host code.
 #pragma once
 
+#include "codegen/Schedule.h"
 #include "frontend/Diagnostics.h"
 #include "sema/Plan.h"
 
@@ -18,8 +19,10 @@ struct EmitOptions {
   std::string precision = "double";  // double or single (float): what the scene computes in
 };
 
-std::string emitCpp(const Plan& plan, const DiagnosticEngine& diags, const EmitOptions& opts);
+// The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.
+std::string emitCpp(const Schedule& sched, const DiagnosticEngine& diags,
+                    const EmitOptions& opts);
 // --backend=opencl: the OpenCL C of the scene's kernels alone (what --emit=opencl prints).
-std::string emitOpenCL(const Plan& plan, const DiagnosticEngine& diags, EmitOptions opts);
+std::string emitOpenCL(const Schedule& sched, const DiagnosticEngine& diags, EmitOptions opts);
 
 }  // namespace sphc

@@ -41,7 +41,7 @@ static cl::opt<std::string> Emit("emit",
 static cl::opt<std::string> DumpAfter("dump-after",
                                       cl::desc("Print the state after a pass and stop: parse, "
                                                "sema, bodies, prune, properties, hazards, pairs, "
-                                               "ghosts"),
+                                               "ghosts, schedule"),
                                       cl::value_desc("pass"), cl::cat(SphcCat));
 static cl::opt<bool> Report("report", cl::desc("Print the execution plan the compiler derived "
                                                "(arrays, properties, groups, pruned equations)"),
@@ -91,12 +91,12 @@ int main(int argc, char** argv) {
     return fail();
   }
   static const char* passes[] = {"parse",      "options", "sema",    "bodies", "prune",
-                                 "properties", "hazards", "pairs",   "ghosts"};
+                                 "properties", "hazards", "pairs",   "ghosts", "schedule"};
   if (!DumpAfter.empty() &&
       std::find(std::begin(passes), std::end(passes), DumpAfter) == std::end(passes)) {
     llvm::errs() << "sphc: error: unknown pass '" << DumpAfter
                  << "' for --dump-after; passes are: parse, options, sema, bodies, prune, "
-                    "properties, hazards, pairs, ghosts\n";
+                    "properties, hazards, pairs, ghosts, schedule\n";
     return fail();
   }
   if (Emit != "exe" && Emit != "cpp" && Emit != "opencl" && Emit != "plan" && Emit != "ast") {
@@ -182,13 +182,19 @@ int main(int argc, char** argv) {
     return 0;
   }
 
-  // --- code generation and build ------------------------------------------------------
-  EmitOptions emitOpts{Backend, Precision};
-  if (Emit == "opencl") {
-    llvm::outs() << emitOpenCL(*plan, diags, emitOpts);
+  // --- the back half: schedule, code generation and build ----------------------------
+  auto schedule = buildSchedule(*plan);
+  log("schedule");
+  if (DumpAfter == "schedule") {
+    printSchedule(*schedule, diags, llvm::outs());
     return 0;
   }
-  std::string cpp = emitCpp(*plan, diags, emitOpts);
+  EmitOptions emitOpts{Backend, Precision};
+  if (Emit == "opencl") {
+    llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
+    return 0;
+  }
+  std::string cpp = emitCpp(*schedule, diags, emitOpts);
   log("emit");
   if (Emit == "cpp") {
     llvm::outs() << cpp;

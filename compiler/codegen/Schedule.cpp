@@ -1,0 +1,467 @@
+#include "codegen/Schedule.h"
+
+#include "analysis/Access.h"
+#include "analysis/Passes.h"
+#include "frontend/Diagnostics.h"
+
+#include <algorithm>
+#include <functional>
+#include <map>
+
+namespace sphc {
+
+namespace {
+
+class ScheduleBuilder {
+ public:
+  explicit ScheduleBuilder(const Plan& plan) : plan_(plan) {}
+  std::unique_ptr<Schedule> run();
+
+ private:
+  const PlanBody& body(const PlanEquation& eq, ast::Method::Kind kind) const {
+    return plan_.bodies[plan_.equationDecls[eq.declIndex].methods.at(kind)];
+  }
+  bool has(const PlanEquation& eq, ast::Method::Kind kind) const {
+    return plan_.equationDecls[eq.declIndex].methods.count(kind) > 0;
+  }
+  std::vector<const PlanEquation*> withMethod(const std::vector<const PlanEquation*>& eqs,
+                                              ast::Method::Kind kind) const {
+    std::vector<const PlanEquation*> with;
+    for (const auto* eq : eqs)
+      if (has(*eq, kind)) with.push_back(eq);
+    return with;
+  }
+  bool hasGhosts(int a) const {
+    return plan_.domain.any() && !plan_.arrays[a].ghostProps.empty();
+  }
+  void group(const PlanGroup& g, const std::string& name, ScheduleGroup& out);
+  Phase phase(const PlanGroup& g, const std::vector<int>& eqIds, const std::string& name);
+  DestinationWork destination(const PlanGroup& g, const std::vector<int>& eqIds, int d);
+  std::vector<NeighbourPass> neighbourPasses(const std::vector<const PlanEquation*>& eqs, int d,
+                                             const PlanGroup& g);
+  std::vector<std::string> ghostRefresh(int d, const std::vector<const PlanEquation*>& eqs) const;
+  std::vector<const PlanEquation*> convergers(const PlanGroup& g) const;
+  void step();
+  void adaptiveDt();
+
+  const Plan& plan_;
+  std::unique_ptr<Schedule> s_;
+  std::set<std::string> sourceNames_, loopNames_;
+};
+
+std::unique_ptr<Schedule> ScheduleBuilder::run() {
+  s_ = std::make_unique<Schedule>();
+  s_->plan = &plan_;
+  s_->domain = plan_.domain.any();
+  group(plan_.root, "equations", s_->equations);
+  for (const auto& n : sourceNames_) s_->cellLists.push_back(plan_.arrayIndex(n));
+  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
+    if (loopNames_.count(plan_.arrays[a].name)) s_->searchArrays.push_back(a);
+  step();
+  adaptiveDt();
+  return std::move(s_);
+}
+
+// Runs of direct equations become fused phases; subgroups run in place, in order. Functions
+// are named by position: the group's name, then `_k` for its k-th member.
+void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, ScheduleGroup& out) {
+  out.name = name;
+  out.group = &g;
+  std::vector<int> run;
+  int part = 0;
+  auto flush = [&] {
+    if (run.empty()) return;
+    std::string fn = name + "_" + std::to_string(part++);
+    out.members.push_back({true, static_cast<int>(out.phases.size())});
+    out.phases.push_back(phase(g, run, fn));
+    out.calls.push_back(fn);
+    run.clear();
+  };
+  for (int entry : g.order) {
+    if (entry >= 0) {
+      run.push_back(g.equations[entry]);
+      continue;
+    }
+    flush();
+    std::string fn = name + "_" + std::to_string(part++);
+    const PlanGroup& sub = *g.subgroups[-entry - 1];
+    out.members.push_back({false, static_cast<int>(out.subgroups.size())});
+    out.subgroups.push_back(std::make_unique<ScheduleGroup>());
+    group(sub, fn, *out.subgroups.back());
+    // A post_step group (top level only) runs after the time step, not with the others.
+    if (sub.postStep)
+      s_->postStep.push_back({fn, &sub});
+    else
+      out.calls.push_back(fn);
+  }
+  flush();
+  if (g.iterate) {
+    out.convergers = convergers(g);
+    // Numbered as the groups are completed (subgroups first).
+    out.statsIndex = static_cast<int>(s_->iteratedGroups.size());
+    s_->iteratedGroups.push_back(g.loc);
+  }
+}
+
+// The `converged` tests of an iterated group: those of its equations and of the equations in
+// its subgroups, at any depth (as PySPH's Group), except inside a nested iterated group.
+std::vector<const PlanEquation*> ScheduleBuilder::convergers(const PlanGroup& g) const {
+  std::vector<const PlanEquation*> out;
+  std::function<void(const PlanGroup&)> collect = [&](const PlanGroup& grp) {
+    for (int entry : grp.order) {
+      if (entry < 0) {
+        const PlanGroup& sub = *grp.subgroups[-entry - 1];
+        if (!sub.iterate) collect(sub);
+        continue;
+      }
+      const auto& eq = plan_.equations[grp.equations[entry]];
+      if (eq.live && has(eq, ast::Method::Converged)) out.push_back(&eq);
+    }
+  };
+  collect(g);
+  return out;
+}
+
+Phase ScheduleBuilder::phase(const PlanGroup& g, const std::vector<int>& eqIds,
+                             const std::string& name) {
+  Phase ph;
+  ph.name = name;
+  ph.group = &g;
+  ph.equations = eqIds;
+  std::vector<int> dests;
+  for (int e : eqIds) {
+    const auto& eq = plan_.equations[e];
+    if (eq.live && std::find(dests.begin(), dests.end(), eq.dest) == dests.end())
+      dests.push_back(eq.dest);
+  }
+  for (int d : dests) ph.destinations.push_back(destination(g, eqIds, d));
+  return ph;
+}
+
+DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vector<int>& eqIds,
+                                             int d) {
+  DestinationWork w;
+  w.array = d;
+  for (int e : eqIds)
+    if (plan_.equations[e].live && plan_.equations[e].dest == d)
+      w.equations.push_back(&plan_.equations[e]);
+  w.onGhosts = !g.real && hasGhosts(d);
+  for (const auto* eq : w.equations)
+    for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods) {
+      for (const auto& r : plan_.bodies[b].facts.dReads) w.destProps.insert(r.prop);
+      for (const auto& wr : plan_.bodies[b].facts.dWrites) w.destProps.insert(wr.prop);
+    }
+  w.initialize = withMethod(w.equations, ast::Method::Initialize);
+  w.passes = neighbourPasses(w.equations, d, g);
+  w.postLoop = withMethod(w.equations, ast::Method::PostLoop);
+  for (const auto* eq : withMethod(w.equations, ast::Method::Reduce)) {
+    const auto& pd = plan_.equationDecls[eq->declIndex];
+    Reduction r;
+    r.equation = eq;
+    r.op = pd.reduceOp;
+    r.target = pd.reduceTarget;
+    r.combine = r.op == "sum" || r.op == "mean" ? LoopOrder::Serial : LoopOrder::Parallel;
+    w.reductions.push_back(r);
+  }
+  if (!w.onGhosts) w.ghostRefresh = ghostRefresh(d, w.equations);
+  return w;
+}
+
+// One pass per source, in order of first use: every equation looping over that source shares
+// its candidates and pair quantities.
+std::vector<NeighbourPass> ScheduleBuilder::neighbourPasses(
+    const std::vector<const PlanEquation*>& eqs, int d, const PlanGroup& g) {
+  std::vector<const PlanEquation*> loopers = withMethod(eqs, ast::Method::Loop);
+  std::vector<int> sources;
+  for (const auto* eq : loopers)
+    for (int s : eq->sources)
+      if (std::find(sources.begin(), sources.end(), s) == sources.end()) sources.push_back(s);
+  std::vector<NeighbourPass> passes;
+  for (int s : sources) {
+    sourceNames_.insert(plan_.arrays[s].name);
+    loopNames_.insert(plan_.arrays[s].name);
+    loopNames_.insert(plan_.arrays[d].name);
+    NeighbourPass pass;
+    pass.source = s;
+    auto it = g.pairQuantities.find({d, s});
+    if (it != g.pairQuantities.end()) pass.pairQuantities = it->second;
+    pass.pairQuantities = pairQuantityClosure(pass.pairQuantities);
+    for (const auto* eq : loopers) {
+      if (std::find(eq->sources.begin(), eq->sources.end(), s) == eq->sources.end()) continue;
+      pass.equations.push_back(eq);
+      for (const auto& r : body(*eq, ast::Method::Loop).facts.sReads)
+        pass.sourceProps.insert(r.prop);
+    }
+    std::vector<std::string> pos = positionProps(plan_.dim);
+    pass.shared.insert(pos.begin(), pos.end());
+    pass.shared.insert("h");
+    std::vector<std::string> vel = {"u", "v", "w"};
+    vel.resize(plan_.dim);
+    if (pass.pairQuantities.count("VIJ")) pass.shared.insert(vel.begin(), vel.end());
+    if (pass.pairQuantities.count("RHOIJ")) pass.shared.insert("rho");
+    passes.push_back(std::move(pass));
+  }
+  return passes;
+}
+
+// Ghosts copy the values a phase computed on the real particles, where they carry them.
+std::vector<std::string> ScheduleBuilder::ghostRefresh(
+    int d, const std::vector<const PlanEquation*>& eqs) const {
+  std::vector<std::string> refresh;
+  if (!hasGhosts(d)) return refresh;
+  std::set<std::string> written;
+  for (const auto* eq : eqs)
+    for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods)
+      for (const auto& w : plan_.bodies[b].facts.dWrites) written.insert(w.prop);
+  for (const auto& p : plan_.arrays[d].ghostProps)
+    if (written.count(p)) refresh.push_back(p);
+  return refresh;
+}
+
+static bool isStepperStatement(const std::string& s) {
+  return s != "compute_accelerations" && s != "update_domain";
+}
+
+void ScheduleBuilder::step() {
+  const auto& steps = plan_.integratorSteps;
+  for (const auto& st : steps) s_->stages += st.rfind("stage", 0) == 0;
+  int done = 0;
+  for (size_t k = 0; k < steps.size();) {
+    if (steps[k] == "compute_accelerations") {
+      s_->step.push_back({StepStatement::ComputeAccelerations, -1, {done}});
+      ++k;
+      continue;
+    }
+    if (steps[k] == "update_domain") {
+      s_->step.push_back({StepStatement::UpdateDomain, -1, {done}});
+      ++k;
+      continue;
+    }
+    // A run of consecutive stepper statements.
+    StepperRun run;
+    run.name = "stepper";
+    StepStatement st;
+    st.kind = StepStatement::Stepper;
+    for (; k < steps.size() && isStepperStatement(steps[k]); ++k) {
+      run.methods.push_back(steps[k]);
+      run.name += "_" + steps[k];
+      st.stagesDone.push_back(done);
+      if (steps[k].rfind("stage", 0) == 0) ++done;
+    }
+    auto same = std::find_if(s_->stepperRuns.begin(), s_->stepperRuns.end(),
+                             [&](const StepperRun& r) { return r.name == run.name; });
+    if (same == s_->stepperRuns.end()) {
+      for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+        const PlanArray& A = plan_.arrays[a];
+        if (A.stepper < 0) continue;
+        StepperRun::Part part;
+        part.array = a;
+        part.stepper = &plan_.steppers[A.stepper];
+        for (size_t j = 0; j < run.methods.size(); ++j) {
+          auto it = part.stepper->methods.find(run.methods[j]);
+          if (it == part.stepper->methods.end()) continue;
+          const PlanBody* b = &plan_.bodies[it->second];
+          part.bodies.push_back({j, b});
+          for (const auto& r : b->facts.dReads) part.destProps.insert(r.prop);
+          for (const auto& w : b->facts.dWrites) part.destProps.insert(w.prop);
+        }
+        if (!part.bodies.empty()) run.parts.push_back(std::move(part));
+      }
+      st.run = static_cast<int>(s_->stepperRuns.size());
+      s_->stepperRuns.push_back(std::move(run));
+    } else {
+      st.run = static_cast<int>(same - s_->stepperRuns.begin());
+    }
+    s_->step.push_back(std::move(st));
+  }
+  std::map<std::string, std::vector<int>> methods;
+  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
+    if (plan_.arrays[a].stepper >= 0)
+      for (const auto& [m, b] : plan_.steppers[plan_.arrays[a].stepper].methods)
+        methods[m].push_back(a);
+  for (auto& [m, arrays] : methods) s_->stepperMethods.push_back({m, arrays});
+}
+
+void ScheduleBuilder::adaptiveDt() {
+  AdaptiveDt& a = s_->adaptiveDt;
+  a.enabled = plan_.adaptiveDt;
+  if (!a.enabled) return;
+  for (int i = 0; i < static_cast<int>(plan_.arrays.size()); ++i)
+    if (movesParticles(plan_, i)) a.arrays.push_back(i);
+  a.cfl = plan_.cfl || !plan_.forceFactor;
+  a.force = plan_.forceFactor != nullptr;
+  a.viscous = plan_.nu != nullptr;
+}
+
+}  // namespace
+
+bool Schedule::isCellList(int array) const {
+  return std::find(cellLists.begin(), cellLists.end(), array) != cellLists.end();
+}
+
+std::unique_ptr<Schedule> buildSchedule(const Plan& plan) { return ScheduleBuilder(plan).run(); }
+
+// ---- --dump-after=schedule ------------------------------------------------------------------
+
+namespace {
+
+class SchedulePrinter {
+ public:
+  SchedulePrinter(const Schedule& s, const DiagnosticEngine& diags, llvm::raw_ostream& os)
+      : s_(s), p_(*s.plan), diags_(diags), os_(os) {}
+  void print();
+
+ private:
+  const std::string& name(int a) const { return p_.arrays[a].name; }
+  std::string eqName(const PlanEquation* eq) const {
+    return eq->name + " (eq " + std::to_string(eq->id) + ")";
+  }
+  std::string eqList(const std::vector<const PlanEquation*>& eqs) const {
+    std::string s;
+    for (const auto* eq : eqs) s += (s.empty() ? "" : ", ") + eqName(eq);
+    return s;
+  }
+  static std::string order(LoopOrder o) { return o == LoopOrder::Parallel ? "parallel" : "serial"; }
+  static std::string list(const std::set<std::string>& xs) {
+    std::string s;
+    for (const auto& x : xs) s += (s.empty() ? "" : " ") + x;
+    return s.empty() ? "-" : s;
+  }
+  void group(const ScheduleGroup& g, int indent);
+  void phase(const Phase& ph, int indent);
+  std::string time(int stagesDone) const {
+    return stagesDone == 0 ? "t"
+                           : "t + " + std::to_string(stagesDone) + "/" +
+                                 std::to_string(s_.stages) + " dt";
+  }
+
+  const Schedule& s_;
+  const Plan& p_;
+  const DiagnosticEngine& diags_;
+  llvm::raw_ostream& os_;
+};
+
+void SchedulePrinter::print() {
+  os_ << "schedule of scene " << p_.sceneName << "\n";
+  os_ << "neighbour search:";
+  if (s_.searchArrays.empty()) os_ << " none";
+  os_ << "\n";
+  if (!s_.searchArrays.empty()) {
+    os_ << "  search domain over:";
+    for (int a : s_.searchArrays) os_ << " " << name(a);
+    os_ << "\n  cell lists:";
+    for (int a : s_.cellLists) os_ << " " << name(a);
+    os_ << "\n";
+    if (s_.domain)
+      for (int a : s_.cellLists) {
+        os_ << "  ghosts of " << name(a) << " carry:";
+        for (const auto& p : p_.arrays[a].ghostProps) os_ << " " << p;
+        os_ << "\n";
+      }
+  }
+  os_ << "evaluation (compute_accelerations):"
+      << (s_.domain ? " update_domain, update_neighbours, equations, remove ghosts"
+                    : " update_neighbours, equations")
+      << "\n";
+  group(s_.equations, 1);
+  if (!s_.postStep.empty()) {
+    os_ << "post_step (after each time step, when one is due):";
+    for (const auto& ps : s_.postStep)
+      os_ << " " << ps.function << (ps.group->every ? " (every)" : "");
+    os_ << "\n";
+  }
+  os_ << "step (integrator " << (p_.integratorName.empty() ? "none" : p_.integratorName)
+      << ", " << s_.stages << " stages):\n";
+  for (const auto& st : s_.step) {
+    if (st.kind == StepStatement::ComputeAccelerations) {
+      os_ << "  compute_accelerations at " << time(st.stagesDone[0]) << "\n";
+    } else if (st.kind == StepStatement::UpdateDomain) {
+      os_ << "  update_domain" << (s_.domain ? "" : " (no periodic or mirror domain: nothing)")
+          << "\n";
+    } else {
+      const StepperRun& r = s_.stepperRuns[st.run];
+      os_ << "  stepper run " << r.name << " [fused, " << order(r.order) << "]:";
+      for (size_t j = 0; j < r.methods.size(); ++j)
+        os_ << (j ? "," : "") << " " << r.methods[j] << " at " << time(st.stagesDone[j]);
+      os_ << "\n";
+      if (r.parts.empty()) os_ << "    no array has these methods: nothing\n";
+      for (const auto& part : r.parts) {
+        os_ << "    " << name(part.array) << ": " << part.stepper->decl->name.name;
+        for (size_t i = 0; i < part.bodies.size(); ++i)
+          os_ << (i ? ", " : ".") << r.methods[part.bodies[i].first];
+        os_ << "\n";
+      }
+    }
+  }
+  if (!s_.postStep.empty()) os_ << "  post_step\n";
+  const AdaptiveDt& a = s_.adaptiveDt;
+  if (a.enabled) {
+    os_ << "adaptive dt [" << order(a.order) << " min]: limits";
+    if (a.cfl) os_ << " cfl";
+    if (a.force) os_ << " force";
+    if (a.viscous) os_ << " viscous";
+    os_ << " over";
+    for (int i : a.arrays) os_ << " " << name(i);
+    if (a.arrays.empty()) os_ << " no moving array";
+    os_ << "\n";
+  }
+}
+
+void SchedulePrinter::group(const ScheduleGroup& g, int indent) {
+  std::string pad(2 * indent, ' ');
+  const PlanGroup& pg = *g.group;
+  os_ << pad << "group " << g.name << ", from " << diags_.lineInfo(pg.loc);
+  if (!pg.real) os_ << ", real = false";
+  if (pg.every) os_ << ", every";
+  if (pg.postStep) os_ << ", post_step";
+  os_ << "\n";
+  if (pg.iterate) {
+    os_ << pad << "  iterated " << pg.minIterations << ".." << pg.maxIterations
+        << " times (statistics " << g.statsIndex << "), converged when: "
+        << (g.convergers.empty() ? "always" : eqList(g.convergers)) << "\n";
+  }
+  for (const auto& m : g.members) {
+    if (m.isPhase)
+      phase(g.phases[m.index], indent + 1);
+    else
+      group(*g.subgroups[m.index], indent + 1);
+  }
+}
+
+void SchedulePrinter::phase(const Phase& ph, int indent) {
+  std::string pad(2 * indent, ' ');
+  os_ << pad << "phase " << ph.name << "\n";
+  for (const auto& w : ph.destinations) {
+    os_ << pad << "  destination " << name(w.array)
+        << (w.onGhosts ? " (real particles and ghosts)" : " (real particles)") << "\n";
+    if (!w.initialize.empty())
+      os_ << pad << "    initialize [" << order(w.perParticle) << "]: " << eqList(w.initialize)
+          << "\n";
+    for (const auto& pass : w.passes) {
+      os_ << pad << "    neighbours " << name(w.array) << " <- " << name(pass.source) << " ["
+          << order(pass.order) << "]: " << eqList(pass.equations) << "\n";
+      os_ << pad << "      pair quantities: " << list(pass.pairQuantities) << "\n";
+      os_ << pad << "      source properties: " << list(pass.sourceProps) << "\n";
+    }
+    if (!w.postLoop.empty())
+      os_ << pad << "    post_loop [" << order(w.perParticle) << "]: " << eqList(w.postLoop)
+          << "\n";
+    for (const auto& r : w.reductions)
+      os_ << pad << "    reduce " << r.op << " into " << name(w.array) << "." << r.target
+          << " [values parallel, combined " << order(r.combine) << "]: " << eqName(r.equation)
+          << (w.onGhosts ? " (real particles only)" : "") << "\n";
+    if (!w.ghostRefresh.empty()) {
+      os_ << pad << "    refresh ghosts:";
+      for (const auto& p : w.ghostRefresh) os_ << " " << p;
+      os_ << "\n";
+    }
+  }
+}
+
+}  // namespace
+
+void printSchedule(const Schedule& s, const DiagnosticEngine& diags, llvm::raw_ostream& os) {
+  SchedulePrinter(s, diags, os).print();
+}
+
+}  // namespace sphc

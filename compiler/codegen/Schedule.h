@@ -1,0 +1,171 @@
+// The schedule: what the generated solver does, in which order and over which particles,
+// decided once from the analysed Plan and read by every backend's printer. It is the back
+// half's counterpart of the Plan: the Plan says what the scene computes, the schedule how
+// one evaluation and one time step run it — phases and their neighbour passes, reductions,
+// iterated groups and their convergence tests, fused stepper runs, ghost refreshes, cell
+// lists, the adaptive time step — with no backend in it. Printers (codegen/*Printer.cpp)
+// decide only spellings: a loop marked parallel is an OpenMP `parallel for` on one backend,
+// a kernel on another and a plain loop on the serial one.
+#pragma once
+
+#include "frontend/Diagnostics.h"
+#include "sema/Plan.h"
+
+#include "llvm/Support/raw_ostream.h"
+
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace sphc {
+
+// How the iterations of a loop over particles may run (as Halide's ForType). Parallel: they
+// are independent (each writes its own particle only: a gather), in any order and at once.
+// Serial: in particle order (a sum whose result must not depend on the thread count).
+enum class LoopOrder { Serial, Parallel };
+
+// One neighbour pass: for every destination particle, every candidate of one source array,
+// the pair quantities once, then the loop body of every equation that loops over that source.
+struct NeighbourPass {
+  int source = -1;                           // array index
+  std::set<std::string> pairQuantities;      // closed under what they need (XIJ, RIJ, ...)
+  std::vector<const PlanEquation*> equations;  // whose `loop` runs here, in group order
+  std::set<std::string> sourceProps;         // s_* properties the loop bodies read
+  // Read on both sides to compute the pair quantities: positions and h always, velocities
+  // for VIJ, rho for RHOIJ.
+  std::set<std::string> shared;
+  LoopOrder order = LoopOrder::Parallel;
+};
+
+// A reduction of one equation over the real particles of its destination into a constant.
+struct Reduction {
+  const PlanEquation* equation = nullptr;
+  std::string op;       // sum, mean, max, min
+  std::string target;   // the destination's constant
+  // sum and mean: the values may be computed in parallel, but they are added in particle
+  // order, so that the result (and the iteration count a convergence test derives from it)
+  // is the serial one bit for bit. max and min: any order.
+  LoopOrder combine = LoopOrder::Parallel;
+};
+
+// What a phase does for one destination array.
+struct DestinationWork {
+  int array = -1;
+  // A group with `real = false` runs on the ghosts too (they follow the real particles);
+  // reductions still see the real particles only.
+  bool onGhosts = false;
+  std::vector<const PlanEquation*> equations;   // every live equation of the phase on it
+  std::set<std::string> destProps;              // d_* properties any of their bodies use
+  std::vector<const PlanEquation*> initialize;  // per particle, before the neighbour passes
+  std::vector<NeighbourPass> passes;            // one per source, in order of first use
+  std::vector<const PlanEquation*> postLoop;    // per particle, after them
+  std::vector<Reduction> reductions;
+  // Carried properties the phase wrote on the real particles: their ghosts are refreshed
+  // after it (empty when the phase ran on the ghosts too).
+  std::vector<std::string> ghostRefresh;
+  LoopOrder perParticle = LoopOrder::Parallel;  // the initialize and post_loop loops
+};
+
+// A fused evaluation of consecutive direct equations of a group (PySPH's Group): per
+// destination, every initialize, the neighbour passes, then post_loop and reduce.
+struct Phase {
+  std::string name;  // the generated function, e.g. equations_0
+  const PlanGroup* group = nullptr;
+  std::vector<int> equations;  // equation ids, live or not, in group order
+  std::vector<DestinationWork> destinations;  // in order of first use
+};
+
+// A group of the scene's equations { }: its phases and subgroups run in order.
+struct ScheduleGroup {
+  std::string name;  // the generated function, e.g. equations or equations_2
+  const PlanGroup* group = nullptr;
+  struct Member {
+    bool isPhase = true;
+    int index = 0;  // into phases or subgroups
+  };
+  std::vector<Member> members;  // in order (post_step subgroups included)
+  std::vector<Phase> phases;
+  std::vector<std::unique_ptr<ScheduleGroup>> subgroups;
+  // The function names this group calls, in order: its phases and subgroups, except
+  // subgroups with post_step = true (those run after the time step).
+  std::vector<std::string> calls;
+  // Iterated groups: the `converged` tests (of its equations and those of its subgroups at
+  // any depth, except inside a nested iterated group, which tests its own) and the index of
+  // its iteration statistics.
+  std::vector<const PlanEquation*> convergers;
+  int statsIndex = -1;
+};
+
+// Consecutive stepper statements (initialize, stageN) of the integrator's step, fused: one
+// pass per array doing all the run's methods per particle. Steppers read and write their own
+// particle only, so this equals running each method on all particles in turn, bit for bit.
+struct StepperRun {
+  std::string name;  // stepper_initialize_stage1
+  std::vector<std::string> methods;  // initialize, stage1, ...
+  struct Part {
+    int array = -1;
+    const PlanStepper* stepper = nullptr;
+    // (position in methods, body) for the methods this array's stepper has.
+    std::vector<std::pair<size_t, const PlanBody*>> bodies;
+    std::set<std::string> destProps;
+  };
+  std::vector<Part> parts;  // arrays with at least one of the run's methods
+  LoopOrder order = LoopOrder::Parallel;
+};
+
+// One statement of the integrator's step.
+struct StepStatement {
+  enum Kind { Stepper, ComputeAccelerations, UpdateDomain } kind = Stepper;
+  int run = -1;  // Stepper: index into Schedule::stepperRuns (a whole run of statements)
+  // The stages completed before each statement (a run: one per method): its time is
+  // t + stagesDone/stages dt.
+  std::vector<int> stagesDone;
+};
+
+// The adaptive time step: per-particle limits over the arrays that move.
+struct AdaptiveDt {
+  bool enabled = false;
+  std::vector<int> arrays;  // stepped arrays whose stepper moves them
+  bool cfl = false;         // h / (cs + |v|)
+  bool force = false;       // sqrt(h / |a|)
+  bool viscous = false;     // h^2 / nu
+  LoopOrder order = LoopOrder::Parallel;  // a min reduction: any order
+};
+
+struct Schedule {
+  const Plan* plan = nullptr;
+  ScheduleGroup equations;  // the root group: compute_accelerations' `equations(t, dt)`
+  // Top-level groups with post_step = true, in order: (function, condition) pairs; the
+  // condition is the group's `every` test (null: always).
+  struct PostStep {
+    std::string function;
+    const PlanGroup* group = nullptr;
+  };
+  std::vector<PostStep> postStep;
+  // Source locations of the iterated groups, by statistics index.
+  std::vector<llvm::SMLoc> iteratedGroups;
+  // Neighbour search: arrays in a neighbour pass as destination or source (the search
+  // domain spans them), in array order; arrays that are a source (they need a cell list,
+  // and with a periodic or mirror domain ghosts), by name.
+  std::vector<int> searchArrays;
+  std::vector<int> cellLists;
+  bool domain = false;  // periodic or mirror sides: wrapping, ghosts
+  // The integrator's step.
+  std::vector<StepperRun> stepperRuns;  // one per distinct run name, in order of first use
+  std::vector<StepStatement> step;
+  int stages = 0;
+  // Each stepper method on its own (printers that do not fuse runs): method -> arrays.
+  std::vector<std::pair<std::string, std::vector<int>>> stepperMethods;
+  AdaptiveDt adaptiveDt;
+
+  bool isCellList(int array) const;
+};
+
+// The schedule of an analysed plan (after the ghost pass). Pure: reads the plan only.
+std::unique_ptr<Schedule> buildSchedule(const Plan& plan);
+
+// --dump-after=schedule.
+void printSchedule(const Schedule& s, const DiagnosticEngine& diags, llvm::raw_ostream& os);
+
+}  // namespace sphc
