@@ -14,9 +14,16 @@
 
 namespace sphc {
 
+// The backends: each is a printer of the schedule (codegen/*Printer.cpp).
+enum class Backend { Serial, OpenMP, OpenCL };
+// What the scene computes in: double, or single (float).
+enum class Precision { Double, Single };
+// "serial", "openmp", "opencl": as on the command line, in prog.backend and the build.
+const char* backendName(Backend b);
+
 struct EmitOptions {
-  std::string backend = "serial";  // serial, openmp or opencl
-  std::string precision = "double";  // double or single (float): what the scene computes in
+  Backend backend = Backend::Serial;
+  Precision precision = Precision::Double;
 };
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.

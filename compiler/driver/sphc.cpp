@@ -22,27 +22,69 @@ using namespace sphc;
 namespace cl = llvm::cl;
 
 static cl::OptionCategory SphcCat("sphc options");
+
+// An enum option's parser whose error names the values it accepts (LLVM's own says only
+// that it found none): "for the --backend option: unknown value 'cuda'; it is one of:
+// serial, openmp, opencl".
+template <class T>
+class NamedValues : public cl::parser<T> {
+ public:
+  using cl::parser<T>::parser;
+  bool parse(cl::Option& o, llvm::StringRef name, llvm::StringRef arg, T& value) {
+    std::string names;
+    for (unsigned i = 0; i < this->getNumOptions(); ++i) {
+      if (this->getOption(i) == (o.hasArgStr() ? arg : name))
+        return cl::parser<T>::parse(o, name, arg, value);
+      names += (i ? ", " : "") + this->getOption(i).str();
+    }
+    return o.error("unknown value '" + arg + "'; it is one of: " + names);
+  }
+};
 static cl::opt<std::string> InputFile(cl::Positional, cl::desc("<scene.sph>"), cl::Required,
                                       cl::cat(SphcCat));
 static cl::opt<std::string> OutputFile("o", cl::desc("Executable to write (default: the scene "
                                                      "file's name without .sph)"),
                                        cl::value_desc("file"), cl::cat(SphcCat));
-static cl::opt<std::string> Backend("backend", cl::desc("serial (default), openmp or opencl"),
-                                    cl::init("serial"), cl::cat(SphcCat));
-static cl::opt<std::string> Precision("precision",
-                                      cl::desc("Floating point the scene computes in: double "
-                                               "(default; on OpenCL it needs fp64) or single"),
-                                      cl::init("double"), cl::cat(SphcCat));
-static cl::opt<std::string> Emit("emit",
-                                 cl::desc("What to produce: exe (default), cpp (the generated "
-                                          "C++ on stdout), opencl (the OpenCL C kernels of "
-                                          "--backend=opencl), plan, ast"),
-                                 cl::init("exe"), cl::cat(SphcCat));
-static cl::opt<std::string> DumpAfter("dump-after",
-                                      cl::desc("Print the state after a pass and stop: parse, "
-                                               "sema, bodies, prune, properties, hazards, pairs, "
-                                               "ghosts, schedule"),
-                                      cl::value_desc("pass"), cl::cat(SphcCat));
+static cl::opt<sphc::Backend, false, NamedValues<sphc::Backend>> BackendOpt(
+    "backend", cl::desc("The solver's backend:"), cl::init(sphc::Backend::Serial),
+    cl::values(clEnumValN(sphc::Backend::Serial, "serial", "one thread (default)"),
+               clEnumValN(sphc::Backend::OpenMP, "openmp", "loops over particles in parallel"),
+               clEnumValN(sphc::Backend::OpenCL, "opencl", "OpenCL kernels on a device")),
+    cl::cat(SphcCat));
+static cl::opt<sphc::Precision, false, NamedValues<sphc::Precision>> PrecisionOpt(
+    "precision", cl::desc("Floating point the scene computes in:"),
+    cl::init(sphc::Precision::Double),
+    cl::values(clEnumValN(sphc::Precision::Double, "double",
+                          "double (default; on OpenCL it needs fp64)"),
+               clEnumValN(sphc::Precision::Single, "single", "float")),
+    cl::cat(SphcCat));
+enum class EmitKind { Exe, Cpp, OpenCL, Plan, Ast };
+static cl::opt<EmitKind, false, NamedValues<EmitKind>> Emit(
+    "emit", cl::desc("What to produce:"), cl::init(EmitKind::Exe),
+    cl::values(clEnumValN(EmitKind::Exe, "exe", "the solver executable (default)"),
+               clEnumValN(EmitKind::Cpp, "cpp", "the generated C++ on stdout"),
+               clEnumValN(EmitKind::OpenCL, "opencl", "the OpenCL C kernels of --backend=opencl"),
+               clEnumValN(EmitKind::Plan, "plan", "the execution plan (as --report)"),
+               clEnumValN(EmitKind::Ast, "ast", "the parsed main module")),
+    cl::cat(SphcCat));
+// The passes in the order the driver runs them: --dump-after=PASS prints the state after it.
+enum class Pass { None, Parse, Options, Sema, Bodies, Prune, Properties, Hazards, Pairs, Ghosts,
+                  Schedule };
+static cl::opt<Pass, false, NamedValues<Pass>> DumpAfter(
+    "dump-after", cl::desc("Print the state after a pass and stop:"), cl::init(Pass::None),
+    cl::value_desc("pass"),
+    cl::values(clEnumValN(Pass::Parse, "parse", "the AST of the main module"),
+               clEnumValN(Pass::Options, "options", "the AST with compile-time options chosen"),
+               clEnumValN(Pass::Sema, "sema", "the plan: arrays, equation instances, groups"),
+               clEnumValN(Pass::Bodies, "bodies", "with what Clang found in the bodies"),
+               clEnumValN(Pass::Prune, "prune", "with equations that reach nothing pruned"),
+               clEnumValN(Pass::Properties, "properties", "with every array's property set"),
+               clEnumValN(Pass::Hazards, "hazards", "after the group hazard check"),
+               clEnumValN(Pass::Pairs, "pairs", "with the pair quantities of every loop"),
+               clEnumValN(Pass::Ghosts, "ghosts", "with what periodic/mirror ghosts carry"),
+               clEnumValN(Pass::Schedule, "schedule",
+                          "how set-up and one time step run (phases, neighbour passes, steppers)")),
+    cl::cat(SphcCat));
 static cl::opt<bool> Report("report", cl::desc("Print the execution plan the compiler derived "
                                                "(arrays, properties, groups, pruned equations)"),
                             cl::cat(SphcCat));
@@ -80,35 +122,11 @@ int main(int argc, char** argv) {
     llvm::errs() << "sphc: " << what << " done at " << llvm::format("%.3f", s) << " s\n";
   };
 
-  if (Backend != "serial" && Backend != "openmp" && Backend != "opencl") {
-    llvm::errs() << "sphc: error: unknown backend '" << Backend
-                 << "'; backends are: serial, openmp, opencl\n";
-    return fail();
-  }
-  if (Precision != "double" && Precision != "single") {
-    llvm::errs() << "sphc: error: unknown --precision '" << Precision
-                 << "'; it is double or single\n";
-    return fail();
-  }
-  static const char* passes[] = {"parse",      "options", "sema",    "bodies", "prune",
-                                 "properties", "hazards", "pairs",   "ghosts", "schedule"};
-  if (!DumpAfter.empty() &&
-      std::find(std::begin(passes), std::end(passes), DumpAfter) == std::end(passes)) {
-    llvm::errs() << "sphc: error: unknown pass '" << DumpAfter
-                 << "' for --dump-after; passes are: parse, options, sema, bodies, prune, "
-                    "properties, hazards, pairs, ghosts, schedule\n";
-    return fail();
-  }
-  if (Emit != "exe" && Emit != "cpp" && Emit != "opencl" && Emit != "plan" && Emit != "ast") {
-    llvm::errs() << "sphc: error: unknown --emit kind '" << Emit
-                 << "'; kinds are: exe, cpp, opencl, plan, ast\n";
-    return fail();
-  }
-
+  const sphc::Backend Backend = BackendOpt;
   Install install = locateInstall(argv[0]);
   // A solver of --backend=opencl needs the OpenCL runtime, built only where CMake found
   // OpenCL; say so before any work (--emit=cpp/opencl do not need it).
-  if (Backend == "opencl" && Emit == "exe") {
+  if (Backend == sphc::Backend::OpenCL && Emit == EmitKind::Exe) {
     std::string why;
     if (!openclAvailable(install, why)) {
       llvm::errs() << "sphc: error: --backend=opencl is not available in this build: " << why
@@ -122,7 +140,7 @@ int main(int argc, char** argv) {
 
   // --- front end ---------------------------------------------------------------------
   std::vector<std::string> includes(IncludeDirs.begin(), IncludeDirs.end());
-  bool parseOnly = Emit == "ast" || DumpAfter == "parse";
+  bool parseOnly = Emit == EmitKind::Ast || DumpAfter == Pass::Parse;
   auto modules = loadModules(InputFile, parseOnly ? std::vector<std::string>{} : includes,
                              install.stdlibDir, diags);
   log("parse");
@@ -137,7 +155,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> defines(Defines.begin(), Defines.end());
   if (!selectOptions(modules, defines, diags, options)) return fail();
   log("options");
-  if (DumpAfter == "options") {
+  if (DumpAfter == Pass::Options) {
     printModule(*modules.front(), llvm::outs(), diags);
     return 0;
   }
@@ -145,12 +163,12 @@ int main(int argc, char** argv) {
   log("sema");
   if (!plan || diags.hasErrors()) return fail();
   plan->options = options;
-  auto dump = [&](const char* pass) {
+  auto dump = [&](Pass pass) {
     if (DumpAfter != pass) return false;
     printPlan(*plan, llvm::outs(), false);
     return true;
   };
-  if (dump("sema")) return 0;
+  if (dump(Pass::Sema)) return 0;
 
   {
     std::vector<BodySource> sources;
@@ -161,23 +179,23 @@ int main(int argc, char** argv) {
   }
   log("bodies");
   if (diags.hasErrors()) return fail();
-  if (dump("bodies")) return 0;
+  if (dump(Pass::Bodies)) return 0;
 
   if (!pruneEquations(*plan, diags)) return fail();
-  if (dump("prune")) return 0;
+  if (dump(Pass::Prune)) return 0;
   if (!inferProperties(*plan, diags)) return fail();
-  if (dump("properties")) return 0;
+  if (dump(Pass::Properties)) return 0;
   if (!checkHazards(*plan, diags)) return fail();
-  if (dump("hazards")) return 0;
+  if (dump(Pass::Hazards)) return 0;
   if (!selectPairQuantities(*plan, diags)) return fail();
-  if (dump("pairs")) return 0;
+  if (dump(Pass::Pairs)) return 0;
   if (!selectGhostProperties(*plan, diags)) return fail();
-  if (dump("ghosts")) return 0;
+  if (dump(Pass::Ghosts)) return 0;
   log("analysis");
   if (diags.hasErrors()) return fail();
 
   if (Report) printPlan(*plan, llvm::outs(), true);
-  if (Emit == "plan") {
+  if (Emit == EmitKind::Plan) {
     if (!Report) printPlan(*plan, llvm::outs(), true);
     return 0;
   }
@@ -185,18 +203,18 @@ int main(int argc, char** argv) {
   // --- the back half: schedule, code generation and build ----------------------------
   auto schedule = buildSchedule(*plan);
   log("schedule");
-  if (DumpAfter == "schedule") {
+  if (DumpAfter == Pass::Schedule) {
     printSchedule(*schedule, diags, llvm::outs());
     return 0;
   }
-  EmitOptions emitOpts{Backend, Precision};
-  if (Emit == "opencl") {
+  EmitOptions emitOpts{Backend, PrecisionOpt};
+  if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;
   }
   std::string cpp = emitCpp(*schedule, diags, emitOpts);
   log("emit");
-  if (Emit == "cpp") {
+  if (Emit == EmitKind::Cpp) {
     llvm::outs() << cpp;
     return 0;
   }
@@ -209,7 +227,7 @@ int main(int argc, char** argv) {
   req.output = output;
   req.cxx = Cxx;
   req.cxxflags = CxxFlags;
-  req.backend = Backend;
+  req.backend = backendName(Backend);
   req.useCache = !NoCache;
   req.verbose = Verbose;
   BuildResult res = buildExecutable(install, req);

@@ -1,0 +1,265 @@
+// Equation and stepper bodies as functions, their parameters and calls, and the per-candidate
+// code of a neighbour pass (pair quantities, then the loop bodies): written once, printed in
+// a Dialect (the C++ of the CPU backends or the OpenCL C of the kernels).
+#include "analysis/Access.h"
+#include "body/BodyAnalysis.h"
+#include "codegen/Printer.h"
+
+#include <algorithm>
+
+namespace sphc {
+
+ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
+                           const EmitOptions& opts)
+    : sched_(sched),
+      plan_(*sched.plan),
+      diags_(diags),
+      backendName_(backendName(opts.backend)),
+      singlePrecision_(opts.precision == Precision::Single),
+      cpuSingle_(singlePrecision_ && opts.backend != Backend::OpenCL),
+      real_(cpuSingle_ ? "float" : "double") {
+  host_ = {real_, "std::int32_t", "std::uint32_t", "", "static inline ", "Kernel::w",
+           "Kernel::gradient", "std::sqrt", "return;", ".", cpuSingle_, cpuSingle_, false};
+  device_ = {"real", "int", "uint", "__global ", "inline ", "kernel_w", "kernel_gradient",
+             "sqrt", "continue;", "_", false, false, true};
+  for (int a : sched.cellLists) sourceArrays_.push_back(arr(a).name);
+  for (int a : sched.searchArrays) loopArrays_.insert(arr(a).name);
+}
+
+int ScenePrinter::propIndex(int a, const std::string& p) const {
+  for (size_t i = 0; i < arr(a).props.size(); ++i)
+    if (arr(a).props[i].name == p) return static_cast<int>(i);
+  return -1;
+}
+
+int ScenePrinter::constIndex(int a, const std::string& c) const {
+  const auto& cs = arr(a).constants;
+  auto it = std::find(cs.begin(), cs.end(), c);
+  return it == cs.end() ? -1 : static_cast<int>(it - cs.begin());
+}
+
+std::string ScenePrinter::propType(int a, const std::string& p, const Dialect& d) const {
+  if (constIndex(a, p) >= 0) return d.real;
+  const PlanProperty* pp = arr(a).find(p);
+  if (pp && pp->type == "int") return d.intType;
+  if (pp && pp->type == "uint") return d.uintType;
+  return d.real;
+}
+
+std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b, int destArray,
+                                                              const Dialect& d) const {
+  std::vector<BodyParam> ps;
+  const std::string& real = d.real;
+  const std::string& global = d.global;
+  const BodyFacts& f = b.facts;
+  bool isLoop = b.source.kind == BodyKind::Loop;
+  ps.push_back({"int d_idx", BodyParam::Idx, ""});
+  if (isLoop) ps.push_back({"int s_idx", BodyParam::SIdx, ""});
+  ps.push_back({real + " t", BodyParam::T, ""});
+  ps.push_back({real + " dt", BodyParam::Dt, ""});
+  for (const auto& q : pairQuantityNames())
+    if (f.pairQuantities.count(q)) {
+      bool vec = q == "XIJ" || q == "VIJ" || q == "DWIJ" || q == "DWI" || q == "DWJ";
+      ps.push_back({(vec ? "const " + real + "* " : real + " ") + q, BodyParam::Pair, q});
+    }
+  for (const auto& s : b.source.scalars)
+    if (f.scalarsUsed.count(s)) ps.push_back({real + " " + s, BodyParam::Scalar, s});
+  std::set<std::string> written;
+  for (const auto& w : f.dWrites) written.insert(w.prop);
+  std::set<std::string> dprops;
+  for (const auto& r : f.dReads) dprops.insert(r.prop);
+  dprops.insert(written.begin(), written.end());
+  for (const auto& p : dprops) {
+    std::string type = real;
+    if (destArray >= 0)
+      if (arr(destArray).find(p)) type = propType(destArray, p, d);
+    bool isConst = destArray >= 0 && constIndex(destArray, p) >= 0;
+    ps.push_back({global + (written.count(p) || isConst ? "" : "const ") + type + "* d_" + p,
+                  BodyParam::DProp, p});
+  }
+  std::set<std::string> sprops;
+  for (const auto& r : f.sReads) sprops.insert(r.prop);
+  for (const auto& p : sprops)
+    ps.push_back({global + "const " + real + "* s_" + p, BodyParam::SProp, p});
+  return ps;
+}
+
+void ScenePrinter::emitBodyFunction(const PlanBody& b, const std::string& name,
+                                    const std::string& ret, int destArray, const Dialect& d,
+                                    std::ostringstream& os) {
+  auto params = bodyParams(b, destArray, d);
+  os << "// " << b.source.label << ", from " << loc(b.source.start) << "\n";
+  // OpenCL build errors in the body name the .sph line (the program is built at run time).
+  if (d.lineDirectives) emitLineDirective(os, b.source.start);
+  os << d.functionPrefix << (ret == "double" ? d.real : ret) << " " << name << "(";
+  for (size_t i = 0; i < params.size(); ++i) os << (i ? ", " : "") << params[i].decl;
+  os << ") {";
+  // The body exactly as written; its first line continues after the opening brace.
+  std::string text = d.floatBodies ? singlePrecisionBody(b.source.text) : b.source.text;
+  os << text;
+  if (text.empty() || text.back() != '\n') os << "\n";
+  os << "}\n";
+  if (d.lineDirectives) resetLineDirective(os);
+  os << "\n";
+}
+
+// KERNEL_W(r, h) and KERNEL_DWDR(r, h), the scene's kernel and its radial derivative at any
+// smoothing length, for bodies that call them (e.g. a kernel at h/2); emitted only then.
+void ScenePrinter::emitKernelFunctions() {
+  bool used = false;
+  for (const auto& b : plan_.bodies)
+    for (const std::string& f : kernelFunctions())
+      used |= b.source.text.find(f) != std::string::npos;
+  if (!used) return;
+  out_ << "static inline double KERNEL_W(double r, double h) { return Kernel::w(r, h); }\n"
+          "static inline double KERNEL_DWDR(double r, double h) {\n"
+          "  const double x[3] = {r, 0.0, 0.0};\n"
+          "  double g[3];\n"
+          "  Kernel::gradient(x, r, h, g);\n"
+          "  return r > 0.0 ? g[0] : 0.0;\n"
+          "}\n\n";
+  deviceKernelFunctions();
+}
+
+void ScenePrinter::emitLineDirective(std::ostringstream& os, llvm::SMLoc l) const {
+  std::string info = loc(l);  // file.sph:line
+  size_t colon = info.rfind(':');
+  if (colon == std::string::npos) return;
+  os << "#line " << info.substr(colon + 1) << " \"" << info.substr(0, colon) << "\"\n";
+}
+
+void ScenePrinter::resetLineDirective(std::ostringstream& os) const {
+  // The directive is on line (newlines so far + 1): the next line is one more.
+  std::string text = os.str();
+  long line = std::count(text.begin(), text.end(), '\n') + 2;
+  os << "#line " << line << " \"" << plan_.sceneName << ".cl\"\n";
+}
+
+std::string ScenePrinter::propPtr(int a, const std::string& p) const {
+  if (cpuSingle_) {
+    int c = constIndex(a, p);
+    if (c >= 0) return "f32_" + arr(a).name + ".constant(" + std::to_string(c) + ")";
+    int i = propIndex(a, p);
+    if (i >= 0 && arr(a).props[i].type != "int" && arr(a).props[i].type != "uint")
+      return "f32_" + arr(a).name + ".f(" + std::to_string(i) + ")";
+  }
+  return hostPtr(a, p);
+}
+
+std::string ScenePrinter::hostPtr(int a, const std::string& p) const {
+  int c = constIndex(a, p);
+  if (c >= 0) return arr(a).name + ".constant(" + std::to_string(c) + ")";
+  int i = propIndex(a, p);
+  if (i < 0) SPHC_INTERNAL("property '" + p + "' of '" + arr(a).name + "' was not allocated");
+  return arr(a).name + "." + accessor(arr(a).props[i].type) + "(" + std::to_string(i) + ")";
+}
+
+std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int dest,
+                                   const std::string& eqValues, const std::string& time,
+                                   const std::string& sep) const {
+  std::string s = fn + "(";
+  bool first = true;
+  for (const auto& p : bodyParams(b, dest, host_)) {
+    s += first ? "" : ", ";
+    first = false;
+    switch (p.kind) {
+      case BodyParam::Idx: s += "d_idx"; break;
+      case BodyParam::SIdx: s += "s_idx"; break;
+      case BodyParam::T: s += time; break;
+      case BodyParam::Dt: s += "dt"; break;
+      case BodyParam::Pair: s += p.name; break;
+      case BodyParam::Scalar: s += eqValues + sep + p.name; break;
+      case BodyParam::DProp: s += "d_" + p.name; break;
+      case BodyParam::SProp: s += "s_" + p.name; break;
+    }
+  }
+  return s + ")";
+}
+
+void ScenePrinter::emitDestLocals(std::ostream& os, const std::string& indent,
+                                  const std::set<std::string>& q, const Dialect& d) const {
+  const std::string& R = d.real;
+  const char* axes[3] = {"x", "y", "z"};
+  const char* vel[3] = {"u", "v", "w"};
+  for (int k = 0; k < 3; ++k)
+    os << indent << "const " << R << " " << axes[k] << "i = "
+       << (k < plan_.dim ? std::string("di_") + axes[k] + "[d_idx]" : d.lit("0.0")) << ";\n";
+  os << indent << "const " << R << " hi = di_h[d_idx];\n";
+  if (q.count("VIJ"))
+    for (int k = 0; k < plan_.dim; ++k)
+      os << indent << "const " << R << " " << vel[k] << "i = di_" << vel[k] << "[d_idx];\n";
+}
+
+void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::string>& q,
+                                      const Dialect& dl) {
+  const std::string& R = dl.real;
+  auto L = [&](const char* v) { return dl.lit(v); };
+  const std::string& W = dl.kernelW;
+  const std::string& GRAD = dl.kernelGradient;
+  const char* axes[3] = {"x", "y", "z"};
+  std::vector<std::string> vel = {"u", "v", "w"};
+  vel.resize(plan_.dim);
+  os << "            const " << R << " hj = sj_h[s_idx];\n";
+  os << "            const " << R << " XIJ[3] = {";
+  for (int k = 0; k < 3; ++k)
+    os << (k ? ", " : "")
+       << (k < plan_.dim ? std::string(axes[k]) + "i - sj_" + axes[k] + "[s_idx]" : L("0.0"));
+  os << "};\n";
+  os << "            const " << R << " R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * "
+        "XIJ[2];\n";
+  os << "            const " << R << " hmax = hi > hj ? hi : hj;\n";
+  os << "            if (R2IJ >= RADIUS2 * hmax * hmax) " << dl.skipCandidate
+     << "  // not a neighbour\n";
+  os << "            const " << R << " HIJ = " << L("0.5") << " * (hi + hj);\n";
+  if (q.count("RIJ")) os << "            const " << R << " RIJ = " << dl.sqrt << "(R2IJ);\n";
+  if (q.count("VIJ")) {
+    os << "            const " << R << " VIJ[3] = {";
+    for (int k = 0; k < 3; ++k)
+      os << (k ? ", " : "")
+         << (k < plan_.dim ? vel[k] + "i - sj_" + vel[k] + "[s_idx]" : L("0.0"));
+    os << "};\n";
+  }
+  if (q.count("WIJ")) os << "            const " << R << " WIJ = " << W << "(RIJ, HIJ);\n";
+  if (q.count("WI")) os << "            const " << R << " WI = " << W << "(RIJ, hi);\n";
+  if (q.count("WJ")) os << "            const " << R << " WJ = " << W << "(RIJ, hj);\n";
+  if (q.count("DWIJ"))
+    os << "            " << R << " DWIJ[3];\n"
+       << "            " << GRAD << "(XIJ, RIJ, HIJ, DWIJ);\n";
+  if (q.count("DWI"))
+    os << "            " << R << " DWI[3];\n"
+       << "            " << GRAD << "(XIJ, RIJ, hi, DWI);\n";
+  if (q.count("DWJ"))
+    os << "            " << R << " DWJ[3];\n"
+       << "            " << GRAD << "(XIJ, RIJ, hj, DWJ);\n";
+  if (q.count("RHOIJ"))
+    os << "            const " << R << " RHOIJ = " << L("0.5")
+       << " * (di_rho[d_idx] + sj_rho[s_idx]);\n";
+  if (q.count("RHOIJ1"))
+    os << "            const " << R << " RHOIJ1 = " << L("1.0") << " / RHOIJ;\n";
+  if (q.count("EPS"))
+    os << "            const " << R << " EPS = " << L("0.01") << " * HIJ * HIJ;\n";
+}
+
+void ScenePrinter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
+                                 const std::vector<const PlanEquation*>& loopers, int d,
+                                 const Dialect& dl) {
+  emitPairQuantities(os, q, dl);
+  for (const auto* eq : loopers)
+    os << "            "
+       << callBody(bodyFunctionName(eq->name, "loop"), methodBody(*eq, ast::Method::Loop), d,
+                   eqStruct(*eq), "t", dl.scalarSep)
+       << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+}
+
+std::string ScenePrinter::propIndexList(int a, const std::vector<std::string>& props) const {
+  std::string s = "{";
+  for (size_t k = 0; k < props.size(); ++k) {
+    int i = propIndex(a, props[k]);
+    if (i < 0) SPHC_INTERNAL("ghost property '" + props[k] + "' of '" + arr(a).name +
+                             "' was not allocated");
+    s += (k ? ", " : "") + std::to_string(i);
+  }
+  return s + "}";
+}
+
+}  // namespace sphc

@@ -1,0 +1,418 @@
+// The CPU backends: a phase's destination as loops over particles, neighbour passes over a
+// CellList, fused stepper runs, the neighbour search and ghosts on the host, the adaptive
+// time step's limits. Serial and OpenMP differ by pragmas only: a loop that the schedule
+// marks parallel gets `#pragma omp parallel for` on OpenMP and nothing on serial. Loops over
+// destination particles only write their own particle (gather), so they need no atomics and
+// give the serial result bit for bit.
+#include "codegen/Printer.h"
+
+namespace sphc {
+
+namespace {
+
+class CpuPrinter : public ScenePrinter {
+ public:
+  CpuPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
+      : ScenePrinter(sched, diags, opts), openmp_(opts.backend == Backend::OpenMP) {}
+
+ private:
+  std::string backendComment() const override {
+    return std::string(openmp_ ? "openmp (loops over particles in parallel)" : "serial") +
+           (cpuSingle_ ? "; single precision (float copies of the arrays)" : "");
+  }
+  void runtimeIncludes() override {
+    if (cpuSingle_) out_ << "#include \"sphc/float_arrays.h\"\n";
+  }
+  void systemIncludes() override {
+    if (openmp_) out_ << "\n#include <omp.h>\n";
+  }
+  void searchMembers() override;
+  std::string ghostsType() const override { return "sphc::Ghosts"; }
+  void extraMembers() override {
+    if (openmp_)
+      out_ << "  std::vector<" << real_ << "> reduce_scratch;  // reduce sum/mean, OpenMP\n";
+  }
+  bool timesNeighbourSearch() const override { return true; }
+  void dataMovement() override;
+  void destination(const DestinationWork& w, const std::string& phase) override;
+  void reduction(const DestinationWork& w, const Reduction& r);
+  void ghostRefresh(const DestinationWork& w);
+  void steppers() override;
+  void stepperCall(const StepStatement& st,
+                   const std::function<std::string(int)>& timeAfter) override;
+  void wrapPeriodic(int a) override {
+    scene_ << "    sphc::wrap_periodic(box, " << hostData(a) << ");\n";
+  }
+  void updateNeighbours() override;
+  void updateNeighboursWithGhosts() override;
+  std::string removeGhosts() const override;
+  void timedNeighbourUpdate() override;
+  void adaptiveDtArray(int a) override;
+  void mainPrologue() override {
+    if (openmp_)
+      out_ << "  sphc::choose_omp_wait(argc, argv);  // spin or sleep at barriers "
+              "(sphc/solver.h)\n";
+  }
+  void mainBackendOptions() override {
+    if (openmp_)
+      out_ << "  prog.set_threads = [](int n) {\n"
+              "    if (n > 0) omp_set_num_threads(n);\n"
+              "    return omp_get_max_threads();\n  };\n";
+  }
+  std::string afterSetup() const override {
+    return cpuSingle_ ? "    scene.to_single();\n" : "";
+  }
+  bool hasToHost() const override { return cpuSingle_; }
+
+  // `#pragma omp parallel for` (with `clauses`) before a loop the schedule marks parallel,
+  // on the OpenMP backend; nothing for serial.
+  std::string parallelFor(const std::string& indent, LoopOrder order,
+                          const std::string& clauses = "") const {
+    if (!openmp_ || order != LoopOrder::Parallel) return "";
+    return indent + "#pragma omp parallel for schedule(static)" +
+           (clauses.empty() ? "" : " " + clauses) + "\n";
+  }
+  // The data the CPU domain functions work on: "a" (the host array) or, with
+  // --precision=single, "f32_a, a" (its float copy, and the host array for the integers).
+  std::string hostData(int a) const {
+    return (cpuSingle_ ? "f32_" + arr(a).name + ", " : std::string()) + arr(a).name;
+  }
+  // The search domain of every array in a neighbour loop, from its doubles or (single) floats.
+  void searchDomain();
+  // Reorders source S into the cell order of cells_S.
+  std::string permuteInCellOrder(const std::string& S) const {
+    return cpuSingle_ ? "f32_" + S + ".permute(cells_" + S + ".cell_order(), " + S + ");"
+                      : S + ".permute(cells_" + S + ".cell_order());";
+  }
+  // The statement that builds the cell list of source S over its first `count` particles.
+  std::string cellListBuild(const std::string& S, const std::string& count) const;
+
+  bool openmp_ = false;
+};
+
+void CpuPrinter::searchMembers() {
+  out_ << "  sphc::SearchDomain domain;\n";
+  if (cpuSingle_)
+    for (const auto& a : plan_.arrays)
+      out_ << "  sphc::FloatArray f32_" << a.name << ";  // what the scene computes on\n";
+  for (const auto& S : sourceArrays_) out_ << "  sphc::CellList cells_" << S << ";\n";
+}
+
+void CpuPrinter::dataMovement() {
+  if (!cpuSingle_) return;
+  // The float copies: made after set-up; the host doubles updated for output and checks.
+  scene_ << "  void to_single() {\n";
+  for (const auto& a : plan_.arrays) scene_ << "    f32_" << a.name << ".upload(" << a.name << ");\n";
+  scene_ << "  }\n\n";
+  scene_ << "  void to_host() {\n";
+  for (const auto& a : plan_.arrays)
+    scene_ << "    f32_" << a.name << ".download(" << a.name << ");\n";
+  scene_ << "  }\n\n";
+}
+
+// One destination of a phase: every initialize, one neighbour pass per source with every
+// loop, then post_loop and the reductions; the ghosts refreshed after.
+void CpuPrinter::destination(const DestinationWork& w, const std::string& phase) {
+  const int d = w.array;
+  const std::string& D = arr(d).name;
+  const bool onGhosts = w.onGhosts;
+  // Pointers of every destination property the bodies use.
+  for (const auto& p : w.destProps)
+    scene_ << "      " << hostType(d, p) << "* d_" << p << " = " << propPtr(d, p) << ";\n";
+  auto perParticle = [&](ast::Method::Kind kind, const char* what) {
+    const std::vector<const PlanEquation*>& with =
+        kind == ast::Method::Initialize ? w.initialize : w.postLoop;
+    if (with.empty()) return;
+    scene_ << parallelFor("      ", w.perParticle);
+    scene_ << "      for (int d_idx = 0; d_idx < n; ++d_idx) {  // " << what << "\n";
+    for (const auto* eq : with) {
+      const auto& pd = plan_.equationDecls[eq->declIndex];
+      const PlanBody& b = plan_.bodies[pd.methods.at(kind)];
+      scene_ << "        "
+             << callBody(bodyFunctionName(eq->name, what), b, d, eqStruct(*eq), "t")
+             << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+    }
+    scene_ << "      }\n";
+  };
+  perParticle(ast::Method::Initialize, "initialize");
+  // One neighbour pass per source.
+  for (const NeighbourPass& pass : w.passes) {
+    const int s = pass.source;
+    const std::string& S = arr(s).name;
+    const std::set<std::string>& q = pass.pairQuantities;
+    scene_ << "      {  // neighbours: " << D << " <- " << S << "\n";
+    for (const auto& p : pass.shared) {
+      scene_ << "        const " << real_ << "* di_" << p << " = " << propPtr(d, p) << ";\n";
+      scene_ << "        const " << real_ << "* sj_" << p << " = " << propPtr(s, p) << ";\n";
+    }
+    for (const auto& p : pass.sourceProps)
+      scene_ << "        const " << real_ << "* s_" << p << " = " << propPtr(s, p) << ";\n";
+    scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
+    // Each thread works on its own copies of the array pointers and scalars
+    // (default(firstprivate)): shared, the outlined loop reads them through the
+    // captured frame at every neighbour, ~4% slower than the serial build (dam break,
+    // ~100k particles, 1 thread). The cell list stays shared: a copy would be a waste.
+    scene_ << parallelFor("        ", pass.order, "default(firstprivate) shared(cells)");
+    scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+    emitDestLocals(scene_, "          ", q, host_);
+    scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
+    scene_ << "            const int s_idx = static_cast<int>(j);\n";
+    emitCandidate(scene_, q, pass.equations, d, host_);
+    scene_ << "          });\n        }\n      }\n";
+  }
+  perParticle(ast::Method::PostLoop, "post_loop");
+  // Reductions over the destination array into its constants.
+  for (const Reduction& r : w.reductions) reduction(w, r);
+  ghostRefresh(w);
+}
+
+// A reduction of the destination's real particles into one of its constants.
+void CpuPrinter::reduction(const DestinationWork& w, const Reduction& r) {
+  const int d = w.array;
+  const std::string& D = arr(d).name;
+  const bool onGhosts = w.onGhosts;
+  const PlanEquation* eq = r.equation;
+  const auto& pd = plan_.equationDecls[eq->declIndex];
+  const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
+  // mean: the sum, divided by the number of particles (0 for an empty array).
+  const bool sum = pd.reduceOp == "sum" || pd.reduceOp == "mean";
+  std::string init = sum ? "0.0"
+                     : pd.reduceOp == "max" ? "-HUGE_VAL"
+                                            : "HUGE_VAL";
+  std::string combine = sum ? "acc += v"
+                         : pd.reduceOp == "max" ? "acc = v > acc ? v : acc"
+                                                : "acc = v < acc ? v : acc";
+  scene_ << "      {  // reduce " << pd.reduceOp << " into " << D << "." << pd.reduceTarget
+         << ": " << eq->name << ", from " << loc(eq->loc) << "\n";
+  scene_ << "        " << real_ << " acc = " << init << ";\n";
+  // Reductions see the real particles only (never the ghosts of a non-real group).
+  const std::string nReal =
+      onGhosts ? "static_cast<int>(" + D + ".n)" : std::string("n");
+  const std::string value =
+      callBody(bodyFunctionName(eq->name, "reduce"), b, d, eqStruct(*eq), "t");
+  if (openmp_ && r.combine == LoopOrder::Serial) {
+    // A sum in the serial order, so that the result (and an iteration count that a
+    // convergence test derives from it) is bitwise the serial one: the values in
+    // parallel, the sum on one thread (n additions, cheap next to a neighbour pass).
+    const std::string loopHead = "        for (int d_idx = 0; d_idx < " + nReal +
+                                 "; ++d_idx)" +
+                                 (onGhosts ? "  // real particles only" : "") + "\n";
+    scene_ << "        std::vector<" << real_ << ">& values = reduce_scratch;\n";
+    scene_ << "        values.resize(" << nReal << ");\n";
+    scene_ << parallelFor("        ", LoopOrder::Parallel);
+    scene_ << loopHead;
+    scene_ << "          values[d_idx] = " << value << ";\n";
+    scene_ << loopHead << "          acc += values[d_idx];\n";
+    if (pd.reduceOp == "mean")
+      scene_ << "        acc = " << nReal << " > 0 ? acc / " << nReal << " : 0.0;\n";
+  } else {
+    scene_ << parallelFor("        ", LoopOrder::Parallel,
+                          std::string("reduction(") + (sum ? "+" : pd.reduceOp) + " : acc)");
+    scene_ << "        for (int d_idx = 0; d_idx < " << nReal << "; ++d_idx) {"
+           << (onGhosts ? "  // real particles only" : "") << "\n";
+    scene_ << "          const " << real_ << " v = " << value << ";\n          " << combine
+           << ";\n        }\n";
+    if (pd.reduceOp == "mean")
+      scene_ << "        acc = " << nReal << " > 0 ? acc / " << nReal << " : 0.0;\n";
+  }
+  scene_ << "        " << propPtr(d, pd.reduceTarget) << "[0] = acc;\n      }\n";
+}
+
+// Ghosts copy the values a phase computed on the real particles, where they carry them.
+void CpuPrinter::ghostRefresh(const DestinationWork& w) {
+  const int d = w.array;
+  const std::string& D = arr(d).name;
+  const std::vector<std::string>& refresh = w.ghostRefresh;
+  if (refresh.empty()) return;
+  scene_ << "      // ghosts follow:";
+  for (const auto& p : refresh) scene_ << " " << p;
+  scene_ << "\n      sphc::refresh_ghosts(box, " << hostData(d) << ", ghosts_" << D << ", "
+           << propIndexList(d, refresh) << ");\n";
+}
+
+// Steppers are per particle (a body reads and writes its own particle d_idx only, as the
+// parallel loops of the OpenMP backend already require), so running the methods of a run
+// one after the other on each particle, in one pass, gives what running each method on all
+// particles in turn gives, bit for bit, with less memory traffic (PECIntegrator's
+// initialize and stage1 both read and write x, u, rho, ...). The arrays' passes share one
+// parallel region (`omp for nowait`: each array's particles are its own).
+void CpuPrinter::steppers() {
+  for (const StepperRun& run : sched_.stepperRuns) {
+    if (run.parts.empty()) continue;
+    const bool parallel = openmp_ && run.order == LoopOrder::Parallel;
+    scene_ << "  void " << run.name << "(";
+    for (size_t k = 0; k < run.methods.size(); ++k) scene_ << "double t_" << k << ", ";
+    scene_ << "double dt) {\n   ";
+    for (size_t k = 0; k < run.methods.size(); ++k) scene_ << " (void)t_" << k << ";";
+    scene_ << " (void)dt;\n";
+    if (parallel) scene_ << "    #pragma omp parallel\n";
+    scene_ << "    {\n";
+    for (const StepperRun::Part& part : run.parts) {
+      const PlanArray& A = arr(part.array);
+      scene_ << "      {  // " << A.name << ": " << part.stepper->decl->name.name;
+      for (size_t i = 0; i < part.bodies.size(); ++i)
+        scene_ << (i ? ", " : ".") << run.methods[part.bodies[i].first];
+      scene_ << "\n        const int n = static_cast<int>(" << A.name << ".n);\n";
+      for (const auto& p : part.destProps)
+        scene_ << "        " << hostType(part.array, p) << "* d_" << p << " = "
+               << propPtr(part.array, p) << ";\n";
+      if (parallel) scene_ << "        #pragma omp for schedule(static) nowait\n";
+      scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+      for (const auto& [k, b] : part.bodies) {
+        scene_ << "          "
+               << callBody(bodyFunctionName(part.stepper->decl->name.name, run.methods[k]), *b,
+                           part.array, "", "t_" + std::to_string(k))
+               << ";\n";
+      }
+      scene_ << "        }\n      }\n";
+    }
+    scene_ << "    }\n  }\n\n";
+  }
+}
+
+void CpuPrinter::searchDomain() {
+  if (cpuSingle_) {
+    // The search domain spans every array that takes part in a neighbour loop (float data).
+    const char* axes[3] = {"x", "y", "z"};
+    scene_ << "    domain = sphc::make_search_domain_float({";
+    bool first = true;
+    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+      if (!loopArrays_.count(arr(a).name)) continue;
+      scene_ << (first ? "" : ",\n                                             ") << "{";
+      for (int k = 0; k < 3; ++k)
+        scene_ << (k < plan_.dim ? propPtr(a, axes[k]) : std::string("nullptr")) << ", ";
+      scene_ << propPtr(a, "h") << ", " << arr(a).name << ".n}";
+      first = false;
+    }
+    scene_ << "}, DIM, Kernel::radius_scale);\n";
+    return;
+  }
+  // The search domain spans every array that takes part in a neighbour loop.
+  scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
+  bool first = true;
+  for (const auto& a : plan_.arrays) {
+    if (!loopArrays_.count(a.name)) continue;
+    scene_ << (first ? "" : ", ") << "&" << a.name;
+    first = false;
+  }
+  scene_ << "};\n";
+  scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
+}
+
+std::string CpuPrinter::cellListBuild(const std::string& S, const std::string& count) const {
+  const char* axes[3] = {"x", "y", "z"};
+  const int s = plan_.arrayIndex(S);
+  std::string b = "cells_" + S + ".build(domain";
+  for (int k = 0; k < 3; ++k)
+    b += ", " + (k >= plan_.dim ? std::string("nullptr") : propPtr(s, axes[k]));
+  return b + ", " + count + ");";
+}
+
+// update_neighbours of a scene with a periodic or mirror domain: the search domain of the
+// real particles, the cell-order permutation (of real particles), then the ghosts of every
+// source array, and the cell lists over real particles and ghosts.
+void CpuPrinter::updateNeighboursWithGhosts() {
+  searchDomain();
+  if (sourceArrays_.empty()) return;
+  scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
+  scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
+  for (const auto& S : sourceArrays_)
+    scene_ << "      " << cellListBuild(S, S + ".n") << "\n      " << permuteInCellOrder(S) << "\n";
+  scene_ << "    }\n";
+  scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
+  scene_ << "    const double cutoff = domain.cell_size;\n";
+  for (const auto& S : sourceArrays_) {
+    int s = plan_.arrayIndex(S);
+    scene_ << "    sphc::add_ghosts(box, " << hostData(s) << ", cutoff, ghosts_" << S << ", "
+           << propIndexList(s, arr(s).ghostProps) << ");  //";
+    for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
+    scene_ << "\n";
+  }
+  scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
+  for (const auto& S : sourceArrays_)
+    scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
+}
+
+std::string CpuPrinter::removeGhosts() const {
+  std::string r;
+  for (const auto& S : sourceArrays_)
+    r += "    sphc::remove_ghosts(" + hostData(plan_.arrayIndex(S)) + ", ghosts_" + S + ");\n";
+  return r;
+}
+
+// update_neighbours of a scene without periodic or mirror domain.
+void CpuPrinter::updateNeighbours() {
+  if (!loopArrays_.empty()) searchDomain();
+  if (!sourceArrays_.empty()) {
+    // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
+    // are close in memory; all per-particle state moves with them.
+    scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+  }
+  for (const auto& S : sourceArrays_) {
+    const std::string build = cellListBuild(S, S + ".n");
+    scene_ << "    " << build << "\n";
+    scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build
+           << "\n    }\n";
+  }
+}
+
+// The call of update_neighbours() in compute_accelerations, timed for --timing.
+void CpuPrinter::timedNeighbourUpdate() {
+  scene_ << "    const double nnps_t0 = sphc::wall_seconds();\n"
+            "    update_neighbours();\n"
+            "    nnps_seconds += sphc::wall_seconds() - nnps_t0;\n";
+}
+
+
+// A run of stepper statements: its fused function, with each statement's time.
+void CpuPrinter::stepperCall(const StepStatement& st,
+                             const std::function<std::string(int)>& timeAfter) {
+  const StepperRun& run = sched_.stepperRuns[st.run];
+  if (run.parts.empty()) return;
+  std::string args;
+  for (int d : st.stagesDone) args += timeAfter(d) + ", ";
+  scene_ << "    " << run.name << "(" << args << "dt);\n";
+}
+
+// The adaptive time step's limits over one moving array: minima of a parallel loop.
+void CpuPrinter::adaptiveDtArray(int a) {
+  const AdaptiveDt& ad = sched_.adaptiveDt;
+  const std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
+  scene_ << "      const " << real_ << "* h = " << propPtr(a, "h") << ";\n";
+  if (ad.cfl) {
+    scene_ << "      const " << real_ << "* cs = " << propPtr(a, "cs") << ";\n";
+    for (int k = 0; k < plan_.dim; ++k)
+      scene_ << "      const " << real_ << "* " << vel[k] << " = " << propPtr(a, vel[k]) << ";\n";
+  }
+  if (ad.force)
+    for (int k = 0; k < plan_.dim; ++k)
+      scene_ << "      const " << real_ << "* " << acc[k] << " = " << propPtr(a, acc[k]) << ";\n";
+  scene_ << parallelFor("      ", ad.order, "reduction(min : dt_cfl, dt_force, h2min)");
+  scene_ << "      for (std::size_t i = 0; i < " << arr(a).name << ".n; ++i) {\n";
+  if (ad.cfl) {
+    scene_ << "        const double vmag = std::sqrt(";
+    for (int k = 0; k < plan_.dim; ++k)
+      scene_ << (k ? " + " : "") << vel[k] << "[i] * " << vel[k] << "[i]";
+    scene_ << ");\n";
+    scene_ << "        dt_cfl = std::fmin(dt_cfl, h[i] / (cs[i] + vmag));\n";
+  }
+  if (ad.viscous) scene_ << "        h2min = std::fmin(h2min, h[i] * h[i]);\n";
+  if (ad.force) {
+    scene_ << "        const double amag = std::sqrt(";
+    for (int k = 0; k < plan_.dim; ++k)
+      scene_ << (k ? " + " : "") << acc[k] << "[i] * " << acc[k] << "[i]";
+    scene_ << ");\n";
+    scene_ << "        if (amag > 0) dt_force = std::fmin(dt_force, std::sqrt(h[i] / amag));\n";
+  }
+  scene_ << "      }\n    }\n";
+}
+
+}  // namespace
+
+std::unique_ptr<ScenePrinter> makeCpuPrinter(const Schedule& sched,
+                                             const DiagnosticEngine& diags,
+                                             const EmitOptions& opts) {
+  return std::make_unique<CpuPrinter>(sched, diags, opts);
+}
+
+}  // namespace sphc

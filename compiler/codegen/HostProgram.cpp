@@ -1,0 +1,526 @@
+// The host program every backend shares: the file's header and includes, the equation and
+// stepper bodies, the scene's parameters and set-up, the functions of groups and phases
+// (their per-destination work is the backend's), iteration and convergence, the integrator's
+// step, the adaptive time step's combination, struct Scene and `main`.
+#include "codegen/Printer.h"
+#include "sema/Geometry.h"
+
+#include "llvm/Support/FileSystem.h"
+#include "llvm/Support/Path.h"
+
+namespace sphc {
+
+void ScenePrinter::emitParams() {
+  scene_ << "  struct Params {\n";
+  for (const auto* p : plan_.params)
+    scene_ << "    double " << p->name.name << " = 0.0;  // from " << loc(p->name.loc) << "\n";
+  scene_ << "  } P;\n\n";
+  // Equation instances: their parameters and constants, evaluated at set-up.
+  for (const auto& eq : plan_.equations) {
+    if (!eq.live) continue;
+    scene_ << "  struct {";
+    for (const auto& [n, v] : eq.values) scene_ << " double " << n << " = 0.0;";
+    scene_ << " } " << eqStruct(eq) << ";  // " << eq.name << "(dest = " << arr(eq.dest).name
+           << "), from " << loc(eq.loc) << "\n";
+  }
+  scene_ << "\n";
+}
+
+void ScenePrinter::emitArraySetup(const PlanArray& a) {
+  const std::string& A = a.name;
+  scene_ << "    // array " << A << ", from " << loc(a.loc) << "\n    {\n";
+  scene_ << "      sphc::Points pts;\n";
+  auto paramNames = [&](const std::string& n) { return paramRef(n); };
+  for (const auto& g : a.decl->geometry) {
+    const GeometryBuilder* b = findGeometryBuilder(g.builder.name);
+    std::map<std::string, std::string> args;
+    for (const auto& arg : b->args)
+      if (arg.defaultValue) args[arg.name] = arg.defaultValue + std::string(".0");
+    for (const auto& kw : g.args)
+      if (kw.value) args[kw.name.name] = exprCpp(*kw.value, paramNames);
+    scene_ << "      {  // geometry " << b->name << ", from " << loc(g.builder.loc) << "\n";
+    const std::string& n = b->name;
+    if (n == "block" || n == "tank") {
+      scene_ << "        const double lo[3] = {" << args["xmin"] << ", " << args["ymin"] << ", "
+             << args["zmin"] << "};\n";
+      scene_ << "        const double hi[3] = {" << args["xmax"] << ", " << args["ymax"] << ", "
+             << args["zmax"] << "};\n";
+      if (n == "block")
+        scene_ << "        pts.append(sphc::block(DIM, lo, hi, " << args["dx"] << "));\n";
+      else
+        scene_ << "        pts.append(sphc::tank(DIM, lo, hi, " << args["dx"]
+               << ", static_cast<int>(" << args["layers"] << "), " << args["top"]
+               << " != 0.0));\n";
+    } else if (n == "disk") {
+      scene_ << "        pts.append(sphc::disk(" << args["cx"] << ", " << args["cy"] << ", "
+             << args["r"] << ", " << args["dx"] << "));\n";
+    } else if (n == "sphere") {
+      scene_ << "        pts.append(sphc::sphere(" << args["cx"] << ", " << args["cy"] << ", "
+             << args["cz"] << ", " << args["r"] << ", " << args["dx"] << "));\n";
+    } else if (n == "cylinder") {
+      scene_ << "        pts.append(sphc::cylinder(" << args["cx"] << ", " << args["cy"] << ", "
+             << args["r"] << ", " << args["zmin"] << ", " << args["zmax"] << ", "
+             << args["dx"] << "));\n";
+    } else if (n == "line") {
+      scene_ << "        const double p0[3] = {" << args["x0"] << ", " << args["y0"] << ", "
+             << args["z0"] << "};\n";
+      scene_ << "        const double p1[3] = {" << args["x1"] << ", " << args["y1"] << ", "
+             << args["z1"] << "};\n";
+      scene_ << "        pts.append(sphc::line(p0, p1, " << args["dx"] << "));\n";
+    }
+    scene_ << "      }\n";
+  }
+  // Files: positions, and the values of any property of this array that the file has.
+  for (const auto& l : a.decl->loads) {
+    std::string path = l.path;
+    scene_ << "      {  // load \"" << path << "\", from " << loc(l.loc) << "\n";
+    scene_ << "        loaded_" << A << ".push_back(sphc::load_particles(source_dir, \"" << path
+           << "\", \"" << A << "\"));\n";
+    scene_ << "        pts.append(sphc::positions_of(loaded_" << A << ".back()));\n";
+    scene_ << "      }\n";
+  }
+  scene_ << "      " << A << ".name = \"" << A << "\";\n";
+  for (const auto& p : a.props)
+    scene_ << "      " << A << ".add_property(\"" << p.name << "\", " << propTypeEnum(p.type)
+           << ", " << p.stride << ");\n";
+  for (const auto* c : [&] {
+         std::vector<const ast::ConstDecl*> v;
+         for (const auto& c : a.decl->constants) v.push_back(&c);
+         return v;
+       }()) {
+    scene_ << "      " << A << ".add_constant(\"" << c->name.name << "\", " << c->size << ", "
+           << (c->init ? exprCpp(*c->init, paramNames) : "0.0") << ");\n";
+  }
+  for (const auto& c : a.constants) {
+    bool declared = false;
+    for (const auto& dc : a.decl->constants) declared |= dc.name.name == c;
+    if (!declared)
+      scene_ << "      " << A << ".add_constant(\"" << c << "\", 1, 0.0);  // reduce target\n";
+  }
+  scene_ << "      " << A << ".resize(pts.size());\n";
+  // Initial values, particle by particle, in declaration order.
+  std::vector<const PlanProperty*> inits;
+  for (const auto& p : a.props)
+    if (p.init) inits.push_back(&p);
+  scene_ << "      for (std::size_t i = 0; i < pts.size(); ++i) {\n";
+  scene_ << "        const double x = pts.x[i], y = pts.y[i], z = pts.z[i];\n";
+  for (const char* c : {"x", "y", "z"})
+    if (propIndex(plan_.arrayIndex(A), c) >= 0)
+      scene_ << "        " << hostPtr(plan_.arrayIndex(A), c) << "[i] = " << c << ";\n";
+  scene_ << "        (void)x; (void)y; (void)z;\n";
+  std::set<std::string> locals = {"x", "y", "z"};
+  auto initNames = [&](const std::string& n) {
+    if (locals.count(n)) return n == "x" || n == "y" || n == "z" ? n : "v_" + n;
+    return paramRef(n);
+  };
+  for (const auto* p : inits) {
+    scene_ << "        const double v_" << p->name << " = " << exprCpp(*p->init, initNames)
+           << ";  // from " << loc(p->declLoc) << "\n";
+    for (int k = 0; k < p->stride; ++k)
+      scene_ << "        " << hostPtr(plan_.arrayIndex(A), p->name) << "[i * " << p->stride
+             << " + " << k << "] = static_cast<" << cppType(p->type) << ">(v_" << p->name
+             << ");\n";
+    locals.insert(p->name);
+  }
+  scene_ << "      }\n";
+  if (!a.decl->loads.empty())
+    scene_ << "      sphc::apply_loaded(" << A << ", pts.size(), loaded_" << A << ");\n";
+  scene_ << "    }\n";
+}
+
+void ScenePrinter::emitSetup() {
+  scene_ << "  void setup(const std::vector<double>& values, sphc::SceneTimes& times) {\n";
+  // Parameters in declaration order: a `param` takes its --set value if given, else its
+  // default (which may use earlier ones); a `let` is always computed.
+  size_t given = 0;
+  for (const auto* p : plan_.params) {
+    std::string value = exprCpp(*p->value, [&](const std::string& n) { return paramRef(n); });
+    if (p->derived) {
+      scene_ << "    P." << p->name.name << " = " << value << ";\n";
+      continue;
+    }
+    scene_ << "    P." << p->name.name << " = std::isnan(values[" << given << "]) ? " << value
+           << " : values[" << given << "];\n";
+    ++given;
+  }
+  for (const auto& eq : plan_.equations) {
+    if (!eq.live) continue;
+    std::set<std::string> earlier;
+    std::string s = eqStruct(eq);
+    for (const auto& [n, v] : eq.values) {
+      // Arguments are scene expressions; defaults and consts use the equation's own values.
+      bool own = false;
+      const auto* decl = plan_.equationDecls[eq.declIndex].decl;
+      for (const auto& c : decl->consts) own |= c.value == v;
+      for (const auto& p : decl->params) own |= p.defaultValue == v;
+      auto names = [&](const std::string& x) {
+        return own && earlier.count(x) ? s + "." + x : paramRef(x);
+      };
+      scene_ << "    " << s << "." << n << " = " << exprCpp(*v, names) << ";\n";
+      earlier.insert(n);
+    }
+  }
+  for (const auto& a : plan_.arrays) emitArraySetup(a);
+  if (hasDomain()) emitDomainSetup();
+  auto pn = [&](const std::string& n) { return paramRef(n); };
+  scene_ << "    times.tf = " << exprCpp(*plan_.tf, pn) << ";\n";
+  scene_ << "    times.dt = " << exprCpp(*plan_.dt, pn) << ";\n";
+  if (plan_.outputEvery)
+    scene_ << "    times.output_every = " << exprCpp(*plan_.outputEvery, pn) << ";\n";
+  for (const auto& t : plan_.outputAt)
+    scene_ << "    times.output_at.push_back(" << exprCpp(*t, pn) << ");\n";
+  scene_ << "  }\n\n";
+}
+
+void ScenePrinter::emitDomainSetup() {
+  const PlanDomain& dom = plan_.domain;
+  auto pn = [&](const std::string& n) { return paramRef(n); };
+  static const char* kAxes[3] = {"x", "y", "z"};
+  scene_ << "    // domain, from " << loc(dom.loc) << "\n";
+  scene_ << "    box.dim = DIM;\n";
+  for (int a = 0; a < 3; ++a)
+    for (int side = 0; side < 2; ++side) {
+      const PlanBoundary& b = side == 0 ? dom.lo[a] : dom.hi[a];
+      if (b.kind == PlanBoundary::Open) continue;
+      const std::string which = side == 0 ? "lo" : "hi";
+      scene_ << "    box." << which << "_kind[" << a << "] = sphc::Boundary::"
+             << (b.kind == PlanBoundary::Periodic ? "Periodic" : "Mirror") << ";  // "
+             << kAxes[a] << ", from " << loc(b.loc) << "\n";
+      scene_ << "    box." << which << "[" << a << "] = " << exprCpp(*b.at, pn) << ";\n";
+    }
+  scene_ << "    sphc::check_domain(box);\n";
+}
+
+void ScenePrinter::emitGroup(const ScheduleGroup& sg) {
+  const PlanGroup& g = *sg.group;
+  const std::string& name = sg.name;
+  // Phases and subgroups first, in order; then the group's own function.
+  for (const auto& m : sg.members) {
+    if (m.isPhase)
+      emitPhase(sg.phases[m.index]);
+    else
+      emitGroup(*sg.subgroups[m.index]);
+  }
+  scene_ << "  // group, from " << loc(g.loc) << "\n";
+  if (g.every) {
+    // `every = N`: only when the number of completed steps is a multiple of N (N < 1: never).
+    auto pn = [&](const std::string& n) { return paramRef(n); };
+    scene_ << "  bool " << name << "_due() const {\n"
+           << "    const long every = static_cast<long>(std::floor(" << exprCpp(*g.every, pn)
+           << " + 0.5));\n"
+           << "    return every >= 1 && step_count % every == 0;\n  }\n\n";
+  }
+  scene_ << "  void " << name << "(double t, double dt) {\n";
+  if (g.every) scene_ << "    if (!" << name << "_due()) return;\n";
+  if (!g.iterate) {
+    for (const auto& c : sg.calls) scene_ << "    " << c << "(t, dt);\n";
+    scene_ << "    (void)t; (void)dt;\n  }\n\n";
+    return;
+  }
+  emitIteration(sg);
+}
+
+// An iterated group: its members again and again until every `converged` test passes (and at
+// least min_iterations ran), or max_iterations ran; the count goes to iteration_stats.
+void ScenePrinter::emitIteration(const ScheduleGroup& sg) {
+  const PlanGroup& g = *sg.group;
+  scene_ << "    int iteration = 1;\n    bool converged = true;\n";
+  scene_ << "    for (;; ++iteration) {\n";
+  for (const auto& c : sg.calls) scene_ << "      " << c << "(t, dt);\n";
+  scene_ << "      converged = true;\n";
+  for (const auto* eq : sg.convergers) emitConverged(*eq);
+  scene_ << "      if (converged && iteration >= " << g.minIterations << ") break;\n";
+  scene_ << "      if (iteration >= " << g.maxIterations << ") break;\n";
+  scene_ << "    }\n";
+  scene_ << "    iteration_stats[" << sg.statsIndex << "].record(iteration, converged);\n  }\n\n";
+}
+
+// `converged` runs on the host for every backend, on particle 0 of its destination
+// (constants are current on the host; properties may need to come back first).
+void ScenePrinter::emitConverged(const PlanEquation& eq) {
+  const auto& pd = plan_.equationDecls[eq.declIndex];
+  const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Converged)];
+  scene_ << "      {\n        const int d_idx = 0;\n";
+  std::set<std::string> dprops;
+  for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
+  bool needsProps = false;
+  for (const auto& p : dprops) needsProps |= constIndex(eq.dest, p) < 0;
+  if (needsProps) beforeConverged(eq);
+  for (const auto& p : dprops)
+    scene_ << "        " << hostType(eq.dest, p) << "* d_" << p << " = " << propPtr(eq.dest, p)
+           << ";\n";
+  scene_ << "        converged = converged && "
+         << callBody(bodyFunctionName(eq.name, "converged"), b, eq.dest, eqStruct(eq), "t")
+         << " > 0;  // " << eq.name << ", from " << loc(eq.loc) << "\n      }\n";
+}
+
+void ScenePrinter::emitPhase(const Phase& ph) {
+  scene_ << "  void " << ph.name << "(double t, double dt) {\n";
+  scene_ << "    (void)t; (void)dt;\n";
+  for (const DestinationWork& w : ph.destinations) {
+    const std::string& D = arr(w.array).name;
+    // Groups with `real = false` run on the ghosts too (they follow the real particles).
+    const bool onGhosts = w.onGhosts;
+    scene_ << "    {  // destination " << D << "\n";
+    scene_ << "      const int n = static_cast<int>(" << D << ".n"
+           << (onGhosts ? " + ghosts_" + D + ".size()" : std::string("")) << ");"
+           << (onGhosts ? "  // real particles and ghosts (real = false)" : "") << "\n";
+    destination(w, ph.name);
+    scene_ << "    }\n";
+  }
+  scene_ << "  }\n\n";
+}
+
+void ScenePrinter::emitStep() {
+  if (hasDomain()) {
+    scene_ << "  // Periodic axes: particles that left the box come back in.\n";
+    scene_ << "  void update_domain() {\n";
+    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) wrapPeriodic(a);
+    scene_ << "  }\n\n";
+    scene_ << "  // Rebuilds the neighbour search of every array that is a source, with ghosts.\n";
+    scene_ << "  void update_neighbours() {\n";
+    if (!loopArrays_.empty()) updateNeighboursWithGhosts();
+    scene_ << "  }\n\n";
+    scene_ << "  // Ghosts exist during an evaluation only: outside it arrays hold real particles.\n";
+    scene_ << "  void compute_accelerations(double t, double dt) {\n";
+    scene_ << "    update_domain();\n";
+    timedNeighbourUpdate();
+    scene_ << "    equations(t, dt);\n";
+    scene_ << removeGhosts();
+    scene_ << "  }\n\n";
+  } else {
+    scene_ << "  // Rebuilds the neighbour search of every array that is a source.\n";
+    scene_ << "  void update_neighbours() {\n";
+    updateNeighbours();
+    scene_ << "  }\n\n";
+    scene_ << "  void compute_accelerations(double t, double dt) {\n";
+    timedNeighbourUpdate();
+    scene_ << "    equations(t, dt);\n  }\n\n";
+  }
+  if (!sched_.postStep.empty()) {
+    // Groups with post_step = true: after the integrator's time step, on the new positions.
+    scene_ << "  // groups with post_step = true, after each time step\n";
+    // No neighbour update when no group is due (a disabled group changes nothing at all).
+    scene_ << "  void post_step(double t, double dt) {\n    if (!(";
+    for (size_t i = 0; i < sched_.postStep.size(); ++i)
+      scene_ << (i ? " || " : "")
+             << (sched_.postStep[i].group->every ? sched_.postStep[i].function + "_due()"
+                                                 : std::string("true"));
+    scene_ << ")) return;\n";
+    scene_ << (hasDomain() ? "    update_domain();\n" : "") << "    update_neighbours();\n";
+    for (const auto& ps : sched_.postStep) scene_ << "    " << ps.function << "(t, dt);\n";
+    if (hasDomain()) scene_ << removeGhosts();
+    scene_ << "  }\n\n";
+  }
+  // The integrator's time step; after stage k of m the time is t + k/m dt.
+  const int stages = sched_.stages;
+  scene_ << "  // integrator " << plan_.integratorName << "\n";
+  scene_ << "  void step(double t, double dt) {\n";
+  auto timeAfter = [&](int stagesDone) {
+    return stagesDone == 0 ? std::string("t")
+                           : "t + " + std::to_string(stagesDone) + ".0 / " +
+                                 std::to_string(stages) + ".0 * dt";
+  };
+  for (const StepStatement& st : sched_.step) {
+    if (st.kind == StepStatement::ComputeAccelerations) {
+      scene_ << "    compute_accelerations(" << timeAfter(st.stagesDone[0]) << ", dt);\n";
+      continue;
+    }
+    if (st.kind == StepStatement::UpdateDomain) {
+      scene_ << (hasDomain() ? "    update_domain();\n"
+                             : "    // update_domain: no periodic or mirror domain in this scene\n");
+      continue;
+    }
+    stepperCall(st, timeAfter);
+  }
+  scene_ << "    ++step_count;\n";
+  if (!sched_.postStep.empty()) scene_ << "    post_step(t + dt, dt);\n";
+  scene_ << "  }\n\n";
+}
+
+void ScenePrinter::emitAdaptiveDt() {
+  const AdaptiveDt& ad = sched_.adaptiveDt;
+  if (!ad.enabled) return;
+  auto pn = [&](const std::string& n) { return paramRef(n); };
+  std::string cfl = plan_.cfl ? exprCpp(*plan_.cfl, pn) : "0.3";
+  scene_ << "  // The stable time step: CFL (h / (c + |v|)), force (sqrt(h / |a|)) and viscous\n"
+            "  // (h^2 / nu) limits over moving particles.\n";
+  scene_ << "  double adaptive_dt() {\n";
+  scene_ << "    double dt_cfl = HUGE_VAL, dt_force = HUGE_VAL, h2min = HUGE_VAL;\n";
+  for (int a : ad.arrays) {
+    scene_ << "    {  // " << arr(a).name << "\n";
+    adaptiveDtArray(a);
+  }
+  scene_ << "    double dt = std::fmin(" << cfl << " * dt_cfl, "
+         << (plan_.forceFactor ? exprCpp(*plan_.forceFactor, pn) : "1.0") << " * dt_force);\n";
+  if (ad.viscous)
+    scene_ << "    dt = std::fmin(dt, "
+           << (plan_.viscousFactor ? exprCpp(*plan_.viscousFactor, pn) : "0.125")
+           << " * h2min / " << exprCpp(*plan_.nu, pn) << ");  // viscous limit\n";
+  scene_ << "    return dt;\n";
+  scene_ << "  }\n\n";
+}
+
+void ScenePrinter::emitMain() {
+  out_ << "int main(int argc, char** argv) {\n";
+  mainPrologue();
+  out_ << "  static Scene scene;\n";
+  out_ << "  sphc::SceneProgram prog;\n";
+  out_ << "  prog.name = \"" << plan_.sceneName << "\";\n";
+  out_ << "  prog.dim = DIM;\n";
+  out_ << "  prog.backend = \"" << backendName_ << "\";\n";
+  mainBackendOptions();
+  for (const auto* p : plan_.params) {
+    if (p->derived) continue;  // `let`: not overridable
+    bool lit = isLiteral(*p->value);
+    char buf[64];
+    snprintf(buf, sizeof buf, "%.17g", lit ? literalValue(*p->value) : 0.0);
+    out_ << "  prog.params.push_back({\"" << p->name.name << "\", "
+         << (lit ? std::string(buf) : "std::nan(\"\")") << ", \""
+         << (lit ? std::string("") : "= " + exprText(*p->value)) << "\"});\n";
+  }
+  for (const auto& o : plan_.options) {
+    std::string choices;
+    for (const auto& c : o.choices) choices += (choices.empty() ? "" : ", ") + c;
+    out_ << "  prog.options.push_back({\"" << o.name << "\", \"" << o.value << "\", \"" << choices
+         << "\"});  // sphc -D " << o.name << "=...\n";
+  }
+  if (singlePrecision_) out_ << "  prog.precision = \"single\";\n";
+  out_ << "  prog.setup = [](const std::vector<double>& v, sphc::SceneTimes& times) {\n"
+          "    scene.setup(v, times);\n"
+       << afterSetup() << "  };\n";
+  out_ << "  prog.arrays = [] { return std::vector<sphc::ParticleArray*>{";
+  bool first = true;
+  for (const auto& a : plan_.arrays) {
+    out_ << (first ? "" : ", ") << "&scene." << a.name;
+    first = false;
+  }
+  out_ << "}; };\n";
+  out_ << "  prog.compute_initial = [](double t, double dt) { scene.compute_accelerations(t, dt); };\n";
+  out_ << "  prog.step = [](double t, double dt) { scene.step(t, dt); };\n";
+  // OpenCL: particle data stays on the device; the run loop asks for it back only when it
+  // writes output or checks for a blow-up.
+  // --precision=single on the CPU: likewise for the float copies.
+  if (hasToHost()) out_ << "  prog.to_host = [] { scene.to_host(); };\n";
+  if (plan_.adaptiveDt) out_ << "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n";
+  if (!sched_.iteratedGroups.empty())
+    out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
+  if (timesNeighbourSearch()) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
+  bool anyOutput = false;
+  for (const auto& a : plan_.arrays) anyOutput |= !a.outputProps.empty();
+  for (const auto& a : plan_.arrays) {
+    if (anyOutput && a.outputProps.empty()) continue;
+    out_ << "  prog.output.push_back({\"" << a.name << "\", {";
+    bool firstProp = true;
+    for (const auto& p : a.outputProps) {
+      if (constIndex(plan_.arrayIndex(a.name), p) >= 0) continue;  // constants: always written
+      out_ << (firstProp ? "" : ", ") << "\"" << p << "\"";
+      firstProp = false;
+    }
+    out_ << "}});\n";
+  }
+  out_ << "  return sphc::run_main(argc, argv, prog);\n}\n";
+}
+
+std::string ScenePrinter::run() {
+  std::string file = llvm::sys::path::filename(plan_.mainFile).str();
+  out_ << "// Generated by sphc from " << file << ": do not edit; edit the .sph and recompile.\n";
+  out_ << "// Backend: " << backendComment() << ".\n";
+  out_ << "// Scene '" << plan_.sceneName << "': dim " << plan_.dim << ", kernel "
+       << plan_.kernel << ", integrator "
+       << (plan_.integratorName.empty() ? "none" : plan_.integratorName) << ".\n";
+  out_ << "#include \"sphc/geometry.h\"\n#include \"sphc/kernels.h\"\n"
+          "#include \"sphc/nnps.h\"\n#include \"sphc/particle_array.h\"\n"
+          "#include \"sphc/solver.h\"\n";
+  bool anyLoad = false;
+  for (const auto& a : plan_.arrays) anyLoad |= !a.decl->loads.empty();
+  if (anyLoad) out_ << "#include \"sphc/load.h\"\n";
+  if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
+  runtimeIncludes();
+  out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
+  systemIncludes();
+  out_ << "\n";
+  out_ << "namespace {\n\n";
+  out_ << "constexpr int DIM = " << plan_.dim << ";\n";
+  out_ << "using Kernel = sphc::" << plan_.kernel << "<DIM>;\n";
+  out_ << "constexpr " << real_
+       << " RADIUS2 = Kernel::radius_scale * Kernel::radius_scale;\n\n";
+  out_ << "// ---- Equation and stepper bodies, as written in the .sph files ----\n\n";
+  emitKernelFunctions();
+  // Bodies of live equations (each declaration once) and of steppers.
+  std::set<int> emittedDecls;
+  for (const auto& eq : plan_.equations) {
+    if (!eq.live || !emittedDecls.insert(eq.declIndex).second) continue;
+    const auto& pd = plan_.equationDecls[eq.declIndex];
+    static const char* names[] = {"initialize", "loop", "post_loop", "reduce", "converged"};
+    static const char* rets[] = {"void", "void", "void", "double", "int"};
+    for (const auto& [kind, b] : pd.methods) {
+      const bool dev = bodyOnDevice(kind == ast::Method::Converged);
+      emitBodyFunction(plan_.bodies[b], bodyFunctionName(eq.name, names[kind]), rets[kind],
+                       eq.dest, dev ? device_ : host_, dev ? cl_ : out_);
+    }
+  }
+  std::set<int> emittedSteppers;
+  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+    int s = arr(a).stepper;
+    if (s < 0 || !emittedSteppers.insert(s).second) continue;
+    for (const auto& [m, b] : plan_.steppers[s].methods)
+      emitBodyFunction(plan_.bodies[b], bodyFunctionName(plan_.steppers[s].decl->name.name, m),
+                       "void", a, bodyOnDevice(false) ? device_ : host_,
+                       bodyOnDevice(false) ? cl_ : out_);
+  }
+
+  emitParams();
+  emitSetup();
+  emitGroup(sched_.equations);
+  steppers();
+  emitStep();
+  emitAdaptiveDt();
+  afterBodies();
+
+  emitSceneMembers();
+  dataMovement();
+  out_ << "\n" << scene_.str() << "};\n\n}  // namespace\n\n";
+  emitMain();
+  return out_.str();
+}
+
+
+// struct Scene: the arrays, the neighbour search and ghosts, statistics.
+void ScenePrinter::emitSceneMembers() {
+  out_ << "// ---- The scene ----\n\n";
+  out_ << "struct Scene {\n";
+  for (const auto& a : plan_.arrays) out_ << "  sphc::ParticleArray " << a.name << ";\n";
+  for (const auto& a : plan_.arrays)
+    if (!a.decl->loads.empty())
+      out_ << "  std::vector<sphc::ParticleArray> loaded_" << a.name << ";\n";
+  searchMembers();
+  if (hasDomain()) {
+    out_ << "  sphc::Domain box;  // periodic and mirror boundaries\n";
+    for (const auto& S : sourceArrays_)
+      out_ << "  " << ghostsType() << " ghosts_" << S << ";\n";
+  }
+  extraMembers();
+  // Iterations per evaluation of each iterated group (--timing prints them).
+  out_ << "  std::vector<sphc::IterationStats> iteration_stats{";
+  for (std::size_t k = 0; k < sched_.iteratedGroups.size(); ++k)
+    out_ << (k ? ", " : "") << "sphc::IterationStats{\"" << loc(sched_.iteratedGroups[k])
+         << "\"}";
+  out_ << "};\n";
+  out_ << "  long step_count = 0;  // completed time steps (group option `every`)\n";
+  if (timesNeighbourSearch()) out_ << "  double nnps_seconds = 0.0;  // in update_neighbours, for --timing\n";
+  if (!sourceArrays_.empty()) {
+    out_ << "  static constexpr long REORDER_EVERY = 50;\n";
+    out_ << "  long builds = 0;\n";
+  }
+  bool anyLoad = false;
+  for (const auto& a : plan_.arrays) anyLoad |= !a.decl->loads.empty();
+  if (anyLoad) {
+    llvm::SmallString<256> dir(plan_.mainFile);
+    llvm::sys::fs::make_absolute(dir);
+    out_ << "  std::string source_dir = \"" << llvm::sys::path::parent_path(dir).str()
+         << "\";  // where the .sph file is\n";
+  }
+}
+
+}  // namespace sphc

@@ -1,0 +1,461 @@
+// --backend=opencl: the same phases as the CPU loops, as OpenCL C kernels (the same bodies,
+// typed `real`) launched from the host: one work item per destination particle (a gather, as
+// the OpenMP loops), a kernel per group phase, destination and method, and per neighbour
+// pass (destination <- source). Only the buffers and scalars the bodies use are arguments.
+// Particle data stays on the device; `converged` tests run on the host.
+#include "codegen/Printer.h"
+
+namespace sphc {
+
+namespace {
+
+class OpenCLPrinter : public ScenePrinter {
+ public:
+  OpenCLPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts,
+                std::string* kernelSource)
+      : ScenePrinter(sched, diags, opts), kernelSource_(kernelSource) {
+    // Line 1 of the kernel source is this directive, so lines are the source's own.
+    cl_ << "#line 2 \"" << plan_.sceneName << ".cl\"\n";
+  }
+
+ private:
+  std::string backendComment() const override {
+    return std::string("opencl (kernels in SCENE_CL, ") +
+           (singlePrecision_ ? "single" : "double") + " precision)";
+  }
+  void systemIncludes() override { out_ << "\n#include \"sphc/opencl.h\"\n"; }
+  // Every body runs on the device but `converged`, which the host evaluates from the host
+  // copy of the constants.
+  bool bodyOnDevice(bool converged) const override { return !converged; }
+  void deviceKernelFunctions() override;
+  void afterBodies() override;
+  void searchMembers() override;
+  std::string ghostsType() const override { return "sphc::ocl::DeviceGhosts"; }
+  // The launches are asynchronous: a host timer would measure nothing.
+  bool timesNeighbourSearch() const override { return false; }
+  void dataMovement() override;
+  void destination(const DestinationWork& w, const std::string& phase) override;
+  void ghostRefresh(const DestinationWork& w);
+  // The test runs on the host; constants are current there, properties are not.
+  void beforeConverged(const PlanEquation& eq) override {
+    scene_ << "        dev_" << arr(eq.dest).name << ".download(ocl, " << arr(eq.dest).name
+           << ");\n";
+  }
+  void steppers() override;
+  void stepperCall(const StepStatement& st,
+                   const std::function<std::string(int)>& timeAfter) override;
+  void wrapPeriodic(int a) override {
+    scene_ << "    sphc::ocl::wrap_periodic(ocl, box, dev_" << arr(a).name << ", " << arr(a).name
+           << ");\n";
+  }
+  void updateNeighbours() override;
+  void updateNeighboursWithGhosts() override;
+  std::string removeGhosts() const override {
+    std::string r;
+    for (const auto& S : sourceArrays_) r += "    ghosts_" + S + ".remove();\n";
+    return r;
+  }
+  void timedNeighbourUpdate() override { scene_ << "    update_neighbours();\n"; }
+  void adaptiveDtArray(int a) override;
+  void mainBackendOptions() override {
+    out_ << "  scene.selection = sphc::ocl::take_options(argc, argv);\n";
+  }
+  std::string afterSetup() const override { return "    scene.to_device();\n"; }
+  bool hasToHost() const override { return true; }
+
+  // Kernel arguments: declarations in the kernel, expressions on the host.
+  struct KernelArgs {
+    std::vector<std::string> decls, host;
+    std::map<std::string, size_t> at;
+    // A buffer that one body reads (const) and another writes becomes non-const.
+    void add(const std::string& decl, const std::string& hostExpr, const std::string& key) {
+      auto it = at.find(key);
+      if (it != at.end()) {
+        if (decl.find("const ") == std::string::npos) decls[it->second] = decl;
+        return;
+      }
+      at[key] = decls.size();
+      decls.push_back(decl);
+      host.push_back(hostExpr);
+    }
+  };
+  std::string devBuffer(int a, const std::string& p) const;
+  void addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int src,
+                   const std::string& eqValues) const;
+  void beginKernel(const std::string& name, const KernelArgs& ka, bool guard = true);
+  std::string launch(const std::string& name, const std::string& n, const KernelArgs& ka) const;
+  // The statement that builds the cell table of source S over its first `count` particles.
+  std::string cellListBuild(const std::string& S, const std::string& count) const;
+  // The extents of the arrays in neighbour loops, for ocl.search_domain / ocl.make_grid.
+  std::string deviceExtents(const std::string& indent) const;
+
+  std::string* kernelSource_;
+};
+
+void OpenCLPrinter::deviceKernelFunctions() {
+  cl_ << "inline real KERNEL_W(real r, real h) { return kernel_w(r, h); }\n"
+         "inline real KERNEL_DWDR(real r, real h) {\n"
+         "  real x[3] = {r, 0.0, 0.0};\n"
+         "  real g[3];\n"
+         "  kernel_gradient(x, r, h, g);\n"
+         "  return r > 0.0 ? g[0] : 0.0;\n"
+         "}\n";
+  resetLineDirective(cl_);
+}
+
+void OpenCLPrinter::afterBodies() {
+  *kernelSource_ = cl_.str();
+  out_ << "// ---- OpenCL C of the kernels, built at start-up with the runtime's ----\n\n";
+  out_ << "constexpr bool DOUBLE_PRECISION = " << (singlePrecision_ ? "false" : "true") << ";\n";
+  out_ << "const char* const SCENE_CL = R\"SPHC_CL(" << *kernelSource_ << ")SPHC_CL\";\n\n";
+}
+
+void OpenCLPrinter::searchMembers() {
+  out_ << "  sphc::ocl::Selection selection;  // --platform, --device\n";
+  out_ << "  sphc::ocl::Context ocl;\n";
+  for (const auto& a : plan_.arrays) out_ << "  sphc::ocl::DeviceArray dev_" << a.name << ";\n";
+  out_ << "  sphc::ocl::Grid grid;\n";
+  for (const auto& S : sourceArrays_) out_ << "  sphc::ocl::CellTable cells_" << S << ";\n";
+}
+
+void OpenCLPrinter::dataMovement() {
+  // Data movement: everything up after set-up; properties back for output and checks.
+  scene_ << "  void to_device() {\n";
+  scene_ << "    ocl.init(selection, DOUBLE_PRECISION, sphc::ocl::kernel_function_source(\""
+         << plan_.kernel << "\", DIM) + SCENE_CL, \"" << plan_.sceneName << "\");\n";
+  for (const auto& a : plan_.arrays)
+    scene_ << "    dev_" << a.name << ".upload(ocl, " << a.name << ");\n";
+  scene_ << "  }\n\n";
+  scene_ << "  void to_host() {\n";
+  for (const auto& a : plan_.arrays)
+    scene_ << "    dev_" << a.name << ".download(ocl, " << a.name << ");\n";
+  scene_ << "  }\n\n";
+}
+
+std::string OpenCLPrinter::cellListBuild(const std::string& S, const std::string& count) const {
+  const char* axes[3] = {"x", "y", "z"};
+  const int s = plan_.arrayIndex(S);
+  std::string b = "cells_" + S + ".build(ocl, grid";
+  for (int k = 0; k < 3; ++k)
+    b += ", " + (k >= plan_.dim ? std::string("nullptr") : devBuffer(s, axes[k]));
+  return b + ", " + count + ");";
+}
+
+// update_neighbours of a scene without periodic or mirror domain, on the device: the search
+// domain from min/max reductions, then a cell table per source (cell keys, bitonic sort, cell
+// start/end). Positions never leave the device.
+void OpenCLPrinter::updateNeighbours() {
+  if (!loopArrays_.empty())
+    scene_ << "    grid = ocl.make_grid(" << deviceExtents("                          ")
+           << ", DIM, Kernel::radius_scale);\n";
+  // Every REORDER_EVERY builds the particles are sorted in cell order on the device, as
+  // on the CPU (same grid, same order), so outputs list particles in the same order.
+  if (!sourceArrays_.empty())
+    scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+  for (const auto& S : sourceArrays_) {
+    const std::string build = cellListBuild(S, S + ".n");
+    scene_ << "    " << build << "\n";
+    scene_ << "    if (reorder) {\n      dev_" << S << ".permute(ocl, cells_" << S << ", " << S
+           << ");\n      " << build << "\n    }\n";
+  }
+}
+
+// A run of stepper statements: each statement's kernels in turn, where an array's stepper
+// has the method (runs are not fused into one kernel).
+void OpenCLPrinter::stepperCall(const StepStatement& st,
+                                const std::function<std::string(int)>& timeAfter) {
+  const StepperRun& run = sched_.stepperRuns[st.run];
+  for (size_t j = 0; j < run.methods.size(); ++j) {
+    bool any = false;
+    for (const auto& part : run.parts)
+      for (const auto& [k, b] : part.bodies) any |= k == j;
+    if (any)
+      scene_ << "    stepper_" << run.methods[j] << "(" << timeAfter(st.stagesDone[j])
+             << ", dt);\n";
+  }
+}
+
+std::string OpenCLPrinter::devBuffer(int a, const std::string& p) const {
+  int c = constIndex(a, p);
+  if (c >= 0) return "dev_" + arr(a).name + ".constant(" + std::to_string(c) + ")";
+  int i = propIndex(a, p);
+  if (i < 0) SPHC_INTERNAL("property '" + p + "' of '" + arr(a).name + "' was not allocated");
+  return "dev_" + arr(a).name + ".prop(" + std::to_string(i) + ")";
+}
+
+void OpenCLPrinter::addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int src,
+                          const std::string& eqValues) const {
+  for (const auto& p : bodyParams(b, dest, device_)) {
+    switch (p.kind) {
+      case BodyParam::Scalar:
+        ka.add("const real " + eqValues + "_" + p.name, eqValues + "." + p.name,
+               eqValues + "." + p.name);
+        break;
+      case BodyParam::DProp: ka.add(p.decl, devBuffer(dest, p.name), "d_" + p.name); break;
+      case BodyParam::SProp:
+        ka.add("__global const real* s_" + p.name, devBuffer(src, p.name), "s_" + p.name);
+        break;
+      default: break;
+    }
+  }
+}
+
+void OpenCLPrinter::beginKernel(const std::string& name, const KernelArgs& ka, bool guard) {
+  cl_ << "__kernel void " << name << "(const int n, const real t, const real dt";
+  for (const auto& d : ka.decls) cl_ << ",\n    " << d;
+  cl_ << ") {\n";
+  if (guard) cl_ << "  const int d_idx = get_global_id(0);\n  if (d_idx >= n) return;\n";
+}
+
+std::string OpenCLPrinter::launch(const std::string& name, const std::string& n,
+                            const KernelArgs& ka) const {
+  std::string s = "ocl.run(\"" + name + "\", " + n + ", " + n + ", t, dt";
+  for (const auto& h : ka.host) s += ", " + h;
+  return s + ");";
+}
+
+// One destination of a phase: a kernel per method (initialize, post_loop), per neighbour pass
+// and per reduction, and their launches; the ghosts refreshed after.
+void OpenCLPrinter::destination(const DestinationWork& w, const std::string& name) {
+  const int d = w.array;
+  const bool onGhosts = w.onGhosts;
+  const std::string& D = arr(d).name;
+  auto perParticle = [&](ast::Method::Kind kind, const char* what) {
+    const std::vector<const PlanEquation*>& with =
+        kind == ast::Method::Initialize ? w.initialize : w.postLoop;
+    if (with.empty()) return;
+    KernelArgs ka;
+    for (const auto* eq : with)
+      addBodyArgs(ka, plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(kind)], d,
+                  -1, eqStruct(*eq));
+    std::string k = name + "_" + D + "_" + what;
+    beginKernel(k, ka);
+    for (const auto* eq : with) {
+      const auto& pd = plan_.equationDecls[eq->declIndex];
+      const PlanBody& b = plan_.bodies[pd.methods.at(kind)];
+      cl_ << "  " << callBody(bodyFunctionName(eq->name, what), b, d, eqStruct(*eq), "t", "_")
+          << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+    }
+    cl_ << "}\n\n";
+    scene_ << "      " << launch(k, "n", ka) << "  // " << what << "\n";
+  };
+  perParticle(ast::Method::Initialize, "initialize");
+  for (const NeighbourPass& pass : w.passes) {
+    const int s = pass.source;
+    const std::string& S = arr(s).name;
+    const std::set<std::string>& q = pass.pairQuantities;
+    KernelArgs ka;
+    for (const auto* eq : pass.equations)
+      addBodyArgs(ka, plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(
+                          ast::Method::Loop)],
+                  d, s, eqStruct(*eq));
+    for (const auto& p : pass.shared) {
+      ka.add("__global const real* di_" + p, devBuffer(d, p), "di_" + p);
+      ka.add("__global const real* sj_" + p, devBuffer(s, p), "sj_" + p);
+    }
+    ka.add("SPHC_CELLS_ARGS(cells)", "cells_" + S, "cells");
+    ka.add("SPHC_GRID_ARGS", "grid", "grid");
+    std::string k = name + "_" + D + "_from_" + S;
+    cl_ << "// neighbours: " << D << " <- " << S << "\n";
+    beginKernel(k, ka);
+    emitDestLocals(cl_, "  ", q, device_);
+    // The 3^dim cells around the particle's cell, by z, y, x (the CPU candidate order).
+    const char* axes[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a)
+      cl_ << "  const int c" << axes[a] << " = "
+          << (a < plan_.dim ? std::string("sphc_axis_cell((") + axes[a] + "i - grid_lo" +
+                                  axes[a] + ") * grid_inv, grid_n" + axes[a] + ")"
+                            : std::string("0"))
+          << ";\n";
+    cl_
+        << "  for (int kz = max(cz - 1, 0); kz <= min(cz + 1, grid_nz - 1); ++kz)\n"
+        << "  for (int ky = max(cy - 1, 0); ky <= min(cy + 1, grid_ny - 1); ++ky)\n"
+        << "  for (int kx = max(cx - 1, 0); kx <= min(cx + 1, grid_nx - 1); ++kx) {\n"
+        << "    const int cell = (kz * grid_ny + ky) * grid_nx + kx;\n"
+        << "    for (uint k = cells_start[cell]; k < cells_end[cell]; ++k) {\n"
+        << "            const int s_idx = (int)cells_order[k];\n";
+    emitCandidate(cl_, q, pass.equations, d, device_);
+    cl_ << "    }\n  }\n}\n\n";
+    scene_ << "      " << launch(k, "n", ka) << "  // neighbours: " << D << " <- " << S << "\n";
+  }
+  perParticle(ast::Method::PostLoop, "post_loop");
+  // Reductions: per-particle values on the device, partial results there, the last step
+  // on the host, into the host copy of the constant (uploaded again).
+  for (const Reduction& r : w.reductions) {
+    const PlanEquation* eq = r.equation;
+    const auto& pd = plan_.equationDecls[eq->declIndex];
+    const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
+    KernelArgs ka;
+    addBodyArgs(ka, b, d, -1, eqStruct(*eq));
+    // Reductions see the real particles only (never the ghosts of a non-real group).
+    const std::string nReal = onGhosts ? "static_cast<int>(" + D + ".n)" : std::string("n");
+    ka.add("__global real* reduce_values", "ocl.scratch(" + nReal + ")", "reduce_values");
+    std::string k = name + "_" + D + "_reduce_" + std::to_string(eq->id);
+    beginKernel(k, ka);
+    cl_ << "  reduce_values[d_idx] = "
+        << callBody(bodyFunctionName(eq->name, "reduce"), b, d, eqStruct(*eq), "t", "_")
+        << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n}\n\n";
+    int c = constIndex(d, pd.reduceTarget);
+    std::string op = pd.reduceOp == "sum" || pd.reduceOp == "mean" ? "Sum"
+                     : pd.reduceOp == "max"                         ? "Max"
+                                                                    : "Min";
+    scene_ << "      {  // reduce " << pd.reduceOp << " into " << D << "." << pd.reduceTarget
+           << ": " << eq->name << ", from " << loc(eq->loc) << "\n";
+    scene_ << "        " << launch(k, nReal, ka) << (onGhosts ? "  // real particles only" : "")
+           << "\n";
+    scene_ << "        " << D << ".constant(" << c << ")[0] = ocl.reduce(ocl.scratch(" << nReal
+           << "), " << nReal << ", sphc::ocl::Op::" << op << ")"
+           << (pd.reduceOp == "mean" ? " / (" + nReal + " > 0 ? " + nReal + " : 1)" : "")
+           << ";\n";
+    scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << c << ");\n";
+    scene_ << "      }\n";
+  }
+  ghostRefresh(w);
+}
+
+void OpenCLPrinter::steppers() {
+  for (const auto& [m, arrays] : sched_.stepperMethods) {
+    scene_ << "  void stepper_" << m << "(double t, double dt) {\n    (void)t; (void)dt;\n";
+    for (int a : arrays) {
+      const PlanArray& A = arr(a);
+      const PlanStepper& st = plan_.steppers[A.stepper];
+      const PlanBody& b = plan_.bodies[st.methods.at(m)];
+      scene_ << "    {  // " << A.name << ": " << st.decl->name.name << "." << m << "\n";
+      scene_ << "      const int n = static_cast<int>(" << A.name << ".n);\n";
+      std::string fn = bodyFunctionName(st.decl->name.name, m);
+      KernelArgs ka;
+      addBodyArgs(ka, b, a, -1, "");
+      std::string k = "stepper_" + m + "_" + A.name;
+      beginKernel(k, ka);
+      cl_ << "  " << callBody(fn, b, a, "", "t", "_") << ";\n}\n\n";
+      scene_ << "      " << launch(k, "n", ka) << "\n    }\n";
+    }
+    scene_ << "  }\n\n";
+  }
+}
+
+std::string OpenCLPrinter::deviceExtents(const std::string& indent) const {
+  const char* axes[3] = {"x", "y", "z"};
+  auto buf = [&](int a, int k) {
+    return k < plan_.dim ? devBuffer(a, axes[k]) : std::string("nullptr");
+  };
+  std::string r = "{";
+  bool first = true;
+  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+    if (!loopArrays_.count(arr(a).name)) continue;
+    r += (first ? "" : ",\n" + indent) + "{" + buf(a, 0) + ", " + buf(a, 1) + ", " + buf(a, 2) +
+         ", " + devBuffer(a, "h") + ", " + arr(a).name + ".n}";
+    first = false;
+  }
+  return r + "}";
+}
+
+// The same on the device (--backend=opencl): the search domain of the real particles from
+// device reductions, the cell-order permutation of the real particles on the device, then the
+// ghost list of every source found on the host from its downloaded positions (the CPU's
+// find_ghosts, so the same ghosts in the same order), the ghost slots filled on the device,
+// and the cell tables over real particles and ghosts on the widened grid.
+void OpenCLPrinter::updateNeighboursWithGhosts() {
+  scene_ << "    sphc::SearchDomain domain = ocl.search_domain(" << deviceExtents("        ")
+         << ", DIM, Kernel::radius_scale);\n";
+  scene_ << "    grid = ocl.grid_of(domain);\n";
+  if (sourceArrays_.empty()) return;
+  scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
+  scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
+  for (const auto& S : sourceArrays_)
+    scene_ << "      " << cellListBuild(S, S + ".n") << "\n      dev_" << S
+           << ".permute(ocl, cells_" << S << ", " << S << ");\n";
+  scene_ << "    }\n";
+  scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
+  scene_ << "    const double cutoff = domain.cell_size;\n";
+  for (const auto& S : sourceArrays_) {
+    int s = plan_.arrayIndex(S);
+    scene_ << "    ghosts_" << S << ".add(ocl, box, " << S << ", dev_" << S << ", cutoff, "
+           << propIndexList(s, arr(s).ghostProps) << ");  //";
+    for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
+    scene_ << "\n";
+  }
+  scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
+  scene_ << "    grid = ocl.grid_of(domain);\n";
+  for (const auto& S : sourceArrays_)
+    scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
+}
+
+// Ghosts copy the values a phase computed on the real particles, where they carry them.
+void OpenCLPrinter::ghostRefresh(const DestinationWork& w) {
+  const int d = w.array;
+  const std::string& D = arr(d).name;
+  const std::vector<std::string>& refresh = w.ghostRefresh;
+  if (refresh.empty()) return;
+  scene_ << "      // ghosts follow:";
+  for (const auto& p : refresh) scene_ << " " << p;
+  scene_ << "\n      ghosts_" << D << ".refresh(ocl, box, " << D << ", dev_" << D << ", "
+         << propIndexList(d, refresh) << ");\n";
+}
+
+// The adaptive time step's limits over one moving array: per-particle limits in a kernel,
+// their minima from device partial reductions in one round trip.
+void OpenCLPrinter::adaptiveDtArray(int a) {
+  const AdaptiveDt& ad = sched_.adaptiveDt;
+  const bool useCfl = ad.cfl;
+  const std::string& A = arr(a).name;
+  const std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
+  // Per-particle limits on the device, their minima from device partial reductions.
+  KernelArgs ka;
+  std::vector<std::string> props = {"h"};
+  if (useCfl) props.push_back("cs");
+  for (int k = 0; k < plan_.dim; ++k) {
+    if (useCfl) props.push_back(vel[k]);
+    if (ad.force) props.push_back(acc[k]);
+  }
+  for (const auto& p : props) ka.add("__global const real* " + p, devBuffer(a, p), p);
+  const char* outs[3] = {"dt_cfl", "dt_force", "h2min"};
+  for (int o = 0; o < 3; ++o)
+    ka.add(std::string("__global real* out_") + outs[o],
+           "ocl.scratch(n, " + std::to_string(o + 1) + ")", outs[o]);
+  std::string k = "adaptive_dt_" + A;
+  beginKernel(k, ka);
+  cl_ << "  const int i = d_idx;\n";
+  auto mag = [&](const std::vector<std::string>& c) {
+    std::string m = "sqrt(";
+    for (int k = 0; k < plan_.dim; ++k) m += (k ? " + " : "") + c[k] + "[i] * " + c[k] + "[i]";
+    return m + ")";
+  };
+  cl_ << "  out_dt_cfl[i] = " << (useCfl ? "h[i] / (cs[i] + " + mag(vel) + ")" : "INFINITY")
+      << ";\n";
+  cl_ << "  out_h2min[i] = h[i] * h[i];\n";
+  if (ad.force)
+    cl_ << "  const real amag = " << mag(acc) << ";\n"
+        << "  out_dt_force[i] = amag > 0 ? sqrt(h[i] / amag) : INFINITY;\n";
+  else
+    cl_ << "  out_dt_force[i] = INFINITY;\n";
+  cl_ << "}\n\n";
+  scene_ << "      const int n = static_cast<int>(" << A << ".n);\n";
+  scene_ << "      const double t = 0.0, dt = 0.0;  // (kernel arguments, unused)\n";
+  scene_ << "      " << launch(k, "n", ka) << "\n";
+  // The minima in one round trip: (limit, scratch slot) for the limits the scene uses.
+  std::vector<std::pair<std::string, int>> mins;
+  if (useCfl) mins.push_back({"dt_cfl", 1});
+  if (ad.force) mins.push_back({"dt_force", 2});
+  if (ad.viscous) mins.push_back({"h2min", 3});
+  scene_ << "      const std::vector<double> mins = ocl.reduce_all({";
+  for (size_t m = 0; m < mins.size(); ++m)
+    scene_ << (m ? ", " : "") << "{ocl.scratch(n, " << mins[m].second
+           << "), static_cast<std::size_t>(n), sphc::ocl::Op::Min}";
+  scene_ << "});\n";
+  for (size_t m = 0; m < mins.size(); ++m)
+    scene_ << "      " << mins[m].first << " = std::fmin(" << mins[m].first << ", mins[" << m
+           << "]);\n";
+  scene_ << "    }\n";
+}
+
+}  // namespace
+
+std::unique_ptr<ScenePrinter> makeOpenCLPrinter(const Schedule& sched,
+                                                const DiagnosticEngine& diags,
+                                                const EmitOptions& opts,
+                                                std::string* kernelSource) {
+  return std::make_unique<OpenCLPrinter>(sched, diags, opts, kernelSource);
+}
+
+}  // namespace sphc

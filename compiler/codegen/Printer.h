@@ -1,0 +1,179 @@
+// The printers of the back half (internal to codegen/). ScenePrinter prints what every
+// backend shares: the file's header, the equation and stepper bodies, the scene's
+// parameters and set-up, the group functions and their iteration, the integrator's step and
+// `main`. Where the execution differs — the loops of a phase's destination, the steppers,
+// the neighbour search, ghosts, the adaptive time step, data movement — it calls a hook that
+// each backend's printer implements: CpuPrinter (serial and OpenMP, which differ by pragmas
+// only: CpuPrinter.cpp) and OpenCLPrinter (kernels and their host launches:
+// OpenCLPrinter.cpp). All of them read the decisions from the Schedule and decide nothing
+// but spellings.
+#pragma once
+
+#include "codegen/CppEmitter.h"
+#include "codegen/CppText.h"
+#include "codegen/Schedule.h"
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace sphc {
+
+// The few spellings in which the C++ of the CPU backends and the OpenCL C of the kernels
+// differ, so that bodies, pair quantities and their calls are written once.
+struct Dialect {
+  std::string real;                  // the floating type: double, float (CPU single), real
+  std::string intType, uintType;     // std::int32_t, std::uint32_t / int, uint
+  std::string global;                // pointer qualifier: "" / "__global "
+  std::string functionPrefix;        // "static inline " / "inline "
+  std::string kernelW, kernelGradient, sqrt;  // Kernel::w ... / kernel_w ...
+  std::string skipCandidate;         // leaves a neighbour candidate: return; (a lambda) / continue;
+  std::string scalarSep;             // eq3.rho0 (host struct) / eq3_rho0 (kernel argument)
+  bool floatLiterals = false;        // 0.5f (CPU single precision)
+  bool floatBodies = false;          // bodies rewritten by singlePrecisionBody
+  bool lineDirectives = false;       // #line to the .sph around bodies
+  std::string lit(const std::string& v) const { return floatLiterals ? v + "f" : v; }
+};
+
+class ScenePrinter {
+ public:
+  ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts);
+  virtual ~ScenePrinter() = default;
+  // The whole C++ file of the solver.
+  std::string run();
+
+ protected:
+  // ---- What each backend prints (hooks) ----
+  virtual std::string backendComment() const = 0;   // after "// Backend: "
+  virtual void runtimeIncludes() {}                 // sphc headers of the backend
+  virtual void systemIncludes() {}                  // <omp.h>, ...
+  // Where the body of an equation method or stepper runs: its dialect and stream.
+  virtual bool bodyOnDevice(bool converged) const { return false; }
+  virtual void deviceKernelFunctions() {}
+  virtual void afterBodies() {}                     // before "The scene" (OpenCL: SCENE_CL)
+  virtual void searchMembers() = 0;                 // neighbour search state of struct Scene
+  virtual std::string ghostsType() const = 0;
+  virtual void extraMembers() {}                    // after the ghosts (OpenMP scratch)
+  virtual bool timesNeighbourSearch() const = 0;    // nnps_seconds for --timing
+  virtual void dataMovement() {}                    // to_device/to_single, to_host
+  // One destination of a phase, after `const int n = ...;` (its ghost refresh included).
+  virtual void destination(const DestinationWork& w, const std::string& phase) = 0;
+  // Before a `converged` test reads properties on the host.
+  virtual void beforeConverged(const PlanEquation& eq) {}
+  virtual void steppers() = 0;
+  // One run of stepper statements in step(), with the time of each statement.
+  virtual void stepperCall(const StepStatement& st,
+                           const std::function<std::string(int)>& timeAfter) = 0;
+  virtual void wrapPeriodic(int a) = 0;             // update_domain, per array
+  virtual void updateNeighbours() = 0;              // its body, without a domain
+  virtual void updateNeighboursWithGhosts() = 0;    // its body, with one
+  virtual std::string removeGhosts() const = 0;
+  virtual void timedNeighbourUpdate() = 0;
+  virtual void adaptiveDtArray(int a) = 0;          // the limits of one moving array
+  virtual void mainPrologue() {}                    // before `static Scene scene;`
+  virtual void mainBackendOptions() {}              // prog.set_threads, device selection
+  virtual std::string afterSetup() const { return ""; }  // "    scene.to_device();\n"
+  virtual bool hasToHost() const { return false; }
+
+  // ---- Bodies, their parameters and calls (Bodies.cpp) ----
+  // Parameters of a body function, in order, as (C++ declaration, argument kind) pairs.
+  struct BodyParam {
+    std::string decl;  // e.g. "const double* s_m"
+    enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp } kind;
+    std::string name;  // property, pair quantity or scalar name
+  };
+  // The body-parameter types: what each property, pair quantity and scalar is declared as.
+  std::vector<BodyParam> bodyParams(const PlanBody& b, int destArray, const Dialect& d) const;
+  void emitBodyFunction(const PlanBody& b, const std::string& name, const std::string& ret,
+                        int destArray, const Dialect& d, std::ostringstream& os);
+  void emitKernelFunctions();
+  // eqValues + sep + scalar: "eq3.rho0" on the host, "eq3_rho0" (a kernel argument) on the
+  // device.
+  std::string callBody(const std::string& fn, const PlanBody& b, int dest,
+                       const std::string& eqValues, const std::string& time,
+                       const std::string& sep = ".") const;
+  // The destination particle's position, h (and velocity) as locals xi, yi, zi, hi (ui...).
+  void emitDestLocals(std::ostream& os, const std::string& indent,
+                      const std::set<std::string>& q, const Dialect& d) const;
+  // The body of the neighbour loop for one candidate s_idx: the pair quantities and the
+  // neighbour criterion (emitPairQuantities), then every loop body. Shared by the C++ loop
+  // and the OpenCL kernel.
+  void emitCandidate(std::ostream& os, const std::set<std::string>& q,
+                     const std::vector<const PlanEquation*>& loopers, int d, const Dialect& dl);
+  // The pair quantities of one candidate (XIJ, R2IJ, the cut-off test, HIJ, RIJ, ...).
+  void emitPairQuantities(std::ostream& os, const std::set<std::string>& q, const Dialect& dl);
+  void emitLineDirective(std::ostringstream& os, llvm::SMLoc l) const;
+  void resetLineDirective(std::ostringstream& os) const;
+  // A property's type in a dialect (constants and floating properties: its real).
+  std::string propType(int array, const std::string& prop, const Dialect& d) const;
+
+  // ---- The host program (HostProgram.cpp) ----
+  void emitParams();
+  void emitSetup();
+  void emitArraySetup(const PlanArray& a);
+  void emitDomainSetup();
+  void emitGroup(const ScheduleGroup& g);
+  void emitPhase(const Phase& ph);
+  // An iterated group's convergence: its loop, the tests, the iteration bounds.
+  void emitIteration(const ScheduleGroup& g);
+  // The convergence test of an iterated group's equation (inside the iteration loop).
+  void emitConverged(const PlanEquation& eq);
+  void emitStep();
+  void emitAdaptiveDt();
+  void emitSceneMembers();
+  // The SceneProgram of `main`: name, params, options, set-up, arrays, step, outputs.
+  void emitMain();
+
+  // ---- Shared helpers ----
+  // The data a scene computes on: host arrays, or their float copies (--precision=single).
+  std::string propPtr(int array, const std::string& prop) const;
+  // The host array's own data (set-up writes it).
+  std::string hostPtr(int array, const std::string& prop) const;
+  // The C++ type of a property or constant in the scene's host loops.
+  std::string hostType(int array, const std::string& prop) const {
+    return propType(array, prop, host_);
+  }
+  bool hasDomain() const { return sched_.domain; }
+  std::string propIndexList(int a, const std::vector<std::string>& props) const;
+  std::string loc(llvm::SMLoc l) const { return diags_.lineInfo(l); }
+  std::string paramRef(const std::string& n) const { return "P." + n; }
+  std::string eqStruct(const PlanEquation& eq) const { return "eq" + std::to_string(eq.id); }
+  const PlanArray& arr(int a) const { return plan_.arrays[a]; }
+  int propIndex(int a, const std::string& p) const;
+  int constIndex(int a, const std::string& c) const;
+  const PlanBody& methodBody(const PlanEquation& eq, ast::Method::Kind kind) const {
+    return plan_.bodies[plan_.equationDecls[eq.declIndex].methods.at(kind)];
+  }
+
+  const Schedule& sched_;
+  const Plan& plan_;
+  const DiagnosticEngine& diags_;
+  std::string backendName_;  // serial, openmp, opencl (prog.backend)
+  bool singlePrecision_ = false;
+  // --precision=single on the CPU backends: the scene computes on float copies of the arrays
+  // (sphc::FloatArray f32_<array>), bodies and neighbour search included; the host arrays
+  // (double) serve set-up and, after to_host(), output.
+  bool cpuSingle_ = false;
+  std::string real_ = "double";  // the C++ floating type the scene computes in
+  Dialect host_, device_;
+  std::ostringstream out_;    // the file
+  std::ostringstream scene_;  // members of struct Scene
+  std::ostringstream cl_;     // OpenCL C of the kernels (--backend=opencl)
+  std::vector<std::string> sourceArrays_;  // arrays that need a cell list, by name
+  std::set<std::string> loopArrays_;       // arrays in a neighbour pass, as dest or source
+};
+
+std::unique_ptr<ScenePrinter> makeCpuPrinter(const Schedule& sched,
+                                             const DiagnosticEngine& diags,
+                                             const EmitOptions& opts);
+// The OpenCL printer; kernelSource receives the OpenCL C of its kernels once run() is done.
+std::unique_ptr<ScenePrinter> makeOpenCLPrinter(const Schedule& sched,
+                                                const DiagnosticEngine& diags,
+                                                const EmitOptions& opts,
+                                                std::string* kernelSource);
+
+}  // namespace sphc
