@@ -11,7 +11,8 @@ compile-time `option` as a case of its own, plus the scenes under tests/lit/Inpu
   text   (always): `--emit=cpp` of both, and for opencl also `--emit=opencl`, must be equal
          after normalisation. Without --normalise the texts must be identical; with it,
          what issue 11 allows to change is ignored: comments (`// ...` to the end of a
-         line), `#line` directives, blank lines and trailing blanks, and with --rename
+         line), `#line` directives, `(void)x;` statements, blank lines and trailing
+         blanks, and with --rename
          OLD=NEW (repeatable, a regular expression and its replacement) function names.
   run    (--run): both solvers are built and run for --steps steps, a snapshot at every
          step, and every snapshot is compared: serial and openmp bitwise (h5diff), opencl
@@ -63,6 +64,7 @@ def normalise(text, renames):
         if re.match(r'\s*#line\b', line):
             continue
         line = re.sub(r'\s*//.*$', '', line).rstrip()
+        line = re.sub(r'\s*\(void\)\w+;', '', line)
         for pat, rep in renames:
             line = re.sub(pat, rep, line)
         if line:

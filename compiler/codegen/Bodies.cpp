@@ -18,10 +18,12 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
       singlePrecision_(opts.precision == Precision::Single),
       cpuSingle_(singlePrecision_ && opts.backend != Backend::OpenCL),
       real_(cpuSingle_ ? "float" : "double") {
-  host_ = {real_, "std::int32_t", "std::uint32_t", "", "static inline ", "Kernel::w",
-           "Kernel::gradient", "std::sqrt", "return;", ".", cpuSingle_, cpuSingle_, false};
-  device_ = {"real", "int", "uint", "__global ", "inline ", "kernel_w", "kernel_gradient",
-             "sqrt", "continue;", "_", false, false, true};
+  host_ = {real_,        "std::int32_t", "std::uint32_t", "",       "static inline ",
+           "Kernel::w",  "Kernel::gradient", "std::sqrt",  "return;", ".",
+           cpuSingle_,   cpuSingle_,     true,            "scene.cpp"};
+  device_ = {"real",     "int",          "uint",          "__global ", "inline ",
+             "kernel_w", "kernel_gradient", "sqrt",     "continue;", "_",
+             false,      false,          true,            plan_.sceneName + ".cl"};
   for (int a : sched.cellLists) sourceArrays_.push_back(arr(a).name);
   for (int a : sched.searchArrays) loopArrays_.insert(arr(a).name);
 }
@@ -99,7 +101,7 @@ void ScenePrinter::emitBodyFunction(const PlanBody& b, const std::string& name,
   os << text;
   if (text.empty() || text.back() != '\n') os << "\n";
   os << "}\n";
-  if (d.lineDirectives) resetLineDirective(os);
+  if (d.lineDirectives) resetLineDirective(os, d);
   os << "\n";
 }
 
@@ -128,11 +130,11 @@ void ScenePrinter::emitLineDirective(std::ostringstream& os, llvm::SMLoc l) cons
   os << "#line " << info.substr(colon + 1) << " \"" << info.substr(0, colon) << "\"\n";
 }
 
-void ScenePrinter::resetLineDirective(std::ostringstream& os) const {
+void ScenePrinter::resetLineDirective(std::ostringstream& os, const Dialect& d) const {
   // The directive is on line (newlines so far + 1): the next line is one more.
   std::string text = os.str();
   long line = std::count(text.begin(), text.end(), '\n') + 2;
-  os << "#line " << line << " \"" << plan_.sceneName << ".cl\"\n";
+  os << "#line " << line << " \"" << d.lineFile << "\"\n";
 }
 
 std::string ScenePrinter::propPtr(int a, const std::string& p) const {

@@ -50,6 +50,13 @@ std::string exprText(const ast::Expr& e) {
   return s;
 }
 
+bool mentions(const ast::Expr& e, const std::string& name) {
+  if (e.kind == ast::Expr::Name && e.text == name) return true;
+  for (const auto& a : e.args)
+    if (a && mentions(*a, name)) return true;
+  return false;
+}
+
 bool isLiteral(const ast::Expr& e) {
   if (e.kind == ast::Expr::Number) return true;
   return e.kind == ast::Expr::Unary && e.op == "-" && e.args[0]->kind == ast::Expr::Number;

@@ -17,6 +17,8 @@ using NameMap = std::function<std::string(const std::string&)>;
 std::string exprCpp(const ast::Expr& e, const NameMap& names);
 // The expression as the user would write it (for --help of the generated program).
 std::string exprText(const ast::Expr& e);
+// Whether the expression refers to `name`.
+bool mentions(const ast::Expr& e, const std::string& name);
 // A number, or a negated number, and its value.
 bool isLiteral(const ast::Expr& e);
 double literalValue(const ast::Expr& e);

@@ -242,9 +242,16 @@ void CpuPrinter::steppers() {
     const bool parallel = openmp_ && run.order == LoopOrder::Parallel;
     scene_ << "  void " << run.name << "(";
     for (size_t k = 0; k < run.methods.size(); ++k) scene_ << "double t_" << k << ", ";
-    scene_ << "double dt) {\n   ";
-    for (size_t k = 0; k < run.methods.size(); ++k) scene_ << " (void)t_" << k << ";";
-    scene_ << " (void)dt;\n";
+    scene_ << "double dt) {\n";
+    // A statement's time is unused when no array's stepper has its method.
+    std::string unused;
+    for (size_t k = 0; k < run.methods.size(); ++k) {
+      bool used = false;
+      for (const auto& part : run.parts)
+        for (const auto& [j, b] : part.bodies) used |= j == k;
+      if (!used) unused += " (void)t_" + std::to_string(k) + ";";
+    }
+    if (!unused.empty()) scene_ << "   " << unused << "\n";
     if (parallel) scene_ << "    #pragma omp parallel\n";
     scene_ << "    {\n";
     for (const StepperRun::Part& part : run.parts) {

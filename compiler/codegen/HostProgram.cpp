@@ -103,11 +103,19 @@ void ScenePrinter::emitArraySetup(const PlanArray& a) {
   for (const auto& p : a.props)
     if (p.init) inits.push_back(&p);
   scene_ << "      for (std::size_t i = 0; i < pts.size(); ++i) {\n";
-  scene_ << "        const double x = pts.x[i], y = pts.y[i], z = pts.z[i];\n";
+  // The coordinates the positions and initial values use.
+  std::vector<std::string> coords;
+  for (const char* c : {"x", "y", "z"}) {
+    bool used = propIndex(plan_.arrayIndex(A), c) >= 0;
+    for (const auto* p : inits) used |= mentions(*p->init, c);
+    if (used) coords.push_back(c);
+  }
+  for (size_t k = 0; k < coords.size(); ++k)
+    scene_ << (k ? ", " : "        const double ") << coords[k] << " = pts." << coords[k]
+           << "[i]" << (k + 1 == coords.size() ? ";\n" : "");
   for (const char* c : {"x", "y", "z"})
     if (propIndex(plan_.arrayIndex(A), c) >= 0)
       scene_ << "        " << hostPtr(plan_.arrayIndex(A), c) << "[i] = " << c << ";\n";
-  scene_ << "        (void)x; (void)y; (void)z;\n";
   std::set<std::string> locals = {"x", "y", "z"};
   auto initNames = [&](const std::string& n) {
     if (locals.count(n)) return n == "x" || n == "y" || n == "z" ? n : "v_" + n;
@@ -214,7 +222,8 @@ void ScenePrinter::emitGroup(const ScheduleGroup& sg) {
   if (g.every) scene_ << "    if (!" << name << "_due()) return;\n";
   if (!g.iterate) {
     for (const auto& c : sg.calls) scene_ << "    " << c << "(t, dt);\n";
-    scene_ << "    (void)t; (void)dt;\n  }\n\n";
+    if (sg.calls.empty()) scene_ << "    (void)t; (void)dt;  // an empty group\n";
+    scene_ << "  }\n\n";
     return;
   }
   emitIteration(sg);
@@ -255,8 +264,14 @@ void ScenePrinter::emitConverged(const PlanEquation& eq) {
 }
 
 void ScenePrinter::emitPhase(const Phase& ph) {
+  // Provenance: the group and the equations fused into this phase.
+  scene_ << "  // phase of the group from " << loc(ph.group->loc) << ":";
+  for (int e : ph.equations)
+    scene_ << " " << plan_.equations[e].name << (plan_.equations[e].live ? "" : " (pruned)");
+  scene_ << "\n";
   scene_ << "  void " << ph.name << "(double t, double dt) {\n";
-  scene_ << "    (void)t; (void)dt;\n";
+  // Every body takes t and dt: only a phase whose equations were all pruned ignores them.
+  if (ph.destinations.empty()) scene_ << "    (void)t; (void)dt;\n";
   for (const DestinationWork& w : ph.destinations) {
     const std::string& D = arr(w.array).name;
     // Groups with `real = false` run on the ghosts too (they follow the real particles).

@@ -100,7 +100,7 @@ void OpenCLPrinter::deviceKernelFunctions() {
          "  kernel_gradient(x, r, h, g);\n"
          "  return r > 0.0 ? g[0] : 0.0;\n"
          "}\n";
-  resetLineDirective(cl_);
+  resetLineDirective(cl_, device_);
 }
 
 void OpenCLPrinter::afterBodies() {
@@ -315,7 +315,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
 
 void OpenCLPrinter::steppers() {
   for (const auto& [m, arrays] : sched_.stepperMethods) {
-    scene_ << "  void stepper_" << m << "(double t, double dt) {\n    (void)t; (void)dt;\n";
+    scene_ << "  void stepper_" << m << "(double t, double dt) {\n";
     for (int a : arrays) {
       const PlanArray& A = arr(a);
       const PlanStepper& st = plan_.steppers[A.stepper];

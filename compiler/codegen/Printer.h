@@ -35,7 +35,11 @@ struct Dialect {
   std::string scalarSep;             // eq3.rho0 (host struct) / eq3_rho0 (kernel argument)
   bool floatLiterals = false;        // 0.5f (CPU single precision)
   bool floatBodies = false;          // bodies rewritten by singlePrecisionBody
-  bool lineDirectives = false;       // #line to the .sph around bodies
+  // `#line N "file.sph"` before each body and `#line M "<lineFile>"` after it, so that
+  // compiler messages and debuggers point at the .sph line (lineFile: the generated file,
+  // as the build names it: scene.cpp in the build cache, <scene>.cl for the kernels).
+  bool lineDirectives = false;
+  std::string lineFile;
   std::string lit(const std::string& v) const { return floatLiterals ? v + "f" : v; }
 };
 
@@ -107,7 +111,7 @@ class ScenePrinter {
   // The pair quantities of one candidate (XIJ, R2IJ, the cut-off test, HIJ, RIJ, ...).
   void emitPairQuantities(std::ostream& os, const std::set<std::string>& q, const Dialect& dl);
   void emitLineDirective(std::ostringstream& os, llvm::SMLoc l) const;
-  void resetLineDirective(std::ostringstream& os) const;
+  void resetLineDirective(std::ostringstream& os, const Dialect& d) const;
   // A property's type in a dialect (constants and floating properties: its real).
   std::string propType(int array, const std::string& prop, const Dialect& d) const;
 
