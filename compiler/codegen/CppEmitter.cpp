@@ -16,17 +16,14 @@ const char* backendName(Backend b) {
 
 std::string emitCpp(const Schedule& sched, const DiagnosticEngine& diags,
                     const EmitOptions& opts) {
-  std::string kernels;
-  auto printer = opts.backend == Backend::OpenCL ? makeOpenCLPrinter(sched, diags, opts, &kernels)
-                                          : makeCpuPrinter(sched, diags, opts);
+  auto printer = opts.backend == Backend::OpenCL ? makeOpenCLPrinter(sched, diags, opts)
+                                                 : makeCpuPrinter(sched, diags, opts);
   return printer->run();
 }
 
 std::string emitOpenCL(const Schedule& sched, const DiagnosticEngine& diags, EmitOptions opts) {
   opts.backend = Backend::OpenCL;
-  std::string kernels;
-  makeOpenCLPrinter(sched, diags, opts, &kernels)->run();
-  return kernels;
+  return makeOpenCLPrinter(sched, diags, opts)->kernelSource();
 }
 
 }  // namespace sphc

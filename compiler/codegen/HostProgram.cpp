@@ -461,6 +461,26 @@ std::string ScenePrinter::run() {
   out_ << "constexpr " << real_
        << " RADIUS2 = Kernel::radius_scale * Kernel::radius_scale;\n\n";
   out_ << "// ---- Equation and stepper bodies, as written in the .sph files ----\n\n";
+  emitBodies();
+  emitParams();
+  emitSetup();
+  emitSceneFunctions();
+  beforeScene();
+  emitSceneMembers();
+  dataMovement();
+  out_ << "\n" << scene_.str() << "};\n\n}  // namespace\n\n";
+  emitMain();
+  return out_.str();
+}
+
+std::string ScenePrinter::kernelSource() {
+  emitBodies();
+  emitSceneFunctions();
+  return cl_.str();
+}
+
+// The functions of equation and stepper bodies (each declaration once), where they run.
+void ScenePrinter::emitBodies() {
   emitKernelFunctions();
   // Bodies of live equations (each declaration once) and of steppers.
   std::set<int> emittedDecls;
@@ -484,20 +504,15 @@ std::string ScenePrinter::run() {
                        "void", a, bodyOnDevice(false) ? device_ : host_,
                        bodyOnDevice(false) ? cl_ : out_);
   }
+}
 
-  emitParams();
-  emitSetup();
+// The members of struct Scene that compute: groups and phases, steppers, the step, adaptive
+// dt (with the OpenCL printer, their kernels too).
+void ScenePrinter::emitSceneFunctions() {
   emitGroup(sched_.equations);
   steppers();
   emitStep();
   emitAdaptiveDt();
-  afterBodies();
-
-  emitSceneMembers();
-  dataMovement();
-  out_ << "\n" << scene_.str() << "};\n\n}  // namespace\n\n";
-  emitMain();
-  return out_.str();
 }
 
 

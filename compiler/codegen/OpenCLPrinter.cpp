@@ -11,9 +11,8 @@ namespace {
 
 class OpenCLPrinter : public ScenePrinter {
  public:
-  OpenCLPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts,
-                std::string* kernelSource)
-      : ScenePrinter(sched, diags, opts), kernelSource_(kernelSource) {
+  OpenCLPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
+      : ScenePrinter(sched, diags, opts) {
     // Line 1 of the kernel source is this directive, so lines are the source's own.
     cl_ << "#line 2 \"" << plan_.sceneName << ".cl\"\n";
   }
@@ -28,7 +27,7 @@ class OpenCLPrinter : public ScenePrinter {
   // copy of the constants.
   bool bodyOnDevice(bool converged) const override { return !converged; }
   void deviceKernelFunctions() override;
-  void afterBodies() override;
+  void beforeScene() override;
   void searchMembers() override;
   std::string ghostsType() const override { return "sphc::ocl::DeviceGhosts"; }
   // The launches are asynchronous: a host timer would measure nothing.
@@ -88,8 +87,6 @@ class OpenCLPrinter : public ScenePrinter {
   std::string cellListBuild(const std::string& S, const std::string& count) const;
   // The extents of the arrays in neighbour loops, for ocl.search_domain / ocl.make_grid.
   std::string deviceExtents(const std::string& indent) const;
-
-  std::string* kernelSource_;
 };
 
 void OpenCLPrinter::deviceKernelFunctions() {
@@ -103,11 +100,10 @@ void OpenCLPrinter::deviceKernelFunctions() {
   resetLineDirective(cl_, device_);
 }
 
-void OpenCLPrinter::afterBodies() {
-  *kernelSource_ = cl_.str();
+void OpenCLPrinter::beforeScene() {
   out_ << "// ---- OpenCL C of the kernels, built at start-up with the runtime's ----\n\n";
   out_ << "constexpr bool DOUBLE_PRECISION = " << (singlePrecision_ ? "false" : "true") << ";\n";
-  out_ << "const char* const SCENE_CL = R\"SPHC_CL(" << *kernelSource_ << ")SPHC_CL\";\n\n";
+  out_ << "const char* const SCENE_CL = R\"SPHC_CL(" << cl_.str() << ")SPHC_CL\";\n\n";
 }
 
 void OpenCLPrinter::searchMembers() {
@@ -453,9 +449,8 @@ void OpenCLPrinter::adaptiveDtArray(int a) {
 
 std::unique_ptr<ScenePrinter> makeOpenCLPrinter(const Schedule& sched,
                                                 const DiagnosticEngine& diags,
-                                                const EmitOptions& opts,
-                                                std::string* kernelSource) {
-  return std::make_unique<OpenCLPrinter>(sched, diags, opts, kernelSource);
+                                                const EmitOptions& opts) {
+  return std::make_unique<OpenCLPrinter>(sched, diags, opts);
 }
 
 }  // namespace sphc

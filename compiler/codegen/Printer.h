@@ -49,6 +49,9 @@ class ScenePrinter {
   virtual ~ScenePrinter() = default;
   // The whole C++ file of the solver.
   std::string run();
+  // The OpenCL C of the kernels alone (--emit=opencl; empty for a CPU printer): the bodies
+  // and scene functions printed, without the host program around them.
+  std::string kernelSource();
 
  protected:
   // ---- What each backend prints (hooks) ----
@@ -58,7 +61,7 @@ class ScenePrinter {
   // Where the body of an equation method or stepper runs: its dialect and stream.
   virtual bool bodyOnDevice(bool converged) const { return false; }
   virtual void deviceKernelFunctions() {}
-  virtual void afterBodies() {}                     // before "The scene" (OpenCL: SCENE_CL)
+  virtual void beforeScene() {}                     // before "The scene" (OpenCL: SCENE_CL)
   virtual void searchMembers() = 0;                 // neighbour search state of struct Scene
   virtual std::string ghostsType() const = 0;
   virtual void extraMembers() {}                    // after the ghosts (OpenMP scratch)
@@ -116,6 +119,8 @@ class ScenePrinter {
   std::string propType(int array, const std::string& prop, const Dialect& d) const;
 
   // ---- The host program (HostProgram.cpp) ----
+  void emitBodies();
+  void emitSceneFunctions();
   void emitParams();
   void emitSetup();
   void emitArraySetup(const PlanArray& a);
@@ -174,10 +179,8 @@ class ScenePrinter {
 std::unique_ptr<ScenePrinter> makeCpuPrinter(const Schedule& sched,
                                              const DiagnosticEngine& diags,
                                              const EmitOptions& opts);
-// The OpenCL printer; kernelSource receives the OpenCL C of its kernels once run() is done.
 std::unique_ptr<ScenePrinter> makeOpenCLPrinter(const Schedule& sched,
                                                 const DiagnosticEngine& diags,
-                                                const EmitOptions& opts,
-                                                std::string* kernelSource);
+                                                const EmitOptions& opts);
 
 }  // namespace sphc

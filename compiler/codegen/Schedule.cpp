@@ -295,10 +295,6 @@ void ScheduleBuilder::adaptiveDt() {
 
 }  // namespace
 
-bool Schedule::isCellList(int array) const {
-  return std::find(cellLists.begin(), cellLists.end(), array) != cellLists.end();
-}
-
 std::unique_ptr<Schedule> buildSchedule(const Plan& plan) { return ScheduleBuilder(plan).run(); }
 
 // ---- --dump-after=schedule ------------------------------------------------------------------

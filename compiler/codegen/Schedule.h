@@ -158,8 +158,6 @@ struct Schedule {
   // Each stepper method on its own (printers that do not fuse runs): method -> arrays.
   std::vector<std::pair<std::string, std::vector<int>>> stepperMethods;
   AdaptiveDt adaptiveDt;
-
-  bool isCellList(int array) const;
 };
 
 // The schedule of an analysed plan (after the ghost pass). Pure: reads the plan only.
