@@ -266,8 +266,10 @@ void ScenePrinter::emitConverged(const PlanEquation& eq) {
 void ScenePrinter::emitPhase(const Phase& ph) {
   // Provenance: the group and the equations fused into this phase.
   scene_ << "  // phase of the group from " << loc(ph.group->loc) << ":";
-  for (int e : ph.equations)
-    scene_ << " " << plan_.equations[e].name << (plan_.equations[e].live ? "" : " (pruned)");
+  for (size_t k = 0; k < ph.equations.size(); ++k) {
+    const PlanEquation& eq = plan_.equations[ph.equations[k]];
+    scene_ << (k ? ", " : " ") << eq.name << (eq.live ? "" : " (pruned)");
+  }
   scene_ << "\n";
   scene_ << "  void " << ph.name << "(double t, double dt) {\n";
   // Every body takes t and dt: only a phase whose equations were all pruned ignores them.
