@@ -14,7 +14,8 @@ namespace {
 
 class ScheduleBuilder {
  public:
-  explicit ScheduleBuilder(const Plan& plan) : plan_(plan) {}
+  ScheduleBuilder(const Plan& plan, const DiagnosticEngine& diags)
+      : plan_(plan), diags_(diags) {}
   std::unique_ptr<Schedule> run();
 
  private:
@@ -44,7 +45,21 @@ class ScheduleBuilder {
   void step();
   void adaptiveDt();
 
+  // A function name not used yet: `base`, else base_2, base_3, ...
+  std::string unique(const std::string& base) {
+    if (used_.insert(base).second) return base;
+    for (int k = 2;; ++k)
+      if (used_.insert(base + "_" + std::to_string(k)).second) return base + "_" + std::to_string(k);
+  }
+  std::string lineOf(llvm::SMLoc l) const {
+    std::string info = diags_.lineInfo(l);  // file.sph:line
+    size_t colon = info.rfind(':');
+    return colon == std::string::npos ? "0" : info.substr(colon + 1);
+  }
+
   const Plan& plan_;
+  const DiagnosticEngine& diags_;
+  std::set<std::string> used_;
   std::unique_ptr<Schedule> s_;
   std::set<std::string> sourceNames_, loopNames_;
 };
@@ -53,7 +68,7 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
   s_ = std::make_unique<Schedule>();
   s_->plan = &plan_;
   s_->domain = plan_.domain.any();
-  group(plan_.root, "equations", s_->equations);
+  group(plan_.root, unique("equations"), s_->equations);
   for (const auto& n : sourceNames_) s_->cellLists.push_back(plan_.arrayIndex(n));
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
     if (loopNames_.count(plan_.arrays[a].name)) s_->searchArrays.push_back(a);
@@ -62,16 +77,23 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
   return std::move(s_);
 }
 
-// Runs of direct equations become fused phases; subgroups run in place, in order. Functions
-// are named by position: the group's name, then `_k` for its k-th member.
+// Runs of direct equations become fused phases; subgroups run in place, in order. A group's
+// function is named by its line (group_114), a phase's by its group and first equation
+// (group_114_TaitEOS), so that names say where the code comes from (and OpenCL profiles,
+// which list kernels named after phases, say what ran).
 void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, ScheduleGroup& out) {
   out.name = name;
   out.group = &g;
   std::vector<int> run;
-  int part = 0;
   auto flush = [&] {
     if (run.empty()) return;
-    std::string fn = name + "_" + std::to_string(part++);
+    const PlanEquation* first = &plan_.equations[run.front()];
+    for (int e : run)
+      if (plan_.equations[e].live) {
+        first = &plan_.equations[e];
+        break;
+      }
+    std::string fn = unique(name + "_" + first->name);
     out.members.push_back({true, static_cast<int>(out.phases.size())});
     out.phases.push_back(phase(g, run, fn));
     out.calls.push_back(fn);
@@ -83,8 +105,8 @@ void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, Schedul
       continue;
     }
     flush();
-    std::string fn = name + "_" + std::to_string(part++);
     const PlanGroup& sub = *g.subgroups[-entry - 1];
+    std::string fn = unique("group_" + lineOf(sub.loc));
     out.members.push_back({false, static_cast<int>(out.subgroups.size())});
     out.subgroups.push_back(std::make_unique<ScheduleGroup>());
     group(sub, fn, *out.subgroups.back());
@@ -295,7 +317,9 @@ void ScheduleBuilder::adaptiveDt() {
 
 }  // namespace
 
-std::unique_ptr<Schedule> buildSchedule(const Plan& plan) { return ScheduleBuilder(plan).run(); }
+std::unique_ptr<Schedule> buildSchedule(const Plan& plan, const DiagnosticEngine& diags) {
+  return ScheduleBuilder(plan, diags).run();
+}
 
 // ---- --dump-after=schedule ------------------------------------------------------------------
 

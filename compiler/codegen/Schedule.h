@@ -70,7 +70,9 @@ struct DestinationWork {
 // A fused evaluation of consecutive direct equations of a group (PySPH's Group): per
 // destination, every initialize, the neighbour passes, then post_loop and reduce.
 struct Phase {
-  std::string name;  // the generated function, e.g. equations_0
+  // The generated function: its group's name and its first equation's, e.g.
+  // group_114_TaitEOS (equations_TaitEOS for direct members of the scene's equations { }).
+  std::string name;
   const PlanGroup* group = nullptr;
   std::vector<int> equations;  // equation ids, live or not, in group order
   std::vector<DestinationWork> destinations;  // in order of first use
@@ -78,7 +80,9 @@ struct Phase {
 
 // A group of the scene's equations { }: its phases and subgroups run in order.
 struct ScheduleGroup {
-  std::string name;  // the generated function, e.g. equations or equations_2
+  // The generated function: `equations` for the scene's equations { }, group_<line> for a
+  // group (its line in the scene file).
+  std::string name;
   const PlanGroup* group = nullptr;
   struct Member {
     bool isPhase = true;
@@ -160,8 +164,9 @@ struct Schedule {
   AdaptiveDt adaptiveDt;
 };
 
-// The schedule of an analysed plan (after the ghost pass). Pure: reads the plan only.
-std::unique_ptr<Schedule> buildSchedule(const Plan& plan);
+// The schedule of an analysed plan (after the ghost pass). Pure: reads the plan only (and
+// the source lines of its groups, which name their functions).
+std::unique_ptr<Schedule> buildSchedule(const Plan& plan, const DiagnosticEngine& diags);
 
 // --dump-after=schedule.
 void printSchedule(const Schedule& s, const DiagnosticEngine& diags, llvm::raw_ostream& os);

@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
   }
 
   // --- the back half: schedule, code generation and build ----------------------------
-  auto schedule = buildSchedule(*plan);
+  auto schedule = buildSchedule(*plan, diags);
   log("schedule");
   if (DumpAfter == Pass::Schedule) {
     printSchedule(*schedule, diags, llvm::outs());
