@@ -168,7 +168,7 @@ void ScenePrinter::emitSetup() {
       earlier.insert(n);
     }
   }
-  for (const auto& a : plan_.arrays) emitArraySetup(a);
+  for (int a : sched_.setupArrays) emitArraySetup(arr(a));
   if (hasDomain()) emitDomainSetup();
   auto pn = [&](const std::string& n) { return paramRef(n); };
   scene_ << "    times.tf = " << exprCpp(*plan_.tf, pn) << ";\n";

@@ -68,6 +68,9 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
   s_ = std::make_unique<Schedule>();
   s_->plan = &plan_;
   s_->domain = plan_.domain.any();
+  // Arrays are made in declaration order (each from its own geometry and files; initial
+  // values read params only, so no array waits for another).
+  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) s_->setupArrays.push_back(a);
   group(plan_.root, unique("equations"), s_->equations);
   for (const auto& n : sourceNames_) s_->cellLists.push_back(plan_.arrayIndex(n));
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
@@ -363,6 +366,13 @@ class SchedulePrinter {
 
 void SchedulePrinter::print() {
   os_ << "schedule of scene " << p_.sceneName << "\n";
+  os_ << "set-up: params, equation constants, arrays";
+  for (int a : s_.setupArrays) {
+    const auto* decl = p_.arrays[a].decl;
+    os_ << " " << name(a) << " (" << decl->geometry.size() << " geometry, " << decl->loads.size()
+        << " files)";
+  }
+  os_ << (s_.domain ? ", domain" : "") << "\n";
   os_ << "neighbour search:";
   if (s_.searchArrays.empty()) os_ << " none";
   os_ << "\n";

@@ -139,6 +139,9 @@ struct AdaptiveDt {
 
 struct Schedule {
   const Plan* plan = nullptr;
+  // Set-up, in order: parameters (declaration order), equation constants, then each array
+  // (geometry, files, properties, initial values) in `setupArrays` order, then the domain.
+  std::vector<int> setupArrays;
   ScheduleGroup equations;  // the root group: compute_accelerations' `equations(t, dt)`
   // Top-level groups with post_step = true, in order: (function, condition) pairs; the
   // condition is the group's `every` test (null: always).
