@@ -1,9 +1,8 @@
-// The serial C++ code generator: a Plan to one readable C++ file that includes the runtime
-// headers and defines `main`. Every equation and stepper body becomes an inline function
-// holding the body as written (with `// from file.sph:line` provenance); each group becomes
-// a function per destination with one fused neighbour pass per source. --backend=opencl
-// shares all of it but the execution of phases, steppers, neighbour search and adaptive dt:
-// those become OpenCL C kernels (the same bodies, typed `real`) launched from the host code.
+// Code generation: a schedule (codegen/Schedule.h) to one readable C++ file that includes the
+// runtime headers and defines `main`, printed by the printer of the chosen backend
+// (codegen/Printer.h: CpuPrinter for serial and OpenMP, OpenCLPrinter for OpenCL C kernels
+// launched from the host code). Every equation and stepper body becomes an inline function
+// holding the body as written (with `// from file.sph:line` provenance and `#line`).
 #pragma once
 
 #include "codegen/Schedule.h"

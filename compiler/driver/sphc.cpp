@@ -1,5 +1,6 @@
 // sphc: the .sph compiler driver. The lowering reads top to bottom, one pass per line:
-//   modules = parse; plan = sema; plan = bodies; plan = prune; ... cpp = emit; exe = build
+//   modules = parse; plan = sema; plan = bodies; plan = prune; ... schedule = lower(plan);
+//   cpp = print(schedule, backend); exe = build
 // `--dump-after=PASS` prints the state after PASS and stops; `--report` prints the plan.
 #include "analysis/Passes.h"
 #include "body/BodyAnalysis.h"
