@@ -408,7 +408,11 @@ class OutputSchedule {
       if (!(later < std::numeric_limits<double>::infinity())) break;
       end = later;
     }
-    return {end - t, end, true};
+    // A requested time within rounding of t + dt (a multiple of a fixed dt, reached by
+    // summing dt) is landed on with the step's own length: dt is not perturbed by a rounding.
+    const double rounding =
+        16 * std::numeric_limits<double>::epsilon() * std::max(std::fabs(t), std::fabs(end));
+    return {std::fabs(end - (t + dt)) <= rounding ? dt : end - t, end, true};
   }
 
  private:
