@@ -403,8 +403,9 @@ class OutputSchedule {
     double end = first_target(t, t + dt, t + dt + merge);
     if (!(end < std::numeric_limits<double>::infinity())) return {dt, t + dt, false};
     // Requested times within `merge` after the one landed on are reached in the same step.
+    // (Multiples of an output interval shorter than that are not: one output per step.)
     for (int k = 0; k < 64; ++k) {
-      const double later = first_target(end, end + merge, end + merge);
+      const double later = first_target(end, end + merge, end + merge, every_ > merge);
       if (!(later < std::numeric_limits<double>::infinity())) break;
       end = later;
     }
@@ -436,13 +437,13 @@ class OutputSchedule {
 
   // The earliest requested time after t that a step ending at `nominal` (lengthened up to
   // `reach`) lands on, or infinity if it lands on none. Only times not written yet count.
-  double first_target(double t, double nominal, double reach) const {
+  double first_target(double t, double nominal, double reach, bool with_every = true) const {
     double end = std::numeric_limits<double>::infinity();
     const double after = t + slack_;
     if (tf_ > after && tf_ <= reach) end = std::min(end, tf_);
     const auto it = std::upper_bound(at_.begin() + static_cast<long>(next_at_), at_.end(), after);
     if (it != at_.end() && *it <= reach) end = std::min(end, *it);
-    if (every_ > 0) {
+    if (every_ > 0 && with_every) {
       // The last multiple the nominal step reaches, else the first one within reach.
       const double first = std::max(static_cast<double>(next_k_), std::floor(after / every_) + 1);
       const double last = std::floor(nominal / every_);

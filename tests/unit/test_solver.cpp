@@ -238,6 +238,14 @@ TEST(Solver, OutputIntervalBelowTheStepWritesOncePerStep) {
   EXPECT_EQ(m.steps, 13);
   EXPECT_EQ(static_cast<long>(h5_files(dir).size()), m.steps + 1);
   EXPECT_EQ(m.last_t_plus_dt, 0.1);
+  // --output-every 1e-12 (every step): the steps stay 0.01 to within the interval (each ends
+  // on a multiple of 1e-12, so differs from 0.01 by less than 1e-12 on each side: 2e-12).
+  const fs::path dir2 = fresh_dir();
+  Mover m2;
+  EXPECT_EQ(run(m2.prog, {"--quiet", "-d", dir2.string(), "--tf", "0.1", "--output-every", "1e-12"}), 0);
+  EXPECT_EQ(m2.steps, 10);
+  for (long k = 0; k < m2.steps; ++k) EXPECT_NEAR(m2.step_dt[k], 0.01, 2e-12) << "step " << k;
+  EXPECT_EQ(static_cast<long>(h5_files(dir2).size()), 11);
 }
 
 TEST(Solver, SetOverridesReachSetup) {
