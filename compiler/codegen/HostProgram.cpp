@@ -236,7 +236,10 @@ void ScenePrinter::emitIteration(const ScheduleGroup& sg) {
   scene_ << "    int iteration = 1;\n    bool converged = true;\n";
   scene_ << "    for (;; ++iteration) {\n";
   for (const auto& c : sg.calls) scene_ << "      " << c << "(t, dt);\n";
-  scene_ << "      converged = true;\n";
+  // As PySPH (its Cython backend): from min_iterations on, every `converged` is called each
+  // iteration, none skipped once one says no (they may keep state), and the results ANDed.
+  scene_ << "      const bool run_tests = iteration >= " << g.minIterations << ";\n";
+  scene_ << "      converged = run_tests;\n";
   for (const auto* eq : sg.convergers) emitConverged(*eq);
   scene_ << "      if (converged && iteration >= " << g.minIterations << ") break;\n";
   scene_ << "      if (iteration >= " << g.maxIterations << ") break;\n";
@@ -249,7 +252,7 @@ void ScenePrinter::emitIteration(const ScheduleGroup& sg) {
 void ScenePrinter::emitConverged(const PlanEquation& eq) {
   const auto& pd = plan_.equationDecls[eq.declIndex];
   const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Converged)];
-  scene_ << "      {\n        const int d_idx = 0;\n";
+  scene_ << "      if (run_tests) {\n        const int d_idx = 0;\n";
   std::set<std::string> dprops;
   for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
   bool needsProps = false;
@@ -258,9 +261,9 @@ void ScenePrinter::emitConverged(const PlanEquation& eq) {
   for (const auto& p : dprops)
     scene_ << "        " << hostType(eq.dest, p) << "* d_" << p << " = " << propPtr(eq.dest, p)
            << ";\n";
-  scene_ << "        converged = converged && "
+  scene_ << "        converged = ("
          << callBody(bodyFunctionName(eq.name, "converged"), b, eq.dest, eqStruct(eq), "t")
-         << " > 0;  // " << eq.name << ", from " << loc(eq.loc) << "\n      }\n";
+         << " > 0) && converged;  // " << eq.name << ", from " << loc(eq.loc) << "\n      }\n";
 }
 
 void ScenePrinter::emitPhase(const Phase& ph) {

@@ -161,13 +161,15 @@ bool checkExpr(const ast::Expr& e, const std::function<bool(const std::string&)>
 namespace {
 
 const std::vector<std::string>& kernelNames() {
-  static const std::vector<std::string> k = {"CubicSpline", "QuinticSpline", "WendlandQuintic",
-                                             "Gaussian"};
+  static const std::vector<std::string> k = {"CubicSpline",       "QuinticSpline",
+                                             "WendlandQuintic",   "Gaussian",
+                                             "WendlandQuinticC4", "WendlandQuinticC6",
+                                             "SuperGaussian"};
   return k;
 }
 
 double kernelRadius(const std::string& k) {
-  return (k == "QuinticSpline" || k == "Gaussian") ? 3.0 : 2.0;
+  return (k == "QuinticSpline" || k == "Gaussian" || k == "SuperGaussian") ? 3.0 : 2.0;
 }
 
 std::string joinNames(const std::vector<std::string>& v) {

@@ -877,7 +877,8 @@ void DeviceGhosts::release() {
 }
 
 std::string kernel_function_source(const std::string& kernel, int dim) {
-  // sigma, radius scale, f(q) and df(q) as in sphc/kernels.h.
+  // sigma, radius scale, f(q) and df(q) as in sphc/kernels.h (same formulas, same order of
+  // operations).
   const double pi = 3.14159265358979323846;
   std::string sigma, f, df, rs;
   char buf[64];
@@ -931,6 +932,46 @@ std::string kernel_function_source(const std::string& kernel, int dim) {
     sigma = num(dim == 1 ? 1.0 / std::sqrt(pi) : dim == 2 ? 1.0 / pi : std::pow(pi, -1.5));
     f = "  return q < 3.0 ? exp(-q * q) : 0.0;\n";
     df = "  return q < 3.0 ? -2.0 * q * exp(-q * q) : 0.0;\n";
+  } else if (kernel == "WendlandQuinticC4") {
+    rs = "2.0";
+    if (dim == 1) {
+      sigma = num(0.75);
+      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+          "  return t2 * t2 * t * (2.0 * q * q + 2.5 * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+           "  return -3.5 * q * (2.0 * q + 1.0) * t2 * t2;\n";
+    } else {
+      sigma = num(dim == 2 ? 9.0 / (4.0 * pi) : 495.0 / (256.0 * pi));
+      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+          "  return t2 * t2 * t2 * ((35.0 / 12.0) * q * q + 3.0 * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+           "  return (-14.0 / 3.0) * q * (1.0 + 2.5 * q) * t2 * t2 * t;\n";
+    }
+  } else if (kernel == "WendlandQuinticC6") {
+    rs = "2.0";
+    if (dim == 1) {
+      sigma = num(55.0 / 64.0);
+      f = "  if (q >= 2.0) return 0.0;\n"
+          "  const real t = 1.0 - 0.5 * q, t2 = t * t, t4 = t2 * t2;\n"
+          "  return t4 * t2 * t * (((2.625 * q + 4.75) * q + 3.5) * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+           "  return -0.5 * q * ((26.25 * q + 27.0) * q + 9.0) * t2 * t2 * t2;\n";
+    } else {
+      sigma = num(dim == 2 ? 78.0 / (28.0 * pi) : 1365.0 / (512.0 * pi));
+      f = "  if (q >= 2.0) return 0.0;\n"
+          "  const real t = 1.0 - 0.5 * q, t2 = t * t, t4 = t2 * t2;\n"
+          "  return t4 * t4 * (((4.0 * q + 6.25) * q + 4.0) * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n"
+           "  const real t = 1.0 - 0.5 * q, t2 = t * t, t4 = t2 * t2;\n"
+           "  return -5.5 * q * ((4.0 * q + 3.5) * q + 1.0) * t4 * t2 * t;\n";
+    }
+  } else if (kernel == "SuperGaussian") {
+    rs = "3.0";
+    sigma = num(dim == 1 ? 1.0 / std::sqrt(pi) : dim == 2 ? 1.0 / pi : std::pow(pi, -1.5));
+    f = "  if (q >= 3.0) return 0.0;\n  const real q2 = q * q;\n  return exp(-q2) * (" +
+        num(1.0 + 0.5 * dim) + " - q2);\n";
+    df = "  if (q >= 3.0) return 0.0;\n  const real q2 = q * q;\n  return q * (2.0 * q2 - " +
+         num(dim + 4.0) + ") * exp(-q2);\n";
   } else {
     throw std::invalid_argument("sphc::ocl: unknown kernel '" + kernel + "'");
   }

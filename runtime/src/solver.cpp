@@ -362,38 +362,105 @@ class OutputWriter {
   std::string newest_;
 };
 
-// When output is due: at multiples of output_every and at the output_at times, at the first
-// step that reaches them (time steps are not shortened to hit output times).
+// Requested times: the outputs (multiples of output_every, the output_at times) and tf.
+// Steps land on them (docs/language.md, "Output times"):
+// - A step from t whose nominal length dt (fixed, or this step's adaptive one) would pass a
+//   requested time is shortened to end exactly on it; a requested time at most
+//   kMergeFraction * dt beyond t + dt is reached by lengthening the step instead, so no step
+//   shorter than that fraction of dt is left behind. The same holds for tf.
+// - Requested times closer together than kMergeFraction * dt are written once, at the later.
+// - Several output_at times within one step each get their own (shortened) step, as in
+//   PySPH; multiples of an output_every shorter than dt do not shorten steps to that
+//   interval: the step ends on the last multiple it reaches, and one snapshot is written.
+// PySPH (solver.py) shortens the step to an output_at time or to tf with a slack of round-off
+// only (2 machine epsilon * tf * steps); sphc's slack is kMergeFraction of the step instead,
+// so that a near miss (tf = 1 with dt = 0.3333) does not leave a step of 1e-4 dt.
+constexpr double kMergeFraction = 1e-3;
+
 class OutputSchedule {
  public:
   OutputSchedule(const SceneTimes& times, double slack)
-      : every_(times.output_every), at_(times.output_at), slack_(slack) {
+      : every_(times.output_every), at_(times.output_at), tf_(times.tf), slack_(slack) {
     std::sort(at_.begin(), at_.end());
-    due(0.0);  // t = 0 is always written
+    // t = 0 is always written; requested times too close to it to take a step are written
+    // with it.
+    due(0.0, kMergeFraction * times.dt);
   }
 
-  // True if t reached an output time not reached before.
-  bool due(double t) {
+  // True if t reached output times not reached before (within tol, by default the
+  // round-off slack: steps end exactly on the times they land on).
+  bool due(double t) { return due(t, slack_); }
+
+  // The step from t whose nominal length is dt: it ends at t + dt, or exactly on the
+  // requested time it lands on (landed).
+  struct Step {
+    double length;
+    double end;
+    bool landed;
+  };
+  Step plan(double t, double dt) const {
+    const double merge = kMergeFraction * dt;
+    double end = first_target(t, t + dt, t + dt + merge);
+    if (!(end < std::numeric_limits<double>::infinity())) return {dt, t + dt, false};
+    // Requested times within `merge` after the one landed on are reached in the same step.
+    // (Multiples of an output interval shorter than that are not: one output per step.)
+    for (int k = 0; k < 64; ++k) {
+      const double later = first_target(end, end + merge, end + merge, every_ > merge);
+      if (!(later < std::numeric_limits<double>::infinity())) break;
+      end = later;
+    }
+    // A requested time within rounding of t + dt (a multiple of a fixed dt, reached by
+    // summing dt) is landed on with the step's own length: dt is not perturbed by a rounding.
+    const double rounding =
+        16 * std::numeric_limits<double>::epsilon() * std::max(std::fabs(t), std::fabs(end));
+    return {std::fabs(end - (t + dt)) <= rounding ? dt : end - t, end, true};
+  }
+
+ private:
+  bool due(double t, double tol) {
     bool reached = false;
-    if (every_ > 0 && static_cast<double>(next_k_) * every_ <= t + slack_) {
+    if (every_ > 0 && static_cast<double>(next_k_) * every_ <= t + tol) {
       // Jump to the first multiple beyond t at once: a step may pass very many output times
       // (--output-every far below dt), and counting them one by one would not end.
       reached = true;
-      const double k = std::floor((t + slack_) / every_);
+      const double k = std::floor((t + tol) / every_);
       next_k_ = std::max(next_k_, static_cast<long>(std::min(k, 9.0e18))) + 1;
-      while (static_cast<double>(next_k_ - 1) * every_ > t + slack_) --next_k_;  // rounding
-      while (static_cast<double>(next_k_) * every_ <= t + slack_) ++next_k_;      // rounding
+      while (static_cast<double>(next_k_ - 1) * every_ > t + tol) --next_k_;  // rounding
+      while (static_cast<double>(next_k_) * every_ <= t + tol) ++next_k_;      // rounding
     }
-    while (next_at_ < at_.size() && at_[next_at_] <= t + slack_) {
+    while (next_at_ < at_.size() && at_[next_at_] <= t + tol) {
       reached = true;
       ++next_at_;
     }
     return reached;
   }
 
- private:
+  // The earliest requested time after t that a step ending at `nominal` (lengthened up to
+  // `reach`) lands on, or infinity if it lands on none. Only times not written yet count.
+  double first_target(double t, double nominal, double reach, bool with_every = true) const {
+    double end = std::numeric_limits<double>::infinity();
+    const double after = t + slack_;
+    if (tf_ > after && tf_ <= reach) end = std::min(end, tf_);
+    const auto it = std::upper_bound(at_.begin() + static_cast<long>(next_at_), at_.end(), after);
+    if (it != at_.end() && *it <= reach) end = std::min(end, *it);
+    if (every_ > 0 && with_every) {
+      // The last multiple the nominal step reaches, else the first one within reach.
+      const double first = std::max(static_cast<double>(next_k_), std::floor(after / every_) + 1);
+      const double last = std::floor(nominal / every_);
+      double m = std::numeric_limits<double>::infinity();
+      if (last >= first) {
+        m = last * every_;
+      } else if (first * every_ <= reach) {
+        m = first * every_;
+      }
+      if (m > after) end = std::min(end, m);
+    }
+    return end;
+  }
+
   double every_;
   std::vector<double> at_;
+  double tf_;
   double slack_;
   long next_k_ = 1;
   std::size_t next_at_ = 0;
@@ -457,13 +524,11 @@ class Simulation {
         dt = prog_.adaptive_dt();
         if (!std::isfinite(dt) || dt < kMinDtFraction * tf) return time_step_failure(dt, tf);
       }
-      const bool last = t_ + dt >= tf - slack;
-      if (last) dt = tf - t_;
-      prog_.step(t_, dt);
+      const OutputSchedule::Step planned = schedule.plan(t_, dt);  // lands on outputs and tf
+      prog_.step(t_, planned.length);
       ++step_;
-      dt_ = dt;
-      // A fixed step computes t as step * dt, so rounding errors do not accumulate.
-      t_ = last ? tf : prog_.adaptive_dt ? t_ + dt : static_cast<double>(step_) * times.dt;
+      dt_ = planned.length;
+      advance_time(planned, times.dt);
       particle_steps += static_cast<double>(particles());
 
       const bool output_due = schedule.due(t_);
@@ -528,6 +593,21 @@ class Simulation {
   }
 
   OutputMeta meta() const { return OutputMeta{t_, step_, dt_, prog_.dim, scene_name(prog_)}; }
+
+  // t after a step: the requested time it landed on, exactly; else, with a fixed dt, the
+  // last landing plus steps * dt (so rounding errors do not accumulate), with an adaptive dt
+  // t + dt.
+  void advance_time(const OutputSchedule::Step& planned, double fixed_dt) {
+    if (planned.landed) {
+      t_ = planned.end;
+      landed_t_ = t_;
+      landed_step_ = step_;
+    } else if (prog_.adaptive_dt) {
+      t_ += planned.length;
+    } else {
+      t_ = landed_t_ + static_cast<double>(step_ - landed_step_) * fixed_dt;
+    }
+  }
 
   void write_output() {
     writer_->write(arrays_, meta());
@@ -618,6 +698,8 @@ class Simulation {
   double dt_ = 0.0;
   long step_ = 0;
   long last_output_step_ = -1;
+  double landed_t_ = 0.0;  // the last requested time a step landed on (advance_time)
+  long landed_step_ = 0;
 };
 
 }  // namespace

@@ -36,6 +36,7 @@ struct Mover {
   std::vector<double> seen_params;
   long steps = 0;
   double last_t_plus_dt = 0;
+  std::vector<double> step_t, step_dt;  // t and dt of every step
   SceneProgram prog;
 
   Mover() {
@@ -62,6 +63,8 @@ struct Mover {
       for (std::size_t i = 0; i < fluid.n; ++i) x[i] += u[i] * dt;
       ++steps;
       last_t_plus_dt = t + dt;
+      step_t.push_back(t);
+      step_dt.push_back(dt);
     };
     prog.output = {{"fluid", {"u"}}};
   }
@@ -130,7 +133,10 @@ TEST(Solver, LastStepIsClippedToEndExactlyAtTf) {
   EXPECT_NEAR(output_time(dir / "mover_000011.h5"), 0.105, 1e-12);
 }
 
-TEST(Solver, OutputAtTimesAreWrittenAtTheFirstStepReachingThem) {
+TEST(Solver, StepsLandOnOutputAtTimes) {
+  // dt = 0.01, output at 0.3 (a multiple of dt) and 0.305 (not): step 31 is shortened to
+  // 0.005 so that its output is at t = 0.305, the steps after it are 0.01 again, and the last
+  // one is shortened to end on tf = 1 (PySPH's rule, pysph/solver/solver.py).
   const fs::path dir = fresh_dir();
   Mover m;
   const auto setup = m.prog.setup;
@@ -141,7 +147,105 @@ TEST(Solver, OutputAtTimesAreWrittenAtTheFirstStepReachingThem) {
   };
   EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string()}), 0);
   EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000030.h5",
-                                                     "mover_000031.h5", "mover_000100.h5"}));
+                                                     "mover_000031.h5", "mover_000101.h5"}));
+  ASSERT_EQ(m.steps, 101);
+  EXPECT_EQ(m.step_t[30], 0.3);  // landed exactly (within rounding: here exact)
+  EXPECT_NEAR(m.step_dt[30], 0.005, 1e-15);
+  EXPECT_EQ(m.step_t[31], 0.305);
+  EXPECT_EQ(m.step_dt[31], 0.01);
+  EXPECT_NEAR(m.step_dt[100], 0.005, 1e-15);
+  EXPECT_EQ(m.last_t_plus_dt, 1.0);
+  EXPECT_NEAR(output_time(dir / "mover_000031.h5"), 0.305, 1e-12);
+  EXPECT_NEAR(output_time(dir / "mover_000101.h5"), 1.0, 1e-12);
+  // No step other than those two is shortened (the steps landing on 0.3 and 1.0, multiples
+  // of dt, differ from 0.01 by a rounding).
+  for (long k = 0; k < m.steps; ++k)
+    if (k != 30 && k != 100) EXPECT_NEAR(m.step_dt[k], 0.01, 1e-15) << "step " << k;
+}
+
+TEST(Solver, NearMissesAreMergedNotTinySteps) {
+  // tf 5e-4 dt beyond the 100th step's end (below kMergeFraction = 1e-3 of dt): the last step
+  // is lengthened to 0.010005 instead of leaving a step of 5e-6. At 2e-3 dt beyond, a
+  // shortened 101st step of 2e-5 is taken.
+  {
+    const fs::path dir = fresh_dir();
+    Mover m;
+    EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string(), "--tf", "1.000005", "--output-every", "0"}), 0);
+    EXPECT_EQ(m.steps, 100);
+    EXPECT_NEAR(m.step_dt.back(), 0.010005, 1e-15);
+    EXPECT_EQ(m.last_t_plus_dt, 1.000005);
+  }
+  {
+    const fs::path dir = fresh_dir();
+    Mover m;
+    EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string(), "--tf", "1.00002", "--output-every", "0"}), 0);
+    EXPECT_EQ(m.steps, 101);
+    EXPECT_NEAR(m.step_dt.back(), 2e-5, 1e-15);
+    EXPECT_EQ(m.last_t_plus_dt, 1.00002);
+  }
+  // Two output times closer than 1e-3 dt: one snapshot, at the later, in one step.
+  {
+    const fs::path dir = fresh_dir();
+    Mover m;
+    const auto setup = m.prog.setup;
+    m.prog.setup = [&](const std::vector<double>& params, SceneTimes& times) {
+      setup(params, times);
+      times.output_every = 0;
+      times.output_at = {0.5, 0.500001};
+    };
+    EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string()}), 0);
+    // Then 49 steps of 0.01 and a last one of 0.009999 to tf.
+    EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000050.h5",
+                                                       "mover_000100.h5"}));
+    EXPECT_NEAR(m.step_dt[49], 0.010001, 1e-15);
+    EXPECT_EQ(m.step_t[50], 0.500001);
+    EXPECT_NEAR(output_time(dir / "mover_000050.h5"), 0.500001, 1e-12);
+  }
+}
+
+TEST(Solver, AdaptiveStepsLandOnOutputTimes) {
+  // An adaptive dt of 0.03 with outputs every 0.25: the steps reaching 0.25, 0.5, 0.75 and
+  // 1.0 are shortened to end on them (0.25 = 8 * 0.03 + 0.01), each output at its time.
+  const fs::path dir = fresh_dir();
+  Mover m;
+  m.prog.adaptive_dt = [] { return 0.03; };
+  EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string()}), 0);
+  const auto files = h5_files(dir);
+  ASSERT_EQ(files.size(), 5u);
+  const double expected[] = {0, 0.25, 0.5, 0.75, 1.0};
+  for (std::size_t k = 0; k < files.size(); ++k)
+    EXPECT_NEAR(output_time(dir / files[k]), expected[k], 1e-12) << files[k];
+  // Each quarter: 8 steps of 0.03 and one of 0.01.
+  EXPECT_EQ(m.steps, 36);
+  for (long k = 0; k < m.steps; ++k) {
+    EXPECT_NEAR(m.step_dt[k], k % 9 == 8 ? 0.01 : 0.03, 1e-14) << "step " << k;
+    if (k % 9 == 8) EXPECT_EQ(m.step_t[k] + m.step_dt[k], expected[k / 9 + 1]) << "step " << k;
+  }
+}
+
+TEST(Solver, OutputIntervalBelowTheStepWritesOncePerStep) {
+  // Output every 0.004 with dt = 0.01: each step ends on the last multiple of 0.004 it
+  // reaches (0.008, 0.016, ..., 0.096), one snapshot per step, all at multiples of 0.004; the
+  // last step, 0.004, ends on tf = 0.1.
+  const fs::path dir = fresh_dir();
+  Mover m;
+  EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string(), "--tf", "0.1", "--output-every", "0.004"}), 0);
+  for (long k = 0; k < m.steps; ++k) {
+    const double end = m.step_t[k] + m.step_dt[k];
+    EXPECT_NEAR(end / 0.004, std::round(end / 0.004), 1e-9) << "step " << k;
+    EXPECT_NEAR(m.step_dt[k], k + 1 < m.steps ? 0.008 : 0.004, 1e-15) << "step " << k;
+  }
+  EXPECT_EQ(m.steps, 13);
+  EXPECT_EQ(static_cast<long>(h5_files(dir).size()), m.steps + 1);
+  EXPECT_EQ(m.last_t_plus_dt, 0.1);
+  // --output-every 1e-12 (every step): the steps stay 0.01 to within the interval (each ends
+  // on a multiple of 1e-12, so differs from 0.01 by less than 1e-12 on each side: 2e-12).
+  const fs::path dir2 = fresh_dir();
+  Mover m2;
+  EXPECT_EQ(run(m2.prog, {"--quiet", "-d", dir2.string(), "--tf", "0.1", "--output-every", "1e-12"}), 0);
+  EXPECT_EQ(m2.steps, 10);
+  for (long k = 0; k < m2.steps; ++k) EXPECT_NEAR(m2.step_dt[k], 0.01, 2e-12) << "step " << k;
+  EXPECT_EQ(static_cast<long>(h5_files(dir2).size()), 11);
 }
 
 TEST(Solver, SetOverridesReachSetup) {

@@ -36,6 +36,25 @@
 //                   The truncation is not renormalised (as in PySPH): the integral over the
 //                   support is erf(3) in 1D, 1 - e^-9 in 2D, erf(3) - 6/sqrt(pi) e^-9 in 3D,
 //                   i.e. 1 - O(1e-4).
+//   WendlandQuinticC4  (Wendland C4, Dehnen & Aly 2012), support 2h
+//                   d = 2, 3: f = (1 - q/2)^6 (35/12 q^2 + 3q + 1),
+//                             sigma = 9/(4 pi), 495/(256 pi)
+//                   d = 1:    the C4 Wendland function of 1D, f = (1 - q/2)^5 (2q^2 + 2.5q + 1),
+//                             sigma = 3/4 (PySPH's WendlandQuinticC4_1D).
+//   WendlandQuinticC6  (Wendland C6, Dehnen & Aly 2012), support 2h
+//                   d = 2, 3: f = (1 - q/2)^8 (4q^3 + 6.25q^2 + 4q + 1),
+//                             sigma = 78/(28 pi), 1365/(512 pi)
+//                   d = 1:    the C6 Wendland function of 1D,
+//                             f = (1 - q/2)^7 (21/8 q^3 + 19/4 q^2 + 3.5q + 1), sigma = 55/64
+//                             (PySPH's WendlandQuinticC6_1D).
+//   SuperGaussian   (Monaghan 1992), truncated at 3h: f = exp(-q^2) (1 + d/2 - q^2),
+//                   sigma = 1/pi^(d/2) as for the Gaussian. It is negative for q > sqrt(1 + d/2).
+//                   Not renormalised either: integrating q^(d+1) e^(-q^2) by parts, the
+//                   integral over the support is the Gaussian's plus S_d 3^d e^-9 / (2 pi^(d/2))
+//                   (S_d = 2, 2 pi, 4 pi), i.e. erf(3) + 3/sqrt(pi) e^-9 in 1D, 1 + 8 e^-9 in 2D,
+//                   erf(3) + 48/sqrt(pi) e^-9 in 3D.
+// The names and normalisations are PySPH's (pysph.base.kernels); for the Wendland C4 and C6
+// kernels PySPH has a separate 1D class, which sphc selects for dim = 1 under the same name.
 #pragma once
 
 #include <cmath>
@@ -192,6 +211,106 @@ struct GaussianShape {
   static inline T df(T q) { return q < T(3) ? T(-2) * q * std::exp(-q * q) : T(0); }
 };
 
+// Wendland C4 for d = 2, 3: (1 - q/2)^6 (35/12 q^2 + 3q + 1).
+template <int Dim>
+struct WendlandC4Shape {
+  static constexpr double radius_scale = 2.0;
+  static constexpr double sigma = Dim == 2 ? 9.0 / (4.0 * kPi) : 495.0 / (256.0 * kPi);
+  template <class T>
+  static inline T f(T q) {
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q, t2 = t * t;
+    return t2 * t2 * t2 * ((T(35) / T(12)) * q * q + T(3) * q + T(1));
+  }
+  template <class T>
+  static inline T df(T q) {
+    // d/dq [t^6 p] = -3 t^5 p + t^6 p' = t^5 (-3 p + t p') = -14/3 q (1 + 5/2 q) t^5
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q, t2 = t * t;
+    return (T(-14) / T(3)) * q * (T(1) + T(2.5) * q) * t2 * t2 * t;
+  }
+};
+
+// Wendland C4 for d = 1: (1 - q/2)^5 (2q^2 + 2.5q + 1).
+template <>
+struct WendlandC4Shape<1> {
+  static constexpr double radius_scale = 2.0;
+  static constexpr double sigma = 0.75;
+  template <class T>
+  static inline T f(T q) {
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q, t2 = t * t;
+    return t2 * t2 * t * (T(2) * q * q + T(2.5) * q + T(1));
+  }
+  template <class T>
+  static inline T df(T q) {
+    // d/dq [t^5 p] = t^4 (-5/2 p + t p') = -7/2 q (2q + 1) t^4
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q, t2 = t * t;
+    return T(-3.5) * q * (T(2) * q + T(1)) * t2 * t2;
+  }
+};
+
+// Wendland C6 for d = 2, 3: (1 - q/2)^8 (4q^3 + 6.25q^2 + 4q + 1).
+template <int Dim>
+struct WendlandC6Shape {
+  static constexpr double radius_scale = 2.0;
+  static constexpr double sigma = Dim == 2 ? 78.0 / (28.0 * kPi) : 1365.0 / (512.0 * kPi);
+  template <class T>
+  static inline T f(T q) {
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q, t2 = t * t, t4 = t2 * t2;
+    return t4 * t4 * (((T(4) * q + T(6.25)) * q + T(4)) * q + T(1));
+  }
+  template <class T>
+  static inline T df(T q) {
+    // d/dq [t^8 p] = t^7 (-4 p + t p') = -11/2 q (4q^2 + 3.5q + 1) t^7
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q, t2 = t * t, t4 = t2 * t2;
+    return T(-5.5) * q * ((T(4) * q + T(3.5)) * q + T(1)) * t4 * t2 * t;
+  }
+};
+
+// Wendland C6 for d = 1: (1 - q/2)^7 (21/8 q^3 + 19/4 q^2 + 3.5q + 1).
+template <>
+struct WendlandC6Shape<1> {
+  static constexpr double radius_scale = 2.0;
+  static constexpr double sigma = 55.0 / 64.0;
+  template <class T>
+  static inline T f(T q) {
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q, t2 = t * t, t4 = t2 * t2;
+    return t4 * t2 * t * (((T(2.625) * q + T(4.75)) * q + T(3.5)) * q + T(1));
+  }
+  template <class T>
+  static inline T df(T q) {
+    // d/dq [t^7 p] = t^6 (-7/2 p + t p') = -1/2 q (105/4 q^2 + 27q + 9) t^6
+    if (q >= T(2)) return T(0);
+    const T t = T(1) - T(0.5) * q, t2 = t * t;
+    return T(-0.5) * q * ((T(26.25) * q + T(27)) * q + T(9)) * t2 * t2 * t2;
+  }
+};
+
+// Super-Gaussian: exp(-q^2) (1 + d/2 - q^2), truncated at 3h.
+template <int Dim>
+struct SuperGaussianShape {
+  static constexpr double radius_scale = 3.0;
+  static constexpr double sigma = GaussianShape<Dim>::sigma;
+  template <class T>
+  static inline T f(T q) {
+    if (q >= T(3)) return T(0);
+    const T q2 = q * q;
+    return std::exp(-q2) * (T(1 + 0.5 * Dim) - q2);
+  }
+  template <class T>
+  static inline T df(T q) {
+    // d/dq [e^(-q^2) (a - q^2)] = q e^(-q^2) (2q^2 - 2a - 2), 2a + 2 = d + 4
+    if (q >= T(3)) return T(0);
+    const T q2 = q * q;
+    return q * (T(2) * q2 - T(Dim + 4)) * std::exp(-q2);
+  }
+};
+
 }  // namespace detail
 
 template <int Dim>
@@ -214,9 +333,38 @@ struct Gaussian : detail::RadialKernel<detail::GaussianShape<Dim>, Dim> {
   static constexpr const char* name = "Gaussian";
 };
 
+template <int Dim>
+struct WendlandQuinticC4 : detail::RadialKernel<detail::WendlandC4Shape<Dim>, Dim> {
+  static constexpr const char* name = "WendlandQuinticC4";
+};
+
+template <int Dim>
+struct WendlandQuinticC6 : detail::RadialKernel<detail::WendlandC6Shape<Dim>, Dim> {
+  static constexpr const char* name = "WendlandQuinticC6";
+};
+
+template <int Dim>
+struct SuperGaussian : detail::RadialKernel<detail::SuperGaussianShape<Dim>, Dim> {
+  static constexpr const char* name = "SuperGaussian";
+};
+
 // ---- Run-time selection (tests and tools; generated code names the kernel type) ----------
 
-enum class KernelKind { CubicSpline, QuinticSpline, WendlandQuintic, Gaussian };
+enum class KernelKind {
+  CubicSpline,
+  QuinticSpline,
+  WendlandQuintic,
+  Gaussian,
+  WendlandQuinticC4,
+  WendlandQuinticC6,
+  SuperGaussian,
+};
+
+// Every kind, in the order above.
+inline constexpr KernelKind kAllKernelKinds[] = {
+    KernelKind::CubicSpline,       KernelKind::QuinticSpline,     KernelKind::WendlandQuintic,
+    KernelKind::Gaussian,          KernelKind::WendlandQuinticC4, KernelKind::WendlandQuinticC6,
+    KernelKind::SuperGaussian};
 
 inline const char* kernel_name(KernelKind k) {
   switch (k) {
@@ -224,14 +372,16 @@ inline const char* kernel_name(KernelKind k) {
     case KernelKind::QuinticSpline: return "QuinticSpline";
     case KernelKind::WendlandQuintic: return "WendlandQuintic";
     case KernelKind::Gaussian: return "Gaussian";
+    case KernelKind::WendlandQuinticC4: return "WendlandQuinticC4";
+    case KernelKind::WendlandQuinticC6: return "WendlandQuinticC6";
+    case KernelKind::SuperGaussian: return "SuperGaussian";
   }
   return "?";
 }
 
 // The kind named `name` (as in kernel_name); false if there is none.
 inline bool parse_kernel_kind(const std::string& name, KernelKind& out) {
-  for (KernelKind k : {KernelKind::CubicSpline, KernelKind::QuinticSpline,
-                       KernelKind::WendlandQuintic, KernelKind::Gaussian}) {
+  for (KernelKind k : kAllKernelKinds) {
     if (name == kernel_name(k)) {
       out = k;
       return true;
@@ -271,6 +421,9 @@ struct AnyKernel {
       case KernelKind::QuinticSpline: return visit_dim<QuinticSpline>(fn);
       case KernelKind::WendlandQuintic: return visit_dim<WendlandQuintic>(fn);
       case KernelKind::Gaussian: return visit_dim<Gaussian>(fn);
+      case KernelKind::WendlandQuinticC4: return visit_dim<WendlandQuinticC4>(fn);
+      case KernelKind::WendlandQuinticC6: return visit_dim<WendlandQuinticC6>(fn);
+      case KernelKind::SuperGaussian: return visit_dim<SuperGaussian>(fn);
     }
     throw std::invalid_argument("sphc::AnyKernel: unknown kernel kind");
   }
