@@ -511,6 +511,7 @@ void Emitter::emitArraySetup(const PlanArray& a) {
   const std::string& A = a.name;
   scene_ << "    // array " << A << ", from " << loc(a.loc) << "\n    {\n";
   scene_ << "      sphc::Points pts;\n";
+  if (!a.decl->loads.empty()) scene_ << "      loaded_" << A << ".clear();  // set-up runs twice\n";
   auto paramNames = [&](const std::string& n) { return paramRef(n); };
   for (const auto& g : a.decl->geometry) {
     const GeometryBuilder* b = findGeometryBuilder(g.builder.name);
@@ -1748,7 +1749,9 @@ void Emitter::emitMain() {
   if (singlePrecision_) out_ << "  prog.precision = \"single\";\n";
   out_ << "  prog.setup = [](const std::vector<double>& v, sphc::SceneTimes& times) {\n"
           "    scene.setup(v, times);\n"
-       << (opencl_ ? "    scene.to_device();\n" : cpuSingle_ ? "    scene.to_single();\n" : "")
+       << (opencl_     ? "    if (!sphc::counting_particles()) scene.to_device();\n"
+           : cpuSingle_ ? "    if (!sphc::counting_particles()) scene.to_single();\n"
+                        : "")
        << "  };\n";
   out_ << "  prog.arrays = [] { return std::vector<sphc::ParticleArray*>{";
   bool first = true;

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
+#include <new>
 #include <filesystem>
 #include <limits>
 #include <optional>
@@ -17,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "sphc/hdf5_io.h"
+#include "sphc/memory.h"
 
 namespace sphc {
 namespace {
@@ -59,6 +62,8 @@ struct Options {
   long max_steps = std::numeric_limits<long>::max();
   long threads = 0;  // 0: the backend's default (all cores)
   std::string directory;  // empty: <scene>_output
+  std::optional<double> max_memory;  // bytes; default: available_memory()
+  bool estimate_memory = false;      // print the memory estimate and stop
   std::vector<std::pair<std::string, double>> sets;
 };
 
@@ -166,6 +171,14 @@ Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
                          ", which has no OpenMP threads");
     }
     else if (option == "--set") o.sets.push_back(parse_set(value(), prog));
+    else if (option == "--max-memory") {
+      const std::string v = value();
+      o.max_memory = parse_memory_size(v);
+      if (!o.max_memory)
+        throw UsageError("--max-memory expects a size such as 4G, 500M or 1e9 (bytes), not '" +
+                         v + "'");
+    }
+    else if (option == "--estimate-memory") flag(o.estimate_memory);
     else if (option == "-d" || option == "--directory") {
       o.directory = value();
       if (o.directory.empty()) throw UsageError(fmt::format("{} expects a directory", option));
@@ -205,6 +218,10 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        left alone)\n"
       "  -d, --directory DIR   output directory (default: {1}_output)\n"
       "  --set NAME=VALUE      set a scene parameter (repeatable)\n"
+      "  --max-memory SIZE     refuse to start when the memory estimate exceeds SIZE (4G,\n"
+      "                        500M, bytes; default: MemAvailable of /proc/meminfo, or a\n"
+      "                        lower cgroup limit)\n"
+      "  --estimate-memory     print the memory estimate of the run, item by item, and stop\n"
       "  --quiet               no progress line and no summary\n"
       "  --no-output           write no files (benchmarks)\n"
       "  --timing              print at the end, for the time loop:\n"
@@ -218,7 +235,8 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "  -h, --help            print this help\n"
       "\n"
       "Output: DIR/{1}_NNNNNN.h5 (NNNNNN: the step) and DIR/{1}.xdmf (for ParaView).\n"
-      "Exit codes: 0 done, 1 error, 2 bad usage, 3 the simulation blew up.\n",
+      "Exit codes: 0 done, 1 error (also: more memory needed than available), 2 bad usage,\n"
+      "3 the simulation blew up.\n",
       program, scene, prog.dim);
   if (!prog.options.empty()) {
     fmt::print("\ncompile-time options (sphc -D NAME=CHOICE builds another executable):\n");
@@ -427,8 +445,11 @@ class Simulation {
       throw std::runtime_error("the scene program has no setup or no step function");
     }
     threads_ = prog_.set_threads ? prog_.set_threads(static_cast<int>(opt_.threads)) : 1;
+    if (!check_memory()) return opt_.estimate_memory ? kExitOk : kExitError;
     SceneTimes times;
+    phase_ = "setting up the arrays";
     prog_.setup(parameter_values(), times);
+    phase_.clear();
     apply_overrides(times);
     arrays_ = prog_.arrays ? prog_.arrays() : std::vector<ParticleArray*>{};
     const std::string dir =
@@ -482,6 +503,40 @@ class Simulation {
   }
 
  private:
+  // The memory the run needs, before the set-up allocates it (sphc/memory.h): the set-up runs
+  // once counting particles, not making them. False: stop here (the estimate was printed, or
+  // the run does not fit, said on stderr).
+  bool check_memory() {
+    if (!prog_.arrays) return !opt_.estimate_memory;
+    std::vector<ArrayFootprint> arrays;
+    {
+      CountingPass pass;
+      SceneTimes unused;
+      prog_.setup(parameter_values(), unused);
+      for (const ParticleArray* a : prog_.arrays()) arrays.push_back(footprint(*a, pass.planned(*a)));
+    }
+    const MemoryEstimate e = estimate_memory(arrays, prog_.precision == "single");
+    estimate_ = e.total;
+    const std::optional<double> available = opt_.max_memory ? opt_.max_memory : available_memory();
+    const std::string limit =
+        !available ? std::string("unknown")
+        : opt_.max_memory ? fmt::format("{} (--max-memory)", format_bytes(*available))
+                          : fmt::format("{} available (MemAvailable of /proc/meminfo or the "
+                                        "cgroup's limit; --max-memory SIZE sets another)",
+                                        format_bytes(*available));
+    if (opt_.estimate_memory) {
+      fmt::print("memory: {} needed, limit {}\n", format_bytes(e.total), limit);
+      for (const MemoryItem& i : e.items) fmt::print("  {:>9}  {}\n", format_bytes(i.bytes), i.what);
+      return false;
+    }
+    if (!available || e.total <= *available) return true;
+    fmt::print(stderr,
+               "error: the run needs about {} of memory, more than the limit of {}: {}; use "
+               "fewer particles (a larger dx or a smaller domain)\n",
+               format_bytes(e.total), limit, e.describe());
+    return false;
+  }
+
   std::vector<double> parameter_values() const {
     std::vector<double> values;
     for (const ParamInfo& p : prog_.params) values.push_back(p.value);
@@ -618,7 +673,49 @@ class Simulation {
   double dt_ = 0.0;
   long step_ = 0;
   long last_output_step_ = -1;
+
+ public:
+  // For the out-of-memory message: what the run was doing, and its estimate.
+  std::string where() const {
+    return phase_.empty() ? fmt::format("at t={}, step {}", t_, step_) : "while " + phase_;
+  }
+  double estimate_ = 0;  // bytes (check_memory)
+
+ private:
+  std::string phase_;
 };
+
+std::string out_of_memory_hint(double estimate) {
+  const std::optional<double> available = available_memory();
+  return fmt::format(
+      "an allocation failed (std::bad_alloc); {}{}; use fewer particles (a larger dx or a "
+      "smaller domain)",
+      estimate > 0 ? "the estimate before the start was " + format_bytes(estimate) : "",
+      available ? fmt::format("{}{} is available now", estimate > 0 ? ", " : "",
+                              format_bytes(*available))
+                : "");
+}
+
+// std::terminate's handler: an exception no one caught (one thrown inside an OpenMP parallel
+// region ends the program there) gets a message, not a bare "terminate called".
+[[noreturn]] void report_uncaught() {
+  std::fflush(stdout);
+  if (std::exception_ptr e = std::current_exception()) {
+    try {
+      std::rethrow_exception(e);
+    } catch (const std::bad_alloc&) {
+      std::fprintf(stderr, "\nerror: out of memory: %s\n", out_of_memory_hint(0).c_str());
+    } catch (const std::exception& x) {
+      std::fprintf(stderr, "\nerror: %s\n", x.what());
+    } catch (...) {
+      std::fprintf(stderr, "\nerror: an unknown exception\n");
+    }
+  } else {
+    std::fprintf(stderr, "\nerror: std::terminate was called\n");
+  }
+  std::fflush(stderr);
+  std::_Exit(kExitError);
+}
 
 }  // namespace
 
@@ -674,8 +771,16 @@ int run_main(int argc, char** argv, SceneProgram& prog) {
     return kExitOk;
   }
   Progress progress;
+  std::set_terminate(report_uncaught);
+  std::optional<Simulation> sim;
   try {
-    return Simulation(prog, opt, progress).run();
+    sim.emplace(prog, opt, progress);
+    return sim->run();
+  } catch (const std::bad_alloc&) {
+    progress.break_line();
+    fmt::print(stderr, "error: out of memory {}: {}\n", sim ? sim->where() : "at the start",
+               out_of_memory_hint(sim ? sim->estimate_ : 0));
+    return kExitError;
   } catch (const std::exception& e) {
     progress.break_line();
     fmt::print(stderr, "error: {}\n", e.what());

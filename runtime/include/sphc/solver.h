@@ -4,7 +4,8 @@
 // owns the command line (see --help), the time loop, output (HDF5 files plus an XDMF index),
 // the progress line and the blow-up diagnosis.
 //
-// Exit codes: 0 success, 1 error (an exception from the scene or from output), 2 bad usage,
+// Exit codes: 0 success, 1 error (an exception from the scene or from output, or a run that
+// needs more memory than is available: see sphc/memory.h), 2 bad usage,
 // 3 the simulation blew up (a non-finite value, or the adaptive time step collapsed).
 #pragma once
 
@@ -14,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "sphc/memory.h"
 #include "sphc/particle_array.h"
 
 namespace sphc {
@@ -65,8 +67,10 @@ struct SceneProgram {
   int dim = 2;
   std::vector<ParamInfo> params;  // defaults, in order; --set overrides by name
   std::vector<OptionInfo> options;  // compile-time options this executable was built with
-  // Called once with the final parameter values (same order as params). Builds arrays, sets
-  // the scene's tf, dt and output times (they may depend on params).
+  // Called with the final parameter values (same order as params). Builds arrays, sets the
+  // scene's tf, dt and output times (they may depend on params). run_main calls it twice:
+  // first inside a CountingPass (sphc/memory.h: no particles are made, only counted, for the
+  // memory estimate; copies to a device or to float arrays are then skipped), then for real.
   std::function<void(const std::vector<double>& params, SceneTimes& times)> setup;
   std::function<std::vector<ParticleArray*>()> arrays;
   std::function<void(double t, double dt)> compute_initial;  // may be empty
