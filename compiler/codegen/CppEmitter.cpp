@@ -301,6 +301,7 @@ class Emitter {
   void emitStep();
   void emitAdaptiveDt();
   void emitMain();
+  void emitLimits();
   std::string loc(llvm::SMLoc l) const { return diags_.lineInfo(l); }
   std::string paramRef(const std::string& n) const { return "P." + n; }
   std::string eqStruct(const PlanEquation& eq) const { return "eq" + std::to_string(eq.id); }
@@ -1770,6 +1771,7 @@ void Emitter::emitMain() {
   if (!iteratedGroups_.empty())
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   if (!opencl_) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
+  if (!plan_.limits.empty()) emitLimits();
   bool anyOutput = false;
   for (const auto& a : plan_.arrays) anyOutput |= !a.outputProps.empty();
   for (const auto& a : plan_.arrays) {
@@ -1784,6 +1786,25 @@ void Emitter::emitMain() {
     out_ << "}});\n";
   }
   out_ << "  return sphc::run_main(argc, argv, prog);\n}\n";
+}
+
+// The scene's limits { } (sphc/sanity.h), evaluated after the set-up from the parameters.
+void Emitter::emitLimits() {
+  auto pn = [&](const std::string& n) { return "scene." + paramRef(n); };
+  auto end = [&](const ast::ExprPtr& e, const char* none) {
+    return e ? exprCpp(*e, pn) : std::string(none);
+  };
+  auto bounds = [&](bool has, const ast::ExprPtr& lo, const ast::ExprPtr& hi) {
+    if (!has) return std::string("std::nullopt");
+    return "sphc::Bounds{" + end(lo, "-HUGE_VAL") + ", " + end(hi, "HUGE_VAL") + "}";
+  };
+  out_ << "  prog.limits = [] {  // limits { }: warn once outside warn, stop outside stop\n"
+          "    std::vector<sphc::Limit> l;\n";
+  for (const auto& l : plan_.limits)
+    out_ << "    l.push_back({\"" << arr(l.array).name << "\", \"" << l.quantity << "\", \""
+         << loc(l.loc) << "\", " << bounds(l.hasWarn, l.warnLo, l.warnHi) << ", "
+         << bounds(l.hasStop, l.stopLo, l.stopHi) << "});\n";
+  out_ << "    return l;\n  };\n";
 }
 
 std::string Emitter::run() {

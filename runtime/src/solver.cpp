@@ -64,6 +64,8 @@ struct Options {
   std::string directory;  // empty: <scene>_output
   std::optional<double> max_memory;  // bytes; default: available_memory()
   bool estimate_memory = false;      // print the memory estimate and stop
+  std::string limits = "on";         // on, warn (never stop), off (sphc/sanity.h)
+  std::vector<std::string> limit_settings;  // --limit ARRAY.QUANTITY.warn|stop=LO:HI
   std::vector<std::pair<std::string, double>> sets;
 };
 
@@ -179,6 +181,20 @@ Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
                          v + "'");
     }
     else if (option == "--estimate-memory") flag(o.estimate_memory);
+    else if (option == "--limits") {
+      o.limits = value();
+      if (o.limits != "on" && o.limits != "warn" && o.limits != "off")
+        throw UsageError("--limits expects on, warn or off, not '" + o.limits + "'");
+    }
+    else if (option == "--limit") {
+      o.limit_settings.push_back(value());
+      std::vector<Limit> probe;
+      try {
+        apply_limit_setting(probe, o.limit_settings.back());
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+      }
+    }
     else if (option == "-d" || option == "--directory") {
       o.directory = value();
       if (o.directory.empty()) throw UsageError(fmt::format("{} expects a directory", option));
@@ -222,6 +238,12 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        500M, bytes; default: MemAvailable of /proc/meminfo, or a\n"
       "                        lower cgroup limit)\n"
       "  --estimate-memory     print the memory estimate of the run, item by item, and stop\n"
+      "  --limits on|warn|off  the scene's limits (limits {{ }}; without any, a box around the\n"
+      "                        particles at set-up): warn once outside warn bounds and stop\n"
+      "                        outside stop bounds (on, the default); only warn; not checked\n"
+      "  --limit A.Q.warn=LO:HI, --limit A.Q.stop=LO:HI\n"
+      "                        set a bound of the limit on quantity Q (a property or speed) of\n"
+      "                        array A (an end may be empty: unbounded; =off removes it)\n"
       "  --quiet               no progress line and no summary\n"
       "  --no-output           write no files (benchmarks)\n"
       "  --timing              print at the end, for the time loop:\n"
@@ -452,6 +474,7 @@ class Simulation {
     phase_.clear();
     apply_overrides(times);
     arrays_ = prog_.arrays ? prog_.arrays() : std::vector<ParticleArray*>{};
+    set_up_limits();
     const std::string dir =
         opt_.directory.empty() ? scene_name(prog_) + "_output" : opt_.directory;
     OutputWriter writer(prog_, dir, !opt_.no_output);
@@ -465,6 +488,7 @@ class Simulation {
     // computed quantities (pressures, summation densities) and not zeros.
     if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
     if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
+    if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
     write_output();
 
     const long check_every = prog_.to_host ? kCheckEveryDevice : kCheckEvery;
@@ -490,14 +514,17 @@ class Simulation {
       const bool output_due = schedule.due(t_);
       if (output_due || step_ % check_every == 0) {
         if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
+        if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
       }
       if (output_due) write_output();
       progress_.update(t_, step_, dt_, particles());
     }
     if (last_output_step_ != step_) {
       if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
+      if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
       write_output();
     }
+    report_limits();
     report(seconds_since(loop_start), particle_steps, tf);
     return kExitOk;
   }
@@ -589,6 +616,123 @@ class Simulation {
     last_output_step_ = step_;
   }
 
+  // -------------------------------------------------------------------------------------------
+  // Limits (sphc/sanity.h): kept apart from the time loop, which only calls check_limits
+  // where it checks for non-finite values, and report_limits at the end.
+
+  static constexpr const char* kLeftLimits = "simulation left its limits";
+
+  struct Watched {
+    Limit limit;
+    const ParticleArray* array = nullptr;
+    bool warned = false;
+    long checks_outside = 0;       // checks that found a particle outside the warn bound
+    double worst_excess = 0;
+    std::string worst;             // that particle, and when
+  };
+
+  // The scene's limits, a default box for every array without a declared limit on a
+  // position, then the command line's --limit settings.
+  void set_up_limits() {
+    if (opt_.limits == "off") return;
+    std::vector<Limit> limits = prog_.limits ? prog_.limits() : std::vector<Limit>{};
+    for (const Limit& box : bounding_box_limits(arrays_, prog_.dim)) {
+      const bool declared = std::any_of(limits.begin(), limits.end(), [&](const Limit& l) {
+        return l.array == box.array && l.quantity == box.quantity;
+      });
+      if (!declared) limits.push_back(box);
+    }
+    for (const std::string& s : opt_.limit_settings) apply_limit_setting(limits, s);
+    if (opt_.limits == "warn")
+      for (Limit& l : limits) l.stop.reset();
+    std::string names;
+    for (const ParticleArray* a : arrays_) names += (names.empty() ? "" : ", ") + a->name;
+    for (const Limit& l : limits) {
+      auto it = std::find_if(arrays_.begin(), arrays_.end(),
+                             [&](const ParticleArray* a) { return a->name == l.array; });
+      if (it == arrays_.end())
+        throw std::runtime_error(fmt::format("limit '{}'{}: the scene has no array '{}' (its "
+                                             "arrays: {})", l.name(),
+                                             l.where.empty() ? "" : " (" + l.where + ")",
+                                             l.array, names));
+      if (!l.warn && !l.stop) continue;
+      check_limit(l, **it, prog_.dim);  // throws if the quantity does not exist
+      watched_.push_back(Watched{l, *it});
+    }
+  }
+
+  // Checks the limits (on host data: call after check_finite) and the iterated groups.
+  // Warns once per limit (and per group); the stop message of the first limit past its stop
+  // bound, or nullopt.
+  std::optional<std::string> check_limits() {
+    check_iterations();
+    for (Watched& w : watched_) {
+      const LimitCheck c = check_limit(w.limit, *w.array, prog_.dim);
+      const std::string from = w.limit.where.empty() ? "" : " (" + w.limit.where + ")";
+      const std::string particle =
+          describe_particle(*w.array, c.worst, prog_.dim, w.limit.quantity, c.value);
+      if (c.outside_stop > 0) {
+        return fmt::format("limit '{}'{}: {} particle{} outside the stop bound {}; the worst: {}",
+                           w.limit.name(), from, c.outside_stop, c.outside_stop == 1 ? "" : "s",
+                           w.limit.stop->text(), particle);
+      }
+      if (c.outside_warn == 0) continue;
+      ++w.checks_outside;
+      if (c.excess > w.worst_excess) {
+        w.worst_excess = c.excess;
+        w.worst = fmt::format("{} at t={}", particle, t_);
+      }
+      if (w.warned) continue;
+      w.warned = true;
+      if (!first_warning_) first_warning_ = {t_, writer_->newest()};
+      progress_.break_line();
+      fmt::print(stderr,
+                 "warning: at t={}, step {}: limit '{}'{}: {} particle{} outside the warn bound "
+                 "{}{}; the worst: {} (warned once per limit)\n",
+                 t_, step_, w.limit.name(), from, c.outside_warn, c.outside_warn == 1 ? "" : "s",
+                 w.limit.warn->text(),
+                 w.limit.stop ? "; the run stops outside " + w.limit.stop->text() : "", particle);
+    }
+    return std::nullopt;
+  }
+
+  // An iterated group whose evaluation stopped at max_iterations: warned once per group.
+  void check_iterations() {
+    if (!prog_.iterations) return;
+    const std::vector<IterationStats> stats = prog_.iterations();
+    unconverged_warned_.resize(stats.size(), false);
+    for (std::size_t k = 0; k < stats.size(); ++k) {
+      if (stats[k].unconverged == 0 || unconverged_warned_[k]) continue;
+      unconverged_warned_[k] = true;
+      if (!first_warning_) first_warning_ = {t_, writer_->newest()};
+      progress_.break_line();
+      fmt::print(stderr,
+                 "warning: at t={}, step {}: the iterated group at {} stopped at its "
+                 "max_iterations without converging ({} of {} evaluations so far; warned once "
+                 "per group, counted at the end)\n",
+                 t_, step_, stats[k].where, stats[k].unconverged, stats[k].evaluations);
+    }
+  }
+
+  // At the end of a run: how often each limit was exceeded, and unconverged groups.
+  void report_limits() {
+    progress_.break_line();
+    for (const Watched& w : watched_) {
+      if (w.checks_outside == 0) continue;
+      fmt::print(stderr, "warning: limit '{}' outside its warn bound {} at {} check{}; the "
+                         "furthest: {}\n",
+                 w.limit.name(), w.limit.warn->text(), w.checks_outside,
+                 w.checks_outside == 1 ? "" : "s", w.worst);
+    }
+    if (!prog_.iterations) return;
+    for (const IterationStats& s : prog_.iterations()) {
+      if (s.unconverged == 0) continue;
+      fmt::print(stderr, "warning: the iterated group at {} did not converge in {} of {} "
+                         "evaluations\n",
+                 s.where, s.unconverged, s.evaluations);
+    }
+  }
+
   int time_step_failure(double dt, double tf) {
     // A non-finite property usually explains a bad time step: name it if there is one.
     if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
@@ -609,6 +753,9 @@ class Simulation {
         const std::string path = writer_->write_blowup(arrays_, meta());
         fmt::print(stderr, "note: the bad state is in '{}'; the last good output is '{}'\n", path,
                    writer_->newest());
+        if (first_warning_)
+          fmt::print(stderr, "note: the first warning was at t={}; the last output before it is "
+                             "'{}'\n", first_warning_->first, first_warning_->second);
       } catch (const std::exception& e) {
         fmt::print(stderr, "note: could not write the bad state: {}\n", e.what());
       }
@@ -673,6 +820,9 @@ class Simulation {
   double dt_ = 0.0;
   long step_ = 0;
   long last_output_step_ = -1;
+  std::vector<Watched> watched_;
+  std::vector<bool> unconverged_warned_;
+  std::optional<std::pair<double, std::string>> first_warning_;  // t, the output before it
 
  public:
   // For the out-of-memory message: what the run was doing, and its estimate.

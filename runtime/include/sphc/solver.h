@@ -6,7 +6,8 @@
 //
 // Exit codes: 0 success, 1 error (an exception from the scene or from output, or a run that
 // needs more memory than is available: see sphc/memory.h), 2 bad usage,
-// 3 the simulation blew up (a non-finite value, or the adaptive time step collapsed).
+// 3 the simulation blew up (a non-finite value, a quantity past the stop bound of a limit:
+// sphc/sanity.h, or the adaptive time step collapsed).
 #pragma once
 
 #include <chrono>
@@ -17,6 +18,7 @@
 
 #include "sphc/memory.h"
 #include "sphc/particle_array.h"
+#include "sphc/sanity.h"
 
 namespace sphc {
 
@@ -92,6 +94,9 @@ struct SceneProgram {
   // Wall seconds spent so far in the neighbour search (search domain, cell lists, reorders
   // into cell order), for the --timing line; empty where not measured.
   std::function<double()> neighbour_seconds;
+  // The scene's limits { } (sphc/sanity.h), computed from the parameters after the set-up;
+  // empty: none declared (the default bounding box applies).
+  std::function<std::vector<Limit>()> limits;
   // Array name -> properties written (empty list = all); empty = every array, all properties.
   std::vector<std::pair<std::string, std::vector<std::string>>> output;
 };
