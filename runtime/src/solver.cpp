@@ -540,11 +540,13 @@ class Simulation {
       CountingPass pass;
       SceneTimes unused;
       prog_.setup(parameter_values(), unused);
-      for (const ParticleArray* a : prog_.arrays()) arrays.push_back(footprint(*a, pass.planned(*a)));
+      for (const ParticleArray* a : prog_.arrays())
+        arrays.push_back(footprint(*a, pass.planned(*a)));
     }
     const MemoryEstimate e = estimate_memory(arrays, prog_.precision == "single");
     estimate_ = e.total;
-    const std::optional<double> available = opt_.max_memory ? opt_.max_memory : available_memory();
+    const std::optional<double> available =
+        opt_.max_memory ? opt_.max_memory : available_memory();
     const std::string limit =
         !available ? std::string("unknown")
         : opt_.max_memory ? fmt::format("{} (--max-memory)", format_bytes(*available))
@@ -553,7 +555,8 @@ class Simulation {
                                         format_bytes(*available));
     if (opt_.estimate_memory) {
       fmt::print("memory: {} needed, limit {}\n", format_bytes(e.total), limit);
-      for (const MemoryItem& i : e.items) fmt::print("  {:>9}  {}\n", format_bytes(i.bytes), i.what);
+      for (const MemoryItem& i : e.items)
+        fmt::print("  {:>9}  {}\n", format_bytes(i.bytes), i.what);
       return false;
     }
     if (!available || e.total <= *available) return true;
