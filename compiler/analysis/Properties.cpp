@@ -45,6 +45,10 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
       readByOthers.insert(p);
       note(p);
     }
+    for (const auto& p : arr.limitProps) {  // the scene's limits { } read them at run time
+      readByOthers.insert(p);
+      note(p);
+    }
     if (movesParticles(plan, a))
       for (const auto& p : adaptiveDtProps(plan)) {
         readByOthers.insert(p);
@@ -102,9 +106,18 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
             diags.note(plan.equations[r.equation].loc,
                        "in this use of '" + plan.equations[r.equation].name + "'");
         } else {
-          diags.error(p.output ? plan.scene->name.loc : arr.loc,
+          const bool limited = std::find(arr.limitProps.begin(), arr.limitProps.end(),
+                                         p.name) != arr.limitProps.end();
+          const PlanLimit* limit = nullptr;
+          for (const auto& l : plan.limits)
+            if (l.array == static_cast<int>(a) && !limit &&
+                (l.quantity == p.name || l.quantity == "speed"))
+              limit = &l;
+          diags.error(p.output ? plan.scene->name.loc : limited && limit ? limit->loc : arr.loc,
                       "property '" + p.name + "' of array '" + arr.name + "' is " +
-                          (p.output ? "output" : "needed by the adaptive time step") +
+                          (p.output    ? "output"
+                           : limited ? "watched by a limit"
+                                     : "needed by the adaptive time step") +
                           " but nothing sets it");
         }
         diags.note(arr.loc, "give it an initial value in array '" + arr.name +

@@ -60,7 +60,7 @@ class CpuPrinter : public ScenePrinter {
               "    return omp_get_max_threads();\n  };\n";
   }
   std::string afterSetup() const override {
-    return cpuSingle_ ? "    scene.to_single();\n" : "";
+    return cpuSingle_ ? "    if (!sphc::counting_particles()) scene.to_single();\n" : "";
   }
   bool hasToHost() const override { return cpuSingle_; }
 

@@ -30,6 +30,7 @@ void ScenePrinter::emitArraySetup(const PlanArray& a) {
   const std::string& A = a.name;
   scene_ << "    // array " << A << ", from " << loc(a.loc) << "\n    {\n";
   scene_ << "      sphc::Points pts;\n";
+  if (!a.decl->loads.empty()) scene_ << "      loaded_" << A << ".clear();  // set-up runs twice\n";
   auto paramNames = [&](const std::string& n) { return paramRef(n); };
   for (const auto& g : a.decl->geometry) {
     const GeometryBuilder* b = findGeometryBuilder(g.builder.name);
@@ -381,6 +382,25 @@ void ScenePrinter::emitAdaptiveDt() {
   scene_ << "  }\n\n";
 }
 
+// The scene's limits { } (sphc/sanity.h), evaluated after the set-up from the parameters.
+void ScenePrinter::emitLimits() {
+  auto pn = [&](const std::string& n) { return "scene." + paramRef(n); };
+  auto end = [&](const ast::ExprPtr& e, const char* none) {
+    return e ? exprCpp(*e, pn) : std::string(none);
+  };
+  auto bounds = [&](bool has, const ast::ExprPtr& lo, const ast::ExprPtr& hi) {
+    if (!has) return std::string("std::nullopt");
+    return "sphc::Bounds{" + end(lo, "-HUGE_VAL") + ", " + end(hi, "HUGE_VAL") + "}";
+  };
+  out_ << "  prog.limits = [] {  // limits { }: warn once outside warn, stop outside stop\n"
+          "    std::vector<sphc::Limit> l;\n";
+  for (const auto& l : plan_.limits)
+    out_ << "    l.push_back({\"" << arr(l.array).name << "\", \"" << l.quantity << "\", \""
+         << loc(l.loc) << "\", " << bounds(l.hasWarn, l.warnLo, l.warnHi) << ", "
+         << bounds(l.hasStop, l.stopLo, l.stopHi) << "});\n";
+  out_ << "    return l;\n  };\n";
+}
+
 void ScenePrinter::emitMain() {
   out_ << "int main(int argc, char** argv) {\n";
   mainPrologue();
@@ -426,6 +446,7 @@ void ScenePrinter::emitMain() {
   if (!sched_.iteratedGroups.empty())
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   if (timesNeighbourSearch()) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
+  if (!plan_.limits.empty()) emitLimits();
   bool anyOutput = false;
   for (const auto& a : plan_.arrays) anyOutput |= !a.outputProps.empty();
   for (const auto& a : plan_.arrays) {

@@ -59,7 +59,9 @@ class OpenCLPrinter : public ScenePrinter {
   void mainBackendOptions() override {
     out_ << "  scene.selection = sphc::ocl::take_options(argc, argv);\n";
   }
-  std::string afterSetup() const override { return "    scene.to_device();\n"; }
+  std::string afterSetup() const override {
+    return "    if (!sphc::counting_particles()) scene.to_device();\n";
+  }
   bool hasToHost() const override { return true; }
 
   // Kernel arguments: declarations in the kernel, expressions on the host.

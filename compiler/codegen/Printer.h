@@ -83,7 +83,7 @@ class ScenePrinter {
   virtual void adaptiveDtArray(int a) = 0;          // the limits of one moving array
   virtual void mainPrologue() {}                    // before `static Scene scene;`
   virtual void mainBackendOptions() {}              // prog.set_threads, device selection
-  virtual std::string afterSetup() const { return ""; }  // "    scene.to_device();\n"
+  virtual std::string afterSetup() const { return ""; }  // "    if (!sphc::counting_particles()) scene.to_device();\n"
   virtual bool hasToHost() const { return false; }
 
   // ---- Bodies, their parameters and calls (Bodies.cpp) ----
@@ -136,6 +136,7 @@ class ScenePrinter {
   void emitSceneMembers();
   // The SceneProgram of `main`: name, params, options, set-up, arrays, step, outputs.
   void emitMain();
+  void emitLimits();
 
   // ---- Shared helpers ----
   // The data a scene computes on: host arrays, or their float copies (--precision=single).

@@ -6,6 +6,7 @@
 #include "llvm/Support/SMLoc.h"
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -218,6 +219,24 @@ struct DomainDecl {
   std::vector<DomainItem> items;
 };
 
+// `limits { fluid.rho warn [lo, hi] stop [lo, hi]; fluid.speed stop <= c; }`: what the run
+// watches (docs/language.md, Limits). A bound is an interval or one side of one.
+struct LimitBound {
+  llvm::SMLoc loc;              // the `warn` / `stop` keyword
+  ExprPtr lo, hi;               // either may be absent (`<= hi`, `>= lo`), not both
+};
+
+struct LimitItem {
+  Ident array;
+  Ident quantity;               // a property of the array, or `speed` (|(u, v, w)|)
+  std::optional<LimitBound> warn, stop;
+};
+
+struct LimitsDecl {
+  llvm::SMLoc loc;              // the `limits` keyword
+  std::vector<LimitItem> items;
+};
+
 struct SceneDecl {
   Ident name;
   std::vector<SceneSetting> settings;
@@ -227,6 +246,7 @@ struct SceneDecl {
   std::vector<KwArg> adaptiveDt;
   std::vector<OutputDecl> outputs;
   std::vector<DomainDecl> domains;  // sema allows one
+  std::vector<LimitsDecl> limits;
   llvm::SMLoc equationsLoc;
   std::vector<GroupItem> equations;
   std::vector<std::shared_ptr<When<SceneDecl>>> whens;  // the chosen branch's items are

@@ -570,7 +570,7 @@ bool Parser::parseScene(ast::Module& mod) {
 bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (!cur().is(Token::Identifier))
     return error(cur().loc, "expected a scene item ('name = value;', stepper, adaptive_dt, "
-                            "output, domain, equations or when), found " + describe(cur()));
+                            "output, domain, limits, equations or when), found " + describe(cur()));
   // The scene's keywords are contextual: `output = 3;` is a setting named output.
   if (lex_.peek().is(Token::Assign)) return parseSceneSetting(scene);
   if (atWhen())
@@ -585,6 +585,7 @@ bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (atWord("adaptive_dt")) return parseAdaptiveDt(scene);
   if (atWord("output")) return parseOutput(scene);
   if (atWord("domain")) return parseDomain(scene);
+  if (atWord("limits")) return parseLimits(scene);
   if (atWord("equations")) {
     scene.equationsLoc = cur().loc;
     advance();
@@ -710,6 +711,63 @@ bool Parser::parseDomainItem(ast::DomainDecl& domain) {
   }
   domain.items.push_back(std::move(item));
   return expect(Token::Semi, "after domain item");
+}
+
+bool Parser::parseLimits(ast::SceneDecl& scene) {
+  ast::LimitsDecl limits;
+  limits.loc = cur().loc;
+  advance();
+  bool ok = parseBlock("limits", [&] { return parseLimitItem(limits); });
+  scene.limits.push_back(std::move(limits));
+  return ok;
+}
+
+// ARRAY.QUANTITY (warn BOUND)? (stop BOUND)?;  at least one of warn and stop.
+bool Parser::parseLimitItem(ast::LimitsDecl& limits) {
+  ast::LimitItem item;
+  if (!parseIdent(item.array, "expected a limit, as in 'fluid.rho warn [990, 1010];', found " +
+                                  describe(cur())))
+    return false;
+  if (!expect(Token::Dot, "after array " + quoted(item.array.name) + " in a limit") ||
+      !parseIdent(item.quantity, "expected a property or 'speed' after '" + item.array.name +
+                                     ".' in a limit"))
+    return false;
+  const std::string head = "limit '" + item.array.name + "." + item.quantity.name + "'";
+  while (atWord("warn") || atWord("stop")) {
+    const bool warn = atWord("warn");
+    auto& slot = warn ? item.warn : item.stop;
+    if (slot)
+      return error(cur().loc, std::string("'") + (warn ? "warn" : "stop") + "' is given twice in " +
+                                  head);
+    slot.emplace();
+    slot->loc = cur().loc;
+    advance();
+    if (!parseLimitBound(*slot, head + (warn ? " warn" : " stop"))) return false;
+  }
+  if (!item.warn && !item.stop)
+    return error(cur().loc, "expected 'warn' or 'stop' and a bound after " + head + ", found " +
+                                describe(cur()));
+  limits.items.push_back(std::move(item));
+  return expect(Token::Semi, "after " + head);
+}
+
+// '[' lo ',' hi ']'  |  '<=' hi  |  '>=' lo
+bool Parser::parseLimitBound(ast::LimitBound& bound, const std::string& head) {
+  if (consumeIf(Token::LBracket)) {
+    if (!(bound.lo = parseExpr())) return false;
+    if (!consumeIf(Token::Comma))
+      return error(cur().loc, "expected ',' between the ends of the interval of " + head +
+                                  ", found " + describe(cur()));
+    if (!(bound.hi = parseExpr())) return false;
+    if (!consumeIf(Token::RBracket))
+      return error(cur().loc, "expected ']' after the interval of " + head + ", found " +
+                                  describe(cur()));
+    return true;
+  }
+  if (consumeIf(Token::LessEq)) return static_cast<bool>(bound.hi = parseExpr());
+  if (consumeIf(Token::GreaterEq)) return static_cast<bool>(bound.lo = parseExpr());
+  return error(cur().loc, "expected '[lo, hi]', '<= hi' or '>= lo' after " + head + ", found " +
+                              describe(cur()));
 }
 
 bool Parser::parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth) {

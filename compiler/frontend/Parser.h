@@ -93,6 +93,9 @@ class Parser {
   bool parseOutputItem(ast::OutputDecl& out);
   bool parseDomain(ast::SceneDecl& scene);
   bool parseDomainItem(ast::DomainDecl& domain);
+  bool parseLimits(ast::SceneDecl& scene);
+  bool parseLimitItem(ast::LimitsDecl& limits);
+  bool parseLimitBound(ast::LimitBound& bound, const std::string& head);
   bool parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth);
   // After `(`: `kwarg, ...)`, consuming the `)`.
   bool parseKwArgs(std::vector<ast::KwArg>& args);

@@ -187,6 +187,7 @@ class OptionSelector {
       append(s.steppers, part->steppers);
       append(s.outputs, part->outputs);
       append(s.domains, part->domains);
+      append(s.limits, part->limits);
       if (part->hasAdaptiveDt) {
         if (s.hasAdaptiveDt) {
           diags_.error(part->adaptiveDtLoc, "adaptive_dt is given twice");

@@ -41,6 +41,7 @@ struct PlanArray {
   std::vector<std::string> constants;    // declared consts and reduce targets
   int stepper = -1;                      // index into Plan::steppers
   std::vector<std::string> outputProps;  // as listed in the scene's output
+  std::vector<std::string> limitProps;   // what the scene's limits read (speed: u, v, w)
   // With a periodic or mirror domain: the properties ghost copies of this array's particles
   // carry (what the source side of a loop reads, and what groups with `real = false` read
   // on it), filled by the ghost pass; empty when the array is no source.
@@ -115,6 +116,17 @@ struct PlanDomain {
   }
 };
 
+// One limit of the scene's `limits { }` (docs/language.md, Limits): the run warns once when
+// the quantity leaves `warn` and stops (as a blow-up) when it leaves `stop`. Absent ends
+// are unbounded; both absent: no such bound.
+struct PlanLimit {
+  llvm::SMLoc loc;                            // the array name of the item
+  int array = -1;
+  std::string quantity;                       // a property, or "speed"
+  bool hasWarn = false, hasStop = false;
+  ast::ExprPtr warnLo, warnHi, stopLo, stopHi;
+};
+
 struct PlanStepper {
   const ast::StepperDecl* decl = nullptr;
   std::map<std::string, int> methods;         // "initialize", "stage1", ... -> body index
@@ -142,6 +154,7 @@ struct Plan {
   std::vector<PlanStepper> steppers;
   std::vector<PlanBody> bodies;
   PlanDomain domain;                          // periodic and mirror boundaries
+  std::vector<PlanLimit> limits;              // what the run watches (limits { })
   PlanGroup root;                             // the scene's equations { } as a group
   std::vector<std::string> notes;             // what the passes decided, for --report
   std::vector<ChosenOption> options;          // compile-time options (sema/Options.h)

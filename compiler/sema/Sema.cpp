@@ -208,6 +208,7 @@ class SemaImpl {
   int useStepper(const ast::StepperDecl* decl);
   std::map<std::string, PropShape> propShapes() const;
   int arrayFromName(const ast::Ident& id, const std::string& role);
+  void buildLimits(const ast::LimitsDecl& d);
 
   const std::vector<std::unique_ptr<ast::Module>>& modules_;
   DiagnosticEngine& diags_;
@@ -577,6 +578,8 @@ void SemaImpl::buildScene() {
     buildDomain(s.domains[i]);
   }
 
+  for (const auto& l : s.limits) buildLimits(l);
+
   plan_->root.loc = s.equationsLoc;
   buildGroup(s.equations, plan_->root, 0);
 }
@@ -607,6 +610,78 @@ std::optional<double> literalValue(const ast::Expr& e) {
       return std::nullopt;
     }
     default: return std::nullopt;
+  }
+}
+
+// limits { ARRAY.QUANTITY warn BOUND stop BOUND; }: the array exists, each quantity is limited
+// once, the bounds are scene expressions, literal intervals are not empty and a literal warn
+// bound lies within the stop bound. Whether the property exists is known after the property
+// analysis (analysis/Properties.cpp reports a limit on a property nothing sets).
+void SemaImpl::buildLimits(const ast::LimitsDecl& d) {
+  for (const auto& item : d.items) {
+    const int a = arrayFromName(item.array, "a limit");
+    if (a < 0) continue;
+    const std::string name = item.array.name + "." + item.quantity.name;
+    bool ok = true;
+    for (const auto& prev : plan_->limits) {
+      if (prev.array == a && prev.quantity == item.quantity.name) {
+        diags_.error(item.array.loc, "limit '" + name + "' is given twice");
+        diags_.note(prev.loc, "first given here");
+        ok = false;
+        break;
+      }
+    }
+    auto checkBound = [&](const ast::LimitBound& b, const char* kind) {
+      for (const auto* e : {&b.lo, &b.hi})
+        if (*e) ok &= checkSceneExpr(*e, "a limit (it may use params)");
+      if (!ok || !b.lo || !b.hi) return;
+      auto lo = literalValue(*b.lo), hi = literalValue(*b.hi);
+      if (lo && hi && !(*lo <= *hi)) {
+        diags_.error(b.lo->loc, std::string("empty ") + kind + " interval of limit '" + name +
+                                    "': the low end must not be above the high end");
+        ok = false;
+      }
+    };
+    if (item.warn) checkBound(*item.warn, "warn");
+    if (item.stop) checkBound(*item.stop, "stop");
+    if (!ok) continue;
+    if (item.warn && item.stop) {
+      // A warn bound outside the stop bound would never warn: said when both are literals.
+      auto outside = [&](const ast::ExprPtr& w, const ast::ExprPtr& st, bool low) {
+        if (!st || !w) return false;  // an unbounded side: no bound to compare
+        auto wv = literalValue(*w), sv = literalValue(*st);
+        return wv && sv && (low ? *wv < *sv : *wv > *sv);
+      };
+      if (outside(item.warn->lo, item.stop->lo, true) ||
+          outside(item.warn->hi, item.stop->hi, false)) {
+        diags_.error(item.warn->loc, "the warn bound of limit '" + name +
+                                         "' reaches beyond its stop bound; it would never warn");
+        diags_.note(item.stop->loc, "the stop bound is here");
+        continue;
+      }
+    }
+    PlanLimit l;
+    l.loc = item.array.loc;
+    l.array = a;
+    l.quantity = item.quantity.name;
+    if (item.warn) {
+      l.hasWarn = true;
+      l.warnLo = item.warn->lo;
+      l.warnHi = item.warn->hi;
+    }
+    if (item.stop) {
+      l.hasStop = true;
+      l.stopLo = item.stop->lo;
+      l.stopHi = item.stop->hi;
+    }
+    auto& props = plan_->arrays[a].limitProps;
+    if (l.quantity == "speed") {
+      static const char* kVel[3] = {"u", "v", "w"};
+      for (int k = 0; k < plan_->dim; ++k) props.push_back(kVel[k]);
+    } else {
+      props.push_back(l.quantity);
+    }
+    plan_->limits.push_back(std::move(l));
   }
 }
 

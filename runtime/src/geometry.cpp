@@ -1,6 +1,8 @@
 // sphc runtime: particle position generators. See geometry.h.
 #include "sphc/geometry.h"
 
+#include "sphc/memory.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -88,12 +90,10 @@ void make_axes(const char* builder, int dim, const double lo[3], const double hi
                int layers, Axis axes[3]) {
   check_dim(builder, dim);
   check_positive(builder, "dx", dx);
-  double count = 1.0;
   for (int a = 0; a < 3; ++a) {
     if (a < dim) {
       check_range(builder, kMin[a], lo[a], kMax[a], hi[a]);
-      count *= (hi[a] - lo[a]) / dx + 2.0 * layers + 1.0;
-      check_count(builder, count);
+      check_count(builder, (hi[a] - lo[a]) / dx + 2.0 * layers + 1.0);  // one axis
       axes[a] = make_axis(lo[a], hi[a], dx, layers);
     } else {
       axes[a] = Axis();
@@ -102,8 +102,24 @@ void make_axes(const char* builder, int dim, const double lo[3], const double hi
   }
 }
 
-// Points of a disk (nd = 2) or ball (nd = 3) of lattice points c + i dx.
-Points ball(const char* builder, int nd, const double c[3], double r, double dx) {
+// The lattice of a disk (nd = 2) or ball (nd = 3): points c + (i, j, k) dx with |i|, |j| <= m,
+// |k| <= mz and i^2 + j^2 + k^2 <= R2 (arguments checked).
+struct BallLattice {
+  double R2 = 0;
+  long m = 0, mz = 0;
+  bool inside(long i, long j, long k) const {
+    return static_cast<double>(i * i + j * j + k * k) <= R2;
+  }
+  std::size_t count() const {  // without building the points (sphc/memory.h)
+    std::size_t n = 0;
+    for (long k = -mz; k <= mz; ++k)
+      for (long j = -m; j <= m; ++j)
+        for (long i = -m; i <= m; ++i) n += inside(i, j, k);
+    return n;
+  }
+};
+
+BallLattice ball_lattice(const char* builder, int nd, const double c[3], double r, double dx) {
   check_positive(builder, "r", r);
   check_positive(builder, "dx", dx);
   const char* const names[3] = {"cx", "cy", "cz"};
@@ -112,14 +128,25 @@ Points ball(const char* builder, int nd, const double c[3], double r, double dx)
   check_count(builder, std::pow(2.0 * R + 1.0, nd));
   // Integer test i^2 + j^2 + k^2 <= R^2, with a relative slack so that points on the circle
   // (e.g. r a whole number of dx) are kept regardless of rounding.
-  const double R2 = R * R * (1.0 + 1e-12);
-  const long m = static_cast<long>(std::floor(R * (1.0 + 1e-12)));
-  const long mz = nd == 3 ? m : 0;
+  BallLattice b;
+  b.R2 = R * R * (1.0 + 1e-12);
+  b.m = static_cast<long>(std::floor(R * (1.0 + 1e-12)));
+  b.mz = nd == 3 ? b.m : 0;
+  return b;
+}
+
+// Points of a disk (nd = 2) or ball (nd = 3) of lattice points c + i dx.
+Points ball(const char* builder, int nd, const double c[3], double r, double dx) {
+  const BallLattice b = ball_lattice(builder, nd, c, r, dx);
+  if (counting_particles()) {  // sphc/memory.h: count, build nothing
+    count_points(b.count());
+    return {};
+  }
   Points p;
-  for (long k = -mz; k <= mz; ++k) {
-    for (long j = -m; j <= m; ++j) {
-      for (long i = -m; i <= m; ++i) {
-        if (static_cast<double>(i * i + j * j + k * k) > R2) continue;
+  for (long k = -b.mz; k <= b.mz; ++k) {
+    for (long j = -b.m; j <= b.m; ++j) {
+      for (long i = -b.m; i <= b.m; ++i) {
+        if (!b.inside(i, j, k)) continue;
         p.push(c[0] + i * dx, c[1] + j * dx, nd == 3 ? c[2] + k * dx : 0.0);
       }
     }
@@ -144,6 +171,13 @@ std::size_t lattice_count(double lo, double hi, double dx) {
 Points block(int dim, const double lo[3], const double hi[3], double dx) {
   Axis axes[3];
   make_axes("block", dim, lo, hi, dx, 0, axes);
+  check_count("block", static_cast<double>(axes[0].v.size()) *
+                           static_cast<double>(axes[1].v.size()) *
+                           static_cast<double>(axes[2].v.size()));
+  if (counting_particles()) {  // sphc/memory.h: count, build nothing
+    count_points(axes[0].v.size() * axes[1].v.size() * axes[2].v.size());
+    return {};
+  }
   Points p;
   for (double z : axes[2].v) {
     for (double y : axes[1].v) {
@@ -158,6 +192,20 @@ Points tank(int dim, const double lo[3], const double hi[3], double dx, int laye
   Axis axes[3];
   make_axes("tank", dim, lo, hi, dx, layers, axes);
   const int up = dim - 1;  // vertical axis
+  // The walls' points: every lattice point less those inside the box and, without a lid,
+  // those above it (the walls alone count against the limit, not the box they enclose).
+  double all = 1, inside = 1, above = 1;
+  for (int a = 0; a < 3; ++a) {
+    all *= static_cast<double>(axes[a].v.size());
+    inside *= static_cast<double>(std::count(axes[a].side.begin(), axes[a].side.end(), 0));
+    above *= a == up ? static_cast<double>(layers) : static_cast<double>(axes[a].v.size());
+  }
+  const double count = all - inside - (top ? 0 : above);
+  check_count("tank", count);
+  if (counting_particles()) {  // sphc/memory.h: count, build nothing
+    count_points(static_cast<std::size_t>(count));
+    return {};
+  }
   Points p;
   int side[3];
   for (std::size_t k = 0; k < axes[2].v.size(); ++k) {
@@ -188,8 +236,14 @@ Points sphere(double cx, double cy, double cz, double r, double dx) {
 Points cylinder(double cx, double cy, double r, double zmin, double zmax, double dx) {
   const double c[3] = {cx, cy, 0.0};
   check_range("cylinder", "zmin", zmin, "zmax", zmax);
-  const Points section = ball("cylinder", 2, c, r, dx);
   const std::size_t layers = lattice_count(zmin, zmax, dx);
+  if (counting_particles()) {  // sphc/memory.h: count, build nothing
+    const std::size_t section = ball_lattice("cylinder", 2, c, r, dx).count();
+    check_count("cylinder", static_cast<double>(layers) * static_cast<double>(section));
+    count_points(layers * section);
+    return {};
+  }
+  const Points section = ball("cylinder", 2, c, r, dx);
   check_count("cylinder", static_cast<double>(layers) * static_cast<double>(section.size()));
   Points p;
   for (std::size_t k = 0; k < layers; ++k) {
@@ -211,12 +265,20 @@ Points line(const double p0[3], const double p1[3], double dx) {
   }
   Points p;
   if (len2 == 0.0) {
+    if (counting_particles()) {
+      count_points(1);
+      return p;
+    }
     p.push(p0[0], p0[1], p0[2]);
     return p;
   }
   const double len = std::sqrt(len2);
   check_count("line", len / dx);
   const std::size_t intervals = std::max<std::size_t>(1, lattice_count(0.0, len, dx));
+  if (counting_particles()) {  // sphc/memory.h: count, build nothing
+    count_points(intervals + 1);
+    return {};
+  }
   for (std::size_t k = 0; k < intervals; ++k) {
     const double t = static_cast<double>(k) / static_cast<double>(intervals);
     p.push(p0[0] + t * d[0], p0[1] + t * d[1], p0[2] + t * d[2]);

@@ -1,6 +1,8 @@
 // sphc runtime: particle arrays. See particle_array.h.
 #include "sphc/particle_array.h"
 
+#include "sphc/memory.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -72,6 +74,7 @@ int ParticleArray::find(const std::string& pname) const {
 }
 
 void ParticleArray::resize(std::size_t new_n) {
+  if (counting_particles()) count_resize(*this, new_n);  // sphc/memory.h: record the size
   for (Property& p : props) resize_prop(p, new_n);
   n = new_n;
 }

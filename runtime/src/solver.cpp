@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
+#include <new>
 #include <filesystem>
 #include <limits>
 #include <optional>
@@ -17,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "sphc/hdf5_io.h"
+#include "sphc/memory.h"
 
 namespace sphc {
 namespace {
@@ -59,6 +62,10 @@ struct Options {
   long max_steps = std::numeric_limits<long>::max();
   long threads = 0;  // 0: the backend's default (all cores)
   std::string directory;  // empty: <scene>_output
+  std::optional<double> max_memory;  // bytes; default: available_memory()
+  bool estimate_memory = false;      // print the memory estimate and stop
+  std::string limits = "on";         // on, warn (never stop), off (sphc/sanity.h)
+  std::vector<std::string> limit_settings;  // --limit ARRAY.QUANTITY.warn|stop=LO:HI
   std::vector<std::pair<std::string, double>> sets;
 };
 
@@ -166,6 +173,28 @@ Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
                          ", which has no OpenMP threads");
     }
     else if (option == "--set") o.sets.push_back(parse_set(value(), prog));
+    else if (option == "--max-memory") {
+      const std::string v = value();
+      o.max_memory = parse_memory_size(v);
+      if (!o.max_memory)
+        throw UsageError("--max-memory expects a size such as 4G, 500M or 1e9 (bytes), not '" +
+                         v + "'");
+    }
+    else if (option == "--estimate-memory") flag(o.estimate_memory);
+    else if (option == "--limits") {
+      o.limits = value();
+      if (o.limits != "on" && o.limits != "warn" && o.limits != "off")
+        throw UsageError("--limits expects on, warn or off, not '" + o.limits + "'");
+    }
+    else if (option == "--limit") {
+      o.limit_settings.push_back(value());
+      std::vector<Limit> probe;
+      try {
+        apply_limit_setting(probe, o.limit_settings.back());
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+      }
+    }
     else if (option == "-d" || option == "--directory") {
       o.directory = value();
       if (o.directory.empty()) throw UsageError(fmt::format("{} expects a directory", option));
@@ -205,6 +234,16 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        left alone)\n"
       "  -d, --directory DIR   output directory (default: {1}_output)\n"
       "  --set NAME=VALUE      set a scene parameter (repeatable)\n"
+      "  --max-memory SIZE     refuse to start when the memory estimate exceeds SIZE (4G,\n"
+      "                        500M, bytes; default: MemAvailable of /proc/meminfo, or a\n"
+      "                        lower cgroup limit)\n"
+      "  --estimate-memory     print the memory estimate of the run, item by item, and stop\n"
+      "  --limits on|warn|off  the scene's limits (limits {{ }}; without any, a box around the\n"
+      "                        particles at set-up): warn once outside warn bounds and stop\n"
+      "                        outside stop bounds (on, the default); only warn; not checked\n"
+      "  --limit A.Q.warn=LO:HI, --limit A.Q.stop=LO:HI\n"
+      "                        set a bound of the limit on quantity Q (a property or speed) of\n"
+      "                        array A (an end may be empty: unbounded; =off removes it)\n"
       "  --quiet               no progress line and no summary\n"
       "  --no-output           write no files (benchmarks)\n"
       "  --timing              print at the end, for the time loop:\n"
@@ -218,7 +257,8 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "  -h, --help            print this help\n"
       "\n"
       "Output: DIR/{1}_NNNNNN.h5 (NNNNNN: the step) and DIR/{1}.xdmf (for ParaView).\n"
-      "Exit codes: 0 done, 1 error, 2 bad usage, 3 the simulation blew up.\n",
+      "Exit codes: 0 done, 1 error (also: more memory needed than available), 2 bad usage,\n"
+      "3 the simulation blew up.\n",
       program, scene, prog.dim);
   if (!prog.options.empty()) {
     fmt::print("\ncompile-time options (sphc -D NAME=CHOICE builds another executable):\n");
@@ -494,10 +534,14 @@ class Simulation {
       throw std::runtime_error("the scene program has no setup or no step function");
     }
     threads_ = prog_.set_threads ? prog_.set_threads(static_cast<int>(opt_.threads)) : 1;
+    if (!check_memory()) return opt_.estimate_memory ? kExitOk : kExitError;
     SceneTimes times;
+    phase_ = "setting up the arrays";
     prog_.setup(parameter_values(), times);
+    phase_.clear();
     apply_overrides(times);
     arrays_ = prog_.arrays ? prog_.arrays() : std::vector<ParticleArray*>{};
+    set_up_limits();
     const std::string dir =
         opt_.directory.empty() ? scene_name(prog_) + "_output" : opt_.directory;
     OutputWriter writer(prog_, dir, !opt_.no_output);
@@ -511,6 +555,7 @@ class Simulation {
     // computed quantities (pressures, summation densities) and not zeros.
     if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
     if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
+    if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
     write_output();
 
     const long check_every = prog_.to_host ? kCheckEveryDevice : kCheckEvery;
@@ -534,19 +579,59 @@ class Simulation {
       const bool output_due = schedule.due(t_);
       if (output_due || step_ % check_every == 0) {
         if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
+        if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
       }
       if (output_due) write_output();
       progress_.update(t_, step_, dt_, particles());
     }
     if (last_output_step_ != step_) {
       if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
+      if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
       write_output();
     }
+    report_limits();
     report(seconds_since(loop_start), particle_steps, tf);
     return kExitOk;
   }
 
  private:
+  // The memory the run needs, before the set-up allocates it (sphc/memory.h): the set-up runs
+  // once counting particles, not making them. False: stop here (the estimate was printed, or
+  // the run does not fit, said on stderr).
+  bool check_memory() {
+    if (!prog_.arrays) return !opt_.estimate_memory;
+    std::vector<ArrayFootprint> arrays;
+    {
+      CountingPass pass;
+      SceneTimes unused;
+      prog_.setup(parameter_values(), unused);
+      for (const ParticleArray* a : prog_.arrays())
+        arrays.push_back(footprint(*a, pass.planned(*a)));
+    }
+    const MemoryEstimate e = estimate_memory(arrays, prog_.precision == "single");
+    estimate_ = e.total;
+    const std::optional<double> available =
+        opt_.max_memory ? opt_.max_memory : available_memory();
+    const std::string limit =
+        !available ? std::string("unknown")
+        : opt_.max_memory ? fmt::format("{} (--max-memory)", format_bytes(*available))
+                          : fmt::format("{} available (MemAvailable of /proc/meminfo or the "
+                                        "cgroup's limit; --max-memory SIZE sets another)",
+                                        format_bytes(*available));
+    if (opt_.estimate_memory) {
+      fmt::print("memory: {} needed, limit {}\n", format_bytes(e.total), limit);
+      for (const MemoryItem& i : e.items)
+        fmt::print("  {:>9}  {}\n", format_bytes(i.bytes), i.what);
+      return false;
+    }
+    if (!available || e.total <= *available) return true;
+    fmt::print(stderr,
+               "error: the run needs about {} of memory, more than the limit of {}: {}; use "
+               "fewer particles (a larger dx or a smaller domain)\n",
+               format_bytes(e.total), limit, e.describe());
+    return false;
+  }
+
   std::vector<double> parameter_values() const {
     std::vector<double> values;
     for (const ParamInfo& p : prog_.params) values.push_back(p.value);
@@ -614,6 +699,123 @@ class Simulation {
     last_output_step_ = step_;
   }
 
+  // -------------------------------------------------------------------------------------------
+  // Limits (sphc/sanity.h): kept apart from the time loop, which only calls check_limits
+  // where it checks for non-finite values, and report_limits at the end.
+
+  static constexpr const char* kLeftLimits = "simulation left its limits";
+
+  struct Watched {
+    Limit limit;
+    const ParticleArray* array = nullptr;
+    bool warned = false;
+    long checks_outside = 0;       // checks that found a particle outside the warn bound
+    double worst_excess = 0;
+    std::string worst;             // that particle, and when
+  };
+
+  // The scene's limits, a default box for every array without a declared limit on a
+  // position, then the command line's --limit settings.
+  void set_up_limits() {
+    if (opt_.limits == "off") return;
+    std::vector<Limit> limits = prog_.limits ? prog_.limits() : std::vector<Limit>{};
+    for (const Limit& box : bounding_box_limits(arrays_, prog_.dim)) {
+      const bool declared = std::any_of(limits.begin(), limits.end(), [&](const Limit& l) {
+        return l.array == box.array && l.quantity == box.quantity;
+      });
+      if (!declared) limits.push_back(box);
+    }
+    for (const std::string& s : opt_.limit_settings) apply_limit_setting(limits, s);
+    if (opt_.limits == "warn")
+      for (Limit& l : limits) l.stop.reset();
+    std::string names;
+    for (const ParticleArray* a : arrays_) names += (names.empty() ? "" : ", ") + a->name;
+    for (const Limit& l : limits) {
+      auto it = std::find_if(arrays_.begin(), arrays_.end(),
+                             [&](const ParticleArray* a) { return a->name == l.array; });
+      if (it == arrays_.end())
+        throw std::runtime_error(fmt::format("limit '{}'{}: the scene has no array '{}' (its "
+                                             "arrays: {})", l.name(),
+                                             l.where.empty() ? "" : " (" + l.where + ")",
+                                             l.array, names));
+      if (!l.warn && !l.stop) continue;
+      check_limit(l, **it, prog_.dim);  // throws if the quantity does not exist
+      watched_.push_back(Watched{l, *it});
+    }
+  }
+
+  // Checks the limits (on host data: call after check_finite) and the iterated groups.
+  // Warns once per limit (and per group); the stop message of the first limit past its stop
+  // bound, or nullopt.
+  std::optional<std::string> check_limits() {
+    check_iterations();
+    for (Watched& w : watched_) {
+      const LimitCheck c = check_limit(w.limit, *w.array, prog_.dim);
+      const std::string from = w.limit.where.empty() ? "" : " (" + w.limit.where + ")";
+      const std::string particle =
+          describe_particle(*w.array, c.worst, prog_.dim, w.limit.quantity, c.value);
+      if (c.outside_stop > 0) {
+        return fmt::format("limit '{}'{}: {} particle{} outside the stop bound {}; the worst: {}",
+                           w.limit.name(), from, c.outside_stop, c.outside_stop == 1 ? "" : "s",
+                           w.limit.stop->text(), particle);
+      }
+      if (c.outside_warn == 0) continue;
+      ++w.checks_outside;
+      if (c.excess > w.worst_excess) {
+        w.worst_excess = c.excess;
+        w.worst = fmt::format("{} at t={}", particle, t_);
+      }
+      if (w.warned) continue;
+      w.warned = true;
+      if (!first_warning_) first_warning_ = {t_, writer_->newest()};
+      progress_.break_line();
+      fmt::print(stderr,
+                 "warning: at t={}, step {}: limit '{}'{}: {} particle{} outside the warn bound "
+                 "{}{}; the worst: {} (warned once per limit)\n",
+                 t_, step_, w.limit.name(), from, c.outside_warn, c.outside_warn == 1 ? "" : "s",
+                 w.limit.warn->text(),
+                 w.limit.stop ? "; the run stops outside " + w.limit.stop->text() : "", particle);
+    }
+    return std::nullopt;
+  }
+
+  // An iterated group whose evaluation stopped at max_iterations: warned once per group.
+  void check_iterations() {
+    if (!prog_.iterations) return;
+    const std::vector<IterationStats> stats = prog_.iterations();
+    unconverged_warned_.resize(stats.size(), false);
+    for (std::size_t k = 0; k < stats.size(); ++k) {
+      if (stats[k].unconverged == 0 || unconverged_warned_[k]) continue;
+      unconverged_warned_[k] = true;
+      if (!first_warning_) first_warning_ = {t_, writer_->newest()};
+      progress_.break_line();
+      fmt::print(stderr,
+                 "warning: at t={}, step {}: the iterated group at {} stopped at its "
+                 "max_iterations without converging ({} of {} evaluations so far; warned once "
+                 "per group, counted at the end)\n",
+                 t_, step_, stats[k].where, stats[k].unconverged, stats[k].evaluations);
+    }
+  }
+
+  // At the end of a run: how often each limit was exceeded, and unconverged groups.
+  void report_limits() {
+    progress_.break_line();
+    for (const Watched& w : watched_) {
+      if (w.checks_outside == 0) continue;
+      fmt::print(stderr, "warning: limit '{}' outside its warn bound {} at {} check{}; the "
+                         "furthest: {}\n",
+                 w.limit.name(), w.limit.warn->text(), w.checks_outside,
+                 w.checks_outside == 1 ? "" : "s", w.worst);
+    }
+    if (!prog_.iterations) return;
+    for (const IterationStats& s : prog_.iterations()) {
+      if (s.unconverged == 0) continue;
+      fmt::print(stderr, "warning: the iterated group at {} did not converge in {} of {} "
+                         "evaluations\n",
+                 s.where, s.unconverged, s.evaluations);
+    }
+  }
+
   int time_step_failure(double dt, double tf) {
     // A non-finite property usually explains a bad time step: name it if there is one.
     if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
@@ -634,6 +836,9 @@ class Simulation {
         const std::string path = writer_->write_blowup(arrays_, meta());
         fmt::print(stderr, "note: the bad state is in '{}'; the last good output is '{}'\n", path,
                    writer_->newest());
+        if (first_warning_)
+          fmt::print(stderr, "note: the first warning was at t={}; the last output before it is "
+                             "'{}'\n", first_warning_->first, first_warning_->second);
       } catch (const std::exception& e) {
         fmt::print(stderr, "note: could not write the bad state: {}\n", e.what());
       }
@@ -700,7 +905,52 @@ class Simulation {
   long last_output_step_ = -1;
   double landed_t_ = 0.0;  // the last requested time a step landed on (advance_time)
   long landed_step_ = 0;
+  std::vector<Watched> watched_;
+  std::vector<bool> unconverged_warned_;
+  std::optional<std::pair<double, std::string>> first_warning_;  // t, the output before it
+
+ public:
+  // For the out-of-memory message: what the run was doing, and its estimate.
+  std::string where() const {
+    return phase_.empty() ? fmt::format("at t={}, step {}", t_, step_) : "while " + phase_;
+  }
+  double estimate_ = 0;  // bytes (check_memory)
+
+ private:
+  std::string phase_;
 };
+
+std::string out_of_memory_hint(double estimate) {
+  const std::optional<double> available = available_memory();
+  return fmt::format(
+      "an allocation failed (std::bad_alloc); {}{}; use fewer particles (a larger dx or a "
+      "smaller domain)",
+      estimate > 0 ? "the estimate before the start was " + format_bytes(estimate) : "",
+      available ? fmt::format("{}{} is available now", estimate > 0 ? ", " : "",
+                              format_bytes(*available))
+                : "");
+}
+
+// std::terminate's handler: an exception no one caught (one thrown inside an OpenMP parallel
+// region ends the program there) gets a message, not a bare "terminate called".
+[[noreturn]] void report_uncaught() {
+  std::fflush(stdout);
+  if (std::exception_ptr e = std::current_exception()) {
+    try {
+      std::rethrow_exception(e);
+    } catch (const std::bad_alloc&) {
+      std::fprintf(stderr, "\nerror: out of memory: %s\n", out_of_memory_hint(0).c_str());
+    } catch (const std::exception& x) {
+      std::fprintf(stderr, "\nerror: %s\n", x.what());
+    } catch (...) {
+      std::fprintf(stderr, "\nerror: an unknown exception\n");
+    }
+  } else {
+    std::fprintf(stderr, "\nerror: std::terminate was called\n");
+  }
+  std::fflush(stderr);
+  std::_Exit(kExitError);
+}
 
 }  // namespace
 
@@ -756,8 +1006,16 @@ int run_main(int argc, char** argv, SceneProgram& prog) {
     return kExitOk;
   }
   Progress progress;
+  std::set_terminate(report_uncaught);
+  std::optional<Simulation> sim;
   try {
-    return Simulation(prog, opt, progress).run();
+    sim.emplace(prog, opt, progress);
+    return sim->run();
+  } catch (const std::bad_alloc&) {
+    progress.break_line();
+    fmt::print(stderr, "error: out of memory {}: {}\n", sim ? sim->where() : "at the start",
+               out_of_memory_hint(sim ? sim->estimate_ : 0));
+    return kExitError;
   } catch (const std::exception& e) {
     progress.break_line();
     fmt::print(stderr, "error: {}\n", e.what());

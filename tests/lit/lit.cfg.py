@@ -40,6 +40,9 @@ if os.path.exists(_buildinfo):
 # Helper scripts of the tests (tests/lit/Inputs), e.g. %h5close A.h5 B.h5 --rtol R.
 config.substitutions.append(('%h5close', 'python3 ' + os.path.join(
     config.sphc_src_root, 'tests', 'lit', 'Inputs', 'h5close.py')))
+# %h5range FILE.h5 DATASET LO HI ...: every value within [LO, HI] (tests/lit/Inputs/h5range.py).
+config.substitutions.append(('%h5range', 'python3 ' + os.path.join(
+    config.sphc_src_root, 'tests', 'lit', 'Inputs', 'h5range.py')))
 # %precision_compare DOUBLE.h5 SINGLE.h5 --id ... --rtol R: a single-precision run against the
 # double one (tests/lit/Inputs/precision_compare.py).
 config.substitutions.append(('%precision_compare', 'python3 ' + os.path.join(

@@ -4,8 +4,10 @@
 // owns the command line (see --help), the time loop, output (HDF5 files plus an XDMF index),
 // the progress line and the blow-up diagnosis.
 //
-// Exit codes: 0 success, 1 error (an exception from the scene or from output), 2 bad usage,
-// 3 the simulation blew up (a non-finite value, or the adaptive time step collapsed).
+// Exit codes: 0 success, 1 error (an exception from the scene or from output, or a run that
+// needs more memory than is available: see sphc/memory.h), 2 bad usage,
+// 3 the simulation blew up (a non-finite value, a quantity past the stop bound of a limit:
+// sphc/sanity.h, or the adaptive time step collapsed).
 #pragma once
 
 #include <chrono>
@@ -14,7 +16,9 @@
 #include <utility>
 #include <vector>
 
+#include "sphc/memory.h"
 #include "sphc/particle_array.h"
+#include "sphc/sanity.h"
 
 namespace sphc {
 
@@ -65,8 +69,10 @@ struct SceneProgram {
   int dim = 2;
   std::vector<ParamInfo> params;  // defaults, in order; --set overrides by name
   std::vector<OptionInfo> options;  // compile-time options this executable was built with
-  // Called once with the final parameter values (same order as params). Builds arrays, sets
-  // the scene's tf, dt and output times (they may depend on params).
+  // Called with the final parameter values (same order as params). Builds arrays, sets the
+  // scene's tf, dt and output times (they may depend on params). run_main calls it twice:
+  // first inside a CountingPass (sphc/memory.h: no particles are made, only counted, for the
+  // memory estimate; copies to a device or to float arrays are then skipped), then for real.
   std::function<void(const std::vector<double>& params, SceneTimes& times)> setup;
   std::function<std::vector<ParticleArray*>()> arrays;
   std::function<void(double t, double dt)> compute_initial;  // may be empty
@@ -88,6 +94,9 @@ struct SceneProgram {
   // Wall seconds spent so far in the neighbour search (search domain, cell lists, reorders
   // into cell order), for the --timing line; empty where not measured.
   std::function<double()> neighbour_seconds;
+  // The scene's limits { } (sphc/sanity.h), computed from the parameters after the set-up;
+  // empty: none declared (the default bounding box applies).
+  std::function<std::vector<Limit>()> limits;
   // Array name -> properties written (empty list = all); empty = every array, all properties.
   std::vector<std::pair<std::string, std::vector<std::string>>> output;
 };
