@@ -124,7 +124,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
         kind == ast::Method::Initialize ? w.initialize : w.postLoop;
     if (with.empty()) return;
     scene_ << parallelFor("      ", w.perParticle);
-    scene_ << "      for (int d_idx = 0; d_idx < n; ++d_idx) {  // " << what << "\n";
+    scene_ << "      for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
+           << "; ++d_idx) {  // " << what << "\n";
     for (const auto* eq : with) {
       const auto& pd = plan_.equationDecls[eq->declIndex];
       const PlanBody& b = plan_.bodies[pd.methods.at(kind)];
@@ -153,7 +154,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     // captured frame at every neighbour, ~4% slower than the serial build (dam break,
     // ~100k particles, 1 thread). The cell list stays shared: a copy would be a waste.
     scene_ << parallelFor("        ", pass.order, "default(firstprivate) shared(cells)");
-    scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+    scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
+           << "; ++d_idx) {\n";
     emitDestLocals(scene_, "          ", q, host_);
     scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
     scene_ << "            const int s_idx = static_cast<int>(j);\n";
