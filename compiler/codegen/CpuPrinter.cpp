@@ -326,7 +326,9 @@ void CpuPrinter::updateNeighboursWithGhosts() {
   scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
   scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
   for (const auto& S : sourceArrays_)
-    scene_ << "      " << cellListBuild(S, S + ".n") << "\n      " << permuteInCellOrder(S) << "\n";
+    if (reorders(S))
+      scene_ << "      " << cellListBuild(S, S + ".n") << "\n      " << permuteInCellOrder(S)
+             << "\n";
   scene_ << "    }\n";
   scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
   scene_ << "    const double cutoff = domain.cell_size;\n";
@@ -352,7 +354,7 @@ std::string CpuPrinter::removeGhosts() const {
 // update_neighbours of a scene without periodic or mirror domain.
 void CpuPrinter::updateNeighbours() {
   if (!loopArrays_.empty()) searchDomain();
-  if (!sourceArrays_.empty()) {
+  if (anyReorders()) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
@@ -360,6 +362,7 @@ void CpuPrinter::updateNeighbours() {
   for (const auto& S : sourceArrays_) {
     const std::string build = cellListBuild(S, S + ".n");
     scene_ << "    " << build << "\n";
+    if (!reorders(S)) continue;  // a ranged group names its particles by index
     scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build
            << "\n    }\n";
   }

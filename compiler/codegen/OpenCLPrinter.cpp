@@ -153,11 +153,12 @@ void OpenCLPrinter::updateNeighbours() {
            << ", DIM, Kernel::radius_scale);\n";
   // Every REORDER_EVERY builds the particles are sorted in cell order on the device, as
   // on the CPU (same grid, same order), so outputs list particles in the same order.
-  if (!sourceArrays_.empty())
+  if (anyReorders())
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
   for (const auto& S : sourceArrays_) {
     const std::string build = cellListBuild(S, S + ".n");
     scene_ << "    " << build << "\n";
+    if (!reorders(S)) continue;  // a ranged group names its particles by index
     scene_ << "    if (reorder) {\n      dev_" << S << ".permute(ocl, cells_" << S << ", " << S
            << ");\n      " << build << "\n    }\n";
   }
@@ -371,8 +372,9 @@ void OpenCLPrinter::updateNeighboursWithGhosts() {
   scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
   scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
   for (const auto& S : sourceArrays_)
-    scene_ << "      " << cellListBuild(S, S + ".n") << "\n      dev_" << S
-           << ".permute(ocl, cells_" << S << ", " << S << ");\n";
+    if (reorders(S))
+      scene_ << "      " << cellListBuild(S, S + ".n") << "\n      dev_" << S
+             << ".permute(ocl, cells_" << S << ", " << S << ");\n";
   scene_ << "    }\n";
   scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
   scene_ << "    const double cutoff = domain.cell_size;\n";

@@ -157,6 +157,16 @@ class ScenePrinter {
     return propType(array, prop, host_);
   }
   bool hasDomain() const { return sched_.domain; }
+  // Whether source S is permuted into cell order (not when a ranged group names its
+  // particles by index), and whether any source is.
+  bool reorders(const std::string& S) const {
+    return !sched_.keepOrder.count(plan_.arrayIndex(S));
+  }
+  bool anyReorders() const {
+    for (const auto& S : sourceArrays_)
+      if (reorders(S)) return true;
+    return false;
+  }
   std::string propIndexList(int a, const std::vector<std::string>& props) const;
   std::string loc(llvm::SMLoc l) const { return diags_.lineInfo(l); }
   std::string paramRef(const std::string& n) const { return "P." + n; }

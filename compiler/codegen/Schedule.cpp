@@ -74,6 +74,13 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) s_->setupArrays.push_back(a);
   group(plan_.root, unique("equations"), s_->equations);
   for (const auto& n : sourceNames_) s_->cellLists.push_back(plan_.arrayIndex(n));
+  std::function<void(const ScheduleGroup&)> ranged = [&](const ScheduleGroup& g) {
+    for (const auto& ph : g.phases)
+      for (const auto& w : ph.destinations)
+        if (w.ranged()) s_->keepOrder.insert(w.array);
+    for (const auto& sub : g.subgroups) ranged(*sub);
+  };
+  ranged(s_->equations);
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
     if (loopNames_.count(plan_.arrays[a].name)) s_->searchArrays.push_back(a);
   step();
@@ -386,6 +393,11 @@ void SchedulePrinter::print() {
     os_ << "\n  cell lists:";
     for (int a : s_.cellLists) os_ << " " << name(a);
     os_ << "\n";
+    if (!s_.keepOrder.empty()) {
+      os_ << "  never reordered (start_idx / stop_idx):";
+      for (int a : s_.keepOrder) os_ << " " << name(a);
+      os_ << "\n";
+    }
     if (s_.domain)
       for (int a : s_.cellLists) {
         os_ << "  ghosts of " << name(a) << " carry:";

@@ -166,6 +166,9 @@ struct Schedule {
   // and with a periodic or mirror domain ghosts), by name.
   std::vector<int> searchArrays;
   std::vector<int> cellLists;
+  // Arrays never permuted into cell order: destinations of a group with start_idx or
+  // stop_idx, whose indices then name the same particles all run long (the set-up order).
+  std::set<int> keepOrder;
   bool domain = false;  // periodic or mirror sides: wrapping, ghosts
   // The integrator's step.
   std::vector<StepperRun> stepperRuns;  // one per distinct run name, in order of first use
