@@ -1,6 +1,7 @@
 #include "analysis/Access.h"
 #include "analysis/Passes.h"
 
+#include <functional>
 #include <set>
 
 namespace sphc {
@@ -26,6 +27,24 @@ bool movesParticles(const Plan& plan, int array) {
   return false;
 }
 
+// Array constants (`arr.c`) that group options read at run time (start_idx, stop_idx,
+// condition): roots of liveness, as what a stepper reads.
+static void groupOptionReads(const Plan& plan, const PlanGroup& g,
+                             std::set<std::pair<int, std::string>>& live) {
+  std::function<void(const ast::Expr&)> walk = [&](const ast::Expr& e) {
+    size_t dot = e.kind == ast::Expr::Name ? e.text.find('.') : std::string::npos;
+    if (dot != std::string::npos) {
+      int a = plan.arrayIndex(e.text.substr(0, dot));
+      if (a >= 0) live.insert({a, e.text.substr(dot + 1)});
+    }
+    for (const auto& x : e.args)
+      if (x) walk(*x);
+  };
+  for (const auto* e : {g.startIdx.get(), g.stopIdx.get(), g.condition.get()})
+    if (e) walk(*e);
+  for (const auto& sub : g.subgroups) groupOptionReads(plan, *sub, live);
+}
+
 bool pruneEquations(Plan& plan, DiagnosticEngine&) {
   using Key = std::pair<int, std::string>;
   std::set<Key> live;
@@ -37,6 +56,7 @@ bool pruneEquations(Plan& plan, DiagnosticEngine&) {
     if (movesParticles(plan, a))
       for (const auto& p : adaptiveDtProps(plan)) live.insert({a, p});
   }
+  groupOptionReads(plan, plan.root, live);
   std::vector<std::vector<Access>> accesses;
   for (const auto& eq : plan.equations) accesses.push_back(equationAccesses(plan, eq));
   std::vector<bool> isLive(plan.equations.size(), false);

@@ -124,7 +124,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
         kind == ast::Method::Initialize ? w.initialize : w.postLoop;
     if (with.empty()) return;
     scene_ << parallelFor("      ", w.perParticle);
-    scene_ << "      for (int d_idx = 0; d_idx < n; ++d_idx) {  // " << what << "\n";
+    scene_ << "      for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
+           << "; ++d_idx) {  // " << what << "\n";
     for (const auto* eq : with) {
       const auto& pd = plan_.equationDecls[eq->declIndex];
       const PlanBody& b = plan_.bodies[pd.methods.at(kind)];
@@ -153,7 +154,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     // captured frame at every neighbour, ~4% slower than the serial build (dam break,
     // ~100k particles, 1 thread). The cell list stays shared: a copy would be a waste.
     scene_ << parallelFor("        ", pass.order, "default(firstprivate) shared(cells)");
-    scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+    scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
+           << "; ++d_idx) {\n";
     emitDestLocals(scene_, "          ", q, host_);
     scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
     scene_ << "            const int s_idx = static_cast<int>(j);\n";
@@ -324,7 +326,9 @@ void CpuPrinter::updateNeighboursWithGhosts() {
   scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
   scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
   for (const auto& S : sourceArrays_)
-    scene_ << "      " << cellListBuild(S, S + ".n") << "\n      " << permuteInCellOrder(S) << "\n";
+    if (reorders(S))
+      scene_ << "      " << cellListBuild(S, S + ".n") << "\n      " << permuteInCellOrder(S)
+             << "\n";
   scene_ << "    }\n";
   scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
   scene_ << "    const double cutoff = domain.cell_size;\n";
@@ -350,7 +354,7 @@ std::string CpuPrinter::removeGhosts() const {
 // update_neighbours of a scene without periodic or mirror domain.
 void CpuPrinter::updateNeighbours() {
   if (!loopArrays_.empty()) searchDomain();
-  if (!sourceArrays_.empty()) {
+  if (anyReorders()) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
@@ -358,6 +362,7 @@ void CpuPrinter::updateNeighbours() {
   for (const auto& S : sourceArrays_) {
     const std::string build = cellListBuild(S, S + ".n");
     scene_ << "    " << build << "\n";
+    if (!reorders(S)) continue;  // a ranged group names its particles by index
     scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build
            << "\n    }\n";
   }

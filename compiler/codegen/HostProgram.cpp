@@ -5,8 +5,11 @@
 #include "codegen/Printer.h"
 #include "sema/Geometry.h"
 
+#include "llvm/ADT/StringRef.h"
 #include "llvm/Support/FileSystem.h"
 #include "llvm/Support/Path.h"
+
+#include <sstream>
 
 namespace sphc {
 
@@ -221,8 +224,12 @@ void ScenePrinter::emitGroup(const ScheduleGroup& sg) {
   }
   scene_ << "  void " << name << "(double t, double dt) {\n";
   if (g.every) scene_ << "    if (!" << name << "_due()) return;\n";
+  if (g.condition)
+    scene_ << "    if (!(" << groupOptionCpp(*g.condition) << ")) return;  // condition = "
+           << exprText(*g.condition) << "\n";
   if (!g.iterate) {
     for (const auto& c : sg.calls) scene_ << "    " << c << "(t, dt);\n";
+    if (sg.rebuildNeighbours) emitNeighbourRebuild("    ");
     if (sg.calls.empty()) scene_ << "    (void)t; (void)dt;  // an empty group\n";
     scene_ << "  }\n\n";
     return;
@@ -237,6 +244,7 @@ void ScenePrinter::emitIteration(const ScheduleGroup& sg) {
   scene_ << "    int iteration = 1;\n    bool converged = true;\n";
   scene_ << "    for (;; ++iteration) {\n";
   for (const auto& c : sg.calls) scene_ << "      " << c << "(t, dt);\n";
+  if (sg.rebuildNeighbours) emitNeighbourRebuild("      ");
   // As PySPH (its Cython backend): from min_iterations on, every `converged` is called each
   // iteration, none skipped once one says no (they may keep state), and the results ANDed.
   scene_ << "      const bool run_tests = iteration >= " << g.minIterations << ";\n";
@@ -286,10 +294,50 @@ void ScenePrinter::emitPhase(const Phase& ph) {
     scene_ << "      const int n = static_cast<int>(" << D << ".n"
            << (onGhosts ? " + ghosts_" + D + ".size()" : std::string("")) << ");"
            << (onGhosts ? "  // real particles and ghosts (real = false)" : "") << "\n";
+    if (w.ranged()) emitParticleRange(w);
     destination(w, ph.name);
     scene_ << "    }\n";
   }
   scene_ << "  }\n\n";
+}
+
+// Group option update_nnps: the neighbour search rebuilt within an evaluation, as at its
+// start (with a domain: the ghosts go, particles wrap into the box, the ghosts come back).
+void ScenePrinter::emitNeighbourRebuild(const std::string& indent) {
+  scene_ << indent << "// update_nnps: positions may have changed, the neighbours with them\n";
+  if (hasDomain()) {
+    // removeGhosts() is written for the 4-space indent of compute_accelerations.
+    std::istringstream lines(removeGhosts());
+    for (std::string line; std::getline(lines, line);)
+      scene_ << indent << llvm::StringRef(line).ltrim().str() << "\n";
+    scene_ << indent << "update_domain();\n";
+  }
+  scene_ << indent << "update_neighbours();\n";
+}
+
+std::string ScenePrinter::groupOptionCpp(const ast::Expr& e) const {
+  return exprCpp(e, [&](const std::string& n) {
+    if (n == "t" || n == "dt") return n;
+    size_t dot = n.find('.');
+    if (dot == std::string::npos) return paramRef(n);
+    int a = plan_.arrayIndex(n.substr(0, dot));
+    return "static_cast<double>(" + propPtr(a, n.substr(dot + 1)) + "[0])";
+  });
+}
+
+// Group options start_idx / stop_idx: the destination particles the per-particle loops and
+// neighbour passes run on, rounded to the nearest integer and clamped to [0, n).
+void ScenePrinter::emitParticleRange(const DestinationWork& w) {
+  auto index = [&](const ast::ExprPtr& e, const std::string& otherwise) {
+    return e ? "std::fmax(0.0, std::floor(" + groupOptionCpp(*e) + " + 0.5))" : otherwise;
+  };
+  scene_ << "      // group options start_idx = " << (w.startIdx ? exprText(*w.startIdx) : "0")
+         << ", stop_idx = " << (w.stopIdx ? exprText(*w.stopIdx) : "n") << "\n";
+  scene_ << "      const int d_end = static_cast<int>(std::fmin(static_cast<double>(n), "
+         << index(w.stopIdx, "static_cast<double>(n)") << "));\n";
+  scene_ << "      const int d_begin = static_cast<int>(std::fmin(static_cast<double>(d_end), "
+         << index(w.startIdx, "0.0") << "));\n";
+  scene_ << "      (void)d_begin;\n";
 }
 
 void ScenePrinter::emitStep() {

@@ -80,6 +80,13 @@ class OpenCLPrinter : public ScenePrinter {
       host.push_back(hostExpr);
     }
   };
+  // start_idx / stop_idx: kernels launched over [0, d_end) return below d_begin.
+  void rangeArg(const DestinationWork& w, KernelArgs& ka) const {
+    if (w.ranged()) ka.add("const int d_begin", "d_begin", "d_begin");
+  }
+  void rangeGuard(const DestinationWork& w) {
+    if (w.ranged()) cl_ << "  if (d_idx < d_begin) return;  // group option start_idx\n";
+  }
   std::string devBuffer(int a, const std::string& p) const;
   void addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int src,
                    const std::string& eqValues) const;
@@ -148,11 +155,12 @@ void OpenCLPrinter::updateNeighbours() {
            << ", DIM, Kernel::radius_scale);\n";
   // Every REORDER_EVERY builds the particles are sorted in cell order on the device, as
   // on the CPU (same grid, same order), so outputs list particles in the same order.
-  if (!sourceArrays_.empty())
+  if (anyReorders())
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
   for (const auto& S : sourceArrays_) {
     const std::string build = cellListBuild(S, S + ".n");
     scene_ << "    " << build << "\n";
+    if (!reorders(S)) continue;  // a ranged group names its particles by index
     scene_ << "    if (reorder) {\n      dev_" << S << ".permute(ocl, cells_" << S << ", " << S
            << ");\n      " << build << "\n    }\n";
   }
@@ -227,7 +235,9 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
       addBodyArgs(ka, plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(kind)], d,
                   -1, eqStruct(*eq));
     std::string k = name + "_" + D + "_" + what;
+    rangeArg(w, ka);
     beginKernel(k, ka);
+    rangeGuard(w);
     for (const auto* eq : with) {
       const auto& pd = plan_.equationDecls[eq->declIndex];
       const PlanBody& b = plan_.bodies[pd.methods.at(kind)];
@@ -235,7 +245,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
           << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
     }
     cl_ << "}\n\n";
-    scene_ << "      " << launch(k, "n", ka) << "  // " << what << "\n";
+    scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // " << what << "\n";
   };
   perParticle(ast::Method::Initialize, "initialize");
   for (const NeighbourPass& pass : w.passes) {
@@ -255,7 +265,9 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     ka.add("SPHC_GRID_ARGS", "grid", "grid");
     std::string k = name + "_" + D + "_from_" + S;
     cl_ << "// neighbours: " << D << " <- " << S << "\n";
+    rangeArg(w, ka);
     beginKernel(k, ka);
+    rangeGuard(w);
     emitDestLocals(cl_, "  ", q, device_);
     // The 3^dim cells around the particle's cell, by z, y, x (the CPU candidate order).
     const char* axes[3] = {"x", "y", "z"};
@@ -274,7 +286,8 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
         << "            const int s_idx = (int)cells_order[k];\n";
     emitCandidate(cl_, q, pass.equations, d, device_);
     cl_ << "    }\n  }\n}\n\n";
-    scene_ << "      " << launch(k, "n", ka) << "  // neighbours: " << D << " <- " << S << "\n";
+    scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // neighbours: " << D << " <- " << S
+           << "\n";
   }
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions: per-particle values on the device, partial results there, the last step
@@ -361,8 +374,9 @@ void OpenCLPrinter::updateNeighboursWithGhosts() {
   scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
   scene_ << "    if (builds++ % REORDER_EVERY == 0) {\n";
   for (const auto& S : sourceArrays_)
-    scene_ << "      " << cellListBuild(S, S + ".n") << "\n      dev_" << S
-           << ".permute(ocl, cells_" << S << ", " << S << ");\n";
+    if (reorders(S))
+      scene_ << "      " << cellListBuild(S, S + ".n") << "\n      dev_" << S
+             << ".permute(ocl, cells_" << S << ", " << S << ");\n";
   scene_ << "    }\n";
   scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
   scene_ << "    const double cutoff = domain.cell_size;\n";

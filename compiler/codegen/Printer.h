@@ -127,6 +127,16 @@ class ScenePrinter {
   void emitDomainSetup();
   void emitGroup(const ScheduleGroup& g);
   void emitPhase(const Phase& ph);
+  // A group option evaluated at run time (start_idx, stop_idx, condition) as C++: params,
+  // array constants `arr.c` (their first value), t and dt.
+  std::string groupOptionCpp(const ast::Expr& e) const;
+  // update_nnps: rebuild the neighbour search inside an evaluation.
+  void emitNeighbourRebuild(const std::string& indent);
+  // d_begin, d_end of a destination with start_idx / stop_idx, clamped to [0, n).
+  void emitParticleRange(const DestinationWork& w);
+  // The first and one-past-last destination particle of a phase's per-particle loops.
+  static std::string rangeBegin(const DestinationWork& w) { return w.ranged() ? "d_begin" : "0"; }
+  static std::string rangeEnd(const DestinationWork& w) { return w.ranged() ? "d_end" : "n"; }
   // An iterated group's convergence: its loop, the tests, the iteration bounds.
   void emitIteration(const ScheduleGroup& g);
   // The convergence test of an iterated group's equation (inside the iteration loop).
@@ -148,6 +158,16 @@ class ScenePrinter {
     return propType(array, prop, host_);
   }
   bool hasDomain() const { return sched_.domain; }
+  // Whether source S is permuted into cell order (not when a ranged group names its
+  // particles by index), and whether any source is.
+  bool reorders(const std::string& S) const {
+    return !sched_.keepOrder.count(plan_.arrayIndex(S));
+  }
+  bool anyReorders() const {
+    for (const auto& S : sourceArrays_)
+      if (reorders(S)) return true;
+    return false;
+  }
   std::string propIndexList(int a, const std::vector<std::string>& props) const;
   std::string loc(llvm::SMLoc l) const { return diags_.lineInfo(l); }
   std::string paramRef(const std::string& n) const { return "P." + n; }

@@ -2,6 +2,7 @@
 
 #include "analysis/Access.h"
 #include "analysis/Passes.h"
+#include "frontend/ASTPrinter.h"
 #include "frontend/Diagnostics.h"
 
 #include <algorithm>
@@ -73,6 +74,13 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) s_->setupArrays.push_back(a);
   group(plan_.root, unique("equations"), s_->equations);
   for (const auto& n : sourceNames_) s_->cellLists.push_back(plan_.arrayIndex(n));
+  std::function<void(const ScheduleGroup&)> ranged = [&](const ScheduleGroup& g) {
+    for (const auto& ph : g.phases)
+      for (const auto& w : ph.destinations)
+        if (w.ranged()) s_->keepOrder.insert(w.array);
+    for (const auto& sub : g.subgroups) ranged(*sub);
+  };
+  ranged(s_->equations);
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
     if (loopNames_.count(plan_.arrays[a].name)) s_->searchArrays.push_back(a);
   step();
@@ -87,6 +95,7 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
 void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, ScheduleGroup& out) {
   out.name = name;
   out.group = &g;
+  out.rebuildNeighbours = g.updateNnps;
   std::vector<int> run;
   auto flush = [&] {
     if (run.empty()) return;
@@ -171,6 +180,8 @@ DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vect
     if (plan_.equations[e].live && plan_.equations[e].dest == d)
       w.equations.push_back(&plan_.equations[e]);
   w.onGhosts = !g.real && hasGhosts(d);
+  w.startIdx = g.startIdx;
+  w.stopIdx = g.stopIdx;
   for (const auto* eq : w.equations)
     for (const auto& [k, b] : plan_.equationDecls[eq->declIndex].methods) {
       for (const auto& r : plan_.bodies[b].facts.dReads) w.destProps.insert(r.prop);
@@ -382,6 +393,11 @@ void SchedulePrinter::print() {
     os_ << "\n  cell lists:";
     for (int a : s_.cellLists) os_ << " " << name(a);
     os_ << "\n";
+    if (!s_.keepOrder.empty()) {
+      os_ << "  never reordered (start_idx / stop_idx):";
+      for (int a : s_.keepOrder) os_ << " " << name(a);
+      os_ << "\n";
+    }
     if (s_.domain)
       for (int a : s_.cellLists) {
         os_ << "  ghosts of " << name(a) << " carry:";
@@ -443,6 +459,7 @@ void SchedulePrinter::group(const ScheduleGroup& g, int indent) {
   os_ << pad << "group " << g.name << ", from " << diags_.lineInfo(pg.loc);
   if (!pg.real) os_ << ", real = false";
   if (pg.every) os_ << ", every";
+  if (pg.condition) os_ << ", condition";
   if (pg.postStep) os_ << ", post_step";
   os_ << "\n";
   if (pg.iterate) {
@@ -456,6 +473,9 @@ void SchedulePrinter::group(const ScheduleGroup& g, int indent) {
     else
       group(*g.subgroups[m.index], indent + 1);
   }
+  if (g.rebuildNeighbours)
+    os_ << pad << "  then rebuild the neighbour search (update_nnps)"
+        << (pg.iterate ? ", in each iteration" : "") << "\n";
 }
 
 void SchedulePrinter::phase(const Phase& ph, int indent) {
@@ -464,6 +484,14 @@ void SchedulePrinter::phase(const Phase& ph, int indent) {
   for (const auto& w : ph.destinations) {
     os_ << pad << "  destination " << name(w.array)
         << (w.onGhosts ? " (real particles and ghosts)" : " (real particles)") << "\n";
+    if (w.ranged())
+    {
+      os_ << pad << "    particles ";
+      if (w.startIdx) printExpr(*w.startIdx, os_); else os_ << "0";
+      os_ << " <= d_idx < ";
+      if (w.stopIdx) printExpr(*w.stopIdx, os_); else os_ << "n";
+      os_ << " (initialize, neighbours, post_loop)\n";
+    }
     if (!w.initialize.empty())
       os_ << pad << "    initialize [" << order(w.perParticle) << "]: " << eqList(w.initialize)
           << "\n";

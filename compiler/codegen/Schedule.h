@@ -65,6 +65,11 @@ struct DestinationWork {
   // after it (empty when the phase ran on the ghosts too).
   std::vector<std::string> ghostRefresh;
   LoopOrder perParticle = LoopOrder::Parallel;  // the initialize and post_loop loops
+  // The group's `start_idx` / `stop_idx` (null: 0 / all particles): initialize, the
+  // neighbour passes and post_loop run on destination particles start <= d_idx < stop only
+  // (clamped to [0, n)); reductions on every real particle.
+  ast::ExprPtr startIdx, stopIdx;
+  bool ranged() const { return startIdx || stopIdx; }
 };
 
 // A fused evaluation of consecutive direct equations of a group (PySPH's Group): per
@@ -99,6 +104,10 @@ struct ScheduleGroup {
   // its iteration statistics.
   std::vector<const PlanEquation*> convergers;
   int statsIndex = -1;
+  // `update_nnps = true`: after the calls (in each iteration of an iterated group), the
+  // neighbour search is rebuilt from the current positions (wrapping into a periodic box,
+  // search domain, cell lists, ghosts), as at the start of an evaluation.
+  bool rebuildNeighbours = false;
 };
 
 // Consecutive stepper statements (initialize, stageN) of the integrator's step, fused: one
@@ -157,6 +166,9 @@ struct Schedule {
   // and with a periodic or mirror domain ghosts), by name.
   std::vector<int> searchArrays;
   std::vector<int> cellLists;
+  // Arrays never permuted into cell order: destinations of a group with start_idx or
+  // stop_idx, whose indices then name the same particles all run long (the set-up order).
+  std::set<int> keepOrder;
   bool domain = false;  // periodic or mirror sides: wrapping, ghosts
   // The integrator's step.
   std::vector<StepperRun> stepperRuns;  // one per distinct run name, in order of first use

@@ -911,6 +911,13 @@ ExprPtr Parser::parsePrimary() {
       auto e = makeExpr(ast::Expr::Name, cur());
       e->text = cur().text.str();
       advance();
+      // `fluid.total`: an array's constant (its first value), as a Name "fluid.total"; sema
+      // says where it may appear (group options start_idx, stop_idx, condition).
+      if (cur().is(Token::Dot) && lex_.peek().is(Token::Identifier)) {
+        advance();
+        e->text += "." + cur().text.str();
+        advance();
+      }
       return e;
     }
     case Token::LParen:

@@ -31,6 +31,28 @@ const char* methodName(ast::Method::Kind k) {
   return names[k];
 }
 
+// start_idx, stop_idx, condition (evaluated at run time).
+void printGroupRunTimeOptions(const PlanGroup& g, llvm::raw_ostream& os) {
+  if (g.startIdx || g.stopIdx) {
+    os << " (particles ";
+    if (g.startIdx)
+      printExpr(*g.startIdx, os);
+    else
+      os << "0";
+    os << " <= d_idx < ";
+    if (g.stopIdx)
+      printExpr(*g.stopIdx, os);
+    else
+      os << "n";
+    os << ")";
+  }
+  if (g.condition) {
+    os << " (when ";
+    printExpr(*g.condition, os);
+    os << ")";
+  }
+}
+
 void printGroup(const Plan& plan, const PlanGroup& g, llvm::raw_ostream& os, int depth,
                 bool report) {
   std::string ind(2 * depth, ' ');
@@ -44,6 +66,8 @@ void printGroup(const Plan& plan, const PlanGroup& g, llvm::raw_ostream& os, int
     os << " steps)";
   }
   if (g.postStep) os << " (after each step)";
+  printGroupRunTimeOptions(g, os);
+  if (g.updateNnps) os << " (then rebuild the neighbour search)";
   os << "\n";
   for (int entry : g.order) {
     if (entry < 0) {

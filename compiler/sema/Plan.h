@@ -88,6 +88,17 @@ struct PlanGroup {
   // instead of in compute_accelerations.
   ast::ExprPtr every;
   bool postStep = false;
+  // `start_idx = A, stop_idx = B` (expressions of params and array constants `arr.c`,
+  // rounded to the nearest integer at each evaluation): the group's direct equations run on
+  // destination particles A <= d_idx < B only (clamped to the particles there are); null:
+  // from 0, to the end. Reductions still see every real particle (PySPH's reduce sees the
+  // whole array). `condition = E` (params, array constants, `t`, `dt`): the group runs only
+  // at evaluations where E is non-zero, tested once before it (and before `pre`).
+  ast::ExprPtr startIdx, stopIdx, condition;
+  // `update_nnps = true`: the neighbour search is rebuilt after the group's members ran
+  // (after each iteration of an iterated group), so that a later group sees positions the
+  // group changed.
+  bool updateNnps = false;
   std::vector<int> equations;                 // direct members, in order
   std::vector<std::unique_ptr<PlanGroup>> subgroups;
   // Order of members: entry >= 0 is equations[entry]; entry < 0 is subgroups[-entry - 1].

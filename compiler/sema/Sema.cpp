@@ -204,6 +204,10 @@ class SemaImpl {
   void buildDomain(const ast::DomainDecl& d);
   void buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g, int depth);
   void instantiate(const ast::EquationInstance& inst, PlanGroup& g);
+  // Group options evaluated at run time from params, array constants (and t, dt):
+  // start_idx, stop_idx, condition.
+  void groupRunTimeOption(const ast::KwArg& kw, PlanGroup& g);
+  bool isArrayConstant(const std::string& n) const;
   int useEquationDecl(const ast::EquationDecl* decl);
   int useStepper(const ast::StepperDecl* decl);
   std::map<std::string, PropShape> propShapes() const;
@@ -799,6 +803,10 @@ void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g
                                     "expression of params)");
         else if (checkSceneExpr(kw.value, "group option 'every'"))
           sub->every = kw.value;
+      } else if (k == "start_idx" || k == "stop_idx" || k == "condition") {
+        groupRunTimeOption(kw, *sub);
+      } else if (k == "update_nnps") {
+        boolValue(sub->updateNnps);
       } else if (k == "post_step") {
         boolValue(sub->postStep);
         if (sub->postStep && depth != 0)
@@ -807,7 +815,8 @@ void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g
       } else
         diags_.error(kw.name.loc, "unknown group option '" + k +
                                       "'; options are: real, iterate, min_iterations, "
-                                      "max_iterations, every, post_step");
+                                      "max_iterations, every, post_step, start_idx, "
+                                      "stop_idx, condition, update_nnps");
     }
     if ((hasMin || hasMax) && !sub->iterate)
       diags_.error(gd.loc, "min_iterations/max_iterations need `iterate = true`");
@@ -818,6 +827,43 @@ void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g
     g.order.push_back(-static_cast<int>(g.subgroups.size()) - 1);
     g.subgroups.push_back(std::move(sub));
   }
+}
+
+// `arr.c`: a `const` declared in array `arr` (the Name the parser makes of `arr.c`).
+bool SemaImpl::isArrayConstant(const std::string& n) const {
+  size_t dot = n.find('.');
+  if (dot == std::string::npos) return false;
+  auto it = arrays_.find(n.substr(0, dot));
+  if (it == arrays_.end()) return false;
+  for (const auto& c : it->second->constants)
+    if (c.name.name == n.substr(dot + 1)) return true;
+  return false;
+}
+
+void SemaImpl::groupRunTimeOption(const ast::KwArg& kw, PlanGroup& g) {
+  const std::string& k = kw.name.name;
+  const bool cond = k == "condition";
+  const std::string takes =
+      cond ? "an expression of params, array constants (`fluid.c`), t and dt"
+           : "a particle index: an expression of params and array constants (`fluid.c`)";
+  if (kw.isList || !kw.value) {
+    diags_.error(kw.name.loc, "group option '" + k + "' takes " + takes);
+    return;
+  }
+  auto known = [&](const std::string& n) {
+    if (isParam(n) || isArrayConstant(n)) return true;
+    if (cond && (n == "t" || n == "dt")) return true;
+    if (n.find('.') != std::string::npos) {
+      diags_.error(kw.value->loc, "'" + n + "' in group option '" + k +
+                                      "' is not a `const` of an array (write `array.const`)");
+      return true;  // reported here
+    }
+    return false;
+  };
+  if (!checkExpr(*kw.value, known, "group option '" + k + "' (it takes " + takes + ")",
+                 diags_))
+    return;
+  (k == "start_idx" ? g.startIdx : k == "stop_idx" ? g.stopIdx : g.condition) = kw.value;
 }
 
 void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
