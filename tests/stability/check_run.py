@@ -10,6 +10,10 @@ particles (array, index, position):
     FAILED (2 problems):
       [no-nan] t = 0.7400: /fluid/rho has 3 non-finite values: fluid[17] at (0.51, 0.02), ...
 
+Energies: sum over the fluid of m (...), with m the written masses, or 1 for every particle
+when the fluid does not write `m` (equal masses: the energies are then per unit particle
+mass, in J/kg, and every energy check is a ratio, so its verdict is the same).
+
 Blanket invariants (every case):
   no-nan        no NaN or Inf in any dataset of any array.
   count         the number of particles of every array is that of the first snapshot.
