@@ -1,0 +1,83 @@
+#!/bin/sh
+# A stability case, in three steps, each of which fails the test when it fails:
+#   1. compile the scene with sphc,
+#   2. run it, writing its snapshots; the exit status must be one of EXPECT_RC (default 0;
+#      "0,3" accepts a run that stopped as a blow-up, exit 3, as long as what it left on disk
+#      passes step 3),
+#   3. check every snapshot with tests/stability/check_run.py (the invariants: see its
+#      docstring).
+#
+# Usage: run_case.sh SPHC SOURCE_DIR SCENE EXE OUT_DIR [-D NAME=CHOICE...] [RUN OPTIONS...]
+#                    [-- CHECK OPTIONS...]
+#   SCENE       the scene, relative to SOURCE_DIR (examples/dambreak.sph)
+#   EXE         the solver to build
+#   OUT_DIR     where the run writes its snapshots (emptied first)
+#   -D NAME=CHOICE  compile-time options of the scene
+#   RUN OPTIONS passed to the solver; "--dt-factor F" (not a solver option) runs a fixed step
+#               of F x DT0, with DT0 given by "--dt0 EXPR" (an awk expression of dx: the
+#               scene's fixed step), and "--set dx=V" sets dx for it
+#   CHECK OPTIONS passed to check_run.py after the output directory
+# Environment: EXPECT_RC (comma-separated accepted exit codes, default 0); SPHC_PYTHON.
+set -eu
+
+if [ $# -lt 5 ]; then
+  echo "usage: $0 SPHC SOURCE_DIR SCENE EXE OUT_DIR [-D NAME=CHOICE...] [RUN OPTIONS...]" \
+       "[-- CHECK OPTIONS...]" >&2
+  exit 2
+fi
+SPHC=$1
+SRC=$2
+SCENE=$3
+EXE=$4
+OUT=$5
+shift 5
+SPHC_OPTS=""
+while [ $# -gt 1 ] && [ "$1" = "-D" ]; do
+  SPHC_OPTS="$SPHC_OPTS -D $2"
+  shift 2
+done
+RUN_OPTS=""
+DX=""
+FACTOR=""
+DT0=""
+while [ $# -gt 0 ] && [ "$1" != "--" ]; do
+  case "$1" in
+    --dt-factor) FACTOR=$2; shift 2; continue ;;
+    --dt0) DT0=$2; shift 2; continue ;;
+    dx=*) DX=${1#dx=} ;;
+  esac
+  RUN_OPTS="$RUN_OPTS $1"
+  shift
+done
+[ $# -gt 0 ] && shift
+if [ -n "$FACTOR" ]; then
+  if [ -z "$DT0" ] || [ -z "$DX" ]; then
+    echo "run_case.sh: --dt-factor needs --dt0 EXPR and --set dx=V" >&2
+    exit 2
+  fi
+  DT=$(awk -v dx="$DX" -v f="$FACTOR" "BEGIN { printf \"%.17g\", f * ($DT0) }")
+  echo "   fixed step: $FACTOR x ($DT0) at dx = $DX: dt = $DT"
+  RUN_OPTS="$RUN_OPTS --dt $DT"
+fi
+
+. "$SRC/tests/validation/common.sh"
+find_python run_case.sh
+fresh_output "$EXE" "$OUT"
+
+echo "== 1. compile: $SPHC $SRC/$SCENE$SPHC_OPTS -o $EXE"
+# shellcheck disable=SC2086  # options are words without spaces
+"$SPHC" "$SRC/$SCENE" $SPHC_OPTS -o "$EXE"
+
+echo "== 2. run: $EXE --quiet --timing -d $OUT$RUN_OPTS"
+start=$(date +%s)
+rc=0
+# shellcheck disable=SC2086
+"$EXE" --quiet --timing -d "$OUT" $RUN_OPTS || rc=$?
+echo "   ran in $(( $(date +%s) - start )) s, exit $rc"
+case ",${EXPECT_RC:-0}," in
+  *",$rc,"*) ;;
+  *) echo "FAILED: the run exited $rc (accepted: ${EXPECT_RC:-0})"; exit 1 ;;
+esac
+
+echo "== 3. check: check_run.py $OUT $*"
+"$PY" "$SRC/tests/stability/check_run.py" "$OUT" "$@"
