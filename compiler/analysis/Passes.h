@@ -2,6 +2,7 @@
 // false when it reported errors. The driver runs them in this order.
 #pragma once
 
+#include "analysis/PlanQueries.h"  // helpers the passes share
 #include "frontend/Diagnostics.h"
 #include "sema/Plan.h"
 
@@ -21,11 +22,5 @@ bool selectPairQuantities(Plan& plan, DiagnosticEngine& diags);
 // analysis/Ghosts.cpp: with a periodic or mirror domain, the properties ghost copies of each
 // source array carry (PlanArray::ghostProps).
 bool selectGhostProperties(Plan& plan, DiagnosticEngine& diags);
-
-// What the adaptive time step reads of a stepped, moving array (h, cs, velocities for the
-// CFL limit; accelerations for the force limit).
-std::vector<std::string> adaptiveDtProps(const Plan& plan);
-// Arrays the adaptive time step looks at: those whose stepper moves them (writes x).
-bool movesParticles(const Plan& plan, int array);
 
 }  // namespace sphc

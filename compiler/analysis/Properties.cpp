@@ -1,5 +1,6 @@
 #include "analysis/Access.h"
 #include "analysis/Passes.h"
+#include "analysis/PlanQueries.h"
 
 #include <map>
 #include <set>

@@ -1,6 +1,7 @@
 #include "codegen/CppEmitter.h"
 
 #include "analysis/Access.h"
+#include "analysis/PairQuantityTable.h"
 #include "analysis/Passes.h"
 #include "body/BodyAnalysis.h"
 #include "sema/Geometry.h"
@@ -361,7 +362,7 @@ std::vector<Emitter::BodyParam> Emitter::bodyParams(const PlanBody& b, int destA
   ps.push_back({real + " dt", BodyParam::Dt, ""});
   for (const auto& q : pairQuantityNames())
     if (f.pairQuantities.count(q)) {
-      bool vec = q == "XIJ" || q == "VIJ" || q == "DWIJ" || q == "DWI" || q == "DWJ";
+      bool vec = findPairQuantity(q)->vector;
       ps.push_back({(vec ? "const " + real + "* " : real + " ") + q, BodyParam::Pair, q});
     }
   for (const auto& s : b.source.scalars)
@@ -656,69 +657,42 @@ void Emitter::emitSetup() {
 void Emitter::emitDestLocals(std::ostream& os, const std::string& indent,
                              const std::set<std::string>& q, bool device) const {
   const std::string R = device ? "real" : real_;
+  // The position, all three axes: the neighbour search takes (xi, yi, zi).
   const char* axes[3] = {"x", "y", "z"};
-  const char* vel[3] = {"u", "v", "w"};
   for (int k = 0; k < 3; ++k)
     os << indent << "const " << R << " " << axes[k] << "i = "
        << (k < plan_.dim ? std::string("di_") + axes[k] + "[d_idx]" : lit("0.0", device))
        << ";\n";
   os << indent << "const " << R << " hi = di_h[d_idx];\n";
-  if (q.count("VIJ"))
-    for (int k = 0; k < plan_.dim; ++k)
-      os << indent << "const " << R << " " << vel[k] << "i = di_" << vel[k] << "[d_idx];\n";
+  // The other vectors of which a pair quantity is a difference (VIJ: ui, vi, wi).
+  for (const PairQuantity& pq : pairQuantityTable())
+    if (pq.form == PairForm::Difference && pq.when != PairWhen::BeforeTest && q.count(pq.name))
+      for (int k = 0; k < plan_.dim; ++k)
+        os << indent << "const " << R << " " << pq.components[k] << "i = di_"
+           << pq.components[k] << "[d_idx];\n";
 }
 
 void Emitter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
                             const std::vector<const PlanEquation*>& loopers, int d, int s,
                             bool device) {
   const std::string R = device ? "real" : real_;
-  auto L = [&](const char* v) { return lit(v, device); };
-  const std::string W = device ? "kernel_w" : "Kernel::w";
-  const std::string GRAD = device ? "kernel_gradient" : "Kernel::gradient";
-  const std::string SQRT = device ? "sqrt" : "std::sqrt";
   const std::string skip = device ? "continue;" : "return;";
-  const char* axes[3] = {"x", "y", "z"};
-  std::vector<std::string> vel = {"u", "v", "w"};
-  vel.resize(plan_.dim);
-  os << "            const " << R << " hj = sj_h[s_idx];\n";
-  os << "            const " << R << " XIJ[3] = {";
-  for (int k = 0; k < 3; ++k)
-    os << (k ? ", " : "")
-           << (k < plan_.dim ? std::string(axes[k]) + "i - sj_" + axes[k] + "[s_idx]"
-                             : L("0.0"));
-  os << "};\n";
-  os << "            const " << R << " R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * "
-            "XIJ[2];\n";
-  os << "            const " << R << " hmax = hi > hj ? hi : hj;\n";
-  os << "            if (R2IJ >= RADIUS2 * hmax * hmax) " << skip << "  // not a neighbour\n";
-  os << "            const " << R << " HIJ = " << L("0.5") << " * (hi + hj);\n";
-  if (q.count("RIJ")) os << "            const " << R << " RIJ = " << SQRT << "(R2IJ);\n";
-  if (q.count("VIJ")) {
-    os << "            const " << R << " VIJ[3] = {";
-    for (int k = 0; k < 3; ++k)
-      os << (k ? ", " : "")
-             << (k < plan_.dim ? vel[k] + "i - sj_" + vel[k] + "[s_idx]" : L("0.0"));
-    os << "};\n";
-  }
-  if (q.count("WIJ")) os << "            const " << R << " WIJ = " << W << "(RIJ, HIJ);\n";
-  if (q.count("WI")) os << "            const " << R << " WI = " << W << "(RIJ, hi);\n";
-  if (q.count("WJ")) os << "            const " << R << " WJ = " << W << "(RIJ, hj);\n";
-  if (q.count("DWIJ"))
-    os << "            " << R << " DWIJ[3];\n"
-              "            " << GRAD << "(XIJ, RIJ, HIJ, DWIJ);\n";
-  if (q.count("DWI"))
-    os << "            " << R << " DWI[3];\n"
-              "            " << GRAD << "(XIJ, RIJ, hi, DWI);\n";
-  if (q.count("DWJ"))
-    os << "            " << R << " DWJ[3];\n"
-              "            " << GRAD << "(XIJ, RIJ, hj, DWJ);\n";
-  if (q.count("RHOIJ"))
-    os << "            const " << R << " RHOIJ = " << L("0.5")
-       << " * (di_rho[d_idx] + sj_rho[s_idx]);\n";
-  if (q.count("RHOIJ1"))
-    os << "            const " << R << " RHOIJ1 = " << L("1.0") << " / RHOIJ;\n";
-  if (q.count("EPS"))
-    os << "            const " << R << " EPS = " << L("0.01") << " * HIJ * HIJ;\n";
+  const std::string indent = "            ";
+  PairDialect dialect;
+  dialect.real = R;
+  dialect.sqrt = device ? "sqrt" : "std::sqrt";
+  dialect.kernelW = device ? "kernel_w" : "Kernel::w";
+  dialect.kernelGradient = device ? "kernel_gradient" : "Kernel::gradient";
+  dialect.literalSuffix = lit("", device);
+  os << indent << "const " << R << " hj = sj_h[s_idx];\n";
+  for (const PairQuantity& pq : pairQuantityTable())
+    if (pq.when == PairWhen::BeforeTest)
+      os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
+  os << indent << "const " << R << " hmax = hi > hj ? hi : hj;\n";
+  os << indent << "if (R2IJ >= RADIUS2 * hmax * hmax) " << skip << "  // not a neighbour\n";
+  for (const PairQuantity& pq : pairQuantityTable())
+    if (pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name)))
+      os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
   for (const auto* eq : loopers) {
     const auto& pd = plan_.equationDecls[eq->declIndex];
     const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Loop)];
@@ -770,13 +744,7 @@ std::vector<Emitter::NeighbourPass> Emitter::neighbourPasses(
           plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(ast::Method::Loop)];
       for (const auto& r : b.facts.sReads) pass.sprops.insert(r.prop);
     }
-    std::vector<std::string> pos = positionProps(plan_.dim);
-    pass.need.insert(pos.begin(), pos.end());
-    pass.need.insert("h");
-    std::vector<std::string> vel = {"u", "v", "w"};
-    vel.resize(plan_.dim);
-    if (pass.q.count("VIJ")) pass.need.insert(vel.begin(), vel.end());
-    if (pass.q.count("RHOIJ")) pass.need.insert("rho");
+    for (const auto& p : pairQuantityProps(plan_.dim, pass.q)) pass.need.insert(p);
     passes.push_back(std::move(pass));
   }
   return passes;
