@@ -12,7 +12,9 @@ namespace sphc {
 // steppers read), output, the adaptive time step or a convergence test as not live.
 bool pruneEquations(Plan& plan, DiagnosticEngine& diags);
 // analysis/Properties.cpp: the exact property set of every array; errors for reads that
-// nothing sets, warnings for writes nothing reads and declarations nothing uses.
+// nothing sets, warnings for writes nothing reads and declarations nothing uses; errors for
+// a body that sees a property with another type than it was checked with (each body is one
+// function, one type per property name), and for `converged` writing particle properties.
 bool inferProperties(Plan& plan, DiagnosticEngine& diags);
 // analysis/Hazards.cpp: within one group, a loop reading a source property that an equation
 // of the same group writes is an error (the result would depend on evaluation order).

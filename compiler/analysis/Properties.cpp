@@ -13,6 +13,75 @@ bool isConstant(const PlanArray& a, const std::string& name) {
   return std::find(a.constants.begin(), a.constants.end(), name) != a.constants.end();
 }
 
+// The element type of `name` in array `a` once its properties are known: constants and
+// properties nobody declares are doubles.
+std::string elementType(const PlanArray& a, const std::string& name) {
+  if (isConstant(a, name)) return "double";
+  const PlanProperty* p = a.find(name);
+  return p ? p->type : "double";
+}
+
+std::string typeWords(const std::string& type) {
+  return type == "int" ? "an int" : type == "uint" ? "a uint" : "a double";
+}
+
+// A body is one function, checked by Clang and emitted once, with one type per d_/s_ property
+// (BodySource::props, by property name). Every array the body sees a property of must store it
+// as that type, or the generated code would not build: a located error otherwise. Also,
+// `converged` runs once per iteration, not per particle: it may write array constants only.
+void checkBodyTypes(const Plan& plan, DiagnosticEngine& diags) {
+  std::set<std::pair<int, std::string>> reported;  // (body, d_/s_ name)
+  auto check = [&](int bodyIdx, const std::vector<PropAccess>& accesses, const char* prefix,
+                   const std::vector<int>& arrays) {
+    const PlanBody& b = plan.bodies[bodyIdx];
+    for (const auto& acc : accesses) {
+      auto shape = b.source.props.find(acc.prop);
+      const std::string checked = shape == b.source.props.end() ? "double" : shape->second.type;
+      // An array of this body with the checked type, to name in the message.
+      const PlanArray* same = nullptr;
+      for (int a : arrays)
+        if (!same && elementType(plan.arrays[a], acc.prop) == checked) same = &plan.arrays[a];
+      for (int a : arrays) {
+        const PlanArray& arr = plan.arrays[a];
+        const std::string actual = elementType(arr, acc.prop);
+        if (actual == checked || !reported.insert({bodyIdx, prefix + acc.prop}).second) continue;
+        diags.error(acc.loc, "property '" + acc.prop + "' is " + typeWords(actual) +
+                                 " in array '" + arr.name + "' but " + typeWords(checked) +
+                                 (same ? " in array '" + same->name + "'"
+                                       : std::string(" in another array")) +
+                                 "; a body (here " + b.source.label +
+                                 ") sees one type per property name");
+        const PlanProperty* p = arr.find(acc.prop);
+        diags.note(p && p->declared ? p->declLoc : arr.loc,
+                   "declare '" + acc.prop + "' with the same type in every array");
+      }
+    }
+  };
+  for (const auto& eq : plan.equations) {
+    if (!eq.live || eq.declIndex < 0) continue;
+    for (const auto& [kind, bodyIdx] : plan.equationDecls[eq.declIndex].methods) {
+      const BodyFacts& f = plan.bodies[bodyIdx].facts;
+      check(bodyIdx, f.dReads, "d_", {eq.dest});
+      check(bodyIdx, f.dWrites, "d_", {eq.dest});
+      if (kind == ast::Method::Loop) check(bodyIdx, f.sReads, "s_", eq.sources);
+      if (kind != ast::Method::Converged) continue;
+      for (const auto& w : f.dWrites)
+        if (!isConstant(plan.arrays[eq.dest], w.prop))
+          diags.error(w.loc, "'converged' runs once per iteration, not per particle: it may "
+                             "write array constants, not the property '" + w.prop +
+                                 "' of array '" + plan.arrays[eq.dest].name + "'");
+    }
+  }
+  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) {
+    if (plan.arrays[a].stepper < 0) continue;
+    for (const auto& [name, bodyIdx] : plan.steppers[plan.arrays[a].stepper].methods) {
+      const BodyFacts& f = plan.bodies[bodyIdx].facts;
+      check(bodyIdx, f.dReads, "d_", {a});
+      check(bodyIdx, f.dWrites, "d_", {a});
+    }
+  }
+}
+
 }  // namespace
 
 bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
@@ -122,6 +191,7 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
     }
     arr.props = std::move(props);
   }
+  if (diags.errorCount() == errorsBefore) checkBodyTypes(plan, diags);
   return diags.errorCount() == errorsBefore;
 }
 

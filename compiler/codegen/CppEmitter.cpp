@@ -383,8 +383,14 @@ std::vector<Emitter::BodyParam> Emitter::bodyParams(const PlanBody& b, int destA
   }
   std::set<std::string> sprops;
   for (const auto& r : f.sReads) sprops.insert(r.prop);
-  for (const auto& p : sprops)
-    ps.push_back({global + "const " + real + "* s_" + p, BodyParam::SProp, p});
+  for (const auto& p : sprops) {
+    // The type the body was checked with, which is the property's type in every source
+    // array (analysis/Properties.cpp checks that).
+    auto shape = b.source.props.find(p);
+    std::string t = shape == b.source.props.end() ? "double" : shape->second.type;
+    std::string type = t == "int" || t == "uint" ? (device ? t : cppType(t)) : real;
+    ps.push_back({global + "const " + type + "* s_" + p, BodyParam::SProp, p});
+  }
   return ps;
 }
 
@@ -823,7 +829,8 @@ void Emitter::emitPhase(const std::vector<int>& eqIds, const std::string& name) 
         scene_ << "        const " << real_ << "* sj_" << p << " = " << propPtr(s, p) << ";\n";
       }
       for (const auto& p : pass.sprops)
-        scene_ << "        const " << real_ << "* s_" << p << " = " << propPtr(s, p) << ";\n";
+        scene_ << "        const " << hostType(s, p) << "* s_" << p << " = " << propPtr(s, p)
+               << ";\n";
       scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
       // Each thread works on its own copies of the array pointers and scalars
       // (default(firstprivate)): shared, the outlined loop reads them through the
@@ -946,7 +953,8 @@ void Emitter::addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int src,
         break;
       case BodyParam::DProp: ka.add(p.decl, devBuffer(dest, p.name), "d_" + p.name); break;
       case BodyParam::SProp:
-        ka.add("__global const real* s_" + p.name, devBuffer(src, p.name), "s_" + p.name);
+        ka.add("__global const " + devType(src, p.name) + "* s_" + p.name,
+               devBuffer(src, p.name), "s_" + p.name);
         break;
       default: break;
     }
@@ -1131,8 +1139,12 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
     const auto& pd = plan_.equationDecls[eq->declIndex];
     const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Converged)];
     scene_ << "      {\n        const int d_idx = 0;\n";
-    std::set<std::string> dprops;
+    std::set<std::string> dprops, written;
     for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
+    // It may write array constants (its state; analysis/Properties.cpp refuses particle
+    // properties): on OpenCL they go to the device after the test.
+    for (const auto& w : b.facts.dWrites) written.insert(w.prop);
+    dprops.insert(written.begin(), written.end());
     // OpenCL: the test runs on the host; constants are current there, properties are not.
     bool needsProps = false;
     for (const auto& p : dprops) needsProps |= constIndex(eq->dest, p) < 0;
@@ -1145,7 +1157,13 @@ void Emitter::emitGroup(const PlanGroup& g, const std::string& name) {
     scene_ << "        converged = converged && "
            << callBody(bodyFunctionName(eq->name, "converged"), b, eq->dest, -1,
                        eqStruct(*eq), "t")
-           << " > 0;  // " << eq->name << ", from " << loc(eq->loc) << "\n      }\n";
+           << " > 0;  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+    if (opencl_)
+      for (const auto& p : written)
+        if (int c = constIndex(eq->dest, p); c >= 0)
+          scene_ << "        dev_" << arr(eq->dest).name << ".upload_constant(ocl, "
+                 << arr(eq->dest).name << ", " << c << ");\n";
+    scene_ << "      }\n";
   }
   scene_ << "      if (converged && iteration >= " << g.minIterations << ") break;\n";
   scene_ << "      if (iteration >= " << g.maxIterations << ") break;\n";
