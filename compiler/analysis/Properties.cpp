@@ -72,6 +72,36 @@ void checkBodyTypes(const Plan& plan, DiagnosticEngine& diags) {
                                  "' of array '" + plan.arrays[eq.dest].name + "'");
     }
   }
+  // What the generated code reads on the bodies' behalf (positions and h for the neighbour
+  // search, what pair quantities read, what the adaptive time step reads) it reads as double
+  // scalars.
+  std::set<std::pair<int, std::string>> implicitReported;
+  auto mustBeDouble = [&](int a, const std::string& prop, const std::string& why,
+                          llvm::SMLoc use, const std::string& useNote) {
+    const PlanArray& arr = plan.arrays[a];
+    const PlanProperty* p = arr.find(prop);
+    if (!p || (p->type == "double" && p->stride == 1) ||
+        !implicitReported.insert({a, prop}).second)
+      return;
+    std::string shape = p->type + (p->stride > 1 ? "[" + std::to_string(p->stride) + "]" : "");
+    diags.error(p->declared ? p->declLoc : arr.loc,
+                "property '" + prop + "' of array '" + arr.name + "' must be a double scalar, not " +
+                    shape + ": " + why + " reads it");
+    if (use.isValid()) diags.note(use, useNote);
+  };
+  for (const auto& eq : plan.equations) {
+    if (!eq.live) continue;
+    for (const auto& acc : equationAccesses(plan, eq))
+      if (acc.implicit)
+        mustBeDouble(acc.array, acc.prop,
+                     "the neighbour loop (neighbour search and pair quantities)", eq.loc,
+                     "in this use of '" + eq.name + "'");
+  }
+  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a)
+    if (movesParticles(plan, a))
+      for (const auto& p : adaptiveDtProps(plan))
+        mustBeDouble(a, p, "the adaptive time step", llvm::SMLoc(), "");
+
   for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) {
     if (plan.arrays[a].stepper < 0) continue;
     for (const auto& [name, bodyIdx] : plan.steppers[plan.arrays[a].stepper].methods) {
