@@ -72,21 +72,32 @@ void checkBodyTypes(const Plan& plan, DiagnosticEngine& diags) {
                                  "' of array '" + plan.arrays[eq.dest].name + "'");
     }
   }
-  // What the generated code reads on the bodies' behalf (positions and h for the neighbour
-  // search, what pair quantities read, what the adaptive time step reads) it reads as double
-  // scalars.
-  std::set<std::pair<int, std::string>> implicitReported;
+  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) {
+    if (plan.arrays[a].stepper < 0) continue;
+    for (const auto& [name, bodyIdx] : plan.steppers[plan.arrays[a].stepper].methods) {
+      const BodyFacts& f = plan.bodies[bodyIdx].facts;
+      check(bodyIdx, f.dReads, "d_", {a});
+      check(bodyIdx, f.dWrites, "d_", {a});
+    }
+  }
+}
+
+// What the generated code reads on the bodies' behalf (positions and h for the neighbour
+// search, what the pair quantities read, what the adaptive time step reads) it reads as
+// double scalars: a located error for any other shape.
+void checkImplicitReads(const Plan& plan, DiagnosticEngine& diags) {
+  std::set<std::pair<int, std::string>> reported;
   auto mustBeDouble = [&](int a, const std::string& prop, const std::string& why,
                           llvm::SMLoc use, const std::string& useNote) {
     const PlanArray& arr = plan.arrays[a];
     const PlanProperty* p = arr.find(prop);
     if (!p || (p->type == "double" && p->stride == 1) ||
-        !implicitReported.insert({a, prop}).second)
+        !reported.insert({a, prop}).second)
       return;
     std::string shape = p->type + (p->stride > 1 ? "[" + std::to_string(p->stride) + "]" : "");
     diags.error(p->declared ? p->declLoc : arr.loc,
-                "property '" + prop + "' of array '" + arr.name + "' must be a double scalar, not " +
-                    shape + ": " + why + " reads it");
+                "property '" + prop + "' of array '" + arr.name +
+                    "' must be a double scalar, not " + shape + ": " + why + " reads it");
     if (use.isValid()) diags.note(use, useNote);
   };
   for (const auto& eq : plan.equations) {
@@ -101,15 +112,6 @@ void checkBodyTypes(const Plan& plan, DiagnosticEngine& diags) {
     if (movesParticles(plan, a))
       for (const auto& p : adaptiveDtProps(plan))
         mustBeDouble(a, p, "the adaptive time step", llvm::SMLoc(), "");
-
-  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) {
-    if (plan.arrays[a].stepper < 0) continue;
-    for (const auto& [name, bodyIdx] : plan.steppers[plan.arrays[a].stepper].methods) {
-      const BodyFacts& f = plan.bodies[bodyIdx].facts;
-      check(bodyIdx, f.dReads, "d_", {a});
-      check(bodyIdx, f.dWrites, "d_", {a});
-    }
-  }
 }
 
 }  // namespace
@@ -221,7 +223,10 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
     }
     arr.props = std::move(props);
   }
-  if (diags.errorCount() == errorsBefore) checkBodyTypes(plan, diags);
+  if (diags.errorCount() == errorsBefore) {
+    checkBodyTypes(plan, diags);
+    checkImplicitReads(plan, diags);
+  }
   return diags.errorCount() == errorsBefore;
 }
 
