@@ -8,30 +8,6 @@ std::vector<std::string> positionProps(int dim) {
   return p;
 }
 
-std::set<std::string> pairQuantityClosure(const std::set<std::string>& used) {
-  // Dependencies between pair quantities, as the generated code computes them.
-  static const std::map<std::string, std::vector<std::string>> deps = {
-      {"RIJ", {"R2IJ"}},          {"R2IJ", {"XIJ"}},
-      {"WIJ", {"RIJ", "HIJ"}},    {"WI", {"RIJ"}},
-      {"WJ", {"RIJ"}},            {"DWIJ", {"XIJ", "RIJ", "HIJ"}},
-      {"DWI", {"XIJ", "RIJ"}},    {"DWJ", {"XIJ", "RIJ"}},
-      {"EPS", {"HIJ"}},           {"RHOIJ1", {"RHOIJ"}}};
-  std::set<std::string> out = used;
-  // XIJ, R2IJ and HIJ are always computed: the neighbour test needs them.
-  out.insert("XIJ");
-  out.insert("R2IJ");
-  bool changed = true;
-  while (changed) {
-    changed = false;
-    for (const auto& q : std::set<std::string>(out)) {
-      auto it = deps.find(q);
-      if (it == deps.end()) continue;
-      for (const auto& d : it->second) changed |= out.insert(d).second;
-    }
-  }
-  return out;
-}
-
 static void addBodyAccesses(std::vector<Access>& out, const BodyFacts& f, int dest,
                             const std::vector<int>& sources, Access proto) {
   for (const auto& r : f.dReads) {
@@ -73,15 +49,8 @@ std::vector<Access> equationAccesses(const Plan& plan, const PlanEquation& eq) {
                     proto);
     if (kind != ast::Method::Loop) continue;
     // What the generated neighbour loop reads for this body.
-    std::set<std::string> q = pairQuantityClosure(f.pairQuantities);
-    std::vector<std::string> implicitProps = positionProps(plan.dim);
-    implicitProps.push_back("h");
-    if (q.count("VIJ")) {
-      std::vector<std::string> vel = {"u", "v", "w"};
-      vel.resize(plan.dim);
-      implicitProps.insert(implicitProps.end(), vel.begin(), vel.end());
-    }
-    if (q.count("RHOIJ")) implicitProps.push_back("rho");
+    std::vector<std::string> implicitProps =
+        pairQuantityProps(plan.dim, pairQuantityClosure(f.pairQuantities));
     std::vector<int> arrays = eq.sources;
     arrays.push_back(eq.dest);
     for (int a : arrays)

@@ -1,9 +1,10 @@
 // Who reads and writes which (array, property): the facts every analysis pass works from.
 // Explicit accesses come from the Clang facts of bodies; implicit ones from what the
-// generated code reads on a body's behalf (positions and h for neighbour search, velocities
-// for VIJ, densities for RHOIJ).
+// generated code reads on a body's behalf (positions and h for neighbour search, and what the
+// pair quantities a loop uses read: analysis/PairQuantityTable.h).
 #pragma once
 
+#include "analysis/PairQuantityTable.h"
 #include "sema/Plan.h"
 
 #include <string>
@@ -29,8 +30,5 @@ std::vector<Access> equationAccesses(const Plan& plan, const PlanEquation& eq);
 std::vector<Access> stepperAccesses(const Plan& plan, int a);
 // The positions an array has in this dimension: x; x, y; x, y, z.
 std::vector<std::string> positionProps(int dim);
-// Pair quantities a loop needs given those its bodies use (closure over dependencies,
-// e.g. DWIJ needs XIJ, RIJ and HIJ).
-std::set<std::string> pairQuantityClosure(const std::set<std::string>& used);
 
 }  // namespace sphc

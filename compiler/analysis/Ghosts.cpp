@@ -1,8 +1,9 @@
 // The ghost pass: with a periodic or mirror domain, the properties that ghost copies of each
 // array's particles must carry. A ghost is read as a neighbour (source) by every loop over its
 // array, and is a destination only of groups with `real = false`; so it carries
-//   - what the neighbour loop reads of a source: positions, h, velocities (VIJ), rho (RHOIJ)
-//     and every s_ property the loop bodies read;
+//   - what the neighbour loop reads of a source: positions, h, what its pair quantities read
+//     (pairQuantityProps: velocities for VIJ, rho for RHOIJ) and every s_ property the loop
+//     bodies read;
 //   - for groups with `real = false` whose destination it is: every d_ property their bodies
 //     read, and what their neighbour loops read of the destination.
 // Properties a `real = false` group writes on ghosts need only storage, which every
@@ -15,18 +16,6 @@
 namespace sphc {
 
 namespace {
-
-std::vector<std::string> neighbourProps(const Plan& plan, const std::set<std::string>& q) {
-  std::vector<std::string> props = positionProps(plan.dim);
-  props.push_back("h");
-  if (q.count("VIJ")) {
-    std::vector<std::string> vel = {"u", "v", "w"};
-    vel.resize(plan.dim);
-    props.insert(props.end(), vel.begin(), vel.end());
-  }
-  if (q.count("RHOIJ")) props.push_back("rho");
-  return props;
-}
 
 void collect(const Plan& plan, const PlanGroup& g, std::vector<std::set<std::string>>& carry,
              std::vector<bool>& isSource) {
@@ -42,7 +31,7 @@ void collect(const Plan& plan, const PlanGroup& g, std::vector<std::set<std::str
         std::set<std::string> q;
         auto it = g.pairQuantities.find({eq.dest, s});
         if (it != g.pairQuantities.end()) q = it->second;
-        for (const auto& p : neighbourProps(plan, pairQuantityClosure(q))) carry[s].insert(p);
+        for (const auto& p : pairQuantityProps(plan.dim, q)) carry[s].insert(p);
         for (const auto& r : f.sReads) carry[s].insert(r.prop);
       }
     }
@@ -52,8 +41,7 @@ void collect(const Plan& plan, const PlanGroup& g, std::vector<std::set<std::str
       for (const auto& r : plan.bodies[b].facts.dReads) carry[eq.dest].insert(r.prop);
     for (const auto& [key, q] : g.pairQuantities)
       if (key.first == eq.dest)
-        for (const auto& p : neighbourProps(plan, pairQuantityClosure(q)))
-          carry[eq.dest].insert(p);
+        for (const auto& p : pairQuantityProps(plan.dim, q)) carry[eq.dest].insert(p);
   }
   for (const auto& sub : g.subgroups) collect(plan, *sub, carry, isSource);
 }

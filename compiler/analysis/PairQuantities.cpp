@@ -1,4 +1,8 @@
+// The pair-quantity pass: per group and (destination, source), the pair quantities its
+// neighbour loop computes: the closure (analysis/PairQuantityTable.h) of those the loop
+// bodies of the group's live equations use.
 #include "analysis/Access.h"
+#include "analysis/PairQuantityTable.h"
 #include "analysis/Passes.h"
 
 namespace sphc {

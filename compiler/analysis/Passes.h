@@ -2,6 +2,7 @@
 // false when it reported errors. The driver runs them in this order.
 #pragma once
 
+#include "analysis/PlanQueries.h"  // helpers the passes share
 #include "frontend/Diagnostics.h"
 #include "sema/Plan.h"
 
@@ -11,7 +12,9 @@ namespace sphc {
 // steppers read), output, the adaptive time step or a convergence test as not live.
 bool pruneEquations(Plan& plan, DiagnosticEngine& diags);
 // analysis/Properties.cpp: the exact property set of every array; errors for reads that
-// nothing sets, warnings for writes nothing reads and declarations nothing uses.
+// nothing sets, warnings for writes nothing reads and declarations nothing uses; errors for
+// a body that sees a property with another type than it was checked with (each body is one
+// function, one type per property name), and for `converged` writing particle properties.
 bool inferProperties(Plan& plan, DiagnosticEngine& diags);
 // analysis/Hazards.cpp: within one group, a loop reading a source property that an equation
 // of the same group writes is an error (the result would depend on evaluation order).
@@ -21,11 +24,5 @@ bool selectPairQuantities(Plan& plan, DiagnosticEngine& diags);
 // analysis/Ghosts.cpp: with a periodic or mirror domain, the properties ghost copies of each
 // source array carry (PlanArray::ghostProps).
 bool selectGhostProperties(Plan& plan, DiagnosticEngine& diags);
-
-// What the adaptive time step reads of a stepped, moving array (h, cs, velocities for the
-// CFL limit; accelerations for the force limit).
-std::vector<std::string> adaptiveDtProps(const Plan& plan);
-// Arrays the adaptive time step looks at: those whose stepper moves them (writes x).
-bool movesParticles(const Plan& plan, int array);
 
 }  // namespace sphc

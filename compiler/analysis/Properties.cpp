@@ -1,5 +1,6 @@
 #include "analysis/Access.h"
 #include "analysis/Passes.h"
+#include "analysis/PlanQueries.h"
 
 #include <map>
 #include <set>
@@ -10,6 +11,107 @@ namespace {
 
 bool isConstant(const PlanArray& a, const std::string& name) {
   return std::find(a.constants.begin(), a.constants.end(), name) != a.constants.end();
+}
+
+// The element type of `name` in array `a` once its properties are known: constants and
+// properties nobody declares are doubles.
+std::string elementType(const PlanArray& a, const std::string& name) {
+  if (isConstant(a, name)) return "double";
+  const PlanProperty* p = a.find(name);
+  return p ? p->type : "double";
+}
+
+std::string typeWords(const std::string& type) {
+  return type == "int" ? "an int" : type == "uint" ? "a uint" : "a double";
+}
+
+// A body is one function, checked by Clang and emitted once, with one type per d_/s_ property
+// (BodySource::props, by property name). Every array the body sees a property of must store it
+// as that type, or the generated code would not build: a located error otherwise. Also,
+// `converged` runs once per iteration, not per particle: it may write array constants only.
+void checkBodyTypes(const Plan& plan, DiagnosticEngine& diags) {
+  std::set<std::pair<int, std::string>> reported;  // (body, d_/s_ name)
+  auto check = [&](int bodyIdx, const std::vector<PropAccess>& accesses, const char* prefix,
+                   const std::vector<int>& arrays) {
+    const PlanBody& b = plan.bodies[bodyIdx];
+    for (const auto& acc : accesses) {
+      auto shape = b.source.props.find(acc.prop);
+      const std::string checked = shape == b.source.props.end() ? "double" : shape->second.type;
+      // An array of this body with the checked type, to name in the message.
+      const PlanArray* same = nullptr;
+      for (int a : arrays)
+        if (!same && elementType(plan.arrays[a], acc.prop) == checked) same = &plan.arrays[a];
+      for (int a : arrays) {
+        const PlanArray& arr = plan.arrays[a];
+        const std::string actual = elementType(arr, acc.prop);
+        if (actual == checked || !reported.insert({bodyIdx, prefix + acc.prop}).second) continue;
+        diags.error(acc.loc, "property '" + acc.prop + "' is " + typeWords(actual) +
+                                 " in array '" + arr.name + "' but " + typeWords(checked) +
+                                 (same ? " in array '" + same->name + "'"
+                                       : std::string(" in another array")) +
+                                 "; a body (here " + b.source.label +
+                                 ") sees one type per property name");
+        const PlanProperty* p = arr.find(acc.prop);
+        diags.note(p && p->declared ? p->declLoc : arr.loc,
+                   "declare '" + acc.prop + "' with the same type in every array");
+      }
+    }
+  };
+  for (const auto& eq : plan.equations) {
+    if (!eq.live || eq.declIndex < 0) continue;
+    for (const auto& [kind, bodyIdx] : plan.equationDecls[eq.declIndex].methods) {
+      const BodyFacts& f = plan.bodies[bodyIdx].facts;
+      check(bodyIdx, f.dReads, "d_", {eq.dest});
+      check(bodyIdx, f.dWrites, "d_", {eq.dest});
+      if (kind == ast::Method::Loop) check(bodyIdx, f.sReads, "s_", eq.sources);
+      if (kind != ast::Method::Converged) continue;
+      for (const auto& w : f.dWrites)
+        if (!isConstant(plan.arrays[eq.dest], w.prop))
+          diags.error(w.loc, "'converged' runs once per iteration, not per particle: it may "
+                             "write array constants, not the property '" + w.prop +
+                                 "' of array '" + plan.arrays[eq.dest].name + "'");
+    }
+  }
+  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) {
+    if (plan.arrays[a].stepper < 0) continue;
+    for (const auto& [name, bodyIdx] : plan.steppers[plan.arrays[a].stepper].methods) {
+      const BodyFacts& f = plan.bodies[bodyIdx].facts;
+      check(bodyIdx, f.dReads, "d_", {a});
+      check(bodyIdx, f.dWrites, "d_", {a});
+    }
+  }
+}
+
+// What the generated code reads on the bodies' behalf (positions and h for the neighbour
+// search, what the pair quantities read, what the adaptive time step reads) it reads as
+// double scalars: a located error for any other shape.
+void checkImplicitReads(const Plan& plan, DiagnosticEngine& diags) {
+  std::set<std::pair<int, std::string>> reported;
+  auto mustBeDouble = [&](int a, const std::string& prop, const std::string& why,
+                          llvm::SMLoc use, const std::string& useNote) {
+    const PlanArray& arr = plan.arrays[a];
+    const PlanProperty* p = arr.find(prop);
+    if (!p || (p->type == "double" && p->stride == 1) ||
+        !reported.insert({a, prop}).second)
+      return;
+    std::string shape = p->type + (p->stride > 1 ? "[" + std::to_string(p->stride) + "]" : "");
+    diags.error(p->declared ? p->declLoc : arr.loc,
+                "property '" + prop + "' of array '" + arr.name +
+                    "' must be a double scalar, not " + shape + ": " + why + " reads it");
+    if (use.isValid()) diags.note(use, useNote);
+  };
+  for (const auto& eq : plan.equations) {
+    if (!eq.live) continue;
+    for (const auto& acc : equationAccesses(plan, eq))
+      if (acc.implicit)
+        mustBeDouble(acc.array, acc.prop,
+                     "the neighbour loop (neighbour search and pair quantities)", eq.loc,
+                     "in this use of '" + eq.name + "'");
+  }
+  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a)
+    if (movesParticles(plan, a))
+      for (const auto& p : adaptiveDtProps(plan))
+        mustBeDouble(a, p, "the adaptive time step", llvm::SMLoc(), "");
 }
 
 }  // namespace
@@ -133,6 +235,10 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
       }
     }
     arr.props = std::move(props);
+  }
+  if (diags.errorCount() == errorsBefore) {
+    checkBodyTypes(plan, diags);
+    checkImplicitReads(plan, diags);
   }
   return diags.errorCount() == errorsBefore;
 }

@@ -42,13 +42,6 @@
 
 namespace sphc {
 
-const std::vector<std::string>& pairQuantityNames() {
-  static const std::vector<std::string> names = {"XIJ", "VIJ", "DWIJ", "DWI", "DWJ",
-                                                 "R2IJ", "RIJ", "HIJ", "WIJ", "WI",
-                                                 "WJ", "RHOIJ", "RHOIJ1", "EPS"};
-  return names;
-}
-
 const std::vector<std::string>& allowedMathFunctions() {
   static const std::vector<std::string> names = {
       "sqrt", "pow",   "exp",  "log",  "log10", "sin",   "cos",  "tan",   "asin", "acos",
@@ -68,15 +61,7 @@ namespace {
 constexpr const char* kUnitName = "<sphc-bodies>.c";
 constexpr llvm::StringLiteral kFunctionPrefix = "__sphc_body_";
 
-// Pair quantities that are 3-vectors; the others are scalars.
-bool isVectorPairQuantity(llvm::StringRef name) {
-  return name == "XIJ" || name == "VIJ" || name == "DWIJ" || name == "DWI" || name == "DWJ";
-}
-
-bool isPairQuantity(const std::string& name) {
-  const auto& q = pairQuantityNames();
-  return std::find(q.begin(), q.end(), name) != q.end();
-}
+bool isPairQuantity(const std::string& name) { return findPairQuantity(name) != nullptr; }
 
 bool isTwoArgumentMathFunction(llvm::StringRef name) {
   return name == "pow" || name == "atan2" || name == "fmin" || name == "fmax" ||
@@ -400,7 +385,9 @@ void Batch::synthesise() {
     params.push_back("const double t");
     params.push_back("const double dt");
     for (const std::string& q : pairQuantityNames())
-      param(isVectorPairQuantity(q) ? "const double " + q + "[const 3]" : "const double " + q, q);
+      param(findPairQuantity(q)->vector ? "const double " + q + "[const 3]"
+                                        : "const double " + q,
+            q);
     std::set<std::string> declared = {"d_idx", "s_idx", "t", "dt"};
     declared.insert(pairQuantityNames().begin(), pairQuantityNames().end());
     for (const std::string& s : b.scalars)

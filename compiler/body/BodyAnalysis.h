@@ -5,6 +5,7 @@
 // Clang: this header is the whole interface.
 #pragma once
 
+#include "analysis/PairQuantityTable.h"
 #include "frontend/Diagnostics.h"
 
 #include "llvm/Support/SMLoc.h"
@@ -52,14 +53,14 @@ struct BodyFacts {
   std::vector<PropAccess> dReads;    // d_ properties read (incl. read in `+=`)
   std::vector<PropAccess> dWrites;   // d_ properties written (=, +=, ++, ...)
   std::vector<PropAccess> sReads;    // s_ properties read
-  std::set<std::string> pairQuantities;  // XIJ, VIJ, R2IJ, RIJ, HIJ, WIJ, WI, WJ, DWIJ, DWI,
-                                         // DWJ, RHOIJ, RHOIJ1, EPS (only in Loop bodies)
+  std::set<std::string> pairQuantities;  // those it uses (analysis/PairQuantityTable.h;
+                                         // only in Loop bodies)
   bool usesT = false, usesDt = false;
   std::set<std::string> scalarsUsed;     // which of BodySource::scalars appear
 };
 
-// The identifiers every body may use, besides d_/s_ properties and the scalars it is given.
-const std::vector<std::string>& pairQuantityNames();
+// The identifiers every body may use, besides d_/s_ properties and the scalars it is given
+// (and, in a loop, the pair quantities: pairQuantityNames()).
 const std::vector<std::string>& allowedMathFunctions();
 // Functions of the scene's smoothing kernel that bodies may call: KERNEL_W(r, h) (the kernel)
 // and KERNEL_DWDR(r, h) (its radial derivative), at any smoothing length h.

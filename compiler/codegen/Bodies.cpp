@@ -2,6 +2,7 @@
 // code of a neighbour pass (pair quantities, then the loop bodies): written once, printed in
 // a Dialect (the C++ of the CPU backends or the OpenCL C of the kernels).
 #include "analysis/Access.h"
+#include "analysis/PairQuantityTable.h"
 #include "body/BodyAnalysis.h"
 #include "codegen/Printer.h"
 
@@ -61,7 +62,7 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b,
   ps.push_back({real + " dt", BodyParam::Dt, ""});
   for (const auto& q : pairQuantityNames())
     if (f.pairQuantities.count(q)) {
-      bool vec = q == "XIJ" || q == "VIJ" || q == "DWIJ" || q == "DWI" || q == "DWJ";
+      bool vec = findPairQuantity(q)->vector;
       ps.push_back({(vec ? "const " + real + "* " : real + " ") + q, BodyParam::Pair, q});
     }
   for (const auto& s : b.source.scalars)
@@ -81,8 +82,14 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b,
   }
   std::set<std::string> sprops;
   for (const auto& r : f.sReads) sprops.insert(r.prop);
-  for (const auto& p : sprops)
-    ps.push_back({global + "const " + real + "* s_" + p, BodyParam::SProp, p});
+  for (const auto& p : sprops) {
+    // The type the body was checked with, which is the property's type in every source
+    // array (analysis/Properties.cpp checks that).
+    auto shape = b.source.props.find(p);
+    std::string t = shape == b.source.props.end() ? "double" : shape->second.type;
+    std::string type = t == "int" ? d.intType : t == "uint" ? d.uintType : real;
+    ps.push_back({global + "const " + type + "* s_" + p, BodyParam::SProp, p});
+  }
   return ps;
 }
 
@@ -181,65 +188,42 @@ std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int
 void ScenePrinter::emitDestLocals(std::ostream& os, const std::string& indent,
                                   const std::set<std::string>& q, const Dialect& d) const {
   const std::string& R = d.real;
+  // The position, all three axes: the neighbour search takes (xi, yi, zi).
   const char* axes[3] = {"x", "y", "z"};
-  const char* vel[3] = {"u", "v", "w"};
   for (int k = 0; k < 3; ++k)
     os << indent << "const " << R << " " << axes[k] << "i = "
        << (k < plan_.dim ? std::string("di_") + axes[k] + "[d_idx]" : d.lit("0.0")) << ";\n";
   os << indent << "const " << R << " hi = di_h[d_idx];\n";
-  if (q.count("VIJ"))
-    for (int k = 0; k < plan_.dim; ++k)
-      os << indent << "const " << R << " " << vel[k] << "i = di_" << vel[k] << "[d_idx];\n";
+  // The other vectors of which a pair quantity is a difference (VIJ: ui, vi, wi).
+  for (const PairQuantity& pq : pairQuantityTable())
+    if (pq.form == PairForm::Difference && pq.when != PairWhen::BeforeTest && q.count(pq.name))
+      for (int k = 0; k < plan_.dim; ++k)
+        os << indent << "const " << R << " " << pq.components[k] << "i = di_"
+           << pq.components[k] << "[d_idx];\n";
 }
 
+// The pair quantities of one candidate, from the table (analysis/PairQuantityTable): those
+// before the neighbour test (XIJ, R2IJ), the test, then every-neighbour and used ones.
 void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::string>& q,
                                       const Dialect& dl) {
   const std::string& R = dl.real;
-  auto L = [&](const char* v) { return dl.lit(v); };
-  const std::string& W = dl.kernelW;
-  const std::string& GRAD = dl.kernelGradient;
-  const char* axes[3] = {"x", "y", "z"};
-  std::vector<std::string> vel = {"u", "v", "w"};
-  vel.resize(plan_.dim);
-  os << "            const " << R << " hj = sj_h[s_idx];\n";
-  os << "            const " << R << " XIJ[3] = {";
-  for (int k = 0; k < 3; ++k)
-    os << (k ? ", " : "")
-       << (k < plan_.dim ? std::string(axes[k]) + "i - sj_" + axes[k] + "[s_idx]" : L("0.0"));
-  os << "};\n";
-  os << "            const " << R << " R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * "
-        "XIJ[2];\n";
-  os << "            const " << R << " hmax = hi > hj ? hi : hj;\n";
-  os << "            if (R2IJ >= RADIUS2 * hmax * hmax) " << dl.skipCandidate
+  const std::string indent = "            ";
+  PairDialect dialect;
+  dialect.real = R;
+  dialect.sqrt = dl.sqrt;
+  dialect.kernelW = dl.kernelW;
+  dialect.kernelGradient = dl.kernelGradient;
+  dialect.literalSuffix = dl.lit("");
+  os << indent << "const " << R << " hj = sj_h[s_idx];\n";
+  for (const PairQuantity& pq : pairQuantityTable())
+    if (pq.when == PairWhen::BeforeTest)
+      os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
+  os << indent << "const " << R << " hmax = hi > hj ? hi : hj;\n";
+  os << indent << "if (R2IJ >= RADIUS2 * hmax * hmax) " << dl.skipCandidate
      << "  // not a neighbour\n";
-  os << "            const " << R << " HIJ = " << L("0.5") << " * (hi + hj);\n";
-  if (q.count("RIJ")) os << "            const " << R << " RIJ = " << dl.sqrt << "(R2IJ);\n";
-  if (q.count("VIJ")) {
-    os << "            const " << R << " VIJ[3] = {";
-    for (int k = 0; k < 3; ++k)
-      os << (k ? ", " : "")
-         << (k < plan_.dim ? vel[k] + "i - sj_" + vel[k] + "[s_idx]" : L("0.0"));
-    os << "};\n";
-  }
-  if (q.count("WIJ")) os << "            const " << R << " WIJ = " << W << "(RIJ, HIJ);\n";
-  if (q.count("WI")) os << "            const " << R << " WI = " << W << "(RIJ, hi);\n";
-  if (q.count("WJ")) os << "            const " << R << " WJ = " << W << "(RIJ, hj);\n";
-  if (q.count("DWIJ"))
-    os << "            " << R << " DWIJ[3];\n"
-       << "            " << GRAD << "(XIJ, RIJ, HIJ, DWIJ);\n";
-  if (q.count("DWI"))
-    os << "            " << R << " DWI[3];\n"
-       << "            " << GRAD << "(XIJ, RIJ, hi, DWI);\n";
-  if (q.count("DWJ"))
-    os << "            " << R << " DWJ[3];\n"
-       << "            " << GRAD << "(XIJ, RIJ, hj, DWJ);\n";
-  if (q.count("RHOIJ"))
-    os << "            const " << R << " RHOIJ = " << L("0.5")
-       << " * (di_rho[d_idx] + sj_rho[s_idx]);\n";
-  if (q.count("RHOIJ1"))
-    os << "            const " << R << " RHOIJ1 = " << L("1.0") << " / RHOIJ;\n";
-  if (q.count("EPS"))
-    os << "            const " << R << " EPS = " << L("0.01") << " * HIJ * HIJ;\n";
+  for (const PairQuantity& pq : pairQuantityTable())
+    if (pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name)))
+      os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
 }
 
 void ScenePrinter::emitCandidate(std::ostream& os, const std::set<std::string>& q,

@@ -147,7 +147,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "        const " << real_ << "* sj_" << p << " = " << propPtr(s, p) << ";\n";
     }
     for (const auto& p : pass.sourceProps)
-      scene_ << "        const " << real_ << "* s_" << p << " = " << propPtr(s, p) << ";\n";
+      scene_ << "        const " << hostType(s, p) << "* s_" << p << " = " << propPtr(s, p)
+             << ";\n";
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     // Each thread works on its own copies of the array pointers and scalars
     // (default(firstprivate)): shared, the outlined loop reads them through the

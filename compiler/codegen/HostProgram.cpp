@@ -262,8 +262,12 @@ void ScenePrinter::emitConverged(const PlanEquation& eq) {
   const auto& pd = plan_.equationDecls[eq.declIndex];
   const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Converged)];
   scene_ << "      if (run_tests) {\n        const int d_idx = 0;\n";
-  std::set<std::string> dprops;
+  std::set<std::string> dprops, written;
   for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
+  // It may write array constants (its state; analysis/Properties.cpp refuses particle
+  // properties): afterConverged sends them where the backend keeps them.
+  for (const auto& w : b.facts.dWrites) written.insert(w.prop);
+  dprops.insert(written.begin(), written.end());
   bool needsProps = false;
   for (const auto& p : dprops) needsProps |= constIndex(eq.dest, p) < 0;
   if (needsProps) beforeConverged(eq);
@@ -272,7 +276,10 @@ void ScenePrinter::emitConverged(const PlanEquation& eq) {
            << ";\n";
   scene_ << "        converged = ("
          << callBody(bodyFunctionName(eq.name, "converged"), b, eq.dest, eqStruct(eq), "t")
-         << " > 0) && converged;  // " << eq.name << ", from " << loc(eq.loc) << "\n      }\n";
+         << " > 0) && converged;  // " << eq.name << ", from " << loc(eq.loc) << "\n";
+  for (const auto& p : written)
+    if (int c = constIndex(eq.dest, p); c >= 0) afterConverged(eq, c);
+  scene_ << "      }\n";
 }
 
 void ScenePrinter::emitPhase(const Phase& ph) {

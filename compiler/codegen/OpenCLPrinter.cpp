@@ -40,6 +40,11 @@ class OpenCLPrinter : public ScenePrinter {
     scene_ << "        dev_" << arr(eq.dest).name << ".download(ocl, " << arr(eq.dest).name
            << ");\n";
   }
+  // ... and constants it wrote go back to the device.
+  void afterConverged(const PlanEquation& eq, int c) override {
+    scene_ << "        dev_" << arr(eq.dest).name << ".upload_constant(ocl, " << arr(eq.dest).name
+           << ", " << c << ");\n";
+  }
   void steppers() override;
   void stepperCall(const StepStatement& st,
                    const std::function<std::string(int)>& timeAfter) override;
@@ -199,7 +204,8 @@ void OpenCLPrinter::addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int
         break;
       case BodyParam::DProp: ka.add(p.decl, devBuffer(dest, p.name), "d_" + p.name); break;
       case BodyParam::SProp:
-        ka.add("__global const real* s_" + p.name, devBuffer(src, p.name), "s_" + p.name);
+        ka.add("__global const " + devType(src, p.name) + "* s_" + p.name,
+               devBuffer(src, p.name), "s_" + p.name);
         break;
       default: break;
     }

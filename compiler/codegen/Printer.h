@@ -71,6 +71,8 @@ class ScenePrinter {
   virtual void destination(const DestinationWork& w, const std::string& phase) = 0;
   // Before a `converged` test reads properties on the host.
   virtual void beforeConverged(const PlanEquation& eq) {}
+  // After a `converged` test wrote the array constant of index c on the host.
+  virtual void afterConverged(const PlanEquation& eq, int c) {}
   virtual void steppers() = 0;
   // One run of stepper statements in step(), with the time of each statement.
   virtual void stepperCall(const StepStatement& st,

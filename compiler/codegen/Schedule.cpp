@@ -1,6 +1,7 @@
 #include "codegen/Schedule.h"
 
 #include "analysis/Access.h"
+#include "analysis/PairQuantityTable.h"
 #include "analysis/Passes.h"
 #include "frontend/ASTPrinter.h"
 #include "frontend/Diagnostics.h"
@@ -228,13 +229,7 @@ std::vector<NeighbourPass> ScheduleBuilder::neighbourPasses(
       for (const auto& r : body(*eq, ast::Method::Loop).facts.sReads)
         pass.sourceProps.insert(r.prop);
     }
-    std::vector<std::string> pos = positionProps(plan_.dim);
-    pass.shared.insert(pos.begin(), pos.end());
-    pass.shared.insert("h");
-    std::vector<std::string> vel = {"u", "v", "w"};
-    vel.resize(plan_.dim);
-    if (pass.pairQuantities.count("VIJ")) pass.shared.insert(vel.begin(), vel.end());
-    if (pass.pairQuantities.count("RHOIJ")) pass.shared.insert("rho");
+    for (const auto& p : pairQuantityProps(plan_.dim, pass.pairQuantities)) pass.shared.insert(p);
     passes.push_back(std::move(pass));
   }
   return passes;
