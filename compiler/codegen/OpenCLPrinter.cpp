@@ -204,7 +204,7 @@ void OpenCLPrinter::addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int
         break;
       case BodyParam::DProp: ka.add(p.decl, devBuffer(dest, p.name), "d_" + p.name); break;
       case BodyParam::SProp:
-        ka.add("__global const " + devType(src, p.name) + "* s_" + p.name,
+        ka.add("__global const " + propType(src, p.name, device_) + "* s_" + p.name,
                devBuffer(src, p.name), "s_" + p.name);
         break;
       default: break;
