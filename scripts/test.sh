@@ -10,4 +10,6 @@ BUILD=${SPHC_BUILD_DIR:-build}
 # Generated solvers are cached by content hash; tests use a cache of their own.
 export SPHC_CACHE_DIR="$PWD/$BUILD/sphc-cache"
 cd "$BUILD"
+# The long stability cases (hours in all) run only when asked for: ctest -L stability-long.
+if [ $# -eq 0 ]; then set -- -LE stability-long; fi
 ctest --output-on-failure -j"$(nproc)" "$@"
