@@ -85,6 +85,7 @@ const char* kindName(BodyKind kind) {
     case BodyKind::Converged: return "converged";
     case BodyKind::StepperInit: return "initialize";
     case BodyKind::StepperStage: return "stage";
+    case BodyKind::Function: return "function";
   }
   return "body";
 }
@@ -277,8 +278,28 @@ class Batch {
   // The .sph `}` closing body `i`.
   llvm::SMLoc closingBrace(int i) const {
     const BodySource& b = bodies_[i];
-    return b.start.isValid() ? llvm::SMLoc::getFromPointer(b.start.getPointer() + b.text.size())
+    // A function's text ends with its `}`; a body's text ends just before it.
+    size_t at = b.text.size() - (b.kind == BodyKind::Function && !b.text.empty() ? 1 : 0);
+    return b.start.isValid() ? llvm::SMLoc::getFromPointer(b.start.getPointer() + at)
                              : llvm::SMLoc();
+  }
+
+  // The helper function (BodyKind::Function) that `fn` is the definition of, or -1.
+  int functionOf(const clang::SourceManager& sm, const clang::FunctionDecl* fn) const {
+    const clang::FunctionDecl* def = fn ? fn->getDefinition() : nullptr;
+    if (!def) return -1;
+    int j = bodyAt(sm, def->getLocation());
+    if (j < 0 || bodies_[j].kind != BodyKind::Function ||
+        def->getName() != bodies_[j].functionName)
+      return -1;
+    return j;
+  }
+  // The helper function named `name`, or -1.
+  int functionNamed(llvm::StringRef name) const {
+    for (size_t j = 0; j < bodies_.size(); ++j)
+      if (bodies_[j].kind == BodyKind::Function && bodies_[j].functionName == name)
+        return static_cast<int>(j);
+    return -1;
   }
 
   // Reports a diagnostic of body `i`, counting the errors it causes (warnings may be errors).
@@ -373,6 +394,19 @@ void Batch::synthesise() {
         if (ch != '\n') ch = ' ';
       tokens = BodyTokens();
       state[i].blanked = true;
+    }
+
+    if (b.kind == BodyKind::Function) {
+      // A helper function is its own C definition, copied as written.
+      DiagnosticEngine::Position pos = diags_.position(b.start);
+      unit_ += "#line " + std::to_string(pos.line ? pos.line : 1) + " " +
+               quoted(pos.file.empty() ? "<function>" : pos.file) + "\n";
+      unit_ += std::string(pos.col ? pos.col - 1 : 0, ' ');
+      regions_[i].textBegin = unit_.size();
+      unit_ += text;
+      regions_[i].end = unit_.size() ? unit_.size() - 1 : 0;
+      unit_ += "\n";
+      continue;
     }
 
     // Only the names the body mentions become parameters (besides indices and time).
@@ -486,6 +520,24 @@ class DiagnosticForwarder : public clang::DiagnosticConsumer {
     const clang::SourceManager& sm = info.getSourceManager();
     llvm::SMLoc loc = batch_.toSph(sm, info.getLocation(), i);
     BodyKind kind = batch_.body(i).kind;
+    if (kind == BodyKind::Function) {
+      // A helper is plain C: Clang's own messages say it best, except for these.
+      switch (info.getID()) {
+        case clang::diag::ext_implicit_function_decl:
+        case clang::diag::ext_implicit_lib_function_decl:
+        case clang::diag::warn_implicit_function_decl:
+          return true;  // the AST walk reports every call it does not allow
+        case clang::diag::warn_falloff_nonvoid_function:
+          batch_.reportMissingReturn(i);
+          return true;
+        case clang::diag::err_conflicting_types:
+          // Only after an implicit declaration by an earlier call (names are unique): that
+          // call was reported as calling a function declared after it.
+          return true;
+        default:
+          return false;
+      }
+    }
     switch (info.getID()) {
       case clang::diag::ext_implicit_function_decl:
       case clang::diag::ext_implicit_lib_function_decl:
@@ -555,6 +607,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
 
   void check(clang::FunctionDecl* fn) {
     batch_.state[i_].checked = true;
+    if (body_.kind == BodyKind::Function) checkSignature(fn);
     TraverseStmt(fn->getBody());
     if (returnsValue(body_.kind) && !returnsValue_) batch_.reportMissingReturn(i_);
   }
@@ -575,6 +628,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   }
 
   bool VisitArraySubscriptExpr(clang::ArraySubscriptExpr* e) {
+    if (body_.kind == BodyKind::Function) return true;  // no properties in helpers
     auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(e->getBase()->IgnoreParenImpCasts());
     if (!ref || !isPropertyParam(ref)) return true;
     indexed_.insert(ref);
@@ -602,6 +656,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
       return true;
     }
     if (!llvm::isa<clang::ParmVarDecl>(decl)) return true;
+    if (body_.kind == BodyKind::Function) return true;  // its parameters are the user's
     std::string name = decl->getName().str();
     if (isPropertyParam(e)) {
       if (!indexed_.count(e) && recovering_ == 0)
@@ -644,12 +699,30 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(callee)) callees_.insert(ref);
     clang::FunctionDecl* fn = call->getDirectCallee();
     if (fn && isAllowedMath(fn)) return true;
+    if (int j = batch_.functionOf(sm_, fn); j >= 0) {
+      if (j == i_)
+        error(callee->getBeginLoc(), "function '" + fn->getName() + "' calls itself: recursion "
+                                     "is not allowed (OpenCL C has none); use a loop");
+      else
+        checkArraySizes(call, fn);
+      return true;
+    }
+    if (fn) {
+      int j = batch_.functionNamed(fn->getName());
+      if (j >= 0 && j != i_) {
+        error(callee->getBeginLoc(), "function '" + fn->getName() + "' is declared after this "
+                                     "one: a function may call only functions declared "
+                                     "before it");
+        return true;
+      }
+    }
     std::string list;
     for (const std::string& f : allowedMathFunctions()) list += (list.empty() ? "" : ", ") + f;
     std::string what = fn ? "call of '" + fn->getName().str() + "'" : std::string("this call");
     error(callee->getBeginLoc(), what + " is not allowed: bodies may call only the math.h "
                                         "functions " + list +
-                                        " and the kernel's KERNEL_W(r, h), KERNEL_DWDR(r, h)");
+                                        ", the kernel's KERNEL_W(r, h), KERNEL_DWDR(r, h) "
+                                        "and the .sph file's functions");
     return true;
   }
 
@@ -686,6 +759,43 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   }
 
  private:
+  // A helper's parameters: values or arrays (`double a[9]`), never pointers or `...`.
+  void checkSignature(clang::FunctionDecl* fn) {
+    for (clang::ParmVarDecl* p : fn->parameters()) {
+      if (containsPointer(p->getOriginalType()))
+        error(p->getLocation(), "pointer parameters are not allowed in functions; declare an "
+                                "array parameter, e.g. 'double a[3]'");
+      else if (p->getOriginalType()->isIncompleteArrayType())
+        error(p->getLocation(), "an array parameter needs its size, e.g. 'double a[3]'");
+    }
+    if (fn->isVariadic())
+      error(fn->getLocation(), "variadic functions ('...') are not allowed");
+  }
+
+  // An array argument must be at least as long as the array parameter it is passed to (C
+  // does not check; out of bounds is undefined on every backend).
+  void checkArraySizes(clang::CallExpr* call, clang::FunctionDecl* fn) {
+    for (unsigned k = 0; k < call->getNumArgs() && k < fn->getNumParams(); ++k) {
+      const auto* want = llvm::dyn_cast_or_null<clang::ConstantArrayType>(
+          fn->getParamDecl(k)->getOriginalType()->getAsArrayTypeUnsafe());
+      if (!want) continue;
+      const clang::Expr* arg = call->getArg(k)->IgnoreParenImpCasts();
+      const auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(arg);
+      if (!ref) continue;
+      clang::QualType type = ref->getDecl()->getType();
+      if (auto* p = llvm::dyn_cast<clang::ParmVarDecl>(ref->getDecl())) type = p->getOriginalType();
+      const auto* have = llvm::dyn_cast_or_null<clang::ConstantArrayType>(
+          type->getAsArrayTypeUnsafe());
+      if (have && have->getSize().ult(want->getSize()))
+        error(arg->getBeginLoc(), "array '" + ref->getDecl()->getName() + "' has " +
+                                      llvm::Twine(have->getSize().getZExtValue()) +
+                                      " elements; parameter '" +
+                                      fn->getParamDecl(k)->getName() + "' of '" +
+                                      fn->getName() + "' needs " +
+                                      llvm::Twine(want->getSize().getZExtValue()));
+    }
+  }
+
   llvm::SMLoc sph(clang::SourceLocation loc) const { return batch_.toSph(sm_, loc, i_); }
   void error(clang::SourceLocation loc, const llvm::Twine& msg) { batch_.error(i_, sph(loc), msg); }
 
@@ -756,7 +866,12 @@ class BodyConsumer : public clang::ASTConsumer {
   bool HandleTopLevelDecl(clang::DeclGroupRef group) override {
     for (clang::Decl* d : group) {
       auto* fn = llvm::dyn_cast<clang::FunctionDecl>(d);
-      if (!fn || !fn->hasBody() || !fn->getName().startswith(kFunctionPrefix)) continue;
+      if (!fn || !fn->hasBody()) continue;
+      if (int j = batch_.functionOf(fn->getASTContext().getSourceManager(), fn); j >= 0) {
+        BodyChecker(batch_, j, fn->getASTContext().getSourceManager()).check(fn);
+        continue;
+      }
+      if (!fn->getName().startswith(kFunctionPrefix)) continue;
       unsigned index = 0;
       if (fn->getName().drop_front(kFunctionPrefix.size()).getAsInteger(10, index))
         SPHC_INTERNAL("unexpected body function " + fn->getName());
@@ -794,7 +909,11 @@ std::vector<BodyFacts> BodyAnalyzer::analyze(const std::vector<BodySource>& bodi
                         "-fno-caret-diagnostics",  // also: no "N errors generated." on stderr
                         "-Wall", "-Wuninitialized", "-Wsometimes-uninitialized",
                         "-Werror=implicit-function-declaration", "-Werror=implicit-int",
-                        "-Werror=return-type", "-Werror=vla", kUnitName};
+                        "-Werror=return-type", "-Werror=vla",
+                        // helpers take arrays: passing the wrong kind is an error in C++ too
+                        "-Werror=incompatible-pointer-types",
+                        "-Werror=incompatible-pointer-types-discards-qualifiers",
+                        "-Werror=int-conversion", kUnitName};
   auto invocation = std::make_shared<clang::CompilerInvocation>();
   {
     // Our own arguments: any complaint about them is a bug in sphc.

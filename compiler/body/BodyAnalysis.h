@@ -24,7 +24,9 @@ enum class BodyKind {
   Reduce,       // equation: per destination particle, `return` a double
   Converged,    // equation: once, `return` an int (>0 converged, <0 not, 0 no opinion)
   StepperInit,  // stepper initialize: per particle
-  StepperStage  // stepper stageN: per particle
+  StepperStage, // stepper stageN: per particle
+  Function      // helper function: `text` is the whole C definition (from its return type to
+                // its closing `}`); bodies and later functions may call it
 };
 
 // How a property is stored, for typing `d_NAME` / `s_NAME` in the synthesised function.
@@ -41,6 +43,7 @@ struct BodySource {
   std::string label;                 // for messages: "equation TaitEOS, method initialize"
   std::vector<std::string> scalars;  // double constants visible by name (params, consts)
   std::map<std::string, PropShape> props;  // known property shapes (by property name)
+  std::string functionName;          // Function: the name it defines
 };
 
 struct PropAccess {
@@ -72,6 +75,8 @@ class BodyAnalyzer {
   // Analyses all bodies in one Clang invocation; facts[i] belongs to bodies[i]. Errors
   // (Clang's and sphc's portability rules) are reported through the DiagnosticEngine at
   // .sph locations.
+  // Helper functions (BodyKind::Function) must come before the bodies that call them, in the
+  // order in which they may call each other.
   std::vector<BodyFacts> analyze(const std::vector<BodySource>& bodies);
 
  private:

@@ -112,11 +112,26 @@ void ScenePrinter::emitBodyFunction(const PlanBody& b, const std::string& name,
   os << "\n";
 }
 
+// A helper function (`function double f(...) { }`), as written after `function`: a plain C
+// definition, the same in C++ and OpenCL C.
+void ScenePrinter::emitHelperFunction(const PlanBody& f, const Dialect& d,
+                                      std::ostringstream& os) {
+  os << "// " << f.source.label << ", from " << loc(f.source.start) << "\n";
+  if (d.lineDirectives) emitLineDirective(os, f.source.start);
+  std::string text = d.floatBodies ? singlePrecisionBody(f.source.text) : f.source.text;
+  os << d.functionPrefix << text << "\n";
+  if (d.lineDirectives) resetLineDirective(os, d);
+  os << "\n";
+}
+
 // KERNEL_W(r, h) and KERNEL_DWDR(r, h), the scene's kernel and its radial derivative at any
 // smoothing length, for bodies that call them (e.g. a kernel at h/2); emitted only then.
 void ScenePrinter::emitKernelFunctions() {
   bool used = false;
   for (const auto& b : plan_.bodies)
+    for (const std::string& f : kernelFunctions())
+      used |= b.source.text.find(f) != std::string::npos;
+  for (const auto& b : plan_.functions)
     for (const std::string& f : kernelFunctions())
       used |= b.source.text.find(f) != std::string::npos;
   if (!used) return;

@@ -563,6 +563,12 @@ std::string ScenePrinter::kernelSource() {
 // The functions of equation and stepper bodies (each declaration once), where they run.
 void ScenePrinter::emitBodies() {
   emitKernelFunctions();
+  // The .sph file's helper functions, before the bodies that call them: on the host (the C++
+  // of the CPU backends, and the host-run converged tests of OpenCL) and in the kernels.
+  for (const auto& f : plan_.functions) {
+    emitHelperFunction(f, host_, out_);
+    if (bodyOnDevice(false)) emitHelperFunction(f, device_, cl_);
+  }
   // Bodies of live equations (each declaration once) and of steppers.
   std::set<int> emittedDecls;
   for (const auto& eq : plan_.equations) {

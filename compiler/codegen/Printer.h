@@ -100,6 +100,7 @@ class ScenePrinter {
   void emitBodyFunction(const PlanBody& b, const std::string& name, const std::string& ret,
                         int destArray, const Dialect& d, std::ostringstream& os);
   void emitKernelFunctions();
+  void emitHelperFunction(const PlanBody& f, const Dialect& d, std::ostringstream& os);
   // eqValues + sep + scalar: "eq3.rho0" on the host, "eq3_rho0" (a kernel argument) on the
   // device.
   std::string callBody(const std::string& fn, const PlanBody& b, int dest,

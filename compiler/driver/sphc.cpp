@@ -172,11 +172,14 @@ int main(int argc, char** argv) {
   if (dump(Pass::Sema)) return 0;
 
   {
+    // Helper functions first: the bodies call them.
     std::vector<BodySource> sources;
+    for (const auto& f : plan->functions) sources.push_back(f.source);
     for (const auto& b : plan->bodies) sources.push_back(b.source);
     auto facts = BodyAnalyzer(diags).analyze(sources);
-    for (size_t i = 0; i < facts.size() && i < plan->bodies.size(); ++i)
-      plan->bodies[i].facts = facts[i];
+    size_t nf = plan->functions.size();
+    for (size_t i = 0; i < facts.size(); ++i)
+      (i < nf ? plan->functions[i] : plan->bodies[i - nf]).facts = facts[i];
   }
   log("bodies");
   if (diags.hasErrors()) return fail();

@@ -147,6 +147,17 @@ struct EquationDecl {
   std::vector<Method> methods;
 };
 
+// `function double NAME(PARAMS) { C99 }`: a helper function that bodies (and later helpers)
+// may call. The parser checks the return type and the name; the parameters and the body are
+// C99 for Clang (body/BodyAnalysis). `text` runs from the return type to the closing `}`
+// inclusive, so Clang's positions in the signature map back to the .sph file too.
+struct FunctionDecl {
+  Ident name;
+  std::string returnType;       // double, int, void
+  llvm::SMLoc loc;              // the `function` keyword
+  Body text;                    // the whole definition without the `function` keyword
+};
+
 struct StepperMethod {
   Ident name;                   // "initialize", "stage1", "stage2", ...
   Body body;
@@ -262,6 +273,7 @@ struct Module {
   std::vector<ParamDecl> params;
   std::vector<ArrayDecl> arrays;
   std::vector<EquationDecl> equations;
+  std::vector<FunctionDecl> functions;
   std::vector<StepperDecl> steppers;
   std::vector<IntegratorDecl> integrators;
   std::vector<SceneDecl> scenes;

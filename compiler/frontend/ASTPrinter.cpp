@@ -67,6 +67,10 @@ class Printer {
     }
     for (const auto& a : mod.arrays) array(a);
     for (const auto& eq : mod.equations) equation(eq);
+    for (const auto& f : mod.functions) {
+      decl(0, "function", f.name) << " returns " << f.returnType;
+      body(f.text);
+    }
     for (const auto& s : mod.steppers) {
       decl(0, "stepper", s.name) << "\n";
       for (const auto& m : s.methods) {

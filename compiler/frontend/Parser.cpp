@@ -14,7 +14,8 @@ using ast::ExprPtr;
 namespace {
 
 constexpr llvm::StringLiteral kTopLevelKeywords[] = {
-    "import", "option", "param", "let", "array", "equation", "stepper", "integrator", "scene"};
+    "import", "option", "param", "let", "array", "equation", "function", "stepper", "integrator",
+    "scene"};
 
 // `stage` followed by one or more digits.
 bool isStageName(llvm::StringRef word) {
@@ -199,11 +200,12 @@ bool Parser::parseItem(ast::Module& mod) {
   if (atWord("param") || atWord("let")) return parseParam(mod);
   if (atWord("array")) return parseArray(mod);
   if (atWord("equation")) return parseEquation(mod);
+  if (atWord("function")) return parseFunction(mod);
   if (atWord("stepper")) return parseStepper(mod);
   if (atWord("integrator")) return parseIntegrator(mod);
   if (atWord("scene")) return parseScene(mod);
   const char* expected =
-      "import, option, param, let, array, equation, stepper, integrator or scene";
+      "import, option, param, let, array, equation, function, stepper, integrator or scene";
   if (cur().is(Token::Identifier))
     return error(cur().loc, "unknown declaration " + quoted(cur().text) + ": expected " + expected);
   return error(cur().loc, "expected a declaration (" + llvm::Twine(expected) + "), found " +
@@ -508,6 +510,40 @@ bool Parser::parseReduce(ast::EquationDecl& eq) {
       !parseBody(method.body, "reduce", "equation " + quoted(eq.name.name)))
     return false;
   eq.methods.push_back(std::move(method));
+  return true;
+}
+
+// `function TYPE NAME(PARAMS) { BODY }`. The parameters are skipped here as tokens up to the
+// matching `)` (Clang checks them); the definition's text is kept whole from TYPE to `}`.
+bool Parser::parseFunction(ast::Module& mod) {
+  ast::FunctionDecl fn;
+  fn.loc = cur().loc;
+  advance();
+  const char* start = cur().text.begin();
+  if (!(atWord("double") || atWord("int") || atWord("void")))
+    return error(cur().loc, "expected the return type of a function after 'function': double, "
+                            "int or void (as in `function double NAME(double a) { ... }`)");
+  fn.returnType = cur().text.str();
+  advance();
+  if (!parseIdent(fn.name, "expected a function name after 'function " + fn.returnType + "'"))
+    return false;
+  std::string what = "function " + quoted(fn.name.name);
+  if (!expect(Token::LParen, "after the name of " + what)) return false;
+  for (int depth = 1; depth > 0;) {
+    if (cur().is(Token::Eof) || cur().is(Token::LBrace) || cur().is(Token::RBrace) ||
+        cur().is(Token::Semi))
+      return error(cur().loc, "expected ')' to end the parameters of " + what + ", found " +
+                                  describe(cur()));
+    if (cur().is(Token::LParen)) ++depth;
+    if (cur().is(Token::RParen)) --depth;
+    advance();
+  }
+  ast::Body body;
+  if (!parseBody(body, "function", what)) return false;
+  const char* end = body.start.getPointer() + body.text.size() + 1;  // after the `}`
+  fn.text.start = llvm::SMLoc::getFromPointer(start);
+  fn.text.text = std::string(start, end);
+  mod.functions.push_back(std::move(fn));
   return true;
 }
 

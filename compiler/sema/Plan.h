@@ -164,6 +164,10 @@ struct Plan {
   std::vector<PlanEquation> equations;
   std::vector<PlanStepper> steppers;
   std::vector<PlanBody> bodies;
+  // Helper functions (`function double f(...) { }`) of every module, callees first (imported
+  // modules before the modules importing them, each in declaration order): analysed with the
+  // bodies and emitted once, before them, into the C++ and the OpenCL source.
+  std::vector<PlanBody> functions;
   PlanDomain domain;                          // periodic and mirror boundaries
   std::vector<PlanLimit> limits;              // what the run watches (limits { })
   PlanGroup root;                             // the scene's equations { } as a group

@@ -198,6 +198,7 @@ class SemaImpl {
   bool checkSceneExpr(const ast::ExprPtr& e, const std::string& what) {
     return e && checkExpr(*e, [this](const std::string& n) { return isParam(n); }, what, diags_);
   }
+  void buildFunctions();
   void buildArrays();
   void checkGeometry(const ast::GeometryDecl& g, const std::string& array);
   void buildScene();
@@ -221,6 +222,7 @@ class SemaImpl {
   std::map<std::string, const ast::ArrayDecl*> arrays_;
   std::map<std::string, const ast::EquationDecl*> equations_;
   std::map<std::string, const ast::StepperDecl*> steppers_;
+  std::map<std::string, const ast::FunctionDecl*> functions_;
   std::map<std::string, const ast::IntegratorDecl*> integrators_;
   std::map<const ast::EquationDecl*, int> usedEquations_;
   std::map<const ast::StepperDecl*, int> usedSteppers_;
@@ -274,9 +276,83 @@ std::unique_ptr<Plan> SemaImpl::run() {
   plan_->sceneName = plan_->scene->name.name;
 
   buildArrays();
+  buildFunctions();
   buildScene();
   if (diags_.hasErrors()) return nullptr;
   return std::move(plan_);
+}
+
+// Names a helper function may not take: they would collide with what the generated C++ and
+// OpenCL C already declare (keywords, math and OpenCL built-in functions, the kernel functions,
+// the generated code's own names).
+static bool isReservedFunctionName(const std::string& n) {
+  static const std::set<std::string> reserved = {
+      // C99 and C++ keywords, OpenCL C qualifiers and types
+      "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else",
+      "enum", "extern", "float", "for", "goto", "if", "inline", "int", "long", "register",
+      "restrict", "return", "short", "signed", "sizeof", "static", "struct", "switch",
+      "typedef", "union", "unsigned", "void", "volatile", "while", "bool", "true", "false",
+      "class", "namespace", "new", "delete", "template", "this", "operator", "private",
+      "public", "protected", "virtual", "friend", "using", "typename", "try", "catch", "throw",
+      "explicit", "mutable", "constexpr", "nullptr", "noexcept", "decltype", "and", "or",
+      "not", "xor", "kernel", "global", "local", "constant", "read_only", "write_only", "half",
+      "uint", "uchar", "ushort", "ulong", "size_t", "real", "main",
+      // OpenCL C built-in functions (math, common, geometric, integer, relational, work-item)
+      "acosh", "acospi", "asinh", "asinpi", "atanh", "atanpi", "atan2pi", "cospi", "erfc",
+      "exp2", "exp10", "expm1", "fdim", "fma", "fract", "frexp", "ilogb", "ldexp", "lgamma",
+      "log2", "log1p", "logb", "mad", "maxmag", "minmag", "modf", "nan", "nextafter", "pown",
+      "powr", "remainder", "remquo", "rint", "rootn", "rsqrt", "sincos", "sinpi", "tanpi",
+      "tgamma", "abs", "abs_diff", "clamp", "degrees", "radians", "max", "min", "mix", "sign",
+      "step", "smoothstep", "cross", "dot", "distance", "length", "normalize", "fast_length",
+      "fast_distance", "fast_normalize", "select", "isnan", "isinf", "isfinite", "signbit",
+      "any", "all", "bitselect", "mul24", "mad24", "clz", "popcount", "rotate", "upsample",
+      "hadd", "rhadd", "barrier", "get_global_id", "get_local_id", "get_group_id",
+      "get_global_size", "get_local_size", "get_num_groups", "get_work_dim", "printf",
+      // the generated code's names
+      "DIM", "Kernel", "RADIUS2", "Scene", "kernel_w", "kernel_gradient", "std", "sphc"};
+  if (reserved.count(n)) return true;
+  for (const std::string& f : allowedMathFunctions())
+    if (n == f) return true;
+  for (const std::string& f : kernelFunctions())
+    if (n == f) return true;
+  return n.empty() || n[0] == '_' || n.find("__") != std::string::npos ||
+         llvm::StringRef(n).startswith("sphc_") || llvm::StringRef(n).startswith("d_") ||
+         llvm::StringRef(n).startswith("s_") || llvm::StringRef(n).startswith("di_") ||
+         llvm::StringRef(n).startswith("sj_");
+}
+
+// Helper functions of all modules, callees first: modules in reverse load order (an imported
+// module before the one importing it), each module's in declaration order.
+void SemaImpl::buildFunctions() {
+  for (auto m = modules_.rbegin(); m != modules_.rend(); ++m)
+    for (const auto& f : (*m)->functions) {
+      if (isReservedFunctionName(f.name.name)) {
+        diags_.error(f.name.loc, "'" + f.name.name + "' cannot name a function: it is a keyword "
+                                 "or a name the generated C++ or OpenCL code already uses "
+                                 "(e.g. a math or OpenCL built-in function, or d_/s_/_ "
+                                 "prefixed); choose another name");
+        continue;
+      }
+      auto [it, inserted] = functions_.emplace(f.name.name, &f);
+      if (!inserted) {
+        diags_.error(f.name.loc, "redefinition of function '" + f.name.name + "'");
+        diags_.note(it->second->name.loc, "previous definition is here");
+        continue;
+      }
+      if (equations_.count(f.name.name) || steppers_.count(f.name.name) ||
+          arrays_.count(f.name.name) || isParam(f.name.name)) {
+        diags_.error(f.name.loc, "function '" + f.name.name + "' has the name of an equation, "
+                                 "stepper, array or parameter; choose another name");
+        continue;
+      }
+      PlanBody body;
+      body.source.text = f.text.text;
+      body.source.start = f.text.start;
+      body.source.kind = BodyKind::Function;
+      body.source.label = "function " + f.name.name;
+      body.source.functionName = f.name.name;
+      plan_->functions.push_back(std::move(body));
+    }
 }
 
 void SemaImpl::buildArrays() {
