@@ -310,12 +310,8 @@ void CpuPrinter::searchDomain() {
 }
 
 std::string CpuPrinter::cellListBuild(const std::string& S, const std::string& count) const {
-  const char* axes[3] = {"x", "y", "z"};
-  const int s = plan_.arrayIndex(S);
-  std::string b = "cells_" + S + ".build(domain";
-  for (int k = 0; k < 3; ++k)
-    b += ", " + (k >= plan_.dim ? std::string("nullptr") : propPtr(s, axes[k]));
-  return b + ", " + count + ");";
+  return cellListBuildCall(S, count, "domain",
+                           [&](int a, const std::string& axis) { return propPtr(a, axis); });
 }
 
 // update_neighbours of a scene with a periodic or mirror domain: the search domain of the

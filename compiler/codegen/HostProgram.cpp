@@ -640,4 +640,15 @@ void ScenePrinter::emitSceneMembers() {
   }
 }
 
+std::string ScenePrinter::cellListBuildCall(
+    const std::string& S, const std::string& count, const std::string& on,
+    const std::function<std::string(int, const std::string&)>& coord) const {
+  const char* axes[3] = {"x", "y", "z"};
+  const int s = plan_.arrayIndex(S);
+  std::string b = "cells_" + S + ".build(" + on;
+  for (int k = 0; k < 3; ++k)
+    b += ", " + (k >= plan_.dim ? std::string("nullptr") : coord(s, axes[k]));
+  return b + ", " + count + ");";
+}
+
 }  // namespace sphc

@@ -143,12 +143,8 @@ void OpenCLPrinter::dataMovement() {
 }
 
 std::string OpenCLPrinter::cellListBuild(const std::string& S, const std::string& count) const {
-  const char* axes[3] = {"x", "y", "z"};
-  const int s = plan_.arrayIndex(S);
-  std::string b = "cells_" + S + ".build(ocl, grid";
-  for (int k = 0; k < 3; ++k)
-    b += ", " + (k >= plan_.dim ? std::string("nullptr") : devBuffer(s, axes[k]));
-  return b + ", " + count + ");";
+  return cellListBuildCall(S, count, "ocl, grid",
+                           [&](int a, const std::string& axis) { return devBuffer(a, axis); });
 }
 
 // update_neighbours of a scene without periodic or mirror domain, on the device: the search

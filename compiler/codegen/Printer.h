@@ -154,6 +154,11 @@ class ScenePrinter {
   // ---- Shared helpers ----
   // The data a scene computes on: host arrays, or their float copies (--precision=single).
   std::string propPtr(int array, const std::string& prop) const;
+  // `cells_S.build(ON, x, y|nullptr, z|nullptr, COUNT);` with each coordinate as coord(a, axis)
+  // gives it (host pointer or device buffer): the one cell-list build statement.
+  std::string cellListBuildCall(
+      const std::string& S, const std::string& count, const std::string& on,
+      const std::function<std::string(int, const std::string&)>& coord) const;
   // The host array's own data (set-up writes it).
   std::string hostPtr(int array, const std::string& prop) const;
   // The C++ type of a property or constant in the scene's host loops.
