@@ -1,4 +1,5 @@
 #include "sema/Sema.h"
+#include "sema/Metrics.h"
 
 #include "frontend/Parser.h"
 #include "sema/Geometry.h"
@@ -659,6 +660,7 @@ void SemaImpl::buildScene() {
   }
 
   for (const auto& l : s.limits) buildLimits(l);
+  buildMetrics(s, *plan_, diags_, [this](const std::string& n) { return isParam(n); });
 
   plan_->root.loc = s.equationsLoc;
   buildGroup(s.equations, plan_->root, 0);
