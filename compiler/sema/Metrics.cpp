@@ -192,7 +192,7 @@ void MetricsBuilder::item(const ast::MetricItem& it) {
   if (m.isNorm()) {
     if (!exact) {
       diags_.error(it.kind.loc, "the norm " + head + " needs 'exact = EXPR' (an expression of "
-                                "x, y, z, t and params)");
+                                "x, y, z, t, params and properties)");
       return;
     }
     if (reference) {
@@ -204,23 +204,15 @@ void MetricsBuilder::item(const ast::MetricItem& it) {
   }
   if (exact) {
     m.exact = exact->value;
-    // Norms: per particle, of its position; scalars: of the time only.
-    const bool perParticle = m.isNorm();
-    ok &= checkExpr(
-        *m.exact,
-        [&](const std::string& n) {
-          return n == "t" || isParam_(n) || (perParticle && isCoordinate(n));
-        },
-        std::string("the exact value of ") + head +
-            (perParticle ? " (it may use x, y, z, t and params)" : " (it may use t and params)"),
-        diags_);
-    if (perParticle) {
-      std::set<std::string> names;
-      namesOf(*m.exact, names);
-      const char* axes[3] = {"x", "y", "z"};
-      for (int k = 0; k < plan_.dim; ++k)
-        if (names.count(axes[k]) && !isParam_(axes[k])) props.insert(axes[k]);
-    }
+    // Norms: per particle, like the measured expression (x, y, z, t, params and the array's
+    // properties, e.g. an initial position for a Lagrangian exact solution); scalars: of the
+    // time and params only.
+    if (m.isNorm())
+      ok &= particleExpr(m.exact, m.array, "the exact value of " + head, props);
+    else
+      ok &= checkExpr(
+          *m.exact, [&](const std::string& n) { return n == "t" || isParam_(n); },
+          "the exact value of " + head + " (it may use t and params)", diags_);
   }
   for (const char* n : {"column", "abscissa", "at"})
     if (arg(n) && !reference) {
