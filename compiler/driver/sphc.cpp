@@ -61,6 +61,10 @@ static cl::opt<sphc::Precision, false, NamedValues<sphc::Precision>> PrecisionOp
                clEnumValN(sphc::Precision::Single, "single", "float")),
     cl::cat(SphcCat));
 enum class EmitKind { Exe, Cpp, OpenCL, Plan, Ast };
+static cl::opt<std::string> KernelOpt(
+    "kernel", cl::desc("Replace the scene's smoothing kernel (CubicSpline, QuinticSpline, "
+                       "WendlandQuintic, ...; sphc study --vary kernel=...)"),
+    cl::value_desc("name"), cl::cat(SphcCat));
 static cl::opt<EmitKind, false, NamedValues<EmitKind>> Emit(
     "emit", cl::desc("What to produce:"), cl::init(EmitKind::Exe),
     cl::values(clEnumValN(EmitKind::Exe, "exe", "the solver executable (default)"),
@@ -169,6 +173,13 @@ int main(int argc, char** argv) {
   log("sema");
   if (!plan || diags.hasErrors()) return fail();
   plan->options = options;
+  if (!KernelOpt.empty()) {
+    std::string why;
+    if (!overrideKernel(*plan, KernelOpt, why)) {
+      llvm::errs() << "sphc: error: --kernel: " << why << "\n";
+      return fail();
+    }
+  }
   auto dump = [&](Pass pass) {
     if (DumpAfter != pass) return false;
     printPlan(*plan, llvm::outs(), false);

@@ -9,9 +9,10 @@ Builds and runs the cross product of the variants and collects, per run, the par
 steps, wall and CPU seconds of the time loop, the peak memory and every metric of the scene
 (its `metrics { }`). A varied NAME is
 
-  - backend or precision: sphc's --backend / --precision (a rebuild, through sphc's cache);
-  - a compile-time option of the scene (`option NAME in [...]`; kernel too, where the scene
-    makes its kernel an option): sphc -D NAME=v (a rebuild, through the cache);
+  - backend, precision or kernel: sphc's --backend / --precision / --kernel (a rebuild,
+    through sphc's build cache);
+  - a compile-time option of the scene (`option NAME in [...]`): sphc -D NAME=v (a rebuild,
+    through the cache);
   - threads: the solver's --threads;
   - otherwise a parameter of the scene: the solver's --set NAME=v (no rebuild).
 
@@ -45,7 +46,7 @@ import subprocess
 import sys
 import time
 
-SPHC_FLAGS = {"backend": "--backend", "precision": "--precision"}
+SPHC_FLAGS = {"backend": "--backend", "precision": "--precision", "kernel": "--kernel"}
 
 
 def fail(msg, code=2):
@@ -133,7 +134,7 @@ def solver_help(exe):
 def classify(varies, options, params):
     kinds = {}
     for name, values in varies:
-        if name in SPHC_FLAGS:
+        if name in SPHC_FLAGS and name not in options:
             kinds[name] = "sphc"
         elif name == "threads":
             kinds[name] = "threads"
@@ -151,13 +152,9 @@ def classify(varies, options, params):
                     fail("--vary %s: parameter values are numbers, not '%s'" % (name, v))
             kinds[name] = "param"
         else:
-            hint = ""
-            if name == "kernel":
-                hint = (" (to vary the kernel, make it an option of the scene: `option kernel "
-                        "in [CubicSpline, WendlandQuintic] = ...;` and `when kernel == ...`)")
             fail("--vary %s: not a parameter (%s), a compile-time option (%s), backend, "
-                 "precision or threads%s" % (name, ", ".join(params) or "none",
-                                             ", ".join(options) or "none", hint))
+                 "precision, kernel or threads" % (name, ", ".join(params) or "none",
+                                                   ", ".join(options) or "none"))
     return kinds
 
 
