@@ -3,7 +3,7 @@
 
     sphc study SCENE.sph --vary NAME=v1,v2,... [--vary ...] [--tf T] [--repeat N]
                [--threads N] [--set NAME=V ...] [--budget METRIC<=VALUE ...]
-               [--resolution NAME] -o DIR
+               [--metric COLUMN ...] [--cost wall_s|cpu_s] [--resolution NAME] -o DIR
 
 Builds and runs the cross product of the variants and collects, per run, the particles,
 steps, wall and CPU seconds of the time loop, the peak memory and every metric of the scene
@@ -17,11 +17,13 @@ steps, wall and CPU seconds of the time loop, the peak memory and every metric o
   - otherwise a parameter of the scene: the solver's --set NAME=v (no rebuild).
 
 Output in DIR: study.csv (one row per run; a study started again with the same DIR reuses the
-runs already in it), summary.txt (the runs, the Pareto front of each metric against wall time,
+runs already in it), summary.txt (the runs, the Pareto front of each metric against the cost,
 the cheapest variant within each error level, the observed convergence orders, and the
 answers to --budget), and, where matplotlib is installed, for each metric M
-M_vs_wall.{png,svg} (log-log, the Pareto front marked, every point labelled with its variant)
-and M_convergence.{png,svg} (M against the resolution parameter, with the fitted order).
+M_vs_wall.{png,svg} (M_vs_cpu with --cost cpu_s; log-log, the Pareto front marked, every
+point labelled with its variant) and M_convergence.{png,svg} (M against the resolution
+parameter, with the fitted order). The cost is the time loop's wall time, or with --cost
+cpu_s its CPU time (on a loaded machine the wall time measures the load as much as the run).
 
 Per run and metric column C of the solver's metric file, study.csv has C (its value at the
 last output where it is finite) and C_max (the largest |C| over the outputs). The error of a
@@ -46,6 +48,7 @@ import subprocess
 import sys
 import time
 
+COST = "wall_s"  # --cost
 SPHC_FLAGS = {"backend": "--backend", "precision": "--precision", "kernel": "--kernel"}
 
 
@@ -74,6 +77,9 @@ def parse_args(argv):
     ap.add_argument("--metric", action="append", default=[], metavar="COLUMN",
                     help="analyse and plot only these columns of the metrics (repeatable; "
                          "default: every column)")
+    ap.add_argument("--cost", choices=("wall_s", "cpu_s"), default="wall_s",
+                    help="the cost the fronts, levels and budgets use: the time loop's wall "
+                         "seconds (default) or its CPU seconds (fairer on a loaded machine)")
     ap.add_argument("--resolution", help="the varied parameter the convergence plot and the "
                     "orders use (default: the first varied parameter whose values are "
                     "numbers)")
@@ -297,9 +303,9 @@ def per_variant(rows, names):
             continue
         key = tuple(r[n] for n in names)
         best = groups.get(key)
-        if best is None or num(r, "wall_s") < num(best, "wall_s"):
+        if best is None or num(r, COST) < num(best, COST):
             groups[key] = r
-    return [(key, groups[key]) for key in sorted(groups, key=lambda k: num(groups[k], "wall_s"))]
+    return [(key, groups[key]) for key in sorted(groups, key=lambda k: num(groups[k], COST))]
 
 
 def metric_columns(rows, fixed):
@@ -351,7 +357,8 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
     lines = []
     p = lines.append
     p("sphc study: %d runs, %d variants (%s)" % (len(rows), len(variants), ", ".join(names)))
-    p("wall_s: the time loop's wall seconds (the fastest of the repeats); cpu_s its CPU seconds")
+    p("wall_s, cpu_s: the time loop's wall and CPU seconds; cost: %s (of each variant, the "
+      "repeat with the least)" % COST)
     p("")
     head = ["variant", "particles", "steps", "wall_s", "cpu_s", "peak_rss_mb"] + cols
     table = [[variant_label(zip(names, k)), r.get("particles", ""), r.get("steps", ""),
@@ -363,14 +370,14 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
     p("")
     fronts = {}
     for c in cols:
-        pts = [(num(r, "wall_s"), abs(num(r, c))) for _, r in variants]
+        pts = [(num(r, COST), abs(num(r, c))) for _, r in variants]
         if not any(math.isfinite(e) for _, e in pts):
             continue
         front = pareto(pts)
         fronts[c] = front
-        p("%s against wall time: Pareto front (no variant is both faster and more accurate):" % c)
+        p("%s against %s: Pareto front (no variant is both cheaper and more accurate):" % (c, COST))
         for i in front:
-            p("  %-40s wall %8.4g s  |%s| %.4g" % (variant_label(zip(names, variants[i][0])),
+            p("  %-40s cost %8.4g s  |%s| %.4g" % (variant_label(zip(names, variants[i][0])),
                                                  pts[i][0], c, pts[i][1]))
         finite = sorted(e for _, e in pts if math.isfinite(e) and e > 0)
         if finite:
@@ -384,7 +391,7 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
                     p("    |%s| <= %-8.0e none" % (c, level))
                     continue
                 i = min(ok, key=lambda j: pts[j][0])
-                p("    |%s| <= %-8.0e %s (wall %.4g s)" % (c, level, variant_label(
+                p("    |%s| <= %-8.0e %s (cost %.4g s)" % (c, level, variant_label(
                     zip(names, variants[i][0])), pts[i][0]))
         p("")
     orders = {}
@@ -414,19 +421,19 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
         if metric not in cols:
             p("  no such column; columns: %s" % ", ".join(cols))
             continue
-        meets = [(num(r, "wall_s"), k, r) for k, r in variants if abs(num(r, metric)) <= limit]
+        meets = [(num(r, COST), k, r) for k, r in variants if abs(num(r, metric)) <= limit]
         if meets:
             w, k, r = min(meets)
-            p("  cheapest: %s (wall %.4g s, |%s| = %.4g)" % (variant_label(zip(names, k)), w,
+            p("  cheapest: %s (cost %.4g s, |%s| = %.4g)" % (variant_label(zip(names, k)), w,
                                                            metric, abs(num(r, metric))))
         else:
             p("  no variant measured meets it")
         for k, r in variants:
             v = abs(num(r, metric))
             if not v <= limit:
-                p("  misses: %-40s |%s| = %.4g, %.3g x the budget (wall %.4g s)"
+                p("  misses: %-40s |%s| = %.4g, %.3g x the budget (cost %.4g s)"
                   % (variant_label(zip(names, k)), metric, v, v / limit if limit else
-                     float("inf"), num(r, "wall_s")))
+                     float("inf"), num(r, COST)))
         p("")
     text = "\n".join(lines) + "\n"
     with open(os.path.join(outdir, "summary.txt"), "w") as f:
@@ -447,7 +454,7 @@ def plot(variants, names, cols, fronts, orders, resolution, outdir):
     for c in cols:
         if c not in fronts:
             continue
-        pts = [(num(r, "wall_s"), abs(num(r, c))) for _, r in variants]
+        pts = [(num(r, COST), abs(num(r, c))) for _, r in variants]
         ok = [i for i, (w, e) in enumerate(pts) if w > 0 and e > 0 and math.isfinite(e)]
         if not ok:
             continue
@@ -461,13 +468,13 @@ def plot(variants, names, cols, fronts, orders, resolution, outdir):
             ax.annotate(variant_label(zip(names, variants[i][0])), pts[i], fontsize=7,
                         xytext=(4, 3), textcoords="offset points",
                         weight="bold" if i in fr else "normal")
-        ax.set_xlabel("wall time of the time loop [s]")
+        ax.set_xlabel("%s time of the time loop [s]" % ("wall" if COST == "wall_s" else "CPU"))
         ax.set_ylabel("|%s|" % c)
-        ax.set_title("%s against wall time" % c)
+        ax.set_title("%s against %s" % (c, COST))
         ax.legend(fontsize=8)
         fig.tight_layout()
         for ext in ("png", "svg"):
-            fig.savefig(os.path.join(outdir, "%s_vs_wall.%s" % (c, ext)), dpi=120)
+            fig.savefig(os.path.join(outdir, "%s_vs_%s.%s" % (c, COST[:-2], ext)), dpi=120)
         plt.close(fig)
         mine = {k: v for k, v in orders.items() if k[0] == c}
         if not mine:
@@ -494,6 +501,8 @@ def plot(variants, names, cols, fronts, orders, resolution, outdir):
 
 def main(argv):
     args, varies, budgets = parse_args(argv)
+    global COST
+    COST = args.cost
     if not os.path.exists(args.scene):
         fail("%s: no such file" % args.scene)
     out = args.output
