@@ -9,6 +9,13 @@ namespace sphc {
 
 namespace {
 
+// The first metric of array a that reads property p (metrics { }), or null.
+const PlanMetric* metricReading(const Plan& plan, int a, const std::string& p) {
+  for (const auto& m : plan.metrics)
+    if (m.array == a && std::find(m.reads.begin(), m.reads.end(), p) != m.reads.end()) return &m;
+  return nullptr;
+}
+
 bool isConstant(const PlanArray& a, const std::string& name) {
   return std::find(a.constants.begin(), a.constants.end(), name) != a.constants.end();
 }
@@ -151,6 +158,11 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
       readByOthers.insert(p);
       note(p);
     }
+    for (const auto& p : arr.metricProps) {  // the scene's metrics { } read them at run time
+      if (isConstant(arr, p)) continue;      // an array constant: on the host already
+      readByOthers.insert(p);
+      note(p);
+    }
     if (movesParticles(plan, a))
       for (const auto& p : adaptiveDtProps(plan)) {
         readByOthers.insert(p);
@@ -207,6 +219,10 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
           if (r.equation >= 0 && !r.implicit)
             diags.note(plan.equations[r.equation].loc,
                        "in this use of '" + plan.equations[r.equation].name + "'");
+        } else if (const PlanMetric* m = metricReading(plan, static_cast<int>(a), p.name);
+                   m && !p.output) {
+          diags.error(m->loc, "property '" + p.name + "' of array '" + arr.name +
+                                  "' is read by metric '" + m->name + "' but nothing sets it");
         } else {
           const bool limited = std::find(arr.limitProps.begin(), arr.limitProps.end(),
                                          p.name) != arr.limitProps.end();

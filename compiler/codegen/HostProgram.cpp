@@ -502,6 +502,7 @@ void ScenePrinter::emitMain() {
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   if (timesNeighbourSearch()) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
   if (!plan_.limits.empty()) emitLimits();
+  emitMetricsMain();
   bool anyOutput = false;
   for (const auto& a : plan_.arrays) anyOutput |= !a.outputProps.empty();
   for (const auto& a : plan_.arrays) {
@@ -532,6 +533,7 @@ std::string ScenePrinter::run() {
   for (const auto& a : plan_.arrays) anyLoad |= !a.decl->loads.empty();
   if (anyLoad) out_ << "#include \"sphc/load.h\"\n";
   if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
+  if (!plan_.metrics.empty()) out_ << "#include \"sphc/metrics.h\"\n";
   runtimeIncludes();
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   systemIncludes();
@@ -601,6 +603,7 @@ void ScenePrinter::emitSceneFunctions() {
   steppers();
   emitStep();
   emitAdaptiveDt();
+  emitMetrics();
 }
 
 

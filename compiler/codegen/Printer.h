@@ -150,6 +150,9 @@ class ScenePrinter {
   // The SceneProgram of `main`: name, params, options, set-up, arrays, step, outputs.
   void emitMain();
   void emitLimits();
+  // metrics { } (MetricsPrinter.cpp): Scene::metrics(t), and their descriptions in main.
+  void emitMetrics();
+  void emitMetricsMain();
 
   // ---- Shared helpers ----
   // The data a scene computes on: host arrays, or their float copies (--precision=single).

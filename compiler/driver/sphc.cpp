@@ -6,6 +6,7 @@
 #include "body/BodyAnalysis.h"
 #include "codegen/CppEmitter.h"
 #include "driver/Build.h"
+#include "driver/Study.h"
 #include "frontend/ASTPrinter.h"
 #include "frontend/Diagnostics.h"
 #include "sema/Options.h"
@@ -60,6 +61,10 @@ static cl::opt<sphc::Precision, false, NamedValues<sphc::Precision>> PrecisionOp
                clEnumValN(sphc::Precision::Single, "single", "float")),
     cl::cat(SphcCat));
 enum class EmitKind { Exe, Cpp, OpenCL, Plan, Ast };
+static cl::opt<std::string> KernelOpt(
+    "kernel", cl::desc("Replace the scene's smoothing kernel (CubicSpline, QuinticSpline, "
+                       "WendlandQuintic, ...; sphc study --vary kernel=...)"),
+    cl::value_desc("name"), cl::cat(SphcCat));
 static cl::opt<EmitKind, false, NamedValues<EmitKind>> Emit(
     "emit", cl::desc("What to produce:"), cl::init(EmitKind::Exe),
     cl::values(clEnumValN(EmitKind::Exe, "exe", "the solver executable (default)"),
@@ -111,11 +116,15 @@ static cl::opt<bool> Verbose("v", cl::desc("Print the build command and timings"
 static int fail() { return 1; }
 
 int main(int argc, char** argv) {
+  // `sphc study ...`: variants of a scene, their cost and accuracy (driver/Study.cpp).
+  if (argc > 1 && std::string(argv[1]) == "study") return sphc::runStudy(argc, argv);
   llvm::InitLLVM init(argc, argv);
   cl::HideUnrelatedOptions(SphcCat);
   cl::SetVersionPrinter([](llvm::raw_ostream& os) { os << "sphc 0.1.0\n"; });
   cl::ParseCommandLineOptions(argc, argv,
-                              "sphc: compiles a .sph SPH scene into a solver executable\n");
+                              "sphc: compiles a .sph SPH scene into a solver executable\n\n"
+                              "  sphc study SCENE.sph --vary NAME=v1,v2 ... -o DIR: runs variants "
+                              "and reports what accuracy costs in time (sphc study --help)\n");
   auto t0 = std::chrono::steady_clock::now();
   auto log = [&](const char* what) {
     if (!Verbose) return;
@@ -164,6 +173,13 @@ int main(int argc, char** argv) {
   log("sema");
   if (!plan || diags.hasErrors()) return fail();
   plan->options = options;
+  if (!KernelOpt.empty()) {
+    std::string why;
+    if (!overrideKernel(*plan, KernelOpt, why)) {
+      llvm::errs() << "sphc: error: --kernel: " << why << "\n";
+      return fail();
+    }
+  }
   auto dump = [&](Pass pass) {
     if (DumpAfter != pass) return false;
     printPlan(*plan, llvm::outs(), false);

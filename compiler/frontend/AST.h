@@ -248,6 +248,30 @@ struct LimitsDecl {
   std::vector<LimitItem> items;
 };
 
+// `metrics { NAME = KIND(ARRAY, EXPR, key = value, ...); }`: what the solver measures at output
+// times (docs/language.md, Metrics). KIND: L1, L2, Linf (a norm against `exact`), max, min,
+// sum, mean (a scalar, compared with `exact` or `reference` if given).
+struct MetricArg {
+  Ident name;
+  ExprPtr value;                // an expression, unless isString
+  bool isString = false;
+  std::string text;             // the string's contents
+  llvm::SMLoc loc;              // the value
+};
+
+struct MetricItem {
+  Ident name;
+  Ident kind;
+  Ident array;
+  ExprPtr expr;                 // per particle: properties of the array, params, t
+  std::vector<MetricArg> args;
+};
+
+struct MetricsDecl {
+  llvm::SMLoc loc;              // the `metrics` keyword
+  std::vector<MetricItem> items;
+};
+
 struct SceneDecl {
   Ident name;
   std::vector<SceneSetting> settings;
@@ -258,6 +282,7 @@ struct SceneDecl {
   std::vector<OutputDecl> outputs;
   std::vector<DomainDecl> domains;  // sema allows one
   std::vector<LimitsDecl> limits;
+  std::vector<MetricsDecl> metrics;
   llvm::SMLoc equationsLoc;
   std::vector<GroupItem> equations;
   std::vector<std::shared_ptr<When<SceneDecl>>> whens;  // the chosen branch's items are

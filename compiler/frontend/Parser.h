@@ -97,6 +97,9 @@ class Parser {
   bool parseLimits(ast::SceneDecl& scene);
   bool parseLimitItem(ast::LimitsDecl& limits);
   bool parseLimitBound(ast::LimitBound& bound, const std::string& head);
+  // metrics { } (ParseMetrics.cpp)
+  bool parseMetrics(ast::SceneDecl& scene);
+  bool parseMetricItem(ast::MetricsDecl& metrics);
   bool parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth);
   // After `(`: `kwarg, ...)`, consuming the `)`.
   bool parseKwArgs(std::vector<ast::KwArg>& args);

@@ -42,6 +42,7 @@ struct PlanArray {
   int stepper = -1;                      // index into Plan::steppers
   std::vector<std::string> outputProps;  // as listed in the scene's output
   std::vector<std::string> limitProps;   // what the scene's limits read (speed: u, v, w)
+  std::vector<std::string> metricProps;  // what the scene's metrics read (sema/Metrics.cpp)
   // With a periodic or mirror domain: the properties ghost copies of this array's particles
   // carry (what the source side of a loop reads, and what groups with `real = false` read
   // on it), filled by the ghost pass; empty when the array is no source.
@@ -138,6 +139,27 @@ struct PlanLimit {
   ast::ExprPtr warnLo, warnHi, stopLo, stopHi;
 };
 
+// One metric of the scene's `metrics { }` (docs/language.md, Metrics; sema/Metrics.cpp):
+// evaluated on the host at every output time (runtime/include/sphc/metrics.h).
+struct PlanMetric {
+  enum Kind { L1, L2, Linf, Max, Min, Sum, Mean };
+  llvm::SMLoc loc;                            // the metric's name
+  std::string name;
+  Kind kind = L1;
+  int array = -1;
+  ast::ExprPtr expr;                          // per particle
+  ast::ExprPtr exact;                         // norms: per particle; scalars: of t and params
+  ast::ExprPtr where;                         // per particle; null: every particle
+  ast::ExprPtr at;                            // the reference's abscissa at time t (default t)
+  bool relative = false;
+  std::string reference;                      // the table's file, as written
+  std::string column, abscissa;               // its columns
+  std::vector<double> refAt, refValue;        // the table, read at compile time
+  std::vector<std::string> reads;             // the array's properties it reads
+  bool isNorm() const { return kind == L1 || kind == L2 || kind == Linf; }
+  bool compared() const { return !isNorm() && (exact || !reference.empty()); }
+};
+
 struct PlanStepper {
   const ast::StepperDecl* decl = nullptr;
   std::map<std::string, int> methods;         // "initialize", "stage1", ... -> body index
@@ -170,6 +192,7 @@ struct Plan {
   std::vector<PlanBody> functions;
   PlanDomain domain;                          // periodic and mirror boundaries
   std::vector<PlanLimit> limits;              // what the run watches (limits { })
+  std::vector<PlanMetric> metrics;            // what the run measures (metrics { })
   PlanGroup root;                             // the scene's equations { } as a group
   std::vector<std::string> notes;             // what the passes decided, for --report
   std::vector<ChosenOption> options;          // compile-time options (sema/Options.h)

@@ -161,7 +161,6 @@ bool checkExpr(const ast::Expr& e, const std::function<bool(const std::string&)>
 
 namespace sema_detail {
 
-
 const std::vector<std::string>& kernelNames() {
   static const std::vector<std::string> k = {"CubicSpline",       "QuinticSpline",
                                              "WendlandQuintic",   "Gaussian",
@@ -173,6 +172,21 @@ const std::vector<std::string>& kernelNames() {
 double kernelRadius(const std::string& k) {
   return (k == "QuinticSpline" || k == "Gaussian" || k == "SuperGaussian") ? 3.0 : 2.0;
 }
+
+}  // namespace sema_detail
+
+bool overrideKernel(Plan& plan, const std::string& name, std::string& error) {
+  const auto& ks = sema_detail::kernelNames();
+  if (std::find(ks.begin(), ks.end(), name) == ks.end()) {
+    error = "unknown kernel '" + name + "'; kernels are: " + sema_detail::joinNames(ks);
+    return false;
+  }
+  plan.kernel = name;
+  plan.kernelRadiusScale = sema_detail::kernelRadius(name);
+  return true;
+}
+
+namespace sema_detail {
 
 std::string joinNames(const std::vector<std::string>& v) {
   std::string s;

@@ -25,6 +25,10 @@ std::vector<std::unique_ptr<ast::Module>> loadModules(
 std::unique_ptr<Plan> buildPlan(const std::vector<std::unique_ptr<ast::Module>>& modules,
                                 DiagnosticEngine& diags);
 
+// sphc --kernel=NAME: the scene's kernel replaced (before the analysis; `sphc study --vary
+// kernel=...` rebuilds with it). False with `error` set for an unknown kernel.
+bool overrideKernel(Plan& plan, const std::string& name, std::string& error);
+
 // Checks a declarative-layer expression: every name must satisfy `isKnown` (which may report
 // nothing; the error is reported here with `what` describing the context), calls must be
 // math functions with the right number of arguments.

@@ -3,6 +3,7 @@
 #include "sema/SemaImpl.h"
 
 #include "sema/Geometry.h"
+#include "sema/Metrics.h"
 
 #include "llvm/ADT/StringExtras.h"
 
@@ -152,6 +153,7 @@ void SemaImpl::buildScene() {
   }
 
   for (const auto& l : s.limits) buildLimits(l);
+  buildMetrics(s, *plan_, diags_, [this](const std::string& n) { return isParam(n); });
 
   plan_->root.loc = s.equationsLoc;
   buildGroup(s.equations, plan_->root, 0);

@@ -12,6 +12,7 @@
 #include <exception>
 #include <new>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -67,6 +68,7 @@ struct Options {
   std::string limits = "on";         // on, warn (never stop), off (sphc/sanity.h)
   std::vector<std::string> limit_settings;  // --limit ARRAY.QUANTITY.warn|stop=LO:HI
   std::vector<std::pair<std::string, double>> sets;
+  std::string metrics_file;  // --metrics FILE (default: DIR/<scene>_metrics.csv)
 };
 
 double parse_number(const std::string& text, const std::string& what) {
@@ -173,6 +175,10 @@ Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
                          ", which has no OpenMP threads");
     }
     else if (option == "--set") o.sets.push_back(parse_set(value(), prog));
+    else if (option == "--metrics") {
+      o.metrics_file = value();
+      if (o.metrics_file.empty()) throw UsageError("--metrics expects a file name");
+    }
     else if (option == "--max-memory") {
       const std::string v = value();
       o.max_memory = parse_memory_size(v);
@@ -245,7 +251,9 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        set a bound of the limit on quantity Q (a property or speed) of\n"
       "                        array A (an end may be empty: unbounded; =off removes it)\n"
       "  --quiet               no progress line and no summary\n"
-      "  --no-output           write no files (benchmarks)\n"
+      "  --no-output           write no snapshots (benchmarks)\n"
+      "  --metrics FILE        write the scene's metrics (metrics {{ }}) to FILE, also with\n"
+      "                        --no-output (default: DIR/{1}_metrics.csv)\n"
       "  --timing              print at the end, for the time loop:\n"
       "                        timing: steps=N particles=P wall_s=W us_per_particle_step=U\n"
       "                        backend=B threads=T [omp_wait=W] precision=double|single\n"
@@ -254,6 +262,8 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        and, per iterated group, the iterations of its evaluations:\n"
       "                        iterations: group=FILE:LINE evaluations=E total=N mean=M\n"
       "                        min=A max=B unconverged=U\n"
+      "                        and the scene's metrics at the end, with the time loop's wall\n"
+      "                        and CPU seconds: metrics: t=T wall_s=W cpu_s=C NAME=V ...\n"
       "  -h, --help            print this help\n"
       "\n"
       "Output: DIR/{1}_NNNNNN.h5 (NNNNNN: the step) and DIR/{1}.xdmf (for ParaView).\n"
@@ -310,6 +320,9 @@ class Progress {
     std::fflush(stderr);
   }
 
+  // The scene's metrics at the latest output, shown at the end of the line.
+  void set_metrics(std::string text) { metrics_ = std::move(text); }
+
   // Ends an in-place line, before anything else is printed.
   void break_line() {
     if (shown_ > 0) fmt::print(stderr, "\n");
@@ -327,7 +340,8 @@ class Progress {
                       : fmt::format("{}m{:02}s", s / 60, s % 60);
     }
     return fmt::format("t={:.{}f}/{:.{}f}  step {}  dt={:.2g}  particles {}  {:.1f}% ETA {}", t,
-                       decimals, tf_, decimals, step, dt, particles, 100.0 * fraction, eta);
+                       decimals, tf_, decimals, step, dt, particles, 100.0 * fraction, eta) +
+           (metrics_.empty() ? "" : "  " + metrics_);
   }
 
   bool enabled_ = false;
@@ -337,6 +351,7 @@ class Progress {
   Clock::time_point last_print_;
   double next_fraction_ = 0.1;
   std::size_t shown_ = 0;  // length of the in-place line on screen, 0 if none
+  std::string metrics_;    // set_metrics
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -546,6 +561,7 @@ class Simulation {
         opt_.directory.empty() ? scene_name(prog_) + "_output" : opt_.directory;
     OutputWriter writer(prog_, dir, !opt_.no_output);
     writer_ = &writer;
+    open_metrics(dir);
 
     const double tf = times.tf;
     const double slack = kTimeSlack * tf;
@@ -560,6 +576,7 @@ class Simulation {
 
     const long check_every = prog_.to_host ? kCheckEveryDevice : kCheckEvery;
     const auto loop_start = Clock::now();
+    metrics_clock_ = {loop_start, cpu_seconds()};
     nnps_start_ = prog_.neighbour_seconds ? prog_.neighbour_seconds() : 0.0;
     progress_.start(!opt_.quiet, tf);
     double particle_steps = 0;
@@ -591,6 +608,7 @@ class Simulation {
     }
     report_limits();
     report(seconds_since(loop_start), particle_steps, tf);
+    report_metrics();
     return kExitOk;
   }
 
@@ -697,7 +715,55 @@ class Simulation {
   void write_output() {
     writer_->write(arrays_, meta());
     last_output_step_ = step_;
+    record_metrics();
   }
+
+  // -------------------------------------------------------------------------------------------
+  // Metrics (sphc/metrics.h): evaluated with every output (the data is on the host then), one
+  // CSV row each, shown on the progress line and at the end.
+
+  void open_metrics(const std::string& dir) {
+    if (prog_.metrics.empty() || !prog_.evaluate_metrics) return;
+    std::string path = opt_.metrics_file;
+    if (path.empty() && !opt_.no_output)
+      path = (std::filesystem::path(dir) / (scene_name(prog_) + "_metrics.csv")).string();
+    if (path.empty()) return;
+    metrics_csv_.open(path, std::ios::trunc);
+    if (!metrics_csv_) throw std::runtime_error("cannot write the metrics to '" + path + "'");
+    metrics_csv_ << metrics_csv_header(prog_.metrics) << "\n" << std::flush;
+  }
+
+  void record_metrics() {
+    if (prog_.metrics.empty() || !prog_.evaluate_metrics) return;
+    MetricsRow row;
+    row.step = step_;
+    row.t = t_;
+    row.dt = dt_;
+    if (metrics_clock_) {  // 0 before the time loop starts (the first output)
+      row.wall_s = seconds_since(metrics_clock_->first);
+      row.cpu_s = cpu_seconds() - metrics_clock_->second;
+    }
+    row.values = prog_.evaluate_metrics(t_);
+    progress_.set_metrics(metrics_text(prog_.metrics, row.values));
+    if (metrics_csv_.is_open()) metrics_csv_ << metrics_csv_row(prog_.metrics, row) << "\n" << std::flush;
+    last_metrics_ = std::move(row);
+  }
+
+  void report_metrics() {
+    if (!last_metrics_) return;
+    const MetricsRow& r = *last_metrics_;
+    if (!opt_.quiet)
+      fmt::print(stderr, "metrics at t={}: {}\n", r.t, metrics_text(prog_.metrics, r.values));
+    if (opt_.timing) {
+      fmt::print("metrics: t={} step={} wall_s={:.6g} cpu_s={:.6g} {}\n", r.t, r.step, r.wall_s,
+                 r.cpu_s, metrics_text(prog_.metrics, r.values, true));
+      std::fflush(stdout);
+    }
+  }
+
+  std::optional<std::pair<Clock::time_point, double>> metrics_clock_;  // wall, CPU at the loop start
+  std::ofstream metrics_csv_;
+  std::optional<MetricsRow> last_metrics_;
 
   // -------------------------------------------------------------------------------------------
   // Limits (sphc/sanity.h): kept apart from the time loop, which only calls check_limits

@@ -18,6 +18,10 @@ Measures, in every snapshot (those of Adami, Hu & Adams 2013 and Ramachandran & 
   - L1 error of the speed: sum_i | |v_i| - |v_e(x_i, t)| | / sum_i |v_e(x_i, t)|, the exact
     field evaluated at the particle positions.
 
+Both are the solver's own metrics (the scene's `metrics { }`: columns decay_err and l1 of
+OUTPUT_DIR/taylor_green_metrics.csv, one row per snapshot); this script checks them, and
+recomputes them from the last snapshot to check the metrics themselves (to 1e-9).
+
 Tolerances (judged at the last snapshot; --decay-tol, --l1-tol). Standard WCSPH (no
 background pressure, no particle shifting or transport velocity) follows the exact solution
 only for a short time on this problem: the negative pressures of the vortex (down to
@@ -71,6 +75,7 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
 
 import plots  # noqa: E402  (tests/validation/plots.py)
 from snapshots import argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
+from metrics_csv import read_metrics, row_at  # noqa: E402  (metrics_csv.py)
 
 
 def exact_velocity(x, y, t, re, U=1.0, L=1.0):
@@ -110,6 +115,12 @@ def main():
     files = snapshots(args.outdir, "taylor_green.py")
     if files is None:
         return 2
+    # The errors are the solver's own metrics (the scene's metrics { }: decay_err, l1), one
+    # row per snapshot; the last snapshot's are recomputed here from the particles as a check
+    # of the metrics themselves.
+    metrics = read_metrics(args.outdir, "taylor_green.py", ("decay_err", "l1", "mass"))
+    if metrics is None:
+        return 2
 
     failures = []
     rows = []
@@ -136,9 +147,28 @@ def main():
         speed = np.hypot(u, v)
         nu = args.U * args.L / args.re
         amp = args.U * np.exp(-2.0 * nu * (2.0 * np.pi / args.L) ** 2 * t)
-        decay_err, l1 = speed_errors(x, y, u, v, t, args.re, args.U, args.L)
+        k = row_at(metrics, t)
+        if k is None:
+            failures.append("%s: no row of the metric file at t = %.17g" % (name, t))
+            continue
+        decay_err, l1 = metrics["decay_err"][k], metrics["l1"][k]
         rows.append((t, float(speed.max()), amp, decay_err, l1))
-        last = (t, x, y, speed)
+        last = (t, x, y, u, v, speed)
+    if len(metrics["t"]) != len(files):
+        failures.append("the metric file has %d rows, there are %d snapshots"
+                        % (len(metrics["t"]), len(files)))
+    if last is not None:
+        # The metrics against an independent computation from the last snapshot (numpy).
+        t, x, y, u, v, _ = last
+        py_decay, py_l1 = speed_errors(x, y, u, v, t, args.re, args.U, args.L)
+        for what, ours, theirs in (("decay error", rows[-1][3], py_decay),
+                                   ("L1 error", rows[-1][4], py_l1)):
+            if not abs(ours - theirs) <= 1e-9 * max(abs(theirs), 1e-12):
+                failures.append("t = %.4f: the solver's metric %s %.17g differs from the one "
+                                "computed from the snapshot, %.17g" % (t, what, ours, theirs))
+    if not rows:
+        print("FAILED: " + "; ".join(failures))
+        return 1
 
     print("Taylor-Green vortex, Re = %g, vs the exact solution: %d snapshots in %s, "
           "%d particles" % (args.re, len(files), args.outdir, n0))
@@ -180,7 +210,7 @@ def main():
         ax2.set_xlabel("t [L/U]")
         ax2.set_ylabel("error [%]")
         ax2.legend(fontsize=8)
-        t, x, y, speed = last
+        t, x, y, _, _, speed = last
         sc = ax3.scatter(x, y, c=speed, s=2, cmap="viridis")
         fig.colorbar(sc, ax=ax3, label="|v| / U")
         ax3.set_aspect("equal")

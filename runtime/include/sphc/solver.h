@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "sphc/memory.h"
+#include "sphc/metrics.h"
 #include "sphc/particle_array.h"
 #include "sphc/sanity.h"
 
@@ -97,6 +98,10 @@ struct SceneProgram {
   // The scene's limits { } (sphc/sanity.h), computed from the parameters after the set-up;
   // empty: none declared (the default bounding box applies).
   std::function<std::vector<Limit>()> limits;
+  // The scene's metrics { } (sphc/metrics.h): what they are, and their values at time t from
+  // the host arrays (the run loop calls it where it writes output); empty: none declared.
+  std::vector<MetricInfo> metrics;
+  std::function<std::vector<MetricValue>(double t)> evaluate_metrics;
   // Array name -> properties written (empty list = all); empty = every array, all properties.
   std::vector<std::pair<std::string, std::vector<std::string>>> output;
 };

@@ -1,0 +1,124 @@
+// The scene's metrics { } in the host program (docs/language.md, Metrics): a member function
+// of struct Scene that evaluates every metric on the host arrays (the run loop calls it where
+// it writes output, after a device backend's data came back), and the metrics' descriptions
+// in `main` (sphc/metrics.h). Shared by every backend.
+#include "codegen/Printer.h"
+
+#include <cstdio>
+
+namespace sphc {
+
+namespace {
+
+const char* normKind(PlanMetric::Kind k) {
+  switch (k) {
+    case PlanMetric::L1: return "sphc::NormKind::L1";
+    case PlanMetric::L2: return "sphc::NormKind::L2";
+    case PlanMetric::Linf: return "sphc::NormKind::Linf";
+    default: return "";
+  }
+}
+
+const char* reduceKind(PlanMetric::Kind k) {
+  switch (k) {
+    case PlanMetric::Max: return "sphc::ReduceKind::Max";
+    case PlanMetric::Min: return "sphc::ReduceKind::Min";
+    case PlanMetric::Sum: return "sphc::ReduceKind::Sum";
+    case PlanMetric::Mean: return "sphc::ReduceKind::Mean";
+    default: return "";
+  }
+}
+
+std::string number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+}  // namespace
+
+// Scene::metrics(t): one block per metric, a loop over the real particles of its array.
+void ScenePrinter::emitMetrics() {
+  if (plan_.metrics.empty()) return;
+  scene_ << "  // metrics { }: evaluated on the host at every output (sphc/metrics.h)\n";
+  scene_ << "  std::vector<sphc::MetricValue> metrics(double t) {\n";
+  scene_ << "    std::vector<sphc::MetricValue> r(" << plan_.metrics.size() << ");\n";
+  for (size_t k = 0; k < plan_.metrics.size(); ++k) {
+    const PlanMetric& m = plan_.metrics[k];
+    const int a = m.array;
+    const std::string& A = arr(a).name;
+    scene_ << "    {  // " << m.name << ", from " << loc(m.loc) << "\n";
+    if (!m.refAt.empty()) {
+      scene_ << "      // reference \"" << m.reference << "\": " << m.abscissa << " -> "
+             << m.column << " (" << m.refAt.size() << " rows, read by sphc)\n";
+      scene_ << "      static const sphc::ReferenceTable ref{{";
+      for (size_t i = 0; i < m.refAt.size(); ++i)
+        scene_ << (i ? ", " : "") << number(m.refAt[i]);
+      scene_ << "},\n                                           {";
+      for (size_t i = 0; i < m.refValue.size(); ++i)
+        scene_ << (i ? ", " : "") << number(m.refValue[i]);
+      scene_ << "}};\n";
+    }
+    scene_ << "      " << (m.isNorm() ? "sphc::NormSums" : "sphc::ScalarSums") << " acc;\n";
+    // The particle's values as locals q_NAME; coordinates the scene has not: 0.
+    std::vector<std::string> locals;
+    for (const auto& p : m.reads)
+      if (constIndex(a, p) < 0 && propIndex(a, p) >= 0) locals.push_back(p);
+    auto particleNames = [&](const std::string& n) -> std::string {
+      if (n == "t") return "t";
+      if (constIndex(a, n) >= 0) return A + ".constant(" + std::to_string(constIndex(a, n)) + ")[0]";
+      for (const auto& l : locals)
+        if (l == n) return "q_" + n;
+      if (n == "x" || n == "y" || n == "z") return "0.0";
+      return paramRef(n);
+    };
+    for (const auto& p : locals)
+      scene_ << "      const auto* p_" << p << " = " << hostPtr(a, p) << ";\n";
+    scene_ << "      for (std::size_t i = 0; i < " << A << ".n; ++i) {  // real particles\n";
+    for (const auto& p : locals) {
+      const int stride = arr(a).props[propIndex(a, p)].stride;
+      scene_ << "        const double q_" << p << " = static_cast<double>(p_" << p << "[i"
+             << (stride > 1 ? " * " + std::to_string(stride) : std::string("")) << "]);\n";
+    }
+    if (m.where)
+      scene_ << "        if (!(" << exprCpp(*m.where, particleNames) << ")) continue;\n";
+    const std::string value = exprCpp(*m.expr, particleNames);
+    if (m.isNorm())
+      scene_ << "        sphc::add(acc, " << value << ", " << exprCpp(*m.exact, particleNames)
+             << ");\n";
+    else
+      scene_ << "        sphc::add(acc, " << value << ");\n";
+    scene_ << "      }\n";
+    if (m.isNorm()) {
+      scene_ << "      r[" << k << "].value = sphc::norm(acc, " << normKind(m.kind) << ", "
+             << (m.relative ? "true" : "false") << ");\n";
+    } else {
+      const std::string v = "sphc::reduce(acc, " + std::string(reduceKind(m.kind)) + ")";
+      auto timeNames = [&](const std::string& n) { return n == "t" ? n : paramRef(n); };
+      if (m.exact)
+        scene_ << "      r[" << k << "] = sphc::compare(" << v << ", "
+               << exprCpp(*m.exact, timeNames) << ", " << (m.relative ? "true" : "false")
+               << ");\n";
+      else if (!m.refAt.empty())
+        scene_ << "      r[" << k << "] = sphc::compare(" << v << ", sphc::interpolate(ref, "
+               << (m.at ? exprCpp(*m.at, timeNames) : std::string("t")) << "), "
+               << (m.relative ? "true" : "false") << ");\n";
+      else
+        scene_ << "      r[" << k << "].value = " << v << ";\n";
+    }
+    scene_ << "    }\n";
+  }
+  scene_ << "    return r;\n  }\n\n";
+}
+
+// In main: what each metric is (for the CSV header and the progress line) and how to
+// evaluate them.
+void ScenePrinter::emitMetricsMain() {
+  if (plan_.metrics.empty()) return;
+  for (const auto& m : plan_.metrics)
+    out_ << "  prog.metrics.push_back({\"" << m.name << "\", " << (m.compared() ? "true" : "false")
+         << ", " << (m.relative ? "true" : "false") << ", \"" << loc(m.loc) << "\"});\n";
+  out_ << "  prog.evaluate_metrics = [](double t) { return scene.metrics(t); };\n";
+}
+
+}  // namespace sphc

@@ -1,0 +1,566 @@
+#!/usr/bin/env python3
+"""sphc study: what accuracy costs in time (docs/accuracy-cost.md).
+
+    sphc study SCENE.sph --vary NAME=v1,v2,... [--vary ...] [--tf T] [--repeat N]
+               [--threads N] [--set NAME=V ...] [--budget METRIC<=VALUE ...]
+               [--metric COLUMN ...] [--cost wall_s|cpu_s] [--resolution NAME] -o DIR
+
+Builds and runs the cross product of the variants and collects, per run, the particles,
+steps, wall and CPU seconds of the time loop, the peak memory and every metric of the scene
+(its `metrics { }`). A varied NAME is
+
+  - backend, precision or kernel: sphc's --backend / --precision / --kernel (a rebuild,
+    through sphc's build cache);
+  - a compile-time option of the scene (`option NAME in [...]`): sphc -D NAME=v (a rebuild,
+    through the cache);
+  - threads: the solver's --threads;
+  - otherwise a parameter of the scene: the solver's --set NAME=v (no rebuild).
+
+Output in DIR: study.csv (one row per run; a study started again with the same DIR reuses the
+runs already in it), summary.txt (the runs, the Pareto front of each metric against the cost,
+the cheapest variant within each error level, the observed convergence orders, and the
+answers to --budget), and, where matplotlib is installed, for each metric M
+M_vs_wall.{png,svg} (M_vs_cpu with --cost cpu_s; log-log, the Pareto front marked, every
+point labelled with its variant) and M_convergence.{png,svg} (M against the resolution
+parameter, with the fitted order). The cost is the time loop's wall time, or with --cost
+cpu_s its CPU time (on a loaded machine the wall time measures the load as much as the run).
+
+Per run and metric column C of the solver's metric file, study.csv has C (its value at the
+last output where it is finite) and C_max (the largest |C| over the outputs). The error of a
+compared metric is its column NAME_err; a plot or budget names any column (e.g. l1,
+front_err_max).
+
+Why a Python helper beside sphc and not C++ in the driver: the study is process management,
+CSV handling and plotting, and the plots need matplotlib, as the validation plots do; the
+helper needs nothing else but the standard library (the fits are written out). `sphc study
+...` runs it with python3 ($SPHC_PYTHON if set), from share/sphc/study.py of the install or
+build tree (compiler/driver/Study.cpp).
+"""
+
+import argparse
+import csv
+import itertools
+import math
+import os
+import re
+import shlex
+import subprocess
+import sys
+import time
+
+COST = "wall_s"  # --cost
+SPHC_FLAGS = {"backend": "--backend", "precision": "--precision", "kernel": "--kernel"}
+
+
+def fail(msg, code=2):
+    sys.stderr.write("sphc study: error: %s\n" % msg)
+    sys.exit(code)
+
+
+def parse_args(argv):
+    ap = argparse.ArgumentParser(prog="sphc study", description=__doc__.split("\n\n")[0])
+    ap.add_argument("scene", help="the .sph scene")
+    ap.add_argument("--vary", action="append", default=[], metavar="NAME=v1,v2,...",
+                    help="a variable and its values (repeatable; the runs are the cross "
+                         "product)")
+    ap.add_argument("--set", action="append", default=[], metavar="NAME=V",
+                    help="a parameter fixed for every run")
+    ap.add_argument("-D", action="append", default=[], dest="defines", metavar="NAME=CHOICE",
+                    help="a compile-time option fixed for every run")
+    ap.add_argument("--tf", type=float, help="final time of every run")
+    ap.add_argument("--repeat", type=int, default=1, help="runs per variant (default 1; the "
+                    "summary takes the fastest wall time)")
+    ap.add_argument("--threads", type=int, help="threads of every run (OpenMP backends)")
+    ap.add_argument("--budget", action="append", default=[], metavar="METRIC<=VALUE",
+                    help="the cheapest variant with METRIC <= VALUE, and how far the others "
+                         "miss it")
+    ap.add_argument("--metric", action="append", default=[], metavar="COLUMN",
+                    help="analyse and plot only these columns of the metrics (repeatable; "
+                         "default: every column)")
+    ap.add_argument("--cost", choices=("wall_s", "cpu_s"), default="wall_s",
+                    help="the cost the fronts, levels and budgets use: the time loop's wall "
+                         "seconds (default) or its CPU seconds (fairer on a loaded machine)")
+    ap.add_argument("--resolution", help="the varied parameter the convergence plot and the "
+                    "orders use (default: the first varied parameter whose values are "
+                    "numbers)")
+    ap.add_argument("-o", "--output", required=True, help="the study's directory")
+    ap.add_argument("--sphc", default=os.environ.get("SPHC", "sphc"), help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.repeat < 1:
+        fail("--repeat expects a positive number")
+    varies = []
+    for v in args.vary:
+        m = re.match(r"^([A-Za-z_][A-Za-z0-9_]*)=(.+)$", v)
+        if not m:
+            fail("--vary %s: expected NAME=v1,v2,..." % v)
+        values = [x.strip() for x in m.group(2).split(",") if x.strip()]
+        if not values:
+            fail("--vary %s: no values" % v)
+        if m.group(1) in [n for n, _ in varies]:
+            fail("--vary %s: %s is varied twice" % (v, m.group(1)))
+        varies.append((m.group(1), values))
+    if not varies:
+        fail("nothing to vary: give --vary NAME=v1,v2,...")
+    budgets = []
+    for b in args.budget:
+        m = re.match(r"^([A-Za-z_][A-Za-z0-9_]*)\s*<=\s*(\S+)$", b)
+        if not m:
+            fail("--budget %s: expected METRIC<=VALUE" % b)
+        budgets.append((m.group(1), float(m.group(2))))
+    return args, varies, budgets
+
+
+# ---- the scene's solver: what it can vary ------------------------------------------------
+
+def solver_help(exe):
+    """(compile-time options {name: choices}, parameters [names]) from the solver's --help."""
+    out = subprocess.run([exe, "--help"], capture_output=True, text=True).stdout
+    options, params, section = {}, [], None
+    for line in out.splitlines():
+        if line.startswith("compile-time options"):
+            section = "options"
+            continue
+        if line.startswith("parameters"):
+            section = "params"
+            continue
+        if not line.startswith("  "):
+            section = None if line.strip() == "" and section is None else section
+            continue
+        m = re.match(r"^  ([A-Za-z_][A-Za-z0-9_]*)", line)
+        if not m:
+            continue
+        if section == "options":
+            c = re.search(r"choices: ([^)]*)\)", line)
+            options[m.group(1)] = [x.strip() for x in c.group(1).split(",")] if c else []
+        elif section == "params":
+            params.append(m.group(1))
+    return options, params
+
+
+def classify(varies, options, params):
+    kinds = {}
+    for name, values in varies:
+        if name in SPHC_FLAGS and name not in options:
+            kinds[name] = "sphc"
+        elif name == "threads":
+            kinds[name] = "threads"
+        elif name in options:
+            bad = [v for v in values if options[name] and v not in options[name]]
+            if bad:
+                fail("--vary %s: %s not among the choices %s" % (name, ", ".join(bad),
+                                                                  ", ".join(options[name])))
+            kinds[name] = "option"
+        elif name in params:
+            for v in values:
+                try:
+                    float(v)
+                except ValueError:
+                    fail("--vary %s: parameter values are numbers, not '%s'" % (name, v))
+            kinds[name] = "param"
+        else:
+            fail("--vary %s: not a parameter (%s), a compile-time option (%s), backend, "
+                 "precision, kernel or threads" % (name, ", ".join(params) or "none",
+                                                   ", ".join(options) or "none"))
+    return kinds
+
+
+# ---- runs --------------------------------------------------------------------------------
+
+def build(args, variant, kinds, bindir, cache):
+    """The solver of a variant's compile-time settings (built once per study, through sphc's
+    build cache)."""
+    flags = []
+    for d in args.defines:
+        flags += ["-D", d]
+    for name, value in variant:
+        if kinds.get(name) == "sphc":
+            flags.append("%s=%s" % (SPHC_FLAGS[name], value))
+        elif kinds.get(name) == "option":
+            flags += ["-D", "%s=%s" % (name, value)]
+    key = "_".join(re.sub(r"[^A-Za-z0-9.=-]", "", f) for f in flags if f != "-D") or "base"
+    if key in cache:
+        return cache[key]
+    exe = os.path.join(bindir, "solver_" + key)
+    cmd = [args.sphc, args.scene] + flags + ["-o", exe]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        fail("building %s failed:\n%s%s" % (" ".join(map(shlex.quote, cmd)), r.stdout,
+                                               r.stderr), 1)
+    cache[key] = exe
+    return exe
+
+
+def read_metric_file(path):
+    """{column: (last finite value, largest |value|)} of a solver's metric file."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    out = {}
+    if not rows:
+        return out
+    for col in rows[0].keys():
+        if col in ("step", "t", "dt", "wall_s", "cpu_s"):
+            continue
+        vals = []
+        for r in rows:
+            try:
+                vals.append(float(r[col]))
+            except ValueError:
+                pass
+        finite = [v for v in vals if math.isfinite(v)]
+        out[col] = (finite[-1] if finite else float("nan"),
+                    max(abs(v) for v in finite) if finite else float("nan"))
+    return out
+
+
+def run_one(args, exe, variant, kinds, rundir):
+    os.makedirs(rundir, exist_ok=True)
+    mfile = os.path.join(rundir, "metrics.csv")
+    cmd = [exe, "--quiet", "--timing", "--no-output", "--metrics", mfile]
+    if args.tf is not None:
+        cmd += ["--tf", repr(args.tf)]
+    if args.threads is not None:
+        cmd += ["--threads", str(args.threads)]
+    for s in args.set:
+        cmd += ["--set", s]
+    for name, value in variant:
+        if kinds.get(name) == "param":
+            cmd += ["--set", "%s=%s" % (name, value)]
+        elif kinds.get(name) == "threads":
+            cmd += ["--threads", value]
+    start = time.time()
+    with open(os.path.join(rundir, "stdout.txt"), "w") as so, \
+            open(os.path.join(rundir, "stderr.txt"), "w") as se:
+        p = subprocess.Popen(cmd, stdout=so, stderr=se)
+        _, status, usage = os.wait4(p.pid, 0)
+    elapsed = time.time() - start
+    code = os.waitstatus_to_exitcode(status) if hasattr(os, "waitstatus_to_exitcode") else status
+    row = {"status": "ok" if code == 0 else "exit %d" % code,
+           "process_s": "%.6g" % elapsed,
+           "peak_rss_mb": "%.4g" % (usage.ru_maxrss / 1024.0),
+           "command": " ".join(map(shlex.quote, cmd))}
+    with open(os.path.join(rundir, "stdout.txt")) as f:
+        text = f.read()
+    m = re.search(r"^timing: steps=(\d+) particles=(\d+) wall_s=(\S+)", text, re.M)
+    if m:
+        row.update(steps=m.group(1), particles=m.group(2), wall_s=m.group(3))
+    m = re.search(r"^metrics: t=(\S+) step=\S+ wall_s=\S+ cpu_s=(\S+)", text, re.M)
+    if m:
+        row.update(t_end=m.group(1), cpu_s=m.group(2))
+    if os.path.exists(mfile):
+        for col, (last, biggest) in read_metric_file(mfile).items():
+            row[col] = repr(last)
+            row[col + "_max"] = repr(biggest)
+    return row
+
+
+def variant_label(variant):
+    return " ".join("%s=%s" % nv for nv in variant)
+
+
+def load_done(path):
+    if not os.path.exists(path):
+        return []
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def write_rows(path, rows, fixed):
+    cols = list(fixed)
+    for r in rows:
+        for c in r:
+            if c not in cols:
+                cols.append(c)
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=cols, restval="")
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+    os.replace(tmp, path)
+
+
+def fmt_s(s):
+    s = max(0, int(round(s)))
+    return "%dh%02dm" % (s // 3600, s // 60 % 60) if s >= 3600 else "%dm%02ds" % (s // 60, s % 60)
+
+
+# ---- analysis ----------------------------------------------------------------------------
+
+def num(r, c):
+    try:
+        v = float(r.get(c, ""))
+    except ValueError:
+        return float("nan")
+    return v
+
+
+def per_variant(rows, names):
+    """One entry per variant: its label, values, the fastest wall time of its repeats, the
+    CPU time of that run and its metrics."""
+    groups = {}
+    for r in rows:
+        if r.get("status") != "ok":
+            continue
+        key = tuple(r[n] for n in names)
+        best = groups.get(key)
+        if best is None or num(r, COST) < num(best, COST):
+            groups[key] = r
+    return [(key, groups[key]) for key in sorted(groups, key=lambda k: num(groups[k], COST))]
+
+
+def metric_columns(rows, fixed):
+    cols = []
+    for r in rows:
+        for c in r:
+            if c not in fixed and c not in cols:
+                cols.append(c)
+    return cols
+
+
+def pareto(points):
+    """Indices of the points (cost, error) no other point beats in both (sorted by cost)."""
+    order = sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1]))
+    front, best = [], float("inf")
+    for i in order:
+        e = points[i][1]
+        if math.isfinite(e) and e < best:
+            front.append(i)
+            best = e
+    return front
+
+
+def fit_order(xs, ys):
+    """Least-squares slope and intercept of log y against log x (None with < 2 points)."""
+    pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys)
+           if x > 0 and y > 0 and math.isfinite(y)]
+    if len(pts) < 2:
+        return None
+    n = len(pts)
+    mx = sum(p[0] for p in pts) / n
+    my = sum(p[1] for p in pts) / n
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    if sxx == 0:
+        return None
+    slope = sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
+    return slope, my - slope * mx
+
+
+def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
+    variants = per_variant(rows, names)
+    cols = [c for c in metric_columns(rows, fixed) if c not in names]
+    if only:
+        missing = [c for c in only if c not in cols]
+        if missing:
+            fail("--metric %s: no such column; the columns are %s"
+                 % (", ".join(missing), ", ".join(cols)))
+        cols = list(only)
+    lines = []
+    p = lines.append
+    p("sphc study: %d runs, %d variants (%s)" % (len(rows), len(variants), ", ".join(names)))
+    p("wall_s, cpu_s: the time loop's wall and CPU seconds; cost: %s (of each variant, the "
+      "repeat with the least)" % COST)
+    p("")
+    head = ["variant", "particles", "steps", "wall_s", "cpu_s", "peak_rss_mb"] + cols
+    table = [[variant_label(zip(names, k)), r.get("particles", ""), r.get("steps", ""),
+              r.get("wall_s", ""), r.get("cpu_s", ""), r.get("peak_rss_mb", "")] +
+             ["%.4g" % num(r, c) for c in cols] for k, r in variants]
+    widths = [max(len(str(x)) for x in col) for col in zip(head, *table)] if table else []
+    for row in [head] + table:
+        p("  ".join(str(x).rjust(w) for x, w in zip(row, widths)))
+    p("")
+    fronts = {}
+    for c in cols:
+        pts = [(num(r, COST), abs(num(r, c))) for _, r in variants]
+        if not any(math.isfinite(e) for _, e in pts):
+            continue
+        front = pareto(pts)
+        fronts[c] = front
+        p("%s against %s: Pareto front (no variant is both cheaper and more accurate):" % (c, COST))
+        for i in front:
+            p("  %-40s cost %8.4g s  |%s| %.4g" % (variant_label(zip(names, variants[i][0])),
+                                                 pts[i][0], c, pts[i][1]))
+        finite = sorted(e for _, e in pts if math.isfinite(e) and e > 0)
+        if finite:
+            lo = math.floor(math.log10(finite[0]))
+            hi = math.ceil(math.log10(finite[-1]))
+            p("  cheapest variant within each error level:")
+            for k in range(hi, lo - 1, -1):
+                level = 10.0 ** k
+                ok = [i for i in range(len(pts)) if pts[i][1] <= level]
+                if not ok:
+                    p("    |%s| <= %-8.0e none" % (c, level))
+                    continue
+                i = min(ok, key=lambda j: pts[j][0])
+                p("    |%s| <= %-8.0e %s (cost %.4g s)" % (c, level, variant_label(
+                    zip(names, variants[i][0])), pts[i][0]))
+        p("")
+    orders = {}
+    if resolution:
+        others = [n for n in names if n != resolution]
+        for c in cols:
+            groups = {}
+            for k, r in variants:
+                key = tuple(r[n] for n in others)
+                groups.setdefault(key, []).append((float(r[resolution]), abs(num(r, c))))
+            for key, pts in groups.items():
+                f = fit_order([x for x, _ in pts], [y for _, y in pts])
+                if f is None:
+                    continue
+                orders[(c, key)] = (f, pts)
+        if orders:
+            p("observed orders: the slope s of log|metric| against log %s (|metric| ~ %s^s; "
+              "s = -p for a count per length such as nx, s = p for a spacing such as dx)"
+              % (resolution, resolution))
+            for (c, key), ((s, _), pts) in sorted(orders.items()):
+                p("  %-16s %-30s s = %+.3g over %s = %s" % (
+                    c, variant_label(zip(others, key)) or "(all)", s, resolution,
+                    ", ".join("%g" % x for x, _ in sorted(pts))))
+            p("")
+    for metric, limit in budgets:
+        p("budget %s <= %g:" % (metric, limit))
+        if metric not in cols:
+            p("  no such column; columns: %s" % ", ".join(cols))
+            continue
+        meets = [(num(r, COST), k, r) for k, r in variants if abs(num(r, metric)) <= limit]
+        if meets:
+            w, k, r = min(meets)
+            p("  cheapest: %s (cost %.4g s, |%s| = %.4g)" % (variant_label(zip(names, k)), w,
+                                                           metric, abs(num(r, metric))))
+        else:
+            p("  no variant measured meets it")
+        for k, r in variants:
+            v = abs(num(r, metric))
+            if not v <= limit:
+                p("  misses: %-40s |%s| = %.4g, %.3g x the budget (cost %.4g s)"
+                  % (variant_label(zip(names, k)), metric, v, v / limit if limit else
+                     float("inf"), num(r, COST)))
+        p("")
+    text = "\n".join(lines) + "\n"
+    with open(os.path.join(outdir, "summary.txt"), "w") as f:
+        f.write(text)
+    plot(variants, names, cols, fronts, orders, resolution, outdir)
+    return text
+
+
+def plot(variants, names, cols, fronts, orders, resolution, outdir):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        sys.stderr.write("sphc study: matplotlib is not installed: no plots (the CSV and "
+                         "summary.txt are written)\n")
+        return
+    for c in cols:
+        if c not in fronts:
+            continue
+        pts = [(num(r, COST), abs(num(r, c))) for _, r in variants]
+        ok = [i for i, (w, e) in enumerate(pts) if w > 0 and e > 0 and math.isfinite(e)]
+        if not ok:
+            continue
+        fig, ax = plt.subplots(figsize=(7, 5))
+        ax.loglog([pts[i][0] for i in ok], [pts[i][1] for i in ok], "o", color="C0",
+                  label="variants")
+        fr = [i for i in fronts[c] if i in ok]
+        ax.loglog([pts[i][0] for i in fr], [pts[i][1] for i in fr], "-", color="C3", lw=1.5,
+                  label="Pareto front")
+        for i in ok:
+            ax.annotate(variant_label(zip(names, variants[i][0])), pts[i], fontsize=7,
+                        xytext=(4, 3), textcoords="offset points",
+                        weight="bold" if i in fr else "normal")
+        ax.set_xlabel("%s time of the time loop [s]" % ("wall" if COST == "wall_s" else "CPU"))
+        ax.set_ylabel("|%s|" % c)
+        ax.set_title("%s against %s" % (c, COST))
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        for ext in ("png", "svg"):
+            fig.savefig(os.path.join(outdir, "%s_vs_%s.%s" % (c, COST[:-2], ext)), dpi=120)
+        plt.close(fig)
+        mine = {k: v for k, v in orders.items() if k[0] == c}
+        if not mine:
+            continue
+        fig, ax = plt.subplots(figsize=(7, 5))
+        for n, ((_, key), ((s, b), pts2)) in enumerate(sorted(mine.items())):
+            pts2 = sorted(pts2)
+            xs = [x for x, _ in pts2]
+            lbl = variant_label(zip([m for m in names if m != resolution], key)) or c
+            ax.loglog(xs, [y for _, y in pts2], "o", color="C%d" % n)
+            ax.loglog(xs, [math.exp(b) * x ** s for x in xs], "--", color="C%d" % n,
+                      label="%s: slope %+.2f" % (lbl, s))
+        ax.set_xlabel(resolution)
+        ax.set_ylabel("|%s|" % c)
+        ax.set_title("convergence of %s (fitted slope)" % c)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        for ext in ("png", "svg"):
+            fig.savefig(os.path.join(outdir, "%s_convergence.%s" % (c, ext)), dpi=120)
+        plt.close(fig)
+
+
+# ---- main --------------------------------------------------------------------------------
+
+def main(argv):
+    args, varies, budgets = parse_args(argv)
+    global COST
+    COST = args.cost
+    if not os.path.exists(args.scene):
+        fail("%s: no such file" % args.scene)
+    out = args.output
+    bindir = os.path.join(out, "bin")
+    os.makedirs(bindir, exist_ok=True)
+    names = [n for n, _ in varies]
+    cache = {}
+    base = build(args, [], {}, bindir, cache)
+    options, params = solver_help(base)
+    kinds = classify(varies, options, params)
+    resolution = args.resolution
+    if resolution is None:
+        resolution = next((n for n, vals in varies if kinds[n] == "param"), None)
+    elif resolution not in names:
+        fail("--resolution %s: not a varied name" % resolution)
+    runs = [(list(zip(names, combo)), rep) for combo in itertools.product(*[v for _, v in varies])
+            for rep in range(args.repeat)]
+    fixed = names + ["repeat", "status", "particles", "steps", "wall_s", "cpu_s", "t_end",
+                     "peak_rss_mb", "process_s", "command"]
+    csv_path = os.path.join(out, "study.csv")
+    rows = load_done(csv_path)
+    done = {(tuple(r.get(n, "") for n in names), r.get("repeat")) for r in rows
+            if r.get("status") == "ok"}
+    rows = [r for r in rows if r.get("status") == "ok"]
+    todo = [(v, rep) for v, rep in runs if (tuple(x for _, x in v), str(rep)) not in done]
+    if len(todo) < len(runs):
+        sys.stderr.write("sphc study: %d of %d runs already in %s; running the other %d\n"
+                         % (len(runs) - len(todo), len(runs), csv_path, len(todo)))
+    started = time.time()
+    for k, (variant, rep) in enumerate(todo):
+        eta = "?"
+        if k > 0:
+            eta = fmt_s((time.time() - started) / k * (len(todo) - k))
+        sys.stderr.write("[%d/%d] %s%s  (ETA %s)\n" % (k + 1, len(todo), variant_label(variant),
+                                                      " repeat %d" % rep if args.repeat > 1
+                                                      else "", eta))
+        exe = build(args, variant, kinds, bindir, cache)
+        rundir = os.path.join(out, "runs", re.sub(r"[^A-Za-z0-9.=_-]", "_",
+                                                  "_".join("%s=%s" % nv for nv in variant)) +
+                              "_r%d" % rep)
+        row = dict(variant)
+        row["repeat"] = str(rep)
+        row.update(run_one(args, exe, variant, kinds, rundir))
+        if row["status"] != "ok":
+            sys.stderr.write("  %s: %s (see %s)\n" % (variant_label(variant), row["status"],
+                                                      rundir))
+        else:
+            sys.stderr.write("  wall %s s, %s particles, %s steps\n"
+                             % (row.get("wall_s", "?"), row.get("particles", "?"),
+                                row.get("steps", "?")))
+        rows.append(row)
+        write_rows(csv_path, rows, fixed)  # after every run: an interrupted study resumes
+    write_rows(csv_path, rows, fixed)
+    text = analyse(rows, names, kinds, resolution, budgets, fixed, out, args.metric)
+    sys.stdout.write(text)
+    failed = [r for r in rows if r.get("status") != "ok"]
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
