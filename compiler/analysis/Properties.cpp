@@ -63,7 +63,7 @@ void checkBodyTypes(const Plan& plan, DiagnosticEngine& diags) {
       const BodyFacts& f = plan.bodies[bodyIdx].facts;
       check(bodyIdx, f.dReads, "d_", {eq.dest});
       check(bodyIdx, f.dWrites, "d_", {eq.dest});
-      if (kind == ast::Method::Loop) check(bodyIdx, f.sReads, "s_", eq.sources);
+      if (ast::seesSources(kind)) check(bodyIdx, f.sReads, "s_", eq.sources);
       if (kind != ast::Method::Converged) continue;
       for (const auto& w : f.dWrites)
         if (!isConstant(plan.arrays[eq.dest], w.prop))

@@ -83,6 +83,8 @@ const char* kindName(BodyKind kind) {
     case BodyKind::PostLoop: return "post_loop";
     case BodyKind::Reduce: return "reduce";
     case BodyKind::Converged: return "converged";
+    case BodyKind::InitializePair: return "initialize_pair";
+    case BodyKind::LoopAll: return "loop_all";
     case BodyKind::StepperInit: return "initialize";
     case BodyKind::StepperStage: return "stage";
     case BodyKind::Function: return "function";
@@ -331,9 +333,12 @@ class Batch {
     if (!state[i].reportedOutsideLoop.insert(name).second) return;
     if (name == "s_idx")
       error(i, loc, "'s_idx' (the neighbour's index) is only available in 'loop'");
+    else if (name == "NBRS" || name == "N_NBRS")
+      error(i, loc, "'" + name + "' (the neighbour list) is only available in 'loop_all', not "
+                        "in '" + kindName(bodies_[i].kind) + "'");
     else if (llvm::StringRef(name).startswith("s_"))
-      error(i, loc, "'" + name + "': s_ properties are only available in 'loop', not in '" +
-                        kindName(bodies_[i].kind) + "'");
+      error(i, loc, "'" + name + "': s_ properties are only available in 'loop', 'loop_all' "
+                        "and 'initialize_pair', not in '" + kindName(bodies_[i].kind) + "'");
     else
       error(i, loc, name + " is a pair quantity, only available in 'loop'");
   }
@@ -415,14 +420,19 @@ void Batch::synthesise() {
       if (tokens.has(name)) params.push_back(decl);
     };
     params.push_back("const int d_idx");
-    param("const int s_idx", "s_idx");
+    // loop_all and initialize_pair have no s_idx of their own: a body may declare one
+    // (`int s_idx = NBRS[k];`, as PySPH's loop_all bodies do).
+    if (b.kind != BodyKind::LoopAll && b.kind != BodyKind::InitializePair)
+      param("const int s_idx", "s_idx");
+    param("const unsigned int *const NBRS", "NBRS");
+    param("const int N_NBRS", "N_NBRS");
     params.push_back("const double t");
     params.push_back("const double dt");
     for (const std::string& q : pairQuantityNames())
       param(findPairQuantity(q)->vector ? "const double " + q + "[const 3]"
                                         : "const double " + q,
             q);
-    std::set<std::string> declared = {"d_idx", "s_idx", "t", "dt"};
+    std::set<std::string> declared = {"d_idx", "s_idx", "t", "dt", "NBRS", "N_NBRS"};
     declared.insert(pairQuantityNames().begin(), pairQuantityNames().end());
     for (const std::string& s : b.scalars)
       if (!isPropertyName(s) && !isReservedInC(s) && declared.insert(s).second)
@@ -573,7 +583,16 @@ class DiagnosticForwarder : public clang::DiagnosticConsumer {
                                   name.substr(0, 2) + "idx] = ...");
         else if (isPropertyName(name) && name[0] == 'd')
           return false;  // d_ elements are writable: something else is const
-        else if ((name[0] == 's' && isPropertyName(name)) || name == "s_idx" ||
+        else if (name[0] == 's' && isPropertyName(name) && seesSources(kind))
+          batch_.error(i, at, "cannot write to source property '" + name +
+                                  "': another thread may own that particle; write d_ "
+                                  "properties only");
+        else if (name == "NBRS" || name == "N_NBRS") {
+          if (kind != BodyKind::LoopAll)
+            batch_.reportOutsideLoop(i, at, name);
+          else
+            batch_.error(i, at, "'" + name + "' is read-only in bodies");
+        } else if ((name[0] == 's' && isPropertyName(name)) || name == "s_idx" ||
                  isPairQuantity(name)) {
           if (kind != BodyKind::Loop)
             batch_.reportOutsideLoop(i, at, name);
@@ -638,7 +657,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     auto w = written_.find(e);
     bool isWrite = w != written_.end(), isRead = !isWrite || w->second;
     if (name[0] == 's') {
-      if (body_.kind != BodyKind::Loop) batch_.reportOutsideLoop(i_, loc, name);
+      if (!seesSources(body_.kind)) batch_.reportOutsideLoop(i_, loc, name);
       else if (isRead) record(facts_.sReads, prop, loc);
       // Writes to s_ elements are rejected by Clang (const) and reported by the forwarder.
     } else {
@@ -662,6 +681,9 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
       if (!indexed_.count(e) && recovering_ == 0)
         error(e->getLocation(), "property '" + name + "' must be indexed, e.g. " + name + "[" +
                                     name.substr(0, 2) + "idx]; there are no pointers in bodies");
+    } else if (name == "NBRS" || name == "N_NBRS") {
+      if (body_.kind != BodyKind::LoopAll)
+        batch_.reportOutsideLoop(i_, sph(e->getLocation()), name);
     } else if (isPairQuantity(name) || name == "s_idx") {
       if (body_.kind != BodyKind::Loop)
         batch_.reportOutsideLoop(i_, sph(e->getLocation()), name);

@@ -23,6 +23,10 @@ enum class BodyKind {
   PostLoop,     // equation: per destination particle
   Reduce,       // equation: per destination particle, `return` a double
   Converged,    // equation: once, `return` an int (>0 converged, <0 not, 0 no opinion)
+  InitializePair,  // equation: per (destination particle, source array), before the loops
+                   // over that source; s_* visible (any index), no s_idx
+  LoopAll,      // equation: per (destination particle, source array) with the neighbour list
+                // NBRS[0..N_NBRS) of source indices; s_* visible, no pair quantities
   StepperInit,  // stepper initialize: per particle
   StepperStage, // stepper stageN: per particle
   Function      // helper function: `text` is the whole C definition (from its return type to
@@ -35,6 +39,11 @@ struct PropShape {
   std::string type = "double";  // double, int, uint
   int stride = 1;
 };
+
+// Bodies that see the source arrays (s_*): loop, loop_all, initialize_pair.
+inline bool seesSources(BodyKind k) {
+  return k == BodyKind::Loop || k == BodyKind::LoopAll || k == BodyKind::InitializePair;
+}
 
 struct BodySource {
   std::string text;                  // raw text between the braces

@@ -574,11 +574,12 @@ void ScenePrinter::emitBodies() {
   for (const auto& eq : plan_.equations) {
     if (!eq.live || !emittedDecls.insert(eq.declIndex).second) continue;
     const auto& pd = plan_.equationDecls[eq.declIndex];
-    static const char* names[] = {"initialize", "loop", "post_loop", "reduce", "converged"};
-    static const char* rets[] = {"void", "void", "void", "double", "int"};
     for (const auto& [kind, b] : pd.methods) {
       const bool dev = bodyOnDevice(kind == ast::Method::Converged);
-      emitBodyFunction(plan_.bodies[b], bodyFunctionName(eq.name, names[kind]), rets[kind],
+      emitBodyFunction(plan_.bodies[b], bodyFunctionName(eq.name, ast::methodKeyword(kind)),
+                       kind == ast::Method::Reduce      ? "double"
+                       : kind == ast::Method::Converged ? "int"
+                                                        : "void",
                        eq.dest, dev ? device_ : host_, dev ? cl_ : out_);
     }
   }

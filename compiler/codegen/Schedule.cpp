@@ -208,26 +208,33 @@ DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vect
 // its candidates and pair quantities.
 std::vector<NeighbourPass> ScheduleBuilder::neighbourPasses(
     const std::vector<const PlanEquation*>& eqs, int d, const PlanGroup& g) {
-  std::vector<const PlanEquation*> loopers = withMethod(eqs, ast::Method::Loop);
   std::vector<int> sources;
-  for (const auto* eq : loopers)
-    for (int s : eq->sources)
-      if (std::find(sources.begin(), sources.end(), s) == sources.end()) sources.push_back(s);
+  for (const auto* eq : eqs)
+    for (auto kind : {ast::Method::InitializePair, ast::Method::LoopAll, ast::Method::Loop})
+      if (has(*eq, kind))
+        for (int s : eq->sources)
+          if (std::find(sources.begin(), sources.end(), s) == sources.end())
+            sources.push_back(s);
   std::vector<NeighbourPass> passes;
   for (int s : sources) {
-    sourceNames_.insert(plan_.arrays[s].name);
-    loopNames_.insert(plan_.arrays[s].name);
-    loopNames_.insert(plan_.arrays[d].name);
     NeighbourPass pass;
     pass.source = s;
     auto it = g.pairQuantities.find({d, s});
     if (it != g.pairQuantities.end()) pass.pairQuantities = it->second;
     pass.pairQuantities = pairQuantityClosure(pass.pairQuantities);
-    for (const auto* eq : loopers) {
-      if (std::find(eq->sources.begin(), eq->sources.end(), s) == eq->sources.end()) continue;
-      pass.equations.push_back(eq);
-      for (const auto& r : body(*eq, ast::Method::Loop).facts.sReads)
-        pass.sourceProps.insert(r.prop);
+    for (auto kind : {ast::Method::InitializePair, ast::Method::LoopAll, ast::Method::Loop})
+      for (const auto* eq : withMethod(eqs, kind)) {
+        if (std::find(eq->sources.begin(), eq->sources.end(), s) == eq->sources.end()) continue;
+        (kind == ast::Method::Loop      ? pass.equations
+         : kind == ast::Method::LoopAll ? pass.loopAll
+                                        : pass.initializePair)
+            .push_back(eq);
+        for (const auto& r : body(*eq, kind).facts.sReads) pass.sourceProps.insert(r.prop);
+      }
+    if (pass.searches()) {
+      sourceNames_.insert(plan_.arrays[s].name);
+      loopNames_.insert(plan_.arrays[s].name);
+      loopNames_.insert(plan_.arrays[d].name);
     }
     for (const auto& p : pairQuantityProps(plan_.dim, pass.pairQuantities)) pass.shared.insert(p);
     passes.push_back(std::move(pass));
@@ -491,8 +498,18 @@ void SchedulePrinter::phase(const Phase& ph, int indent) {
       os_ << pad << "    initialize [" << order(w.perParticle) << "]: " << eqList(w.initialize)
           << "\n";
     for (const auto& pass : w.passes) {
+      if (!pass.initializePair.empty())
+        os_ << pad << "    initialize_pair " << name(w.array) << " <- " << name(pass.source)
+            << " [" << order(pass.order) << "]: " << eqList(pass.initializePair) << "\n";
+      if (!pass.searches()) {
+        os_ << pad << "      source properties: " << list(pass.sourceProps) << "\n";
+        continue;
+      }
       os_ << pad << "    neighbours " << name(w.array) << " <- " << name(pass.source) << " ["
           << order(pass.order) << "]: " << eqList(pass.equations) << "\n";
+      if (!pass.loopAll.empty())
+        os_ << pad << "      loop_all (neighbour list NBRS, N_NBRS): " << eqList(pass.loopAll)
+            << "\n";
       os_ << pad << "      pair quantities: " << list(pass.pairQuantities) << "\n";
       os_ << pad << "      source properties: " << list(pass.sourceProps) << "\n";
     }

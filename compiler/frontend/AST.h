@@ -132,13 +132,28 @@ struct EqConst {
 };
 
 struct Method {
-  enum Kind { Initialize, Loop, PostLoop, Reduce, Converged };
+  // InitializePair (per destination particle and source array, before that source's
+  // neighbours) and LoopAll (per destination particle and source array, with the whole
+  // neighbour list NBRS, N_NBRS) are PySPH's initialize_pair and loop_all.
+  enum Kind { Initialize, Loop, PostLoop, Reduce, Converged, InitializePair, LoopAll };
   Kind kind = Initialize;
   llvm::SMLoc loc;              // the method keyword
   std::string reduceOp;         // Reduce: "sum", "max", "min", "mean"
   Ident reduceTarget;           // Reduce: the array constant receiving the result
   Body body;
 };
+
+// The method's keyword in .sph (and in generated function names).
+inline const char* methodKeyword(Method::Kind k) {
+  static const char* const names[] = {"initialize", "loop",           "post_loop", "reduce",
+                                      "converged",  "initialize_pair", "loop_all"};
+  return names[k];
+}
+
+// The methods that see the source arrays (s_*): they run once per source the instance lists.
+inline bool seesSources(Method::Kind k) {
+  return k == Method::Loop || k == Method::LoopAll || k == Method::InitializePair;
+}
 
 struct EquationDecl {
   Ident name;

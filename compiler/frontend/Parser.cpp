@@ -455,7 +455,9 @@ bool Parser::parseEquationParams(ast::EquationDecl& eq) {
 
 bool Parser::parseEquationItem(ast::EquationDecl& eq) {
   static constexpr std::pair<llvm::StringLiteral, ast::Method::Kind> kMethods[] = {
+      {"initialize_pair", ast::Method::InitializePair},
       {"initialize", ast::Method::Initialize},
+      {"loop_all", ast::Method::LoopAll},
       {"loop", ast::Method::Loop},
       {"post_loop", ast::Method::PostLoop},
       {"converged", ast::Method::Converged}};
@@ -474,7 +476,8 @@ bool Parser::parseEquationItem(ast::EquationDecl& eq) {
   }
   if (cur().is(Token::Identifier))
     return error(cur().loc, "unknown method " + quoted(cur().text) + " in " + owner +
-                                ": expected initialize, loop, post_loop, reduce or converged");
+                                ": expected initialize, initialize_pair, loop, loop_all, post_loop, reduce "
+                                "or converged");
   return error(cur().loc, "expected a method or 'const' in " + owner + ", found " +
                               describe(cur()));
 }

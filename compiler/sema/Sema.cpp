@@ -467,14 +467,14 @@ int SemaImpl::useEquationDecl(const ast::EquationDecl* decl) {
       diags_.error(m.loc, "equation '" + decl->name.name + "' defines this method twice");
       continue;
     }
-    static const char* names[] = {"initialize", "loop", "post_loop", "reduce", "converged"};
     static const BodyKind kinds[] = {BodyKind::Initialize, BodyKind::Loop, BodyKind::PostLoop,
-                                     BodyKind::Reduce, BodyKind::Converged};
+                                     BodyKind::Reduce, BodyKind::Converged,
+                                     BodyKind::InitializePair, BodyKind::LoopAll};
     PlanBody body;
     body.source.text = m.body.text;
     body.source.start = m.body.start;
     body.source.kind = kinds[m.kind];
-    body.source.label = "equation " + decl->name.name + ", method " + names[m.kind];
+    body.source.label = "equation " + decl->name.name + ", method " + ast::methodKeyword(m.kind);
     body.source.scalars = scalars;
     body.source.props = propShapes();
     pd.methods[m.kind] = static_cast<int>(plan_->bodies.size());
@@ -954,7 +954,12 @@ void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
   eq.name = decl->name.name;
   eq.loc = inst.equation.loc;
   bool hasLoop = false;
-  for (const auto& m : decl->methods) hasLoop |= m.kind == ast::Method::Loop;
+  const char* loopKind = "loop";  // the first method that needs sources
+  for (const auto& m : decl->methods)
+    if (ast::seesSources(m.kind) && !hasLoop) {
+      hasLoop = true;
+      loopKind = ast::methodKeyword(m.kind);
+    }
   std::map<std::string, ast::ExprPtr> given;
   bool sawDest = false, sawSources = false;
   for (const auto& kw : inst.args) {
@@ -1013,8 +1018,8 @@ void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
   if (!sawDest) diags_.error(inst.equation.loc, "equation '" + decl->name.name +
                                                     "' needs a destination: dest = ARRAY");
   if (hasLoop && (!sawSources || eq.sources.empty()) && sawDest)
-    diags_.error(inst.equation.loc, "equation '" + decl->name.name + "' has a loop and needs "
-                                    "sources: sources = [ARRAY, ...]");
+    diags_.error(inst.equation.loc, "equation '" + decl->name.name + "' has a " + loopKind +
+                                    " and needs sources: sources = [ARRAY, ...]");
   if (!hasLoop && !eq.sources.empty())
     diags_.warning(inst.equation.loc, "equation '" + decl->name.name + "' has no loop: its "
                                       "sources are not used");
