@@ -50,6 +50,10 @@ const std::vector<std::string>& allowedMathFunctions() {
   return names;
 }
 
+bool isState(const BodySource& b, const std::string& name) {
+  return std::find(b.states.begin(), b.states.end(), name) != b.states.end();
+}
+
 const std::vector<std::string>& kernelFunctions() {
   static const std::vector<std::string> names = {"KERNEL_W", "KERNEL_DWDR"};
   return names;
@@ -282,7 +286,8 @@ void Batch::synthesise() {
     declared.insert(pairQuantityNames().begin(), pairQuantityNames().end());
     for (const std::string& s : b.scalars)
       if (!isPropertyName(s) && !isReservedInC(s) && declared.insert(s).second)
-        param("const double " + s, s);
+        param((isState(b, s) && b.kind == BodyKind::Converged ? "double " : "const double ") + s,
+              s);
     for (const std::string& p : tokens.identifiers) {
       if (!isPropertyName(p)) continue;
       auto shape = b.props.find(p.substr(2));
@@ -448,6 +453,10 @@ class DiagnosticForwarder : public clang::DiagnosticConsumer {
                                     "properties only");
           else
             batch_.error(i, at, "'" + name + "' is read-only in bodies");
+        } else if (scalar && isState(b, name)) {
+          batch_.error(i, at, "state '" + name + "' can be written only in 'converged' (on the "
+                              "host, once per call); '" + kindName(kind) +
+                              "' runs per particle, in parallel, and reads it");
         } else if (name == "d_idx" || name == "t" || name == "dt" || scalar) {
           batch_.error(i, at, "'" + name + "' is read-only in bodies");
         } else {

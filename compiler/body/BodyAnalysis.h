@@ -40,6 +40,10 @@ struct PropShape {
   int stride = 1;
 };
 
+struct BodySource;
+// Whether `name` is one of the body's equation states.
+bool isState(const BodySource& b, const std::string& name);
+
 // Bodies that see the source arrays (s_*): loop, loop_all, initialize_pair.
 inline bool seesSources(BodyKind k) {
   return k == BodyKind::Loop || k == BodyKind::LoopAll || k == BodyKind::InitializePair;
@@ -50,7 +54,10 @@ struct BodySource {
   llvm::SMLoc start;                 // location of text[0] in the .sph buffer
   BodyKind kind = BodyKind::Initialize;
   std::string label;                 // for messages: "equation TaitEOS, method initialize"
-  std::vector<std::string> scalars;  // double constants visible by name (params, consts)
+  std::vector<std::string> scalars;  // double constants visible by name (params, consts,
+                                     // states)
+  std::vector<std::string> states;   // those of scalars that are the instance's state:
+                                     // writable in `converged` (host side), read elsewhere
   std::map<std::string, PropShape> props;  // known property shapes (by property name)
   std::string functionName;          // Function: the name it defines
 };
@@ -69,6 +76,7 @@ struct BodyFacts {
                                          // only in Loop bodies)
   bool usesT = false, usesDt = false;
   std::set<std::string> scalarsUsed;     // which of BodySource::scalars appear
+  std::set<std::string> statesWritten;   // which of BodySource::states it assigns
 };
 
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given

@@ -254,6 +254,11 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   void markWritten(clang::Expr* lhs, bool alsoRead) {
     if (auto* e = llvm::dyn_cast<clang::ArraySubscriptExpr>(lhs->IgnoreParens()))
       written_[e] = alsoRead;
+    // An equation state assigned (only `converged` declares them writable).
+    if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(lhs->IgnoreParens()))
+      if (llvm::isa<clang::ParmVarDecl>(ref->getDecl()) &&
+          isState(body_, ref->getDecl()->getName().str()))
+        facts_.statesWritten.insert(ref->getDecl()->getName().str());
   }
 
   static void record(std::vector<PropAccess>& list, const std::string& prop, llvm::SMLoc loc) {

@@ -71,7 +71,10 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b,
       ps.push_back({(vec ? "const " + real + "* " : real + " ") + q, BodyParam::Pair, q});
     }
   for (const auto& s : b.source.scalars)
-    if (f.scalarsUsed.count(s)) ps.push_back({real + " " + s, BodyParam::Scalar, s});
+    if (f.scalarsUsed.count(s))
+      // A state the body writes (converged, on the host): the instance's own member.
+      ps.push_back({(f.statesWritten.count(s) ? std::string("double&") : real) + " " + s,
+                    BodyParam::Scalar, s});
   std::set<std::string> written;
   for (const auto& w : f.dWrites) written.insert(w.prop);
   std::set<std::string> dprops;

@@ -164,6 +164,7 @@ void ScenePrinter::emitSetup() {
       bool own = false;
       const auto* decl = plan_.equationDecls[eq.declIndex].decl;
       for (const auto& c : decl->consts) own |= c.value == v;
+      for (const auto& c : decl->states) own |= c.value == v;
       for (const auto& p : decl->params) own |= p.defaultValue == v;
       auto names = [&](const std::string& x) {
         return own && earlier.count(x) ? s + "." + x : paramRef(x);

@@ -159,6 +159,9 @@ struct EquationDecl {
   Ident name;
   std::vector<EqParam> params;
   std::vector<EqConst> consts;
+  // `state NAME = expr;`: per-instance state (PySPH's self.NAME), initialised at set-up from
+  // the instance's parameters and consts, kept between calls; `converged` may write it.
+  std::vector<EqConst> states;
   std::vector<Method> methods;
 };
 

@@ -446,6 +446,7 @@ bool Parser::parseEquationItem(ast::EquationDecl& eq) {
       {"converged", ast::Method::Converged}};
   std::string owner = "equation " + quoted(eq.name.name);
   if (atWord("const")) return parseEquationConst(eq);
+  if (atWord("state")) return parseEquationState(eq);
   if (atWord("reduce")) return parseReduce(eq);
   for (const auto& [name, kind] : kMethods) {
     if (!atWord(name)) continue;
@@ -461,7 +462,7 @@ bool Parser::parseEquationItem(ast::EquationDecl& eq) {
     return error(cur().loc, "unknown method " + quoted(cur().text) + " in " + owner +
                                 ": expected initialize, initialize_pair, loop, loop_all, post_loop, reduce "
                                 "or converged");
-  return error(cur().loc, "expected a method or 'const' in " + owner + ", found " +
+  return error(cur().loc, "expected a method, 'const' or 'state' in " + owner + ", found " +
                               describe(cur()));
 }
 
@@ -474,6 +475,19 @@ bool Parser::parseEquationConst(ast::EquationDecl& eq) {
     return false;
   eq.consts.push_back(std::move(c));
   return expect(Token::Semi, "after constant declaration");
+}
+
+// `state NAME = expr;` (PySPH's self.NAME): like a const, but bodies may write it.
+bool Parser::parseEquationState(ast::EquationDecl& eq) {
+  advance();
+  ast::EqConst c;
+  if (!parseIdent(c.name, "expected a state name after 'state'") ||
+      !expect(Token::Assign, "after state " + quoted(c.name.name) +
+                                 " (a state needs its initial value: state NAME = EXPR;)") ||
+      !(c.value = parseExpr()))
+    return false;
+  eq.states.push_back(std::move(c));
+  return expect(Token::Semi, "after state declaration");
 }
 
 bool Parser::parseReduce(ast::EquationDecl& eq) {

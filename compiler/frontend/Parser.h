@@ -82,6 +82,7 @@ class Parser {
   bool parseEquationItem(ast::EquationDecl& eq);
   bool parseReduce(ast::EquationDecl& eq);
   bool parseEquationConst(ast::EquationDecl& eq);
+  bool parseEquationState(ast::EquationDecl& eq);
   bool parseFunction(ast::Module& mod);
   bool parseStepper(ast::Module& mod);
   bool parseIntegrator(ast::Module& mod);

@@ -414,6 +414,14 @@ int SemaImpl::useEquationDecl(const ast::EquationDecl* decl) {
   std::vector<std::string> scalars;
   for (const auto& p : decl->params) scalars.push_back(p.name.name);
   for (const auto& c : decl->consts) scalars.push_back(c.name.name);
+  std::vector<std::string> states;
+  for (const auto& st : decl->states) {
+    if (std::find(scalars.begin(), scalars.end(), st.name.name) != scalars.end())
+      diags_.error(st.name.loc, "state '" + st.name.name + "' has the name of a parameter, "
+                                "const or state of equation '" + decl->name.name + "'");
+    scalars.push_back(st.name.name);
+    states.push_back(st.name.name);
+  }
   for (const auto& m : decl->methods) {
     if (pd.methods.count(m.kind)) {
       diags_.error(m.loc, "equation '" + decl->name.name + "' defines this method twice");
@@ -428,6 +436,7 @@ int SemaImpl::useEquationDecl(const ast::EquationDecl* decl) {
     body.source.kind = kinds[m.kind];
     body.source.label = "equation " + decl->name.name + ", method " + ast::methodKeyword(m.kind);
     body.source.scalars = scalars;
+    body.source.states = states;
     body.source.props = propShapes();
     pd.methods[m.kind] = static_cast<int>(plan_->bodies.size());
     plan_->bodies.push_back(std::move(body));

@@ -233,6 +233,16 @@ void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
       visible.insert(c.name.name);
       eq.values.emplace_back(c.name.name, c.value);
     }
+    // States: initial values of the parameters, consts and earlier states (set-up time).
+    for (const auto& st : decl->states) {
+      checkExpr(*st.value, [&](const std::string& n) { return visible.count(n) != 0; },
+                "state '" + st.name.name + "' of equation '" + decl->name.name +
+                    "' (its initial value may use the equation's parameters, consts and "
+                    "earlier states)",
+                diags_);
+      visible.insert(st.name.name);
+      eq.values.emplace_back(st.name.name, st.value);
+    }
   }
   if (eq.dest < 0) return;
   eq.declIndex = useEquationDecl(decl);
