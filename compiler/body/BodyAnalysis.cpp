@@ -50,6 +50,8 @@ const std::vector<std::string>& allowedMathFunctions() {
   return names;
 }
 
+bool writesStates(BodyKind k) { return k == BodyKind::Converged || k == BodyKind::HostReduce; }
+
 bool isState(const BodySource& b, const std::string& name) {
   return std::find(b.states.begin(), b.states.end(), name) != b.states.end();
 }
@@ -269,7 +271,8 @@ void Batch::synthesise() {
     auto param = [&](const std::string& decl, const std::string& name) {
       if (tokens.has(name)) params.push_back(decl);
     };
-    params.push_back("const int d_idx");
+    // A host reduce has the number of real particles N instead of a particle index.
+    params.push_back(b.kind == BodyKind::HostReduce ? "const int N" : "const int d_idx");
     // loop_all and initialize_pair have no s_idx of their own: a body may declare one
     // (`int s_idx = NBRS[k];`, as PySPH's loop_all bodies do).
     if (b.kind != BodyKind::LoopAll && b.kind != BodyKind::InitializePair)
@@ -286,8 +289,7 @@ void Batch::synthesise() {
     declared.insert(pairQuantityNames().begin(), pairQuantityNames().end());
     for (const std::string& s : b.scalars)
       if (!isPropertyName(s) && !isReservedInC(s) && declared.insert(s).second)
-        param((isState(b, s) && b.kind == BodyKind::Converged ? "double " : "const double ") + s,
-              s);
+        param((isState(b, s) && writesStates(b.kind) ? "double " : "const double ") + s, s);
     for (const std::string& p : tokens.identifiers) {
       if (!isPropertyName(p)) continue;
       auto shape = b.props.find(p.substr(2));
@@ -454,8 +456,8 @@ class DiagnosticForwarder : public clang::DiagnosticConsumer {
           else
             batch_.error(i, at, "'" + name + "' is read-only in bodies");
         } else if (scalar && isState(b, name)) {
-          batch_.error(i, at, "state '" + name + "' can be written only in 'converged' (on the "
-                              "host, once per call); '" + kindName(kind) +
+          batch_.error(i, at, "state '" + name + "' can be written only in 'converged' and "
+                              "'reduce { }' (on the host, once per call); '" + kindName(kind) +
                               "' runs per particle, in parallel, and reads it");
         } else if (name == "d_idx" || name == "t" || name == "dt" || scalar) {
           batch_.error(i, at, "'" + name + "' is read-only in bodies");

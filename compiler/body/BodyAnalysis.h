@@ -27,6 +27,8 @@ enum class BodyKind {
                    // over that source; s_* visible (any index), no s_idx
   LoopAll,      // equation: per (destination particle, source array) with the neighbour list
                 // NBRS[0..N_NBRS) of source indices; s_* visible, no pair quantities
+  HostReduce,   // equation `reduce { }`: once on the host, N (the number of real particles)
+                // instead of d_idx; reads properties at any index, writes constants, states
   StepperInit,  // stepper initialize: per particle
   StepperStage, // stepper stageN: per particle
   Function      // helper function: `text` is the whole C definition (from its return type to
@@ -43,6 +45,8 @@ struct PropShape {
 struct BodySource;
 // Whether `name` is one of the body's equation states.
 bool isState(const BodySource& b, const std::string& name);
+// Bodies that run on the host once per call and may write the equation's states.
+bool writesStates(BodyKind k);
 
 // Bodies that see the source arrays (s_*): loop, loop_all, initialize_pair.
 inline bool seesSources(BodyKind k) {

@@ -35,6 +35,7 @@ inline const char* kindName(BodyKind kind) {
     case BodyKind::PostLoop: return "post_loop";
     case BodyKind::Reduce: return "reduce";
     case BodyKind::Converged: return "converged";
+    case BodyKind::HostReduce: return "reduce";
     case BodyKind::InitializePair: return "initialize_pair";
     case BodyKind::LoopAll: return "loop_all";
     case BodyKind::StepperInit: return "initialize";

@@ -56,7 +56,10 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b,
   const std::string& global = d.global;
   const BodyFacts& f = b.facts;
   bool isLoop = b.source.kind == BodyKind::Loop;
-  ps.push_back({"int d_idx", BodyParam::Idx, ""});
+  if (b.source.kind == BodyKind::HostReduce)
+    ps.push_back({"int N", BodyParam::N, ""});  // the real particles of the destination
+  else
+    ps.push_back({"int d_idx", BodyParam::Idx, ""});
   if (isLoop) ps.push_back({"int s_idx", BodyParam::SIdx, ""});
   if (b.source.kind == BodyKind::LoopAll) {
     // PySPH's neighbour list: source indices, and how many.
@@ -205,6 +208,7 @@ std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int
       case BodyParam::SProp: s += "s_" + p.name; break;
       case BodyParam::Nbrs: s += "NBRS"; break;
       case BodyParam::NNbrs: s += "N_NBRS"; break;
+      case BodyParam::N: s += "N"; break;
     }
   }
   return s + ")";

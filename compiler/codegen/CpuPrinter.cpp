@@ -216,6 +216,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions over the destination array into its constants.
   for (const Reduction& r : w.reductions) reduction(w, r);
+  emitHostReduces(w);
   ghostRefresh(w);
 }
 

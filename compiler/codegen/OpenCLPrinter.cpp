@@ -384,6 +384,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << c << ");\n";
     scene_ << "      }\n";
   }
+  emitHostReduces(w);
   ghostRefresh(w);
 }
 

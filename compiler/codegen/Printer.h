@@ -92,7 +92,7 @@ class ScenePrinter {
   // Parameters of a body function, in order, as (C++ declaration, argument kind) pairs.
   struct BodyParam {
     std::string decl;  // e.g. "const double* s_m"
-    enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp, Nbrs, NNbrs } kind;
+    enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp, Nbrs, NNbrs, N } kind;
     std::string name;  // property, pair quantity or scalar name
   };
   // The body-parameter types: what each property, pair quantity and scalar is declared as.
@@ -148,6 +148,9 @@ class ScenePrinter {
   void emitIteration(const ScheduleGroup& g);
   // The convergence test of an iterated group's equation (inside the iteration loop).
   void emitConverged(const PlanEquation& eq);
+  // `reduce { }` (PySPH's reduce(dst, t, dt)) of a destination's equations, on the host,
+  // after its per-particle work (HostProgram.cpp).
+  void emitHostReduces(const DestinationWork& w);
   void emitStep();
   void emitAdaptiveDt();
   void emitSceneMembers();

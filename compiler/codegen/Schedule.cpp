@@ -200,6 +200,7 @@ DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vect
     r.combine = r.op == "sum" || r.op == "mean" ? LoopOrder::Serial : LoopOrder::Parallel;
     w.reductions.push_back(r);
   }
+  w.hostReduce = withMethod(w.equations, ast::Method::HostReduce);
   if (!w.onGhosts) w.ghostRefresh = ghostRefresh(d, w.equations);
   return w;
 }
@@ -516,6 +517,8 @@ void SchedulePrinter::phase(const Phase& ph, int indent) {
     if (!w.postLoop.empty())
       os_ << pad << "    post_loop [" << order(w.perParticle) << "]: " << eqList(w.postLoop)
           << "\n";
+    if (!w.hostReduce.empty())
+      os_ << pad << "    reduce on the host: " << eqList(w.hostReduce) << "\n";
     for (const auto& r : w.reductions)
       os_ << pad << "    reduce " << r.op << " into " << name(w.array) << "." << r.target
           << " [values parallel, combined " << order(r.combine) << "]: " << eqName(r.equation)

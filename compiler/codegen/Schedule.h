@@ -68,6 +68,8 @@ struct DestinationWork {
   std::vector<NeighbourPass> passes;            // one per source, in order of first use
   std::vector<const PlanEquation*> postLoop;    // per particle, after them
   std::vector<Reduction> reductions;
+  // `reduce { }` (PySPH's reduce(dst, t, dt)): on the host, after the reductions, in order.
+  std::vector<const PlanEquation*> hostReduce;
   // Carried properties the phase wrote on the real particles: their ghosts are refreshed
   // after it (empty when the phase ran on the ghosts too).
   std::vector<std::string> ghostRefresh;

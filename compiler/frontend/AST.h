@@ -135,7 +135,10 @@ struct Method {
   // InitializePair (per destination particle and source array, before that source's
   // neighbours) and LoopAll (per destination particle and source array, with the whole
   // neighbour list NBRS, N_NBRS) are PySPH's initialize_pair and loop_all.
-  enum Kind { Initialize, Loop, PostLoop, Reduce, Converged, InitializePair, LoopAll };
+  // HostReduce: `reduce { }` without an operator, PySPH's reduce(dst, t, dt): once per
+  // evaluation, on the host, after the group's per-particle work on the destination.
+  enum Kind { Initialize, Loop, PostLoop, Reduce, Converged, InitializePair, LoopAll,
+              HostReduce };
   Kind kind = Initialize;
   llvm::SMLoc loc;              // the method keyword
   std::string reduceOp;         // Reduce: "sum", "max", "min", "mean"
@@ -146,7 +149,7 @@ struct Method {
 // The method's keyword in .sph (and in generated function names).
 inline const char* methodKeyword(Method::Kind k) {
   static const char* const names[] = {"initialize", "loop",           "post_loop", "reduce",
-                                      "converged",  "initialize_pair", "loop_all"};
+                                      "converged",  "initialize_pair", "loop_all",  "reduce"};
   return names[k];
 }
 

@@ -495,6 +495,13 @@ bool Parser::parseReduce(ast::EquationDecl& eq) {
   method.kind = ast::Method::Reduce;
   method.loc = cur().loc;
   advance();
+  if (cur().is(Token::LBrace)) {
+    // PySPH's reduce(dst, t, dt): once per evaluation on the host, over the whole array.
+    method.kind = ast::Method::HostReduce;
+    if (!parseBody(method.body, "reduce", "equation " + quoted(eq.name.name))) return false;
+    eq.methods.push_back(std::move(method));
+    return true;
+  }
   if (atWord("sum") || atWord("max") || atWord("min") || atWord("mean")) {
     method.reduceOp = cur().text.str();
     advance();
@@ -503,7 +510,8 @@ bool Parser::parseReduce(ast::EquationDecl& eq) {
                                 ": expected sum, max, min or mean");
   } else {
     return error(cur().loc,
-                 "expected a reduction operator after 'reduce': sum, max, min or mean");
+                 "expected a reduction operator after 'reduce': sum, max, min or mean "
+                 "(or a body: 'reduce { ... }', once on the host over the whole array)");
   }
   if (!parseIdent(method.reduceTarget, "expected the array constant receiving the result after "
                                        "'reduce " + method.reduceOp + "'") ||

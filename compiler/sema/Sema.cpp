@@ -429,7 +429,8 @@ int SemaImpl::useEquationDecl(const ast::EquationDecl* decl) {
     }
     static const BodyKind kinds[] = {BodyKind::Initialize, BodyKind::Loop, BodyKind::PostLoop,
                                      BodyKind::Reduce, BodyKind::Converged,
-                                     BodyKind::InitializePair, BodyKind::LoopAll};
+                                     BodyKind::InitializePair, BodyKind::LoopAll,
+                                     BodyKind::HostReduce};
     PlanBody body;
     body.source.text = m.body.text;
     body.source.start = m.body.start;
