@@ -114,7 +114,12 @@ void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, Schedul
   };
   for (int entry : g.order) {
     if (entry >= 0) {
+      // A group's pre/post body is a phase of its own: it runs before (after) the whole
+      // per-particle work of the group's other members.
+      const bool hook = plan_.equations[g.equations[entry]].hook;
+      if (hook) flush();
       run.push_back(g.equations[entry]);
+      if (hook) flush();
       continue;
     }
     flush();

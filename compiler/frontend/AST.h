@@ -197,6 +197,9 @@ struct IntegratorDecl {
 struct EquationInstance {
   Ident equation;
   std::vector<KwArg> args;      // dest = a, sources = [b, c], param = expr
+  // A group's `pre ARRAY { }` / `post ARRAY { }`: an unnamed equation whose only method is a
+  // host `reduce { }` (set only for those; `equation` then names it for messages).
+  std::shared_ptr<EquationDecl> inlineDecl;
 };
 
 struct GroupDecl;
@@ -212,6 +215,9 @@ struct GroupDecl {
   llvm::SMLoc loc;              // the `group` keyword
   std::vector<KwArg> options;   // real, iterate, min_iterations, max_iterations
   std::vector<GroupItem> items;
+  // `pre ARRAY { BODY }`, `post ARRAY { BODY }` (PySPH's Group(pre=, post=)): host bodies run
+  // before and after the group's members (in each iteration of an iterated group).
+  std::shared_ptr<EquationInstance> pre, post;
 };
 
 struct OutputDecl {

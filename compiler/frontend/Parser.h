@@ -99,6 +99,9 @@ class Parser {
   bool parseLimitItem(ast::LimitsDecl& limits);
   bool parseLimitBound(ast::LimitBound& bound, const std::string& head);
   bool parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth);
+  // `pre ARRAY { BODY }` / `post ARRAY { BODY }` in a group (ParseGroupHooks.cpp).
+  bool atGroupHook();
+  bool parseGroupHook(ast::GroupDecl& group);
   // After `(`: `kwarg, ...)`, consuming the `)`.
   bool parseKwArgs(std::vector<ast::KwArg>& args);
   // After `[`: `name, ...]`, consuming the `]`; `what` names the list in errors.

@@ -76,7 +76,9 @@ void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g
     if (sub->iterate && !hasMax) sub->maxIterations = 100;
     if (sub->minIterations > sub->maxIterations)
       diags_.error(gd.loc, "min_iterations is larger than max_iterations");
+    if (gd.pre) instantiate(*gd.pre, *sub);    // PySPH's pre: before the members
     buildGroup(gd.items, *sub, depth + 1);
+    if (gd.post) instantiate(*gd.post, *sub);  // and post after them
     g.order.push_back(-static_cast<int>(g.subgroups.size()) - 1);
     g.subgroups.push_back(std::move(sub));
   }
@@ -121,13 +123,14 @@ void SemaImpl::groupRunTimeOption(const ast::KwArg& kw, PlanGroup& g) {
 
 void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
   auto it = equations_.find(inst.equation.name);
-  if (it == equations_.end()) {
+  if (!inst.inlineDecl && it == equations_.end()) {
     diags_.error(inst.equation.loc, "unknown equation '" + inst.equation.name +
                                         "' (is its module imported?)");
     return;
   }
-  const ast::EquationDecl* decl = it->second;
+  const ast::EquationDecl* decl = inst.inlineDecl ? inst.inlineDecl.get() : it->second;
   PlanEquation eq;
+  eq.hook = inst.inlineDecl != nullptr;
   eq.name = decl->name.name;
   eq.loc = inst.equation.loc;
   bool hasLoop = false;
