@@ -45,12 +45,13 @@ std::vector<Access> equationAccesses(const Plan& plan, const PlanEquation& eq) {
     Access proto;
     proto.equation = eq.id;
     proto.method = kind;
-    addBodyAccesses(out, f, eq.dest, kind == ast::Method::Loop ? eq.sources : std::vector<int>{},
+    addBodyAccesses(out, f, eq.dest, ast::seesSources(kind) ? eq.sources : std::vector<int>{},
                     proto);
-    if (kind != ast::Method::Loop) continue;
-    // What the generated neighbour loop reads for this body.
-    std::vector<std::string> implicitProps =
-        pairQuantityProps(plan.dim, pairQuantityClosure(f.pairQuantities));
+    if (kind != ast::Method::Loop && kind != ast::Method::LoopAll) continue;
+    // What the generated neighbour loop reads for this body (loop_all: the neighbour test).
+    std::vector<std::string> implicitProps = pairQuantityProps(
+        plan.dim, pairQuantityClosure(kind == ast::Method::Loop ? f.pairQuantities
+                                                                : std::set<std::string>{}));
     std::vector<int> arrays = eq.sources;
     arrays.push_back(eq.dest);
     for (int a : arrays)

@@ -35,6 +35,19 @@ void collect(const Plan& plan, const PlanGroup& g, std::vector<std::set<std::str
         for (const auto& r : f.sReads) carry[s].insert(r.prop);
       }
     }
+    // loop_all (and its neighbour test: positions and h) and initialize_pair read sources
+    // too; initialize_pair searches no neighbours, so its sources get ghosts only when a
+    // loop or loop_all searches them.
+    for (ast::Method::Kind k : {ast::Method::LoopAll, ast::Method::InitializePair}) {
+      auto m = pd.methods.find(k);
+      if (m == pd.methods.end()) continue;
+      for (int s : eq.sources) {
+        for (const auto& r : plan.bodies[m->second].facts.sReads) carry[s].insert(r.prop);
+        if (k != ast::Method::LoopAll) continue;
+        isSource[s] = true;
+        for (const auto& p : pairQuantityProps(plan.dim, {})) carry[s].insert(p);
+      }
+    }
     if (g.real) continue;
     // A `real = false` group also runs on the ghosts of its destination.
     for (const auto& [kind, b] : pd.methods)

@@ -13,7 +13,7 @@ void checkGroup(const Plan& plan, const PlanGroup& g, DiagnosticEngine& diags) {
     const PlanEquation& reader = plan.equations[g.equations[i]];
     if (!reader.live) continue;
     for (const auto& r : acc[i]) {
-      if (r.write || !r.viaSource || r.implicit || r.method != ast::Method::Loop) continue;
+      if (r.write || !r.viaSource || r.implicit || !ast::seesSources(r.method)) continue;
       for (size_t j = 0; j < g.equations.size(); ++j) {
         const PlanEquation& writer = plan.equations[g.equations[j]];
         if (!writer.live) continue;
@@ -23,10 +23,11 @@ void checkGroup(const Plan& plan, const PlanGroup& g, DiagnosticEngine& diags) {
           // its loops start and every `post_loop` starts after they end: no hazard. Only
           // writes made while loops run, or to another destination (whose turn may come
           // before or after), make the result order dependent.
-          if (writer.dest == reader.dest && w.method != ast::Method::Loop) continue;
+          if (writer.dest == reader.dest && !ast::seesSources(w.method)) continue;
           const std::string& arr = plan.arrays[r.array].name;
           diags.error(r.loc, "equation '" + reader.name + "' reads 's_" + r.prop + "' of '" +
-                                 arr + "' in its loop, but " +
+                                 arr + "' in its " +
+                                 ast::methodKeyword(r.method) + ", but " +
                                  (i == j ? std::string("it also writes")
                                          : "equation '" + writer.name + "' writes") +
                                  " '" + r.prop + "' of '" + arr +

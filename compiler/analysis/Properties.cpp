@@ -70,13 +70,16 @@ void checkBodyTypes(const Plan& plan, DiagnosticEngine& diags) {
       const BodyFacts& f = plan.bodies[bodyIdx].facts;
       check(bodyIdx, f.dReads, "d_", {eq.dest});
       check(bodyIdx, f.dWrites, "d_", {eq.dest});
-      if (kind == ast::Method::Loop) check(bodyIdx, f.sReads, "s_", eq.sources);
-      if (kind != ast::Method::Converged) continue;
+      if (ast::seesSources(kind)) check(bodyIdx, f.sReads, "s_", eq.sources);
+      if (kind != ast::Method::Converged && kind != ast::Method::HostReduce) continue;
       for (const auto& w : f.dWrites)
         if (!isConstant(plan.arrays[eq.dest], w.prop))
-          diags.error(w.loc, "'converged' runs once per iteration, not per particle: it may "
-                             "write array constants, not the property '" + w.prop +
-                                 "' of array '" + plan.arrays[eq.dest].name + "'");
+          diags.error(w.loc, std::string(kind == ast::Method::Converged
+                                             ? "'converged' runs once per iteration"
+                                             : "'reduce { }' runs once per evaluation") +
+                                 ", not per particle: it may write array constants, not the "
+                                 "property '" + w.prop + "' of array '" +
+                                 plan.arrays[eq.dest].name + "'");
     }
   }
   for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) {

@@ -42,8 +42,8 @@ bool pruneEquations(Plan& plan, DiagnosticEngine&) {
   std::vector<bool> isLive(plan.equations.size(), false);
   // An equation with a convergence test steers its group: it is always live.
   for (const auto& eq : plan.equations)
-    if (eq.declIndex >= 0 &&
-        plan.equationDecls[eq.declIndex].methods.count(ast::Method::Converged))
+    if (eq.hook || (eq.declIndex >= 0 &&
+                    plan.equationDecls[eq.declIndex].methods.count(ast::Method::Converged)))
       isLive[eq.id] = true;
   auto addReads = [&](int e) {
     for (const auto& acc : accesses[e])

@@ -50,6 +50,12 @@ const std::vector<std::string>& allowedMathFunctions() {
   return names;
 }
 
+bool writesStates(BodyKind k) { return k == BodyKind::Converged || k == BodyKind::HostReduce; }
+
+bool isState(const BodySource& b, const std::string& name) {
+  return std::find(b.states.begin(), b.states.end(), name) != b.states.end();
+}
+
 const std::vector<std::string>& kernelFunctions() {
   static const std::vector<std::string> names = {"KERNEL_W", "KERNEL_DWDR"};
   return names;
@@ -265,19 +271,25 @@ void Batch::synthesise() {
     auto param = [&](const std::string& decl, const std::string& name) {
       if (tokens.has(name)) params.push_back(decl);
     };
-    params.push_back("const int d_idx");
-    param("const int s_idx", "s_idx");
+    // A host reduce has the number of real particles N instead of a particle index.
+    params.push_back(b.kind == BodyKind::HostReduce ? "const int N" : "const int d_idx");
+    // loop_all and initialize_pair have no s_idx of their own: a body may declare one
+    // (`int s_idx = NBRS[k];`, as PySPH's loop_all bodies do).
+    if (b.kind != BodyKind::LoopAll && b.kind != BodyKind::InitializePair)
+      param("const int s_idx", "s_idx");
+    param("const unsigned int *const NBRS", "NBRS");
+    param("const int N_NBRS", "N_NBRS");
     params.push_back("const double t");
     params.push_back("const double dt");
     for (const std::string& q : pairQuantityNames())
       param(findPairQuantity(q)->vector ? "const double " + q + "[const 3]"
                                         : "const double " + q,
             q);
-    std::set<std::string> declared = {"d_idx", "s_idx", "t", "dt"};
+    std::set<std::string> declared = {"d_idx", "s_idx", "t", "dt", "NBRS", "N_NBRS"};
     declared.insert(pairQuantityNames().begin(), pairQuantityNames().end());
     for (const std::string& s : b.scalars)
       if (!isPropertyName(s) && !isReservedInC(s) && declared.insert(s).second)
-        param("const double " + s, s);
+        param((isState(b, s) && writesStates(b.kind) ? "double " : "const double ") + s, s);
     for (const std::string& p : tokens.identifiers) {
       if (!isPropertyName(p)) continue;
       auto shape = b.props.find(p.substr(2));
@@ -424,7 +436,16 @@ class DiagnosticForwarder : public clang::DiagnosticConsumer {
                                   name.substr(0, 2) + "idx] = ...");
         else if (isPropertyName(name) && name[0] == 'd')
           return false;  // d_ elements are writable: something else is const
-        else if ((name[0] == 's' && isPropertyName(name)) || name == "s_idx" ||
+        else if (name[0] == 's' && isPropertyName(name) && seesSources(kind))
+          batch_.error(i, at, "cannot write to source property '" + name +
+                                  "': another thread may own that particle; write d_ "
+                                  "properties only");
+        else if (name == "NBRS" || name == "N_NBRS") {
+          if (kind != BodyKind::LoopAll)
+            batch_.reportOutsideLoop(i, at, name);
+          else
+            batch_.error(i, at, "'" + name + "' is read-only in bodies");
+        } else if ((name[0] == 's' && isPropertyName(name)) || name == "s_idx" ||
                  isPairQuantity(name)) {
           if (kind != BodyKind::Loop)
             batch_.reportOutsideLoop(i, at, name);
@@ -434,6 +455,10 @@ class DiagnosticForwarder : public clang::DiagnosticConsumer {
                                     "properties only");
           else
             batch_.error(i, at, "'" + name + "' is read-only in bodies");
+        } else if (scalar && isState(b, name)) {
+          batch_.error(i, at, "state '" + name + "' can be written only in 'converged' and "
+                              "'reduce { }' (on the host, once per call); '" + kindName(kind) +
+                              "' runs per particle, in parallel, and reads it");
         } else if (name == "d_idx" || name == "t" || name == "dt" || scalar) {
           batch_.error(i, at, "'" + name + "' is read-only in bodies");
         } else {

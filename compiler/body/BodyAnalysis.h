@@ -23,6 +23,12 @@ enum class BodyKind {
   PostLoop,     // equation: per destination particle
   Reduce,       // equation: per destination particle, `return` a double
   Converged,    // equation: once, `return` an int (>0 converged, <0 not, 0 no opinion)
+  InitializePair,  // equation: per (destination particle, source array), before the loops
+                   // over that source; s_* visible (any index), no s_idx
+  LoopAll,      // equation: per (destination particle, source array) with the neighbour list
+                // NBRS[0..N_NBRS) of source indices; s_* visible, no pair quantities
+  HostReduce,   // equation `reduce { }`: once on the host, N (the number of real particles)
+                // instead of d_idx; reads properties at any index, writes constants, states
   StepperInit,  // stepper initialize: per particle
   StepperStage, // stepper stageN: per particle
   Function      // helper function: `text` is the whole C definition (from its return type to
@@ -36,12 +42,26 @@ struct PropShape {
   int stride = 1;
 };
 
+struct BodySource;
+// Whether `name` is one of the body's equation states.
+bool isState(const BodySource& b, const std::string& name);
+// Bodies that run on the host once per call and may write the equation's states.
+bool writesStates(BodyKind k);
+
+// Bodies that see the source arrays (s_*): loop, loop_all, initialize_pair.
+inline bool seesSources(BodyKind k) {
+  return k == BodyKind::Loop || k == BodyKind::LoopAll || k == BodyKind::InitializePair;
+}
+
 struct BodySource {
   std::string text;                  // raw text between the braces
   llvm::SMLoc start;                 // location of text[0] in the .sph buffer
   BodyKind kind = BodyKind::Initialize;
   std::string label;                 // for messages: "equation TaitEOS, method initialize"
-  std::vector<std::string> scalars;  // double constants visible by name (params, consts)
+  std::vector<std::string> scalars;  // double constants visible by name (params, consts,
+                                     // states)
+  std::vector<std::string> states;   // those of scalars that are the instance's state:
+                                     // writable in `converged` (host side), read elsewhere
   std::map<std::string, PropShape> props;  // known property shapes (by property name)
   std::string functionName;          // Function: the name it defines
 };
@@ -60,6 +80,7 @@ struct BodyFacts {
                                          // only in Loop bodies)
   bool usesT = false, usesDt = false;
   std::set<std::string> scalarsUsed;     // which of BodySource::scalars appear
+  std::set<std::string> statesWritten;   // which of BodySource::states it assigns
 };
 
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given

@@ -35,6 +35,9 @@ inline const char* kindName(BodyKind kind) {
     case BodyKind::PostLoop: return "post_loop";
     case BodyKind::Reduce: return "reduce";
     case BodyKind::Converged: return "converged";
+    case BodyKind::HostReduce: return "reduce";
+    case BodyKind::InitializePair: return "initialize_pair";
+    case BodyKind::LoopAll: return "loop_all";
     case BodyKind::StepperInit: return "initialize";
     case BodyKind::StepperStage: return "stage";
     case BodyKind::Function: return "function";
@@ -148,9 +151,12 @@ class Batch {
     if (!state[i].reportedOutsideLoop.insert(name).second) return;
     if (name == "s_idx")
       error(i, loc, "'s_idx' (the neighbour's index) is only available in 'loop'");
+    else if (name == "NBRS" || name == "N_NBRS")
+      error(i, loc, "'" + name + "' (the neighbour list) is only available in 'loop_all', not "
+                        "in '" + kindName(bodies_[i].kind) + "'");
     else if (llvm::StringRef(name).startswith("s_"))
-      error(i, loc, "'" + name + "': s_ properties are only available in 'loop', not in '" +
-                        kindName(bodies_[i].kind) + "'");
+      error(i, loc, "'" + name + "': s_ properties are only available in 'loop', 'loop_all' "
+                        "and 'initialize_pair', not in '" + kindName(bodies_[i].kind) + "'");
     else
       error(i, loc, name + " is a pair quantity, only available in 'loop'");
   }

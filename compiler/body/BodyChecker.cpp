@@ -52,7 +52,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     auto w = written_.find(e);
     bool isWrite = w != written_.end(), isRead = !isWrite || w->second;
     if (name[0] == 's') {
-      if (body_.kind != BodyKind::Loop) batch_.reportOutsideLoop(i_, loc, name);
+      if (!seesSources(body_.kind)) batch_.reportOutsideLoop(i_, loc, name);
       else if (isRead) record(facts_.sReads, prop, loc);
       // Writes to s_ elements are rejected by Clang (const) and reported by the forwarder.
     } else {
@@ -76,6 +76,9 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
       if (!indexed_.count(e) && recovering_ == 0)
         error(e->getLocation(), "property '" + name + "' must be indexed, e.g. " + name + "[" +
                                     name.substr(0, 2) + "idx]; there are no pointers in bodies");
+    } else if (name == "NBRS" || name == "N_NBRS") {
+      if (body_.kind != BodyKind::LoopAll)
+        batch_.reportOutsideLoop(i_, sph(e->getLocation()), name);
     } else if (isPairQuantity(name) || name == "s_idx") {
       if (body_.kind != BodyKind::Loop)
         batch_.reportOutsideLoop(i_, sph(e->getLocation()), name);
@@ -251,6 +254,11 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   void markWritten(clang::Expr* lhs, bool alsoRead) {
     if (auto* e = llvm::dyn_cast<clang::ArraySubscriptExpr>(lhs->IgnoreParens()))
       written_[e] = alsoRead;
+    // An equation state assigned (only `converged` declares them writable).
+    if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(lhs->IgnoreParens()))
+      if (llvm::isa<clang::ParmVarDecl>(ref->getDecl()) &&
+          isState(body_, ref->getDecl()->getName().str()))
+        facts_.statesWritten.insert(ref->getDecl()->getName().str());
   }
 
   static void record(std::vector<PropAccess>& list, const std::string& prop, llvm::SMLoc loc) {

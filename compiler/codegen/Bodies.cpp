@@ -56,8 +56,16 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b,
   const std::string& global = d.global;
   const BodyFacts& f = b.facts;
   bool isLoop = b.source.kind == BodyKind::Loop;
-  ps.push_back({"int d_idx", BodyParam::Idx, ""});
+  if (b.source.kind == BodyKind::HostReduce)
+    ps.push_back({"int N", BodyParam::N, ""});  // the real particles of the destination
+  else
+    ps.push_back({"int d_idx", BodyParam::Idx, ""});
   if (isLoop) ps.push_back({"int s_idx", BodyParam::SIdx, ""});
+  if (b.source.kind == BodyKind::LoopAll) {
+    // PySPH's neighbour list: source indices, and how many.
+    ps.push_back({"const " + d.uintType + "* NBRS", BodyParam::Nbrs, ""});
+    ps.push_back({"int N_NBRS", BodyParam::NNbrs, ""});
+  }
   ps.push_back({real + " t", BodyParam::T, ""});
   ps.push_back({real + " dt", BodyParam::Dt, ""});
   for (const auto& q : pairQuantityNames())
@@ -66,7 +74,10 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b,
       ps.push_back({(vec ? "const " + real + "* " : real + " ") + q, BodyParam::Pair, q});
     }
   for (const auto& s : b.source.scalars)
-    if (f.scalarsUsed.count(s)) ps.push_back({real + " " + s, BodyParam::Scalar, s});
+    if (f.scalarsUsed.count(s))
+      // A state the body writes (converged, on the host): the instance's own member.
+      ps.push_back({(f.statesWritten.count(s) ? std::string("double&") : real) + " " + s,
+                    BodyParam::Scalar, s});
   std::set<std::string> written;
   for (const auto& w : f.dWrites) written.insert(w.prop);
   std::set<std::string> dprops;
@@ -231,6 +242,9 @@ std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int
       case BodyParam::Scalar: s += eqValues + sep + p.name; break;
       case BodyParam::DProp: s += "d_" + p.name; break;
       case BodyParam::SProp: s += "s_" + p.name; break;
+      case BodyParam::Nbrs: s += "NBRS"; break;
+      case BodyParam::NNbrs: s += "N_NBRS"; break;
+      case BodyParam::N: s += "N"; break;
     }
   }
   return s + ")";
@@ -251,6 +265,23 @@ void ScenePrinter::emitDestLocals(std::ostream& os, const std::string& indent,
       for (int k = 0; k < plan_.dim; ++k)
         os << indent << "const " << R << " " << pq.components[k] << "i = di_"
            << pq.components[k] << "[d_idx];\n";
+}
+
+void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
+                                     const std::string& indent) {
+  const std::string& R = dl.real;
+  PairDialect dialect;
+  dialect.real = R;
+  dialect.sqrt = dl.sqrt;
+  dialect.kernelW = dl.kernelW;
+  dialect.kernelGradient = dl.kernelGradient;
+  dialect.literalSuffix = dl.lit("");
+  os << indent << "const " << R << " hj = sj_h[s_idx];\n";
+  for (const PairQuantity& pq : pairQuantityTable())
+    if (pq.when == PairWhen::BeforeTest)
+      os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
+  os << indent << "const " << R << " hmax = hi > hj ? hi : hj;\n";
+  os << indent << "if (R2IJ >= RADIUS2 * hmax * hmax) " << skip << "  // not a neighbour\n";
 }
 
 // The pair quantities of one candidate, from the table (analysis/PairQuantityTable): those

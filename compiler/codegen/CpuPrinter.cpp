@@ -31,6 +31,11 @@ class CpuPrinter : public ScenePrinter {
   void extraMembers() override {
     if (openmp_)
       out_ << "  std::vector<" << real_ << "> reduce_scratch;  // reduce sum/mean, OpenMP\n";
+    bool loopAll = false;
+    for (const auto& eq : plan_.equations)
+      loopAll |= eq.live && plan_.equationDecls[eq.declIndex].methods.count(ast::Method::LoopAll);
+    if (loopAll)
+      out_ << "  std::vector<std::vector<std::uint32_t>> nbrs_lists;  // loop_all, per thread\n";
   }
   bool timesNeighbourSearch() const override { return true; }
   void dataMovement() override;
@@ -141,15 +146,36 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     const int s = pass.source;
     const std::string& S = arr(s).name;
     const std::set<std::string>& q = pass.pairQuantities;
-    scene_ << "      {  // neighbours: " << D << " <- " << S << "\n";
-    for (const auto& p : pass.shared) {
-      scene_ << "        const " << real_ << "* di_" << p << " = " << propPtr(d, p) << ";\n";
-      scene_ << "        const " << real_ << "* sj_" << p << " = " << propPtr(s, p) << ";\n";
-    }
+    scene_ << "      {  // " << (pass.searches() ? "neighbours: " : "initialize_pair: ") << D
+           << " <- " << S << "\n";
+    if (pass.searches())
+      for (const auto& p : pass.shared) {
+        scene_ << "        const " << real_ << "* di_" << p << " = " << propPtr(d, p) << ";\n";
+        scene_ << "        const " << real_ << "* sj_" << p << " = " << propPtr(s, p) << ";\n";
+      }
     for (const auto& p : pass.sourceProps)
       scene_ << "        const " << hostType(s, p) << "* s_" << p << " = " << propPtr(s, p)
              << ";\n";
+    // PySPH's initialize_pair: per destination particle, before this source's neighbours.
+    if (!pass.initializePair.empty()) {
+      scene_ << parallelFor("        ", w.perParticle);
+      scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
+             << "; ++d_idx) {  // initialize_pair\n";
+      for (const auto* eq : pass.initializePair)
+        scene_ << "          "
+               << callBody(bodyFunctionName(eq->name, "initialize_pair"),
+                           methodBody(*eq, ast::Method::InitializePair), d, eqStruct(*eq), "t")
+               << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+      scene_ << "        }\n";
+    }
+    if (!pass.searches()) {
+      scene_ << "      }\n";
+      continue;
+    }
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
+    if (!pass.loopAll.empty())
+      scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
+             << (openmp_ ? "omp_get_max_threads()" : "1") << "));\n";
     // Each thread works on its own copies of the array pointers and scalars
     // (default(firstprivate)): shared, the outlined loop reads them through the
     // captured frame at every neighbour, ~4% slower than the serial build (dam break,
@@ -158,14 +184,39 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
            << "; ++d_idx) {\n";
     emitDestLocals(scene_, "          ", q, host_);
-    scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
-    scene_ << "            const int s_idx = static_cast<int>(j);\n";
-    emitCandidate(scene_, q, pass.equations, d, host_);
-    scene_ << "          });\n        }\n      }\n";
+    if (!pass.loopAll.empty()) {
+      // PySPH's loop_all: the neighbour list first (in candidate order), every loop_all
+      // with it, then the loops over the same neighbours.
+      // loop_all's neighbour list: one per thread, reused from particle to particle.
+      scene_ << "          std::vector<std::uint32_t>& nbrs_list = nbrs_lists["
+             << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
+      scene_ << "          nbrs_list.clear();\n";
+      scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
+      scene_ << "            const int s_idx = static_cast<int>(j);\n";
+      emitNeighbourTest(scene_, host_, "return;", "            ");
+      scene_ << "            nbrs_list.push_back(j);\n          });\n";
+      scene_ << "          {\n";
+      scene_ << "            const std::uint32_t* NBRS = nbrs_list.data();\n";
+      scene_ << "            const int N_NBRS = static_cast<int>(nbrs_list.size());\n";
+      for (const auto* eq : pass.loopAll)
+        scene_ << "            "
+               << callBody(bodyFunctionName(eq->name, "loop_all"),
+                           methodBody(*eq, ast::Method::LoopAll), d, eqStruct(*eq), "t")
+               << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+      scene_ << "          }\n";
+    }
+    if (!pass.equations.empty()) {
+      scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
+      scene_ << "            const int s_idx = static_cast<int>(j);\n";
+      emitCandidate(scene_, q, pass.equations, d, host_);
+      scene_ << "          });\n";
+    }
+    scene_ << "        }\n      }\n";
   }
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions over the destination array into its constants.
   for (const Reduction& r : w.reductions) reduction(w, r);
+  emitHostReduces(w);
   ghostRefresh(w);
 }
 

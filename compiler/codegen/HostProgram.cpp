@@ -164,6 +164,7 @@ void ScenePrinter::emitSetup() {
       bool own = false;
       const auto* decl = plan_.equationDecls[eq.declIndex].decl;
       for (const auto& c : decl->consts) own |= c.value == v;
+      for (const auto& c : decl->states) own |= c.value == v;
       for (const auto& p : decl->params) own |= p.defaultValue == v;
       auto names = [&](const std::string& x) {
         return own && earlier.count(x) ? s + "." + x : paramRef(x);
@@ -280,6 +281,33 @@ void ScenePrinter::emitConverged(const PlanEquation& eq) {
   for (const auto& p : written)
     if (int c = constIndex(eq.dest, p); c >= 0) afterConverged(eq, c);
   scene_ << "      }\n";
+}
+
+// PySPH's reduce(dst, t, dt): once per evaluation, on the host, with N the real particles
+// of the destination; it reads properties (brought to the host first, on a device) and may
+// write array constants (sent back) and the equation's states.
+void ScenePrinter::emitHostReduces(const DestinationWork& w) {
+  const int d = w.array;
+  const std::string& D = arr(d).name;
+  for (const PlanEquation* eq : w.hostReduce) {
+    const PlanBody& b = methodBody(*eq, ast::Method::HostReduce);
+    scene_ << "      {  // reduce on the host: " << eq->name << ", from " << loc(eq->loc) << "\n";
+    scene_ << "        const int N = static_cast<int>(" << D << ".n);\n";
+    std::set<std::string> dprops, written;
+    for (const auto& r : b.facts.dReads) dprops.insert(r.prop);
+    for (const auto& wr : b.facts.dWrites) written.insert(wr.prop);
+    dprops.insert(written.begin(), written.end());
+    bool needsProps = false;
+    for (const auto& p : dprops) needsProps |= constIndex(d, p) < 0;
+    if (needsProps) beforeConverged(*eq);
+    for (const auto& p : dprops)
+      scene_ << "        " << hostType(d, p) << "* d_" << p << " = " << propPtr(d, p) << ";\n";
+    scene_ << "        " << callBody(bodyFunctionName(eq->name, "host_reduce"), b, d, eqStruct(*eq), "t")
+           << ";\n";
+    for (const auto& p : written)
+      if (int c = constIndex(d, p); c >= 0) afterConverged(*eq, c);
+    scene_ << "      }\n";
+  }
 }
 
 void ScenePrinter::emitPhase(const Phase& ph) {
@@ -577,11 +605,16 @@ void ScenePrinter::emitBodies() {
   for (const auto& eq : plan_.equations) {
     if (!eq.live || !emittedDecls.insert(eq.declIndex).second) continue;
     const auto& pd = plan_.equationDecls[eq.declIndex];
-    static const char* names[] = {"initialize", "loop", "post_loop", "reduce", "converged"};
-    static const char* rets[] = {"void", "void", "void", "double", "int"};
     for (const auto& [kind, b] : pd.methods) {
-      const bool dev = bodyOnDevice(kind == ast::Method::Converged);
-      emitBodyFunction(plan_.bodies[b], bodyFunctionName(eq.name, names[kind]), rets[kind],
+      const bool host = kind == ast::Method::Converged || kind == ast::Method::HostReduce;
+      const bool dev = bodyOnDevice(host);
+      emitBodyFunction(plan_.bodies[b],
+                       bodyFunctionName(eq.name, kind == ast::Method::HostReduce
+                                                     ? "host_reduce"
+                                                     : ast::methodKeyword(kind)),
+                       kind == ast::Method::Reduce      ? "double"
+                       : kind == ast::Method::Converged ? "int"
+                                                        : "void",
                        eq.dest, dev ? device_ : host_, dev ? cl_ : out_);
     }
   }

@@ -69,6 +69,11 @@ class OpenCLPrinter : public ScenePrinter {
   }
   bool hasToHost() const override { return true; }
 
+  // loop_all on the device: the capacity of a work item's neighbour list (private memory),
+  // and the scratch slot of the neighbour counts that the host checks against it.
+  static constexpr int kMaxNbrs = 256;
+  static constexpr int kNbrsSlot = 64;
+
   // Kernel arguments: declarations in the kernel, expressions on the host.
   struct KernelArgs {
     std::vector<std::string> decls, host;
@@ -254,11 +259,38 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     const int s = pass.source;
     const std::string& S = arr(s).name;
     const std::set<std::string>& q = pass.pairQuantities;
+    // PySPH's initialize_pair: a kernel per destination particle, before the neighbours.
+    if (!pass.initializePair.empty()) {
+      KernelArgs ia;
+      for (const auto* eq : pass.initializePair)
+        addBodyArgs(ia, methodBody(*eq, ast::Method::InitializePair), d, s, eqStruct(*eq));
+      std::string k = name + "_" + D + "_from_" + S + "_initialize_pair";
+      rangeArg(w, ia);
+      beginKernel(k, ia);
+      rangeGuard(w);
+      for (const auto* eq : pass.initializePair)
+        cl_ << "  "
+            << callBody(bodyFunctionName(eq->name, "initialize_pair"),
+                        methodBody(*eq, ast::Method::InitializePair), d, eqStruct(*eq), "t", "_")
+            << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+      cl_ << "}\n\n";
+      scene_ << "      " << launch(k, rangeEnd(w), ia) << "  // initialize_pair: " << D
+             << " <- " << S << "\n";
+    }
+    if (!pass.searches()) continue;
     KernelArgs ka;
+    for (const auto* eq : pass.loopAll)
+      addBodyArgs(ka, methodBody(*eq, ast::Method::LoopAll), d, s, eqStruct(*eq));
     for (const auto* eq : pass.equations)
       addBodyArgs(ka, plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(
                           ast::Method::Loop)],
                   d, s, eqStruct(*eq));
+    // loop_all: each work item's neighbour list is private, of at most SPHC_MAX_NBRS entries;
+    // the count goes to a scratch buffer, which the host checks after the launch.
+    const bool all = !pass.loopAll.empty();
+    if (all)
+      ka.add("__global real* nbrs_count", "ocl.scratch(" + rangeEnd(w) + ", " + std::to_string(kNbrsSlot) + ")",
+             "nbrs_count");
     for (const auto& p : pass.shared) {
       ka.add("__global const real* di_" + p, devBuffer(d, p), "di_" + p);
       ka.add("__global const real* sj_" + p, devBuffer(s, p), "sj_" + p);
@@ -268,8 +300,13 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     std::string k = name + "_" + D + "_from_" + S;
     cl_ << "// neighbours: " << D << " <- " << S << "\n";
     rangeArg(w, ka);
+    if (all)
+      cl_ << "#define SPHC_MAX_NBRS " << kMaxNbrs << "  // loop_all's neighbour list\n";
     beginKernel(k, ka);
-    rangeGuard(w);
+    if (all && w.ranged())
+      cl_ << "  if (d_idx < d_begin) { nbrs_count[d_idx] = 0; return; }  // start_idx\n";
+    else
+      rangeGuard(w);
     emitDestLocals(cl_, "  ", q, device_);
     // The 3^dim cells around the particle's cell, by z, y, x (the CPU candidate order).
     const char* axes[3] = {"x", "y", "z"};
@@ -279,17 +316,41 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
                                   axes[a] + ") * grid_inv, grid_n" + axes[a] + ")"
                             : std::string("0"))
           << ";\n";
-    cl_
-        << "  for (int kz = max(cz - 1, 0); kz <= min(cz + 1, grid_nz - 1); ++kz)\n"
-        << "  for (int ky = max(cy - 1, 0); ky <= min(cy + 1, grid_ny - 1); ++ky)\n"
-        << "  for (int kx = max(cx - 1, 0); kx <= min(cx + 1, grid_nx - 1); ++kx) {\n"
-        << "    const int cell = (kz * grid_ny + ky) * grid_nx + kx;\n"
-        << "    for (uint k = cells_start[cell]; k < cells_end[cell]; ++k) {\n"
-        << "            const int s_idx = (int)cells_order[k];\n";
-    emitCandidate(cl_, q, pass.equations, d, device_);
-    cl_ << "    }\n  }\n}\n\n";
+    const std::string cellLoops =
+        "  for (int kz = max(cz - 1, 0); kz <= min(cz + 1, grid_nz - 1); ++kz)\n"
+        "  for (int ky = max(cy - 1, 0); ky <= min(cy + 1, grid_ny - 1); ++ky)\n"
+        "  for (int kx = max(cx - 1, 0); kx <= min(cx + 1, grid_nx - 1); ++kx) {\n"
+        "    const int cell = (kz * grid_ny + ky) * grid_nx + kx;\n"
+        "    for (uint k = cells_start[cell]; k < cells_end[cell]; ++k) {\n"
+        "            const int s_idx = (int)cells_order[k];\n";
+    if (all) {
+      // The neighbour list in candidate order (the CPU's), every loop_all with it.
+      cl_ << "  uint NBRS[SPHC_MAX_NBRS];\n  int found = 0;\n" << cellLoops;
+      emitNeighbourTest(cl_, device_, "continue;", "            ");
+      cl_ << "            if (found < SPHC_MAX_NBRS) NBRS[found] = (uint)s_idx;\n"
+          << "            ++found;\n    }\n  }\n";
+      cl_ << "  nbrs_count[d_idx] = (real)found;  // checked on the host\n";
+      cl_ << "  const int N_NBRS = min(found, SPHC_MAX_NBRS);\n";
+      for (const auto* eq : pass.loopAll)
+        cl_ << "  "
+            << callBody(bodyFunctionName(eq->name, "loop_all"),
+                        methodBody(*eq, ast::Method::LoopAll), d, eqStruct(*eq), "t", "_")
+            << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+    }
+    if (!pass.equations.empty()) {
+      cl_ << cellLoops;
+      emitCandidate(cl_, q, pass.equations, d, device_);
+      cl_ << "    }\n  }\n";
+    }
+    cl_ << "}\n";
+    if (all) cl_ << "#undef SPHC_MAX_NBRS\n";
+    cl_ << "\n";
     scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // neighbours: " << D << " <- " << S
            << "\n";
+    if (all)
+      scene_ << "      sphc::ocl::check_neighbour_lists(ocl, ocl.scratch(" << rangeEnd(w)
+             << ", " << kNbrsSlot << "), " << rangeEnd(w) << ", " << kMaxNbrs << ", \"" << D << " <- " << S
+             << "\");  // loop_all\n";
   }
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions: per-particle values on the device, partial results there, the last step
@@ -323,6 +384,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << constSlot(d, c) << ");\n";
     scene_ << "      }\n";
   }
+  emitHostReduces(w);
   ghostRefresh(w);
 }
 

@@ -92,7 +92,7 @@ class ScenePrinter {
   // Parameters of a body function, in order, as (C++ declaration, argument kind) pairs.
   struct BodyParam {
     std::string decl;  // e.g. "const double* s_m"
-    enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp } kind;
+    enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp, Nbrs, NNbrs, N } kind;
     std::string name;  // property, pair quantity or scalar name
   };
   // The body-parameter types: what each property, pair quantity and scalar is declared as.
@@ -114,6 +114,10 @@ class ScenePrinter {
   // and the OpenCL kernel.
   void emitCandidate(std::ostream& os, const std::set<std::string>& q,
                      const std::vector<const PlanEquation*>& loopers, int d, const Dialect& dl);
+  // loop_all: the neighbour test of one candidate s_idx (hj, XIJ, R2IJ and the cut-off,
+  // leaving with `skip`), before it joins the neighbour list.
+  void emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
+                         const std::string& indent);
   // The pair quantities of one candidate (XIJ, R2IJ, the cut-off test, HIJ, RIJ, ...).
   void emitPairQuantities(std::ostream& os, const std::set<std::string>& q, const Dialect& dl);
   void emitLineDirective(std::ostringstream& os, llvm::SMLoc l) const;
@@ -144,6 +148,9 @@ class ScenePrinter {
   void emitIteration(const ScheduleGroup& g);
   // The convergence test of an iterated group's equation (inside the iteration loop).
   void emitConverged(const PlanEquation& eq);
+  // `reduce { }` (PySPH's reduce(dst, t, dt)) of a destination's equations, on the host,
+  // after its per-particle work (HostProgram.cpp).
+  void emitHostReduces(const DestinationWork& w);
   void emitStep();
   void emitAdaptiveDt();
   void emitSceneMembers();

@@ -114,7 +114,12 @@ void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, Schedul
   };
   for (int entry : g.order) {
     if (entry >= 0) {
+      // A group's pre/post body is a phase of its own: it runs before (after) the whole
+      // per-particle work of the group's other members.
+      const bool hook = plan_.equations[g.equations[entry]].hook;
+      if (hook) flush();
       run.push_back(g.equations[entry]);
+      if (hook) flush();
       continue;
     }
     flush();
@@ -200,6 +205,7 @@ DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vect
     r.combine = r.op == "sum" || r.op == "mean" ? LoopOrder::Serial : LoopOrder::Parallel;
     w.reductions.push_back(r);
   }
+  w.hostReduce = withMethod(w.equations, ast::Method::HostReduce);
   if (!w.onGhosts) w.ghostRefresh = ghostRefresh(d, w.equations);
   return w;
 }
@@ -208,26 +214,33 @@ DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vect
 // its candidates and pair quantities.
 std::vector<NeighbourPass> ScheduleBuilder::neighbourPasses(
     const std::vector<const PlanEquation*>& eqs, int d, const PlanGroup& g) {
-  std::vector<const PlanEquation*> loopers = withMethod(eqs, ast::Method::Loop);
   std::vector<int> sources;
-  for (const auto* eq : loopers)
-    for (int s : eq->sources)
-      if (std::find(sources.begin(), sources.end(), s) == sources.end()) sources.push_back(s);
+  for (const auto* eq : eqs)
+    for (auto kind : {ast::Method::InitializePair, ast::Method::LoopAll, ast::Method::Loop})
+      if (has(*eq, kind))
+        for (int s : eq->sources)
+          if (std::find(sources.begin(), sources.end(), s) == sources.end())
+            sources.push_back(s);
   std::vector<NeighbourPass> passes;
   for (int s : sources) {
-    sourceNames_.insert(plan_.arrays[s].name);
-    loopNames_.insert(plan_.arrays[s].name);
-    loopNames_.insert(plan_.arrays[d].name);
     NeighbourPass pass;
     pass.source = s;
     auto it = g.pairQuantities.find({d, s});
     if (it != g.pairQuantities.end()) pass.pairQuantities = it->second;
     pass.pairQuantities = pairQuantityClosure(pass.pairQuantities);
-    for (const auto* eq : loopers) {
-      if (std::find(eq->sources.begin(), eq->sources.end(), s) == eq->sources.end()) continue;
-      pass.equations.push_back(eq);
-      for (const auto& r : body(*eq, ast::Method::Loop).facts.sReads)
-        pass.sourceProps.insert(r.prop);
+    for (auto kind : {ast::Method::InitializePair, ast::Method::LoopAll, ast::Method::Loop})
+      for (const auto* eq : withMethod(eqs, kind)) {
+        if (std::find(eq->sources.begin(), eq->sources.end(), s) == eq->sources.end()) continue;
+        (kind == ast::Method::Loop      ? pass.equations
+         : kind == ast::Method::LoopAll ? pass.loopAll
+                                        : pass.initializePair)
+            .push_back(eq);
+        for (const auto& r : body(*eq, kind).facts.sReads) pass.sourceProps.insert(r.prop);
+      }
+    if (pass.searches()) {
+      sourceNames_.insert(plan_.arrays[s].name);
+      loopNames_.insert(plan_.arrays[s].name);
+      loopNames_.insert(plan_.arrays[d].name);
     }
     for (const auto& p : pairQuantityProps(plan_.dim, pass.pairQuantities)) pass.shared.insert(p);
     passes.push_back(std::move(pass));
@@ -491,14 +504,26 @@ void SchedulePrinter::phase(const Phase& ph, int indent) {
       os_ << pad << "    initialize [" << order(w.perParticle) << "]: " << eqList(w.initialize)
           << "\n";
     for (const auto& pass : w.passes) {
+      if (!pass.initializePair.empty())
+        os_ << pad << "    initialize_pair " << name(w.array) << " <- " << name(pass.source)
+            << " [" << order(pass.order) << "]: " << eqList(pass.initializePair) << "\n";
+      if (!pass.searches()) {
+        os_ << pad << "      source properties: " << list(pass.sourceProps) << "\n";
+        continue;
+      }
       os_ << pad << "    neighbours " << name(w.array) << " <- " << name(pass.source) << " ["
           << order(pass.order) << "]: " << eqList(pass.equations) << "\n";
+      if (!pass.loopAll.empty())
+        os_ << pad << "      loop_all (neighbour list NBRS, N_NBRS): " << eqList(pass.loopAll)
+            << "\n";
       os_ << pad << "      pair quantities: " << list(pass.pairQuantities) << "\n";
       os_ << pad << "      source properties: " << list(pass.sourceProps) << "\n";
     }
     if (!w.postLoop.empty())
       os_ << pad << "    post_loop [" << order(w.perParticle) << "]: " << eqList(w.postLoop)
           << "\n";
+    if (!w.hostReduce.empty())
+      os_ << pad << "    reduce on the host: " << eqList(w.hostReduce) << "\n";
     for (const auto& r : w.reductions)
       os_ << pad << "    reduce " << r.op << " into " << name(w.array) << "." << r.target
           << " [values parallel, combined " << order(r.combine) << "]: " << eqName(r.equation)

@@ -31,7 +31,14 @@ struct NeighbourPass {
   int source = -1;                           // array index
   std::set<std::string> pairQuantities;      // closed under what they need (XIJ, RIJ, ...)
   std::vector<const PlanEquation*> equations;  // whose `loop` runs here, in group order
-  std::set<std::string> sourceProps;         // s_* properties the loop bodies read
+  // PySPH's order per source: every initialize_pair over the destination particles first;
+  // then per destination particle the neighbour list, every loop_all with it, then the
+  // loops over the same neighbours.
+  std::vector<const PlanEquation*> initializePair;  // whose `initialize_pair` runs here
+  std::vector<const PlanEquation*> loopAll;         // whose `loop_all` runs here
+  // Whether the pass visits neighbours at all (not for initialize_pair alone).
+  bool searches() const { return !equations.empty() || !loopAll.empty(); }
+  std::set<std::string> sourceProps;         // s_* properties the bodies read
   // Read on both sides to compute the pair quantities: positions and h always, velocities
   // for VIJ, rho for RHOIJ.
   std::set<std::string> shared;
@@ -61,6 +68,8 @@ struct DestinationWork {
   std::vector<NeighbourPass> passes;            // one per source, in order of first use
   std::vector<const PlanEquation*> postLoop;    // per particle, after them
   std::vector<Reduction> reductions;
+  // `reduce { }` (PySPH's reduce(dst, t, dt)): on the host, after the reductions, in order.
+  std::vector<const PlanEquation*> hostReduce;
   // Carried properties the phase wrote on the real particles: their ghosts are refreshed
   // after it (empty when the phase ran on the ghosts too).
   std::vector<std::string> ghostRefresh;

@@ -132,7 +132,13 @@ struct EqConst {
 };
 
 struct Method {
-  enum Kind { Initialize, Loop, PostLoop, Reduce, Converged };
+  // InitializePair (per destination particle and source array, before that source's
+  // neighbours) and LoopAll (per destination particle and source array, with the whole
+  // neighbour list NBRS, N_NBRS) are PySPH's initialize_pair and loop_all.
+  // HostReduce: `reduce { }` without an operator, PySPH's reduce(dst, t, dt): once per
+  // evaluation, on the host, after the group's per-particle work on the destination.
+  enum Kind { Initialize, Loop, PostLoop, Reduce, Converged, InitializePair, LoopAll,
+              HostReduce };
   Kind kind = Initialize;
   llvm::SMLoc loc;              // the method keyword
   std::string reduceOp;         // Reduce: "sum", "max", "min", "mean"
@@ -140,10 +146,25 @@ struct Method {
   Body body;
 };
 
+// The method's keyword in .sph (and in generated function names).
+inline const char* methodKeyword(Method::Kind k) {
+  static const char* const names[] = {"initialize", "loop",           "post_loop", "reduce",
+                                      "converged",  "initialize_pair", "loop_all",  "reduce"};
+  return names[k];
+}
+
+// The methods that see the source arrays (s_*): they run once per source the instance lists.
+inline bool seesSources(Method::Kind k) {
+  return k == Method::Loop || k == Method::LoopAll || k == Method::InitializePair;
+}
+
 struct EquationDecl {
   Ident name;
   std::vector<EqParam> params;
   std::vector<EqConst> consts;
+  // `state NAME = expr;`: per-instance state (PySPH's self.NAME), initialised at set-up from
+  // the instance's parameters and consts, kept between calls; `converged` may write it.
+  std::vector<EqConst> states;
   std::vector<Method> methods;
 };
 
@@ -176,6 +197,9 @@ struct IntegratorDecl {
 struct EquationInstance {
   Ident equation;
   std::vector<KwArg> args;      // dest = a, sources = [b, c], param = expr
+  // A group's `pre ARRAY { }` / `post ARRAY { }`: an unnamed equation whose only method is a
+  // host `reduce { }` (set only for those; `equation` then names it for messages).
+  std::shared_ptr<EquationDecl> inlineDecl;
 };
 
 struct GroupDecl;
@@ -191,6 +215,9 @@ struct GroupDecl {
   llvm::SMLoc loc;              // the `group` keyword
   std::vector<KwArg> options;   // real, iterate, min_iterations, max_iterations
   std::vector<GroupItem> items;
+  // `pre ARRAY { BODY }`, `post ARRAY { BODY }` (PySPH's Group(pre=, post=)): host bodies run
+  // before and after the group's members (in each iteration of an iterated group).
+  std::shared_ptr<EquationInstance> pre, post;
 };
 
 struct OutputDecl {

@@ -204,10 +204,8 @@ class Printer {
       init(c.value);
       os_ << "\n";
     }
-    static const char* const kNames[] = {"initialize", "loop", "post_loop", "reduce",
-                                         "converged"};
     for (const auto& m : eq.methods) {
-      line(1) << kNames[m.kind];
+      line(1) << ast::methodKeyword(m.kind);
       if (m.kind == ast::Method::Reduce) os_ << " " << m.reduceOp << " " << m.reduceTarget.name;
       at(m.loc);
       body(m.body);

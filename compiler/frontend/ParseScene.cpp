@@ -236,7 +236,10 @@ bool Parser::parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth) 
     advance();
     if (consumeIf(Token::LParen) && !parseKwArgs(group->options)) return false;
     items.push_back(ast::GroupItem{group, nullptr, nullptr});
-    return parseBlock("group", [&] { return parseGroupItem(group->items, depth + 1); });
+    return parseBlock("group", [&] {
+      if (atGroupHook()) return parseGroupHook(*group);
+      return parseGroupItem(group->items, depth + 1);
+    });
   }
   if (atWhen()) {
     std::vector<std::shared_ptr<ast::When<std::vector<ast::GroupItem>>>> whens;

@@ -438,12 +438,15 @@ bool Parser::parseEquationParams(ast::EquationDecl& eq) {
 
 bool Parser::parseEquationItem(ast::EquationDecl& eq) {
   static constexpr std::pair<llvm::StringLiteral, ast::Method::Kind> kMethods[] = {
+      {"initialize_pair", ast::Method::InitializePair},
       {"initialize", ast::Method::Initialize},
+      {"loop_all", ast::Method::LoopAll},
       {"loop", ast::Method::Loop},
       {"post_loop", ast::Method::PostLoop},
       {"converged", ast::Method::Converged}};
   std::string owner = "equation " + quoted(eq.name.name);
   if (atWord("const")) return parseEquationConst(eq);
+  if (atWord("state")) return parseEquationState(eq);
   if (atWord("reduce")) return parseReduce(eq);
   for (const auto& [name, kind] : kMethods) {
     if (!atWord(name)) continue;
@@ -457,8 +460,9 @@ bool Parser::parseEquationItem(ast::EquationDecl& eq) {
   }
   if (cur().is(Token::Identifier))
     return error(cur().loc, "unknown method " + quoted(cur().text) + " in " + owner +
-                                ": expected initialize, loop, post_loop, reduce or converged");
-  return error(cur().loc, "expected a method or 'const' in " + owner + ", found " +
+                                ": expected initialize, initialize_pair, loop, loop_all, post_loop, reduce "
+                                "or converged");
+  return error(cur().loc, "expected a method, 'const' or 'state' in " + owner + ", found " +
                               describe(cur()));
 }
 
@@ -473,11 +477,31 @@ bool Parser::parseEquationConst(ast::EquationDecl& eq) {
   return expect(Token::Semi, "after constant declaration");
 }
 
+// `state NAME = expr;` (PySPH's self.NAME): like a const, but bodies may write it.
+bool Parser::parseEquationState(ast::EquationDecl& eq) {
+  advance();
+  ast::EqConst c;
+  if (!parseIdent(c.name, "expected a state name after 'state'") ||
+      !expect(Token::Assign, "after state " + quoted(c.name.name) +
+                                 " (a state needs its initial value: state NAME = EXPR;)") ||
+      !(c.value = parseExpr()))
+    return false;
+  eq.states.push_back(std::move(c));
+  return expect(Token::Semi, "after state declaration");
+}
+
 bool Parser::parseReduce(ast::EquationDecl& eq) {
   ast::Method method;
   method.kind = ast::Method::Reduce;
   method.loc = cur().loc;
   advance();
+  if (cur().is(Token::LBrace)) {
+    // PySPH's reduce(dst, t, dt): once per evaluation on the host, over the whole array.
+    method.kind = ast::Method::HostReduce;
+    if (!parseBody(method.body, "reduce", "equation " + quoted(eq.name.name))) return false;
+    eq.methods.push_back(std::move(method));
+    return true;
+  }
   if (atWord("sum") || atWord("max") || atWord("min") || atWord("mean")) {
     method.reduceOp = cur().text.str();
     advance();
@@ -486,7 +510,8 @@ bool Parser::parseReduce(ast::EquationDecl& eq) {
                                 ": expected sum, max, min or mean");
   } else {
     return error(cur().loc,
-                 "expected a reduction operator after 'reduce': sum, max, min or mean");
+                 "expected a reduction operator after 'reduce': sum, max, min or mean "
+                 "(or a body: 'reduce { ... }', once on the host over the whole array)");
   }
   if (!parseIdent(method.reduceTarget, "expected the array constant receiving the result after "
                                        "'reduce " + method.reduceOp + "'") ||

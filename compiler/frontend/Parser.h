@@ -82,6 +82,7 @@ class Parser {
   bool parseEquationItem(ast::EquationDecl& eq);
   bool parseReduce(ast::EquationDecl& eq);
   bool parseEquationConst(ast::EquationDecl& eq);
+  bool parseEquationState(ast::EquationDecl& eq);
   bool parseFunction(ast::Module& mod);
   bool parseStepper(ast::Module& mod);
   bool parseIntegrator(ast::Module& mod);
@@ -101,6 +102,9 @@ class Parser {
   bool parseMetrics(ast::SceneDecl& scene);
   bool parseMetricItem(ast::MetricsDecl& metrics);
   bool parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth);
+  // `pre ARRAY { BODY }` / `post ARRAY { BODY }` in a group (ParseGroupHooks.cpp).
+  bool atGroupHook();
+  bool parseGroupHook(ast::GroupDecl& group);
   // After `(`: `kwarg, ...)`, consuming the `)`.
   bool parseKwArgs(std::vector<ast::KwArg>& args);
   // After `[`: `name, ...]`, consuming the `]`; `what` names the list in errors.

@@ -27,8 +27,7 @@ PlanProperty* PlanArray::find(const std::string& p) {
 namespace {
 
 const char* methodName(ast::Method::Kind k) {
-  static const char* names[] = {"initialize", "loop", "post_loop", "reduce", "converged"};
-  return names[k];
+  return ast::methodKeyword(k);
 }
 
 // start_idx, stop_idx, condition (evaluated at run time).

@@ -76,6 +76,9 @@ struct PlanEquation {
   std::vector<std::pair<std::string, ast::ExprPtr>> values;
   bool live = true;
   std::string pruneReason;
+  // A group's `pre`/`post` body (an unnamed equation with a host reduce): always run, in a
+  // phase of its own.
+  bool hook = false;
 };
 
 struct PlanGroup {

@@ -428,20 +428,30 @@ int SemaImpl::useEquationDecl(const ast::EquationDecl* decl) {
   std::vector<std::string> scalars;
   for (const auto& p : decl->params) scalars.push_back(p.name.name);
   for (const auto& c : decl->consts) scalars.push_back(c.name.name);
+  std::vector<std::string> states;
+  for (const auto& st : decl->states) {
+    if (std::find(scalars.begin(), scalars.end(), st.name.name) != scalars.end())
+      diags_.error(st.name.loc, "state '" + st.name.name + "' has the name of a parameter, "
+                                "const or state of equation '" + decl->name.name + "'");
+    scalars.push_back(st.name.name);
+    states.push_back(st.name.name);
+  }
   for (const auto& m : decl->methods) {
     if (pd.methods.count(m.kind)) {
       diags_.error(m.loc, "equation '" + decl->name.name + "' defines this method twice");
       continue;
     }
-    static const char* names[] = {"initialize", "loop", "post_loop", "reduce", "converged"};
     static const BodyKind kinds[] = {BodyKind::Initialize, BodyKind::Loop, BodyKind::PostLoop,
-                                     BodyKind::Reduce, BodyKind::Converged};
+                                     BodyKind::Reduce, BodyKind::Converged,
+                                     BodyKind::InitializePair, BodyKind::LoopAll,
+                                     BodyKind::HostReduce};
     PlanBody body;
     body.source.text = m.body.text;
     body.source.start = m.body.start;
     body.source.kind = kinds[m.kind];
-    body.source.label = "equation " + decl->name.name + ", method " + names[m.kind];
+    body.source.label = "equation " + decl->name.name + ", method " + ast::methodKeyword(m.kind);
     body.source.scalars = scalars;
+    body.source.states = states;
     body.source.props = propShapes();
     pd.methods[m.kind] = static_cast<int>(plan_->bodies.size());
     plan_->bodies.push_back(std::move(body));

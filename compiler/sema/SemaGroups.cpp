@@ -76,7 +76,9 @@ void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g
     if (sub->iterate && !hasMax) sub->maxIterations = 100;
     if (sub->minIterations > sub->maxIterations)
       diags_.error(gd.loc, "min_iterations is larger than max_iterations");
+    if (gd.pre) instantiate(*gd.pre, *sub);    // PySPH's pre: before the members
     buildGroup(gd.items, *sub, depth + 1);
+    if (gd.post) instantiate(*gd.post, *sub);  // and post after them
     g.order.push_back(-static_cast<int>(g.subgroups.size()) - 1);
     g.subgroups.push_back(std::move(sub));
   }
@@ -121,17 +123,23 @@ void SemaImpl::groupRunTimeOption(const ast::KwArg& kw, PlanGroup& g) {
 
 void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
   auto it = equations_.find(inst.equation.name);
-  if (it == equations_.end()) {
+  if (!inst.inlineDecl && it == equations_.end()) {
     diags_.error(inst.equation.loc, "unknown equation '" + inst.equation.name +
                                         "' (is its module imported?)");
     return;
   }
-  const ast::EquationDecl* decl = it->second;
+  const ast::EquationDecl* decl = inst.inlineDecl ? inst.inlineDecl.get() : it->second;
   PlanEquation eq;
+  eq.hook = inst.inlineDecl != nullptr;
   eq.name = decl->name.name;
   eq.loc = inst.equation.loc;
   bool hasLoop = false;
-  for (const auto& m : decl->methods) hasLoop |= m.kind == ast::Method::Loop;
+  const char* loopKind = "loop";  // the first method that needs sources
+  for (const auto& m : decl->methods)
+    if (ast::seesSources(m.kind) && !hasLoop) {
+      hasLoop = true;
+      loopKind = ast::methodKeyword(m.kind);
+    }
   std::map<std::string, ast::ExprPtr> given;
   bool sawDest = false, sawSources = false;
   for (const auto& kw : inst.args) {
@@ -190,8 +198,8 @@ void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
   if (!sawDest) diags_.error(inst.equation.loc, "equation '" + decl->name.name +
                                                     "' needs a destination: dest = ARRAY");
   if (hasLoop && (!sawSources || eq.sources.empty()) && sawDest)
-    diags_.error(inst.equation.loc, "equation '" + decl->name.name + "' has a loop and needs "
-                                    "sources: sources = [ARRAY, ...]");
+    diags_.error(inst.equation.loc, "equation '" + decl->name.name + "' has a " + loopKind +
+                                    " and needs sources: sources = [ARRAY, ...]");
   if (!hasLoop && !eq.sources.empty())
     diags_.warning(inst.equation.loc, "equation '" + decl->name.name + "' has no loop: its "
                                       "sources are not used");
@@ -227,6 +235,16 @@ void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
                   diags_);
       visible.insert(c.name.name);
       eq.values.emplace_back(c.name.name, c.value);
+    }
+    // States: initial values of the parameters, consts and earlier states (set-up time).
+    for (const auto& st : decl->states) {
+      checkExpr(*st.value, [&](const std::string& n) { return visible.count(n) != 0; },
+                "state '" + st.name.name + "' of equation '" + decl->name.name +
+                    "' (its initial value may use the equation's parameters, consts and "
+                    "earlier states)",
+                diags_);
+      visible.insert(st.name.name);
+      eq.values.emplace_back(st.name.name, st.value);
     }
   }
   if (eq.dest < 0) return;

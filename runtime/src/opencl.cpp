@@ -791,6 +791,19 @@ int real_prop(const ParticleArray& a, const char* name) {
 }
 }  // namespace
 
+void check_neighbour_lists(Context& ctx, cl_mem counts, std::size_t n, int capacity,
+                           const char* what) {
+  if (n == 0) return;
+  const double most = ctx.reduce(counts, n, Op::Max);
+  if (most <= capacity) return;
+  throw std::runtime_error(
+      "loop_all (" + std::string(what) + "): a particle has " +
+      std::to_string(static_cast<long>(most)) + " neighbours, more than the " +
+      std::to_string(capacity) +
+      " an OpenCL neighbour list holds; run this scene on the CPU backends (serial, openmp), "
+      "or with a smaller h / dx ratio");
+}
+
 void wrap_periodic(Context& ctx, const Domain& d, DeviceArray& dev, const ParticleArray& a) {
   for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
     if (!d.periodic(ax)) continue;

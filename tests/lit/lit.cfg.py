@@ -47,3 +47,7 @@ config.substitutions.append(('%h5range', 'python3 ' + os.path.join(
 # double one (tests/lit/Inputs/precision_compare.py).
 config.substitutions.append(('%precision_compare', 'python3 ' + os.path.join(
     config.sphc_src_root, 'tests', 'lit', 'Inputs', 'precision_compare.py')))
+# %h5consts FILE.h5 ARRAY NAME CHECK ...: array constants against exact values or bounds
+# ('=V', '<V', '>V'; tests/lit/Inputs/h5consts.py).
+config.substitutions.append(('%h5consts', 'python3 ' + os.path.join(
+    config.sphc_src_root, 'tests', 'lit', 'Inputs', 'h5consts.py')))

@@ -184,6 +184,13 @@ class Context {
   std::map<std::string, std::pair<double, long>> profile_times_;
 };
 
+// loop_all on the device: each work item gathers its neighbour list in private memory of
+// `capacity` entries and writes how many neighbours it found to `counts` (n reals). Throws
+// std::runtime_error naming the pass (`what`: "fluid <- fluid") and the largest count when
+// a list overflowed (the bodies then saw a truncated list: the evaluation is wrong).
+void check_neighbour_lists(Context& ctx, cl_mem counts, std::size_t n, int capacity,
+                           const char* what);
+
 // Periodic and mirror domains on the device (sphc/domain.h, the same ghosts in the same
 // order as the CPU backends).
 //
