@@ -17,7 +17,9 @@
 #               of F x DT0, with DT0 given by "--dt0 EXPR" (an awk expression of dx: the
 #               scene's fixed step), and "--set dx=V" sets dx for it
 #   CHECK OPTIONS passed to check_run.py after the output directory
-# Environment: EXPECT_RC (comma-separated accepted exit codes, default 0); SPHC_PYTHON.
+# Environment: EXPECT_RC (comma-separated accepted exit codes, default 0); EXPECT_MESSAGE (a
+# fixed string the run's standard error must contain, e.g. the stop's "the last good output
+# is"); SPHC_PYTHON.
 set -eu
 
 if [ $# -lt 5 ]; then
@@ -72,12 +74,17 @@ echo "== 2. run: $EXE --quiet --timing -d $OUT$RUN_OPTS"
 start=$(date +%s)
 rc=0
 # shellcheck disable=SC2086
-"$EXE" --quiet --timing -d "$OUT" $RUN_OPTS || rc=$?
+"$EXE" --quiet --timing -d "$OUT" $RUN_OPTS 2>"$OUT.stderr" || rc=$?
+cat "$OUT.stderr" >&2
 echo "   ran in $(( $(date +%s) - start )) s, exit $rc"
 case ",${EXPECT_RC:-0}," in
   *",$rc,"*) ;;
   *) echo "FAILED: the run exited $rc (accepted: ${EXPECT_RC:-0})"; exit 1 ;;
 esac
+if [ -n "${EXPECT_MESSAGE:-}" ] && ! grep -qF "$EXPECT_MESSAGE" "$OUT.stderr"; then
+  echo "FAILED: the run's standard error does not say \"$EXPECT_MESSAGE\""
+  exit 1
+fi
 
 echo "== 3. check: check_run.py $OUT $*"
 "$PY" "$SRC/tests/stability/check_run.py" "$OUT" "$@"
