@@ -18,6 +18,8 @@
 #               scene's fixed step), and "--set dx=V" sets dx for it
 #   CHECK OPTIONS passed to check_run.py after the output directory
 # Environment: EXPECT_RC (comma-separated accepted exit codes, default 0); SPHC_PYTHON.
+# A run that stops as a blow-up (exit 3) must say on its standard error which output is "the
+# last good output".
 set -eu
 
 if [ $# -lt 5 ]; then
@@ -72,12 +74,17 @@ echo "== 2. run: $EXE --quiet --timing -d $OUT$RUN_OPTS"
 start=$(date +%s)
 rc=0
 # shellcheck disable=SC2086
-"$EXE" --quiet --timing -d "$OUT" $RUN_OPTS || rc=$?
+"$EXE" --quiet --timing -d "$OUT" $RUN_OPTS 2>"$OUT.stderr" || rc=$?
+cat "$OUT.stderr" >&2
 echo "   ran in $(( $(date +%s) - start )) s, exit $rc"
 case ",${EXPECT_RC:-0}," in
   *",$rc,"*) ;;
   *) echo "FAILED: the run exited $rc (accepted: ${EXPECT_RC:-0})"; exit 1 ;;
 esac
+if [ "$rc" = 3 ] && ! grep -qF "the last good output is" "$OUT.stderr"; then
+  echo "FAILED: the run stopped (exit 3) without naming the last good output"
+  exit 1
+fi
 
 echo "== 3. check: check_run.py $OUT $*"
 "$PY" "$SRC/tests/stability/check_run.py" "$OUT" "$@"
