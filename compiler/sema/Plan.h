@@ -75,6 +75,7 @@ struct PlanEquation {
   std::vector<std::pair<std::string, ast::ExprPtr>> values;
   bool live = true;
   std::string pruneReason;
+  std::vector<std::string> effects;           // the effects whose `when` kept it
 };
 
 struct PlanGroup {

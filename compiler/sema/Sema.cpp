@@ -953,6 +953,7 @@ void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
   PlanEquation eq;
   eq.name = decl->name.name;
   eq.loc = inst.equation.loc;
+  eq.effects = inst.effects;
   bool hasLoop = false;
   for (const auto& m : decl->methods) hasLoop |= m.kind == ast::Method::Loop;
   std::map<std::string, ast::ExprPtr> given;
