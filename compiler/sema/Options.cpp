@@ -306,7 +306,9 @@ class OptionSelector {
     }
   }
   void recordDropped(const ast::SceneDecl& s, ChosenOption& c) { recordDropped(s.equations, c); }
-  void recordDropped(const ast::ArrayDecl&, ChosenOption&) {}
+  void recordDropped(const ast::ArrayDecl& a, ChosenOption& c) {
+    for (const auto& p : a.properties) c.droppedProperties.push_back(a.name.name + "." + p.name.name);
+  }
 
   // Flattens `when` items into the enclosing list, in place, recursively.
   void groupItems(std::vector<ast::GroupItem>& items, bool& ok) {

@@ -33,6 +33,7 @@ struct ChosenOption {
   // equations of the `when NAME` branches dropped, "Name -> dest", for --report.
   std::vector<std::string> params;
   std::vector<std::string> droppedEquations;
+  std::vector<std::string> droppedProperties;  // "fluid.L" of `when NAME` array items
   bool on() const { return isEffect && value == "on"; }
 };
 
