@@ -13,6 +13,7 @@ The dam break runs with its fixed time step (-D timestep=fixed), so every varian
 same steps.
 
 Usage: python3 bench/effects.py [--sphc build/bin/sphc] [--steps 300] [--repeat 2]
+                                [--only dambreak|taylor_green]
 """
 
 import argparse
@@ -87,6 +88,7 @@ def main():
     ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
     ap.add_argument("--steps", type=int, default=300)
     ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--only", choices=["dambreak", "taylor_green"], help="one scene only")
     a = ap.parse_args()
     cpu = "unknown CPU"
     try:
@@ -98,10 +100,12 @@ def main():
         pass
     print(f"sphc effects benchmark on {cpu} (serial, double)")
     with tempfile.TemporaryDirectory() as tmp:
-        bench(a.sphc, os.path.join(ROOT, "examples", "dambreak.sph"), ["-D", "timestep=fixed"],
-              ["gravity", "artificial_viscosity", "xsph"], a.steps, a.repeat, tmp, [])
-        bench(a.sphc, os.path.join(ROOT, "examples", "taylor_green.sph"), [],
-              ["laminar_viscosity", "xsph"], a.steps, a.repeat, tmp, [])
+        if a.only != "taylor_green":
+            bench(a.sphc, os.path.join(ROOT, "examples", "dambreak.sph"), ["-D", "timestep=fixed"],
+                  ["gravity", "artificial_viscosity", "xsph"], a.steps, a.repeat, tmp, [])
+        if a.only != "dambreak":
+            bench(a.sphc, os.path.join(ROOT, "examples", "taylor_green.sph"), [],
+                  ["laminar_viscosity", "xsph"], a.steps, a.repeat, tmp, [])
 
 
 if __name__ == "__main__":
