@@ -71,6 +71,16 @@ struct PropAccess {
   llvm::SMLoc loc;                   // first occurrence in the body
 };
 
+// Where a body indexes a property: text[begin, end) is `d_NAME[...]` or `s_NAME[...]`. The
+// dimension pass (analysis/Dimensions.cpp) rewrites the sites of the z-components of a 2D
+// scene (reads become 0, writes go to a local sink) so that they are never allocated.
+struct PropSite {
+  std::string prop;                  // without the prefix
+  bool source = false;               // s_
+  bool write = false;                // the left side of an assignment (=, +=, ++, ...)
+  unsigned begin = 0, end = 0;       // offsets into BodySource::text
+};
+
 struct BodyFacts {
   bool ok = false;                   // false: errors were reported for this body
   std::vector<PropAccess> dReads;    // d_ properties read (incl. read in `+=`)
@@ -81,6 +91,7 @@ struct BodyFacts {
   bool usesT = false, usesDt = false;
   std::set<std::string> scalarsUsed;     // which of BodySource::scalars appear
   std::set<std::string> statesWritten;   // which of BodySource::states it assigns
+  std::vector<PropSite> sites;           // every indexing of a property
 };
 
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given

@@ -51,6 +51,14 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     llvm::SMLoc loc = sph(e->getBeginLoc());
     auto w = written_.find(e);
     bool isWrite = w != written_.end(), isRead = !isWrite || w->second;
+    llvm::SMLoc end = sph(e->getRBracketLoc());
+    if (loc.isValid() && end.isValid() && body_.start.isValid() &&
+        end.getPointer() >= loc.getPointer()) {
+      unsigned b = static_cast<unsigned>(loc.getPointer() - body_.start.getPointer());
+      unsigned en = static_cast<unsigned>(end.getPointer() - body_.start.getPointer()) + 1;
+      if (en <= body_.text.size() && body_.text.compare(b, name.size(), name) == 0)
+        facts_.sites.push_back({prop, name[0] == 's', isWrite, b, en});
+    }
     if (name[0] == 's') {
       if (!seesSources(body_.kind)) batch_.reportOutsideLoop(i_, loc, name);
       else if (isRead) record(facts_.sReads, prop, loc);

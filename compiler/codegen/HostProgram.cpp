@@ -9,6 +9,8 @@
 #include "llvm/Support/FileSystem.h"
 #include "llvm/Support/Path.h"
 
+#include <algorithm>
+#include <functional>
 #include <sstream>
 
 namespace sphc {
@@ -507,6 +509,25 @@ void ScenePrinter::emitMain() {
     for (const auto& c : o.choices) choices += (choices.empty() ? "" : ", ") + c;
     out_ << "  prog.options.push_back({\"" << o.name << "\", \"" << o.value << "\", \"" << choices
          << "\"});  // sphc -D " << o.name << "=...\n";
+  }
+  for (const auto& o : plan_.options) {
+    if (!o.isEffect || o.on()) continue;
+    // The sphc command that turns the effect on, with the effects it needs that are off.
+    std::vector<std::string> turnOn;
+    std::function<void(const std::string&)> need = [&](const std::string& name) {
+      for (const auto& d : plan_.options)
+        if (d.name == name && !d.on() &&
+            std::find(turnOn.begin(), turnOn.end(), name) == turnOn.end()) {
+          for (const auto& n : d.needs) need(n);
+          turnOn.push_back(name);
+        }
+    };
+    need(o.name);
+    std::string cmd = "sphc " + llvm::sys::path::filename(plan_.mainFile).str();
+    for (const auto& n : turnOn) cmd += " -D " + n + "=on";
+    for (const auto& p : o.params)
+      out_ << "  prog.effect_params.push_back({\"" << p << "\", \"" << o.name << "\", \"" << cmd
+           << "\"});\n";
   }
   if (singlePrecision_) out_ << "  prog.precision = \"single\";\n";
   out_ << "  prog.setup = [](const std::vector<double>& v, sphc::SceneTimes& times) {\n"

@@ -201,6 +201,7 @@ int main(int argc, char** argv) {
   if (diags.hasErrors()) return fail();
   if (dump(Pass::Bodies)) return 0;
 
+  if (!dropAbsentComponents(*plan, diags)) return fail();
   if (!pruneEquations(*plan, diags)) return fail();
   if (dump(Pass::Prune)) return 0;
   if (!inferProperties(*plan, diags)) return fail();

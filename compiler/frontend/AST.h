@@ -54,13 +54,25 @@ struct OptionDecl {
   Ident defaultChoice;
 };
 
-// `when NAME == v`, `when NAME != v`, `when NAME in [v, w]`.
+// `effect delta_sph needs [density_gradient] "Marrone et al. 2011 density diffusion";`: a
+// physical effect a scheme can simulate (docs/effects.md). An effect is a compile-time option
+// with the choices off and on: a scene's `effects = [...]` turns the listed ones on, `sphc -D
+// NAME=on|off` overrides, and `when NAME { ... }` keeps what only the effect needs.
+struct EffectDecl {
+  Ident name;
+  std::vector<Ident> needs;     // effects this one needs on
+  std::string doc;              // one line for --report and --help (may be empty)
+};
+
+// `when NAME == v`, `when NAME != v`, `when NAME in [v, w]`; for an effect `when NAME` and
+// `when !NAME` (NAME == on, NAME != on).
 struct WhenCondition {
   llvm::SMLoc loc;              // the `when` keyword
   Ident option;
   std::vector<Ident> values;    // one for == and !=
   bool negated = false;         // !=
   bool isIn = false;            // `in [...]`
+  bool bare = false;            // `when NAME` / `when !NAME`: an effect's on/off
 };
 
 // `when C1 { ... } else when C2 { ... } else { ... }`: the first branch whose condition holds
@@ -85,6 +97,7 @@ struct ParamDecl {
   Ident name;
   ExprPtr value;
   bool derived = false;  // `let`: computed from params, not overridable at run time
+  Ident effect;          // `param delta = 0.1 for delta_sph;`: exists only with the effect on
 };
 
 struct PropertyDecl {
@@ -200,6 +213,7 @@ struct EquationInstance {
   // A group's `pre ARRAY { }` / `post ARRAY { }`: an unnamed equation whose only method is a
   // host `reduce { }` (set only for those; `equation` then names it for messages).
   std::shared_ptr<EquationDecl> inlineDecl;
+  std::vector<std::string> effects;  // the `when EFFECT` blocks it was kept by (options pass)
 };
 
 struct GroupDecl;
@@ -299,8 +313,19 @@ struct MetricsDecl {
   std::vector<MetricItem> items;
 };
 
+// `scheme wcsph(fluids = [fluid], solids = [boundary], rho0 = ro, c0 = co);` in a scene: the
+// scheme's items (sema/Schemes.cpp) are added to the scene with the arguments substituted.
+struct SchemeUse {
+  Ident scheme;
+  std::vector<KwArg> args;
+  llvm::SMLoc loc;              // the `scheme` keyword
+};
+
 struct SceneDecl {
   Ident name;
+  llvm::SMLoc effectsLoc;       // `effects = [a, b];` (invalid when the scene has none)
+  std::vector<Ident> effects;
+  std::vector<SchemeUse> schemes;
   std::vector<SceneSetting> settings;
   std::vector<SceneStepper> steppers;
   bool hasAdaptiveDt = false;
@@ -316,12 +341,30 @@ struct SceneDecl {
                                                         // added after the others
 };
 
+// `scheme NAME(fluids, solids = [], rho0, c0, alpha = 0.1) { scene items }` at top level: a
+// scheme written once, as per-effect `when` blocks of scene items (integrator, steppers,
+// settings, adaptive_dt, equations). A parameter is bound to an array list (`[fluid]`) or an
+// expression; array-list parameters expand in `dest =`, `sources = [...]` and `stepper`.
+struct SchemeParam {
+  Ident name;
+  bool hasDefault = false;
+  KwArg defaultValue;           // name = the parameter's name
+};
+
+struct SchemeDecl {
+  Ident name;
+  std::vector<SchemeParam> params;
+  std::shared_ptr<SceneDecl> body;
+};
+
 // One parsed file. Sema merges a scene's module with the modules it imports.
 struct Module {
   std::string filename;         // as given on the command line or resolved for an import
   unsigned bufferId = 0;        // in the DiagnosticEngine's SourceMgr
   std::vector<ImportDecl> imports;
   std::vector<OptionDecl> options;
+  std::vector<EffectDecl> effects;
+  std::vector<SchemeDecl> schemes;
   std::vector<ParamDecl> params;
   std::vector<ArrayDecl> arrays;
   std::vector<EquationDecl> equations;

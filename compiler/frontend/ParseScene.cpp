@@ -27,7 +27,9 @@ bool Parser::parseSceneItem(ast::SceneDecl& scene) {
     return error(cur().loc, "expected a scene item ('name = value;', stepper, adaptive_dt, "
                             "output, domain, limits, metrics, equations or when), found " + describe(cur()));
   // The scene's keywords are contextual: `output = 3;` is a setting named output.
+  if (atWord("effects") && lex_.peek().is(Token::Assign)) return parseSceneEffects(scene);
   if (lex_.peek().is(Token::Assign)) return parseSceneSetting(scene);
+  if (atWord("scheme") && lex_.peek().is(Token::Identifier)) return parseSchemeUse(scene);
   if (atWhen())
     return parseWhen<ast::SceneDecl>(
         scene.whens, "scene " + quoted(scene.name.name),
@@ -48,6 +50,34 @@ bool Parser::parseSceneItem(ast::SceneDecl& scene) {
     return parseBlock("equations", [&] { return parseGroupItem(scene.equations, 0); });
   }
   return error(lex_.peek().loc, "expected '=' after scene setting " + quoted(cur().text));
+}
+
+// `effects = [a, b];` in a scene.
+bool Parser::parseSceneEffects(ast::SceneDecl& scene) {
+  llvm::SMLoc loc = cur().loc;
+  advance();
+  advance();  // '='
+  if (scene.effectsLoc.isValid())
+    return error(loc, "the scene's effects are given twice");
+  scene.effectsLoc = loc;
+  if (!expect(Token::LBracket, "after 'effects =' (a list: effects = [gravity, xsph])") ||
+      !parseNameList(scene.effects, "the scene's effects"))
+    return false;
+  return expect(Token::Semi, "after the scene's effects");
+}
+
+// `scheme NAME(arg = value, ...);` in a scene.
+bool Parser::parseSchemeUse(ast::SceneDecl& scene) {
+  ast::SchemeUse use;
+  use.loc = cur().loc;
+  advance();
+  if (!parseIdent(use.scheme, "expected a scheme name after 'scheme'") ||
+      !expect(Token::LParen, "after scheme " + quoted(use.scheme.name)) ||
+      !parseKwArgs(use.args))
+    return false;
+  std::string what = "after 'scheme " + use.scheme.name + "(...)'";
+  scene.schemes.push_back(std::move(use));
+  return expect(Token::Semi, what);
 }
 
 bool Parser::parseSceneSetting(ast::SceneDecl& scene) {

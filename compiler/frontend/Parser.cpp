@@ -180,6 +180,8 @@ std::unique_ptr<ast::Module> Parser::parseModule() {
 bool Parser::parseItem(ast::Module& mod) {
   if (atWord("import")) return parseImport(mod);
   if (atWord("option")) return parseOption(mod);
+  if (atWord("effect")) return parseEffect(mod);
+  if (atWord("scheme")) return parseSchemeDecl(mod);
   if (atWord("param") || atWord("let")) return parseParam(mod);
   if (atWord("array")) return parseArray(mod);
   if (atWord("equation")) return parseEquation(mod);
@@ -188,7 +190,8 @@ bool Parser::parseItem(ast::Module& mod) {
   if (atWord("integrator")) return parseIntegrator(mod);
   if (atWord("scene")) return parseScene(mod);
   const char* expected =
-      "import, option, param, let, array, equation, function, stepper, integrator or scene";
+      "import, option, effect, scheme, param, let, array, equation, function, stepper, "
+      "integrator or scene";
   if (cur().is(Token::Identifier))
     return error(cur().loc, "unknown declaration " + quoted(cur().text) + ": expected " + expected);
   return error(cur().loc, "expected a declaration (" + llvm::Twine(expected) + "), found " +
@@ -231,17 +234,83 @@ bool Parser::parseOption(ast::Module& mod) {
   return expect(Token::Semi, "after option declaration");
 }
 
-// `when` starts a conditional block where it is followed by an option name (so that an
-// equation, setting or property called `when` still parses).
-bool Parser::atWhen() {
-  return atWord("when") && lex_.peek().is(Token::Identifier);
+// effect NAME (needs [a, b])? "doc"? ;
+bool Parser::parseEffect(ast::Module& mod) {
+  advance();
+  ast::EffectDecl e;
+  if (!parseIdent(e.name, "expected an effect name after 'effect'")) return false;
+  if (atWord("needs")) {
+    advance();
+    if (!expect(Token::LBracket, "after 'needs'") ||
+        !parseNameList(e.needs, "the effects " + quoted(e.name.name) + " needs"))
+      return false;
+  }
+  if (cur().is(Token::String)) {
+    e.doc = cur().value;
+    advance();
+  }
+  mod.effects.push_back(std::move(e));
+  return expect(Token::Semi, "after effect declaration");
 }
 
-// NAME == v | NAME != v | NAME in [v, w]
+// scheme NAME(p, q = expr, r = [a, b]) { scene items }
+bool Parser::parseSchemeDecl(ast::Module& mod) {
+  advance();
+  ast::SchemeDecl sc;
+  if (!parseIdent(sc.name, "expected a scheme name after 'scheme'") ||
+      !expect(Token::LParen, "after scheme " + quoted(sc.name.name)))
+    return false;
+  if (!consumeIf(Token::RParen)) {
+    do {
+      ast::SchemeParam p;
+      if (!parseIdent(p.name, "expected a parameter name of scheme " + quoted(sc.name.name)))
+        return false;
+      if (consumeIf(Token::Assign)) {
+        p.hasDefault = true;
+        p.defaultValue.name = p.name;
+        if (consumeIf(Token::LBracket)) {
+          p.defaultValue.isList = true;
+          if (!parseNameList(p.defaultValue.list, "the default of " + quoted(p.name.name)))
+            return false;
+        } else if (!(p.defaultValue.value = parseExpr())) {
+          return false;
+        }
+      }
+      sc.params.push_back(std::move(p));
+    } while (consumeIf(Token::Comma));
+    if (!expect(Token::RParen, "after the parameters of scheme " + quoted(sc.name.name)))
+      return false;
+  }
+  sc.body = std::make_shared<ast::SceneDecl>();
+  sc.body->name = sc.name;
+  bool ok = parseBlock(
+      "scheme " + quoted(sc.name.name), [&] { return parseSceneItem(*sc.body); },
+      /*sceneStepper=*/true);
+  mod.schemes.push_back(std::move(sc));
+  return ok;
+}
+
+// `when` starts a conditional block where it is followed by an option or effect name (so that
+// an equation, setting or property called `when` still parses), or by `!` and an effect.
+bool Parser::atWhen() {
+  return atWord("when") &&
+         (lex_.peek().is(Token::Identifier) || lex_.peek().is(Token::Not));
+}
+
+// NAME == v | NAME != v | NAME in [v, w] | EFFECT | !EFFECT
 bool Parser::parseWhenCondition(ast::WhenCondition& cond) {
   cond.loc = cur().loc;
   advance();
+  if (consumeIf(Token::Not)) {
+    cond.bare = true;
+    cond.negated = true;
+    return parseIdent(cond.option, "expected an effect name after 'when !'");
+  }
   if (!parseIdent(cond.option, "expected an option name after 'when'")) return false;
+  if (cur().is(Token::LBrace)) {
+    cond.bare = true;
+    return true;
+  }
   if (cur().is(Token::EqEq) || cur().is(Token::NotEq)) {
     cond.negated = cur().is(Token::NotEq);
     advance();
@@ -261,7 +330,7 @@ bool Parser::parseWhenCondition(ast::WhenCondition& cond) {
                                   " in [...]'");
     return parseNameList(cond.values, "the choices of 'when " + cond.option.name + " in'");
   }
-  return error(cur().loc, "expected '==', '!=' or 'in' after 'when " + cond.option.name +
+  return error(cur().loc, "expected '==', '!=', 'in' or '{' after 'when " + cond.option.name +
                               "', found " + describe(cur()));
 }
 
@@ -289,7 +358,7 @@ bool Parser::parseWhen(std::vector<std::shared_ptr<ast::When<Body>>>& out,
       return false;
     if (!hasCondition || !atWord("else")) return true;
     advance();  // else
-    if (atWord("when") && !lex_.peek().is(Token::Identifier))
+    if (atWord("when") && !lex_.peek().is(Token::Identifier) && !lex_.peek().is(Token::Not))
       return error(lex_.peek().loc, "expected an option name after 'else when', found " +
                                         describe(lex_.peek()));
   }
@@ -305,6 +374,10 @@ bool Parser::parseParam(ast::Module& mod) {
     return false;
   param.value = parseExpr();
   if (!param.value) return false;
+  if (atWord("for")) {
+    advance();
+    if (!parseIdent(param.effect, "expected an effect name after 'for'")) return false;
+  }
   mod.params.push_back(std::move(param));
   return expect(Token::Semi, "after parameter declaration");
 }

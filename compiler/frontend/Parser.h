@@ -62,6 +62,10 @@ class Parser {
   bool parseItem(ast::Module& mod);
   bool parseImport(ast::Module& mod);
   bool parseOption(ast::Module& mod);
+  bool parseEffect(ast::Module& mod);
+  bool parseSchemeDecl(ast::Module& mod);
+  bool parseSceneEffects(ast::SceneDecl& scene);
+  bool parseSchemeUse(ast::SceneDecl& scene);
   bool atWhen();
   bool parseWhenCondition(ast::WhenCondition& cond);
   // `when C { items } else when C { items } else { items }`; parseItem parses one item of the

@@ -1,4 +1,5 @@
 #include "sema/Options.h"
+#include "sema/Schemes.h"
 
 #include "llvm/ADT/STLExtras.h"
 #include "llvm/ADT/StringRef.h"
@@ -17,7 +18,8 @@ std::string joined(const std::vector<std::string>& names) {
 
 class OptionSelector {
  public:
-  OptionSelector(DiagnosticEngine& diags) : diags_(diags) {}
+  OptionSelector(DiagnosticEngine& diags, const std::vector<std::unique_ptr<ast::Module>>& modules)
+      : diags_(diags), modules_(&modules) {}
 
   bool declare(const std::vector<std::unique_ptr<ast::Module>>& modules) {
     bool ok = true;
@@ -54,6 +56,129 @@ class OptionSelector {
         chosen_.push_back(std::move(c));
       }
     }
+    for (const auto& mod : modules) {
+      for (const auto& e : mod->effects) {
+        if (auto it = effectDecls_.find(e.name.name); it != effectDecls_.end()) {
+          diags_.error(e.name.loc, "effect '" + e.name.name + "' is declared twice");
+          diags_.note(it->second->name.loc, "first declared here");
+          ok = false;
+          continue;
+        }
+        if (auto it = decls_.find(e.name.name); it != decls_.end()) {
+          diags_.error(e.name.loc, "'" + e.name.name + "' is declared as an option and an effect");
+          diags_.note(it->second->name.loc, "the option is declared here");
+          ok = false;
+          continue;
+        }
+        effectDecls_[e.name.name] = &e;
+        ChosenOption c;
+        c.name = e.name.name;
+        c.choices = {"off", "on"};
+        c.value = "off";
+        c.isEffect = true;
+        c.doc = e.doc;
+        for (const auto& n : e.needs) c.needs.push_back(n.name);
+        chosen_.push_back(std::move(c));
+      }
+    }
+    for (const auto& [name, e] : effectDecls_)
+      for (const auto& n : e->needs)
+        if (!effectDecls_.count(n.name)) {
+          diags_.error(n.loc, "effect '" + name + "' needs '" + n.name +
+                                  "', which is no effect (" + knownEffects() + ")");
+          ok = false;
+        }
+    return ok;
+  }
+
+  std::string knownEffects() const {
+    std::vector<std::string> names;
+    for (const auto& c : chosen_)
+      if (c.isEffect) names.push_back(c.name);
+    return names.empty() ? "no effect is declared: declare one with 'effect NAME;'"
+                         : "known effects: " + joined(names);
+  }
+
+  // The scene's `effects = [a, b];` turns a and b on (before -D, which overrides).
+  bool sceneEffects(const ast::SceneDecl& s) {
+    bool ok = true;
+    std::map<std::string, llvm::SMLoc> seen;
+    for (const auto& e : s.effects) {
+      ChosenOption* c = find(e.name);
+      if (!c || !c->isEffect) {
+        diags_.error(e.loc, "unknown effect '" + e.name + "' (" + knownEffects() + ")");
+        if (c) diags_.note(decls_[c->name]->name.loc, "'" + e.name + "' is an option: choose "
+                                                      "it with 'when' and -D " + e.name + "=...");
+        ok = false;
+        continue;
+      }
+      if (auto it = seen.find(e.name); it != seen.end()) {
+        diags_.error(e.loc, "effect '" + e.name + "' is listed twice");
+        diags_.note(it->second, "first listed here");
+        ok = false;
+        continue;
+      }
+      seen[e.name] = e.loc;
+      c->value = "on";
+      c->fromScene = true;
+      effectLocs_[e.name] = e.loc;
+    }
+    return ok;
+  }
+
+  // Every effect that is on has the effects it needs on.
+  bool checkNeeds() {
+    bool ok = true;
+    for (const auto& c : chosen_) {
+      if (!c.on()) continue;
+      for (const auto& n : c.needs) {
+        const ChosenOption* d = find(n);
+        if (!d || d->on()) continue;
+        std::string how = d->fromCommandLine ? " (-D " + n + "=off)" : "";
+        std::string msg = "effect '" + c.name + "' needs '" + n + "', which is off" + how +
+                          (c.fromScene ? ": add " + n + " to the scene's effects"
+                                       : ": turn it on too, -D " + n + "=on");
+        if (auto it = effectLocs_.find(c.name); it != effectLocs_.end())
+          diags_.error(it->second, msg);
+        else
+          diags_.error(msg + " (" + c.name + " is on by -D " + c.name + "=on)");
+        const ast::EffectDecl* decl = effectDecls_[c.name];
+        for (const auto& need : decl->needs)
+          if (need.name == n)
+            diags_.note(need.loc, c.name + " needs " + n +
+                                      (effectDecls_[n]->doc.empty() ? std::string()
+                                                                    : " (" + effectDecls_[n]->doc + ")"));
+        ok = false;
+      }
+    }
+    return ok;
+  }
+
+  // `param P = v for EFFECT;`: removed when the effect is off (and recorded, so the solver
+  // can say which effect a --set of it needs).
+  bool effectParams(ast::Module& mod) {
+    bool ok = true;
+    std::vector<ast::ParamDecl> kept;
+    for (auto& p : mod.params) {
+      if (p.effect.name.empty()) {
+        kept.push_back(std::move(p));
+        continue;
+      }
+      ChosenOption* c = find(p.effect.name);
+      if (!c || !c->isEffect) {
+        diags_.error(p.effect.loc, "param '" + p.name.name + "' is declared for '" +
+                                       p.effect.name + "', which is no effect (" +
+                                       knownEffects() + ")");
+        ok = false;
+        continue;
+      }
+      if (c->on()) {
+        kept.push_back(std::move(p));
+        continue;
+      }
+      c->params.push_back(p.name.name);
+    }
+    mod.params = std::move(kept);
     return ok;
   }
 
@@ -103,6 +228,18 @@ class OptionSelector {
   // choice. `ok` is cleared on error.
   bool holds(const ast::WhenCondition& cond, bool& ok) {
     ChosenOption* c = find(cond.option.name);
+    if (cond.bare) {
+      if (!c || !c->isEffect) {
+        diags_.error(cond.option.loc,
+                     "'when " + cond.option.name + "' without a comparison needs an effect; '" +
+                         cond.option.name + "' is " +
+                         (c ? "an option (write 'when " + cond.option.name + " == CHOICE')"
+                            : std::string("no effect (") + knownEffects() + ")"));
+        ok = false;
+        return false;
+      }
+      return c->on() != cond.negated;
+    }
     if (!c) {
       std::vector<std::string> names;
       for (const auto& o : chosen_) names.push_back(o.name);
@@ -133,9 +270,44 @@ class OptionSelector {
     Body* pick = nullptr;
     for (auto& b : w.branches) {
       bool h = !b.hasCondition || holds(b.condition, ok);
-      if (h && !pick) pick = &b.body;
+      if (h && !pick) {
+        pick = &b.body;
+      } else if (b.hasCondition && b.condition.bare && !b.condition.negated) {
+        if (ChosenOption* c = find(b.condition.option.name)) recordDropped(b.body, *c);
+      }
     }
     return pick;
+  }
+
+  void tagEffect(std::vector<ast::GroupItem>& items, const std::string& effect) {
+    for (auto& item : items) {
+      if (item.equation) {
+        auto copy = std::make_shared<ast::EquationInstance>(*item.equation);
+        copy->effects.push_back(effect);
+        item.equation = copy;
+      }
+      if (item.group) tagEffect(item.group->items, effect);
+    }
+  }
+
+  // What a `when EFFECT` branch not taken held, for --report ("left out").
+  void recordDropped(const std::vector<ast::GroupItem>& items, ChosenOption& c) {
+    for (const auto& item : items) {
+      if (item.group) recordDropped(item.group->items, c);
+      if (item.equation) {
+        std::string dest;
+        for (const auto& a : item.equation->args)
+          if (a.name.name == "dest" && a.value && a.value->kind == ast::Expr::Name)
+            dest = " -> " + a.value->text;
+        c.droppedEquations.push_back(item.equation->equation.name + dest);
+      }
+      if (item.when)
+        for (const auto& b : item.when->branches) recordDropped(b.body, c);
+    }
+  }
+  void recordDropped(const ast::SceneDecl& s, ChosenOption& c) { recordDropped(s.equations, c); }
+  void recordDropped(const ast::ArrayDecl& a, ChosenOption& c) {
+    for (const auto& p : a.properties) c.droppedProperties.push_back(a.name.name + "." + p.name.name);
   }
 
   // Flattens `when` items into the enclosing list, in place, recursively.
@@ -145,6 +317,10 @@ class OptionSelector {
       if (item.when) {
         if (auto* body = choose(*item.when, ok)) {
           groupItems(*body, ok);
+          // The effect whose `when` kept these items (for --report).
+          for (const auto& b : item.when->branches)
+            if (&b.body == body && b.hasCondition && b.condition.bare && !b.condition.negated)
+              tagEffect(*body, b.condition.option.name);
           for (auto& sub : *body) out.push_back(std::move(sub));
         }
         continue;
@@ -172,17 +348,25 @@ class OptionSelector {
     }
   }
 
-  void scene(ast::SceneDecl& s, bool& ok) {
+  // `top`: the scene itself (not a `when` branch of it), where schemes are expanded: first
+  // those it uses outright, then those of its chosen branches.
+  void scene(ast::SceneDecl& s, bool& ok, bool top = true) {
+    if (top && !s.schemes.empty()) ok = expandSchemes(*modules_, s, diags_) && ok;
     groupItems(s.equations, ok);
     auto whens = std::move(s.whens);
     s.whens.clear();
     for (auto& w : whens) {
       ast::SceneDecl* part = choose(*w, ok);
       if (!part) continue;
-      scene(*part, ok);
+      if (part->effectsLoc.isValid()) {
+        diags_.error(part->effectsLoc, "the scene's effects cannot be inside a 'when'");
+        ok = false;
+      }
+      scene(*part, ok, /*top=*/false);
       auto append = [](auto& to, auto& from) {
         for (auto& x : from) to.push_back(std::move(x));
       };
+      append(s.schemes, part->schemes);
       append(s.settings, part->settings);
       append(s.steppers, part->steppers);
       append(s.outputs, part->outputs);
@@ -214,6 +398,7 @@ class OptionSelector {
         }
       }
     }
+    if (top && !s.schemes.empty()) scene(s, ok);  // schemes a chosen branch used
   }
 
   std::vector<ChosenOption> chosen() const { return chosen_; }
@@ -226,7 +411,10 @@ class OptionSelector {
   }
 
   DiagnosticEngine& diags_;
+  const std::vector<std::unique_ptr<ast::Module>>* modules_;
   std::map<std::string, const ast::OptionDecl*> decls_;
+  std::map<std::string, const ast::EffectDecl*> effectDecls_;
+  std::map<std::string, llvm::SMLoc> effectLocs_;  // where the scene turned an effect on
   std::vector<ChosenOption> chosen_;
 };
 
@@ -235,9 +423,13 @@ class OptionSelector {
 bool selectOptions(std::vector<std::unique_ptr<ast::Module>>& modules,
                    const std::vector<std::string>& defines, DiagnosticEngine& diags,
                    std::vector<ChosenOption>& chosen) {
-  OptionSelector sel(diags);
+  OptionSelector sel(diags, modules);
   bool ok = sel.declare(modules);
+  for (auto& mod : modules)
+    for (auto& s : mod->scenes) ok = sel.sceneEffects(s) && ok;
   ok = sel.applyDefines(defines) && ok;
+  ok = ok && sel.checkNeeds();
+  for (auto& mod : modules) ok = sel.effectParams(*mod) && ok;
   for (auto& mod : modules) {
     for (auto& a : mod->arrays) sel.array(a, ok);
     for (auto& s : mod->scenes) sel.scene(s, ok);

@@ -24,8 +24,25 @@ struct ChosenOption {
   std::vector<std::string> choices;  // as declared; the first-declared default is `value`
                                      // unless -D changed it
   bool fromCommandLine = false;
+  // An effect (`effect NAME ...;`, docs/effects.md): choices off and on.
+  bool isEffect = false;
+  std::string doc;
+  std::vector<std::string> needs;
+  bool fromScene = false;                  // listed in the scene's `effects = [...]`
+  // With the effect off: the params declared `for` it (removed from the scene), and the
+  // equations of the `when NAME` branches dropped, "Name -> dest", for --report.
+  std::vector<std::string> params;
+  std::vector<std::string> droppedEquations;
+  std::vector<std::string> droppedProperties;  // "fluid.L" of `when NAME` array items
+  bool on() const { return isEffect && value == "on"; }
 };
 
+// Effects: `effect NAME needs [..] "doc";` declares one (an option with the choices off and
+// on), the scene's `effects = [a, b];` turns effects on, -D NAME=on|off overrides, `when NAME`
+// keeps what only the effect needs, `param P = v for NAME;` exists only with it, and an effect
+// on whose `needs` is off is an error. Schemes used by the scene are expanded here too
+// (sema/Schemes.h), before the `when`s are chosen.
+//
 // `defines` are the -D arguments, "NAME=VALUE". Returns false after reporting errors.
 bool selectOptions(std::vector<std::unique_ptr<ast::Module>>& modules,
                    const std::vector<std::string>& defines, DiagnosticEngine& diags,

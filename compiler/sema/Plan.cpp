@@ -1,5 +1,7 @@
 #include "sema/Plan.h"
 
+#include <algorithm>
+
 #include "frontend/ASTPrinter.h"
 
 #include "llvm/Support/Format.h"
@@ -103,6 +105,66 @@ void printGroup(const Plan& plan, const PlanGroup& g, llvm::raw_ostream& os, int
   }
 }
 
+int bytesPerParticle(const PlanArray& a) {
+  int bytes = 0;
+  for (const auto& p : a.props) bytes += (p.type == "double" ? 8 : 4) * p.stride;
+  return bytes;
+}
+
+// The scene's effects (docs/effects.md): on or off, and what an effect that is off left out.
+void printEffects(const Plan& plan, llvm::raw_ostream& os) {
+  bool any = false;
+  for (const auto& o : plan.options) any |= o.isEffect;
+  if (!any) return;
+  os << "effects:\n";
+  for (const auto& o : plan.options) {
+    if (!o.isEffect) continue;
+    os << "  " << o.name << ": " << o.value
+       << (o.fromCommandLine ? " (-D)" : o.fromScene ? " (the scene's effects)" : " (not listed)");
+    if (!o.doc.empty()) os << "  -- " << o.doc;
+    os << "\n";
+    if (o.on()) continue;
+    if (!o.droppedEquations.empty()) {
+      os << "    left out (effect off): ";
+      for (size_t i = 0; i < o.droppedEquations.size(); ++i)
+        os << (i ? ", " : "") << o.droppedEquations[i];
+      os << "\n";
+    }
+    if (!o.droppedProperties.empty()) {
+      os << "    properties left out:";
+      for (const auto& p : o.droppedProperties) os << " " << p;
+      os << "\n";
+    }
+    if (!o.params.empty()) {
+      os << "    params left out (--set is an error naming the effect):";
+      for (const auto& p : o.params) os << " " << p;
+      os << "\n";
+    }
+  }
+}
+
+// Per array: the effects its live equations belong to, and the equations kept.
+void printArrayEffects(const Plan& plan, const PlanArray& a, llvm::raw_ostream& os) {
+  int index = plan.arrayIndex(a.name);
+  std::vector<std::string> effects, kept;
+  for (const auto& eq : plan.equations) {
+    if (eq.dest != index || !eq.live) continue;
+    if (std::find(kept.begin(), kept.end(), eq.name) == kept.end()) kept.push_back(eq.name);
+    for (const auto& e : eq.effects)
+      if (std::find(effects.begin(), effects.end(), e) == effects.end()) effects.push_back(e);
+  }
+  if (!effects.empty()) {
+    os << "    effects simulated:";
+    for (const auto& e : effects) os << " " << e;
+    os << "\n";
+  }
+  if (!kept.empty()) {
+    os << "    equations kept:";
+    for (const auto& e : kept) os << " " << e;
+    os << "\n";
+  }
+}
+
 }  // namespace
 
 void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
@@ -115,10 +177,13 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
     os << "\n";
   }
   if (plan.adaptiveDt) os << "adaptive time step: yes\n";
-  if (!plan.options.empty()) {
+  bool anyOption = false;
+  for (const auto& o : plan.options) anyOption |= !o.isEffect;
+  if (anyOption) {
     os << "options:";
     for (const auto& o : plan.options)
-      os << " " << o.name << "=" << o.value << (o.fromCommandLine ? " (-D)" : " (default)");
+      if (!o.isEffect)
+        os << " " << o.name << "=" << o.value << (o.fromCommandLine ? " (-D)" : " (default)");
     os << "\n";
   }
   if (plan.domain.any()) {
@@ -148,16 +213,20 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
       if (p->derived) os << " " << p->name.name;
     os << "\n";
   }
+  if (report) printEffects(plan, os);
   for (const auto& a : plan.arrays) {
     os << "array " << a.name;
     if (a.stepper >= 0) os << " (stepper " << plan.steppers[a.stepper].decl->name.name << ")";
-    os << ": " << a.props.size() << " properties\n   ";
+    os << ": " << a.props.size() << " properties";
+    if (report) os << ", " << bytesPerParticle(a) << " bytes per particle (in double precision)";
+    os << "\n   ";
     for (const auto& p : a.props) {
       os << " " << p.name;
       if (p.type != "double") os << ":" << p.type;
       if (p.stride != 1) os << "[" << p.stride << "]";
     }
     os << "\n";
+    if (report) printArrayEffects(plan, a, os);
     if (!a.ghostProps.empty()) {
       os << "    ghosts carry:";
       for (const auto& p : a.ghostProps) os << " " << p;

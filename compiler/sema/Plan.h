@@ -79,6 +79,7 @@ struct PlanEquation {
   // A group's `pre`/`post` body (an unnamed equation with a host reduce): always run, in a
   // phase of its own.
   bool hook = false;
+  std::vector<std::string> effects;           // the effects whose `when` kept it
 };
 
 struct PlanGroup {

@@ -133,6 +133,7 @@ void SemaImpl::instantiate(const ast::EquationInstance& inst, PlanGroup& g) {
   eq.hook = inst.inlineDecl != nullptr;
   eq.name = decl->name.name;
   eq.loc = inst.equation.loc;
+  eq.effects = inst.effects;
   bool hasLoop = false;
   const char* loopKind = "loop";  // the first method that needs sources
   for (const auto& m : decl->methods)

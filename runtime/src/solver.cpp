@@ -117,6 +117,14 @@ std::pair<std::string, double> parse_set(const std::string& arg, const SceneProg
   const std::string name = arg.substr(0, eq);
   const bool known = std::any_of(prog.params.begin(), prog.params.end(),
                                  [&](const ParamInfo& p) { return p.name == name; });
+  for (const EffectParamInfo& e : prog.effect_params) {
+    if (e.name == name) {
+      throw UsageError(fmt::format(
+          "--set {}: parameter '{}' belongs to the effect '{}', which this executable was "
+          "built without; build one with it: `{}`",
+          arg, name, e.effect, e.command));
+    }
+  }
   for (const OptionInfo& o : prog.options) {
     if (o.name == name) {
       throw UsageError(fmt::format(

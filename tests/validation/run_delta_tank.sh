@@ -15,12 +15,13 @@ OUT=$4
 . "$(dirname "$0")/common.sh"
 find_python run_delta_tank.sh
 fresh_output "$EXE" "$OUT"
-echo "== 1. compile"
+echo "== 1. compile: without delta-SPH (the default) and with it (its effects, docs/effects.md)"
 "$SPHC" "$SRC/examples/hydrostatic_tank.sph" -o "$EXE"
+"$SPHC" "$SRC/examples/hydrostatic_tank.sph" -D density_gradient=on -D delta_sph=on -o "$EXE.delta"
 echo "== 2. run without delta-SPH (alpha = 0.1)"
-"$EXE" --quiet --timing -d "$OUT/without" --set alpha=0.1 --set delta=0 --set hdx=1.3
+"$EXE" --quiet --timing -d "$OUT/without" --set alpha=0.1 --set hdx=1.3
 echo "== 3. run with delta-SPH (alpha = 0.1, delta = 0.1)"
-"$EXE" --quiet --timing -d "$OUT/with" --set alpha=0.1 --set delta=0.1 --set hdx=1.3
+"$EXE.delta" --quiet --timing -d "$OUT/with" --set alpha=0.1 --set delta=0.1 --set hdx=1.3
 echo "== 4. check"
 "$PY" "$SRC/tests/validation/delta_sph_tank.py" "$OUT/without" "$OUT/with" \
   --plot "$OUT/delta_sph_tank.png"

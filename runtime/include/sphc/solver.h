@@ -37,6 +37,15 @@ struct OptionInfo {
   std::string choices;  // "wcsph, edac, tvf"
 };
 
+// A parameter of an effect this executable was built without (`param delta = 0.1 for
+// delta_sph;`, docs/effects.md): `--set` of it is an error that names the effect and the
+// sphc command that builds a solver with it.
+struct EffectParamInfo {
+  std::string name;
+  std::string effect;
+  std::string command;  // "sphc dambreak.sph -D density_gradient=on -D delta_sph=on"
+};
+
 // Times a scene computes from its parameters; the command line may override them.
 struct SceneTimes {
   double tf = 1.0;                 // final time
@@ -70,6 +79,7 @@ struct SceneProgram {
   int dim = 2;
   std::vector<ParamInfo> params;  // defaults, in order; --set overrides by name
   std::vector<OptionInfo> options;  // compile-time options this executable was built with
+  std::vector<EffectParamInfo> effect_params;  // params of effects it was built without
   // Called with the final parameter values (same order as params). Builds arrays, sets the
   // scene's tf, dt and output times (they may depend on params). run_main calls it twice:
   // first inside a CountingPass (sphc/memory.h: no particles are made, only counted, for the
