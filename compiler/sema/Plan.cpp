@@ -247,6 +247,17 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
        << plan.equations.size() - live << " pruned\n";
     for (const auto& n : plan.notes) os << "note: " << n << "\n";
   }
+  if (!plan.metrics.empty()) {  // metrics { } (sema/Metrics.cpp)
+    static const char* kKinds[] = {"L1", "L2", "Linf", "max", "min", "sum", "mean"};
+    os << "metrics:";
+    for (const auto& m : plan.metrics) {
+      os << " " << m.name << " = " << kKinds[m.kind] << "(" << plan.arrays[m.array].name << ")";
+      if (!m.reference.empty()) os << " vs \"" << m.reference << "\"";
+      else if (m.exact) os << " vs exact";
+      os << (m.relative ? " relative;" : ";");
+    }
+    os << "\n";
+  }
 }
 
 }  // namespace sphc
