@@ -174,6 +174,7 @@ void ScenePrinter::emitSetup() {
   }
   for (int a : sched_.setupArrays) emitArraySetup(arr(a));
   if (hasDomain()) emitDomainSetup();
+  if (hasZones()) emitZoneSetup();
   auto pn = [&](const std::string& n) { return paramRef(n); };
   scene_ << "    times.tf = " << exprCpp(*plan_.tf, pn) << ";\n";
   scene_ << "    times.dt = " << exprCpp(*plan_.dt, pn) << ";\n";
@@ -402,6 +403,10 @@ void ScenePrinter::emitStep() {
       scene_ << "    compute_accelerations(" << timeAfter(st.stagesDone[0]) << ", dt);\n";
       continue;
     }
+    if (st.kind == StepStatement::InletOutlet) {
+      scene_ << "    inlet_outlet(" << timeAfter(st.stagesDone[0]) << ");\n";
+      continue;
+    }
     if (st.kind == StepStatement::UpdateDomain) {
       scene_ << (hasDomain() ? "    update_domain();\n"
                              : "    // update_domain: no periodic or mirror domain in this scene\n");
@@ -513,6 +518,8 @@ void ScenePrinter::emitMain() {
       out_ << (firstProp ? "" : ", ") << "\"" << p << "\"";
       firstProp = false;
     }
+    // Arrays that grow and shrink: every output carries the global ids.
+    if (hasZones() && !firstProp) out_ << ", \"gid\"";
     out_ << "}});\n";
   }
   out_ << "  return sphc::run_main(argc, argv, prog);\n}\n";
@@ -532,6 +539,7 @@ std::string ScenePrinter::run() {
   for (const auto& a : plan_.arrays) anyLoad |= !a.decl->loads.empty();
   if (anyLoad) out_ << "#include \"sphc/load.h\"\n";
   if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
+  if (hasZones()) out_ << "#include \"sphc/inlet_outlet.h\"\n";
   runtimeIncludes();
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   systemIncludes();
@@ -599,6 +607,7 @@ void ScenePrinter::emitSceneFunctions() {
   emitGroup(sched_.equations);
   steppers();
   emitStep();
+  if (hasZones()) emitInletOutlet();
   emitAdaptiveDt();
 }
 
@@ -618,6 +627,7 @@ void ScenePrinter::emitSceneMembers() {
       out_ << "  " << ghostsType() << " ghosts_" << S << ";\n";
   }
   extraMembers();
+  if (hasZones()) out_ << "  sphc::InletOutlet io;  // inlets and outlets (sphc/inlet_outlet.h)\n";
   // Iterations per evaluation of each iterated group (--timing prints them).
   out_ << "  std::vector<sphc::IterationStats> iteration_stats{";
   for (std::size_t k = 0; k < sched_.iteratedGroups.size(); ++k)

@@ -68,6 +68,16 @@ class OpenCLPrinter : public ScenePrinter {
     return "    if (!sphc::counting_particles()) scene.to_device();\n";
   }
   bool hasToHost() const override { return true; }
+  // The manager works on the host arrays: down before it, up after (DeviceArray::upload
+  // grows the buffers' capacity by at least a quarter when an array outgrows it).
+  void arraysToHost(const std::vector<int>& arrays) override {
+    for (int a : arrays)
+      scene_ << "    dev_" << arr(a).name << ".download(ocl, " << arr(a).name << ");\n";
+  }
+  void arraysFromHost(const std::vector<int>& arrays) override {
+    for (int a : arrays)
+      scene_ << "    dev_" << arr(a).name << ".upload(ocl, " << arr(a).name << ");\n";
+  }
 
   // Kernel arguments: declarations in the kernel, expressions on the host.
   struct KernelArgs {

@@ -87,6 +87,10 @@ class ScenePrinter {
   virtual void mainBackendOptions() {}              // prog.set_threads, device selection
   virtual std::string afterSetup() const { return ""; }  // "    if (!sphc::counting_particles()) scene.to_device();\n"
   virtual bool hasToHost() const { return false; }
+  // The inlet/outlet step runs on the host: the arrays it resizes come to the host before
+  // it and go back to where the scene computes after it (their new sizes included).
+  virtual void arraysToHost(const std::vector<int>& arrays) {}
+  virtual void arraysFromHost(const std::vector<int>& arrays) {}
 
   // ---- Bodies, their parameters and calls (Bodies.cpp) ----
   // Parameters of a body function, in order, as (C++ declaration, argument kind) pairs.
@@ -150,6 +154,13 @@ class ScenePrinter {
   // The SceneProgram of `main`: name, params, options, set-up, arrays, step, outputs.
   void emitMain();
   void emitLimits();
+
+  // ---- Inlets and outlets (InletOutletPrinter.cpp) ----
+  bool hasZones() const { return !plan_.zones.empty(); }
+  // In setup(), after the arrays: the zones of the scene and init_inlet_outlet.
+  void emitZoneSetup();
+  // The Scene member inlet_outlet(t), the schedule's InletOutlet statement.
+  void emitInletOutlet();
 
   // ---- Shared helpers ----
   // The data a scene computes on: host arrays, or their float copies (--precision=single).

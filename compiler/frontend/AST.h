@@ -248,6 +248,15 @@ struct LimitsDecl {
   std::vector<LimitItem> items;
 };
 
+// `inlet NAME(array = a, feeds = fluid, ...);` / `outlet NAME(array = a, from = fluid, ...);`:
+// an open-boundary zone (docs/language.md, Inlets and outlets; sema/Zones.cpp checks it).
+struct ZoneDecl {
+  bool inlet = true;
+  Ident name;
+  llvm::SMLoc loc;              // the `inlet` / `outlet` keyword
+  std::vector<KwArg> args;
+};
+
 struct SceneDecl {
   Ident name;
   std::vector<SceneSetting> settings;
@@ -258,6 +267,7 @@ struct SceneDecl {
   std::vector<OutputDecl> outputs;
   std::vector<DomainDecl> domains;  // sema allows one
   std::vector<LimitsDecl> limits;
+  std::vector<ZoneDecl> zones;
   llvm::SMLoc equationsLoc;
   std::vector<GroupItem> equations;
   std::vector<std::shared_ptr<When<SceneDecl>>> whens;  // the chosen branch's items are

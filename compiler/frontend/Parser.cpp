@@ -606,7 +606,7 @@ bool Parser::parseScene(ast::Module& mod) {
 bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (!cur().is(Token::Identifier))
     return error(cur().loc, "expected a scene item ('name = value;', stepper, adaptive_dt, "
-                            "output, domain, limits, equations or when), found " + describe(cur()));
+                            "output, domain, limits, inlet, outlet, equations or when), found " + describe(cur()));
   // The scene's keywords are contextual: `output = 3;` is a setting named output.
   if (lex_.peek().is(Token::Assign)) return parseSceneSetting(scene);
   if (atWhen())
@@ -622,6 +622,7 @@ bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (atWord("output")) return parseOutput(scene);
   if (atWord("domain")) return parseDomain(scene);
   if (atWord("limits")) return parseLimits(scene);
+  if (atWord("inlet") || atWord("outlet")) return parseZone(scene);
   if (atWord("equations")) {
     scene.equationsLoc = cur().loc;
     advance();

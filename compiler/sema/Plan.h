@@ -42,6 +42,8 @@ struct PlanArray {
   int stepper = -1;                      // index into Plan::steppers
   std::vector<std::string> outputProps;  // as listed in the scene's output
   std::vector<std::string> limitProps;   // what the scene's limits read (speed: u, v, w)
+  // What the inlet/outlet manager copies between arrays and sets on the host (sema/Zones.cpp).
+  std::vector<std::string> zoneProps;
   // With a periodic or mirror domain: the properties ghost copies of this array's particles
   // carry (what the source side of a loop reads, and what groups with `real = false` read
   // on it), filled by the ghost pass; empty when the array is no source.
@@ -138,6 +140,20 @@ struct PlanLimit {
   ast::ExprPtr warnLo, warnHi, stopLo, stopHi;
 };
 
+// An inlet or outlet of the scene (sema/Zones.cpp; runtime: sphc/inlet_outlet.h). The
+// expressions are of params; the velocity of an inlet also of x, y, z and t.
+struct PlanZone {
+  bool inlet = true;
+  std::string name;
+  llvm::SMLoc loc;
+  int array = -1;      // the zone's particles
+  int other = -1;      // inlet: the array it feeds; outlet: the array it takes from
+  ast::ExprPtr point[3], normal[3], length, width;
+  ast::ExprPtr velocity[3];  // inlet: u, v, w (null: not prescribed on that axis: 0)
+  std::vector<std::string> copy;  // empty: every property both arrays have
+  std::string type = "do_nothing";  // outlet condition
+};
+
 struct PlanStepper {
   const ast::StepperDecl* decl = nullptr;
   std::map<std::string, int> methods;         // "initialize", "stage1", ... -> body index
@@ -170,6 +186,7 @@ struct Plan {
   std::vector<PlanBody> functions;
   PlanDomain domain;                          // periodic and mirror boundaries
   std::vector<PlanLimit> limits;              // what the run watches (limits { })
+  std::vector<PlanZone> zones;                // inlets and outlets, in order
   PlanGroup root;                             // the scene's equations { } as a group
   std::vector<std::string> notes;             // what the passes decided, for --report
   std::vector<ChosenOption> options;          // compile-time options (sema/Options.h)

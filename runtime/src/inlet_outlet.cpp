@@ -151,6 +151,16 @@ void set_velocity(InletZone& in, double t) {
 }
 }  // namespace
 
+double largest_h(const std::vector<ParticleArray*>& arrays) {
+  double h = 0.0;
+  for (const ParticleArray* a : arrays) {
+    const int k = a->find("h");
+    if (k < 0 || a->props[k].type != PropType::F64) continue;
+    for (std::size_t i = 0; i < a->n; ++i) h = std::fmax(h, a->f64(k)[i]);
+  }
+  return h;
+}
+
 void init_inlet_outlet(InletOutlet& io, const std::vector<ParticleArray*>& all, double support,
                        double t) {
   for (auto& in : io.inlets) check_zone(in.zone, support);

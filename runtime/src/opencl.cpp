@@ -669,8 +669,13 @@ std::size_t value_size(const Context& ctx, const Property& p) {
 void DeviceArray::upload(Context& ctx, const ParticleArray& a) {
   const bool realloc = props.size() != a.props.size() || a.n > capacity || props.empty();
   if (realloc) {
+    // Arrays that grow between steps (inlets): room for a quarter more, as reserve() gives,
+    // so that a growing array reallocates rarely.
+    const std::size_t grown = props.size() == a.props.size() && !props.empty()
+                                  ? std::max(a.n, capacity + capacity / 4)
+                                  : a.n;
     release();
-    capacity = a.n;
+    capacity = grown;
   }
   n = a.n;
   std::vector<float> tmp;

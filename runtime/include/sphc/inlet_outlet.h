@@ -102,6 +102,9 @@ struct InletOutlet {
   double seconds = 0.0;  // wall time spent in update_inlet_outlet (for --timing)
 };
 
+// The largest smoothing length h over the arrays (0 if none has h or particles).
+double largest_h(const std::vector<ParticleArray*>& arrays);
+
 // After set-up: checks every zone (support: radius_scale * the largest h of the arrays),
 // numbers the particles of `all` (every array of the scene) with global ids, makes the copy
 // maps and sets the inlet velocities at time t.
