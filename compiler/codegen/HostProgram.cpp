@@ -506,6 +506,7 @@ void ScenePrinter::emitMain() {
   if (!sched_.iteratedGroups.empty())
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   if (timesNeighbourSearch()) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
+  if (hasZones()) out_ << "  prog.inlet_outlet_seconds = [] { return scene.io_seconds; };\n";
   if (!plan_.limits.empty()) emitLimits();
   bool anyOutput = false;
   for (const auto& a : plan_.arrays) anyOutput |= !a.outputProps.empty();
@@ -627,7 +628,9 @@ void ScenePrinter::emitSceneMembers() {
       out_ << "  " << ghostsType() << " ghosts_" << S << ";\n";
   }
   extraMembers();
-  if (hasZones()) out_ << "  sphc::InletOutlet io;  // inlets and outlets (sphc/inlet_outlet.h)\n";
+  if (hasZones())
+    out_ << "  sphc::InletOutlet io;  // inlets and outlets (sphc/inlet_outlet.h)\n"
+            "  double io_seconds = 0.0;  // in inlet_outlet, for --timing\n";
   // Iterations per evaluation of each iterated group (--timing prints them).
   out_ << "  std::vector<sphc::IterationStats> iteration_stats{";
   for (std::size_t k = 0; k < sched_.iteratedGroups.size(); ++k)

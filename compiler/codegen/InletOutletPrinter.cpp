@@ -71,9 +71,11 @@ void ScenePrinter::emitInletOutlet() {
   for (int a : sched_.resized) scene_ << " " << arr(a).name;
   scene_ << "\n  // change size here, between steps only.\n";
   scene_ << "  void inlet_outlet(double t) {\n";
+  scene_ << "    const double start = sphc::wall_seconds();\n";
   arraysToHost(sched_.resized);
   scene_ << "    sphc::update_inlet_outlet(io, t);\n";
   arraysFromHost(sched_.resized);
+  scene_ << "    io_seconds += sphc::wall_seconds() - start;  // for --timing\n";
   scene_ << "  }\n\n";
 }
 

@@ -99,7 +99,6 @@ struct InletOutlet {
   std::vector<InletZone> inlets;
   std::vector<OutletZone> outlets;
   GlobalIds ids;
-  double seconds = 0.0;  // wall time spent in update_inlet_outlet (for --timing)
 };
 
 // The largest smoothing length h over the arrays (0 if none has h or particles).
