@@ -72,6 +72,16 @@ void ScenePrinter::emitInletOutlet() {
   scene_ << "\n  // change size here, between steps only.\n";
   scene_ << "  void inlet_outlet(double t) {\n";
   scene_ << "    const double start = sphc::wall_seconds();\n";
+  if (checksZonesFirst()) {
+    std::vector<int> inlets;
+    for (const PlanZone& z : plan_.zones)
+      if (z.inlet) inlets.push_back(z.array);
+    positionsToHost(sched_.resized);
+    scene_ << "    if (!sphc::inlet_outlet_due(io)) {  // no particle changes array this step\n";
+    scene_ << "      sphc::set_inlet_velocities(io, t);\n";
+    inletVelocitiesFromHost(inlets);
+    scene_ << "      io_seconds += sphc::wall_seconds() - start;\n      return;\n    }\n";
+  }
   arraysToHost(sched_.resized);
   scene_ << "    sphc::update_inlet_outlet(io, t);\n";
   arraysFromHost(sched_.resized);

@@ -78,6 +78,24 @@ class OpenCLPrinter : public ScenePrinter {
     for (int a : arrays)
       scene_ << "    dev_" << arr(a).name << ".upload(ocl, " << arr(a).name << ");\n";
   }
+  bool checksZonesFirst() const override { return true; }
+  void positionsToHost(const std::vector<int>& arrays) override {
+    for (int a : arrays)
+      scene_ << "    dev_" << arr(a).name << ".download(ocl, " << arr(a).name << ", {"
+             << zoneProps(a, {"x", "y", "z"}) << "});  // positions\n";
+  }
+  void inletVelocitiesFromHost(const std::vector<int>& arrays) override {
+    for (int a : arrays)
+      scene_ << "      dev_" << arr(a).name << ".upload(ocl, " << arr(a).name << ", {"
+             << zoneProps(a, {"u", "v", "w"}) << "});  // velocities\n";
+  }
+  // The indices of those of `names` the array has, as a list.
+  std::string zoneProps(int a, const std::vector<std::string>& names) const {
+    std::string s;
+    for (const auto& n : names)
+      if (int i = propIndex(a, n); i >= 0) s += (s.empty() ? "" : ", ") + std::to_string(i);
+    return s;
+  }
 
   // Kernel arguments: declarations in the kernel, expressions on the host.
   struct KernelArgs {

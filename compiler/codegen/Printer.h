@@ -91,6 +91,13 @@ class ScenePrinter {
   // it and go back to where the scene computes after it (their new sizes included).
   virtual void arraysToHost(const std::vector<int>& arrays) {}
   virtual void arraysFromHost(const std::vector<int>& arrays) {}
+  // A backend whose data is elsewhere may first bring the positions only (positionsToHost)
+  // and, when no particle is due to move (sphc::inlet_outlet_due), send back the inlets'
+  // new velocities only (inletVelocitiesFromHost): the whole arrays travel only on steps
+  // where particles change arrays.
+  virtual bool checksZonesFirst() const { return false; }
+  virtual void positionsToHost(const std::vector<int>& arrays) {}
+  virtual void inletVelocitiesFromHost(const std::vector<int>& inletArrays) {}
 
   // ---- Bodies, their parameters and calls (Bodies.cpp) ----
   // Parameters of a body function, in order, as (C++ declaration, argument kind) pairs.

@@ -248,6 +248,35 @@ bool update_outlet(OutletZone& out) {
   return gone > 0 || out.returned + out.entered != moved;
 }
 
+bool inlet_outlet_due(const InletOutlet& io) {
+  double p[3];
+  for (const auto& in : io.inlets) {
+    const Positions pos(*in.inlet);
+    for (std::size_t i = 0; i < in.inlet->n; ++i) {
+      pos.at(i, p);
+      if (in.zone.depth(p) < 0.0) return true;
+    }
+  }
+  for (const auto& out : io.outlets) {
+    const Positions pos(*out.outlet);
+    for (std::size_t i = 0; i < out.outlet->n; ++i) {
+      pos.at(i, p);
+      const double s = out.zone.depth(p);
+      if (!(s >= 0.0 && s <= out.zone.length)) return true;
+    }
+    const Positions from(*out.from);
+    for (std::size_t i = 0; i < out.from->n; ++i) {
+      from.at(i, p);
+      if (out.zone.depth(p) >= 0.0 && out.zone.across(p)) return true;
+    }
+  }
+  return false;
+}
+
+void set_inlet_velocities(InletOutlet& io, double t) {
+  for (auto& in : io.inlets) set_velocity(in, t);
+}
+
 bool update_inlet_outlet(InletOutlet& io, double t) {
   bool changed = false;
   for (auto& in : io.inlets) changed |= update_inlet(in, io.ids, t);

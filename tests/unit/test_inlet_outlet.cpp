@@ -164,7 +164,8 @@ TEST(InletOutlet, UniformFlowThroughAChannel) {
     move(fluid);
     move(inlet);
     move(outlet);
-    sphc::update_inlet_outlet(io, s * dt);
+    const bool due = sphc::inlet_outlet_due(io);
+    EXPECT_EQ(sphc::update_inlet_outlet(io, s * dt), due);
     EXPECT_EQ(inlet.n, 20u);
     EXPECT_LE(fluid.n, 110u);
     EXPECT_LE(outlet.n, 30u);
@@ -207,7 +208,10 @@ TEST(InletOutlet, BackflowReturnsToTheSource) {
   out.from = &fluid;
   io.outlets.push_back(out);
   sphc::init_inlet_outlet(io, {&fluid, &outlet}, 0.1, 0.0);
+  EXPECT_FALSE(sphc::inlet_outlet_due(io));
+  EXPECT_FALSE(sphc::update_inlet_outlet(io, 0.05));
   fluid.f64("x")[0] = 1.01;   // enters
+  EXPECT_TRUE(sphc::inlet_outlet_due(io));
   outlet.f64("x")[0] = 0.99;  // flows back
   EXPECT_TRUE(sphc::update_inlet_outlet(io, 0.1));
   ASSERT_EQ(fluid.n, 1u);

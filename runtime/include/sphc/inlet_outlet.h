@@ -110,6 +110,12 @@ double largest_h(const std::vector<ParticleArray*>& arrays);
 void init_inlet_outlet(InletOutlet& io, const std::vector<ParticleArray*>& all, double support,
                        double t);
 
+// Whether update_inlet_outlet would move any particle (from positions only): a backend
+// whose data lives elsewhere reads the positions, and everything else only when this says so.
+bool inlet_outlet_due(const InletOutlet& io);
+// The prescribed velocities of every inlet's particles at time t (positions only).
+void set_inlet_velocities(InletOutlet& io, double t);
+
 // One inlet or outlet after a time step (new time t); update_inlet_outlet does every inlet,
 // then every outlet. Returns whether any array changed size.
 bool update_inlet(InletZone& in, GlobalIds& ids, double t);
