@@ -1,5 +1,7 @@
 // HDF5 output and input, the XDMF index and CSV loading (runtime/src/hdf5_io.cpp).
 #include "sphc/hdf5_io.h"
+#include "sphc/load.h"
+#include "sphc/memory.h"
 
 #include <gtest/gtest.h>
 #include <hdf5.h>
@@ -305,6 +307,23 @@ TEST(Csv, ReadsColumnsAndAddsMissingPositions) {
   EXPECT_EQ(std::vector<double>(a.f64("y"), a.f64("y") + 2), (std::vector<double>{1e-3, 3.25}));
   EXPECT_EQ(std::vector<double>(a.f64("rho"), a.f64("rho") + 2), (std::vector<double>{1000, 999.5}));
   EXPECT_EQ(std::vector<double>(a.f64("z"), a.f64("z") + 2), (std::vector<double>{0, 0}));
+}
+
+// The set-up runs twice (a counting pass, then the real one): a file is read once, in the
+// counting pass, and the real pass gets what was counted even if the file changed since.
+TEST(Csv, ALoadedFileIsReadOnceForBothSetUpPasses) {
+  const fs::path dir = fresh_dir();
+  const std::string path = write_csv(dir, "x,rho\n0.5,1000\n1.5,999\n");
+  {
+    CountingPass pass;
+    EXPECT_EQ(load_particles("", path, "fluid").n, 2u);
+  }
+  fs::remove(path);  // a second read would fail now
+  const ParticleArray a = load_particles("", path, "fluid");
+  ASSERT_EQ(a.n, 2u);
+  EXPECT_EQ(a.f64("rho")[1], 999);
+  // Handed over once: a later set-up (another run in this process) reads the file again.
+  EXPECT_THROW(load_particles("", path, "fluid"), std::runtime_error);
 }
 
 TEST(Csv, BadNumberNamesFileLineAndColumn) {
