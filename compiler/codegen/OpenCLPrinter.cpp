@@ -93,7 +93,7 @@ class OpenCLPrinter : public ScenePrinter {
   std::string zoneProps(int a, const std::vector<std::string>& names) const {
     std::string s;
     for (const auto& n : names)
-      if (int i = propIndex(a, n); i >= 0) s += (s.empty() ? "" : ", ") + std::to_string(i);
+      if (int i = propIndex(a, n); i >= 0) s += (s.empty() ? "" : ", ") + propSlot(a, i);
     return s;
   }
 
