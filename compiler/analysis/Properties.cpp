@@ -166,6 +166,10 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
       readByOthers.insert(p);
       note(p);
     }
+    for (const auto& p : arr.zoneProps) {  // the inlet/outlet manager copies them
+      readByOthers.insert(p);
+      note(p);
+    }
     if (movesParticles(plan, a))
       for (const auto& p : adaptiveDtProps(plan)) {
         readByOthers.insert(p);
@@ -238,7 +242,10 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
                       "property '" + p.name + "' of array '" + arr.name + "' is " +
                           (p.output    ? "output"
                            : limited ? "watched by a limit"
-                                     : "needed by the adaptive time step") +
+                           : std::find(arr.zoneProps.begin(), arr.zoneProps.end(), p.name) !=
+                                   arr.zoneProps.end()
+                               ? "copied by an inlet or outlet"
+                               : "needed by the adaptive time step") +
                           " but nothing sets it");
         }
         diags.note(arr.loc, "give it an initial value in array '" + arr.name +

@@ -68,6 +68,15 @@ class CpuPrinter : public ScenePrinter {
     return cpuSingle_ ? "    if (!sphc::counting_particles()) scene.to_single();\n" : "";
   }
   bool hasToHost() const override { return cpuSingle_; }
+  // --precision=single: the manager works on the host doubles; the float copies follow.
+  void arraysToHost(const std::vector<int>& arrays) override {
+    if (!cpuSingle_) return;
+    for (int a : arrays) scene_ << "    f32_" << arr(a).name << ".download(" << arr(a).name << ");\n";
+  }
+  void arraysFromHost(const std::vector<int>& arrays) override {
+    if (!cpuSingle_) return;
+    for (int a : arrays) scene_ << "    f32_" << arr(a).name << ".upload(" << arr(a).name << ");\n";
+  }
 
   // `#pragma omp parallel for` (with `clauses`) before a loop the schedule marks parallel,
   // on the OpenMP backend; nothing for serial.

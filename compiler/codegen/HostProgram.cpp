@@ -177,6 +177,7 @@ void ScenePrinter::emitSetup() {
   }
   for (int a : sched_.setupArrays) emitArraySetup(arr(a));
   if (hasDomain()) emitDomainSetup();
+  if (hasZones()) emitZoneSetup();
   auto pn = [&](const std::string& n) { return paramRef(n); };
   scene_ << "    times.tf = " << exprCpp(*plan_.tf, pn) << ";\n";
   scene_ << "    times.dt = " << exprCpp(*plan_.dt, pn) << ";\n";
@@ -432,6 +433,10 @@ void ScenePrinter::emitStep() {
       scene_ << "    compute_accelerations(" << timeAfter(st.stagesDone[0]) << ", dt);\n";
       continue;
     }
+    if (st.kind == StepStatement::InletOutlet) {
+      scene_ << "    inlet_outlet(" << timeAfter(st.stagesDone[0]) << ");\n";
+      continue;
+    }
     if (st.kind == StepStatement::UpdateDomain) {
       scene_ << (hasDomain() ? "    update_domain();\n"
                              : "    // update_domain: no periodic or mirror domain in this scene\n");
@@ -550,6 +555,7 @@ void ScenePrinter::emitMain() {
   if (!sched_.iteratedGroups.empty())
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   if (timesNeighbourSearch()) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
+  if (hasZones()) out_ << "  prog.inlet_outlet_seconds = [] { return scene.io_seconds; };\n";
   if (!plan_.limits.empty()) emitLimits();
   emitMetricsMain();
   bool anyOutput = false;
@@ -563,6 +569,8 @@ void ScenePrinter::emitMain() {
       out_ << (firstProp ? "" : ", ") << "\"" << p << "\"";
       firstProp = false;
     }
+    // Arrays that grow and shrink: every output carries the global ids.
+    if (hasZones() && !firstProp) out_ << ", \"gid\"";
     out_ << "}});\n";
   }
   out_ << "  return sphc::run_main(argc, argv, prog);\n}\n";
@@ -583,6 +591,7 @@ std::string ScenePrinter::run() {
   if (anyLoad) out_ << "#include \"sphc/load.h\"\n";
   if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
   if (!plan_.metrics.empty()) out_ << "#include \"sphc/metrics.h\"\n";
+  if (hasZones()) out_ << "#include \"sphc/inlet_outlet.h\"\n";
   runtimeIncludes();
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   systemIncludes();
@@ -656,6 +665,7 @@ void ScenePrinter::emitSceneFunctions() {
   emitGroup(sched_.equations);
   steppers();
   emitStep();
+  if (hasZones()) emitInletOutlet();
   emitAdaptiveDt();
   emitMetrics();
 }
@@ -676,6 +686,9 @@ void ScenePrinter::emitSceneMembers() {
       out_ << "  " << ghostsType() << " ghosts_" << S << ";\n";
   }
   extraMembers();
+  if (hasZones())
+    out_ << "  sphc::InletOutlet io;  // inlets and outlets (sphc/inlet_outlet.h)\n"
+            "  double io_seconds = 0.0;  // in inlet_outlet, for --timing\n";
   // Iterations per evaluation of each iterated group (--timing prints them).
   out_ << "  std::vector<sphc::IterationStats> iteration_stats{";
   for (std::size_t k = 0; k < sched_.iteratedGroups.size(); ++k)

@@ -68,6 +68,34 @@ class OpenCLPrinter : public ScenePrinter {
     return "    if (!sphc::counting_particles()) scene.to_device();\n";
   }
   bool hasToHost() const override { return true; }
+  // The manager works on the host arrays: down before it, up after (DeviceArray::upload
+  // grows the buffers' capacity by at least a quarter when an array outgrows it).
+  void arraysToHost(const std::vector<int>& arrays) override {
+    for (int a : arrays)
+      scene_ << "    dev_" << arr(a).name << ".download(ocl, " << arr(a).name << ");\n";
+  }
+  void arraysFromHost(const std::vector<int>& arrays) override {
+    for (int a : arrays)
+      scene_ << "    dev_" << arr(a).name << ".upload(ocl, " << arr(a).name << ");\n";
+  }
+  bool checksZonesFirst() const override { return true; }
+  void positionsToHost(const std::vector<int>& arrays) override {
+    for (int a : arrays)
+      scene_ << "    dev_" << arr(a).name << ".download(ocl, " << arr(a).name << ", {"
+             << zoneProps(a, {"x", "y", "z"}) << "});  // positions\n";
+  }
+  void inletVelocitiesFromHost(const std::vector<int>& arrays) override {
+    for (int a : arrays)
+      scene_ << "      dev_" << arr(a).name << ".upload(ocl, " << arr(a).name << ", {"
+             << zoneProps(a, {"u", "v", "w"}) << "});  // velocities\n";
+  }
+  // The indices of those of `names` the array has, as a list.
+  std::string zoneProps(int a, const std::vector<std::string>& names) const {
+    std::string s;
+    for (const auto& n : names)
+      if (int i = propIndex(a, n); i >= 0) s += (s.empty() ? "" : ", ") + propSlot(a, i);
+    return s;
+  }
 
   // loop_all on the device: the capacity of a work item's neighbour list (private memory),
   // and the scratch slot of the neighbour counts that the host checks against it.

@@ -87,6 +87,17 @@ class ScenePrinter {
   virtual void mainBackendOptions() {}              // prog.set_threads, device selection
   virtual std::string afterSetup() const { return ""; }  // "    if (!sphc::counting_particles()) scene.to_device();\n"
   virtual bool hasToHost() const { return false; }
+  // The inlet/outlet step runs on the host: the arrays it resizes come to the host before
+  // it and go back to where the scene computes after it (their new sizes included).
+  virtual void arraysToHost(const std::vector<int>& arrays) {}
+  virtual void arraysFromHost(const std::vector<int>& arrays) {}
+  // A backend whose data is elsewhere may first bring the positions only (positionsToHost)
+  // and, when no particle is due to move (sphc::inlet_outlet_due), send back the inlets'
+  // new velocities only (inletVelocitiesFromHost): the whole arrays travel only on steps
+  // where particles change arrays.
+  virtual bool checksZonesFirst() const { return false; }
+  virtual void positionsToHost(const std::vector<int>& arrays) {}
+  virtual void inletVelocitiesFromHost(const std::vector<int>& inletArrays) {}
 
   // ---- Bodies, their parameters and calls (Bodies.cpp) ----
   // Parameters of a body function, in order, as (C++ declaration, argument kind) pairs.
@@ -160,6 +171,13 @@ class ScenePrinter {
   // metrics { } (MetricsPrinter.cpp): Scene::metrics(t), and their descriptions in main.
   void emitMetrics();
   void emitMetricsMain();
+
+  // ---- Inlets and outlets (InletOutletPrinter.cpp) ----
+  bool hasZones() const { return !plan_.zones.empty(); }
+  // In setup(), after the arrays: the zones of the scene and init_inlet_outlet.
+  void emitZoneSetup();
+  // The Scene member inlet_outlet(t), the schedule's InletOutlet statement.
+  void emitInletOutlet();
 
   // ---- Shared helpers ----
   // The data a scene computes on: host arrays, or their float copies (--precision=single).

@@ -318,6 +318,12 @@ void ScheduleBuilder::step() {
     }
     s_->step.push_back(std::move(st));
   }
+  if (!plan_.zones.empty()) {  // the inlet/outlet manager, at the end of the step
+    s_->step.push_back({StepStatement::InletOutlet, -1, {s_->stages}});
+    std::set<int> resized;
+    for (const auto& z : plan_.zones) resized.insert({z.array, z.other});
+    s_->resized.assign(resized.begin(), resized.end());
+  }
   std::map<std::string, std::vector<int>> methods;
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
     if (plan_.arrays[a].stepper >= 0)
@@ -432,6 +438,14 @@ void SchedulePrinter::print() {
     } else if (st.kind == StepStatement::UpdateDomain) {
       os_ << "  update_domain" << (s_.domain ? "" : " (no periodic or mirror domain: nothing)")
           << "\n";
+    } else if (st.kind == StepStatement::InletOutlet) {
+      os_ << "  inlet_outlet at " << time(st.stagesDone[0]) << " [serial, on the host]:";
+      for (const auto& z : p_.zones)
+        os_ << " " << (z.inlet ? "inlet " : "outlet ") << z.name << " ("
+            << name(z.array) << (z.inlet ? " -> " : " <- ") << name(z.other) << ")";
+      os_ << "; resizes";
+      for (int a : s_.resized) os_ << " " << name(a);
+      os_ << "\n";
     } else {
       const StepperRun& r = s_.stepperRuns[st.run];
       os_ << "  stepper run " << r.name << " [fused, " << order(r.order) << "]:";

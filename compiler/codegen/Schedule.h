@@ -138,7 +138,10 @@ struct StepperRun {
 
 // One statement of the integrator's step.
 struct StepStatement {
-  enum Kind { Stepper, ComputeAccelerations, UpdateDomain } kind = Stepper;
+  // InletOutlet: after the integrator's statements, the inlet/outlet manager moves particles
+  // between arrays, creates and removes them (Schedule::resized): arrays change size between
+  // steps only, never within an evaluation.
+  enum Kind { Stepper, ComputeAccelerations, UpdateDomain, InletOutlet } kind = Stepper;
   int run = -1;  // Stepper: index into Schedule::stepperRuns (a whole run of statements)
   // The stages completed before each statement (a run: one per method): its time is
   // t + stagesDone/stages dt.
@@ -183,6 +186,10 @@ struct Schedule {
   std::vector<StepperRun> stepperRuns;  // one per distinct run name, in order of first use
   std::vector<StepStatement> step;
   int stages = 0;
+  // Arrays whose particle count changes in the InletOutlet statement (zones and the arrays
+  // they feed or take from), in array order; empty without inlets and outlets. Their data
+  // is on the host for the manager (printers: arraysToHost / arraysFromHost).
+  std::vector<int> resized;
   // Each stepper method on its own (printers that do not fuse runs): method -> arrays.
   std::vector<std::pair<std::string, std::vector<int>>> stepperMethods;
   AdaptiveDt adaptiveDt;

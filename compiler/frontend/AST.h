@@ -321,6 +321,15 @@ struct SchemeUse {
   llvm::SMLoc loc;              // the `scheme` keyword
 };
 
+// `inlet NAME(array = a, feeds = fluid, ...);` / `outlet NAME(array = a, from = fluid, ...);`:
+// an open-boundary zone (docs/language.md, Inlets and outlets; sema/Zones.cpp checks it).
+struct ZoneDecl {
+  bool inlet = true;
+  Ident name;
+  llvm::SMLoc loc;              // the `inlet` / `outlet` keyword
+  std::vector<KwArg> args;
+};
+
 struct SceneDecl {
   Ident name;
   llvm::SMLoc effectsLoc;       // `effects = [a, b];` (invalid when the scene has none)
@@ -335,6 +344,7 @@ struct SceneDecl {
   std::vector<DomainDecl> domains;  // sema allows one
   std::vector<LimitsDecl> limits;
   std::vector<MetricsDecl> metrics;
+  std::vector<ZoneDecl> zones;
   llvm::SMLoc equationsLoc;
   std::vector<GroupItem> equations;
   std::vector<std::shared_ptr<When<SceneDecl>>> whens;  // the chosen branch's items are

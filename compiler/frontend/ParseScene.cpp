@@ -25,7 +25,7 @@ bool Parser::parseScene(ast::Module& mod) {
 bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (!cur().is(Token::Identifier))
     return error(cur().loc, "expected a scene item ('name = value;', stepper, adaptive_dt, "
-                            "output, domain, limits, metrics, equations or when), found " + describe(cur()));
+                            "output, domain, limits, metrics, inlet, outlet, equations or when), found " + describe(cur()));
   // The scene's keywords are contextual: `output = 3;` is a setting named output.
   if (atWord("effects") && lex_.peek().is(Token::Assign)) return parseSceneEffects(scene);
   if (lex_.peek().is(Token::Assign)) return parseSceneSetting(scene);
@@ -44,6 +44,7 @@ bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (atWord("domain")) return parseDomain(scene);
   if (atWord("limits")) return parseLimits(scene);
   if (atWord("metrics")) return parseMetrics(scene);
+  if (atWord("inlet") || atWord("outlet")) return parseZone(scene);
   if (atWord("equations")) {
     scene.equationsLoc = cur().loc;
     advance();

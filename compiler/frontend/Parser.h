@@ -100,6 +100,7 @@ class Parser {
   bool parseDomain(ast::SceneDecl& scene);
   bool parseDomainItem(ast::DomainDecl& domain);
   bool parseLimits(ast::SceneDecl& scene);
+  bool parseZone(ast::SceneDecl& scene);  // ParseZones.cpp
   bool parseLimitItem(ast::LimitsDecl& limits);
   bool parseLimitBound(ast::LimitBound& bound, const std::string& head);
   // metrics { } (ParseMetrics.cpp)

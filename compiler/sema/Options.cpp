@@ -373,6 +373,7 @@ class OptionSelector {
       append(s.domains, part->domains);
       append(s.limits, part->limits);
       append(s.metrics, part->metrics);
+      append(s.zones, part->zones);
       if (part->hasAdaptiveDt) {
         if (s.hasAdaptiveDt) {
           diags_.error(part->adaptiveDtLoc, "adaptive_dt is given twice");

@@ -43,6 +43,8 @@ struct PlanArray {
   std::vector<std::string> outputProps;  // as listed in the scene's output
   std::vector<std::string> limitProps;   // what the scene's limits read (speed: u, v, w)
   std::vector<std::string> metricProps;  // what the scene's metrics read (sema/Metrics.cpp)
+  // What the inlet/outlet manager copies between arrays and sets on the host (sema/Zones.cpp).
+  std::vector<std::string> zoneProps;
   // With a periodic or mirror domain: the properties ghost copies of this array's particles
   // carry (what the source side of a loop reads, and what groups with `real = false` read
   // on it), filled by the ghost pass; empty when the array is no source.
@@ -164,6 +166,20 @@ struct PlanMetric {
   bool compared() const { return !isNorm() && (exact || !reference.empty()); }
 };
 
+// An inlet or outlet of the scene (sema/Zones.cpp; runtime: sphc/inlet_outlet.h). The
+// expressions are of params; the velocity of an inlet also of x, y, z and t.
+struct PlanZone {
+  bool inlet = true;
+  std::string name;
+  llvm::SMLoc loc;
+  int array = -1;      // the zone's particles
+  int other = -1;      // inlet: the array it feeds; outlet: the array it takes from
+  ast::ExprPtr point[3], normal[3], length, width;
+  ast::ExprPtr velocity[3];  // inlet: u, v, w (null: not prescribed on that axis: 0)
+  std::vector<std::string> copy;  // empty: every property both arrays have
+  std::string type = "do_nothing";  // outlet condition
+};
+
 struct PlanStepper {
   const ast::StepperDecl* decl = nullptr;
   std::map<std::string, int> methods;         // "initialize", "stage1", ... -> body index
@@ -197,6 +213,7 @@ struct Plan {
   PlanDomain domain;                          // periodic and mirror boundaries
   std::vector<PlanLimit> limits;              // what the run watches (limits { })
   std::vector<PlanMetric> metrics;            // what the run measures (metrics { })
+  std::vector<PlanZone> zones;                // inlets and outlets, in order
   PlanGroup root;                             // the scene's equations { } as a group
   std::vector<std::string> notes;             // what the passes decided, for --report
   std::vector<ChosenOption> options;          // compile-time options (sema/Options.h)

@@ -1,5 +1,6 @@
 #include "sema/Sema.h"
 #include "sema/SemaImpl.h"
+#include "sema/Zones.h"
 
 #include "frontend/Parser.h"
 #include "sema/Geometry.h"
@@ -244,6 +245,7 @@ std::unique_ptr<Plan> SemaImpl::run() {
   buildArrays();
   buildFunctions();
   buildScene();
+  if (!diags_.hasErrors()) buildZones(*plan_->scene, *plan_, diags_);  // sema/Zones.cpp
   if (diags_.hasErrors()) return nullptr;
   return std::move(plan_);
 }

@@ -669,8 +669,13 @@ std::size_t value_size(const Context& ctx, const Property& p) {
 void DeviceArray::upload(Context& ctx, const ParticleArray& a) {
   const bool realloc = props.size() != a.props.size() || a.n > capacity || props.empty();
   if (realloc) {
+    // Arrays that grow between steps (inlets): room for a quarter more, as reserve() gives,
+    // so that a growing array reallocates rarely.
+    const std::size_t grown = props.size() == a.props.size() && !props.empty()
+                                  ? std::max(a.n, capacity + capacity / 4)
+                                  : a.n;
     release();
-    capacity = a.n;
+    capacity = grown;
   }
   n = a.n;
   std::vector<float> tmp;
@@ -717,8 +722,39 @@ void DeviceArray::upload_constant(Context& ctx, const ParticleArray& a, int c) {
 }
 
 void DeviceArray::download(Context& ctx, ParticleArray& a) {
+  std::vector<int> all;
+  for (std::size_t i = 0; i < a.props.size() && i < props.size(); ++i)
+    all.push_back(static_cast<int>(i));
+  download(ctx, a, all);
+}
+
+void DeviceArray::upload(Context& ctx, const ParticleArray& a, const std::vector<int>& which) {
   std::vector<float> tmp;
-  for (std::size_t i = 0; i < a.props.size() && i < props.size(); ++i) {
+  for (int i : which) {
+    const Property& p = a.props[i];
+    const std::size_t count = n * static_cast<std::size_t>(p.stride);
+    if (count == 0) continue;
+    const void* data = nullptr;
+    std::size_t bytes = count * 4;
+    if (p.type == PropType::F64) {
+      if (ctx.double_precision()) {
+        data = p.f64.data();
+        bytes = count * sizeof(double);
+      } else {
+        tmp.assign(p.f64.begin(), p.f64.begin() + count);
+        data = tmp.data();
+      }
+    } else {
+      data = p.type == PropType::I32 ? static_cast<const void*>(p.i32.data()) : p.u32.data();
+    }
+    check(clEnqueueWriteBuffer(ctx.queue(), props[i], CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
+          "clEnqueueWriteBuffer (property)");
+  }
+}
+
+void DeviceArray::download(Context& ctx, ParticleArray& a, const std::vector<int>& which) {
+  std::vector<float> tmp;
+  for (int i : which) {
     Property& p = a.props[i];
     const std::size_t count = n * static_cast<std::size_t>(p.stride);
     if (count == 0) continue;

@@ -157,6 +157,41 @@ void ParticleArray::append_from(const ParticleArray& src, std::size_t i) {
 
 namespace {
 template <class T>
+void compact_values(std::vector<T>& v, const std::vector<std::uint8_t>& remove, std::size_t s) {
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < remove.size(); ++i) {
+    if (remove[i]) continue;
+    if (out != i)
+      for (std::size_t k = 0; k < s; ++k) v[out * s + k] = v[i * s + k];
+    ++out;
+  }
+  v.resize(out * s);
+}
+}  // namespace
+
+std::size_t ParticleArray::remove_particles(const std::vector<std::uint8_t>& remove) {
+  if (remove.size() != n) {
+    throw std::invalid_argument("remove_particles: array '" + name + "' has " +
+                                std::to_string(n) + " particles, the removal mask " +
+                                std::to_string(remove.size()));
+  }
+  std::size_t removed = 0;
+  for (std::uint8_t r : remove) removed += r != 0;
+  if (removed == 0) return 0;
+  for (Property& p : props) {
+    const std::size_t s = static_cast<std::size_t>(p.stride);
+    switch (p.type) {
+      case PropType::F64: compact_values(p.f64, remove, s); break;
+      case PropType::I32: compact_values(p.i32, remove, s); break;
+      case PropType::U32: compact_values(p.u32, remove, s); break;
+    }
+  }
+  n -= removed;
+  return removed;
+}
+
+namespace {
+template <class T>
 void permute_values(std::vector<T>& v, const std::vector<std::uint32_t>& order, int stride,
                     std::vector<T>& scratch) {
   const std::size_t s = static_cast<std::size_t>(stride);

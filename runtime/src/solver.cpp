@@ -586,6 +586,7 @@ class Simulation {
     const auto loop_start = Clock::now();
     metrics_clock_ = {loop_start, cpu_seconds()};
     nnps_start_ = prog_.neighbour_seconds ? prog_.neighbour_seconds() : 0.0;
+    io_start_ = prog_.inlet_outlet_seconds ? prog_.inlet_outlet_seconds() : 0.0;
     progress_.start(!opt_.quiet, tf);
     double particle_steps = 0;
     while (t_ < tf - slack && step_ < opt_.max_steps) {
@@ -936,6 +937,10 @@ class Simulation {
         const double s = prog_.neighbour_seconds() - nnps_start_;
         nnps = fmt::format(" nnps_s={:.6g} nnps_share={:.4f}", s, wall_s > 0 ? s / wall_s : 0.0);
       }
+      if (prog_.inlet_outlet_seconds) {
+        const double s = prog_.inlet_outlet_seconds() - io_start_;
+        nnps += fmt::format(" io_s={:.6g} io_share={:.4f}", s, wall_s > 0 ? s / wall_s : 0.0);
+      }
       if (prog_.iterations) {
         long total = 0;
         for (const IterationStats& s : prog_.iterations()) total += s.total;
@@ -971,6 +976,7 @@ class Simulation {
   Progress& progress_;
   int threads_ = 1;
   double nnps_start_ = 0.0;  // neighbour_seconds() when the time loop started
+  double io_start_ = 0.0;    // inlet_outlet_seconds() then
   OutputWriter* writer_ = nullptr;
   std::vector<ParticleArray*> arrays_;
   double t_ = 0.0;

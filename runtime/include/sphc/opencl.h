@@ -89,6 +89,10 @@ struct DeviceArray {
   void upload_constant(Context& ctx, const ParticleArray& a, int c);
   // Copies every property (not the constants: the host copy is the reference) back.
   void download(Context& ctx, ParticleArray& a);
+  // Only the properties `which` (indices into a.props) of the n particles, down or up (same
+  // n; the inlet/outlet step reads positions and writes inlet velocities this way).
+  void download(Context& ctx, ParticleArray& a, const std::vector<int>& which);
+  void upload(Context& ctx, const ParticleArray& a, const std::vector<int>& which);
   // Reorders the particles on the device into the cell order of `cells` (built on this
   // array): ParticleArray::permute(cell_order) of the CPU backends.
   void permute(Context& ctx, const CellTable& cells, const ParticleArray& a);

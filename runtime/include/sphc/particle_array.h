@@ -72,6 +72,13 @@ struct ParticleArray {
   // Appends particle `i` of `src` (same property names) to this array; properties missing in
   // src are 0. Used by inlets and by loading.
   void append_from(const ParticleArray& src, std::size_t i);
+
+  // Removes the particles i with remove[i] != 0 (remove.size() == n, else
+  // std::invalid_argument), keeping the order of the others (a stable compaction of every
+  // property); returns how many were removed. The storage keeps its capacity, so an array
+  // that shrinks and grows again (outlets and inlets) does not reallocate. Serial: the same
+  // result on every backend.
+  std::size_t remove_particles(const std::vector<std::uint8_t>& remove);
 };
 
 // True if order holds each of 0..n-1 exactly once.

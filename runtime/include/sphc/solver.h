@@ -105,6 +105,9 @@ struct SceneProgram {
   // Wall seconds spent so far in the neighbour search (search domain, cell lists, reorders
   // into cell order), for the --timing line; empty where not measured.
   std::function<double()> neighbour_seconds;
+  // Wall seconds spent so far in the inlet/outlet step (sphc/inlet_outlet.h, with the data
+  // movement it needs), for the --timing line; empty without inlets and outlets.
+  std::function<double()> inlet_outlet_seconds;
   // The scene's limits { } (sphc/sanity.h), computed from the parameters after the set-up;
   // empty: none declared (the default bounding box applies).
   std::function<std::vector<Limit>()> limits;

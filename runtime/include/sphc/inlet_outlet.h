@@ -1,0 +1,125 @@
+// sphc runtime: the inlet/outlet manager (open boundaries).
+//
+// A zone is a box outside the fluid: a face (a plane through `point` with the unit outward
+// normal `normal`, pointing away from the fluid), the zone's depth `length` along the normal
+// and its `width` across it (centred on `point`; in 3D a square of that side). A position x
+// is in the zone when 0 <= s <= length and |t_k| <= width / 2 for the tangential coordinates,
+// with s = (x - point) . normal.
+//
+// Inlet [the open boundaries of PySPH's inlet/outlet manager and of Negi, Ramachandran &
+// Haftu (2019)]: the zone holds the particles of the inlet array, which move with the
+// prescribed velocity (towards the fluid, -normal). After each time step (update_inlet):
+//   - every inlet particle gets the prescribed velocity at its position and the new time;
+//   - an inlet particle that crossed the face (s < 0) is appended to the fed array (the
+//     listed properties copied, its gid kept), and the inlet particle itself moves back by
+//     `length` along the normal (to the far end of the zone) with a fresh gid: the zone keeps
+//     its particles and the lattice they came in.
+// Outlet: the zone holds the particles of the outlet array. After each time step
+// (update_outlet):
+//   - a particle of the source array inside the outlet zone's cross-section with s >= 0 moves
+//     to the outlet array (copied, gid kept, removed from the source);
+//   - an outlet particle with s < 0 (flowing back) returns to the source array;
+//   - an outlet particle past the zone (s > length) is removed.
+// The outlet condition (how outlet particles get their properties) is the scene's
+// equations on the outlet array; `do_nothing` (Negi et al. 2019, sec. 3.1) means their
+// velocity and pressure are those they carried in: the manager changes nothing.
+//
+// Arrays change size only here, between time steps, never during an evaluation: the neighbour
+// search, ghosts and cell lists are rebuilt from the current sizes at every evaluation. All
+// of it is serial and in particle order, so every backend produces the same arrays.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "sphc/global_ids.h"
+#include "sphc/particle_array.h"
+
+namespace sphc {
+
+struct Zone {
+  std::string name;           // for messages: "inlet 'in' (channel.sph:40:3)"
+  int dim = 2;
+  double point[3] = {0, 0, 0};
+  double normal[3] = {0, 0, 0};  // outward; normalised by check_zone
+  double length = 0.0;
+  double width = 0.0;
+  // s (along the normal) of position p, and whether p lies within the zone's cross-section.
+  double depth(const double p[3]) const;
+  bool across(const double p[3]) const;
+};
+
+// Throws std::invalid_argument naming the zone and the numbers unless the normal has
+// non-zero length (then it is normalised), length > 0 and width > 0, and length >= support
+// (the kernel's support radius_scale * h: a thinner zone leaves fluid particles near the face
+// with an incomplete neighbourhood).
+void check_zone(Zone& z, double support);
+
+// How the properties of a particle moving between arrays are copied: to[k] from from[k]
+// (indices into the arrays' props; properties not listed are 0 in the new particle).
+struct CopyMap {
+  std::vector<int> to, from;
+};
+// The map of the properties `names` (empty: every property both arrays have), gid always
+// included. Throws std::invalid_argument if a name is missing from either array or types
+// differ.
+CopyMap make_copy_map(const ParticleArray& to, const ParticleArray& from,
+                      const std::vector<std::string>& names);
+// Appends particle i of `from` to `to` through the map.
+void append_particle(ParticleArray& to, const ParticleArray& from, std::size_t i,
+                     const CopyMap& map);
+
+struct InletZone {
+  Zone zone;
+  ParticleArray* inlet = nullptr;  // the zone's particles
+  ParticleArray* feeds = nullptr;  // the array they join
+  std::vector<std::string> copy;   // properties copied (empty: all common)
+  // The prescribed velocity at position p and time t into v[0..2] (empty: velocities kept).
+  std::function<void(const double* p, double t, double* v)> velocity;
+  CopyMap map;                     // set by init_inlet_outlet
+  std::size_t created = 0;         // particles that entered the fed array so far
+};
+
+enum class OutletKind : std::uint8_t { DoNothing };
+
+struct OutletZone {
+  Zone zone;
+  ParticleArray* outlet = nullptr;  // the zone's particles
+  ParticleArray* from = nullptr;    // the array whose particles flow into it
+  std::vector<std::string> copy;
+  OutletKind kind = OutletKind::DoNothing;
+  CopyMap in, back;                 // from -> outlet, outlet -> from
+  std::size_t entered = 0, returned = 0, removed = 0;
+};
+
+struct InletOutlet {
+  std::vector<InletZone> inlets;
+  std::vector<OutletZone> outlets;
+  GlobalIds ids;
+};
+
+// The largest smoothing length h over the arrays (0 if none has h or particles).
+double largest_h(const std::vector<ParticleArray*>& arrays);
+
+// After set-up: checks every zone (support: radius_scale * the largest h of the arrays),
+// numbers the particles of `all` (every array of the scene) with global ids, makes the copy
+// maps and sets the inlet velocities at time t.
+void init_inlet_outlet(InletOutlet& io, const std::vector<ParticleArray*>& all, double support,
+                       double t);
+
+// Whether update_inlet_outlet would move any particle (from positions only): a backend
+// whose data lives elsewhere reads the positions, and everything else only when this says so.
+bool inlet_outlet_due(const InletOutlet& io);
+// The prescribed velocities of every inlet's particles at time t (positions only).
+void set_inlet_velocities(InletOutlet& io, double t);
+
+// One inlet or outlet after a time step (new time t); update_inlet_outlet does every inlet,
+// then every outlet. Returns whether any array changed size.
+bool update_inlet(InletZone& in, GlobalIds& ids, double t);
+bool update_outlet(OutletZone& out);
+bool update_inlet_outlet(InletOutlet& io, double t);
+
+}  // namespace sphc

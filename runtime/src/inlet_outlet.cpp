@@ -1,0 +1,287 @@
+// sphc runtime: the inlet/outlet manager (sphc/inlet_outlet.h).
+#include "sphc/inlet_outlet.h"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+
+namespace sphc {
+
+namespace {
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+// The coordinates of particle i (0 for an axis the array lacks).
+struct Positions {
+  const double* c[3] = {nullptr, nullptr, nullptr};
+  explicit Positions(const ParticleArray& a) {
+    const char* names[3] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k) {
+      int idx = a.find(names[k]);
+      if (idx >= 0 && a.props[idx].type == PropType::F64) c[k] = a.f64(idx);
+    }
+  }
+  void at(std::size_t i, double p[3]) const {
+    for (int k = 0; k < 3; ++k) p[k] = c[k] ? c[k][i] : 0.0;
+  }
+};
+
+// Moves position k of particle i by d along the normal.
+void shift(ParticleArray& a, std::size_t i, const double n[3], double d) {
+  const char* names[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    if (n[k] == 0.0) continue;
+    int idx = a.find(names[k]);
+    if (idx >= 0) a.f64(idx)[i] += d * n[k];
+  }
+}
+
+}  // namespace
+
+double Zone::depth(const double p[3]) const {
+  double s = 0.0;
+  for (int k = 0; k < dim; ++k) s += (p[k] - point[k]) * normal[k];
+  return s;
+}
+
+bool Zone::across(const double p[3]) const {
+  // Tangential offset: the part of p - point orthogonal to the normal, per axis.
+  const double s = depth(p);
+  double t2max = 0.0;
+  if (dim == 2) {
+    const double t = -(p[0] - point[0]) * normal[1] + (p[1] - point[1]) * normal[0];
+    t2max = std::fabs(t);
+  } else {
+    for (int k = 0; k < dim; ++k) {
+      const double t = p[k] - point[k] - s * normal[k];
+      t2max = std::fmax(t2max, std::fabs(t));
+    }
+  }
+  return dim == 1 || t2max <= 0.5 * width;
+}
+
+void check_zone(Zone& z, double support) {
+  double len2 = 0.0;
+  for (int k = 0; k < z.dim; ++k) len2 += z.normal[k] * z.normal[k];
+  const std::string head = z.name + ": ";
+  if (!(len2 > 0.0) || !std::isfinite(len2))
+    throw std::invalid_argument(head + "the outward normal has zero length");
+  for (int k = 0; k < 3; ++k) z.normal[k] = k < z.dim ? z.normal[k] / std::sqrt(len2) : 0.0;
+  if (!(z.length > 0.0))
+    throw std::invalid_argument(head + "length must be > 0 (got " + num(z.length) + ")");
+  if (!(z.width > 0.0) && z.dim > 1)
+    throw std::invalid_argument(head + "width must be > 0 (got " + num(z.width) + ")");
+  if (z.length < support)
+    throw std::invalid_argument(head + "length " + num(z.length) +
+                                " is narrower than the kernel support " + num(support) +
+                                ": particles near the face would miss neighbours");
+}
+
+CopyMap make_copy_map(const ParticleArray& to, const ParticleArray& from,
+                      const std::vector<std::string>& names) {
+  CopyMap m;
+  auto add = [&](const std::string& p, bool required) {
+    const int t = to.find(p), f = from.find(p);
+    if (t < 0 || f < 0) {
+      if (!required) return;
+      throw std::invalid_argument("property '" + p + "' to copy from array '" + from.name +
+                                  "' to '" + to.name + "' is missing in '" +
+                                  (t < 0 ? to.name : from.name) + "'");
+    }
+    const Property &a = to.props[t], &b = from.props[f];
+    if (a.type != b.type || a.stride != b.stride)
+      throw std::invalid_argument("property '" + p + "' has another type in array '" +
+                                  from.name + "' than in '" + to.name + "'");
+    for (int k : m.to)
+      if (k == t) return;
+    m.to.push_back(t);
+    m.from.push_back(f);
+  };
+  if (names.empty()) {
+    for (const Property& p : to.props) add(p.name, false);
+  } else {
+    for (const std::string& p : names) add(p, true);
+    add("gid", false);
+  }
+  return m;
+}
+
+void append_particle(ParticleArray& to, const ParticleArray& from, std::size_t i,
+                     const CopyMap& map) {
+  const std::size_t j = to.n;
+  to.resize(j + 1);  // every property grows; new values 0 (std::vector: amortised growth)
+  for (std::size_t k = 0; k < map.to.size(); ++k) {
+    Property& p = to.props[map.to[k]];
+    const Property& q = from.props[map.from[k]];
+    const std::size_t s = static_cast<std::size_t>(p.stride);
+    for (std::size_t c = 0; c < s; ++c) {
+      switch (p.type) {
+        case PropType::F64: p.f64[j * s + c] = q.f64[i * s + c]; break;
+        case PropType::I32: p.i32[j * s + c] = q.i32[i * s + c]; break;
+        case PropType::U32: p.u32[j * s + c] = q.u32[i * s + c]; break;
+      }
+    }
+  }
+}
+
+namespace {
+void set_velocity(InletZone& in, double t) {
+  if (!in.velocity) return;
+  ParticleArray& a = *in.inlet;
+  const Positions pos(a);
+  double* vel[3] = {nullptr, nullptr, nullptr};
+  const char* names[3] = {"u", "v", "w"};
+  for (int k = 0; k < 3; ++k)
+    if (int idx = a.find(names[k]); idx >= 0 && a.props[idx].type == PropType::F64)
+      vel[k] = a.f64(idx);
+  for (std::size_t i = 0; i < a.n; ++i) {
+    double p[3], v[3] = {0, 0, 0};
+    pos.at(i, p);
+    in.velocity(p, t, v);
+    for (int k = 0; k < 3; ++k)
+      if (vel[k]) vel[k][i] = v[k];
+  }
+}
+}  // namespace
+
+double largest_h(const std::vector<ParticleArray*>& arrays) {
+  double h = 0.0;
+  for (const ParticleArray* a : arrays) {
+    const int k = a->find("h");
+    if (k < 0 || a->props[k].type != PropType::F64) continue;
+    for (std::size_t i = 0; i < a->n; ++i) h = std::fmax(h, a->f64(k)[i]);
+  }
+  return h;
+}
+
+void init_inlet_outlet(InletOutlet& io, const std::vector<ParticleArray*>& all, double support,
+                       double t) {
+  for (auto& in : io.inlets) check_zone(in.zone, support);
+  for (auto& out : io.outlets) check_zone(out.zone, support);
+  io.ids = GlobalIds{};
+  assign_global_ids(all, io.ids);
+  for (auto& in : io.inlets) {
+    in.map = make_copy_map(*in.feeds, *in.inlet, in.copy);
+    set_velocity(in, t);
+  }
+  for (auto& out : io.outlets) {
+    out.in = make_copy_map(*out.outlet, *out.from, out.copy);
+    out.back = make_copy_map(*out.from, *out.outlet, out.copy);
+  }
+}
+
+bool update_inlet(InletZone& in, GlobalIds& ids, double t) {
+  ParticleArray& a = *in.inlet;
+  const int gid = a.find("gid");
+  bool changed = false;
+  for (std::size_t i = 0; i < a.n; ++i) {
+    double p[3];
+    Positions(a).at(i, p);
+    // A particle may have come more than a zone length (not with a stable time step): it
+    // enters once, and moves back as often as needed.
+    if (in.zone.depth(p) >= 0.0) continue;
+    append_particle(*in.feeds, a, i, in.map);
+    ++in.created;
+    changed = true;
+    while (in.zone.depth(p) < 0.0) {
+      shift(a, i, in.zone.normal, in.zone.length);
+      Positions(a).at(i, p);
+    }
+    if (gid >= 0) a.u32(gid)[i] = ids.take();
+  }
+  set_velocity(in, t);
+  return changed;
+}
+
+bool update_outlet(OutletZone& out) {
+  ParticleArray& src = *out.from;
+  ParticleArray& o = *out.outlet;
+  // Outlet particles flowing back, or gone past the zone.
+  std::vector<std::uint8_t> drop(o.n, 0);
+  const std::size_t n_outlet = o.n;
+  {
+    const Positions pos(o);
+    for (std::size_t i = 0; i < n_outlet; ++i) {
+      double p[3];
+      pos.at(i, p);
+      const double s = out.zone.depth(p);
+      if (s > out.zone.length || !std::isfinite(s)) {
+        drop[i] = 1;
+        ++out.removed;
+      } else if (s < 0.0) {
+        drop[i] = 2;
+      }
+    }
+  }
+  // Source particles entering the zone (decided before any return, so a returning particle
+  // does not bounce straight back).
+  std::vector<std::uint8_t> leave(src.n, 0);
+  {
+    const Positions pos(src);
+    for (std::size_t i = 0; i < src.n; ++i) {
+      double p[3];
+      pos.at(i, p);
+      leave[i] = out.zone.depth(p) >= 0.0 && out.zone.across(p);
+    }
+  }
+  const std::size_t n_src = src.n;
+  const std::size_t moved = out.returned + out.entered;
+  for (std::size_t i = 0; i < n_outlet; ++i)
+    if (drop[i] == 2) {
+      append_particle(src, o, i, out.back);
+      ++out.returned;
+    }
+  for (std::size_t i = 0; i < n_src; ++i)
+    if (leave[i]) {
+      append_particle(o, src, i, out.in);
+      ++out.entered;
+    }
+  leave.resize(src.n, 0);  // returned particles stay
+  drop.resize(o.n, 0);     // entered particles stay
+  const std::size_t gone = src.remove_particles(leave) + o.remove_particles(drop);
+  return gone > 0 || out.returned + out.entered != moved;
+}
+
+bool inlet_outlet_due(const InletOutlet& io) {
+  double p[3];
+  for (const auto& in : io.inlets) {
+    const Positions pos(*in.inlet);
+    for (std::size_t i = 0; i < in.inlet->n; ++i) {
+      pos.at(i, p);
+      if (in.zone.depth(p) < 0.0) return true;
+    }
+  }
+  for (const auto& out : io.outlets) {
+    const Positions pos(*out.outlet);
+    for (std::size_t i = 0; i < out.outlet->n; ++i) {
+      pos.at(i, p);
+      const double s = out.zone.depth(p);
+      if (!(s >= 0.0 && s <= out.zone.length)) return true;
+    }
+    const Positions from(*out.from);
+    for (std::size_t i = 0; i < out.from->n; ++i) {
+      from.at(i, p);
+      if (out.zone.depth(p) >= 0.0 && out.zone.across(p)) return true;
+    }
+  }
+  return false;
+}
+
+void set_inlet_velocities(InletOutlet& io, double t) {
+  for (auto& in : io.inlets) set_velocity(in, t);
+}
+
+bool update_inlet_outlet(InletOutlet& io, double t) {
+  bool changed = false;
+  for (auto& in : io.inlets) changed |= update_inlet(in, io.ids, t);
+  for (auto& out : io.outlets) changed |= update_outlet(out);
+  return changed;
+}
+
+}  // namespace sphc
