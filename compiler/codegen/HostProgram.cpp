@@ -173,7 +173,7 @@ void ScenePrinter::emitSetup() {
     }
   }
   for (int a : sched_.setupArrays) emitArraySetup(arr(a));
-  if (hasDomain()) emitDomainSetup();
+  if (plan_.domain.any()) emitDomainSetup();
   auto pn = [&](const std::string& n) { return paramRef(n); };
   scene_ << "    times.tf = " << exprCpp(*plan_.tf, pn) << ";\n";
   scene_ << "    times.dt = " << exprCpp(*plan_.dt, pn) << ";\n";
@@ -250,6 +250,7 @@ void ScenePrinter::emitIteration(const ScheduleGroup& sg) {
   scene_ << "      const bool run_tests = iteration >= " << g.minIterations << ";\n";
   scene_ << "      converged = run_tests;\n";
   for (const auto* eq : sg.convergers) emitConverged(*eq);
+  if (mpi_) scene_ << "      converged = sphc::mpi::all(converged);  // the same on every rank\n";
   scene_ << "      if (converged && iteration >= " << g.minIterations << ") break;\n";
   scene_ << "      if (iteration >= " << g.maxIterations << ") break;\n";
   scene_ << "    }\n";
@@ -459,6 +460,7 @@ void ScenePrinter::emitLimits() {
 void ScenePrinter::emitMain() {
   out_ << "int main(int argc, char** argv) {\n";
   mainPrologue();
+  if (mpi_) out_ << "  sphc::mpi::Session mpi_session(&argc, &argv);  // MPI_Init, MPI_Finalize\n";
   out_ << "  static Scene scene;\n";
   out_ << "  sphc::SceneProgram prog;\n";
   out_ << "  prog.name = \"" << plan_.sceneName << "\";\n";
@@ -483,7 +485,7 @@ void ScenePrinter::emitMain() {
   if (singlePrecision_) out_ << "  prog.precision = \"single\";\n";
   out_ << "  prog.setup = [](const std::vector<double>& v, sphc::SceneTimes& times) {\n"
           "    scene.setup(v, times);\n"
-       << afterSetup() << "  };\n";
+       << afterSetupDistributed() << afterSetup() << "  };\n";
   out_ << "  prog.arrays = [] { return std::vector<sphc::ParticleArray*>{";
   bool first = true;
   for (const auto& a : plan_.arrays) {
@@ -497,7 +499,9 @@ void ScenePrinter::emitMain() {
   // writes output or checks for a blow-up.
   // --precision=single on the CPU: likewise for the float copies.
   if (hasToHost()) out_ << "  prog.to_host = [] { scene.to_host(); };\n";
-  if (plan_.adaptiveDt) out_ << "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n";
+  if (plan_.adaptiveDt)
+    out_ << (mpi_ ? "  prog.adaptive_dt = [] { return sphc::mpi::min(scene.adaptive_dt()); };  // every rank's\n"
+                  : "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n");
   if (!sched_.iteratedGroups.empty())
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   if (timesNeighbourSearch()) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
@@ -513,9 +517,14 @@ void ScenePrinter::emitMain() {
       out_ << (firstProp ? "" : ", ") << "\"" << p << "\"";
       firstProp = false;
     }
+    // Global ids are written too (an empty list writes every property, gid included).
+    if (globalIds_ && !firstProp) out_ << ", \"gid\"";
     out_ << "}});\n";
   }
-  out_ << "  return sphc::run_main(argc, argv, prog);\n}\n";
+  distributedMain();
+  out_ << (mpi_ ? "  // A rank that fails ends the whole job (MPI_Abort), so none waits forever.\n"
+                  "  return sphc::mpi::finish(sphc::run_main(argc, argv, prog));\n}\n"
+                : "  return sphc::run_main(argc, argv, prog);\n}\n");
 }
 
 std::string ScenePrinter::run() {
@@ -532,6 +541,9 @@ std::string ScenePrinter::run() {
   for (const auto& a : plan_.arrays) anyLoad |= !a.decl->loads.empty();
   if (anyLoad) out_ << "#include \"sphc/load.h\"\n";
   if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
+  if (mpi_)
+    out_ << "#include \"sphc/mpi/comm.h\"\n#include \"sphc/mpi/decomposition.h\"\n"
+            "#include \"sphc/mpi/gather.h\"\n#include \"sphc/mpi/halo.h\"\n";
   runtimeIncludes();
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   systemIncludes();
@@ -600,6 +612,7 @@ void ScenePrinter::emitSceneFunctions() {
   steppers();
   emitStep();
   emitAdaptiveDt();
+  distributedFunctions();
 }
 
 
@@ -618,6 +631,7 @@ void ScenePrinter::emitSceneMembers() {
       out_ << "  " << ghostsType() << " ghosts_" << S << ";\n";
   }
   extraMembers();
+  distributedMembers();
   // Iterations per evaluation of each iterated group (--timing prints them).
   out_ << "  std::vector<sphc::IterationStats> iteration_stats{";
   for (std::size_t k = 0; k < sched_.iteratedGroups.size(); ++k)

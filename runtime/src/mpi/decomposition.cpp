@@ -86,7 +86,17 @@ void position_props(const ParticleArray& a, int dim, int pos[3]) {
 }  // namespace
 
 Decomposition::~Decomposition() {
-  if (zz) Zoltan_Destroy(&zz);
+  // A solver's Scene is static: after MPI_Finalize nothing may be freed through MPI.
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (zz && !finalized) Zoltan_Destroy(&zz);
+}
+
+bool inside_region(const Decomposition& d, const double lo[3], const double hi[3]) {
+  if (!d.has_region) return false;
+  for (int c = 0; c < d.dim; ++c)
+    if (!(lo[c] > d.region_lo[c] && hi[c] < d.region_hi[c])) return false;
+  return true;
 }
 
 void init_decomposition(Decomposition& d, int dim, const std::string& method) {
@@ -139,7 +149,7 @@ void unpack_particle(ParticleArray& a, std::size_t j, const double* buf) {
 }
 
 int owner(const Decomposition& d, const double pos[3]) {
-  if (!d.cut) return rank();
+  if (!d.cut || inside_region(d, pos, pos)) return rank();
   double c[3] = {pos[0], pos[1], pos[2]};
   int proc = 0;
   check(Zoltan_LB_Point_Assign(d.zz, c, &proc), "Zoltan_LB_Point_Assign");
@@ -242,6 +252,15 @@ void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   Zoltan_LB_Free_Part(&egid, &elid, &eproc, &epart);
   d.cut = true;
   ++d.rebalances;
+  d.has_region = false;
+  if (d.method == "RCB") {
+    int ndim = 0;
+    double* lo = d.region_lo;
+    double* hi = d.region_hi;
+    if (Zoltan_RCB_Box(d.zz, rank(), &ndim, &lo[0], &lo[1], &lo[2], &hi[0], &hi[1], &hi[2]) ==
+        ZOLTAN_OK)
+      d.has_region = true;
+  }
   migrate(d, arrays);
 }
 

@@ -135,6 +135,7 @@ std::size_t exchange_halo(const Decomposition& dec, const Domain& d, ParticleArr
         lo[c] = c < dec.dim ? p[c] - cutoff : 0.0;
         hi[c] = c < dec.dim ? p[c] + cutoff : 0.0;
       }
+      if (image == 0 && inside_region(dec, lo, hi)) continue;  // needed here only
       ranks_near(dec, lo, hi, ranks);
       for (int r : ranks) {
         if (r == me && image == 0) continue;

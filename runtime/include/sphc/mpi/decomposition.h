@@ -46,6 +46,11 @@ struct Decomposition {
   long rebalances = 0;
   long migrated = 0;              // particles this rank sent by migration, all arrays
   bool cut = false;               // Zoltan has cuts (after the first rebalance)
+  // RCB: this rank's region, a box (Zoltan_RCB_Box; infinite on outer sides). A point strictly
+  // inside it is this rank's without asking Zoltan, and a particle whose interaction box lies
+  // strictly inside it is in no other rank's halo (the fast path of migrate and the halo).
+  bool has_region = false;
+  double region_lo[3] = {0, 0, 0}, region_hi[3] = {0, 0, 0};
 
   Decomposition() = default;
   Decomposition(const Decomposition&) = delete;
@@ -74,6 +79,9 @@ void update(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
 // Largest particle count of a rank over the mean (1 = perfect balance). Collective.
 double imbalance(const std::vector<ParticleArray*>& arrays);
+
+// Whether the box [lo, hi] lies strictly inside this rank's region (false without one).
+bool inside_region(const Decomposition& d, const double lo[3], const double hi[3]);
 
 // The rank owning a position (pos[0..dim-1]).
 int owner(const Decomposition& d, const double pos[3]);
