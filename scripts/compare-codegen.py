@@ -44,21 +44,10 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-OPTION = re.compile(r'^\s*option\s+(\w+)\s+in\s+\[([^\]]*)\]\s*=\s*(\w+)\s*;', re.M)
-
-
-def cases(path):
-    """(case name, [sphc -D flags]) for a scene: the default build, then every non-default
-    choice of each option (as tests/lit/Inputs/every_example.py)."""
-    scene = os.path.splitext(os.path.basename(path))[0]
-    with open(path) as f:
-        text = f.read()
-    out = [(scene, [])]
-    for name, choices, default in OPTION.findall(text):
-        for c in (c.strip() for c in choices.split(',')):
-            if c and c != default:
-                out.append((scene + ':' + c, ['-D', name + '=' + c]))
-    return out
+# One list of a scene's cases (the default build, then each non-default choice of each
+# compile-time option): the one every_example.py, the lit test of every example, uses.
+sys.path.insert(0, os.path.join(ROOT, 'tests', 'lit', 'Inputs'))
+from every_example import cases  # noqa: E402
 
 
 def normalise(text, renames):

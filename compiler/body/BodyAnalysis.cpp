@@ -21,10 +21,10 @@
 // (O(1), and robust to anything the user writes in the body); the #line directive keeps Clang's
 // own view of the positions (__LINE__, presumed locations) consistent with that.
 #include "body/BodyAnalysis.h"
+#include "body/BodyBatch.h"
 
 #include "clang/AST/ASTConsumer.h"
 #include "clang/AST/ASTContext.h"
-#include "clang/AST/RecursiveASTVisitor.h"
 #include "clang/Basic/DiagnosticSema.h"
 #include "clang/Frontend/CompilerInstance.h"
 #include "clang/Frontend/CompilerInvocation.h"
@@ -55,13 +55,9 @@ const std::vector<std::string>& kernelFunctions() {
   return names;
 }
 
-namespace {
+}  // namespace sphc
 
-// Names of the synthesised translation unit and of the body functions in it.
-constexpr const char* kUnitName = "<sphc-bodies>.c";
-constexpr llvm::StringLiteral kFunctionPrefix = "__sphc_body_";
-
-bool isPairQuantity(const std::string& name) { return findPairQuantity(name) != nullptr; }
+namespace sphc::body_detail {
 
 bool isTwoArgumentMathFunction(llvm::StringRef name) {
   return name == "pow" || name == "atan2" || name == "fmin" || name == "fmax" ||
@@ -69,28 +65,6 @@ bool isTwoArgumentMathFunction(llvm::StringRef name) {
 }
 
 bool isIdentChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
-
-// `d_NAME` / `s_NAME` (a property access), but not the indices d_idx / s_idx.
-bool isPropertyName(llvm::StringRef name) {
-  return (name.startswith("d_") || name.startswith("s_")) && name.size() > 2 &&
-         name != "d_idx" && name != "s_idx";
-}
-
-const char* kindName(BodyKind kind) {
-  switch (kind) {
-    case BodyKind::Initialize: return "initialize";
-    case BodyKind::Loop: return "loop";
-    case BodyKind::PostLoop: return "post_loop";
-    case BodyKind::Reduce: return "reduce";
-    case BodyKind::Converged: return "converged";
-    case BodyKind::StepperInit: return "initialize";
-    case BodyKind::StepperStage: return "stage";
-    case BodyKind::Function: return "function";
-  }
-  return "body";
-}
-
-bool returnsValue(BodyKind kind) { return kind == BodyKind::Reduce || kind == BodyKind::Converged; }
 
 // What a quick lexical scan of a body finds: its identifiers (in order of first appearance,
 // outside comments and literals) and the offsets of preprocessor directives other than
@@ -226,129 +200,6 @@ std::string prelude() {
   for (const std::string& f : kernelFunctions()) out += "double " + f + "(double r, double h);\n";
   return out;
 }
-
-// Where a body's text (and the closing brace after it) lies in the translation unit.
-struct BodyRegion {
-  unsigned textBegin = 0;  // offset of text[0]
-  unsigned end = 0;        // offset of the closing `}` (the .sph `}` after the text)
-};
-
-// Per-body bookkeeping shared by the diagnostic forwarder and the AST walk.
-struct BodyState {
-  unsigned errors = 0;
-  bool checked = false;  // its function reached the AST walk (not after a fatal error)
-  bool missingReturnReported = false;
-  bool blanked = false;  // left out of the unit after an error (unbalanced brackets)
-  std::set<std::string> reportedOutsideLoop;  // s_/pair-quantity names already reported
-};
-
-// One analysis: the bodies, the synthesised unit, and everything reported so far.
-class Batch {
- public:
-  Batch(DiagnosticEngine& diags, const std::vector<BodySource>& bodies)
-      : facts(bodies.size()), state(bodies.size()), diags_(diags), bodies_(bodies) {
-    synthesise();
-  }
-
-  const std::string& unit() const { return unit_; }
-  const BodySource& body(int i) const { return bodies_[i]; }
-  DiagnosticEngine& diags() { return diags_; }
-
-  // The body whose text contains `loc` (after macro expansion), or -1.
-  int bodyAt(const clang::SourceManager& sm, clang::SourceLocation loc) const {
-    if (loc.isInvalid()) return -1;
-    loc = sm.getExpansionLoc(loc);
-    if (sm.getFileID(loc) != sm.getMainFileID()) return -1;
-    unsigned off = sm.getFileOffset(loc);
-    auto it = std::upper_bound(regions_.begin(), regions_.end(), off,
-                               [](unsigned o, const BodyRegion& r) { return o < r.textBegin; });
-    if (it == regions_.begin()) return -1;
-    --it;
-    return off <= it->end ? static_cast<int>(it - regions_.begin()) : -1;
-  }
-
-  // The .sph location of `loc`, which lies in body `i`.
-  llvm::SMLoc toSph(const clang::SourceManager& sm, clang::SourceLocation loc, int i) const {
-    if (!bodies_[i].start.isValid()) return llvm::SMLoc();
-    unsigned off = sm.getFileOffset(sm.getExpansionLoc(loc));
-    return llvm::SMLoc::getFromPointer(bodies_[i].start.getPointer() +
-                                       (off - regions_[i].textBegin));
-  }
-
-  // The .sph `}` closing body `i`.
-  llvm::SMLoc closingBrace(int i) const {
-    const BodySource& b = bodies_[i];
-    // A function's text ends with its `}`; a body's text ends just before it.
-    size_t at = b.text.size() - (b.kind == BodyKind::Function && !b.text.empty() ? 1 : 0);
-    return b.start.isValid() ? llvm::SMLoc::getFromPointer(b.start.getPointer() + at)
-                             : llvm::SMLoc();
-  }
-
-  // The helper function (BodyKind::Function) that `fn` is the definition of, or -1.
-  int functionOf(const clang::SourceManager& sm, const clang::FunctionDecl* fn) const {
-    const clang::FunctionDecl* def = fn ? fn->getDefinition() : nullptr;
-    if (!def) return -1;
-    int j = bodyAt(sm, def->getLocation());
-    if (j < 0 || bodies_[j].kind != BodyKind::Function ||
-        def->getName() != bodies_[j].functionName)
-      return -1;
-    return j;
-  }
-  // The helper function named `name`, or -1.
-  int functionNamed(llvm::StringRef name) const {
-    for (size_t j = 0; j < bodies_.size(); ++j)
-      if (bodies_[j].kind == BodyKind::Function && bodies_[j].functionName == name)
-        return static_cast<int>(j);
-    return -1;
-  }
-
-  // Reports a diagnostic of body `i`, counting the errors it causes (warnings may be errors).
-  void report(int i, llvm::SourceMgr::DiagKind kind, llvm::SMLoc loc, const llvm::Twine& msg) {
-    unsigned before = diags_.errorCount();
-    switch (kind) {
-      case llvm::SourceMgr::DK_Error: diags_.error(loc, msg); break;
-      case llvm::SourceMgr::DK_Warning: diags_.warning(loc, msg); break;
-      case llvm::SourceMgr::DK_Remark: diags_.remark(loc, msg); break;
-      case llvm::SourceMgr::DK_Note: diags_.note(loc, msg); break;
-    }
-    if (i >= 0) state[i].errors += diags_.errorCount() - before;
-  }
-  void error(int i, llvm::SMLoc loc, const llvm::Twine& msg) {
-    report(i, llvm::SourceMgr::DK_Error, loc, msg);
-  }
-
-  // sphc's messages shared by the diagnostic forwarder and the AST walk.
-  void reportMissingReturn(int i) {
-    if (state[i].missingReturnReported || state[i].blanked) return;
-    state[i].missingReturnReported = true;
-    const BodySource& b = bodies_[i];
-    std::string what = b.label.empty() ? std::string("a '") + kindName(b.kind) + "' body"
-                                       : b.label;
-    error(i, closingBrace(i),
-          "missing 'return': " + what + " must return a value on every path ('return EXPR;')");
-  }
-  void reportOutsideLoop(int i, llvm::SMLoc loc, const std::string& name) {
-    if (!state[i].reportedOutsideLoop.insert(name).second) return;
-    if (name == "s_idx")
-      error(i, loc, "'s_idx' (the neighbour's index) is only available in 'loop'");
-    else if (llvm::StringRef(name).startswith("s_"))
-      error(i, loc, "'" + name + "': s_ properties are only available in 'loop', not in '" +
-                        kindName(bodies_[i].kind) + "'");
-    else
-      error(i, loc, name + " is a pair quantity, only available in 'loop'");
-  }
-
-  std::vector<BodyFacts> facts;
-  std::vector<BodyState> state;
-
- private:
-  void synthesise();
-
-  DiagnosticEngine& diags_;
-  const std::vector<BodySource>& bodies_;
-  std::string unit_;
-  std::vector<BodyRegion> regions_;  // ordered by offset
-};
 
 // The function of a body. Every sphc name the body mentions is a const parameter, so the C type
 // system rejects writes to it; s_ names and pair quantities are declared in every kind of body
@@ -599,263 +450,11 @@ class DiagnosticForwarder : public clang::DiagnosticConsumer {
   bool dropNotes_ = true;  // the last error/warning was not forwarded: drop its notes
 };
 
-// The AST walk over one body: facts, and sphc's portability rules.
-class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
- public:
-  BodyChecker(Batch& batch, int index, const clang::SourceManager& sm)
-      : batch_(batch), i_(index), sm_(sm), body_(batch.body(index)), facts_(batch.facts[index]) {}
+}  // namespace sphc::body_detail
 
-  void check(clang::FunctionDecl* fn) {
-    batch_.state[i_].checked = true;
-    if (body_.kind == BodyKind::Function) checkSignature(fn);
-    TraverseStmt(fn->getBody());
-    if (returnsValue(body_.kind) && !returnsValue_) batch_.reportMissingReturn(i_);
-  }
-
-  // --- facts ---
-
-  bool VisitBinaryOperator(clang::BinaryOperator* op) {
-    if (op->isAssignmentOp()) markWritten(op->getLHS(), op->isCompoundAssignmentOp());
-    return true;
-  }
-
-  bool VisitUnaryOperator(clang::UnaryOperator* op) {
-    if (op->isIncrementDecrementOp()) markWritten(op->getSubExpr(), /*alsoRead=*/true);
-    if (op->getOpcode() == clang::UO_AddrOf)
-      error(op->getOperatorLoc(), "'&' (address-of) is not allowed in bodies: there are no "
-                                  "pointers; use the value or index the property directly");
-    return true;
-  }
-
-  bool VisitArraySubscriptExpr(clang::ArraySubscriptExpr* e) {
-    if (body_.kind == BodyKind::Function) return true;  // no properties in helpers
-    auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(e->getBase()->IgnoreParenImpCasts());
-    if (!ref || !isPropertyParam(ref)) return true;
-    indexed_.insert(ref);
-    std::string name = ref->getDecl()->getName().str();
-    std::string prop = name.substr(2);
-    llvm::SMLoc loc = sph(e->getBeginLoc());
-    auto w = written_.find(e);
-    bool isWrite = w != written_.end(), isRead = !isWrite || w->second;
-    if (name[0] == 's') {
-      if (body_.kind != BodyKind::Loop) batch_.reportOutsideLoop(i_, loc, name);
-      else if (isRead) record(facts_.sReads, prop, loc);
-      // Writes to s_ elements are rejected by Clang (const) and reported by the forwarder.
-    } else {
-      if (isRead) record(facts_.dReads, prop, loc);
-      if (isWrite) record(facts_.dWrites, prop, loc);
-    }
-    return true;
-  }
-
-  bool VisitDeclRefExpr(clang::DeclRefExpr* e) {
-    clang::ValueDecl* decl = e->getDecl();
-    if (llvm::isa<clang::FunctionDecl>(decl)) {
-      if (!callees_.count(e) && recovering_ == 0)
-        error(e->getLocation(), "a function can only be called in a body, not used as a value");
-      return true;
-    }
-    if (!llvm::isa<clang::ParmVarDecl>(decl)) return true;
-    if (body_.kind == BodyKind::Function) return true;  // its parameters are the user's
-    std::string name = decl->getName().str();
-    if (isPropertyParam(e)) {
-      if (!indexed_.count(e) && recovering_ == 0)
-        error(e->getLocation(), "property '" + name + "' must be indexed, e.g. " + name + "[" +
-                                    name.substr(0, 2) + "idx]; there are no pointers in bodies");
-    } else if (isPairQuantity(name) || name == "s_idx") {
-      if (body_.kind != BodyKind::Loop)
-        batch_.reportOutsideLoop(i_, sph(e->getLocation()), name);
-      else if (name != "s_idx")
-        facts_.pairQuantities.insert(name);
-    } else if (name == "t") {
-      facts_.usesT = true;
-    } else if (name == "dt") {
-      facts_.usesDt = true;
-    } else if (std::find(body_.scalars.begin(), body_.scalars.end(), name) !=
-               body_.scalars.end()) {
-      facts_.scalarsUsed.insert(name);
-    }
-    return true;
-  }
-
-  bool VisitReturnStmt(clang::ReturnStmt* s) {
-    if (s->getRetValue()) returnsValue_ = true;
-    return true;
-  }
-
-  // Inside an expression Clang could not build (already an error), a call or a subscript need
-  // not look like one: the "must be indexed" and "only called" rules are not checked there.
-  bool TraverseRecoveryExpr(clang::RecoveryExpr* e) {
-    ++recovering_;
-    bool more = RecursiveASTVisitor::TraverseRecoveryExpr(e);
-    --recovering_;
-    return more;
-  }
-
-  // --- portability rules ---
-
-  bool VisitCallExpr(clang::CallExpr* call) {
-    clang::Expr* callee = call->getCallee()->IgnoreParenImpCasts();
-    if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(callee)) callees_.insert(ref);
-    clang::FunctionDecl* fn = call->getDirectCallee();
-    if (fn && isAllowedMath(fn)) return true;
-    if (int j = batch_.functionOf(sm_, fn); j >= 0) {
-      if (j == i_)
-        error(callee->getBeginLoc(), "function '" + fn->getName() + "' calls itself: recursion "
-                                     "is not allowed (OpenCL C has none); use a loop");
-      else
-        checkArraySizes(call, fn);
-      return true;
-    }
-    if (fn) {
-      int j = batch_.functionNamed(fn->getName());
-      if (j >= 0 && j != i_) {
-        error(callee->getBeginLoc(), "function '" + fn->getName() + "' is declared after this "
-                                     "one: a function may call only functions declared "
-                                     "before it");
-        return true;
-      }
-    }
-    std::string list;
-    for (const std::string& f : allowedMathFunctions()) list += (list.empty() ? "" : ", ") + f;
-    std::string what = fn ? "call of '" + fn->getName().str() + "'" : std::string("this call");
-    error(callee->getBeginLoc(), what + " is not allowed: bodies may call only the math.h "
-                                        "functions " + list +
-                                        ", the kernel's KERNEL_W(r, h), KERNEL_DWDR(r, h) "
-                                        "and the .sph file's functions");
-    return true;
-  }
-
-  bool VisitVarDecl(clang::VarDecl* v) {
-    if (v->isStaticLocal())
-      error(v->getLocation(), "'static' local variables are not allowed in bodies: a body keeps "
-                              "no state between calls; use a property");
-    else if (v->hasExternalStorage())
-      error(v->getLocation(), "'extern' declarations are not allowed in bodies");
-    if (containsPointer(v->getType()))
-      error(v->getLocation(), "pointer variables are not allowed in bodies; use a local array "
-                              "or index a property (d_NAME[d_idx])");
-    return true;
-  }
-
-  bool VisitCStyleCastExpr(clang::CStyleCastExpr* e) {
-    if (containsPointer(e->getTypeAsWritten()))
-      error(e->getBeginLoc(), "pointer casts are not allowed in bodies");
-    return true;
-  }
-
-  bool VisitGotoStmt(clang::GotoStmt* s) { return gotoError(s->getBeginLoc()); }
-  bool VisitIndirectGotoStmt(clang::IndirectGotoStmt* s) { return gotoError(s->getBeginLoc()); }
-  bool VisitAddrLabelExpr(clang::AddrLabelExpr* e) { return gotoError(e->getBeginLoc()); }
-
-  bool VisitStringLiteral(clang::StringLiteral* e) {
-    error(e->getBeginLoc(), "string literals are not allowed in bodies");
-    return true;
-  }
-
-  bool VisitAsmStmt(clang::AsmStmt* s) {
-    error(s->getBeginLoc(), "inline assembly is not allowed in bodies");
-    return true;
-  }
-
- private:
-  // A helper's parameters: values or arrays (`double a[9]`), never pointers or `...`.
-  void checkSignature(clang::FunctionDecl* fn) {
-    for (clang::ParmVarDecl* p : fn->parameters()) {
-      if (containsPointer(p->getOriginalType()))
-        error(p->getLocation(), "pointer parameters are not allowed in functions; declare an "
-                                "array parameter, e.g. 'double a[3]'");
-      else if (p->getOriginalType()->isIncompleteArrayType())
-        error(p->getLocation(), "an array parameter needs its size, e.g. 'double a[3]'");
-    }
-    if (fn->isVariadic())
-      error(fn->getLocation(), "variadic functions ('...') are not allowed");
-  }
-
-  // An array argument must be at least as long as the array parameter it is passed to (C
-  // does not check; out of bounds is undefined on every backend).
-  void checkArraySizes(clang::CallExpr* call, clang::FunctionDecl* fn) {
-    for (unsigned k = 0; k < call->getNumArgs() && k < fn->getNumParams(); ++k) {
-      const auto* want = llvm::dyn_cast_or_null<clang::ConstantArrayType>(
-          fn->getParamDecl(k)->getOriginalType()->getAsArrayTypeUnsafe());
-      if (!want) continue;
-      const clang::Expr* arg = call->getArg(k)->IgnoreParenImpCasts();
-      const auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(arg);
-      if (!ref) continue;
-      clang::QualType type = ref->getDecl()->getType();
-      if (auto* p = llvm::dyn_cast<clang::ParmVarDecl>(ref->getDecl())) type = p->getOriginalType();
-      const auto* have = llvm::dyn_cast_or_null<clang::ConstantArrayType>(
-          type->getAsArrayTypeUnsafe());
-      if (have && have->getSize().ult(want->getSize()))
-        error(arg->getBeginLoc(), "array '" + ref->getDecl()->getName() + "' has " +
-                                      llvm::Twine(have->getSize().getZExtValue()) +
-                                      " elements; parameter '" +
-                                      fn->getParamDecl(k)->getName() + "' of '" +
-                                      fn->getName() + "' needs " +
-                                      llvm::Twine(want->getSize().getZExtValue()));
-    }
-  }
-
-  llvm::SMLoc sph(clang::SourceLocation loc) const { return batch_.toSph(sm_, loc, i_); }
-  void error(clang::SourceLocation loc, const llvm::Twine& msg) { batch_.error(i_, sph(loc), msg); }
-
-  bool gotoError(clang::SourceLocation loc) {
-    error(loc, "'goto' is not allowed in bodies; use if, for, while, break and continue");
-    return true;
-  }
-
-  static bool isPropertyParam(const clang::DeclRefExpr* ref) {
-    return llvm::isa<clang::ParmVarDecl>(ref->getDecl()) &&
-           isPropertyName(ref->getDecl()->getName());
-  }
-
-  // A math function declared by the prelude (not only implicitly or by a body itself). The
-  // prelude's declaration of a library builtin such as sqrt redeclares Clang's implicit one.
-  bool isAllowedMath(const clang::FunctionDecl* fn) const {
-    const auto& allowed = allowedMathFunctions();
-    const auto& kernel = kernelFunctions();
-    const std::string name = fn->getName().str();
-    if (std::find(allowed.begin(), allowed.end(), name) == allowed.end() &&
-        std::find(kernel.begin(), kernel.end(), name) == kernel.end())
-      return false;
-    for (const clang::FunctionDecl* d : fn->redecls())
-      if (!d->isImplicit() && batch_.bodyAt(sm_, d->getLocation()) < 0) return true;
-    return false;
-  }
-
-  static bool containsPointer(clang::QualType type) {
-    for (const clang::Type* t = type.getTypePtrOrNull(); t;) {
-      if (t->isPointerType()) return true;
-      const clang::ArrayType* a = t->getAsArrayTypeUnsafe();
-      if (!a) return false;
-      t = a->getElementType().getTypePtrOrNull();
-    }
-    return false;
-  }
-
-  // `lhs` is assigned to (and also read, for compound assignment and ++/--).
-  void markWritten(clang::Expr* lhs, bool alsoRead) {
-    if (auto* e = llvm::dyn_cast<clang::ArraySubscriptExpr>(lhs->IgnoreParens()))
-      written_[e] = alsoRead;
-  }
-
-  static void record(std::vector<PropAccess>& list, const std::string& prop, llvm::SMLoc loc) {
-    for (const PropAccess& a : list)
-      if (a.prop == prop) return;
-    list.push_back({prop, loc});
-  }
-
-  Batch& batch_;
-  int i_;
-  const clang::SourceManager& sm_;
-  const BodySource& body_;
-  BodyFacts& facts_;
-  bool returnsValue_ = false;
-  int recovering_ = 0;  // depth of RecoveryExprs being traversed
-  std::map<const clang::ArraySubscriptExpr*, bool> written_;  // -> also read
-  std::set<const clang::DeclRefExpr*> indexed_;  // d_/s_ references that are subscripted
-  std::set<const clang::DeclRefExpr*> callees_;  // function references that are called
-};
+namespace sphc {
+namespace {
+using namespace body_detail;
 
 // Checks each body function as soon as Clang has parsed it, so sphc's messages come right
 // after Clang's for the same body.
@@ -868,14 +467,14 @@ class BodyConsumer : public clang::ASTConsumer {
       auto* fn = llvm::dyn_cast<clang::FunctionDecl>(d);
       if (!fn || !fn->hasBody()) continue;
       if (int j = batch_.functionOf(fn->getASTContext().getSourceManager(), fn); j >= 0) {
-        BodyChecker(batch_, j, fn->getASTContext().getSourceManager()).check(fn);
+        checkBodyFunction(batch_, j, fn->getASTContext().getSourceManager(), fn);
         continue;
       }
       if (!fn->getName().startswith(kFunctionPrefix)) continue;
       unsigned index = 0;
       if (fn->getName().drop_front(kFunctionPrefix.size()).getAsInteger(10, index))
         SPHC_INTERNAL("unexpected body function " + fn->getName());
-      BodyChecker(batch_, index, fn->getASTContext().getSourceManager()).check(fn);
+      checkBodyFunction(batch_, index, fn->getASTContext().getSourceManager(), fn);
     }
     return true;
   }

@@ -164,20 +164,56 @@ void ScenePrinter::resetLineDirective(std::ostringstream& os, const Dialect& d) 
 std::string ScenePrinter::propPtr(int a, const std::string& p) const {
   if (cpuSingle_) {
     int c = constIndex(a, p);
-    if (c >= 0) return "f32_" + arr(a).name + ".constant(" + std::to_string(c) + ")";
+    if (c >= 0) return "f32_" + arr(a).name + ".constant(" + constSlot(a, c) + ")";
     int i = propIndex(a, p);
     if (i >= 0 && arr(a).props[i].type != "int" && arr(a).props[i].type != "uint")
-      return "f32_" + arr(a).name + ".f(" + std::to_string(i) + ")";
+      return "f32_" + arr(a).name + ".f(" + propSlot(a, i) + ")";
   }
   return hostPtr(a, p);
 }
 
 std::string ScenePrinter::hostPtr(int a, const std::string& p) const {
   int c = constIndex(a, p);
-  if (c >= 0) return arr(a).name + ".constant(" + std::to_string(c) + ")";
+  if (c >= 0) return arr(a).name + ".constant(" + constSlot(a, c) + ")";
   int i = propIndex(a, p);
   if (i < 0) SPHC_INTERNAL("property '" + p + "' of '" + arr(a).name + "' was not allocated");
-  return arr(a).name + "." + accessor(arr(a).props[i].type) + "(" + std::to_string(i) + ")";
+  return arr(a).name + "." + accessor(arr(a).props[i].type) + "(" + propSlot(a, i) + ")";
+}
+
+std::string ScenePrinter::propSlot(int a, int i) const {
+  return arr(a).name + "_props::" + cppSafeName(arr(a).props[i].name);
+}
+
+std::string ScenePrinter::constSlot(int a, int c) const {
+  return arr(a).name + "_consts::" + cppSafeName(arr(a).constants[c]);
+}
+
+// One enum of property slots (and one of constant slots) per array, in the order setup()
+// adds them, so that generated code says `fluid.f64(fluid_props::rho)`, not `fluid.f64(3)`.
+void ScenePrinter::emitSlots() {
+  out_ << "// Where each array keeps its properties and constants (the order setup() adds them).\n";
+  for (size_t a = 0; a < plan_.arrays.size(); ++a) {
+    const auto& A = arr(static_cast<int>(a));
+    auto emitEnum = [&](const std::string& kind, const std::vector<std::string>& names) {
+      out_ << "struct " << A.name << "_" << kind << " {\n  enum : int {";
+      std::string line;
+      for (size_t i = 0; i < names.size(); ++i) {
+        std::string item = cppSafeName(names[i]) + " = " + std::to_string(i) +
+                           (i + 1 < names.size() ? "," : "");
+        if (line.size() + item.size() > 88) {
+          out_ << line << "\n";
+          line = "   ";
+        }
+        line += " " + item;
+      }
+      out_ << line << " };\n};\n";
+    };
+    std::vector<std::string> props;
+    for (const auto& p : A.props) props.push_back(p.name);
+    emitEnum("props", props);
+    if (!A.constants.empty()) emitEnum("consts", A.constants);
+  }
+  out_ << "\n";
 }
 
 std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int dest,
@@ -260,7 +296,7 @@ std::string ScenePrinter::propIndexList(int a, const std::vector<std::string>& p
     int i = propIndex(a, props[k]);
     if (i < 0) SPHC_INTERNAL("ghost property '" + props[k] + "' of '" + arr(a).name +
                              "' was not allocated");
-    s += (k ? ", " : "") + std::to_string(i);
+    s += (k ? ", " : "") + propSlot(a, i);
   }
   return s + "}";
 }

@@ -1,6 +1,7 @@
 #include "codegen/CppText.h"
 
 #include <cctype>
+#include <set>
 
 namespace sphc {
 
@@ -82,6 +83,23 @@ std::string accessor(const std::string& t) {
   if (t == "int") return "i32";
   if (t == "uint") return "u32";
   return "f64";
+}
+
+std::string cppSafeName(const std::string& name) {
+  static const std::set<std::string> keywords = {
+      "alignas", "alignof", "and", "and_eq", "asm", "auto", "bitand", "bitor", "bool", "break",
+      "case", "catch", "char", "char16_t", "char32_t", "char8_t", "class", "co_await",
+      "co_return", "co_yield", "compl", "concept", "const", "const_cast", "consteval",
+      "constexpr", "constinit", "continue", "decltype", "default", "delete", "do", "double",
+      "dynamic_cast", "else", "enum", "explicit", "export", "extern", "false", "float", "for",
+      "friend", "goto", "if", "inline", "int", "long", "mutable", "namespace", "new",
+      "noexcept", "not", "not_eq", "nullptr", "operator", "or", "or_eq", "private",
+      "protected", "public", "register", "reinterpret_cast", "requires", "return", "short",
+      "signed", "sizeof", "static", "static_assert", "static_cast", "struct", "switch",
+      "template", "this", "thread_local", "throw", "true", "try", "typedef", "typeid",
+      "typename", "union", "unsigned", "using", "virtual", "void", "volatile", "wchar_t",
+      "while", "xor", "xor_eq"};
+  return keywords.count(name) ? name + "_" : name;
 }
 
 std::string bodyFunctionName(const std::string& owner, const std::string& method) {

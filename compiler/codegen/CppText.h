@@ -32,6 +32,9 @@ std::string accessor(const std::string& t);
 // The function holding method `method` of an equation or stepper: Owner_method.
 std::string bodyFunctionName(const std::string& owner, const std::string& method);
 
+// `name`, or `name_` where `name` is a C++ keyword (a property may be called `new`).
+std::string cppSafeName(const std::string& name);
+
 // A body for --precision=single on the CPU: `double` becomes `float` and every floating
 // literal without a suffix gets `f`, so the body computes in float as it does in OpenCL C.
 std::string singlePrecisionBody(const std::string& text);

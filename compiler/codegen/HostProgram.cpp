@@ -469,11 +469,11 @@ void ScenePrinter::emitMain() {
   mainBackendOptions();
   for (const auto* p : plan_.params) {
     if (p->derived) continue;  // `let`: not overridable
+    // A literal default is printed as setup() prints it (the .sph spelling, `0.03`).
     bool lit = isLiteral(*p->value);
-    char buf[64];
-    snprintf(buf, sizeof buf, "%.17g", lit ? literalValue(*p->value) : 0.0);
+    auto none = [](const std::string& n) -> std::string { SPHC_INTERNAL("name in literal " + n); };
     out_ << "  prog.params.push_back({\"" << p->name.name << "\", "
-         << (lit ? std::string(buf) : "std::nan(\"\")") << ", \""
+         << (lit ? exprCpp(*p->value, none) : "std::nan(\"\")") << ", \""
          << (lit ? std::string("") : "= " + exprText(*p->value)) << "\"});\n";
   }
   for (const auto& o : plan_.options) {
@@ -553,6 +553,7 @@ std::string ScenePrinter::run() {
   out_ << "using Kernel = sphc::" << plan_.kernel << "<DIM>;\n";
   out_ << "constexpr " << real_
        << " RADIUS2 = Kernel::radius_scale * Kernel::radius_scale;\n\n";
+  emitSlots();
   out_ << "// ---- Equation and stepper bodies, as written in the .sph files ----\n\n";
   emitBodies();
   emitParams();

@@ -43,7 +43,7 @@ class OpenCLPrinter : public ScenePrinter {
   // ... and constants it wrote go back to the device.
   void afterConverged(const PlanEquation& eq, int c) override {
     scene_ << "        dev_" << arr(eq.dest).name << ".upload_constant(ocl, " << arr(eq.dest).name
-           << ", " << c << ");\n";
+           << ", " << constSlot(eq.dest, c) << ");\n";
   }
   void steppers() override;
   void stepperCall(const StepStatement& st,
@@ -184,10 +184,10 @@ void OpenCLPrinter::stepperCall(const StepStatement& st,
 
 std::string OpenCLPrinter::devBuffer(int a, const std::string& p) const {
   int c = constIndex(a, p);
-  if (c >= 0) return "dev_" + arr(a).name + ".constant(" + std::to_string(c) + ")";
+  if (c >= 0) return "dev_" + arr(a).name + ".constant(" + constSlot(a, c) + ")";
   int i = propIndex(a, p);
   if (i < 0) SPHC_INTERNAL("property '" + p + "' of '" + arr(a).name + "' was not allocated");
-  return "dev_" + arr(a).name + ".prop(" + std::to_string(i) + ")";
+  return "dev_" + arr(a).name + ".prop(" + propSlot(a, i) + ")";
 }
 
 void OpenCLPrinter::addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int src,
@@ -316,11 +316,11 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
            << ": " << eq->name << ", from " << loc(eq->loc) << "\n";
     scene_ << "        " << launch(k, nReal, ka) << (onGhosts ? "  // real particles only" : "")
            << "\n";
-    scene_ << "        " << D << ".constant(" << c << ")[0] = ocl.reduce(ocl.scratch(" << nReal
+    scene_ << "        " << D << ".constant(" << constSlot(d, c) << ")[0] = ocl.reduce(ocl.scratch(" << nReal
            << "), " << nReal << ", sphc::ocl::Op::" << op << ")"
            << (pd.reduceOp == "mean" ? " / (" + nReal + " > 0 ? " + nReal + " : 1)" : "")
            << ";\n";
-    scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << c << ");\n";
+    scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << constSlot(d, c) << ");\n";
     scene_ << "      }\n";
   }
   ghostRefresh(w);

@@ -194,6 +194,11 @@ class ScenePrinter {
     return false;
   }
   std::string propIndexList(int a, const std::vector<std::string>& props) const;
+  // The name of property slot i / constant slot c of array a in the generated code
+  // (`fluid_props::rho`, `fluid_consts::dim`), declared by emitSlots().
+  std::string propSlot(int a, int i) const;
+  std::string constSlot(int a, int c) const;
+  void emitSlots();
   std::string loc(llvm::SMLoc l) const { return diags_.lineInfo(l); }
   std::string paramRef(const std::string& n) const { return "P." + n; }
   std::string eqStruct(const PlanEquation& eq) const { return "eq" + std::to_string(eq.id); }

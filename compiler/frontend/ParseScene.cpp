@@ -1,0 +1,298 @@
+// The parser, part 2: the scene block (settings, output, domain, limits, groups) and the
+// keyword-argument and name lists it uses. Part 1 (module items) is Parser.cpp.
+#include "frontend/Parser.h"
+#include "frontend/ParseUtil.h"
+
+#include "llvm/ADT/STLExtras.h"
+#include "llvm/ADT/StringExtras.h"
+
+namespace sphc {
+
+using ast::ExprPtr;
+using namespace parse_detail;
+
+bool Parser::parseScene(ast::Module& mod) {
+  advance();
+  ast::SceneDecl scene;
+  if (!parseIdent(scene.name, "expected a scene name after 'scene'")) return false;
+  bool ok = parseBlock(
+      "scene " + quoted(scene.name.name), [&] { return parseSceneItem(scene); },
+      /*sceneStepper=*/true);
+  mod.scenes.push_back(std::move(scene));
+  return ok;
+}
+
+bool Parser::parseSceneItem(ast::SceneDecl& scene) {
+  if (!cur().is(Token::Identifier))
+    return error(cur().loc, "expected a scene item ('name = value;', stepper, adaptive_dt, "
+                            "output, domain, limits, equations or when), found " + describe(cur()));
+  // The scene's keywords are contextual: `output = 3;` is a setting named output.
+  if (lex_.peek().is(Token::Assign)) return parseSceneSetting(scene);
+  if (atWhen())
+    return parseWhen<ast::SceneDecl>(
+        scene.whens, "scene " + quoted(scene.name.name),
+        [&](ast::SceneDecl& part) {
+          part.name = scene.name;
+          return parseSceneItem(part);
+        },
+        /*sceneStepper=*/true);
+  if (atWord("stepper")) return parseSceneStepper(scene);
+  if (atWord("adaptive_dt")) return parseAdaptiveDt(scene);
+  if (atWord("output")) return parseOutput(scene);
+  if (atWord("domain")) return parseDomain(scene);
+  if (atWord("limits")) return parseLimits(scene);
+  if (atWord("equations")) {
+    scene.equationsLoc = cur().loc;
+    advance();
+    return parseBlock("equations", [&] { return parseGroupItem(scene.equations, 0); });
+  }
+  return error(lex_.peek().loc, "expected '=' after scene setting " + quoted(cur().text));
+}
+
+bool Parser::parseSceneSetting(ast::SceneDecl& scene) {
+  ast::SceneSetting setting;
+  setting.key = identOf(cur());
+  advance();
+  advance();  // '='
+  if (!(setting.value = parseExpr())) return false;
+  scene.settings.push_back(std::move(setting));
+  return expect(Token::Semi, "after scene setting " + quoted(scene.settings.back().key.name));
+}
+
+bool Parser::parseSceneStepper(ast::SceneDecl& scene) {
+  advance();
+  ast::SceneStepper st;
+  if (!parseIdent(st.array, "expected an array name after 'stepper'") ||
+      !expect(Token::Assign, "after 'stepper " + st.array.name + "'") ||
+      !parseIdent(st.stepper, "expected a stepper name after 'stepper " + st.array.name + " ='"))
+    return false;
+  scene.steppers.push_back(std::move(st));
+  return expect(Token::Semi, "after scene stepper");
+}
+
+bool Parser::parseAdaptiveDt(ast::SceneDecl& scene) {
+  scene.hasAdaptiveDt = true;
+  scene.adaptiveDtLoc = cur().loc;
+  advance();
+  if (!expect(Token::LParen, "after 'adaptive_dt'") || !parseKwArgs(scene.adaptiveDt))
+    return false;
+  return expect(Token::Semi, "after 'adaptive_dt(...)'");
+}
+
+bool Parser::parseOutput(ast::SceneDecl& scene) {
+  ast::OutputDecl out;
+  out.loc = cur().loc;
+  advance();
+  if (atWord("every")) {
+    advance();
+    if (!(out.every = parseExpr())) return false;
+  } else if (atWord("at")) {
+    advance();
+    if (!expect(Token::LBracket, "after 'output at'")) return false;
+    do {
+      ExprPtr t = parseExpr();
+      if (!t) return false;
+      out.at.push_back(std::move(t));
+    } while (consumeIf(Token::Comma));
+    if (!consumeIf(Token::RBracket))
+      return error(cur().loc, "expected ',' or ']' in the output times, found " + describe(cur()));
+  } else {
+    return error(cur().loc, "expected 'every' or 'at' after 'output', found " + describe(cur()));
+  }
+  bool ok = parseBlock("output", [&] { return parseOutputItem(out); });
+  scene.outputs.push_back(std::move(out));
+  return ok;
+}
+
+bool Parser::parseOutputItem(ast::OutputDecl& out) {
+  ast::OutputDecl::Item item;
+  if (!parseIdent(item.array, "expected an array name in output, as in 'fluid(x, y);'") ||
+      !expect(Token::LParen, "after array " + quoted(item.array.name) + " in output"))
+    return false;
+  do {
+    ast::Ident prop;
+    if (!parseIdent(prop, "expected a property name in the output of " + quoted(item.array.name)))
+      return false;
+    item.props.push_back(std::move(prop));
+  } while (consumeIf(Token::Comma));
+  if (!consumeIf(Token::RParen))
+    return error(cur().loc, "expected ',' or ')' in the output of " + quoted(item.array.name) +
+                                ", found " + describe(cur()));
+  out.items.push_back(std::move(item));
+  return expect(Token::Semi, "after output item");
+}
+
+bool Parser::parseDomain(ast::SceneDecl& scene) {
+  ast::DomainDecl domain;
+  domain.loc = cur().loc;
+  advance();
+  bool ok = parseBlock("domain", [&] { return parseDomainItem(domain); });
+  scene.domains.push_back(std::move(domain));
+  return ok;
+}
+
+// periodic AXIS in [lo, hi];  mirror AXIS in [lo, hi];  mirror AXIS >= lo;  mirror AXIS <= hi;
+bool Parser::parseDomainItem(ast::DomainDecl& domain) {
+  ast::DomainItem item;
+  if (atWord("periodic"))
+    item.kind = ast::DomainItem::Periodic;
+  else if (atWord("mirror"))
+    item.kind = ast::DomainItem::Mirror;
+  else
+    return error(cur().loc, "expected 'periodic' or 'mirror' in domain, found " + describe(cur()));
+  std::string what = item.kind == ast::DomainItem::Periodic ? "periodic" : "mirror";
+  item.loc = cur().loc;
+  advance();
+  if (!parseIdent(item.axis, "expected an axis (x, y or z) after '" + what + "'")) return false;
+  const std::string head = "'" + what + " " + item.axis.name + "'";
+  if (atWord("in")) {
+    advance();
+    if (!expect(Token::LBracket, "after " + head + " in")) return false;
+    if (!(item.lo = parseExpr())) return false;
+    if (!consumeIf(Token::Comma))
+      return error(cur().loc, "expected ',' between the ends of the interval of " + head +
+                                  ", found " + describe(cur()));
+    if (!(item.hi = parseExpr())) return false;
+    if (!consumeIf(Token::RBracket))
+      return error(cur().loc, "expected ']' after the interval of " + head + ", found " +
+                                  describe(cur()));
+  } else if (consumeIf(Token::GreaterEq)) {
+    if (!(item.lo = parseExpr())) return false;
+  } else if (consumeIf(Token::LessEq)) {
+    if (!(item.hi = parseExpr())) return false;
+  } else {
+    return error(cur().loc, "expected 'in [lo, hi]', '>= lo' or '<= hi' after " + head +
+                                ", found " + describe(cur()));
+  }
+  domain.items.push_back(std::move(item));
+  return expect(Token::Semi, "after domain item");
+}
+
+bool Parser::parseLimits(ast::SceneDecl& scene) {
+  ast::LimitsDecl limits;
+  limits.loc = cur().loc;
+  advance();
+  bool ok = parseBlock("limits", [&] { return parseLimitItem(limits); });
+  scene.limits.push_back(std::move(limits));
+  return ok;
+}
+
+// ARRAY.QUANTITY (warn BOUND)? (stop BOUND)?;  at least one of warn and stop.
+bool Parser::parseLimitItem(ast::LimitsDecl& limits) {
+  ast::LimitItem item;
+  if (!parseIdent(item.array, "expected a limit, as in 'fluid.rho warn [990, 1010];', found " +
+                                  describe(cur())))
+    return false;
+  if (!expect(Token::Dot, "after array " + quoted(item.array.name) + " in a limit") ||
+      !parseIdent(item.quantity, "expected a property or 'speed' after '" + item.array.name +
+                                     ".' in a limit"))
+    return false;
+  const std::string head = "limit '" + item.array.name + "." + item.quantity.name + "'";
+  while (atWord("warn") || atWord("stop")) {
+    const bool warn = atWord("warn");
+    auto& slot = warn ? item.warn : item.stop;
+    if (slot)
+      return error(cur().loc, std::string("'") + (warn ? "warn" : "stop") + "' is given twice in " +
+                                  head);
+    slot.emplace();
+    slot->loc = cur().loc;
+    advance();
+    if (!parseLimitBound(*slot, head + (warn ? " warn" : " stop"))) return false;
+  }
+  if (!item.warn && !item.stop)
+    return error(cur().loc, "expected 'warn' or 'stop' and a bound after " + head + ", found " +
+                                describe(cur()));
+  limits.items.push_back(std::move(item));
+  return expect(Token::Semi, "after " + head);
+}
+
+// '[' lo ',' hi ']'  |  '<=' hi  |  '>=' lo
+bool Parser::parseLimitBound(ast::LimitBound& bound, const std::string& head) {
+  if (consumeIf(Token::LBracket)) {
+    if (!(bound.lo = parseExpr())) return false;
+    if (!consumeIf(Token::Comma))
+      return error(cur().loc, "expected ',' between the ends of the interval of " + head +
+                                  ", found " + describe(cur()));
+    if (!(bound.hi = parseExpr())) return false;
+    if (!consumeIf(Token::RBracket))
+      return error(cur().loc, "expected ']' after the interval of " + head + ", found " +
+                                  describe(cur()));
+    return true;
+  }
+  if (consumeIf(Token::LessEq)) return static_cast<bool>(bound.hi = parseExpr());
+  if (consumeIf(Token::GreaterEq)) return static_cast<bool>(bound.lo = parseExpr());
+  return error(cur().loc, "expected '[lo, hi]', '<= hi' or '>= lo' after " + head + ", found " +
+                              describe(cur()));
+}
+
+bool Parser::parseGroupItem(std::vector<ast::GroupItem>& items, unsigned depth) {
+  if (atWord("group") && (lex_.peek().is(Token::LParen) || lex_.peek().is(Token::LBrace))) {
+    if (depth >= kMaxNesting)
+      return error(cur().loc, "groups nested too deeply (more than " +
+                                  llvm::Twine(kMaxNesting) + " levels)");
+    auto group = std::make_shared<ast::GroupDecl>();
+    group->loc = cur().loc;
+    advance();
+    if (consumeIf(Token::LParen) && !parseKwArgs(group->options)) return false;
+    items.push_back(ast::GroupItem{group, nullptr, nullptr});
+    return parseBlock("group", [&] { return parseGroupItem(group->items, depth + 1); });
+  }
+  if (atWhen()) {
+    std::vector<std::shared_ptr<ast::When<std::vector<ast::GroupItem>>>> whens;
+    bool ok = parseWhen<std::vector<ast::GroupItem>>(
+        whens, "an equations list", [&](std::vector<ast::GroupItem>& part) {
+          return parseGroupItem(part, depth + 1);
+        });
+    if (!whens.empty()) items.push_back(ast::GroupItem{nullptr, nullptr, whens.front()});
+    return ok;
+  }
+  if (!cur().is(Token::Identifier))
+    return error(cur().loc, "expected an equation instance 'Name(arg = value, ...);' or a group, "
+                            "found " + describe(cur()));
+  auto inst = std::make_shared<ast::EquationInstance>();
+  inst->equation = identOf(cur());
+  advance();
+  if (!expect(Token::LParen, "after equation " + quoted(inst->equation.name)) ||
+      !parseKwArgs(inst->args))
+    return false;
+  items.push_back(ast::GroupItem{nullptr, inst, nullptr});
+  return expect(Token::Semi, "after equation instance " + quoted(inst->equation.name));
+}
+
+bool Parser::parseKwArgs(std::vector<ast::KwArg>& args) {
+  if (consumeIf(Token::RParen)) return true;
+  do {
+    if (!cur().is(Token::Identifier))
+      return error(cur().loc, "expected an argument 'name = value', found " + describe(cur()));
+    if (!lex_.peek().is(Token::Assign))
+      return error(lex_.peek().loc, "expected '=' after argument name " + quoted(cur().text));
+    ast::KwArg arg;
+    arg.name = identOf(cur());
+    advance();
+    advance();  // '='
+    if (consumeIf(Token::LBracket)) {
+      arg.isList = true;
+      if (!parseNameList(arg.list, "the list of " + quoted(arg.name.name))) return false;
+    } else if (!(arg.value = parseExpr())) {
+      return false;
+    }
+    args.push_back(std::move(arg));
+  } while (consumeIf(Token::Comma));
+  if (!consumeIf(Token::RParen))
+    return error(cur().loc, "expected ',' or ')' after argument " + quoted(args.back().name.name) +
+                                ", found " + describe(cur()));
+  return true;
+}
+
+bool Parser::parseNameList(std::vector<ast::Ident>& names, const llvm::Twine& what) {
+  if (consumeIf(Token::RBracket)) return true;
+  do {
+    ast::Ident name;
+    if (!parseIdent(name, "expected an array name in " + what)) return false;
+    names.push_back(std::move(name));
+  } while (consumeIf(Token::Comma));
+  if (!consumeIf(Token::RBracket))
+    return error(cur().loc, "expected ',' or ']' in " + what + ", found " + describe(cur()));
+  return true;
+}
+}  // namespace sphc
