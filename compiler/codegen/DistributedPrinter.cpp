@@ -59,6 +59,7 @@ void ScenePrinter::distributedMembers() {
   if (mpi_) {
     out_ << "  sphc::mpi::Decomposition decomposition;  // this rank's region (Zoltan)\n";
     out_ << "  std::vector<sphc::ParticleArray> gathered;  // output: every rank's particles, rank 0\n";
+    out_ << "  std::vector<sphc::Limit> default_limits;  // the whole set-up's box (sanity.h)\n";
   }
 }
 
@@ -71,6 +72,7 @@ void ScenePrinter::distributedFunctions() {
     scene_ << "    sphc::mpi::init_decomposition(decomposition, DIM, \"" << d.method << "\");\n";
     scene_ << "    decomposition.rebalance_every = " << d.rebalanceEvery << ";\n";
     scene_ << "    decomposition.imbalance_limit = " << d.imbalanceLimit << ";\n";
+    scene_ << "    default_limits = sphc::bounding_box_limits(" << allArrays("") << ", DIM);\n";
     scene_ << "    sphc::mpi::distribute(decomposition, " << allArrays("") << ");\n";
     scene_ << "  }\n\n";
   } else if (globalIds_) {
@@ -98,6 +100,7 @@ void ScenePrinter::distributedMain() {
   out_ << "    std::vector<sphc::ParticleArray*> out;\n";
   out_ << "    for (sphc::ParticleArray& a : scene.gathered) out.push_back(&a);\n";
   out_ << "    return out;\n  };\n";
+  out_ << "  prog.default_limits = [] { return scene.default_limits; };\n";
 }
 
 }  // namespace sphc

@@ -719,7 +719,8 @@ class Simulation {
   void set_up_limits() {
     if (opt_.limits == "off") return;
     std::vector<Limit> limits = prog_.limits ? prog_.limits() : std::vector<Limit>{};
-    for (const Limit& box : bounding_box_limits(arrays_, prog_.dim)) {
+    for (const Limit& box : prog_.default_limits ? prog_.default_limits()
+                                                  : bounding_box_limits(arrays_, prog_.dim)) {
       const bool declared = std::any_of(limits.begin(), limits.end(), [&](const Limit& l) {
         return l.array == box.array && l.quantity == box.quantity;
       });

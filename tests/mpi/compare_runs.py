@@ -6,7 +6,7 @@
 Both directories hold the HDF5 files of a run (scene_NNNNNN.h5) written with global ids
 (`sphc --global-ids`, implied by `--mpi`). Every file of the reference must exist in the other
 run (every output time); in each, every array must have the same particles (the same set of
-gid) and every property of the reference must agree within T times that property's scale
+gid) and every property (and constant) of the reference must agree within T times that property's scale
 (the largest |value| of the reference's property in that file, at least 1e-300). Prints the
 worst difference per property over all files and exits 1 if any exceeds T or anything is
 missing.
@@ -29,6 +29,9 @@ def arrays(path):
                 continue
             props = g["arrays"] if "arrays" in g else g
             out[name] = {k: np.array(props[k]) for k in props if isinstance(props[k], h5py.Dataset)}
+            if "constants" in g:  # per-array constants (reductions), as attributes
+                for k, v in g["constants"].attrs.items():
+                    out[name]["const:" + k] = np.array(v)
     return out
 
 
@@ -66,8 +69,11 @@ def main():
                 if prop not in op:
                     print(f"compare_runs: {fo}: {name}.{prop} missing")
                     return 1
-                a = rv[ri].astype(float)
-                b = op[prop][oi].astype(float)
+                if prop.startswith("const:"):  # one value per array, not per particle
+                    a, b = rv.astype(float), op[prop].astype(float)
+                else:
+                    a = rv[ri].astype(float)
+                    b = op[prop][oi].astype(float)
                 scale = max(np.max(np.abs(a)) if a.size else 0.0, 1e-300)
                 d = float(np.max(np.abs(a - b)) / scale) if a.size else 0.0
                 key = f"{name}.{prop}"

@@ -106,6 +106,9 @@ struct SceneProgram {
   // The arrays an output writes, when they are not `arrays` (distributed: every rank's
   // particles gathered to rank 0). Called on every rank at each output (collective).
   std::function<std::vector<ParticleArray*>()> output_arrays;
+  // The default box limits (sanity.h), when not those of `arrays` after the set-up
+  // (distributed: the box of the whole set-up, taken before each rank kept its particles).
+  std::function<std::vector<Limit>()> default_limits;
 };
 
 // Seconds on a steady clock (for the scene's own timers, e.g. neighbour_seconds).
