@@ -92,6 +92,16 @@ std::string ScenePrinter::afterSetupDistributed() const {
   return "";
 }
 
+std::string ScenePrinter::distributedReport() const {
+  std::string halos, arrays;
+  for (const auto& S : sourceArrays_) {
+    halos += (halos.empty() ? "&scene.ghosts_" : ", &scene.ghosts_") + S;
+    arrays += (arrays.empty() ? "&scene." : ", &scene.") + S;
+  }
+  return "  sphc::mpi::report_stats(scene.decomposition, {" + arrays + "}, {" + halos +
+         "});  // SPHC_MPI_STATS=1\n";
+}
+
 void ScenePrinter::distributedMain() {
   if (!mpi_) return;
   out_ << "  prog.rank = sphc::mpi::rank();  // rank 0 writes the files and the progress line\n";

@@ -522,9 +522,12 @@ void ScenePrinter::emitMain() {
     out_ << "}});\n";
   }
   distributedMain();
-  out_ << (mpi_ ? "  // A rank that fails ends the whole job (MPI_Abort), so none waits forever.\n"
-                  "  return sphc::mpi::finish(sphc::run_main(argc, argv, prog));\n}\n"
-                : "  return sphc::run_main(argc, argv, prog);\n}\n");
+  if (mpi_)
+    out_ << "  const int rc = sphc::run_main(argc, argv, prog);\n" << distributedReport()
+         << "  // A rank that fails ends the whole job (MPI_Abort), so none waits forever.\n"
+            "  return sphc::mpi::finish(rc);\n}\n";
+  else
+    out_ << "  return sphc::run_main(argc, argv, prog);\n}\n";
 }
 
 std::string ScenePrinter::run() {

@@ -165,6 +165,7 @@ class ScenePrinter {
   // In main: after the set-up (distribute or number), the MPI session, SceneProgram fields.
   std::string afterSetupDistributed() const;
   void distributedMain();
+  std::string distributedReport() const;  // after run_main: halo volumes (SPHC_MPI_STATS)
   // The array list `{&a, &b}` of every array (prefix: "" inside Scene, "scene." in main).
   std::string allArrays(const std::string& prefix) const;
 

@@ -4,7 +4,10 @@
 #include <mpi.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <string>
 
 #include "sphc/mpi/comm.h"
 
@@ -161,6 +164,28 @@ void refresh_halo(const Domain& d, ParticleArray& a, Halo& h, const std::vector<
 void remove_halo(ParticleArray& a, Halo& h) {
   grow_storage(a, a.n);
   h.count = 0;
+}
+
+void report_stats(const Decomposition& dec, const std::vector<const ParticleArray*>& arrays,
+                  const std::vector<const Halo*>& halos) {
+  if (!std::getenv("SPHC_MPI_STATS")) return;
+  std::size_t bytes = 0;
+  std::string sizes;
+  for (std::size_t k = 0; k < halos.size(); ++k) {
+    bytes += halos[k]->bytes_sent;
+    std::size_t last = 0;
+    for (int c : halos[k]->recv_count) last += static_cast<std::size_t>(c);
+    sizes += " halo_" + (k < arrays.size() ? arrays[k]->name : std::to_string(k)) + "=" +
+             std::to_string(last);
+  }
+  std::size_t n = 0;
+  for (const ParticleArray* a : arrays) n += a->n;
+  std::fprintf(stderr,
+               "mpi: rank=%d ranks=%d particles=%zu evaluations=%ld rebalances=%ld migrated=%ld "
+               "halo_bytes=%zu halo_bytes_per_evaluation=%.0f%s\n",
+               rank(), size(), n, dec.evaluations, dec.rebalances, dec.migrated, bytes,
+               dec.evaluations ? static_cast<double>(bytes) / dec.evaluations : 0.0,
+               sizes.c_str());
 }
 
 double global_cutoff(const std::vector<const ParticleArray*>& arrays, double radius_scale) {

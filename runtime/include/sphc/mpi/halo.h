@@ -55,6 +55,13 @@ void refresh_halo(const Domain& d, ParticleArray& a, Halo& h, const std::vector<
 // Storage back to a.n particles.
 void remove_halo(ParticleArray& a, Halo& h);
 
+// With SPHC_MPI_STATS set in the environment, prints one line per rank to stderr: evaluations,
+// re-balances, particles migrated away, halo bytes sent (all exchanges and refreshes) in
+// total and per evaluation, the latest halo size per array. Not collective (a measurement
+// for docs/scaling.md; generated main calls it after the run).
+void report_stats(const Decomposition& dec, const std::vector<const ParticleArray*>& arrays,
+                  const std::vector<const Halo*>& halos);
+
 // The search domain of the real particles and halos of `arrays` (positions over n + halo),
 // cells of cutoff = radius_scale * the largest h of any rank: the same cell size everywhere.
 // Collective (the h maximum).
