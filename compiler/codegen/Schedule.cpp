@@ -203,6 +203,10 @@ DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vect
     r.combine = r.op == "sum" || r.op == "mean" ? LoopOrder::Serial : LoopOrder::Parallel;
     w.reductions.push_back(r);
   }
+  // --mpi: a `real = false` phase with neighbour loops runs on the real particles only and
+  // the halo then receives the owners' values (a refresh): halo particles at a rank cut lack
+  // the neighbours beyond it. Per-particle phases still run on the halo (same values).
+  if (w.onGhosts && plan_.distributed && !w.passes.empty()) w.onGhosts = false;
   if (!w.onGhosts) w.ghostRefresh = ghostRefresh(d, w.equations);
   return w;
 }
