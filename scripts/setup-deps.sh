@@ -15,6 +15,9 @@ PACKAGES=(
   # the validation checks' plots (PNG, matplotlib's Agg backend; a check without it still runs)
   python3-matplotlib
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo  # --backend=opencl (PoCL: CPU)
+  # sphc --mpi: Open MPI, Zoltan (domain decomposition), parallel HDF5 (optional: the build
+  # without them has no --mpi and runs every other test)
+  libopenmpi-dev openmpi-bin libtrilinos-zoltan-dev libhdf5-openmpi-dev
 )
 
 missing=()
@@ -31,3 +34,8 @@ echo "setup-deps: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# libhdf5-openmpi-dev makes pkg-config's hdf5.pc the MPI one; the solvers link the serial
+# library (CMake's FindHDF5 through h5cc), so keep pkg-config saying the same.
+if [ -e /usr/lib/x86_64-linux-gnu/pkgconfig/hdf5-serial.pc ]; then
+  $SUDO update-alternatives --quiet --set hdf5.pc /usr/lib/x86_64-linux-gnu/pkgconfig/hdf5-serial.pc || true
+fi

@@ -63,7 +63,8 @@ void collect(const Plan& plan, const PlanGroup& g, std::vector<std::set<std::str
 
 bool selectGhostProperties(Plan& plan, DiagnosticEngine&) {
   for (auto& a : plan.arrays) a.ghostProps.clear();
-  if (!plan.domain.any()) return true;
+  // --mpi: the halo of remote particles carries the same, with or without a domain.
+  if (!plan.domain.any() && !plan.distributed) return true;
   std::vector<std::set<std::string>> carry(plan.arrays.size());
   std::vector<bool> isSource(plan.arrays.size(), false);
   collect(plan, plan.root, carry, isSource);

@@ -27,6 +27,8 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
              false,      false,          true,            plan_.sceneName + ".cl"};
   for (int a : sched.cellLists) sourceArrays_.push_back(arr(a).name);
   for (int a : sched.searchArrays) loopArrays_.insert(arr(a).name);
+  mpi_ = sched.distribution.enabled;
+  globalIds_ = opts.globalIds || mpi_;
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {

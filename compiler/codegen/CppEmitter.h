@@ -23,6 +23,9 @@ const char* backendName(Backend b);
 struct EmitOptions {
   Backend backend = Backend::Serial;
   Precision precision = Precision::Double;
+  // Every particle gets a global id `gid` (its set-up index), written with the output, so runs
+  // can be compared particle by particle (--global-ids; always with --mpi).
+  bool globalIds = false;
 };
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.

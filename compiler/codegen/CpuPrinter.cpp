@@ -27,7 +27,7 @@ class CpuPrinter : public ScenePrinter {
     if (openmp_) out_ << "\n#include <omp.h>\n";
   }
   void searchMembers() override;
-  std::string ghostsType() const override { return "sphc::Ghosts"; }
+  std::string ghostsType() const override { return mpi_ ? "sphc::mpi::Halo" : "sphc::Ghosts"; }
   void extraMembers() override {
     if (openmp_)
       out_ << "  std::vector<" << real_ << "> reduce_scratch;  // reduce sum/mean, OpenMP\n";
@@ -266,7 +266,7 @@ void CpuPrinter::reduction(const DestinationWork& w, const Reduction& r) {
     scene_ << loopHead;
     scene_ << "          values[d_idx] = " << value << ";\n";
     scene_ << loopHead << "          acc += values[d_idx];\n";
-    if (pd.reduceOp == "mean")
+    if (pd.reduceOp == "mean" && !mpi_)
       scene_ << "        acc = " << nReal << " > 0 ? acc / " << nReal << " : 0.0;\n";
   } else {
     scene_ << parallelFor("        ", LoopOrder::Parallel,
@@ -275,9 +275,10 @@ void CpuPrinter::reduction(const DestinationWork& w, const Reduction& r) {
            << (onGhosts ? "  // real particles only" : "") << "\n";
     scene_ << "          const " << real_ << " v = " << value << ";\n          " << combine
            << ";\n        }\n";
-    if (pd.reduceOp == "mean")
+    if (pd.reduceOp == "mean" && !mpi_)
       scene_ << "        acc = " << nReal << " > 0 ? acc / " << nReal << " : 0.0;\n";
   }
+  if (mpi_) scene_ << globalReduction(pd.reduceOp, nReal);  // every rank's particles
   scene_ << "        " << propPtr(d, pd.reduceTarget) << "[0] = acc;\n      }\n";
 }
 
@@ -289,7 +290,8 @@ void CpuPrinter::ghostRefresh(const DestinationWork& w) {
   if (refresh.empty()) return;
   scene_ << "      // ghosts follow:";
   for (const auto& p : refresh) scene_ << " " << p;
-  scene_ << "\n      sphc::refresh_ghosts(box, " << hostData(d) << ", ghosts_" << D << ", "
+  scene_ << (mpi_ ? "\n      sphc::mpi::refresh_halo(box, " : "\n      sphc::refresh_ghosts(box, ")
+         << hostData(d) << ", ghosts_" << D << ", "
            << propIndexList(d, refresh) << ");\n";
 }
 
@@ -378,6 +380,7 @@ std::string CpuPrinter::cellListBuild(const std::string& S, const std::string& c
 // real particles, the cell-order permutation (of real particles), then the ghosts of every
 // source array, and the cell lists over real particles and ghosts.
 void CpuPrinter::updateNeighboursWithGhosts() {
+  if (mpi_) emitMigration();  // --mpi: particles that left this rank's region go first
   searchDomain();
   if (sourceArrays_.empty()) return;
   scene_ << "    // Every REORDER_EVERY builds the real particles are sorted in cell order.\n";
@@ -387,16 +390,20 @@ void CpuPrinter::updateNeighboursWithGhosts() {
       scene_ << "      " << cellListBuild(S, S + ".n") << "\n      " << permuteInCellOrder(S)
              << "\n";
   scene_ << "    }\n";
-  scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
-  scene_ << "    const double cutoff = domain.cell_size;\n";
-  for (const auto& S : sourceArrays_) {
-    int s = plan_.arrayIndex(S);
-    scene_ << "    sphc::add_ghosts(box, " << hostData(s) << ", cutoff, ghosts_" << S << ", "
-           << propIndexList(s, arr(s).ghostProps) << ");  //";
-    for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
-    scene_ << "\n";
+  if (mpi_) {
+    emitHaloExchange();  // --mpi: remote particles and images replace the ghosts
+  } else {
+    scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
+    scene_ << "    const double cutoff = domain.cell_size;\n";
+    for (const auto& S : sourceArrays_) {
+      int s = plan_.arrayIndex(S);
+      scene_ << "    sphc::add_ghosts(box, " << hostData(s) << ", cutoff, ghosts_" << S << ", "
+             << propIndexList(s, arr(s).ghostProps) << ");  //";
+      for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
+      scene_ << "\n";
+    }
+    scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
   }
-  scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
   for (const auto& S : sourceArrays_)
     scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
 }
@@ -404,7 +411,7 @@ void CpuPrinter::updateNeighboursWithGhosts() {
 std::string CpuPrinter::removeGhosts() const {
   std::string r;
   for (const auto& S : sourceArrays_)
-    r += "    sphc::remove_ghosts(" + hostData(plan_.arrayIndex(S)) + ", ghosts_" + S + ");\n";
+    r += std::string(mpi_ ? "    sphc::mpi::remove_halo(" : "    sphc::remove_ghosts(") + hostData(plan_.arrayIndex(S)) + ", ghosts_" + S + ");\n";
   return r;
 }
 

@@ -176,7 +176,7 @@ void ScenePrinter::emitSetup() {
     }
   }
   for (int a : sched_.setupArrays) emitArraySetup(arr(a));
-  if (hasDomain()) emitDomainSetup();
+  if (plan_.domain.any()) emitDomainSetup();
   if (hasZones()) emitZoneSetup();
   auto pn = [&](const std::string& n) { return paramRef(n); };
   scene_ << "    times.tf = " << exprCpp(*plan_.tf, pn) << ";\n";
@@ -254,6 +254,7 @@ void ScenePrinter::emitIteration(const ScheduleGroup& sg) {
   scene_ << "      const bool run_tests = iteration >= " << g.minIterations << ";\n";
   scene_ << "      converged = run_tests;\n";
   for (const auto* eq : sg.convergers) emitConverged(*eq);
+  if (mpi_) scene_ << "      converged = sphc::mpi::all(converged);  // the same on every rank\n";
   scene_ << "      if (converged && iteration >= " << g.minIterations << ") break;\n";
   scene_ << "      if (iteration >= " << g.maxIterations << ") break;\n";
   scene_ << "    }\n";
@@ -494,6 +495,7 @@ void ScenePrinter::emitLimits() {
 void ScenePrinter::emitMain() {
   out_ << "int main(int argc, char** argv) {\n";
   mainPrologue();
+  if (mpi_) out_ << "  sphc::mpi::Session mpi_session(&argc, &argv);  // MPI_Init, MPI_Finalize\n";
   out_ << "  static Scene scene;\n";
   out_ << "  sphc::SceneProgram prog;\n";
   out_ << "  prog.name = \"" << plan_.sceneName << "\";\n";
@@ -537,7 +539,7 @@ void ScenePrinter::emitMain() {
   if (singlePrecision_) out_ << "  prog.precision = \"single\";\n";
   out_ << "  prog.setup = [](const std::vector<double>& v, sphc::SceneTimes& times) {\n"
           "    scene.setup(v, times);\n"
-       << afterSetup() << "  };\n";
+       << afterSetupDistributed() << afterSetup() << "  };\n";
   out_ << "  prog.arrays = [] { return std::vector<sphc::ParticleArray*>{";
   bool first = true;
   for (const auto& a : plan_.arrays) {
@@ -551,7 +553,9 @@ void ScenePrinter::emitMain() {
   // writes output or checks for a blow-up.
   // --precision=single on the CPU: likewise for the float copies.
   if (hasToHost()) out_ << "  prog.to_host = [] { scene.to_host(); };\n";
-  if (plan_.adaptiveDt) out_ << "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n";
+  if (plan_.adaptiveDt)
+    out_ << (mpi_ ? "  prog.adaptive_dt = [] { return sphc::mpi::min(scene.adaptive_dt()); };  // every rank's\n"
+                  : "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n");
   if (!sched_.iteratedGroups.empty())
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   if (timesNeighbourSearch()) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
@@ -569,11 +573,18 @@ void ScenePrinter::emitMain() {
       out_ << (firstProp ? "" : ", ") << "\"" << p << "\"";
       firstProp = false;
     }
-    // Arrays that grow and shrink: every output carries the global ids.
-    if (hasZones() && !firstProp) out_ << ", \"gid\"";
+    // Global ids: arrays that grow and shrink, and --global-ids / --mpi runs (an empty
+    // list writes every property, gid included).
+    if ((hasZones() || globalIds_) && !firstProp) out_ << ", \"gid\"";
     out_ << "}});\n";
   }
-  out_ << "  return sphc::run_main(argc, argv, prog);\n}\n";
+  distributedMain();
+  if (mpi_)
+    out_ << "  const int rc = sphc::run_main(argc, argv, prog);\n" << distributedReport()
+         << "  // A rank that fails ends the whole job (MPI_Abort), so none waits forever.\n"
+            "  return sphc::mpi::finish(rc);\n}\n";
+  else
+    out_ << "  return sphc::run_main(argc, argv, prog);\n}\n";
 }
 
 std::string ScenePrinter::run() {
@@ -592,6 +603,9 @@ std::string ScenePrinter::run() {
   if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
   if (!plan_.metrics.empty()) out_ << "#include \"sphc/metrics.h\"\n";
   if (hasZones()) out_ << "#include \"sphc/inlet_outlet.h\"\n";
+  if (mpi_)
+    out_ << "#include \"sphc/mpi/comm.h\"\n#include \"sphc/mpi/decomposition.h\"\n"
+            "#include \"sphc/mpi/gather.h\"\n#include \"sphc/mpi/halo.h\"\n";
   runtimeIncludes();
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   systemIncludes();
@@ -668,6 +682,7 @@ void ScenePrinter::emitSceneFunctions() {
   if (hasZones()) emitInletOutlet();
   emitAdaptiveDt();
   emitMetrics();
+  distributedFunctions();
 }
 
 
@@ -689,6 +704,7 @@ void ScenePrinter::emitSceneMembers() {
   if (hasZones())
     out_ << "  sphc::InletOutlet io;  // inlets and outlets (sphc/inlet_outlet.h)\n"
             "  double io_seconds = 0.0;  // in inlet_outlet, for --timing\n";
+  distributedMembers();
   // Iterations per evaluation of each iterated group (--timing prints them).
   out_ << "  std::vector<sphc::IterationStats> iteration_stats{";
   for (std::size_t k = 0; k < sched_.iteratedGroups.size(); ++k)

@@ -179,6 +179,24 @@ class ScenePrinter {
   // The Scene member inlet_outlet(t), the schedule's InletOutlet statement.
   void emitInletOutlet();
 
+  // ---- Distributed runs, sphc --mpi (DistributedPrinter.cpp) ----
+  // update_neighbours' first statement: migration (and re-balancing when due).
+  void emitMigration();
+  // The halo exchange of every source array and the search domain over real + halo particles
+  // (after the cell-order permutation of the real particles; `all` is in scope).
+  void emitHaloExchange();
+  // Lines that combine a reduction's `acc` (over nReal local particles) over every rank.
+  std::string globalReduction(const std::string& op, const std::string& nReal) const;
+  // Members of struct Scene (decomposition, gathered output) and its distribute()/number().
+  void distributedMembers();
+  void distributedFunctions();
+  // In main: after the set-up (distribute or number), the MPI session, SceneProgram fields.
+  std::string afterSetupDistributed() const;
+  void distributedMain();
+  std::string distributedReport() const;  // after run_main: halo volumes (SPHC_MPI_STATS)
+  // The array list `{&a, &b}` of every array (prefix: "" inside Scene, "scene." in main).
+  std::string allArrays(const std::string& prefix) const;
+
   // ---- Shared helpers ----
   // The data a scene computes on: host arrays, or their float copies (--precision=single).
   std::string propPtr(int array, const std::string& prop) const;
@@ -230,6 +248,8 @@ class ScenePrinter {
   // (double) serve set-up and, after to_host(), output.
   bool cpuSingle_ = false;
   std::string real_ = "double";  // the C++ floating type the scene computes in
+  bool mpi_ = false;        // sphc --mpi (the schedule's Distribution)
+  bool globalIds_ = false;  // particles carry gid (--global-ids, --mpi)
   Dialect host_, device_;
   std::ostringstream out_;    // the file
   std::ostringstream scene_;  // members of struct Scene

@@ -1,4 +1,5 @@
 #include "codegen/Schedule.h"
+#include "codegen/ScheduleDistribution.h"
 
 #include "analysis/Access.h"
 #include "analysis/PairQuantityTable.h"
@@ -35,7 +36,7 @@ class ScheduleBuilder {
     return with;
   }
   bool hasGhosts(int a) const {
-    return plan_.domain.any() && !plan_.arrays[a].ghostProps.empty();
+    return (plan_.domain.any() || plan_.distributed) && !plan_.arrays[a].ghostProps.empty();
   }
   void group(const PlanGroup& g, const std::string& name, ScheduleGroup& out);
   Phase phase(const PlanGroup& g, const std::vector<int>& eqIds, const std::string& name);
@@ -69,7 +70,8 @@ class ScheduleBuilder {
 std::unique_ptr<Schedule> ScheduleBuilder::run() {
   s_ = std::make_unique<Schedule>();
   s_->plan = &plan_;
-  s_->domain = plan_.domain.any();
+  // --mpi: halos take the ghosts' place (the same code paths), with or without a domain.
+  s_->domain = plan_.domain.any() || plan_.distributed;
   // Arrays are made in declaration order (each from its own geometry and files; initial
   // values read params only, so no array waits for another).
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) s_->setupArrays.push_back(a);
@@ -86,6 +88,7 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
     if (loopNames_.count(plan_.arrays[a].name)) s_->searchArrays.push_back(a);
   step();
   adaptiveDt();
+  s_->distribution = distributionOf(plan_, s_->cellLists);
   return std::move(s_);
 }
 
@@ -206,6 +209,10 @@ DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vect
     w.reductions.push_back(r);
   }
   w.hostReduce = withMethod(w.equations, ast::Method::HostReduce);
+  // --mpi: a `real = false` phase with neighbour loops runs on the real particles only and
+  // the halo then receives the owners' values (a refresh): halo particles at a rank cut lack
+  // the neighbours beyond it. Per-particle phases still run on the halo (same values).
+  if (w.onGhosts && plan_.distributed && !w.passes.empty()) w.onGhosts = false;
   if (!w.onGhosts) w.ghostRefresh = ghostRefresh(d, w.equations);
   return w;
 }
@@ -397,7 +404,7 @@ void SchedulePrinter::print() {
     os_ << " " << name(a) << " (" << decl->geometry.size() << " geometry, " << decl->loads.size()
         << " files)";
   }
-  os_ << (s_.domain ? ", domain" : "") << "\n";
+  os_ << (p_.domain.any() ? ", domain" : "") << "\n";
   os_ << "neighbour search:";
   if (s_.searchArrays.empty()) os_ << " none";
   os_ << "\n";
@@ -412,7 +419,7 @@ void SchedulePrinter::print() {
       for (int a : s_.keepOrder) os_ << " " << name(a);
       os_ << "\n";
     }
-    if (s_.domain)
+    if (s_.domain && !s_.distribution.enabled)  // distributed: the halo lines below
       for (int a : s_.cellLists) {
         os_ << "  ghosts of " << name(a) << " carry:";
         for (const auto& p : p_.arrays[a].ghostProps) os_ << " " << p;
@@ -420,8 +427,10 @@ void SchedulePrinter::print() {
       }
   }
   os_ << "evaluation (compute_accelerations):"
-      << (s_.domain ? " update_domain, update_neighbours, equations, remove ghosts"
-                    : " update_neighbours, equations")
+      << (s_.distribution.enabled
+              ? " update_domain, update_neighbours (migrate, halo exchange), equations, remove halo"
+          : s_.domain ? " update_domain, update_neighbours, equations, remove ghosts"
+                      : " update_neighbours, equations")
       << "\n";
   group(s_.equations, 1);
   if (!s_.postStep.empty()) {
@@ -436,7 +445,7 @@ void SchedulePrinter::print() {
     if (st.kind == StepStatement::ComputeAccelerations) {
       os_ << "  compute_accelerations at " << time(st.stagesDone[0]) << "\n";
     } else if (st.kind == StepStatement::UpdateDomain) {
-      os_ << "  update_domain" << (s_.domain ? "" : " (no periodic or mirror domain: nothing)")
+      os_ << "  update_domain" << (p_.domain.any() ? "" : " (no periodic or mirror domain: nothing)")
           << "\n";
     } else if (st.kind == StepStatement::InletOutlet) {
       os_ << "  inlet_outlet at " << time(st.stagesDone[0]) << " [serial, on the host]:";
@@ -471,8 +480,10 @@ void SchedulePrinter::print() {
     os_ << " over";
     for (int i : a.arrays) os_ << " " << name(i);
     if (a.arrays.empty()) os_ << " no moving array";
-    os_ << "\n";
+    os_ << (s_.distribution.enabled ? ", then the minimum over all ranks (MPI_Allreduce)" : "")
+        << "\n";
   }
+  printDistribution(s_, os_);
 }
 
 void SchedulePrinter::group(const ScheduleGroup& g, int indent) {
@@ -487,7 +498,8 @@ void SchedulePrinter::group(const ScheduleGroup& g, int indent) {
   if (pg.iterate) {
     os_ << pad << "  iterated " << pg.minIterations << ".." << pg.maxIterations
         << " times (statistics " << g.statsIndex << "), converged when: "
-        << (g.convergers.empty() ? "always" : eqList(g.convergers)) << "\n";
+        << (g.convergers.empty() ? "always" : eqList(g.convergers))
+        << (s_.distribution.enabled ? " (on every rank: MPI_Allreduce)" : "") << "\n";
   }
   for (const auto& m : g.members) {
     if (m.isPhase)
@@ -541,9 +553,10 @@ void SchedulePrinter::phase(const Phase& ph, int indent) {
     for (const auto& r : w.reductions)
       os_ << pad << "    reduce " << r.op << " into " << name(w.array) << "." << r.target
           << " [values parallel, combined " << order(r.combine) << "]: " << eqName(r.equation)
-          << (w.onGhosts ? " (real particles only)" : "") << "\n";
+          << (w.onGhosts ? " (real particles only)" : "")
+          << (s_.distribution.enabled ? ", then over all ranks (MPI_Allreduce)" : "") << "\n";
     if (!w.ghostRefresh.empty()) {
-      os_ << pad << "    refresh ghosts:";
+      os_ << pad << (s_.distribution.enabled ? "    refresh halo:" : "    refresh ghosts:");
       for (const auto& p : w.ghostRefresh) os_ << " " << p;
       os_ << "\n";
     }

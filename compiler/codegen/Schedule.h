@@ -158,8 +158,26 @@ struct AdaptiveDt {
   LoopOrder order = LoopOrder::Parallel;  // a min reduction: any order
 };
 
+// sphc --mpi: how the scene runs on several ranks (runtime/include/sphc/mpi/). Each
+// evaluation's neighbour update starts with `migrate` (particles that left their rank's
+// region go to its owner, every property; a re-balance every `rebalanceEvery` evaluations or
+// when the imbalance passes `imbalanceLimit`), then a halo exchange per source array (remote
+// particles and periodic/mirror images within the interaction radius, carrying `halo`: the
+// ghost pass's properties) replaces the ghosts; a ghost refresh becomes a halo refresh;
+// reductions, the adaptive dt and the convergence of iterated groups are global
+// (MPI_Allreduce); output is gathered to rank 0 in global-id order.
+struct Distribution {
+  bool enabled = false;
+  std::string method = "RCB";        // Zoltan's LB_METHOD
+  long rebalanceEvery = 100;         // evaluations
+  double imbalanceLimit = 1.1;       // largest rank's particles / mean
+  std::vector<int> migrate;          // every array (all properties move)
+  std::vector<std::pair<int, std::vector<std::string>>> halo;  // source array, properties sent
+};
+
 struct Schedule {
   const Plan* plan = nullptr;
+  Distribution distribution;
   // Set-up, in order: parameters (declaration order), equation constants, then each array
   // (geometry, files, properties, initial values) in `setupArrays` order, then the domain.
   std::vector<int> setupArrays;

@@ -98,6 +98,12 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
                                                 : std::string("-DCL_TARGET_OPENCL_VERSION=120"));
     libs += " " + info["opencl_libs"];
   }
+  // --mpi: libsphc_mpi (before the runtime it uses), MPI and Zoltan.
+  const std::string mpiLib = install.libDir + "/libsphc_mpi.a";
+  if (req.mpi) {
+    flags += " " + info["mpi_flags"];
+    libs = info["mpi_libs"] + " " + libs;
+  }
 
   // The key: generated code, compiler, flags, libraries, the runtime library and headers.
   llvm::SHA1 sha;
@@ -111,6 +117,12 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
     headers.push_back(it->path());
   std::sort(headers.begin(), headers.end());
   for (const auto& hdr : headers) addFileToHash(sha, hdr);
+  if (req.mpi) {
+    addFileToHash(sha, mpiLib);
+    for (fs::directory_iterator it(install.includeDir + "/sphc/mpi", ec), end; it != end && !ec;
+         it.increment(ec))
+      addFileToHash(sha, it->path());
+  }
   std::string key = llvm::toHex(sha.final()).substr(0, 24);
 
   llvm::SmallString<256> dir(cacheDirectory());
@@ -166,6 +178,7 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   for (auto p : parts) args.push_back(p.str());
   args.push_back("-I" + install.includeDir);
   args.push_back(cppFile);
+  if (req.mpi) args.push_back(mpiLib);
   args.push_back(runtimeLib);
   parts.clear();
   llvm::StringRef(libs).split(parts, ' ', -1, false);
@@ -198,6 +211,25 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   fs::rename(cppFile, std::string(dir) + "/scene.cpp");
   fs::remove(logFile);
   return deliver();
+}
+
+bool mpiAvailable(const Install& install, std::string& why) {
+  std::string err;
+  auto info = readBuildInfo(install.buildInfo, err);
+  if (!err.empty()) {
+    why = err;
+    return false;
+  }
+  if (info["mpi_libs"].empty()) {
+    why = "CMake did not find MPI and Zoltan when sphc was built (scripts/setup-deps.sh "
+          "installs them: libopenmpi-dev openmpi-bin libtrilinos-zoltan-dev; then reconfigure)";
+    return false;
+  }
+  if (!fs::exists(install.libDir + "/libsphc_mpi.a")) {
+    why = "the MPI runtime library '" + install.libDir + "/libsphc_mpi.a' is missing";
+    return false;
+  }
+  return true;
 }
 
 bool openclAvailable(const Install& install, std::string& why) {

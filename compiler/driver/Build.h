@@ -22,6 +22,7 @@ struct BuildRequest {
   std::string cxx;          // override of the C++ compiler ("" = from buildinfo)
   std::string cxxflags;     // override of the flags ("" = from buildinfo)
   std::string backend = "serial";  // serial, openmp or opencl: which runtime and flags
+  bool mpi = false;         // --mpi: link libsphc_mpi, MPI and Zoltan
   bool useCache = true;
   bool verbose = false;
 };
@@ -38,6 +39,10 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req);
 // Whether solvers of --backend=opencl can be built (CMake found OpenCL: buildinfo.txt has a
 // non-empty opencl_libs and lib/libsphc_runtime_ocl.a exists); else false and why.
 bool openclAvailable(const Install& install, std::string& why);
+
+// Whether solvers of --mpi can be built (CMake found MPI and Zoltan: buildinfo.txt has a
+// non-empty mpi_libs and lib/libsphc_mpi.a exists); else false and why.
+bool mpiAvailable(const Install& install, std::string& why);
 
 // The cache directory: $SPHC_CACHE_DIR, else $XDG_CACHE_HOME/sphc, else ~/.cache/sphc.
 std::string cacheDirectory();

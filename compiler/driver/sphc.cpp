@@ -110,6 +110,13 @@ static cl::opt<bool> NoCache("no-cache", cl::desc("Always rebuild, ignoring the 
                              cl::cat(SphcCat));
 static cl::opt<bool> WarningsAsErrors("Werror", cl::desc("Treat warnings as errors"),
                                       cl::cat(SphcCat));
+static cl::opt<bool> Mpi("mpi", cl::desc("Build a distributed solver (MPI; run it with mpirun -np N): "
+                                         "domain decomposition, migration, halo exchange"),
+                         cl::cat(SphcCat));
+static cl::opt<bool> GlobalIds("global-ids",
+                               cl::desc("Give every particle a global id `gid` (its set-up index), "
+                                        "written with the output (implied by --mpi)"),
+                               cl::cat(SphcCat));
 static cl::opt<bool> Verbose("v", cl::desc("Print the build command and timings"),
                              cl::cat(SphcCat));
 
@@ -141,6 +148,19 @@ int main(int argc, char** argv) {
     if (!openclAvailable(install, why)) {
       llvm::errs() << "sphc: error: --backend=opencl is not available in this build: " << why
                    << "\n";
+      return fail();
+    }
+  }
+  // --mpi: the CPU backends in double precision, and a build that found MPI and Zoltan.
+  if (Mpi && (Backend == sphc::Backend::OpenCL || PrecisionOpt == sphc::Precision::Single)) {
+    llvm::errs() << "sphc: error: --mpi works with --backend=serial or openmp in double "
+                    "precision (not with --backend=opencl or --precision=single yet)\n";
+    return fail();
+  }
+  if (Mpi && Emit == EmitKind::Exe) {
+    std::string why;
+    if (!mpiAvailable(install, why)) {
+      llvm::errs() << "sphc: error: --mpi is not available in this build: " << why << "\n";
       return fail();
     }
   }
@@ -179,6 +199,16 @@ int main(int argc, char** argv) {
       llvm::errs() << "sphc: error: --kernel: " << why << "\n";
       return fail();
     }
+  }
+  plan->distributed = Mpi;
+  // Not distributed yet: metrics (evaluated on each rank's own particles) and inlets/outlets
+  // (arrays that grow and shrink on one rank).
+  if (Mpi && (!plan->metrics.empty() || !plan->zones.empty())) {
+    diags.error(!plan->metrics.empty() ? plan->metrics.front().loc : plan->zones.front().loc,
+                std::string("--mpi does not support ") +
+                    (!plan->metrics.empty() ? "metrics { }" : "inlets and outlets") +
+                    " yet: build this scene without --mpi");
+    return fail();
   }
   auto dump = [&](Pass pass) {
     if (DumpAfter != pass) return false;
@@ -228,7 +258,7 @@ int main(int argc, char** argv) {
     printSchedule(*schedule, diags, llvm::outs());
     return 0;
   }
-  EmitOptions emitOpts{Backend, PrecisionOpt};
+  EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi};
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;
@@ -249,6 +279,7 @@ int main(int argc, char** argv) {
   req.cxx = Cxx;
   req.cxxflags = CxxFlags;
   req.backend = backendName(Backend);
+  req.mpi = Mpi;
   req.useCache = !NoCache;
   req.verbose = Verbose;
   BuildResult res = buildExecutable(install, req);

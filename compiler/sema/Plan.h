@@ -217,6 +217,9 @@ struct Plan {
   PlanGroup root;                             // the scene's equations { } as a group
   std::vector<std::string> notes;             // what the passes decided, for --report
   std::vector<ChosenOption> options;          // compile-time options (sema/Options.h)
+  // sphc --mpi: a distributed solver. Halos of remote particles play the ghosts' part, with or
+  // without a domain (analysis/Ghosts selects what they carry; codegen/Schedule the steps).
+  bool distributed = false;
 
   int arrayIndex(const std::string& name) const;
 };

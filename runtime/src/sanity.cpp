@@ -160,7 +160,9 @@ std::string describe_particle(const ParticleArray& a, std::size_t i, int dim,
   std::string pos;
   for (int k = 0; k < dim && k < 3; ++k) {
     const int idx = a.find(kAxes[k]);
-    const double x = idx >= 0 && a.props[idx].type == PropType::F64 ? a.f64(idx)[i] : 0.0;
+    // (i < n: an array may hold no particles, e.g. on one rank of a distributed run.)
+    const double x =
+        idx >= 0 && i < a.n && a.props[idx].type == PropType::F64 ? a.f64(idx)[i] : 0.0;
     pos += (k ? ", " : "") + number(x);
   }
   return fmt::format("particle {} of array '{}' at ({}) has {} = {}", i, a.name, pos, quantity,

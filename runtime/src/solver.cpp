@@ -567,7 +567,7 @@ class Simulation {
     set_up_limits();
     const std::string dir =
         opt_.directory.empty() ? scene_name(prog_) + "_output" : opt_.directory;
-    OutputWriter writer(prog_, dir, !opt_.no_output);
+    OutputWriter writer(prog_, dir, !opt_.no_output && prog_.rank <= 0);
     writer_ = &writer;
     open_metrics(dir);
 
@@ -587,7 +587,7 @@ class Simulation {
     metrics_clock_ = {loop_start, cpu_seconds()};
     nnps_start_ = prog_.neighbour_seconds ? prog_.neighbour_seconds() : 0.0;
     io_start_ = prog_.inlet_outlet_seconds ? prog_.inlet_outlet_seconds() : 0.0;
-    progress_.start(!opt_.quiet, tf);
+    progress_.start(!opt_.quiet && prog_.rank <= 0, tf);
     double particle_steps = 0;
     while (t_ < tf - slack && step_ < opt_.max_steps) {
       double dt = times.dt;
@@ -722,7 +722,7 @@ class Simulation {
   }
 
   void write_output() {
-    writer_->write(arrays_, meta());
+    writer_->write(prog_.output_arrays ? prog_.output_arrays() : arrays_, meta());
     last_output_step_ = step_;
     record_metrics();
   }
@@ -794,7 +794,8 @@ class Simulation {
   void set_up_limits() {
     if (opt_.limits == "off") return;
     std::vector<Limit> limits = prog_.limits ? prog_.limits() : std::vector<Limit>{};
-    for (const Limit& box : bounding_box_limits(arrays_, prog_.dim)) {
+    for (const Limit& box : prog_.default_limits ? prog_.default_limits()
+                                                  : bounding_box_limits(arrays_, prog_.dim)) {
       const bool declared = std::any_of(limits.begin(), limits.end(), [&](const Limit& l) {
         return l.array == box.array && l.quantity == box.quantity;
       });
@@ -924,7 +925,7 @@ class Simulation {
   void report(double wall_s, double particle_steps, double tf) {
     const double us = particle_steps > 0 ? wall_s * 1e6 / particle_steps : 0.0;
     progress_.break_line();
-    if (!opt_.quiet) {
+    if (!opt_.quiet && prog_.rank <= 0) {
       const char* why = step_ >= opt_.max_steps && t_ < tf ? " (--max-steps reached)" : "";
       fmt::print(stderr, "done: t={} after {} steps{}, {:.3g} s, {:.3g} us/particle/step\n", t_,
                  step_, why, wall_s, us);
@@ -954,9 +955,9 @@ class Simulation {
                                                                                  : "default");
       }
       fmt::print("timing: steps={} particles={} wall_s={:.6g} us_per_particle_step={:.6g} "
-                 "backend={} threads={}{} precision={}{}\n",
+                 "backend={} threads={}{} precision={}{}{}\n",
                  step_, particles(), wall_s, us, prog_.backend, threads_, wait, prog_.precision,
-                 nnps);
+                 nnps, prog_.rank >= 0 ? fmt::format(" rank={}", prog_.rank) : "");
       // Counted from the first evaluation, the one before the first step, included.
       if (prog_.iterations) {
         for (const IterationStats& s : prog_.iterations()) {

@@ -117,6 +117,16 @@ struct SceneProgram {
   std::function<std::vector<MetricValue>(double t)> evaluate_metrics;
   // Array name -> properties written (empty list = all); empty = every array, all properties.
   std::vector<std::pair<std::string, std::vector<std::string>>> output;
+  // Distributed runs (sphc --mpi, sphc/mpi/): this process's rank (-1: not distributed). Only
+  // rank 0 writes files and prints the progress line and the summary; the --timing lines of
+  // every rank name it (rank=R), so iteration counts can be compared between ranks.
+  int rank = -1;
+  // The arrays an output writes, when they are not `arrays` (distributed: every rank's
+  // particles gathered to rank 0). Called on every rank at each output (collective).
+  std::function<std::vector<ParticleArray*>()> output_arrays;
+  // The default box limits (sanity.h), when not those of `arrays` after the set-up
+  // (distributed: the box of the whole set-up, taken before each rank kept its particles).
+  std::function<std::vector<Limit>()> default_limits;
 };
 
 // Seconds on a steady clock (for the scene's own timers, e.g. neighbour_seconds).

@@ -1,0 +1,297 @@
+// sphc runtime, distributed runs: see sphc/mpi/decomposition.h.
+#include "sphc/mpi/decomposition.h"
+
+#include <mpi.h>
+#include <zoltan.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "sphc/mpi/comm.h"
+
+namespace sphc::mpi {
+
+namespace {
+
+// What Zoltan's callbacks see: every particle of every array, numbered in array order.
+struct Objects {
+  const std::vector<ParticleArray*>* arrays = nullptr;
+  int dim = 2;
+  unsigned long first = 0;  // global number of this rank's first object
+};
+
+std::size_t local_count(const std::vector<ParticleArray*>& arrays) {
+  std::size_t n = 0;
+  for (const ParticleArray* a : arrays) n += a->n;
+  return n;
+}
+
+int num_obj(void* data, int* ierr) {
+  *ierr = ZOLTAN_OK;
+  return static_cast<int>(local_count(*static_cast<Objects*>(data)->arrays));
+}
+
+void obj_list(void* data, int, int, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int, float*,
+              int* ierr) {
+  const Objects& o = *static_cast<Objects*>(data);
+  const std::size_t n = local_count(*o.arrays);
+  for (std::size_t i = 0; i < n; ++i) {
+    gids[i] = static_cast<ZOLTAN_ID_TYPE>(o.first + i);
+    lids[i] = static_cast<ZOLTAN_ID_TYPE>(i);
+  }
+  *ierr = ZOLTAN_OK;
+}
+
+int num_geom(void* data, int* ierr) {
+  *ierr = ZOLTAN_OK;
+  return static_cast<Objects*>(data)->dim;
+}
+
+void geom_multi(void* data, int, int, int num, ZOLTAN_ID_PTR, ZOLTAN_ID_PTR lids, int dim,
+                double* out, int* ierr) {
+  const Objects& o = *static_cast<Objects*>(data);
+  // Local ids run over the arrays in order: find each one's array by its offset.
+  for (int k = 0; k < num; ++k) {
+    std::size_t i = lids[k];
+    for (const ParticleArray* a : *o.arrays) {
+      if (i < a->n) {
+        static const char* names[3] = {"x", "y", "z"};
+        for (int c = 0; c < dim; ++c) {
+          const int p = a->find(names[c]);
+          out[k * dim + c] = p >= 0 ? a->props[p].f64[i] : 0.0;
+        }
+        break;
+      }
+      i -= a->n;
+    }
+  }
+  *ierr = ZOLTAN_OK;
+}
+
+void check(int rc, const char* what) {
+  if (rc != ZOLTAN_OK && rc != ZOLTAN_WARN)
+    abort_job(1, std::string("Zoltan failed in ") + what);
+}
+
+// The position of particle i as 3 doubles (0 beyond the array's axes).
+void position(const ParticleArray& a, const int pos[3], std::size_t i, double out[3]) {
+  for (int c = 0; c < 3; ++c) out[c] = pos[c] >= 0 ? a.props[pos[c]].f64[i] : 0.0;
+}
+
+void position_props(const ParticleArray& a, int dim, int pos[3]) {
+  static const char* names[3] = {"x", "y", "z"};
+  for (int c = 0; c < 3; ++c) pos[c] = c < dim ? a.find(names[c]) : -1;
+}
+
+}  // namespace
+
+Decomposition::~Decomposition() {
+  // A solver's Scene is static: after MPI_Finalize nothing may be freed through MPI.
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (zz && !finalized) Zoltan_Destroy(&zz);
+}
+
+bool inside_region(const Decomposition& d, const double lo[3], const double hi[3]) {
+  if (!d.has_region) return false;
+  for (int c = 0; c < d.dim; ++c)
+    if (!(lo[c] > d.region_lo[c] && hi[c] < d.region_hi[c])) return false;
+  return true;
+}
+
+void init_decomposition(Decomposition& d, int dim, const std::string& method) {
+  if (method != "RCB" && method != "HSFC")
+    throw std::invalid_argument("unknown decomposition method '" + method + "' (RCB or HSFC)");
+  float version = 0;
+  check(Zoltan_Initialize(0, nullptr, &version), "Zoltan_Initialize");
+  d.dim = dim;
+  d.method = method;
+  d.zz = Zoltan_Create(MPI_COMM_WORLD);
+  Zoltan_Set_Param(d.zz, "DEBUG_LEVEL", "0");
+  Zoltan_Set_Param(d.zz, "LB_METHOD", method.c_str());
+  Zoltan_Set_Param(d.zz, "NUM_GID_ENTRIES", "1");
+  Zoltan_Set_Param(d.zz, "NUM_LID_ENTRIES", "1");
+  Zoltan_Set_Param(d.zz, "OBJ_WEIGHT_DIM", "0");
+  Zoltan_Set_Param(d.zz, "RETURN_LISTS", "NONE");  // migration is ours (owner per particle)
+  Zoltan_Set_Param(d.zz, "KEEP_CUTS", "1");        // for Point_Assign and Box_Assign
+}
+
+std::size_t packed_size(const ParticleArray& a) {
+  std::size_t s = 0;
+  for (const Property& p : a.props) s += static_cast<std::size_t>(p.stride);
+  return s;
+}
+
+void pack_particle(const ParticleArray& a, std::size_t i, std::vector<double>& buf) {
+  for (const Property& p : a.props) {
+    const std::size_t o = i * static_cast<std::size_t>(p.stride);
+    for (int k = 0; k < p.stride; ++k) {
+      switch (p.type) {
+        case PropType::F64: buf.push_back(p.f64[o + k]); break;
+        case PropType::I32: buf.push_back(static_cast<double>(p.i32[o + k])); break;
+        case PropType::U32: buf.push_back(static_cast<double>(p.u32[o + k])); break;
+      }
+    }
+  }
+}
+
+void unpack_particle(ParticleArray& a, std::size_t j, const double* buf) {
+  for (Property& p : a.props) {
+    const std::size_t o = j * static_cast<std::size_t>(p.stride);
+    for (int k = 0; k < p.stride; ++k, ++buf) {
+      switch (p.type) {
+        case PropType::F64: p.f64[o + k] = *buf; break;
+        case PropType::I32: p.i32[o + k] = static_cast<std::int32_t>(*buf); break;
+        case PropType::U32: p.u32[o + k] = static_cast<std::uint32_t>(*buf); break;
+      }
+    }
+  }
+}
+
+int owner(const Decomposition& d, const double pos[3]) {
+  if (!d.cut || inside_region(d, pos, pos)) return rank();
+  double c[3] = {pos[0], pos[1], pos[2]};
+  int proc = 0;
+  check(Zoltan_LB_Point_Assign(d.zz, c, &proc), "Zoltan_LB_Point_Assign");
+  return proc;
+}
+
+void ranks_near(const Decomposition& d, const double lo[3], const double hi[3],
+                std::vector<int>& ranks) {
+  ranks.clear();
+  if (!d.cut) {
+    ranks.push_back(rank());
+    return;
+  }
+  static thread_local std::vector<int> procs;
+  procs.resize(static_cast<std::size_t>(size()));
+  int count = 0;
+  check(Zoltan_LB_Box_Assign(d.zz, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], procs.data(),
+                             &count),
+        "Zoltan_LB_Box_Assign");
+  ranks.assign(procs.begin(), procs.begin() + count);
+  std::sort(ranks.begin(), ranks.end());
+}
+
+std::size_t migrate(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
+  const int P = size(), me = rank();
+  std::size_t sent_total = 0;
+  for (ParticleArray* a : arrays) {
+    int pos[3];
+    position_props(*a, d.dim, pos);
+    const std::size_t width = packed_size(*a);
+    std::vector<std::vector<double>> out(P);
+    std::vector<std::uint32_t> keep;
+    keep.reserve(a->n);
+    for (std::size_t i = 0; i < a->n; ++i) {
+      double x[3];
+      position(*a, pos, i, x);
+      const int r = owner(d, x);
+      if (r == me) {
+        keep.push_back(static_cast<std::uint32_t>(i));
+      } else {
+        pack_particle(*a, i, out[r]);
+        ++sent_total;
+      }
+    }
+    std::vector<int> send_counts(P), recv_counts(P), sdispl(P), rdispl(P);
+    std::vector<double> send;
+    for (int r = 0; r < P; ++r) {
+      send_counts[r] = static_cast<int>(out[r].size());
+      sdispl[r] = static_cast<int>(send.size());
+      send.insert(send.end(), out[r].begin(), out[r].end());
+    }
+    MPI_Alltoall(send_counts.data(), 1, MPI_INT, recv_counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+    int total = 0;
+    for (int r = 0; r < P; ++r) {
+      rdispl[r] = total;
+      total += recv_counts[r];
+    }
+    std::vector<double> recv(static_cast<std::size_t>(total));
+    MPI_Alltoallv(send.data(), send_counts.data(), sdispl.data(), MPI_DOUBLE, recv.data(),
+                  recv_counts.data(), rdispl.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+    // Stayers keep their order (compacted in place), arrivals follow by sending rank.
+    if (keep.size() != a->n) {
+      for (Property& p : a->props) {
+        const std::size_t s = static_cast<std::size_t>(p.stride);
+        for (std::size_t k = 0; k < keep.size(); ++k)
+          for (std::size_t c = 0; c < s; ++c) {
+            const std::size_t to = k * s + c, from = keep[k] * s + c;
+            if (p.type == PropType::F64) p.f64[to] = p.f64[from];
+            else if (p.type == PropType::I32) p.i32[to] = p.i32[from];
+            else p.u32[to] = p.u32[from];
+          }
+      }
+    }
+    const std::size_t arrivals = width ? recv.size() / width : 0;
+    a->resize(keep.size() + arrivals);
+    for (std::size_t k = 0; k < arrivals; ++k) unpack_particle(*a, keep.size() + k, &recv[k * width]);
+  }
+  d.migrated += static_cast<long>(sent_total);
+  return sent_total;
+}
+
+void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
+  Objects o;
+  o.arrays = &arrays;
+  o.dim = d.dim;
+  const unsigned long n = local_count(arrays);
+  MPI_Exscan(&n, &o.first, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
+  if (rank() == 0) o.first = 0;
+  Zoltan_Set_Num_Obj_Fn(d.zz, num_obj, &o);
+  Zoltan_Set_Obj_List_Fn(d.zz, obj_list, &o);
+  Zoltan_Set_Num_Geom_Fn(d.zz, num_geom, &o);
+  Zoltan_Set_Geom_Multi_Fn(d.zz, geom_multi, &o);
+  int changes = 0, ngid = 0, nlid = 0, nimp = 0, nexp = 0;
+  ZOLTAN_ID_PTR igid = nullptr, ilid = nullptr, egid = nullptr, elid = nullptr;
+  int *iproc = nullptr, *ipart = nullptr, *eproc = nullptr, *epart = nullptr;
+  check(Zoltan_LB_Partition(d.zz, &changes, &ngid, &nlid, &nimp, &igid, &ilid, &iproc, &ipart,
+                            &nexp, &egid, &elid, &eproc, &epart),
+        "Zoltan_LB_Partition");
+  Zoltan_LB_Free_Part(&igid, &ilid, &iproc, &ipart);
+  Zoltan_LB_Free_Part(&egid, &elid, &eproc, &epart);
+  d.cut = true;
+  ++d.rebalances;
+  d.has_region = false;
+  if (d.method == "RCB") {
+    int ndim = 0;
+    double* lo = d.region_lo;
+    double* hi = d.region_hi;
+    if (Zoltan_RCB_Box(d.zz, rank(), &ndim, &lo[0], &lo[1], &lo[2], &hi[0], &hi[1], &hi[2]) ==
+        ZOLTAN_OK)
+      d.has_region = true;
+  }
+  migrate(d, arrays);
+}
+
+void distribute(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
+  const std::size_t P = static_cast<std::size_t>(size()), r = static_cast<std::size_t>(rank());
+  for (ParticleArray* a : arrays) {
+    const int g = a->add_property("gid", PropType::U32, 1);
+    for (std::size_t i = 0; i < a->n; ++i) a->props[g].u32[i] = static_cast<std::uint32_t>(i);
+    const std::size_t begin = a->n * r / P, end = a->n * (r + 1) / P;
+    std::vector<std::uint32_t> order;
+    for (std::size_t i = begin; i < end; ++i) order.push_back(static_cast<std::uint32_t>(i));
+    for (std::size_t i = 0; i < a->n; ++i)
+      if (i < begin || i >= end) order.push_back(static_cast<std::uint32_t>(i));
+    a->permute(order);
+    a->resize(end - begin);
+  }
+  rebalance(d, arrays);
+}
+
+double imbalance(const std::vector<ParticleArray*>& arrays) {
+  const long n = static_cast<long>(local_count(arrays));
+  const long total = sum(n), most = max(n);
+  const double mean = static_cast<double>(total) / size();
+  return mean > 0 ? static_cast<double>(most) / mean : 1.0;
+}
+
+void update(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
+  ++d.evaluations;
+  migrate(d, arrays);
+  const bool scheduled = d.rebalance_every > 0 && d.evaluations % d.rebalance_every == 0;
+  if (scheduled || imbalance(arrays) > d.imbalance_limit) rebalance(d, arrays);
+}
+
+}  // namespace sphc::mpi

@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""Compares the outputs of two runs of one scene particle by particle, matched by global id.
+
+    compare_runs.py REFERENCE_DIR OTHER_DIR [--tol T]
+
+Both directories hold the HDF5 files of a run (scene_NNNNNN.h5) written with global ids
+(`sphc --global-ids`, implied by `--mpi`). Every file of the reference must exist in the other
+run (every output time); in each, every array must have the same particles (the same set of
+gid) and every property (and constant) of the reference must agree within T times that property's scale
+(the largest |value| of the reference's property in that file, at least 1e-300). Prints the
+worst difference per property over all files and exits 1 if any exceeds T or anything is
+missing.
+"""
+import glob
+import os
+import sys
+
+import h5py
+import numpy as np
+
+
+def arrays(path):
+    out = {}
+    with h5py.File(path, "r") as f:
+        grp = f["particles"] if "particles" in f else f
+        for name in grp:
+            g = grp[name]
+            if not isinstance(g, h5py.Group):
+                continue
+            props = g["arrays"] if "arrays" in g else g
+            out[name] = {k: np.array(props[k]) for k in props if isinstance(props[k], h5py.Dataset)}
+            if "constants" in g:  # per-array constants (reductions), as attributes
+                for k, v in g["constants"].attrs.items():
+                    out[name]["const:" + k] = np.array(v)
+    return out
+
+
+def main():
+    args = sys.argv[1:]
+    tol = 1e-9
+    if "--tol" in args:
+        k = args.index("--tol")
+        tol = float(args[k + 1])
+        del args[k:k + 2]
+    ref_dir, other_dir = args
+    files = sorted(glob.glob(os.path.join(ref_dir, "*_[0-9]*.h5")))
+    if not files:
+        print(f"compare_runs: no output files in {ref_dir}")
+        return 1
+    worst = {}
+    ok = True
+    for fr in files:
+        fo = os.path.join(other_dir, os.path.basename(fr))
+        if not os.path.exists(fo):
+            print(f"compare_runs: {fo} missing (the reference has {os.path.basename(fr)})")
+            return 1
+        ra, oa = arrays(fr), arrays(fo)
+        for name, rp in ra.items():
+            if name not in oa or "gid" not in rp or "gid" not in oa[name]:
+                print(f"compare_runs: array {name} or its gid missing in {fo}")
+                return 1
+            op = oa[name]
+            ri, oi = np.argsort(rp["gid"]), np.argsort(op["gid"])
+            if not np.array_equal(rp["gid"][ri], op["gid"][oi]):
+                print(f"compare_runs: {fo}: array {name} has other particles "
+                      f"({len(op['gid'])} against {len(rp['gid'])})")
+                return 1
+            for prop, rv in rp.items():
+                if prop not in op:
+                    print(f"compare_runs: {fo}: {name}.{prop} missing")
+                    return 1
+                if prop.startswith("const:"):  # one value per array, not per particle
+                    a, b = rv.astype(float), op[prop].astype(float)
+                else:
+                    a = rv[ri].astype(float)
+                    b = op[prop][oi].astype(float)
+                scale = max(np.max(np.abs(a)) if a.size else 0.0, 1e-300)
+                d = float(np.max(np.abs(a - b)) / scale) if a.size else 0.0
+                key = f"{name}.{prop}"
+                if d > worst.get(key, (-1, ""))[0]:
+                    worst[key] = (d, os.path.basename(fr))
+                ok = ok and d <= tol
+    for key, (d, f) in sorted(worst.items()):
+        print(f"{key:<16} worst {d:.3e} of its scale ({f})")
+    print(f"compare_runs: {len(files)} files, tolerance {tol:g}: {'ok' if ok else 'FAILED'}")
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

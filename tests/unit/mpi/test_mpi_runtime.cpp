@@ -1,0 +1,259 @@
+// The MPI runtime (sphc/mpi/*.h) under mpirun -np 1, 2 and 4: decomposition, migration, halo
+// exchange (remote particles, periodic and mirror images), reductions and gathered output.
+// Every check compares with what a serial brute force gives for the same particles.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include "sphc/domain.h"
+#include "sphc/mpi/comm.h"
+#include "sphc/mpi/decomposition.h"
+#include "sphc/mpi/gather.h"
+#include "sphc/mpi/halo.h"
+
+namespace {
+
+// An nx x nx lattice in [0, 1)^2 with u = gid, v = 2 gid + 1, h = dx, and a scalar "q".
+sphc::ParticleArray lattice(int nx) {
+  sphc::ParticleArray a;
+  a.name = "fluid";
+  for (const char* p : {"x", "y", "z", "u", "v", "h", "q"}) a.add_property(p);
+  a.resize(static_cast<std::size_t>(nx * nx));
+  const double dx = 1.0 / nx;
+  for (int j = 0; j < nx; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const std::size_t k = static_cast<std::size_t>(j * nx + i);
+      a.f64("x")[k] = (i + 0.5) * dx;
+      a.f64("y")[k] = (j + 0.5) * dx;
+      a.f64("u")[k] = static_cast<double>(k);
+      a.f64("v")[k] = 2.0 * k + 1;
+      a.f64("h")[k] = dx;
+      a.f64("q")[k] = std::sin(static_cast<double>(k));
+    }
+  return a;
+}
+
+std::vector<std::uint32_t> all_gids(const sphc::ParticleArray& a) {
+  const int g = a.find("gid");
+  std::vector<std::uint32_t> mine(a.props[g].u32.begin(), a.props[g].u32.begin() + a.n);
+  int n = static_cast<int>(mine.size());
+  const int P = sphc::mpi::size();
+  std::vector<int> counts(P), displ(P);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD);
+  int total = 0;
+  for (int r = 0; r < P; ++r) displ[r] = total, total += counts[r];
+  std::vector<std::uint32_t> all(static_cast<std::size_t>(total));
+  MPI_Allgatherv(mine.data(), n, MPI_UNSIGNED, all.data(), counts.data(), displ.data(),
+                 MPI_UNSIGNED, MPI_COMM_WORLD);
+  std::sort(all.begin(), all.end());
+  return all;
+}
+
+// True on every rank iff true on all.
+bool everywhere(bool ok) { return sphc::mpi::all(ok); }
+
+}  // namespace
+
+TEST(MpiComm, ReductionsAgreeOnEveryRank) {
+  const int P = sphc::mpi::size(), r = sphc::mpi::rank();
+  EXPECT_EQ(sphc::mpi::sum(static_cast<double>(r + 1)), P * (P + 1) / 2.0);
+  EXPECT_EQ(sphc::mpi::min(static_cast<double>(r + 3)), 3.0);
+  EXPECT_EQ(sphc::mpi::max(static_cast<double>(r)), P - 1.0);
+  EXPECT_EQ(sphc::mpi::sum(static_cast<long>(2)), 2L * P);
+  EXPECT_TRUE(sphc::mpi::all(true));
+  EXPECT_EQ(sphc::mpi::all(r != P - 1), false);  // one rank says no: no on every rank
+}
+
+TEST(MpiDecomposition, EveryParticleOnceOnItsOwnerAndBalanced) {
+  sphc::ParticleArray a = lattice(20);
+  sphc::mpi::Decomposition d;
+  sphc::mpi::init_decomposition(d, 2, "RCB");
+  sphc::mpi::distribute(d, {&a});
+  const std::vector<std::uint32_t> gids = all_gids(a);
+  ASSERT_EQ(gids.size(), 400u);
+  for (std::uint32_t k = 0; k < 400; ++k) EXPECT_EQ(gids[k], k);
+  bool owned = true, kept = true;
+  for (std::size_t i = 0; i < a.n; ++i) {
+    const double p[3] = {a.f64("x")[i], a.f64("y")[i], 0.0};
+    owned = owned && sphc::mpi::owner(d, p) == sphc::mpi::rank();
+    const std::uint32_t g = a.props[a.find("gid")].u32[i];
+    kept = kept && a.f64("u")[i] == g && a.f64("v")[i] == 2.0 * g + 1;
+  }
+  EXPECT_TRUE(everywhere(owned));
+  EXPECT_TRUE(everywhere(kept));
+  // RCB splits 400 points on a lattice into equal halves (to a particle per cut).
+  EXPECT_LE(sphc::mpi::imbalance({&a}), 1.05);
+}
+
+TEST(MpiDecomposition, HilbertCurveToo) {
+  sphc::ParticleArray a = lattice(16);
+  sphc::mpi::Decomposition d;
+  sphc::mpi::init_decomposition(d, 2, "HSFC");
+  sphc::mpi::distribute(d, {&a});
+  EXPECT_EQ(all_gids(a).size(), 256u);
+  EXPECT_LE(sphc::mpi::imbalance({&a}), 1.2);
+  EXPECT_THROW(sphc::mpi::init_decomposition(d, 2, "METIS"), std::invalid_argument);
+}
+
+TEST(MpiDecomposition, MigrationMovesLeaversWithTheirProperties) {
+  sphc::ParticleArray a = lattice(20);
+  sphc::mpi::Decomposition d;
+  sphc::mpi::init_decomposition(d, 2);
+  sphc::mpi::distribute(d, {&a});
+  // Shift everything by a third of the box along x (no wrapping: regions reach infinity).
+  for (std::size_t i = 0; i < a.n; ++i) a.f64("x")[i] += 0.33;
+  const long sent = sphc::mpi::sum(static_cast<long>(sphc::mpi::migrate(d, {&a})));
+  if (sphc::mpi::size() > 1) EXPECT_GT(sent, 0);
+  EXPECT_EQ(all_gids(a).size(), 400u);
+  bool ok = true;
+  for (std::size_t i = 0; i < a.n; ++i) {
+    const double p[3] = {a.f64("x")[i], a.f64("y")[i], 0.0};
+    const std::uint32_t g = a.props[a.find("gid")].u32[i];
+    const double x0 = (g % 20 + 0.5) * (1.0 / 20) + 0.33;  // as lattice() computes it
+    ok = ok && sphc::mpi::owner(d, p) == sphc::mpi::rank() && a.f64("x")[i] == x0 &&
+         a.f64("u")[i] == g && a.f64("q")[i] == std::sin(static_cast<double>(g));
+  }
+  EXPECT_TRUE(everywhere(ok));
+}
+
+// The neighbours of every real particle among real + halo particles are exactly those of a
+// serial brute force over all particles and their periodic images (or mirror images), with
+// the carried properties transformed.
+void check_halo(const sphc::Domain& box, bool mirror) {
+  const int nx = 12;
+  const sphc::ParticleArray all = lattice(nx);
+  sphc::ParticleArray a = lattice(nx);
+  sphc::mpi::Decomposition d;
+  sphc::mpi::init_decomposition(d, 2);
+  sphc::mpi::distribute(d, {&a});
+  const double cutoff = 2.0 / nx;  // radius_scale 2, h = dx
+  sphc::mpi::Halo h;
+  const std::vector<int> carried = {a.find("x"), a.find("y"), a.find("u"), a.find("v"),
+                                    a.find("gid")};
+  sphc::mpi::exchange_halo(d, box, a, cutoff, h, carried);
+  // Serial images: every particle through every combination of sides (as find_ghosts).
+  struct Pt { double x, y, u, v; std::uint32_t gid; };
+  std::vector<Pt> serial;
+  for (std::size_t k = 0; k < all.n; ++k) {
+    for (int ix = -1; ix <= 1; ++ix)
+      for (int iy = -1; iy <= 1; ++iy) {
+        Pt p{all.f64("x")[k], all.f64("y")[k], all.f64("u")[k], all.f64("v")[k],
+             static_cast<std::uint32_t>(k)};
+        if (mirror) {  // mirror x: 2 lo - x / 2 hi - x, u negated; periodic y
+          if (ix == -1) p.x = -p.x, p.u = -p.u;
+          if (ix == 1) p.x = 2.0 - p.x, p.u = -p.u;
+        } else {
+          p.x += ix;
+        }
+        p.y += iy;
+        serial.push_back(p);
+      }
+  }
+  const int gidp = a.find("gid");
+  const std::size_t m = a.n + h.size();
+  bool ok = true;
+  long checked = 0;
+  for (std::size_t i = 0; i < a.n; ++i) {
+    const double xi = a.f64("x")[i], yi = a.f64("y")[i];
+    std::multimap<std::uint32_t, std::vector<double>> got, want;
+    for (std::size_t j = 0; j < m; ++j) {
+      const double dx = xi - a.f64("x")[j], dy = yi - a.f64("y")[j];
+      if (j != i && dx * dx + dy * dy < cutoff * cutoff)
+        got.insert({a.props[gidp].u32[j], {a.f64("x")[j], a.f64("y")[j], a.f64("u")[j], a.f64("v")[j]}});
+    }
+    const std::uint32_t gi = a.props[gidp].u32[i];
+    for (const Pt& p : serial) {
+      const double dx = xi - p.x, dy = yi - p.y;
+      if (dx * dx + dy * dy < cutoff * cutoff && !(p.gid == gi && p.x == xi && p.y == yi))
+        want.insert({p.gid, {p.x, p.y, p.u, p.v}});
+    }
+    ok = ok && got.size() == want.size();
+    for (auto& [g, v] : want) {
+      bool found = false;
+      auto range = got.equal_range(g);
+      for (auto it = range.first; it != range.second; ++it)
+        found = found || (std::abs(it->second[0] - v[0]) < 1e-12 &&
+                          std::abs(it->second[1] - v[1]) < 1e-12 && it->second[2] == v[2] &&
+                          it->second[3] == v[3]);
+      ok = ok && found;
+    }
+    ++checked;
+  }
+  EXPECT_TRUE(everywhere(ok));
+  EXPECT_EQ(sphc::mpi::sum(checked), static_cast<long>(nx * nx));
+  sphc::mpi::remove_halo(a, h);
+  EXPECT_EQ(a.props[0].f64.size(), a.n);
+}
+
+TEST(MpiHalo, PeriodicBoxNeighboursAsSerial) {
+  sphc::Domain box;
+  box.dim = 2;
+  for (int ax = 0; ax < 2; ++ax) {
+    box.lo_kind[ax] = box.hi_kind[ax] = sphc::Boundary::Periodic;
+    box.lo[ax] = 0.0;
+    box.hi[ax] = 1.0;
+  }
+  check_halo(box, false);
+}
+
+TEST(MpiHalo, MirrorXPeriodicYNeighboursAsSerial) {
+  sphc::Domain box;
+  box.dim = 2;
+  box.lo_kind[0] = box.hi_kind[0] = sphc::Boundary::Mirror;
+  box.lo_kind[1] = box.hi_kind[1] = sphc::Boundary::Periodic;
+  box.hi[0] = box.hi[1] = 1.0;
+  check_halo(box, true);
+}
+
+TEST(MpiHalo, RefreshSendsNewValues) {
+  sphc::ParticleArray a = lattice(10);
+  sphc::mpi::Decomposition d;
+  sphc::mpi::init_decomposition(d, 2);
+  sphc::mpi::distribute(d, {&a});
+  sphc::Domain open;
+  sphc::mpi::Halo h;
+  const int q = a.find("q"), g = a.find("gid");
+  sphc::mpi::exchange_halo(d, open, a, 0.25, h, {a.find("x"), a.find("y"), g});
+  for (std::size_t i = 0; i < a.n; ++i) a.f64(q)[i] = 3.0 * a.props[g].u32[i];
+  sphc::mpi::refresh_halo(open, a, h, {q});
+  bool ok = true;
+  for (std::size_t j = a.n; j < a.n + h.size(); ++j) ok = ok && a.f64(q)[j] == 3.0 * a.props[g].u32[j];
+  EXPECT_TRUE(everywhere(ok));
+  if (sphc::mpi::size() > 1) EXPECT_GT(sphc::mpi::sum(static_cast<long>(h.size())), 0);
+  else EXPECT_EQ(h.size(), 0u);  // one rank, open domain: no halo
+}
+
+TEST(MpiGather, RankZeroGetsEveryParticleInGidOrder) {
+  sphc::ParticleArray a = lattice(9);
+  sphc::mpi::Decomposition d;
+  sphc::mpi::init_decomposition(d, 2);
+  sphc::mpi::distribute(d, {&a});
+  std::vector<sphc::ParticleArray> out;
+  sphc::mpi::gather_arrays({&a}, out);
+  ASSERT_EQ(out.size(), 1u);
+  if (sphc::mpi::rank() == 0) {
+    ASSERT_EQ(out[0].n, 81u);
+    for (std::size_t k = 0; k < 81; ++k) {
+      EXPECT_EQ(out[0].props[out[0].find("gid")].u32[k], k);
+      EXPECT_EQ(out[0].f64("v")[k], 2.0 * k + 1);
+    }
+  } else {
+    EXPECT_EQ(out[0].n, 0u);
+  }
+}
+
+int main(int argc, char** argv) {
+  sphc::mpi::Session session(&argc, &argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  // Only rank 0 prints gtest's report; every rank's failures count in the exit code.
+  if (sphc::mpi::rank() != 0) {
+    auto& listeners = ::testing::UnitTest::GetInstance()->listeners();
+    delete listeners.Release(listeners.default_result_printer());
+  }
+  const int rc = RUN_ALL_TESTS();
+  return sphc::mpi::max(static_cast<long>(rc)) != 0 ? 1 : 0;
+}
