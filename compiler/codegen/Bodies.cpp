@@ -269,15 +269,21 @@ void ScenePrinter::emitDestLocals(std::ostream& os, const std::string& indent,
            << pq.components[k] << "[d_idx];\n";
 }
 
-void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
-                                     const std::string& indent) {
-  const std::string& R = dl.real;
+// The spellings the pair-quantity statements take in a dialect.
+static PairDialect pairDialectOf(const Dialect& dl) {
   PairDialect dialect;
-  dialect.real = R;
+  dialect.real = dl.real;
   dialect.sqrt = dl.sqrt;
   dialect.kernelW = dl.kernelW;
   dialect.kernelGradient = dl.kernelGradient;
   dialect.literalSuffix = dl.lit("");
+  return dialect;
+}
+
+void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
+                                     const std::string& indent) {
+  const std::string& R = dl.real;
+  const PairDialect dialect = pairDialectOf(dl);
   os << indent << "const " << R << " hj = sj_h[s_idx];\n";
   for (const PairQuantity& pq : pairQuantityTable())
     if (pq.when == PairWhen::BeforeTest)
@@ -290,21 +296,9 @@ void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const 
 // before the neighbour test (XIJ, R2IJ), the test, then every-neighbour and used ones.
 void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::string>& q,
                                       const Dialect& dl) {
-  const std::string& R = dl.real;
   const std::string indent = "            ";
-  PairDialect dialect;
-  dialect.real = R;
-  dialect.sqrt = dl.sqrt;
-  dialect.kernelW = dl.kernelW;
-  dialect.kernelGradient = dl.kernelGradient;
-  dialect.literalSuffix = dl.lit("");
-  os << indent << "const " << R << " hj = sj_h[s_idx];\n";
-  for (const PairQuantity& pq : pairQuantityTable())
-    if (pq.when == PairWhen::BeforeTest)
-      os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
-  os << indent << "const " << R << " hmax = hi > hj ? hi : hj;\n";
-  os << indent << "if (R2IJ >= RADIUS2 * hmax * hmax) " << dl.skipCandidate
-     << "  // not a neighbour\n";
+  emitNeighbourTest(os, dl, dl.skipCandidate, indent);
+  const PairDialect dialect = pairDialectOf(dl);
   for (const PairQuantity& pq : pairQuantityTable())
     if (pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name)))
       os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
