@@ -23,7 +23,7 @@ const char* backendName(Backend b);
 struct EmitOptions {
   Backend backend = Backend::Serial;
   Precision precision = Precision::Double;
-  // Every particle gets a global id `gid` (its set-up index), written with the output, so runs
+  // Every particle gets a global id `gid` (unique over the arrays, in set-up order), written with the output, so runs
   // can be compared particle by particle (--global-ids; always with --mpi).
   bool globalIds = false;
 };

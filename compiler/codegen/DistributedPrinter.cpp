@@ -67,7 +67,7 @@ void ScenePrinter::distributedFunctions() {
   if (mpi_) {
     const Distribution& d = sched_.distribution;
     scene_ << "  // --mpi: the set-up ran on every rank; each keeps the particles of its region, with\n"
-              "  // their set-up index as global id gid (sphc/mpi/decomposition.h).\n";
+              "  // a global id gid (set-up order, sphc/global_ids.h).\n";
     scene_ << "  void distribute() {\n";
     scene_ << "    sphc::mpi::init_decomposition(decomposition, DIM, \"" << d.method << "\");\n";
     scene_ << "    decomposition.rebalance_every = " << d.rebalanceEvery << ";\n";
@@ -76,13 +76,12 @@ void ScenePrinter::distributedFunctions() {
     scene_ << "    sphc::mpi::distribute(decomposition, " << allArrays("") << ");\n";
     scene_ << "  }\n\n";
   } else if (globalIds_) {
-    scene_ << "  // --global-ids: every particle's set-up index as gid, which moves with it.\n";
+    scene_ << "  // --global-ids: every particle gets a global id gid, unique over the arrays in set-up\n"
+              "  // order (sphc/global_ids.h, as --mpi numbers them), which moves with it.\n";
     scene_ << "  void number_particles() {\n";
-    scene_ << "    for (sphc::ParticleArray* a : std::vector<sphc::ParticleArray*>"
-           << allArrays("") << ") {\n";
-    scene_ << "      const int g = a->add_property(\"gid\", sphc::PropType::U32, 1);\n";
-    scene_ << "      for (std::size_t i = 0; i < a->n; ++i) a->u32(g)[i] = static_cast<std::uint32_t>(i);\n";
-    scene_ << "    }\n  }\n\n";
+    scene_ << "    sphc::GlobalIds ids;\n";
+    scene_ << "    sphc::assign_global_ids(" << allArrays("") << ", ids);\n";
+    scene_ << "  }\n\n";
   }
 }
 

@@ -603,6 +603,7 @@ std::string ScenePrinter::run() {
   if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
   if (!plan_.metrics.empty()) out_ << "#include \"sphc/metrics.h\"\n";
   if (hasZones()) out_ << "#include \"sphc/inlet_outlet.h\"\n";
+  if (globalIds_) out_ << "#include \"sphc/global_ids.h\"\n";
   if (mpi_)
     out_ << "#include \"sphc/mpi/comm.h\"\n#include \"sphc/mpi/decomposition.h\"\n"
             "#include \"sphc/mpi/gather.h\"\n#include \"sphc/mpi/halo.h\"\n";

@@ -1,6 +1,8 @@
 // sphc runtime, distributed runs: see sphc/mpi/decomposition.h.
 #include "sphc/mpi/decomposition.h"
 
+#include "sphc/global_ids.h"
+
 #include <mpi.h>
 #include <zoltan.h>
 
@@ -266,9 +268,9 @@ void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
 
 void distribute(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   const std::size_t P = static_cast<std::size_t>(size()), r = static_cast<std::size_t>(rank());
+  GlobalIds ids;  // sphc/global_ids.h: unique over all arrays, in set-up order (as --global-ids)
+  assign_global_ids(arrays, ids);
   for (ParticleArray* a : arrays) {
-    const int g = a->add_property("gid", PropType::U32, 1);
-    for (std::size_t i = 0; i < a->n; ++i) a->props[g].u32[i] = static_cast<std::uint32_t>(i);
     const std::size_t begin = a->n * r / P, end = a->n * (r + 1) / P;
     std::vector<std::uint32_t> order;
     for (std::size_t i = begin; i < end; ++i) order.push_back(static_cast<std::uint32_t>(i));

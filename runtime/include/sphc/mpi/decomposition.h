@@ -62,8 +62,9 @@ struct Decomposition {
 // std::invalid_argument).
 void init_decomposition(Decomposition& d, int dim, const std::string& method = "RCB");
 
-// After a replicated set-up: adds `gid` (U32, the set-up index) to every array, keeps the
-// block [r n / P, (r + 1) n / P) of each array on rank r, then rebalance().
+// After a replicated set-up: adds `gid` (U32, unique over the arrays in set-up order:
+// sphc/global_ids.h) to every array, keeps the block [r n / P, (r + 1) n / P) of each array
+// on rank r, then rebalance().
 void distribute(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
 // Cuts space anew from the current particles (Zoltan_LB_Partition) and migrates.
