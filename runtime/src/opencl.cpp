@@ -926,8 +926,8 @@ void DeviceGhosts::release() {
 }
 
 std::string kernel_function_source(const std::string& kernel, int dim) {
-  // sigma, radius scale, f(q) and df(q) as in sphc/kernels.h (same formulas; the Wendland
-  // ones through pown, equal to kernels.h's products to rounding).
+  // sigma, radius scale, f(q) and df(q) as in sphc/kernels.h (same formulas, same order of
+  // operations).
   const double pi = 3.14159265358979323846;
   std::string sigma, f, df, rs;
   char buf[64];
@@ -936,13 +936,6 @@ std::string kernel_function_source(const std::string& kernel, int dim) {
     std::string s = buf;
     if (s.find_first_of(".e") == std::string::npos) s += ".0";
     return s;
-  };
-  // The Wendland kernels share one shape: zero from q = 2 on, f(q) = t^n P(q) and
-  // f'(q) = -q t^(n-1) Q(q) with t = 1 - q/2 (kernels.h has each one written out).
-  auto wendland = [&](int n, const std::string& P, const std::string& Q) {
-    const std::string head = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n";
-    f = head + "  return pown(t, " + std::to_string(n) + ") * (" + P + ");\n";
-    df = head + "  return -q * pown(t, " + std::to_string(n - 1) + ") * (" + Q + ");\n";
   };
   if (kernel == "CubicSpline") {
     rs = "2.0";
@@ -970,9 +963,19 @@ std::string kernel_function_source(const std::string& kernel, int dim) {
          "  return v;\n";
   } else if (kernel == "WendlandQuintic") {
     rs = "2.0";
-    sigma = num(dim == 1 ? 5.0 / 8.0 : dim == 2 ? 7.0 / (4.0 * pi) : 21.0 / (16.0 * pi));
-    if (dim == 1) wendland(3, "1.5 * q + 1.0", "3.0");
-    else wendland(4, "2.0 * q + 1.0", "5.0");
+    if (dim == 1) {
+      sigma = num(5.0 / 8.0);
+      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n"
+          "  return t * t * t * (1.5 * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n"
+           "  return -3.0 * q * t * t;\n";
+    } else {
+      sigma = num(dim == 2 ? 7.0 / (4.0 * pi) : 21.0 / (16.0 * pi));
+      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+          "  return t2 * t2 * (2.0 * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n"
+           "  return -5.0 * q * t * t * t;\n";
+    }
   } else if (kernel == "Gaussian") {
     rs = "3.0";
     sigma = num(dim == 1 ? 1.0 / std::sqrt(pi) : dim == 2 ? 1.0 / pi : std::pow(pi, -1.5));
@@ -980,16 +983,37 @@ std::string kernel_function_source(const std::string& kernel, int dim) {
     df = "  return q < 3.0 ? -2.0 * q * exp(-q * q) : 0.0;\n";
   } else if (kernel == "WendlandQuinticC4") {
     rs = "2.0";
-    sigma = num(dim == 1 ? 0.75 : dim == 2 ? 9.0 / (4.0 * pi) : 495.0 / (256.0 * pi));
-    if (dim == 1) wendland(5, "2.0 * q * q + 2.5 * q + 1.0", "3.5 * (2.0 * q + 1.0)");
-    else wendland(6, "(35.0 / 12.0) * q * q + 3.0 * q + 1.0", "(14.0 / 3.0) * (1.0 + 2.5 * q)");
+    if (dim == 1) {
+      sigma = num(0.75);
+      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+          "  return t2 * t2 * t * (2.0 * q * q + 2.5 * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+           "  return -3.5 * q * (2.0 * q + 1.0) * t2 * t2;\n";
+    } else {
+      sigma = num(dim == 2 ? 9.0 / (4.0 * pi) : 495.0 / (256.0 * pi));
+      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+          "  return t2 * t2 * t2 * ((35.0 / 12.0) * q * q + 3.0 * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+           "  return (-14.0 / 3.0) * q * (1.0 + 2.5 * q) * t2 * t2 * t;\n";
+    }
   } else if (kernel == "WendlandQuinticC6") {
     rs = "2.0";
-    sigma = num(dim == 1 ? 55.0 / 64.0 : dim == 2 ? 78.0 / (28.0 * pi) : 1365.0 / (512.0 * pi));
-    if (dim == 1)
-      wendland(7, "((2.625 * q + 4.75) * q + 3.5) * q + 1.0", "0.5 * ((26.25 * q + 27.0) * q + 9.0)");
-    else
-      wendland(8, "((4.0 * q + 6.25) * q + 4.0) * q + 1.0", "5.5 * ((4.0 * q + 3.5) * q + 1.0)");
+    if (dim == 1) {
+      sigma = num(55.0 / 64.0);
+      f = "  if (q >= 2.0) return 0.0;\n"
+          "  const real t = 1.0 - 0.5 * q, t2 = t * t, t4 = t2 * t2;\n"
+          "  return t4 * t2 * t * (((2.625 * q + 4.75) * q + 3.5) * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
+           "  return -0.5 * q * ((26.25 * q + 27.0) * q + 9.0) * t2 * t2 * t2;\n";
+    } else {
+      sigma = num(dim == 2 ? 78.0 / (28.0 * pi) : 1365.0 / (512.0 * pi));
+      f = "  if (q >= 2.0) return 0.0;\n"
+          "  const real t = 1.0 - 0.5 * q, t2 = t * t, t4 = t2 * t2;\n"
+          "  return t4 * t4 * (((4.0 * q + 6.25) * q + 4.0) * q + 1.0);\n";
+      df = "  if (q >= 2.0) return 0.0;\n"
+           "  const real t = 1.0 - 0.5 * q, t2 = t * t, t4 = t2 * t2;\n"
+           "  return -5.5 * q * ((4.0 * q + 3.5) * q + 1.0) * t4 * t2 * t;\n";
+    }
   } else if (kernel == "SuperGaussian") {
     rs = "3.0";
     sigma = num(dim == 1 ? 1.0 / std::sqrt(pi) : dim == 2 ? 1.0 / pi : std::pow(pi, -1.5));
