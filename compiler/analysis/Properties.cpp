@@ -3,6 +3,7 @@
 #include "analysis/PlanQueries.h"
 
 #include <map>
+#include <regex>
 #include <set>
 
 namespace sphc {
@@ -122,6 +123,48 @@ void checkImplicitReads(const Plan& plan, DiagnosticEngine& diags) {
     if (movesParticles(plan, a))
       for (const auto& p : adaptiveDtProps(plan))
         mustBeDouble(a, p, "the adaptive time step", llvm::SMLoc(), "");
+}
+
+// A property that no array declares is allocated as a scalar (stride 1). A body that indexes
+// it with a stride (`d_L[9 * d_idx + k]`) would read and write past the end: a located error
+// that says what to declare.
+void checkUndeclaredStrides(const Plan& plan, DiagnosticEngine& diags) {
+  static const std::regex stride(R"(^\s*(\d+)\s*\*\s*\(?\s*[ds]_idx\b|\b[ds]_idx\s*\)?\s*\*\s*(\d+))");
+  std::set<std::pair<int, std::string>> reported;
+  auto checkBody = [&](int bodyIdx, const std::vector<int>& dests, const std::vector<int>& srcs) {
+    const PlanBody& b = plan.bodies[bodyIdx];
+    for (const PropSite& site : b.facts.sites) {
+      if (site.end <= site.begin || site.end > b.source.text.size()) continue;
+      const std::string text = b.source.text.substr(site.begin, site.end - site.begin);
+      const size_t open = text.find('[');
+      if (open == std::string::npos) continue;
+      std::smatch m;
+      const std::string index = text.substr(open + 1);
+      if (!std::regex_search(index, m, stride)) continue;
+      const std::string n = m[1].matched ? m[1].str() : m[2].str();
+      for (int a : site.source ? srcs : dests) {
+        const PlanProperty* p = plan.arrays[a].find(site.prop);
+        if (!p || p->declared || p->stride != 1 || !reported.insert({a, site.prop}).second)
+          continue;
+        diags.error(llvm::SMLoc::getFromPointer(b.source.start.getPointer() + site.begin),
+                    "property '" + site.prop + "' of array '" + plan.arrays[a].name +
+                        "' is indexed with a stride of " + n + " but not declared (an "
+                        "undeclared property is a scalar): declare it in the array, e.g. "
+                        "`property double[" + n + "] " + site.prop + " = 0;`");
+        diags.note(plan.arrays[a].loc, "array '" + plan.arrays[a].name + "' is declared here");
+      }
+    }
+  };
+  for (const auto& eq : plan.equations) {
+    if (!eq.live || eq.declIndex < 0) continue;
+    for (const auto& [kind, bodyIdx] : plan.equationDecls[eq.declIndex].methods)
+      checkBody(bodyIdx, {eq.dest}, ast::seesSources(kind) ? eq.sources : std::vector<int>{});
+  }
+  for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) {
+    if (plan.arrays[a].stepper < 0) continue;
+    for (const auto& [name, bodyIdx] : plan.steppers[plan.arrays[a].stepper].methods)
+      checkBody(bodyIdx, {a}, {});
+  }
 }
 
 }  // namespace
@@ -265,6 +308,7 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
   if (diags.errorCount() == errorsBefore) {
     checkBodyTypes(plan, diags);
     checkImplicitReads(plan, diags);
+    checkUndeclaredStrides(plan, diags);
   }
   return diags.errorCount() == errorsBefore;
 }
