@@ -22,6 +22,7 @@
 #   OUT_DIR     where the run writes its snapshots (emptied first)
 #   -D NAME=CHOICE  a compile-time option of the scene, passed to sphc (e.g. -D scheme=edac:
 #               examples/taylor_green.sph built with EDAC); any number, before the run options
+#   --global-ids    passed to sphc (the solver writes each particle's gid), before the run options
 #   RUN OPTIONS passed to the solver (e.g. --set dx=0.01)
 #   CHECK OPTIONS passed to the check after the output directory (e.g. --rho-err-tol 1e-4)
 # The Python interpreter is $SPHC_PYTHON if set, else the first of python3, /usr/bin/python3
@@ -43,9 +44,14 @@ shift 5
 # Compile-time options first (-D NAME=CHOICE, for sphc), then run options up to "--", check
 # options after it.
 SPHC_OPTS=""
-while [ $# -gt 1 ] && [ "$1" = "-D" ]; do
-  SPHC_OPTS="$SPHC_OPTS -D $2"
-  shift 2
+while [ $# -gt 0 ] && { [ "$1" = "-D" ] || [ "$1" = "--global-ids" ]; }; do
+  if [ "$1" = "-D" ]; then
+    SPHC_OPTS="$SPHC_OPTS -D $2"
+    shift 2
+  else
+    SPHC_OPTS="$SPHC_OPTS $1"
+    shift
+  fi
 done
 RUN_OPTS=""
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do
