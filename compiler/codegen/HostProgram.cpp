@@ -185,6 +185,7 @@ void ScenePrinter::emitSetup() {
     scene_ << "    times.output_every = " << exprCpp(*plan_.outputEvery, pn) << ";\n";
   for (const auto& t : plan_.outputAt)
     scene_ << "    times.output_at.push_back(" << exprCpp(*t, pn) << ");\n";
+  if (plan_.outputNearestStep) scene_ << "    times.output_nearest_step = true;\n";
   scene_ << "  }\n\n";
 }
 

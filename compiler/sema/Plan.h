@@ -198,6 +198,7 @@ struct Plan {
   ast::ExprPtr viscousFactor, nu;  // viscous limit: viscousFactor * h^2 / nu (if nu is given)
   ast::ExprPtr outputEvery;
   std::vector<ast::ExprPtr> outputAt;
+  bool outputNearestStep = false;  // output_landing = nearest_step
   std::vector<std::string> integratorSteps;   // initialize, stage1, compute_accelerations, ...
   std::string integratorName;
   std::vector<const ast::ParamDecl*> params;  // in order

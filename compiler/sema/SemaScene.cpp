@@ -14,7 +14,8 @@ namespace sphc::sema_detail {
 void SemaImpl::buildScene() {
   const ast::SceneDecl& s = *plan_->scene;
   std::set<std::string> seen;
-  static const std::vector<std::string> known = {"dim", "kernel", "tf", "dt", "integrator"};
+  static const std::vector<std::string> known = {"dim", "kernel", "tf", "dt", "integrator",
+                                                 "output_landing"};
   for (const auto& set : s.settings) {
     const std::string& k = set.key.name;
     if (!seen.insert(k).second) {
@@ -41,6 +42,14 @@ void SemaImpl::buildScene() {
       if (checkSceneExpr(set.value, "tf")) plan_->tf = set.value;
     } else if (k == "dt") {
       if (checkSceneExpr(set.value, "dt")) plan_->dt = set.value;
+    } else if (k == "output_landing") {
+      // exact: steps shortened to land on output times (the default, PySPH's rule);
+      // nearest_step: whole steps, outputs at the nearest step end (docs/language.md).
+      if (v.kind == ast::Expr::Name && (v.text == "exact" || v.text == "nearest_step"))
+        plan_->outputNearestStep = v.text == "nearest_step";
+      else
+        diags_.error(v.loc, "output_landing must be 'exact' (steps end on the output times) "
+                            "or 'nearest_step' (whole steps; outputs at the nearest step end)");
     } else if (k == "integrator") {
       integratorGiven_ = true;
       auto it = v.kind == ast::Expr::Name ? integrators_.find(v.text) : integrators_.end();

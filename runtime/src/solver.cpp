@@ -60,6 +60,7 @@ struct Options {
   std::optional<double> tf;
   std::optional<double> dt;
   std::optional<double> output_every;
+  std::optional<bool> output_nearest_step;  // --output-landing exact|nearest_step
   long max_steps = std::numeric_limits<long>::max();
   long threads = 0;  // 0: the backend's default (all cores)
   std::string directory;  // empty: <scene>_output
@@ -166,6 +167,12 @@ Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
     else if (option == "--tf") o.tf = parse_time(value(), option, true);
     else if (option == "--dt") o.dt = parse_time(value(), option, false);
     else if (option == "--output-every") o.output_every = parse_time(value(), option, true);
+    else if (option == "--output-landing") {
+      const std::string v = value();
+      if (v != "exact" && v != "nearest_step")
+        throw UsageError("--output-landing expects exact or nearest_step, not '" + v + "'");
+      o.output_nearest_step = v == "nearest_step";
+    }
     else if (option == "--max-steps") o.max_steps = parse_count(value(), option);
     else if (option == "--threads") {
       o.threads = parse_count(value(), option);
@@ -237,6 +244,9 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        time step (default: the scene's)\n"
       "  --output-every T      output interval in simulation time, replacing the scene's\n"
       "                        output times (0: first and last state only)\n"
+      "  --output-landing L    exact: steps are shortened to end on output times and tf;\n"
+      "                        nearest_step: steps keep their length, each output is taken\n"
+      "                        at the step end nearest to its time (default: the scene's)\n"
       "  --max-steps N         stop after N time steps\n"
       "  --threads N           threads to use (multi-threaded backends; default: all cores)\n"
       "  --omp-wait W          OpenMP barrier wait: active (spin: fastest on an idle machine),\n"
@@ -443,16 +453,27 @@ constexpr double kMergeFraction = 1e-3;
 class OutputSchedule {
  public:
   OutputSchedule(const SceneTimes& times, double slack)
-      : every_(times.output_every), at_(times.output_at), tf_(times.tf), slack_(slack) {
+      : every_(times.output_every), at_(times.output_at), tf_(times.tf), slack_(slack),
+        nearest_(times.output_nearest_step) {
     std::sort(at_.begin(), at_.end());
     // t = 0 is always written; requested times too close to it to take a step are written
-    // with it.
-    due(0.0, kMergeFraction * times.dt);
+    // with it (nearest_step: those nearer to 0 than to the end of the first step).
+    reached(0.0, nearest_ ? 0.5 * times.dt : kMergeFraction * times.dt);
   }
 
   // True if t reached output times not reached before (within tol, by default the
-  // round-off slack: steps end exactly on the times they land on).
-  bool due(double t) { return due(t, slack_); }
+  // round-off slack: steps end exactly on the times they land on). With nearest_step, `dt`
+  // is the step just taken, the estimate of the next one: a time T is due at the step end
+  // t nearest to it, t >= T - dt/2 (a time halfway between two ends goes to the earlier).
+  bool due(double t, double dt) {
+    return reached(t, nearest_ ? 0.5 * dt + slack_ : slack_);
+  }
+
+  // nearest_step: the run ends at the step end nearest to tf: not with one more step of dt
+  // from t when t is at least as near to tf as t + dt would be (within the slack).
+  bool ends_before_step(double t, double dt) const {
+    return nearest_ && t >= tf_ - 0.5 * dt - slack_;
+  }
 
   // The step from t whose nominal length is dt: it ends at t + dt, or exactly on the
   // requested time it lands on (landed).
@@ -462,6 +483,7 @@ class OutputSchedule {
     bool landed;
   };
   Step plan(double t, double dt) const {
+    if (nearest_) return {dt, t + dt, false};  // steps keep their length
     const double merge = kMergeFraction * dt;
     double end = first_target(t, t + dt, t + dt + merge);
     if (!(end < std::numeric_limits<double>::infinity())) return {dt, t + dt, false};
@@ -480,7 +502,7 @@ class OutputSchedule {
   }
 
  private:
-  bool due(double t, double tol) {
+  bool reached(double t, double tol) {
     bool reached = false;
     if (every_ > 0 && static_cast<double>(next_k_) * every_ <= t + tol) {
       // Jump to the first multiple beyond t at once: a step may pass very many output times
@@ -525,6 +547,7 @@ class OutputSchedule {
   std::vector<double> at_;
   double tf_;
   double slack_;
+  bool nearest_ = false;
   long next_k_ = 1;
   std::size_t next_at_ = 0;
 };
@@ -595,6 +618,7 @@ class Simulation {
         dt = prog_.adaptive_dt();
         if (!std::isfinite(dt) || dt < kMinDtFraction * tf) return time_step_failure(dt, tf);
       }
+      if (schedule.ends_before_step(t_, dt)) break;  // nearest_step: t_ is nearest to tf
       const OutputSchedule::Step planned = schedule.plan(t_, dt);  // lands on outputs and tf
       prog_.step(t_, planned.length);
       ++step_;
@@ -602,7 +626,7 @@ class Simulation {
       advance_time(planned, times.dt);
       particle_steps += static_cast<double>(particles());
 
-      const bool output_due = schedule.due(t_);
+      const bool output_due = schedule.due(t_, planned.length);
       if (output_due || step_ % check_every == 0) {
         if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
         if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
@@ -677,6 +701,7 @@ class Simulation {
       times.output_every = *opt_.output_every;
       times.output_at.clear();
     }
+    if (opt_.output_nearest_step) times.output_nearest_step = *opt_.output_nearest_step;
     auto require = [](bool ok, const char* what, double value) {
       if (!ok) {
         throw std::runtime_error(

@@ -52,6 +52,10 @@ struct SceneTimes {
   double dt = 1e-4;                // fixed time step, or the initial one with adaptive_dt
   double output_every = 0.0;       // sim-time interval; 0 = no periodic output
   std::vector<double> output_at;   // extra output times
+  // output_landing = nearest_step (docs/language.md, "Output times"): steps keep their length
+  // and each output (and the end) is taken at the end of the step nearest to its time, with
+  // the time actually reached; for schemes whose result depends on the step (IISPH).
+  bool output_nearest_step = false;
 };
 
 // How many iterations the evaluations of one iterated group took (group (iterate = true)):
