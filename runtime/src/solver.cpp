@@ -736,7 +736,7 @@ class Simulation {
     std::string path = opt_.metrics_file;
     if (path.empty() && !opt_.no_output)
       path = (std::filesystem::path(dir) / (scene_name(prog_) + "_metrics.csv")).string();
-    if (path.empty()) return;
+    if (path.empty() || prog_.rank > 0) return;  // a distributed run: rank 0 writes it
     metrics_csv_.open(path, std::ios::trunc);
     if (!metrics_csv_) throw std::runtime_error("cannot write the metrics to '" + path + "'");
     metrics_csv_ << metrics_csv_header(prog_.metrics) << "\n" << std::flush;
@@ -761,7 +761,7 @@ class Simulation {
   void report_metrics() {
     if (!last_metrics_) return;
     const MetricsRow& r = *last_metrics_;
-    if (!opt_.quiet)
+    if (!opt_.quiet && prog_.rank <= 0)
       fmt::print(stderr, "metrics at t={}: {}\n", r.t, metrics_text(prog_.metrics, r.values));
     if (opt_.timing) {
       fmt::print("metrics: t={} step={} wall_s={:.6g} cpu_s={:.6g} {}\n", r.t, r.step, r.wall_s,

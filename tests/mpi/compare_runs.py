@@ -10,6 +10,11 @@ gid) and every property (and constant) of the reference must agree within T time
 (the largest |value| of the reference's property in that file, at least 1e-300). Prints the
 worst difference per property over all files and exits 1 if any exceeds T or anything is
 missing.
+
+Where the reference has a metrics CSV (*_metrics.csv, the scene's metrics { }), the other run
+must have it too, with the same rows (step, t) and every metric column (value, reference,
+error) within T times that column's scale (its largest |value| in the reference); the time
+columns wall_s and cpu_s are not compared.
 """
 import glob
 import os
@@ -33,6 +38,46 @@ def arrays(path):
                 for k, v in g["constants"].attrs.items():
                     out[name]["const:" + k] = np.array(v)
     return out
+
+
+def read_csv(path):
+    with open(path) as f:
+        header = f.readline().strip().split(",")
+        rows = [[float(v) for v in line.strip().split(",")] for line in f if line.strip()]
+    return header, np.array(rows, dtype=float).reshape(len(rows), len(header))
+
+
+def compare_metrics(ref_dir, other_dir, tol):
+    """(ok, lines) for the metrics CSVs; ok is None without one in the reference."""
+    files = sorted(glob.glob(os.path.join(ref_dir, "*_metrics.csv")))
+    if not files:
+        return None, []
+    ok, lines = True, []
+    for fr in files:
+        fo = os.path.join(other_dir, os.path.basename(fr))
+        if not os.path.exists(fo):
+            return False, [f"compare_runs: {fo} missing (the reference has metrics)"]
+        hr, r = read_csv(fr)
+        ho, o = read_csv(fo)
+        if hr != ho or r.shape != o.shape:
+            return False, [f"compare_runs: {fo}: columns {ho} and {o.shape[0]} rows, the "
+                           f"reference {hr} and {r.shape[0]} rows"]
+        if not np.array_equal(r[:, 0], o[:, 0]):
+            return False, [f"compare_runs: {fo}: other steps than the reference"]
+        for k, name in enumerate(hr):
+            if name in ("step", "wall_s", "cpu_s"):
+                continue
+            a, b = r[:, k], o[:, k]
+            if not np.array_equal(np.isnan(a), np.isnan(b)):
+                ok = False
+                lines.append(f"metric {name:<10} NaN in one run only")
+                continue
+            m = ~np.isnan(a)
+            scale = max(float(np.max(np.abs(a[m]))) if m.any() else 0.0, 1e-300)
+            d = float(np.max(np.abs(a[m] - b[m]))) / scale if m.any() else 0.0
+            lines.append(f"metric {name:<10} worst {d:.3e} of its scale ({r.shape[0]} rows)")
+            ok = ok and d <= tol
+    return ok, lines
 
 
 def main():
@@ -82,6 +127,11 @@ def main():
                 ok = ok and d <= tol
     for key, (d, f) in sorted(worst.items()):
         print(f"{key:<16} worst {d:.3e} of its scale ({f})")
+    mok, lines = compare_metrics(ref_dir, other_dir, tol)
+    for line in lines:
+        print(line)
+    if mok is not None:
+        ok = ok and mok
     print(f"compare_runs: {len(files)} files, tolerance {tol:g}: {'ok' if ok else 'FAILED'}")
     return 0 if ok else 1
 
