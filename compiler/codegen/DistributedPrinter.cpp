@@ -58,7 +58,6 @@ std::string ScenePrinter::globalReduction(const std::string& op, const std::stri
 void ScenePrinter::distributedMembers() {
   if (mpi_) {
     out_ << "  sphc::mpi::Decomposition decomposition;  // this rank's region (Zoltan)\n";
-    out_ << "  std::vector<sphc::ParticleArray> gathered;  // output: every rank's particles, rank 0\n";
     out_ << "  std::vector<sphc::Limit> default_limits;  // the whole set-up's box (sanity.h)\n";
   }
 }
@@ -104,11 +103,9 @@ std::string ScenePrinter::distributedReport() const {
 void ScenePrinter::distributedMain() {
   if (!mpi_) return;
   out_ << "  prog.rank = sphc::mpi::rank();  // rank 0 writes the files and the progress line\n";
-  out_ << "  prog.output_arrays = [] {  // every rank's particles, gathered to rank 0 in gid order\n";
-  out_ << "    sphc::mpi::gather_arrays(" << allArrays("scene.") << ", scene.gathered);\n";
-  out_ << "    std::vector<sphc::ParticleArray*> out;\n";
-  out_ << "    for (sphc::ParticleArray& a : scene.gathered) out.push_back(&a);\n";
-  out_ << "    return out;\n  };\n";
+  out_ << "  // Output: collective parallel HDF5, or gathered to rank 0 (sphc/mpi/output.h).\n";
+  out_ << "  sphc::mpi::set_output(prog, [] {\n";
+  out_ << "    return std::vector<sphc::ParticleArray*>" << allArrays("scene.") << ";\n  });\n";
   out_ << "  prog.default_limits = [] { return scene.default_limits; };\n";
 }
 

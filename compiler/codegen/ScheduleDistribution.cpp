@@ -33,7 +33,7 @@ void printDistribution(const Schedule& s, llvm::raw_ostream& os) {
     os << "\n";
   }
   os << "  global (MPI_Allreduce): reductions, adaptive dt, converged of iterated groups\n";
-  os << "  output: gathered to rank 0 in gid order\n";
+  os << "  output: parallel HDF5 (collective, gid order), or gathered to rank 0 without it\n";
 }
 
 }  // namespace sphc

@@ -379,15 +379,22 @@ class OutputWriter {
     if (!enabled_) return;
     const std::string file = fmt::format("{}_{:06d}.h5", scene_, meta.step);
     const std::vector<OutputArray> selection = selected(arrays);
-    write_particles_hdf5(in_dir(file), selection, meta);
-    series_.push_back(make_xdmf_entry(file, meta.t, selection));
-    write_xdmf(in_dir(scene_ + ".xdmf"), series_, prog_.dim);
+    if (prog_.write_particles) {  // every rank writes its part (sphc/mpi/output.h)
+      series_.push_back(prog_.write_particles(in_dir(file), file, selection, meta));
+    } else {
+      write_particles_hdf5(in_dir(file), selection, meta);
+      series_.push_back(make_xdmf_entry(file, meta.t, selection));
+    }
+    if (prog_.rank <= 0) write_xdmf(in_dir(scene_ + ".xdmf"), series_, prog_.dim);
     newest_ = in_dir(file);
   }
 
   // Every property of every array, for inspection; not indexed by the XDMF file.
   std::string write_blowup(const std::vector<ParticleArray*>& arrays, const OutputMeta& meta) {
-    const std::string path = in_dir(scene_ + "_blowup.h5");
+    // A distributed run: each rank that stops writes its own particles.
+    const std::string path =
+        in_dir(prog_.rank > 0 ? fmt::format("{}_blowup_rank{}.h5", scene_, prog_.rank)
+                              : scene_ + "_blowup.h5");
     std::vector<OutputArray> all;
     for (const ParticleArray* a : arrays) all.push_back(OutputArray{a, {}});
     write_particles_hdf5(path, all, meta);
@@ -567,7 +574,9 @@ class Simulation {
     set_up_limits();
     const std::string dir =
         opt_.directory.empty() ? scene_name(prog_) + "_output" : opt_.directory;
-    OutputWriter writer(prog_, dir, !opt_.no_output && prog_.rank <= 0);
+    // Distributed: rank 0 writes, or every rank with collective output (write_particles).
+    OutputWriter writer(prog_, dir,
+                        !opt_.no_output && (prog_.rank <= 0 || prog_.write_particles != nullptr));
     writer_ = &writer;
     open_metrics(dir);
 

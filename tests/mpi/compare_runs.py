@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Compares the outputs of two runs of one scene particle by particle, matched by global id.
 
-    compare_runs.py REFERENCE_DIR OTHER_DIR [--tol T]
+    compare_runs.py REFERENCE_DIR OTHER_DIR [--tol T] [--gid-order]
 
 Both directories hold the HDF5 files of a run (scene_NNNNNN.h5) written with global ids
 (`sphc --global-ids`, implied by `--mpi`). Every file of the reference must exist in the other
@@ -10,6 +10,11 @@ gid) and every property (and constant) of the reference must agree within T time
 (the largest |value| of the reference's property in that file, at least 1e-300). Prints the
 worst difference per property over all files and exits 1 if any exceeds T or anything is
 missing.
+
+The files must also have the reference's layout: the same root attributes (step, dim and scene
+equal, t and dt within T), the same array groups and datasets in the same order with the same
+types and shapes; with --gid-order, the other run's particles in gid order (the order a
+distributed run writes, whatever the rank count; a serial run may have reordered its own).
 
 Where the reference has a metrics CSV (*_metrics.csv, the scene's metrics { }), the other run
 must have it too, with the same rows (step, t) and every metric column (value, reference,
@@ -37,6 +42,39 @@ def arrays(path):
             if "constants" in g:  # per-array constants (reductions), as attributes
                 for k, v in g["constants"].attrs.items():
                     out[name]["const:" + k] = np.array(v)
+    return out
+
+
+def layout_problems(fr, fo, tol, gid_order):
+    """What differs in the layout (attributes, groups, datasets, order) of two files."""
+    out = []
+    with h5py.File(fr, "r") as a, h5py.File(fo, "r") as b:
+        if sorted(a.attrs) != sorted(b.attrs):
+            out.append(f"root attributes {sorted(b.attrs)}, expected {sorted(a.attrs)}")
+        for k in ("step", "dim", "scene"):
+            if k in a.attrs and k in b.attrs and a.attrs[k] != b.attrs[k]:
+                out.append(f"root attribute {k} = {b.attrs[k]}, expected {a.attrs[k]}")
+        for k in ("t", "dt"):
+            if k in a.attrs and k in b.attrs and abs(a.attrs[k] - b.attrs[k]) > tol * max(abs(a.attrs[k]), 1e-300):
+                out.append(f"root attribute {k} = {b.attrs[k]}, expected {a.attrs[k]}")
+        if list(a.keys()) != list(b.keys()):
+            out.append(f"groups {list(b.keys())}, expected {list(a.keys())}")
+        for name in a:
+            if name not in b or not isinstance(a[name], h5py.Group):
+                continue
+            ga, gb = a[name], b[name]
+            if list(ga.keys()) != list(gb.keys()):
+                out.append(f"{name}: members {list(gb.keys())}, expected {list(ga.keys())}")
+            if ga.attrs.get("n") != gb.attrs.get("n"):
+                out.append(f"{name}: n = {gb.attrs.get('n')}, expected {ga.attrs.get('n')}")
+            for k in ga:
+                if k in gb and isinstance(ga[k], h5py.Dataset):
+                    if ga[k].dtype != gb[k].dtype or ga[k].shape != gb[k].shape:
+                        out.append(f"{name}/{k}: {gb[k].dtype} {gb[k].shape}, expected "
+                                   f"{ga[k].dtype} {ga[k].shape}")
+            if gid_order and "gid" in gb:
+                if not np.all(np.diff(np.array(gb["gid"]).astype(np.int64)) > 0):
+                    out.append(f"{name}: particles not in gid order")
     return out
 
 
@@ -87,6 +125,9 @@ def main():
         k = args.index("--tol")
         tol = float(args[k + 1])
         del args[k:k + 2]
+    gid_order = "--gid-order" in args
+    if gid_order:
+        args.remove("--gid-order")
     ref_dir, other_dir = args
     files = sorted(glob.glob(os.path.join(ref_dir, "*_[0-9]*.h5")))
     if not files:
@@ -99,6 +140,9 @@ def main():
         if not os.path.exists(fo):
             print(f"compare_runs: {fo} missing (the reference has {os.path.basename(fr)})")
             return 1
+        for problem in layout_problems(fr, fo, tol, gid_order):
+            print(f"compare_runs: {fo}: {problem}")
+            ok = False
         ra, oa = arrays(fr), arrays(fo)
         for name, rp in ra.items():
             if name not in oa or "gid" not in rp or "gid" not in oa[name]:
