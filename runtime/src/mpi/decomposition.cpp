@@ -7,6 +7,7 @@
 #include <zoltan.h>
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 
 #include "sphc/mpi/comm.h"
@@ -177,6 +178,7 @@ void ranks_near(const Decomposition& d, const double lo[3], const double hi[3],
 
 std::size_t migrate(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   const int P = size(), me = rank();
+  if (P == 1) return 0;  // every particle is the only rank's
   std::size_t sent_total = 0;
   for (ParticleArray* a : arrays) {
     int pos[3];
@@ -255,7 +257,16 @@ void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   d.cut = true;
   ++d.rebalances;
   d.has_region = false;
-  if (d.method == "RCB") {
+  if (size() == 1) {
+    // One rank owns all space: every position and halo box is inside its region, so
+    // migration and the halo take the fast path (no Zoltan query per particle; Zoltan keeps
+    // no RCB box for a single part).
+    for (int c = 0; c < 3; ++c) {
+      d.region_lo[c] = -std::numeric_limits<double>::infinity();
+      d.region_hi[c] = std::numeric_limits<double>::infinity();
+    }
+    d.has_region = true;
+  } else if (d.method == "RCB") {
     int ndim = 0;
     double* lo = d.region_lo;
     double* hi = d.region_hi;
