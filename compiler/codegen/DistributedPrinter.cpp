@@ -4,6 +4,8 @@
 // own file so that the serial printers read as before.
 #include "codegen/Printer.h"
 
+#include <cstdio>
+
 namespace sphc {
 
 std::string ScenePrinter::allArrays(const std::string& prefix) const {
@@ -71,6 +73,15 @@ void ScenePrinter::distributedFunctions() {
     scene_ << "    sphc::mpi::init_decomposition(decomposition, DIM, \"" << d.method << "\");\n";
     scene_ << "    decomposition.rebalance_every = " << d.rebalanceEvery << ";\n";
     scene_ << "    decomposition.imbalance_limit = " << d.imbalanceLimit << ";\n";
+    scene_ << "    // Work per particle of each array (1 + neighbour passes as destination).\n";
+    scene_ << "    sphc::mpi::set_weights(decomposition, {";
+    for (size_t a = 0; a < d.weights.size(); ++a)
+    {
+      char w[32];
+      std::snprintf(w, sizeof w, "%.17g", d.weights[a]);
+      scene_ << (a ? ", " : "") << w;
+    }
+    scene_ << "});\n";
     scene_ << "    default_limits = sphc::bounding_box_limits(" << allArrays("") << ", DIM);\n";
     scene_ << "    sphc::mpi::distribute(decomposition, " << allArrays("") << ");\n";
     scene_ << "  }\n\n";

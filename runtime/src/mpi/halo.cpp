@@ -184,7 +184,10 @@ void report_stats(const Decomposition& dec, const std::vector<const ParticleArra
              std::to_string(last);
   }
   std::size_t n = 0;
-  for (const ParticleArray* a : arrays) n += a->n;
+  for (const ParticleArray* a : arrays) {
+    n += a->n;
+    sizes += " n_" + a->name + "=" + std::to_string(a->n);
+  }
   std::fprintf(stderr,
                "mpi: rank=%d ranks=%d particles=%zu evaluations=%ld rebalances=%ld migrated=%ld "
                "halo_bytes=%zu halo_bytes_per_evaluation=%.0f%s\n",
