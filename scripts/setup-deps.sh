@@ -34,8 +34,9 @@ echo "setup-deps: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-# libhdf5-openmpi-dev makes pkg-config's hdf5.pc the MPI one; the solvers link the serial
-# library (CMake's FindHDF5 through h5cc), so keep pkg-config saying the same.
+# libhdf5-openmpi-dev makes pkg-config's hdf5.pc the MPI one; the serial solvers and the
+# runtime link the serial library (CMake's FindHDF5 through h5cc), so keep pkg-config saying
+# the same (--mpi solvers link the parallel library by its path, runtime/CMakeLists.txt).
 if [ -e /usr/lib/x86_64-linux-gnu/pkgconfig/hdf5-serial.pc ]; then
   $SUDO update-alternatives --quiet --set hdf5.pc /usr/lib/x86_64-linux-gnu/pkgconfig/hdf5-serial.pc || true
 fi

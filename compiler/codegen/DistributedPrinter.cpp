@@ -4,6 +4,8 @@
 // own file so that the serial printers read as before.
 #include "codegen/Printer.h"
 
+#include <cstdio>
+
 namespace sphc {
 
 std::string ScenePrinter::allArrays(const std::string& prefix) const {
@@ -58,7 +60,6 @@ std::string ScenePrinter::globalReduction(const std::string& op, const std::stri
 void ScenePrinter::distributedMembers() {
   if (mpi_) {
     out_ << "  sphc::mpi::Decomposition decomposition;  // this rank's region (Zoltan)\n";
-    out_ << "  std::vector<sphc::ParticleArray> gathered;  // output: every rank's particles, rank 0\n";
     out_ << "  std::vector<sphc::Limit> default_limits;  // the whole set-up's box (sanity.h)\n";
   }
 }
@@ -72,6 +73,15 @@ void ScenePrinter::distributedFunctions() {
     scene_ << "    sphc::mpi::init_decomposition(decomposition, DIM, \"" << d.method << "\");\n";
     scene_ << "    decomposition.rebalance_every = " << d.rebalanceEvery << ";\n";
     scene_ << "    decomposition.imbalance_limit = " << d.imbalanceLimit << ";\n";
+    scene_ << "    // Work per particle of each array (1 + neighbour passes as destination).\n";
+    scene_ << "    sphc::mpi::set_weights(decomposition, {";
+    for (size_t a = 0; a < d.weights.size(); ++a)
+    {
+      char w[32];
+      std::snprintf(w, sizeof w, "%.17g", d.weights[a]);
+      scene_ << (a ? ", " : "") << w;
+    }
+    scene_ << "});\n";
     scene_ << "    default_limits = sphc::bounding_box_limits(" << allArrays("") << ", DIM);\n";
     scene_ << "    sphc::mpi::distribute(decomposition, " << allArrays("") << ");\n";
     scene_ << "  }\n\n";
@@ -104,11 +114,9 @@ std::string ScenePrinter::distributedReport() const {
 void ScenePrinter::distributedMain() {
   if (!mpi_) return;
   out_ << "  prog.rank = sphc::mpi::rank();  // rank 0 writes the files and the progress line\n";
-  out_ << "  prog.output_arrays = [] {  // every rank's particles, gathered to rank 0 in gid order\n";
-  out_ << "    sphc::mpi::gather_arrays(" << allArrays("scene.") << ", scene.gathered);\n";
-  out_ << "    std::vector<sphc::ParticleArray*> out;\n";
-  out_ << "    for (sphc::ParticleArray& a : scene.gathered) out.push_back(&a);\n";
-  out_ << "    return out;\n  };\n";
+  out_ << "  // Output: collective parallel HDF5, or gathered to rank 0 (sphc/mpi/output.h).\n";
+  out_ << "  sphc::mpi::set_output(prog, [] {\n";
+  out_ << "    return std::vector<sphc::ParticleArray*>" << allArrays("scene.") << ";\n  });\n";
   out_ << "  prog.default_limits = [] { return scene.default_limits; };\n";
 }
 

@@ -607,7 +607,8 @@ std::string ScenePrinter::run() {
   if (globalIds_) out_ << "#include \"sphc/global_ids.h\"\n";
   if (mpi_)
     out_ << "#include \"sphc/mpi/comm.h\"\n#include \"sphc/mpi/decomposition.h\"\n"
-            "#include \"sphc/mpi/gather.h\"\n#include \"sphc/mpi/halo.h\"\n";
+            "#include \"sphc/mpi/gather.h\"\n#include \"sphc/mpi/halo.h\"\n"
+            "#include \"sphc/mpi/output.h\"\n";
   runtimeIncludes();
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   systemIncludes();

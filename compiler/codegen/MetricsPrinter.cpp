@@ -1,7 +1,8 @@
 // The scene's metrics { } in the host program (docs/language.md, Metrics): a member function
 // of struct Scene that evaluates every metric on the host arrays (the run loop calls it where
 // it writes output, after a device backend's data came back), and the metrics' descriptions
-// in `main` (sphc/metrics.h). Shared by every backend.
+// in `main` (sphc/metrics.h). Shared by every backend; under --mpi each metric's sums are
+// combined over the ranks before it is finished (a collective call on every rank).
 #include "codegen/Printer.h"
 
 #include <cstdio>
@@ -89,6 +90,8 @@ void ScenePrinter::emitMetrics() {
     else
       scene_ << "        sphc::add(acc, " << value << ");\n";
     scene_ << "      }\n";
+    // --mpi: the sums of every rank's particles (sphc/mpi/comm.h), the same on every rank.
+    if (mpi_) scene_ << "      sphc::mpi::all_reduce(acc);  // over every rank's particles\n";
     if (m.isNorm()) {
       scene_ << "      r[" << k << "].value = sphc::norm(acc, " << normKind(m.kind) << ", "
              << (m.relative ? "true" : "false") << ");\n";

@@ -173,6 +173,9 @@ struct Distribution {
   double imbalanceLimit = 1.1;       // largest rank's particles / mean
   std::vector<int> migrate;          // every array (all properties move)
   std::vector<std::pair<int, std::vector<std::string>>> halo;  // source array, properties sent
+  // Per array (plan order): the estimated work of one of its particles, Zoltan's object
+  // weight (ScheduleDistribution.cpp, workWeights).
+  std::vector<double> weights;
 };
 
 struct Schedule {

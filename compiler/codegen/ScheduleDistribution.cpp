@@ -8,12 +8,34 @@
 
 namespace sphc {
 
+namespace {
+
+// The work of a particle of each array, estimated from the equations: 1 (its per-particle
+// work: steppers, initialize) plus one per neighbour pass it is the destination of (each live
+// equation with a loop or loop_all, once per source array it lists). A wall that only sums
+// a density from the fluid weighs little next to a fluid particle with pressure, viscosity
+// and diffusion loops over fluid and walls, so RCB splits the work, not the particle count.
+std::vector<double> workWeights(const Plan& plan) {
+  std::vector<double> w(plan.arrays.size(), 1.0);
+  for (const PlanEquation& e : plan.equations) {
+    if (!e.live || e.dest < 0 || e.declIndex < 0) continue;
+    bool pairs = false;
+    for (const auto& [kind, body] : plan.equationDecls[e.declIndex].methods)
+      pairs |= kind == ast::Method::Loop || kind == ast::Method::LoopAll;
+    if (pairs) w[e.dest] += static_cast<double>(e.sources.size());
+  }
+  return w;
+}
+
+}  // namespace
+
 Distribution distributionOf(const Plan& plan, const std::vector<int>& cellLists) {
   Distribution d;
   d.enabled = plan.distributed;
   if (!d.enabled) return d;
   for (int a = 0; a < static_cast<int>(plan.arrays.size()); ++a) d.migrate.push_back(a);
   for (int a : cellLists) d.halo.push_back({a, plan.arrays[a].ghostProps});
+  d.weights = workWeights(plan);
   return d;
 }
 
@@ -22,8 +44,12 @@ void printDistribution(const Schedule& s, llvm::raw_ostream& os) {
   if (!d.enabled) return;
   const Plan& p = *s.plan;
   os << "distributed (MPI): Zoltan " << d.method << ", re-balance every " << d.rebalanceEvery
-     << " evaluations or when max/mean particles per rank > "
+     << " evaluations or when max/mean work (weighted particles) per rank > "
      << llvm::format("%g", d.imbalanceLimit) << "\n";
+  os << "  particle weights (work estimate: 1 + neighbour passes as destination):";
+  for (size_t a = 0; a < d.weights.size(); ++a)
+    os << " " << p.arrays[a].name << "=" << llvm::format("%g", d.weights[a]);
+  os << "\n";
   os << "  update_neighbours starts with: migrate";
   for (int a : d.migrate) os << " " << p.arrays[a].name;
   os << " (every property, global id gid)\n";
@@ -33,7 +59,7 @@ void printDistribution(const Schedule& s, llvm::raw_ostream& os) {
     os << "\n";
   }
   os << "  global (MPI_Allreduce): reductions, adaptive dt, converged of iterated groups\n";
-  os << "  output: gathered to rank 0 in gid order\n";
+  os << "  output: parallel HDF5 (collective, gid order), or gathered to rank 0 without it\n";
 }
 
 }  // namespace sphc

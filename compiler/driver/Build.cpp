@@ -102,6 +102,10 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   const std::string mpiLib = install.libDir + "/libsphc_mpi.a";
   if (req.mpi) {
     flags += " " + info["mpi_flags"];
+    // Parallel HDF5 in place of the serial library (collective output), where found.
+    const std::string base = info["mpi_base_libs"];
+    if (!base.empty() && libs.compare(0, info["libs"].size(), info["libs"]) == 0)
+      libs = base + libs.substr(info["libs"].size());
     libs = info["mpi_libs"] + " " + libs;
   }
 

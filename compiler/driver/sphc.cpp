@@ -201,20 +201,12 @@ int main(int argc, char** argv) {
     }
   }
   plan->distributed = Mpi;
-  // Not distributed yet: inlets and outlets (arrays that grow and shrink on one rank), and
-  // metrics (they would read each rank's own particles): a distributed build leaves the
-  // metrics out, with a warning, and refuses zones.
+  // Not distributed yet: inlets and outlets (arrays that grow and shrink on one rank).
+  // Metrics are: their sums are combined over the ranks (sphc/mpi/comm.h, all_reduce).
   if (Mpi && !plan->zones.empty()) {
     diags.error(plan->zones.front().loc, "--mpi does not support inlets and outlets yet: "
                                          "build this scene without --mpi");
     return fail();
-  }
-  if (Mpi && !plan->metrics.empty()) {
-    diags.warning(plan->metrics.front().loc,
-                  "--mpi: the scene's metrics { } are not evaluated in a distributed run yet "
-                  "(no metrics CSV); run without --mpi to measure them");
-    plan->metrics.clear();
-    for (auto& a : plan->arrays) a.metricProps.clear();
   }
   auto dump = [&](Pass pass) {
     if (DumpAfter != pass) return false;

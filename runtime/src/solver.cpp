@@ -389,15 +389,22 @@ class OutputWriter {
     if (!enabled_) return;
     const std::string file = fmt::format("{}_{:06d}.h5", scene_, meta.step);
     const std::vector<OutputArray> selection = selected(arrays);
-    write_particles_hdf5(in_dir(file), selection, meta);
-    series_.push_back(make_xdmf_entry(file, meta.t, selection));
-    write_xdmf(in_dir(scene_ + ".xdmf"), series_, prog_.dim);
+    if (prog_.write_particles) {  // every rank writes its part (sphc/mpi/output.h)
+      series_.push_back(prog_.write_particles(in_dir(file), file, selection, meta));
+    } else {
+      write_particles_hdf5(in_dir(file), selection, meta);
+      series_.push_back(make_xdmf_entry(file, meta.t, selection));
+    }
+    if (prog_.rank <= 0) write_xdmf(in_dir(scene_ + ".xdmf"), series_, prog_.dim);
     newest_ = in_dir(file);
   }
 
   // Every property of every array, for inspection; not indexed by the XDMF file.
   std::string write_blowup(const std::vector<ParticleArray*>& arrays, const OutputMeta& meta) {
-    const std::string path = in_dir(scene_ + "_blowup.h5");
+    // A distributed run: each rank that stops writes its own particles.
+    const std::string path =
+        in_dir(prog_.rank > 0 ? fmt::format("{}_blowup_rank{}.h5", scene_, prog_.rank)
+                              : scene_ + "_blowup.h5");
     std::vector<OutputArray> all;
     for (const ParticleArray* a : arrays) all.push_back(OutputArray{a, {}});
     write_particles_hdf5(path, all, meta);
@@ -590,7 +597,9 @@ class Simulation {
     set_up_limits();
     const std::string dir =
         opt_.directory.empty() ? scene_name(prog_) + "_output" : opt_.directory;
-    OutputWriter writer(prog_, dir, !opt_.no_output && prog_.rank <= 0);
+    // Distributed: rank 0 writes, or every rank with collective output (write_particles).
+    OutputWriter writer(prog_, dir,
+                        !opt_.no_output && (prog_.rank <= 0 || prog_.write_particles != nullptr));
     writer_ = &writer;
     open_metrics(dir);
 
@@ -761,7 +770,7 @@ class Simulation {
     std::string path = opt_.metrics_file;
     if (path.empty() && !opt_.no_output)
       path = (std::filesystem::path(dir) / (scene_name(prog_) + "_metrics.csv")).string();
-    if (path.empty()) return;
+    if (path.empty() || prog_.rank > 0) return;  // a distributed run: rank 0 writes it
     metrics_csv_.open(path, std::ios::trunc);
     if (!metrics_csv_) throw std::runtime_error("cannot write the metrics to '" + path + "'");
     metrics_csv_ << metrics_csv_header(prog_.metrics) << "\n" << std::flush;
@@ -786,7 +795,7 @@ class Simulation {
   void report_metrics() {
     if (!last_metrics_) return;
     const MetricsRow& r = *last_metrics_;
-    if (!opt_.quiet)
+    if (!opt_.quiet && prog_.rank <= 0)
       fmt::print(stderr, "metrics at t={}: {}\n", r.t, metrics_text(prog_.metrics, r.values));
     if (opt_.timing) {
       fmt::print("metrics: t={} step={} wall_s={:.6g} cpu_s={:.6g} {}\n", r.t, r.step, r.wall_s,

@@ -32,7 +32,7 @@ for np in "$@"; do
   timeout 300 "$MPIRUN" --allow-run-as-root --oversubscribe -np "$np" "$W/mpi" $RUN_ARGS \
     --max-steps "$STEPS" --quiet --timing -d "$W/out_$np" > "$W/np$np.txt"
   echo "== $np ranks"
-  "$PY" "$SRC/tests/mpi/compare_runs.py" "$W/out_serial" "$W/out_$np"
+  "$PY" "$SRC/tests/mpi/compare_runs.py" --gid-order "$W/out_serial" "$W/out_$np"
   ranks=$(grep -c '^timing:.* rank=' "$W/np$np.txt")
   if [ "$ranks" -ne "$np" ]; then
     echo "run_compare: $ranks timing lines for $np ranks"; exit 1

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "sphc/hdf5_io.h"
 #include "sphc/memory.h"
 #include "sphc/metrics.h"
 #include "sphc/particle_array.h"
@@ -128,6 +129,13 @@ struct SceneProgram {
   // The arrays an output writes, when they are not `arrays` (distributed: every rank's
   // particles gathered to rank 0). Called on every rank at each output (collective).
   std::function<std::vector<ParticleArray*>()> output_arrays;
+  // Distributed runs with collective output (sphc/mpi/output.h): writes the output file `path`
+  // (named `file` in the output directory) from every rank's particles of the selection, on
+  // every rank together, and returns the file's XDMF entry (whole-job particle counts).
+  // Empty: rank 0 writes with write_particles_hdf5.
+  std::function<XdmfEntry(const std::string& path, const std::string& file,
+                          const std::vector<OutputArray>& selection, const OutputMeta& meta)>
+      write_particles;
   // The default box limits (sanity.h), when not those of `arrays` after the set-up
   // (distributed: the box of the whole set-up, taken before each rank kept its particles).
   std::function<std::vector<Limit>()> default_limits;

@@ -3,8 +3,11 @@
 
 #include <mpi.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <vector>
 
 namespace sphc::mpi {
 
@@ -47,6 +50,60 @@ double max(double x) { return reduce(x, MPI_DOUBLE, MPI_MAX); }
 long sum(long x) { return reduce(x, MPI_LONG, MPI_SUM); }
 long max(long x) { return reduce(x, MPI_LONG, MPI_MAX); }
 bool all(bool x) { return reduce(x ? 1 : 0, MPI_INT, MPI_MIN) == 1; }
+
+namespace {
+// Every rank's `k` doubles, in rank order, on every rank.
+std::vector<double> all_gather(const double* mine, int k) {
+  std::vector<double> all(static_cast<std::size_t>(k) * static_cast<std::size_t>(size()));
+  MPI_Allgather(mine, k, MPI_DOUBLE, all.data(), k, MPI_DOUBLE, MPI_COMM_WORLD);
+  return all;
+}
+
+double nan_max(double a, double b) {
+  return std::isnan(a) || std::isnan(b) ? kNoValue : std::max(a, b);
+}
+double nan_min(double a, double b) {
+  return std::isnan(a) || std::isnan(b) ? kNoValue : std::min(a, b);
+}
+
+// Neumaier: adds v to (sum, c).
+void add_compensated(double& sum, double& c, double v) {
+  const double t = sum + v;
+  c += std::fabs(sum) >= std::fabs(v) ? (sum - t) + v : (v - t) + sum;
+  sum = t;
+}
+}  // namespace
+
+void all_reduce(NormSums& s) {
+  const double mine[7] = {s.err_abs, s.err_sq, s.err_max, s.ref_abs,
+                          s.ref_sq,  s.ref_max, static_cast<double>(s.n)};
+  const std::vector<double> all = all_gather(mine, 7);
+  NormSums r;
+  for (std::size_t k = 0; k + 7 <= all.size(); k += 7) {
+    r.err_abs += all[k];
+    r.err_sq += all[k + 1];
+    r.err_max = nan_max(r.err_max, all[k + 2]);
+    r.ref_abs += all[k + 3];
+    r.ref_sq += all[k + 4];
+    r.ref_max = std::max(r.ref_max, all[k + 5]);
+    r.n += static_cast<long>(all[k + 6]);
+  }
+  s = r;
+}
+
+void all_reduce(ScalarSums& s) {
+  const double mine[5] = {s.max, s.min, s.sum, s.compensation, static_cast<double>(s.n)};
+  const std::vector<double> all = all_gather(mine, 5);
+  ScalarSums r;
+  for (std::size_t k = 0; k + 5 <= all.size(); k += 5) {
+    r.max = nan_max(r.max, all[k]);
+    r.min = nan_min(r.min, all[k + 1]);
+    add_compensated(r.sum, r.compensation, all[k + 2]);
+    add_compensated(r.sum, r.compensation, all[k + 3]);
+    r.n += static_cast<long>(all[k + 4]);
+  }
+  s = r;
+}
 
 int finish(int rc) {
   if (rc == 0) {

@@ -7,6 +7,8 @@
 #include <zoltan.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <limits>
 #include <stdexcept>
 
 #include "sphc/mpi/comm.h"
@@ -18,6 +20,7 @@ namespace {
 // What Zoltan's callbacks see: every particle of every array, numbered in array order.
 struct Objects {
   const std::vector<ParticleArray*>* arrays = nullptr;
+  const std::vector<double>* weights = nullptr;  // per array; empty: none
   int dim = 2;
   unsigned long first = 0;  // global number of this rank's first object
 };
@@ -33,13 +36,20 @@ int num_obj(void* data, int* ierr) {
   return static_cast<int>(local_count(*static_cast<Objects*>(data)->arrays));
 }
 
-void obj_list(void* data, int, int, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int, float*,
-              int* ierr) {
+void obj_list(void* data, int, int, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int wdim,
+              float* wgts, int* ierr) {
   const Objects& o = *static_cast<Objects*>(data);
   const std::size_t n = local_count(*o.arrays);
   for (std::size_t i = 0; i < n; ++i) {
     gids[i] = static_cast<ZOLTAN_ID_TYPE>(o.first + i);
     lids[i] = static_cast<ZOLTAN_ID_TYPE>(i);
+  }
+  if (wdim == 1 && wgts && o.weights && !o.weights->empty()) {
+    std::size_t i = 0;
+    for (std::size_t k = 0; k < o.arrays->size(); ++k) {
+      const float w = static_cast<float>(k < o.weights->size() ? (*o.weights)[k] : 1.0);
+      for (std::size_t j = 0; j < (*o.arrays)[k]->n; ++j) wgts[i++] = w;
+    }
   }
   *ierr = ZOLTAN_OK;
 }
@@ -118,6 +128,12 @@ void init_decomposition(Decomposition& d, int dim, const std::string& method) {
   Zoltan_Set_Param(d.zz, "KEEP_CUTS", "1");        // for Point_Assign and Box_Assign
 }
 
+void set_weights(Decomposition& d, const std::vector<double>& per_array) {
+  // SPHC_MPI_UNWEIGHTED=1: every particle weighs 1 (to measure what the weights change).
+  d.weights = std::getenv("SPHC_MPI_UNWEIGHTED") ? std::vector<double>{} : per_array;
+  Zoltan_Set_Param(d.zz, "OBJ_WEIGHT_DIM", d.weights.empty() ? "0" : "1");
+}
+
 std::size_t packed_size(const ParticleArray& a) {
   std::size_t s = 0;
   for (const Property& p : a.props) s += static_cast<std::size_t>(p.stride);
@@ -177,6 +193,7 @@ void ranks_near(const Decomposition& d, const double lo[3], const double hi[3],
 
 std::size_t migrate(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   const int P = size(), me = rank();
+  if (P == 1) return 0;  // every particle is the only rank's
   std::size_t sent_total = 0;
   for (ParticleArray* a : arrays) {
     int pos[3];
@@ -236,6 +253,7 @@ std::size_t migrate(Decomposition& d, const std::vector<ParticleArray*>& arrays)
 void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   Objects o;
   o.arrays = &arrays;
+  o.weights = &d.weights;
   o.dim = d.dim;
   const unsigned long n = local_count(arrays);
   MPI_Exscan(&n, &o.first, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
@@ -255,7 +273,16 @@ void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   d.cut = true;
   ++d.rebalances;
   d.has_region = false;
-  if (d.method == "RCB") {
+  if (size() == 1) {
+    // One rank owns all space: every position and halo box is inside its region, so
+    // migration and the halo take the fast path (no Zoltan query per particle; Zoltan keeps
+    // no RCB box for a single part).
+    for (int c = 0; c < 3; ++c) {
+      d.region_lo[c] = -std::numeric_limits<double>::infinity();
+      d.region_hi[c] = std::numeric_limits<double>::infinity();
+    }
+    d.has_region = true;
+  } else if (d.method == "RCB") {
     int ndim = 0;
     double* lo = d.region_lo;
     double* hi = d.region_hi;
@@ -289,11 +316,21 @@ double imbalance(const std::vector<ParticleArray*>& arrays) {
   return mean > 0 ? static_cast<double>(most) / mean : 1.0;
 }
 
+double imbalance(const Decomposition& d, const std::vector<ParticleArray*>& arrays) {
+  if (d.weights.empty()) return imbalance(arrays);
+  double w = 0;
+  for (std::size_t k = 0; k < arrays.size(); ++k)
+    w += static_cast<double>(arrays[k]->n) * (k < d.weights.size() ? d.weights[k] : 1.0);
+  const double total = sum(w), most = max(w);
+  const double mean = total / size();
+  return mean > 0 ? most / mean : 1.0;
+}
+
 void update(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   ++d.evaluations;
   migrate(d, arrays);
   const bool scheduled = d.rebalance_every > 0 && d.evaluations % d.rebalance_every == 0;
-  if (scheduled || imbalance(arrays) > d.imbalance_limit) rebalance(d, arrays);
+  if (scheduled || imbalance(d, arrays) > d.imbalance_limit) rebalance(d, arrays);
 }
 
 }  // namespace sphc::mpi

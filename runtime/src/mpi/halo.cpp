@@ -125,7 +125,11 @@ std::size_t exchange_halo(const Decomposition& dec, const Domain& d, ParticleArr
   if (d.any()) find_ghosts(d, pos, a.n, cutoff, images, a.name);
   std::size_t g = 0;
   std::vector<int> ranks;
-  for (std::size_t i = 0; i < a.n; ++i) {
+  if (P == 1) {  // one rank: its halo is the images of its particles, in find_ghosts order
+    h.send_index[0].assign(images.source.begin(), images.source.end());
+    h.send_image[0].assign(images.image.begin(), images.image.end());
+  }
+  for (std::size_t i = 0; i < (P == 1 ? 0 : a.n); ++i) {
     // Image 0 (the particle itself), then its ghosts.
     for (bool first = true; first || (g < images.size() && images.source[g] == i); ) {
       std::uint8_t image = 0;
@@ -138,7 +142,8 @@ std::size_t exchange_halo(const Decomposition& dec, const Domain& d, ParticleArr
         lo[c] = c < dec.dim ? p[c] - cutoff : 0.0;
         hi[c] = c < dec.dim ? p[c] + cutoff : 0.0;
       }
-      if (image == 0 && inside_region(dec, lo, hi)) continue;  // needed here only
+      // Needed here only (one rank: its own particles are never in its halo).
+      if (image == 0 && (P == 1 || inside_region(dec, lo, hi))) continue;
       ranks_near(dec, lo, hi, ranks);
       for (int r : ranks) {
         if (r == me && image == 0) continue;
@@ -179,7 +184,10 @@ void report_stats(const Decomposition& dec, const std::vector<const ParticleArra
              std::to_string(last);
   }
   std::size_t n = 0;
-  for (const ParticleArray* a : arrays) n += a->n;
+  for (const ParticleArray* a : arrays) {
+    n += a->n;
+    sizes += " n_" + a->name + "=" + std::to_string(a->n);
+  }
   std::fprintf(stderr,
                "mpi: rank=%d ranks=%d particles=%zu evaluations=%ld rebalances=%ld migrated=%ld "
                "halo_bytes=%zu halo_bytes_per_evaluation=%.0f%s\n",

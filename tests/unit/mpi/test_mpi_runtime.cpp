@@ -257,3 +257,53 @@ int main(int argc, char** argv) {
   const int rc = RUN_ALL_TESTS();
   return sphc::mpi::max(static_cast<long>(rc)) != 0 ? 1 : 0;
 }
+
+// Metrics (sphc/metrics.h) over ranks: each rank adds the values of its share of 1000
+// particles (rank r: indices r, r + P, ...; rank 1 of 2 or more none at all when asked), and
+// all_reduce must give what one accumulator of every value gives, on every rank.
+TEST(MpiMetrics, AllReduceEqualsOneAccumulator) {
+  const int P = sphc::mpi::size(), me = sphc::mpi::rank();
+  auto value = [](int i) { return std::sin(0.1 * i) * 1e3 + 1e-3 * i; };
+  sphc::ScalarSums all_s, mine_s;
+  sphc::NormSums all_n, mine_n;
+  for (int i = 0; i < 1000; ++i) {
+    sphc::add(all_s, value(i));
+    sphc::add(all_n, value(i), std::cos(0.1 * i));
+    const bool empty_rank = P > 1 && me == 1;  // a rank without particles
+    if (!empty_rank && i % (P > 1 ? P - 1 : 1) == (me == 0 ? 0 : me - 1) % (P > 1 ? P - 1 : 1)) {
+      sphc::add(mine_s, value(i));
+      sphc::add(mine_n, value(i), std::cos(0.1 * i));
+    }
+  }
+  sphc::mpi::all_reduce(mine_s);
+  sphc::mpi::all_reduce(mine_n);
+  EXPECT_EQ(mine_s.n, 1000);
+  EXPECT_EQ(mine_n.n, 1000);
+  for (auto k : {sphc::ReduceKind::Max, sphc::ReduceKind::Min, sphc::ReduceKind::Sum,
+                 sphc::ReduceKind::Mean})
+    EXPECT_NEAR(sphc::reduce(mine_s, k), sphc::reduce(all_s, k),
+                1e-13 * std::fabs(sphc::reduce(all_s, k)));
+  for (auto k : {sphc::NormKind::L1, sphc::NormKind::L2, sphc::NormKind::Linf})
+    for (bool rel : {false, true})
+      EXPECT_NEAR(sphc::norm(mine_n, k, rel), sphc::norm(all_n, k, rel),
+                  1e-13 * sphc::norm(all_n, k, rel));
+}
+
+// A NaN on one rank makes the max, min and the norm's maximum NaN on every rank.
+TEST(MpiMetrics, NanOnOneRankIsNanEverywhere) {
+  const int P = sphc::mpi::size(), me = sphc::mpi::rank();
+  sphc::ScalarSums s;
+  sphc::NormSums n;
+  sphc::add(s, 1.0 + me);
+  sphc::add(n, 1.0 + me, 0.5);
+  if (me == P - 1) {
+    sphc::add(s, std::nan(""));
+    sphc::add(n, std::nan(""), 0.5);
+  }
+  sphc::mpi::all_reduce(s);
+  sphc::mpi::all_reduce(n);
+  EXPECT_TRUE(std::isnan(sphc::reduce(s, sphc::ReduceKind::Max)));
+  EXPECT_TRUE(std::isnan(sphc::reduce(s, sphc::ReduceKind::Min)));
+  EXPECT_TRUE(std::isnan(sphc::norm(n, sphc::NormKind::Linf, false)));
+  EXPECT_EQ(s.n, P + 1);
+}

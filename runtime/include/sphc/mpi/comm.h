@@ -16,6 +16,8 @@
 #include <cstdint>
 #include <string>
 
+#include "sphc/metrics.h"
+
 namespace sphc::mpi {
 
 // MPI_Init in the constructor, MPI_Finalize in the destructor (generated main holds one).
@@ -37,6 +39,14 @@ long sum(long x);
 long max(long x);
 // True on every rank iff `x` is true on every rank (an iterated group's convergence).
 bool all(bool x);
+
+// A metric's sums over every rank's particles (metrics { }): each rank's sums are gathered
+// to every rank (MPI_Allgather) and combined in rank order with the serial rules (NaN stays
+// NaN in max/min; the compensated sums and their compensations added with Neumaier's
+// method), so every rank holds the same result and a metric differs from the serial run's
+// only by the order of its sums. Collective.
+void all_reduce(NormSums& s);
+void all_reduce(ScalarSums& s);
 
 // The exit of a rank's run_main: 0 returns 0 (after a barrier); any other code prints a line
 // naming the rank and ends every rank of the job with MPI_Abort(code) (does not return).

@@ -46,6 +46,9 @@ struct Decomposition {
   long rebalances = 0;
   long migrated = 0;              // particles this rank sent by migration, all arrays
   bool cut = false;               // Zoltan has cuts (after the first rebalance)
+  // Per array (in the order the arrays are passed): the work of one particle, Zoltan's object
+  // weight (set_weights); empty: every particle weighs 1.
+  std::vector<double> weights;
   // RCB: this rank's region, a box (Zoltan_RCB_Box; infinite on outer sides). A point strictly
   // inside it is this rank's without asking Zoltan, and a particle whose interaction box lies
   // strictly inside it is in no other rank's halo (the fast path of migrate and the halo).
@@ -61,6 +64,12 @@ struct Decomposition {
 // Creates the Zoltan structure (MPI must be initialised). method: "RCB" or "HSFC" (else
 // std::invalid_argument).
 void init_decomposition(Decomposition& d, int dim, const std::string& method = "RCB");
+
+// Weights the particles of each array by `per_array` (the compiler's work estimate: RCB then
+// gives each rank about equal work, not equal particle counts; the imbalance that triggers a
+// re-balance is measured in the same weights). Before distribute. SPHC_MPI_UNWEIGHTED=1 in
+// the environment leaves the weights out (a measurement switch).
+void set_weights(Decomposition& d, const std::vector<double>& per_array);
 
 // After a replicated set-up: adds `gid` (U32, unique over the arrays in set-up order:
 // sphc/global_ids.h) to every array, keeps the block [r n / P, (r + 1) n / P) of each array
@@ -80,6 +89,8 @@ void update(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
 // Largest particle count of a rank over the mean (1 = perfect balance). Collective.
 double imbalance(const std::vector<ParticleArray*>& arrays);
+// The same in d's weights (the particle count without weights).
+double imbalance(const Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
 // Whether the box [lo, hi] lies strictly inside this rank's region (false without one).
 bool inside_region(const Decomposition& d, const double lo[3], const double hi[3]);
