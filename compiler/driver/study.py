@@ -3,7 +3,7 @@
 
     sphc study SCENE.sph --vary NAME=v1,v2,... [--vary ...] [--tf T] [--repeat N]
                [--threads N] [--set NAME=V ...] [--budget METRIC<=VALUE ...]
-               [--metric COLUMN ...] [--cost wall_s|cpu_s] [--resolution NAME] -o DIR
+               [--metric COLUMN ...] [--cost wall_s|cpu_s] [--resolution NAME] [--pysph] -o DIR
 
 Builds and runs the cross product of the variants and collects, per run, the particles,
 steps, wall and CPU seconds of the time loop, the peak memory and every metric of the scene
@@ -24,6 +24,10 @@ M_vs_wall.{png,svg} (M_vs_cpu with --cost cpu_s; log-log, the Pareto front marke
 point labelled with its variant) and M_convergence.{png,svg} (M against the resolution
 parameter, with the fitted order). The cost is the time loop's wall time, or with --cost
 cpu_s its CPU time (on a loaded machine the wall time measures the load as much as the run).
+
+With --pysph, PySPH's matching example runs at the same resolutions (study_pysph.py); its
+rows have code = pysph, and the summary and plots show each code's Pareto front and, for each
+error level reached by both, the cheapest variant of each and the ratio of their costs.
 
 Per run and metric column C of the solver's metric file, study.csv has C (its value at the
 last output where it is finite) and C_max (the largest |C| over the outputs). The error of a
