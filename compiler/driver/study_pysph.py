@@ -253,7 +253,7 @@ def drive(spec_path):
     from pysph.solver.utils import get_files
     files = get_files(outdir, app.fname)
     ctx = resolve_ctx(case, spec["ctx"], spec["scene_dir"])
-    particles = sum(pa.get_number_of_particles() for pa in app.particles)
+    particles = sum(pa.get_number_of_particles(real=True) for pa in app.particles)  # no ghosts
     rows = metric_rows(case, ctx, files, load_arrays)
     write_metrics(spec["metrics_file"], rows, wall, cpu)
     steps = app.solver.count
