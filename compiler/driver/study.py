@@ -285,7 +285,10 @@ def run_pysph(args, python, case_name, pargs, ctx, times, rundir):
     import json
     os.makedirs(rundir, exist_ok=True)
     mfile = os.path.join(rundir, "metrics.csv")
-    spec = {"case": case_name, "args": pargs, "ctx": ctx, "tf": args.tf, "times": times,
+    # The scene's end time where the study gives none (the last time of the sphc run's metric
+    # file): PySPH's examples have their own (the dam break's 2.5 s, against the scene's 1 s).
+    tf = args.tf if args.tf is not None else (max(times) if times else None)
+    spec = {"case": case_name, "args": pargs, "ctx": ctx, "tf": tf, "times": times,
             "outdir": os.path.join(rundir, "pysph_out"), "metrics_file": mfile,
             "scene_dir": os.path.dirname(os.path.abspath(args.scene)),
             "threads": args.threads}
