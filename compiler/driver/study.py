@@ -3,7 +3,7 @@
 
     sphc study SCENE.sph --vary NAME=v1,v2,... [--vary ...] [--tf T] [--repeat N]
                [--threads N] [--set NAME=V ...] [--budget METRIC<=VALUE ...]
-               [--metric COLUMN ...] [--cost wall_s|cpu_s] [--resolution NAME] -o DIR
+               [--metric COLUMN ...] [--cost wall_s|cpu_s] [--resolution NAME] [--pysph] -o DIR
 
 Builds and runs the cross product of the variants and collects, per run, the particles,
 steps, wall and CPU seconds of the time loop, the peak memory and every metric of the scene
@@ -24,6 +24,10 @@ M_vs_wall.{png,svg} (M_vs_cpu with --cost cpu_s; log-log, the Pareto front marke
 point labelled with its variant) and M_convergence.{png,svg} (M against the resolution
 parameter, with the fitted order). The cost is the time loop's wall time, or with --cost
 cpu_s its CPU time (on a loaded machine the wall time measures the load as much as the run).
+
+With --pysph, PySPH's matching example runs at the same resolutions (study_pysph.py); its
+rows have code = pysph, and the summary and plots show each code's Pareto front and, for each
+error level reached by both, the cheapest variant of each and the ratio of their costs.
 
 Per run and metric column C of the solver's metric file, study.csv has C (its value at the
 last output where it is finite) and C_max (the largest |C| over the outputs). The error of a
@@ -83,6 +87,12 @@ def parse_args(argv):
     ap.add_argument("--resolution", help="the varied parameter the convergence plot and the "
                     "orders use (default: the first varied parameter whose values are "
                     "numbers)")
+    ap.add_argument("--pysph", action="store_true", help="also run PySPH's matching example "
+                    "(where the scene has one and PySPH is installed) at the same resolutions "
+                    "and put its points on the same CSV, summary and plots")
+    ap.add_argument("--pysph-python", default=os.environ.get("SPHC_PYSPH_PYTHON"),
+                    help="the Python that has PySPH (default: the first of python3 and "
+                         "/usr/bin/python3 that imports it)")
     ap.add_argument("-o", "--output", required=True, help="the study's directory")
     ap.add_argument("--sphc", default=os.environ.get("SPHC", "sphc"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -238,7 +248,13 @@ def run_one(args, exe, variant, kinds, rundir):
            "process_s": "%.6g" % elapsed,
            "peak_rss_mb": "%.4g" % (usage.ru_maxrss / 1024.0),
            "command": " ".join(map(shlex.quote, cmd))}
-    with open(os.path.join(rundir, "stdout.txt")) as f:
+    parse_run(row, os.path.join(rundir, "stdout.txt"), mfile)
+    return row
+
+
+def parse_run(row, stdout_path, mfile):
+    """The `timing:` and `metrics:` lines of a run's output and its metric file, into row."""
+    with open(stdout_path) as f:
         text = f.read()
     m = re.search(r"^timing: steps=(\d+) particles=(\d+) wall_s=(\S+)", text, re.M)
     if m:
@@ -250,11 +266,129 @@ def run_one(args, exe, variant, kinds, rundir):
         for col, (last, biggest) in read_metric_file(mfile).items():
             row[col] = repr(last)
             row[col + "_max"] = repr(biggest)
+
+
+def find_pysph_python(args):
+    """The Python that imports pysph (--pysph-python, else python3, else /usr/bin/python3)."""
+    cands = [args.pysph_python] if args.pysph_python else ["python3", "/usr/bin/python3"]
+    for c in cands:
+        try:
+            if subprocess.run([c, "-c", "import pysph"], capture_output=True).returncode == 0:
+                return c
+        except OSError:
+            pass
+    return None
+
+
+def run_pysph(args, python, case_name, pargs, ctx, times, rundir):
+    """One run of PySPH's example (study_pysph.py's driver): the row of the study's CSV."""
+    import json
+    os.makedirs(rundir, exist_ok=True)
+    mfile = os.path.join(rundir, "metrics.csv")
+    # The scene's end time where the study gives none (the last time of the sphc run's metric
+    # file): PySPH's examples have their own (the dam break's 2.5 s, against the scene's 1 s).
+    tf = args.tf if args.tf is not None else (max(times) if times else None)
+    spec = {"case": case_name, "args": pargs, "ctx": ctx, "tf": tf, "times": times,
+            "outdir": os.path.join(rundir, "pysph_out"), "metrics_file": mfile,
+            "scene_dir": os.path.dirname(os.path.abspath(args.scene)),
+            "threads": args.threads}
+    with open(os.path.join(rundir, "spec.json"), "w") as f:
+        json.dump(spec, f, indent=1)
+    driver = os.path.join(os.path.dirname(os.path.abspath(__file__)), "study_pysph.py")
+    cmd = [python, driver, "run", os.path.join(rundir, "spec.json")]
+    env = dict(os.environ)
+    # libgomp's default spin-wait makes PySPH's OpenMP runs many times slower on a shared
+    # machine (docs/accuracy-cost.md): wait passively; serial unless --threads.
+    env["OMP_WAIT_POLICY"] = "passive"
+    env["OMP_NUM_THREADS"] = str(args.threads or 1)
+    start = time.time()
+    with open(os.path.join(rundir, "stdout.txt"), "w") as so, \
+            open(os.path.join(rundir, "stderr.txt"), "w") as se:
+        p = subprocess.Popen(cmd, stdout=so, stderr=se, env=env)
+        _, status, usage = os.wait4(p.pid, 0)
+    code = os.waitstatus_to_exitcode(status) if hasattr(os, "waitstatus_to_exitcode") else status
+    row = {"status": "ok" if code == 0 else "exit %d" % code,
+           "process_s": "%.6g" % (time.time() - start),
+           "peak_rss_mb": "%.4g" % (usage.ru_maxrss / 1024.0),
+           "command": "PySPH " + case_name + " " + " ".join(map(shlex.quote, pargs))}
+    parse_run(row, os.path.join(rundir, "stdout.txt"), mfile)
     return row
 
 
+def metric_times(path):
+    """The output times of a metric file (where PySPH is asked for output)."""
+    try:
+        with open(path, newline="") as f:
+            return sorted({float(r["t"]) for r in csv.DictReader(f)})
+    except (OSError, KeyError, ValueError):
+        return []
+
+
+def pysph_runs(args, names, runs, rows, out, csv_path, fixed):
+    """--pysph: PySPH's matching example for each distinct mapped variant (and repeat) not in
+    rows yet; appends to rows."""
+    import study_pysph as sp
+    case = sp.case_of(args.scene)
+    stem = os.path.splitext(os.path.basename(args.scene))[0]
+    if case is None:
+        sys.stderr.write("sphc study: --pysph: %s has no PySPH counterpart (the cases: %s); "
+                         "no PySPH runs\n" % (stem, ", ".join(sorted(sp.CASES))))
+        return
+    python = find_pysph_python(args)
+    if python is None:
+        sys.stderr.write("sphc study: --pysph: no Python here imports pysph (PySPH 1.0b1: "
+                         "Debian python3-pysph; or --pysph-python): no PySPH runs\n")
+        return
+    fixed_sets = [tuple(x.split("=", 1)) for x in args.set if "=" in x]
+    todo, seen = [], set()
+    for variant, rep in runs:
+        mapped = sp.pysph_args(case, variant, fixed_sets)
+        if mapped is None:
+            continue
+        pargs, ctx, skipped = mapped
+        key = (sp.pysph_key(pargs), rep)
+        if key in seen:
+            continue
+        seen.add(key)
+        shown = [(n, "-" if n in skipped else v) for n, v in variant]
+        todo.append((shown, rep, pargs, ctx, variant))
+    done = {(tuple(r.get(n, "") for n in names), r.get("repeat")) for r in rows
+            if r.get("code") == "pysph"}
+    todo = [t for t in todo if (tuple(v for _, v in t[0]), str(t[1])) not in done]
+    started = time.time()
+    for k, (shown, rep, pargs, ctx, variant) in enumerate(todo):
+        eta = fmt_s((time.time() - started) / k * (len(todo) - k)) if k else "?"
+        sys.stderr.write("[PySPH %d/%d] %s  %s  (ETA %s)\n" % (
+            k + 1, len(todo), stem, " ".join(pargs), eta))
+        sphc_dir = os.path.join(out, "runs", run_dir_name(variant) + "_r0")
+        times = metric_times(os.path.join(sphc_dir, "metrics.csv"))
+        if not times:
+            every = case["every"]
+            tf = args.tf if args.tf is not None else 1.0
+            times = [i * every for i in range(int(tf / every + 1e-9) + 1)]
+        rundir = os.path.join(out, "runs", "pysph_" + run_dir_name(shown) + "_r%d" % rep)
+        row = dict(shown)
+        row.update(code="pysph", repeat=str(rep))
+        row.update(run_pysph(args, python, os.path.basename(os.path.splitext(
+            args.scene)[0]), pargs, ctx, times, rundir))
+        sys.stderr.write("  %s\n" % ("wall %s s, %s particles, %s steps" % (
+            row.get("wall_s", "?"), row.get("particles", "?"), row.get("steps", "?"))
+            if row["status"] == "ok" else "%s (see %s)" % (row["status"], rundir)))
+        rows.append(row)
+        write_rows(csv_path, rows, fixed)
+
+
+def run_dir_name(variant):
+    return re.sub(r"[^A-Za-z0-9.=_-]", "_", "_".join("%s=%s" % nv for nv in variant))
+
+
 def variant_label(variant):
-    return " ".join("%s=%s" % nv for nv in variant)
+    return " ".join("%s=%s" % nv for nv in variant if nv[1] != "-")
+
+
+def label(names, key):
+    """A variant's label; key is its values and the code (per_variant)."""
+    return ("PySPH " if key[-1] == "pysph" else "") + variant_label(zip(names, key))
 
 
 def load_done(path):
@@ -301,7 +435,7 @@ def per_variant(rows, names):
     for r in rows:
         if r.get("status") != "ok":
             continue
-        key = tuple(r[n] for n in names)
+        key = tuple(r[n] for n in names) + (r.get("code") or "sphc",)
         best = groups.get(key)
         if best is None or num(r, COST) < num(best, COST):
             groups[key] = r
@@ -345,6 +479,42 @@ def fit_order(xs, ys):
     return slope, my - slope * mx
 
 
+def error_levels(lo, hi):
+    """The error levels 1, 1.5, 2, 3, 5, 7 x 10^k between lo and the first level >= hi,
+    largest first."""
+    out = []
+    for k in range(math.floor(math.log10(lo)), math.ceil(math.log10(hi)) + 1):
+        out += [m * 10.0 ** k for m in (1, 1.5, 2, 3, 5, 7)]
+    out = [v for v in out if v >= lo]
+    above = [v for v in out if v >= hi]
+    return sorted([v for v in out if v < hi] + above[:1], reverse=True)
+
+
+def compare_codes(c, pts, variants, names):
+    """Lines: for each error level (1, 1.5, 2, 3, 5, 7 x 10^k) reached by both sphc and PySPH,
+    the cheapest variant of each and the ratio of their costs."""
+    out = ["  sphc against PySPH: the cheapest variant of each code within each error level "
+           "reached by both, and PySPH's cost / sphc's:"]
+    finite = [e for _, e in pts if math.isfinite(e) and e > 0]
+    n = 0
+    for level in error_levels(min(finite), max(finite)):
+        best = {}
+        for code in ("sphc", "pysph"):
+            ok = [i for i, (k, _) in enumerate(variants) if k[-1] == code and pts[i][1] <= level]
+            if ok:
+                best[code] = min(ok, key=lambda j: pts[j][0])
+        if len(best) < 2:
+            continue
+        i, j = best["sphc"], best["pysph"]
+        n += 1
+        out.append("    |%s| <= %-6.2g sphc: %-24s %8.4g s  PySPH: %-24s %8.4g s  ratio %.3g"
+                   % (c, level, label(names, variants[i][0]), pts[i][0],
+                      label(names, variants[j][0])[6:], pts[j][0], pts[j][0] / pts[i][0]))
+    if n == 0:
+        out.append("    none: no error level is reached by both codes")
+    return out
+
+
 def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
     variants = per_variant(rows, names)
     cols = [c for c in metric_columns(rows, fixed) if c not in names]
@@ -361,26 +531,35 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
       "repeat with the least)" % COST)
     p("")
     head = ["variant", "particles", "steps", "wall_s", "cpu_s", "peak_rss_mb"] + cols
-    table = [[variant_label(zip(names, k)), r.get("particles", ""), r.get("steps", ""),
+    table = [[label(names, k), r.get("particles", ""), r.get("steps", ""),
               r.get("wall_s", ""), r.get("cpu_s", ""), r.get("peak_rss_mb", "")] +
              ["%.4g" % num(r, c) for c in cols] for k, r in variants]
     widths = [max(len(str(x)) for x in col) for col in zip(head, *table)] if table else []
     for row in [head] + table:
         p("  ".join(str(x).rjust(w) for x, w in zip(row, widths)))
+    for r in rows:
+        if r.get("code") == "pysph" and r.get("status") != "ok":
+            p("PySPH run failed (%s): %s" % (r.get("status"), r.get("command")))
     p("")
     fronts = {}
+    codes = sorted({k[-1] for k, _ in variants}, key=lambda c: c != "sphc")
     for c in cols:
         pts = [(num(r, COST), abs(num(r, c))) for _, r in variants]
         if not any(math.isfinite(e) for _, e in pts):
             continue
-        front = pareto(pts)
-        fronts[c] = front
-        p("%s against %s: Pareto front (no variant is both cheaper and more accurate):" % (c, COST))
-        for i in front:
-            p("  %-40s cost %8.4g s  |%s| %.4g" % (variant_label(zip(names, variants[i][0])),
-                                                 pts[i][0], c, pts[i][1]))
+        fronts[c] = {}
+        for code in codes:
+            mine = [i for i, (k, _) in enumerate(variants) if k[-1] == code]
+            front = [mine[j] for j in pareto([pts[i] for i in mine])]
+            fronts[c][code] = front
+            p("%s against %s: %sPareto front (no variant is both cheaper and more accurate):"
+              % (c, COST, "PySPH's " if code == "pysph" else "sphc's " if len(codes) > 1
+                 else ""))
+            for i in front:
+                p("  %-40s cost %8.4g s  |%s| %.4g" % (label(names, variants[i][0]),
+                                                     pts[i][0], c, pts[i][1]))
         finite = sorted(e for _, e in pts if math.isfinite(e) and e > 0)
-        if finite:
+        if finite and len(codes) == 1:
             lo = math.floor(math.log10(finite[0]))
             hi = math.ceil(math.log10(finite[-1]))
             p("  cheapest variant within each error level:")
@@ -391,8 +570,11 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
                     p("    |%s| <= %-8.0e none" % (c, level))
                     continue
                 i = min(ok, key=lambda j: pts[j][0])
-                p("    |%s| <= %-8.0e %s (cost %.4g s)" % (c, level, variant_label(
-                    zip(names, variants[i][0])), pts[i][0]))
+                p("    |%s| <= %-8.0e %s (cost %.4g s)" % (c, level, label(
+                    names, variants[i][0]), pts[i][0]))
+        elif finite:
+            for code_line in compare_codes(c, pts, variants, names):
+                p(code_line)
         p("")
     orders = {}
     if resolution:
@@ -400,7 +582,7 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
         for c in cols:
             groups = {}
             for k, r in variants:
-                key = tuple(r[n] for n in others)
+                key = tuple(r[n] for n in others) + (k[-1],)
                 groups.setdefault(key, []).append((float(r[resolution]), abs(num(r, c))))
             for key, pts in groups.items():
                 f = fit_order([x for x, _ in pts], [y for _, y in pts])
@@ -413,7 +595,8 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
               % (resolution, resolution))
             for (c, key), ((s, _), pts) in sorted(orders.items()):
                 p("  %-16s %-30s s = %+.3g over %s = %s" % (
-                    c, variant_label(zip(others, key)) or "(all)", s, resolution,
+                    c, label(others, key) or ("sphc" if len(codes) > 1 else "(all)"), s,
+                    resolution,
                     ", ".join("%g" % x for x, _ in sorted(pts))))
             p("")
     for metric, limit in budgets:
@@ -424,7 +607,7 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
         meets = [(num(r, COST), k, r) for k, r in variants if abs(num(r, metric)) <= limit]
         if meets:
             w, k, r = min(meets)
-            p("  cheapest: %s (cost %.4g s, |%s| = %.4g)" % (variant_label(zip(names, k)), w,
+            p("  cheapest: %s (cost %.4g s, |%s| = %.4g)" % (label(names, k), w,
                                                            metric, abs(num(r, metric))))
         else:
             p("  no variant measured meets it")
@@ -432,7 +615,7 @@ def analyse(rows, names, kinds, resolution, budgets, fixed, outdir, only=()):
             v = abs(num(r, metric))
             if not v <= limit:
                 p("  misses: %-40s |%s| = %.4g, %.3g x the budget (cost %.4g s)"
-                  % (variant_label(zip(names, k)), metric, v, v / limit if limit else
+                  % (label(names, k), metric, v, v / limit if limit else
                      float("inf"), num(r, COST)))
         p("")
     text = "\n".join(lines) + "\n"
@@ -459,13 +642,21 @@ def plot(variants, names, cols, fronts, orders, resolution, outdir):
         if not ok:
             continue
         fig, ax = plt.subplots(figsize=(7, 5))
-        ax.loglog([pts[i][0] for i in ok], [pts[i][1] for i in ok], "o", color="C0",
-                  label="variants")
-        fr = [i for i in fronts[c] if i in ok]
-        ax.loglog([pts[i][0] for i in fr], [pts[i][1] for i in fr], "-", color="C3", lw=1.5,
-                  label="Pareto front")
+        fr = []
+        for code, (mark, col, line) in (("sphc", ("o", "C0", "C3")),
+                                        ("pysph", ("s", "C1", "C2"))):
+            mine = [i for i in ok if variants[i][0][-1] == code]
+            if not mine:
+                continue
+            name = "sphc" if code == "sphc" else "PySPH"
+            ax.loglog([pts[i][0] for i in mine], [pts[i][1] for i in mine], mark, color=col,
+                      label="%s variants" % name)
+            f = [i for i in fronts[c].get(code, []) if i in ok]
+            fr += f
+            ax.loglog([pts[i][0] for i in f], [pts[i][1] for i in f], "-", color=line,
+                      lw=1.5, label="%s Pareto front" % name)
         for i in ok:
-            ax.annotate(variant_label(zip(names, variants[i][0])), pts[i], fontsize=7,
+            ax.annotate(label(names, variants[i][0]), pts[i], fontsize=7,
                         xytext=(4, 3), textcoords="offset points",
                         weight="bold" if i in fr else "normal")
         ax.set_xlabel("%s time of the time loop [s]" % ("wall" if COST == "wall_s" else "CPU"))
@@ -483,7 +674,7 @@ def plot(variants, names, cols, fronts, orders, resolution, outdir):
         for n, ((_, key), ((s, b), pts2)) in enumerate(sorted(mine.items())):
             pts2 = sorted(pts2)
             xs = [x for x, _ in pts2]
-            lbl = variant_label(zip([m for m in names if m != resolution], key)) or c
+            lbl = label([m for m in names if m != resolution], key) or c
             ax.loglog(xs, [y for _, y in pts2], "o", color="C%d" % n)
             ax.loglog(xs, [math.exp(b) * x ** s for x in xs], "--", color="C%d" % n,
                       label="%s: slope %+.2f" % (lbl, s))
@@ -520,16 +711,18 @@ def main(argv):
         fail("--resolution %s: not a varied name" % resolution)
     runs = [(list(zip(names, combo)), rep) for combo in itertools.product(*[v for _, v in varies])
             for rep in range(args.repeat)]
-    fixed = names + ["repeat", "status", "particles", "steps", "wall_s", "cpu_s", "t_end",
+    fixed = names + ["code", "repeat", "status", "particles", "steps", "wall_s", "cpu_s", "t_end",
                      "peak_rss_mb", "process_s", "command"]
     csv_path = os.path.join(out, "study.csv")
     rows = load_done(csv_path)
+    for r in rows:
+        r["code"] = r.get("code") or "sphc"
     done = {(tuple(r.get(n, "") for n in names), r.get("repeat")) for r in rows
-            if r.get("status") == "ok"}
+            if r.get("status") == "ok" and r["code"] == "sphc"}
     rows = [r for r in rows if r.get("status") == "ok"]
     todo = [(v, rep) for v, rep in runs if (tuple(x for _, x in v), str(rep)) not in done]
     if len(todo) < len(runs):
-        sys.stderr.write("sphc study: %d of %d runs already in %s; running the other %d\n"
+        sys.stderr.write("sphc study: %d of %d sphc runs already in %s; running the other %d\n"
                          % (len(runs) - len(todo), len(runs), csv_path, len(todo)))
     started = time.time()
     for k, (variant, rep) in enumerate(todo):
@@ -540,11 +733,9 @@ def main(argv):
                                                       " repeat %d" % rep if args.repeat > 1
                                                       else "", eta))
         exe = build(args, variant, kinds, bindir, cache)
-        rundir = os.path.join(out, "runs", re.sub(r"[^A-Za-z0-9.=_-]", "_",
-                                                  "_".join("%s=%s" % nv for nv in variant)) +
-                              "_r%d" % rep)
+        rundir = os.path.join(out, "runs", run_dir_name(variant) + "_r%d" % rep)
         row = dict(variant)
-        row["repeat"] = str(rep)
+        row.update(code="sphc", repeat=str(rep))
         row.update(run_one(args, exe, variant, kinds, rundir))
         if row["status"] != "ok":
             sys.stderr.write("  %s: %s (see %s)\n" % (variant_label(variant), row["status"],
@@ -555,10 +746,12 @@ def main(argv):
                                 row.get("steps", "?")))
         rows.append(row)
         write_rows(csv_path, rows, fixed)  # after every run: an interrupted study resumes
+    if args.pysph:
+        pysph_runs(args, names, runs, rows, out, csv_path, fixed)
     write_rows(csv_path, rows, fixed)
     text = analyse(rows, names, kinds, resolution, budgets, fixed, out, args.metric)
     sys.stdout.write(text)
-    failed = [r for r in rows if r.get("status") != "ok"]
+    failed = [r for r in rows if r.get("status") != "ok" and r.get("code") != "pysph"]
     return 1 if failed else 0
 
 

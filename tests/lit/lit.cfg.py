@@ -51,3 +51,15 @@ config.substitutions.append(('%precision_compare', 'python3 ' + os.path.join(
 # ('=V', '<V', '>V'; tests/lit/Inputs/h5consts.py).
 config.substitutions.append(('%h5consts', 'python3 ' + os.path.join(
     config.sphc_src_root, 'tests', 'lit', 'Inputs', 'h5consts.py')))
+# `REQUIRES: pysph`: a Python here imports PySPH (Debian python3-pysph), for the tests of
+# `sphc study --pysph`; %pysph_python is that Python.
+import subprocess as _sp
+for _py in ('python3', '/usr/bin/python3'):
+    try:
+        if _sp.run([_py, '-c', 'import pysph'], stdout=_sp.DEVNULL,
+                   stderr=_sp.DEVNULL).returncode == 0:
+            config.available_features.add('pysph')
+            config.substitutions.append(('%pysph_python', _py))
+            break
+    except OSError:
+        pass
