@@ -148,11 +148,15 @@ def pair_rates(args, tmp):
     import numpy as np
     rows = []
     for scene in args.scenes.split(","):
-        print("%s: compiling, %d steps ..." % (scene, args.steps), flush=True)
+        print("%s: compiling ..." % scene, flush=True)
         exe = build(args.sphc, scene, tmp)
         out = os.path.join(tmp, scene + "-out")
-        r = solve(exe, args.steps, [], outdir=out)
-        one = solve(exe, 1, [])
+        extra = ["--tf", "100"]   # the step count decides, not the scene's tf (cube: 5 steps)
+        one = solve(exe, 1, extra)
+        # at least --steps, and at least --particle-steps / particles (small scenes)
+        steps = max(args.steps, int(args.particle_steps / one["particles"]) + 1)
+        print("%s: %d particles, %d steps ..." % (scene, one["particles"], steps), flush=True)
+        r = solve(exe, steps, extra, outdir=out)
         pos = last_positions(out, scene)
         _, _, h, support, groups, _ = SCENES[scene]
         pairs, per_dest = pairs_per_step(pos, h, groups, support)
@@ -193,9 +197,11 @@ SCALING = {
 def scaling(args, tmp):
     rows = []
     for scene, (param, values) in SCALING.items():
+        if scene not in args.scaling_scenes.split(","):
+            continue
         exe = build(args.sphc, scene, tmp)
         for v in values:
-            extra = ["--set", "%s=%r" % (param, v)]
+            extra = ["--set", "%s=%r" % (param, v), "--tf", "100"]  # steps decide, not tf
             # steps: about 3 M particle-steps, at least 3
             probe = solve(exe, 1, extra)
             n = probe["particles"]
@@ -205,6 +211,7 @@ def scaling(args, tmp):
             print("%s %s=%r: %d particles, %d steps ..." % (scene, param, v, n, steps),
                   flush=True)
             r = solve(exe, steps + 1, extra)
+            steps = r["steps"] - probe["steps"]
             loop = r["loop"] - probe["loop"]
             cpu = r["cpu"] - probe["cpu"]
             rows.append(dict(scene=scene, value=v, particles=n, steps=steps,
@@ -232,6 +239,7 @@ def main():
     ap.add_argument("--scenes", default="dambreak2d,cube,dambreak3d_dualsphysics")
     ap.add_argument("--scaling", action="store_true", help="cost from 10k to 1M particles")
     ap.add_argument("--scaling-only", action="store_true")
+    ap.add_argument("--scaling-scenes", default="dambreak2d,cube")
     ap.add_argument("--max-particles", type=int, default=1100000)
     ap.add_argument("--particle-steps", type=float, default=3e6,
                     help="particle-steps per scaling run (default 3e6)")

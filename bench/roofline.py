@@ -50,11 +50,14 @@ sys.path.insert(0, HERE)
 import pair_rate  # noqa: E402
 from pair_rate import SCENES, last_positions, pairs_per_step, run  # noqa: E402
 
-# scene: (parameters of the counted run, parameters of the timed run, steps S1, S2, timed steps)
+# scene: (parameters of the counted run, parameters of the timed run, steps S1, S2, timed
+# steps, h of the counted run, h of the timed run)
 SIZES = {
-    "cube": (["--set", "nx=20"], ["--tf", "1"], 1, 3, 10),
-    "dambreak2d": (["--set", "dx=0.03"], ["--set", "dx=0.0047"], 1, 3, 30),
-    "dambreak3d_dualsphysics": (["--set", "dp=0.02"], [], 1, 3, 5),
+    "cube": (["--set", "nx=20"], ["--tf", "1"], 1, 3, 10, 1.5 / 20, 1.5 / 47),
+    "dambreak2d": (["--set", "dx=0.03"], ["--set", "dx=0.0047"], 1, 3, 30, 1.3 * 0.03,
+                   1.3 * 0.0047),
+    "dambreak3d_dualsphysics": (["--set", "dp=0.02"], [], 1, 3, 5, 3 ** 0.5 * 0.02,
+                                3 ** 0.5 * 0.0085),
 }
 
 FMA_RE = re.compile(r"^vf(n?m(add|sub)|maddsub|msubadd)(132|213|231)?(s|p)(d|s)$")
@@ -193,7 +196,7 @@ def main():
             out, _, _ = run([triad], e)
             bw[t] = float(re.search(r"triad_GBps=([0-9.]+)", out).group(1))
         for scene in args.scenes.split(","):
-            counted, timed, s1, s2, tsteps = SIZES[scene]
+            counted, timed, s1, s2, tsteps, h_counted, h_timed = SIZES[scene]
             src = os.path.join(ROOT, SCENES[scene][0])
             exe = os.path.join(tmp, scene + "_avx2")
             print("%s: counting flops under callgrind (%d and %d steps) ..." % (scene, s1, s2),
@@ -217,12 +220,7 @@ def main():
             d_ins = (funcs[s2][loop_fn][0] - funcs[s1][loop_fn][0]) / (s2 - s1)
             d_fl = (funcs[s2][loop_fn][1] - funcs[s1][loop_fn][1]) / (s2 - s1)
             pos = last_positions(outdir, scene)
-            h = SCENES[scene][2]
-            if scene == "cube":
-                h = 1.5 / 20
-            elif scene == "dambreak3d_dualsphysics":
-                h = 3 ** 0.5 * 0.02
-            pairs_small, _ = pairs_per_step(pos, h, SCENES[scene][4], SCENES[scene][3])
+            pairs_small, _ = pairs_per_step(pos, h_counted, SCENES[scene][4], SCENES[scene][3])
             fpp = d_fl / pairs_small
             ipp = d_ins / pairs_small
             # Timed run: default (native) build at the benchmark size, perf for the share.
@@ -252,8 +250,7 @@ def main():
             # shared machine the wall time counts the other jobs' time too).
             t_cpu = samples / HZ
             tpos = last_positions(tout, scene)
-            pairs, nb = pairs_per_step(tpos, SCENES[scene][2], SCENES[scene][4],
-                                       SCENES[scene][3])
+            pairs, nb = pairs_per_step(tpos, h_timed, SCENES[scene][4], SCENES[scene][3])
             t_loop = t_cpu
             gflops = fpp * pairs * steps / t_loop / 1e9 if t_loop > 0 else float("nan")
             rw = bytes_per_particle(args.sphc, scene, tmp)
