@@ -232,6 +232,16 @@ void ScenePrinter::emitGroup(const ScheduleGroup& sg) {
   if (g.condition)
     scene_ << "    if (!(" << groupOptionCpp(*g.condition) << ")) return;  // condition = "
            << exprText(*g.condition) << "\n";
+  if (!g.iterate && &sg == &sched_.equations && timesGroups()) {
+    // --timing: the wall time of each top-level group (group_seconds).
+    for (std::size_t k = 0; k < sg.calls.size(); ++k)
+      scene_ << "    {\n      const double t0 = sphc::wall_seconds();\n      " << sg.calls[k]
+             << "(t, dt);\n      group_seconds[" << k << "] += sphc::wall_seconds() - t0;\n    }\n";
+    if (sg.rebuildNeighbours) emitNeighbourRebuild("    ");
+    if (sg.calls.empty()) scene_ << "    (void)t; (void)dt;  // an empty group\n";
+    scene_ << "  }\n\n";
+    return;
+  }
   if (!g.iterate) {
     for (const auto& c : sg.calls) scene_ << "    " << c << "(t, dt);\n";
     if (sg.rebuildNeighbours) emitNeighbourRebuild("    ");
@@ -240,6 +250,41 @@ void ScenePrinter::emitGroup(const ScheduleGroup& sg) {
     return;
   }
   emitIteration(sg);
+}
+
+std::vector<std::pair<std::string, std::string>> ScenePrinter::topGroupLabels() const {
+  std::vector<std::pair<std::string, std::string>> labels;
+  std::function<void(const ScheduleGroup&, std::string&)> collect = [&](const ScheduleGroup& g,
+                                                                        std::string& names) {
+    for (const auto& m : g.members) {
+      if (!m.isPhase) {
+        collect(*g.subgroups[m.index], names);
+        continue;
+      }
+      for (int e : g.phases[m.index].equations)
+        if (plan_.equations[e].live)
+          names += (names.empty() ? "" : ",") + plan_.equations[e].name;
+    }
+  };
+  const ScheduleGroup& root = sched_.equations;
+  for (const auto& m : root.members) {
+    std::string names;
+    if (m.isPhase) {
+      const Phase& ph = root.phases[m.index];
+      for (int e : ph.equations)
+        if (plan_.equations[e].live)
+          names += (names.empty() ? "" : ",") + plan_.equations[e].name;
+      labels.push_back({ph.equations.empty() ? std::string("equations")
+                                              : loc(plan_.equations[ph.equations.front()].loc),
+                        names});
+      continue;
+    }
+    const ScheduleGroup& sub = *root.subgroups[m.index];
+    if (sub.group->postStep) continue;  // runs in step(), not in equations()
+    collect(sub, names);
+    labels.push_back({loc(sub.group->loc), names});
+  }
+  return labels;
 }
 
 // An iterated group: its members again and again until every `converged` test passes (and at
@@ -561,6 +606,16 @@ void ScenePrinter::emitMain() {
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
   if (timesNeighbourSearch()) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
   if (hasZones()) out_ << "  prog.inlet_outlet_seconds = [] { return scene.io_seconds; };\n";
+  if (timesGroups() && !sched_.equations.group->iterate) {
+    const auto labels = topGroupLabels();
+    if (labels.size() == sched_.equations.calls.size()) {
+      out_ << "  prog.group_seconds = [] {\n    return std::vector<sphc::GroupSeconds>{";
+      for (std::size_t k = 0; k < labels.size(); ++k)
+        out_ << (k ? "," : "") << "\n        {\"" << labels[k].first << "\", \""
+             << labels[k].second << "\", scene.group_seconds[" << k << "]}";
+      out_ << "};\n  };\n";
+    }
+  }
   if (!plan_.limits.empty()) emitLimits();
   emitMetricsMain();
   bool anyOutput = false;
@@ -716,6 +771,9 @@ void ScenePrinter::emitSceneMembers() {
   out_ << "};\n";
   out_ << "  long step_count = 0;  // completed time steps (group option `every`)\n";
   if (timesNeighbourSearch()) out_ << "  double nnps_seconds = 0.0;  // in update_neighbours, for --timing\n";
+  if (timesGroups())
+    out_ << "  std::vector<double> group_seconds = std::vector<double>("
+         << sched_.equations.calls.size() << ", 0.0);  // per top-level group, for --timing\n";
   if (!sourceArrays_.empty()) {
     out_ << "  static constexpr long REORDER_EVERY = 50;\n";
     out_ << "  long builds = 0;\n";

@@ -66,6 +66,9 @@ class ScenePrinter {
   virtual std::string ghostsType() const = 0;
   virtual void extraMembers() {}                    // after the ghosts (OpenMP scratch)
   virtual bool timesNeighbourSearch() const = 0;    // nnps_seconds for --timing
+  // group_seconds for --timing: the wall time of each top-level group (the CPU backends:
+  // their groups run synchronously; OpenCL's kernels do not, so it does not time them).
+  virtual bool timesGroups() const { return timesNeighbourSearch(); }
   virtual void dataMovement() {}                    // to_device/to_single, to_host
   // One destination of a phase, after `const int n = ...;` (its ghost refresh included).
   virtual void destination(const DestinationWork& w, const std::string& phase) = 0;
@@ -160,6 +163,9 @@ class ScenePrinter {
   static std::string rangeEnd(const DestinationWork& w) { return w.ranged() ? "d_end" : "n"; }
   // An iterated group's convergence: its loop, the tests, the iteration bounds.
   void emitIteration(const ScheduleGroup& g);
+  // --timing: (FILE:LINE, live equations comma-separated) of each call of the top-level
+  // group `equations`, in call order.
+  std::vector<std::pair<std::string, std::string>> topGroupLabels() const;
   // The convergence test of an iterated group's equation (inside the iteration loop).
   void emitConverged(const PlanEquation& eq);
   // `reduce { }` (PySPH's reduce(dst, t, dt)) of a destination's equations, on the host,

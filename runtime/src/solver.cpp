@@ -277,6 +277,10 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        backend=B threads=T [omp_wait=W] precision=double|single\n"
       "                        [nnps_s=S nnps_share=F: time in the neighbour search]\n"
       "                        [iterations=I: of iterated groups, in all]\n"
+      "                        serial, OpenMP: per top-level group of the equations,\n"
+      "                        timing-group: name=FILE:LINE s=S share=F equations=E,...\n"
+      "                        and timing-split: wall_s=W groups_s=G nnps_s=N\n"
+      "                        integrator_s=I outside_steps_s=O (G+N+I+O = W)\n"
       "                        and, per iterated group, the iterations of its evaluations:\n"
       "                        iterations: group=FILE:LINE evaluations=E total=N mean=M\n"
       "                        min=A max=B unconverged=U\n"
@@ -619,6 +623,7 @@ class Simulation {
     metrics_clock_ = {loop_start, cpu_seconds()};
     nnps_start_ = prog_.neighbour_seconds ? prog_.neighbour_seconds() : 0.0;
     io_start_ = prog_.inlet_outlet_seconds ? prog_.inlet_outlet_seconds() : 0.0;
+    if (prog_.group_seconds) group_start_ = prog_.group_seconds();
     progress_.start(!opt_.quiet && prog_.rank <= 0, tf);
     double particle_steps = 0;
     while (t_ < tf - slack && step_ < opt_.max_steps) {
@@ -629,7 +634,9 @@ class Simulation {
       }
       if (schedule.ends_before_step(t_, dt)) break;  // nearest_step: t_ is nearest to tf
       const OutputSchedule::Step planned = schedule.plan(t_, dt);  // lands on outputs and tf
+      const auto step_start = Clock::now();
       prog_.step(t_, planned.length);
+      step_seconds_ += std::chrono::duration<double>(Clock::now() - step_start).count();
       ++step_;
       dt_ = planned.length;
       advance_time(planned, times.dt);
@@ -992,6 +999,7 @@ class Simulation {
                  "backend={} threads={}{} precision={}{}{}\n",
                  step_, particles(), wall_s, us, prog_.backend, threads_, wait, prog_.precision,
                  nnps, prog_.rank >= 0 ? fmt::format(" rank={}", prog_.rank) : "");
+      if (prog_.group_seconds) report_groups(wall_s);
       // Counted from the first evaluation, the one before the first step, included.
       if (prog_.iterations) {
         for (const IterationStats& s : prog_.iterations()) {
@@ -1006,12 +1014,35 @@ class Simulation {
     }
   }
 
+  // --timing, serial and OpenMP: the time loop's wall time by part. One line per top-level
+  // group of the equations (all its evaluations in the time loop), then the split of wall_s:
+  // groups_s (their sum), nnps_s (the neighbour search), integrator_s (the rest of the time
+  // steps: steppers, periodic wraps, ghosts, post_step groups, inlets/outlets) and
+  // outside_steps_s (output, blow-up and limit checks, metrics, progress); the four add up
+  // to wall_s.
+  void report_groups(double wall_s) {
+    const std::vector<GroupSeconds> now = prog_.group_seconds();
+    double groups = 0.0;
+    for (std::size_t k = 0; k < now.size(); ++k) {
+      const double s = now[k].seconds - (k < group_start_.size() ? group_start_[k].seconds : 0.0);
+      groups += s;
+      fmt::print("timing-group: name={} s={:.6g} share={:.4f} equations={}\n", now[k].name, s,
+                 wall_s > 0 ? s / wall_s : 0.0, now[k].equations);
+    }
+    const double nnps = prog_.neighbour_seconds ? prog_.neighbour_seconds() - nnps_start_ : 0.0;
+    fmt::print("timing-split: wall_s={:.6g} groups_s={:.6g} nnps_s={:.6g} integrator_s={:.6g} "
+               "outside_steps_s={:.6g}\n",
+               wall_s, groups, nnps, step_seconds_ - groups - nnps, wall_s - step_seconds_);
+  }
+
   SceneProgram& prog_;
   const Options& opt_;
   Progress& progress_;
   int threads_ = 1;
   double nnps_start_ = 0.0;  // neighbour_seconds() when the time loop started
   double io_start_ = 0.0;    // inlet_outlet_seconds() then
+  std::vector<GroupSeconds> group_start_;  // group_seconds() then
+  double step_seconds_ = 0.0;  // wall seconds in prog_.step within the time loop
   OutputWriter* writer_ = nullptr;
   std::vector<ParticleArray*> arrays_;
   double t_ = 0.0;

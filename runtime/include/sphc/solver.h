@@ -59,6 +59,13 @@ struct SceneTimes {
   bool output_nearest_step = false;
 };
 
+// The wall time of one top-level group of the equations (--timing).
+struct GroupSeconds {
+  std::string name;     // FILE:LINE of the group
+  std::string equations;  // its live equations, comma-separated
+  double seconds = 0.0;
+};
+
 // How many iterations the evaluations of one iterated group took (group (iterate = true)):
 // the generated code records every evaluation; --timing prints the figures.
 struct IterationStats {
@@ -110,6 +117,11 @@ struct SceneProgram {
   // Wall seconds spent so far in the neighbour search (search domain, cell lists, reorders
   // into cell order), for the --timing line; empty where not measured.
   std::function<double()> neighbour_seconds;
+  // Wall seconds spent so far in each top-level group of the equations, with its name
+  // (FILE:LINE and the equations in it), for the --timing lines `timing-group:`; empty where
+  // not measured (OpenCL: its kernels run asynchronously, so the host's clock would time
+  // their enqueueing, not their work).
+  std::function<std::vector<GroupSeconds>()> group_seconds;
   // Wall seconds spent so far in the inlet/outlet step (sphc/inlet_outlet.h, with the data
   // movement it needs), for the --timing line; empty without inlets and outlets.
   std::function<double()> inlet_outlet_seconds;
