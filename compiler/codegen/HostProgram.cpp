@@ -42,9 +42,12 @@ void ScenePrinter::emitArraySetup(const PlanArray& a) {
     std::map<std::string, std::string> args;
     for (const auto& arg : b->args)
       if (arg.defaultValue) args[arg.name] = arg.defaultValue + std::string(".0");
+    const ast::Expr* where = nullptr;
     for (const auto& kw : g.args)
-      if (kw.value) args[kw.name.name] = exprCpp(*kw.value, paramNames);
+      if (kw.name.name == "where") where = kw.value.get();
+      else if (kw.value) args[kw.name.name] = exprCpp(*kw.value, paramNames);
     scene_ << "      {  // geometry " << b->name << ", from " << loc(g.builder.loc) << "\n";
+    if (where) scene_ << "        const std::size_t first = pts.size();\n";
     const std::string& n = b->name;
     if (n == "block" || n == "tank") {
       scene_ << "        const double lo[3] = {" << args["xmin"] << ", " << args["ymin"] << ", "
@@ -73,6 +76,20 @@ void ScenePrinter::emitArraySetup(const PlanArray& a) {
       scene_ << "        const double p1[3] = {" << args["x1"] << ", " << args["y1"] << ", "
              << args["z1"] << "};\n";
       scene_ << "        pts.append(sphc::line(p0, p1, " << args["dx"] << "));\n";
+    }
+    if (where) {  // `where = E`: keep the new points where E != 0, in order
+      auto whereNames = [&](const std::string& v) {
+        return v == "x" || v == "y" || v == "z" ? v : paramRef(v);
+      };
+      scene_ << "        std::size_t kept = first;\n";
+      scene_ << "        for (std::size_t i = first; i < pts.size(); ++i) {\n";
+      scene_ << "          const double x = pts.x[i], y = pts.y[i], z = pts.z[i];\n";
+      scene_ << "          (void)x; (void)y; (void)z;\n";
+      scene_ << "          if ((" << exprCpp(*where, whereNames) << ") != 0.0) {  // where, from "
+             << loc(g.builder.loc) << "\n";
+      scene_ << "            pts.x[kept] = x; pts.y[kept] = y; pts.z[kept] = z; ++kept;\n";
+      scene_ << "          }\n        }\n";
+      scene_ << "        pts.x.resize(kept); pts.y.resize(kept); pts.z.resize(kept);\n";
     }
     scene_ << "      }\n";
   }

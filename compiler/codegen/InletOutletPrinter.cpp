@@ -31,6 +31,8 @@ void ScenePrinter::emitZoneSetup() {
       scene_ << "      zn.inlet = &" << A << ";\n      zn.feeds = &" << O << ";\n";
     else
       scene_ << "      zn.outlet = &" << A << ";\n      zn.from = &" << O << ";\n";
+    if (!z.inlet && z.type == "mirror")  // properties interpolated at the image points
+      scene_ << "      zn.kind = sphc::OutletKind::Mirror;\n";
     if (!z.copy.empty()) {
       scene_ << "      zn.copy = {";
       for (size_t i = 0; i < z.copy.size(); ++i)
@@ -72,7 +74,9 @@ void ScenePrinter::emitInletOutlet() {
   scene_ << "\n  // change size here, between steps only.\n";
   scene_ << "  void inlet_outlet(double t) {\n";
   scene_ << "    const double start = sphc::wall_seconds();\n";
-  if (checksZonesFirst()) {
+  bool mirror = false;  // a mirror outlet sets its particles every step: no shortcut
+  for (const PlanZone& z : plan_.zones) mirror |= !z.inlet && z.type == "mirror";
+  if (checksZonesFirst() && !mirror) {
     std::vector<int> inlets;
     for (const PlanZone& z : plan_.zones)
       if (z.inlet) inlets.push_back(z.array);

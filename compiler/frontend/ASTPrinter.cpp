@@ -235,6 +235,11 @@ class Printer {
     }
     for (const auto& out : s.outputs) output(out, indent);
     for (const auto& d : s.domains) domain(d, indent);
+    for (const auto& z : s.zones) {  // inlet NAME (kwargs) <loc>  (ParseZones.cpp)
+      line(indent) << (z.inlet ? "inlet " : "outlet ") << z.name.name;
+      kwargs(z.args);
+      at(z.loc) << "\n";
+    }
     if (s.equationsLoc.isValid()) {
       line(indent) << "equations";
       at(s.equationsLoc) << "\n";

@@ -201,6 +201,46 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
     }
     os << "\n";
   }
+  for (const auto& z : plan.zones) {  // inlets and outlets (sema/Zones.cpp)
+    auto ex = [&](const ast::ExprPtr& e) {
+      if (e) printExpr(*e, os);
+      else os << "0";
+    };
+    os << (z.inlet ? "inlet " : "outlet ") << z.name << ": " << plan.arrays[z.array].name
+       << (z.inlet ? " -> " : " <- ") << plan.arrays[z.other].name << "; face (";
+    for (int k = 0; k < plan.dim; ++k) {
+      if (k) os << ", ";
+      ex(z.point[k]);
+    }
+    os << "), normal (";
+    for (int k = 0; k < plan.dim; ++k) {
+      if (k) os << ", ";
+      ex(z.normal[k]);
+    }
+    os << "), length ";
+    ex(z.length);
+    if (z.width) {
+      os << ", width ";
+      ex(z.width);
+    }
+    if (z.inlet) {
+      os << "; velocity";
+      const char* sep = " ";
+      for (int k = 0; k < 3; ++k)
+        if (z.velocity[k]) {
+          os << sep << "uvw"[k] << " = ";
+          ex(z.velocity[k]);
+          sep = ", ";
+        }
+      if (*sep == ' ') os << " kept";
+    } else {
+      os << "; type " << z.type;
+    }
+    os << "; copies ";
+    if (z.copy.empty()) os << "every common property";
+    for (size_t i = 0; i < z.copy.size(); ++i) os << (i ? " " : "") << z.copy[i];
+    os << "\n";
+  }
   os << "parameters:";
   for (const auto* p : plan.params)
     if (!p->derived) os << " " << p->name.name;

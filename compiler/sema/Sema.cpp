@@ -382,6 +382,21 @@ void SemaImpl::checkGeometry(const ast::GeometryDecl& g, const std::string& arra
   }
   std::set<std::string> given;
   for (const auto& kw : g.args) {
+    if (kw.name.name == "where") {  // keep the points where E != 0 (any builder)
+      if (!given.insert("where").second)
+        diags_.error(kw.name.loc, "argument 'where' is given twice");
+      if (kw.isList || !kw.value)
+        diags_.error(kw.name.loc, "geometry argument 'where' takes an expression of x, y, z");
+      else
+        checkExpr(*kw.value,
+                  [&](const std::string& n) {
+                    return isParam(n) || n == "x" || n == "y" || n == "z";
+                  },
+                  "'where' of a geometry of array '" + array +
+                      "' (it may use x, y, z and params)",
+                  diags_);
+      continue;
+    }
     bool known = false;
     for (const auto& a : b->args) known |= a.name == kw.name.name;
     if (!known) {

@@ -3,7 +3,7 @@
 //   inlet NAME(array = A, feeds = F, x = X, y = Y, z = Z, nx = NX, ny = NY, nz = NZ,
 //              length = L, width = W, u = U, v = V, w = W, copy = [p, q, ...]);
 //   outlet NAME(array = A, from = F, x = .., nx = .., length = .., width = .., copy = [..],
-//               type = do_nothing);
+//               type = do_nothing | mirror);
 //
 // (x, y, z): a point on the face between the fluid and the zone; (nx, ny, nz): the outward
 // normal (away from the fluid); length: the zone's depth along it; width: its extent across.
@@ -132,7 +132,7 @@ std::vector<Box> geometryBoxes(const ast::ArrayDecl& a, int dim, DefaultValues& 
     std::map<std::string, double> v = {{"zmin", 0.0}, {"zmax", 0.0}};
     bool ok = true;
     for (const auto& kw : g.args) {
-      if (!kw.value) continue;
+      if (!kw.value || kw.name.name == "where") continue;  // where: the box still bounds
       auto x = eval(*kw.value);
       if (x) v[kw.name.name] = *x;
       else if (kw.name.name != "dx") ok = false;
@@ -317,15 +317,15 @@ bool buildZones(const ast::SceneDecl& scene, Plan& plan, DiagnosticEngine& diags
     if (auto it = args.find("type"); it != args.end()) {
       const ast::KwArg& kw = *it->second;
       const std::string t = kw.value && kw.value->kind == ast::Expr::Name ? kw.value->text : "";
-      if (t == "do_nothing") {
+      if (t == "do_nothing" || t == "mirror") {
         pz.type = t;
-      } else if (t == "hybrid" || t == "characteristic" || t == "mirror") {
+      } else if (t == "hybrid" || t == "characteristic") {
         diags.error(kw.value->loc, "outlet type '" + t + "' (Negi et al. 2019) is not "
-                                   "implemented yet; use type = do_nothing");
+                                   "implemented yet; use type = do_nothing or mirror");
         ok = false;
       } else {
-        diags.error(kw.name.loc, "outlet type is do_nothing (hybrid, characteristic and "
-                                 "mirror are not implemented yet)");
+        diags.error(kw.name.loc, "outlet type is do_nothing or mirror (hybrid and "
+                                 "characteristic are not implemented yet)");
         ok = false;
       }
     }

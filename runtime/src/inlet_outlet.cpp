@@ -1,6 +1,7 @@
 // sphc runtime: the inlet/outlet manager (sphc/inlet_outlet.h).
 #include "sphc/inlet_outlet.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -173,7 +174,64 @@ void init_inlet_outlet(InletOutlet& io, const std::vector<ParticleArray*>& all, 
   for (auto& out : io.outlets) {
     out.in = make_copy_map(*out.outlet, *out.from, out.copy);
     out.back = make_copy_map(*out.from, *out.outlet, out.copy);
+    out.support = support;
+    out.mirrored = CopyMap{};
+    for (std::size_t k = 0; k < out.in.to.size(); ++k) {
+      const Property& p = out.outlet->props[out.in.to[k]];
+      if (p.type != PropType::F64 || p.stride != 1 || p.name == "x" || p.name == "y" || p.name == "z" ||
+          p.name == "m" || p.name == "h" || p.name == "gid")
+        continue;
+      out.mirrored.to.push_back(out.in.to[k]);
+      out.mirrored.from.push_back(out.in.from[k]);
+    }
   }
+}
+
+std::size_t mirror_outlet(OutletZone& out) {
+  ParticleArray& o = *out.outlet;
+  const ParticleArray& src = *out.from;
+  const Zone& z = out.zone;
+  const double R = out.support;
+  if (!(R > 0.0) || out.mirrored.to.empty()) return 0;
+  // The source particles an image point can reach: depth in [-(2 length + R), 0].
+  std::vector<std::size_t> near;
+  const Positions sp(src);
+  for (std::size_t j = 0; j < src.n; ++j) {
+    double q[3];
+    sp.at(j, q);
+    const double s = z.depth(q);
+    if (s <= 0.0 && s >= -(2.0 * z.length + R)) near.push_back(j);
+  }
+  const Positions op(o);
+  const std::size_t np = out.mirrored.to.size();
+  std::vector<double> acc(np);
+  std::size_t lonely = 0;
+  for (std::size_t i = 0; i < o.n; ++i) {
+    double p[3];
+    op.at(i, p);
+    const double s = z.depth(p);
+    double img[3];
+    for (int k = 0; k < 3; ++k) img[k] = p[k] - 2.0 * s * z.normal[k];
+    double wsum = 0.0;
+    std::fill(acc.begin(), acc.end(), 0.0);
+    for (std::size_t j : near) {
+      double q[3];
+      sp.at(j, q);
+      double r2 = 0.0;
+      for (int k = 0; k < z.dim; ++k) r2 += (q[k] - img[k]) * (q[k] - img[k]);
+      if (r2 >= R * R) continue;
+      const double x = std::sqrt(r2) / R, a = 1.0 - x;
+      const double w = a * a * a * a * (1.0 + 4.0 * x);  // Wendland C2 (unnormalised)
+      wsum += w;
+      for (std::size_t k = 0; k < np; ++k) acc[k] += w * src.props[out.mirrored.from[k]].f64[j];
+    }
+    if (!(wsum > 0.0)) {
+      ++lonely;
+      continue;
+    }
+    for (std::size_t k = 0; k < np; ++k) o.props[out.mirrored.to[k]].f64[i] = acc[k] / wsum;
+  }
+  return lonely;
 }
 
 bool update_inlet(InletZone& in, GlobalIds& ids, double t) {
@@ -258,6 +316,7 @@ bool inlet_outlet_due(const InletOutlet& io) {
     }
   }
   for (const auto& out : io.outlets) {
+    if (out.kind == OutletKind::Mirror) return true;  // sets the outlet every step
     const Positions pos(*out.outlet);
     for (std::size_t i = 0; i < out.outlet->n; ++i) {
       pos.at(i, p);
@@ -280,7 +339,10 @@ void set_inlet_velocities(InletOutlet& io, double t) {
 bool update_inlet_outlet(InletOutlet& io, double t) {
   bool changed = false;
   for (auto& in : io.inlets) changed |= update_inlet(in, io.ids, t);
-  for (auto& out : io.outlets) changed |= update_outlet(out);
+  for (auto& out : io.outlets) {
+    changed |= update_outlet(out);
+    if (out.kind == OutletKind::Mirror) mirror_outlet(out);
+  }
   return changed;
 }
 

@@ -226,3 +226,78 @@ TEST(InletOutlet, BackflowReturnsToTheSource) {
 }
 
 }  // namespace
+
+// The mirror outlet: every outlet particle takes the velocity (and any copied property other
+// than positions, m, h, gid) of the fluid interpolated at its image across the face (x = 1).
+// A field that varies only along the face (u = 1 + 0.5 y) comes out exactly at particles whose image neighbourhood is
+// symmetric in y (a lattice row away from the walls); positions, masses and ids are kept;
+// with an interpolation radius that reaches no fluid particle the values are kept; the
+// do-nothing outlet changes nothing.
+TEST(InletOutlet, MirrorOutletInterpolatesAtTheImage) {
+  const double dx = 0.1;
+  auto fill = [&](ParticleArray& a, double x0, double x1) {
+    for (double x = x0 + dx / 2; x < x1; x += dx)
+      for (double y = dx / 2; y < 1.0; y += dx) {
+        a.resize(a.n + 1);
+        a.f64("x")[a.n - 1] = x;
+        a.f64("y")[a.n - 1] = y;
+        a.f64("m")[a.n - 1] = 1.0;
+        a.f64("u")[a.n - 1] = x < 1.0 ? 1.0 + 0.5 * y : -7.0;
+        a.f64("v")[a.n - 1] = x < 1.0 ? 0.2 * x : -7.0;
+      }
+  };
+  for (const sphc::OutletKind kind : {sphc::OutletKind::Mirror, sphc::OutletKind::DoNothing}) {
+    for (const double support : {0.2, 0.01}) {
+      ParticleArray fluid = make_array("fluid", 0), outlet = make_array("outlet", 0);
+      fill(fluid, 0.0, 1.0);
+      fill(outlet, 1.0, 1.2);
+      outlet.f64("y")[0] += 0.03;  // off the lattice: its image is 0.03 from any particle
+      sphc::InletOutlet io;
+      sphc::OutletZone out;
+      out.zone.name = "outlet";
+      out.zone.point[0] = 1.0;
+      out.zone.point[1] = 0.5;
+      out.zone.normal[0] = 1.0;
+      out.zone.length = 0.2;
+      out.zone.width = 1.0;
+      out.outlet = &outlet;
+      out.from = &fluid;
+      out.copy = {"x", "y", "u", "v", "m"};
+      out.kind = kind;
+      io.outlets.push_back(out);
+      sphc::init_inlet_outlet(io, {&fluid, &outlet}, support, 0.0);
+      ASSERT_EQ(outlet.n, 20u);
+      const std::uint32_t gid0 = outlet.u32(outlet.find("gid"))[3];
+      EXPECT_EQ(sphc::inlet_outlet_due(io), kind == sphc::OutletKind::Mirror);
+      sphc::update_inlet_outlet(io, 0.0);
+      ASSERT_EQ(outlet.n, 20u);
+      ASSERT_EQ(fluid.n, 100u);
+      EXPECT_EQ(outlet.u32(outlet.find("gid"))[3], gid0);
+      const bool mirror = kind == sphc::OutletKind::Mirror;
+      for (std::size_t i = 0; i < outlet.n; ++i) {
+        const double x = outlet.f64("x")[i], y = outlet.f64("y")[i];
+        const double img = 2.0 - x;  // the image across x = 1
+        EXPECT_EQ(outlet.f64("m")[i], 1.0);
+        EXPECT_GT(x, 1.0);
+        if (!mirror || (support < dx && i == 0)) {  // nothing to interpolate from: kept
+          EXPECT_EQ(outlet.f64("u")[i], -7.0) << i;
+          EXPECT_EQ(outlet.f64("v")[i], -7.0) << i;
+        } else if (support < dx) {  // the image is a fluid particle, the only one in reach
+          EXPECT_NEAR(outlet.f64("u")[i], 1.0 + 0.5 * y, 1e-12) << i;
+          EXPECT_NEAR(outlet.f64("v")[i], 0.2 * img, 1e-12) << i;
+        } else {
+          // v = 0.2 x, interpolated one-sided (no fluid beyond the face): within the values
+          // of the fluid in reach of the image, below the face's 0.2.
+          EXPECT_GT(outlet.f64("v")[i], 0.2 * (img - support)) << i;
+          EXPECT_LT(outlet.f64("v")[i], 0.2) << i;
+          // u = 1 + 0.5 y: exact where the fluid around the image is symmetric in y.
+          if (i > 0 && y > support && y < 1.0 - support)
+            EXPECT_NEAR(outlet.f64("u")[i], 1.0 + 0.5 * y, 1e-12) << i;
+          else
+            EXPECT_NEAR(outlet.f64("u")[i], 1.0 + 0.5 * y, 0.5 * support) << i;
+        }
+      }
+      if (mirror) EXPECT_EQ(sphc::mirror_outlet(io.outlets[0]), support < dx ? 1u : 0u);
+    }
+  }
+}

@@ -20,9 +20,18 @@
 //     to the outlet array (copied, gid kept, removed from the source);
 //   - an outlet particle with s < 0 (flowing back) returns to the source array;
 //   - an outlet particle past the zone (s > length) is removed.
-// The outlet condition (how outlet particles get their properties) is the scene's
-// equations on the outlet array; `do_nothing` (Negi et al. 2019, sec. 3.1) means their
-// velocity and pressure are those they carried in: the manager changes nothing.
+// The outlet condition (how outlet particles get their properties):
+//   - do_nothing (Negi et al. 2019, sec. 3.1): their velocity and pressure are those they
+//     carried in; the manager changes nothing (the scene's equations on the outlet array may).
+//   - mirror (after the mirror condition of Negi et al. 2019: outlet properties taken from
+//     the fluid through the image point): after the moves, every outlet particle at depth s
+//     takes the copied properties other than x, y, z, m, h and gid (velocity, pressure,
+//     density, ...) interpolated from the source array at its mirror image across the face,
+//     p - 2 s normal, by a Shepard average with the Wendland C2 weight of radius `support`
+//     (the kernel support). A zero normal gradient at the face: the outflow continues with
+//     the fluid's velocity profile and pressure instead of the values frozen when each
+//     particle left. A particle whose image has no source particle within the support keeps
+//     its values. Serial and in particle order, as everything here.
 //
 // Arrays change size only here, between time steps, never during an evaluation: the neighbour
 // search, ghosts and cell lists are rebuilt from the current sizes at every evaluation. All
@@ -83,7 +92,7 @@ struct InletZone {
   std::size_t created = 0;         // particles that entered the fed array so far
 };
 
-enum class OutletKind : std::uint8_t { DoNothing };
+enum class OutletKind : std::uint8_t { DoNothing, Mirror };
 
 struct OutletZone {
   Zone zone;
@@ -93,6 +102,8 @@ struct OutletZone {
   OutletKind kind = OutletKind::DoNothing;
   CopyMap in, back;                 // from -> outlet, outlet -> from
   std::size_t entered = 0, returned = 0, removed = 0;
+  double support = 0.0;             // mirror: the interpolation radius (set by init)
+  CopyMap mirrored;                 // mirror: outlet <- from, the interpolated properties
 };
 
 struct InletOutlet {
@@ -120,6 +131,10 @@ void set_inlet_velocities(InletOutlet& io, double t);
 // then every outlet. Returns whether any array changed size.
 bool update_inlet(InletZone& in, GlobalIds& ids, double t);
 bool update_outlet(OutletZone& out);
+// The mirror condition (OutletKind::Mirror): interpolates out.mirrored at every outlet
+// particle's image point. Returns the number of particles that found no source near their
+// image (and kept their values).
+std::size_t mirror_outlet(OutletZone& out);
 bool update_inlet_outlet(InletOutlet& io, double t);
 
 }  // namespace sphc

@@ -1,0 +1,154 @@
+#!/usr/bin/env python3
+"""Check of examples/cylinder.sph: flow past a cylinder in a channel (the 2D benchmark of
+Schaefer & Turek 1996, "DFG benchmark"), with an inlet and an outlet. Reads the run's metrics
+(cylinder_metrics.csv: cd, cl, their time integrals cd_int, cl_int, and nfluid) at every
+output.
+
+Steady case (Re = 20, [ST96] case 2D-1, the default): the mean drag and lift coefficients over
+[--t-start, end], from the time integrals (exact means of every step's force, not of the
+sampled snapshots), must lie within --cd-tol (relative) of Cd = 5.58 and within --cl-tol
+(absolute) of Cl = 0.0106 ([ST96] table 4: Cd 5.57-5.59, Cl 0.0104-0.0110; the blockage of
+the channel, D/H = 0.24, is part of the benchmark). The mean over the second half of that
+window must differ from the mean over the first half by less than --drift-tol (relative):
+the flow has settled. At every output the fluid's particle count stays within --count-tol of
+its start (the inlet feeds what the outlet removes) and every metric is finite.
+
+Shedding case (--shedding: Re = 100, [ST96] case 2D-2): the Strouhal number St = f D / Ubar,
+f the peak of the spectrum of the lift after --t-start (averaged over --smooth), within
+--st-tol (relative) of 0.300 ([ST96]: 0.295-0.305), at least 3 periods; the mean drag and
+the lift amplitude are printed against [ST96]'s Cd_max 3.22-3.24 and Cl_max 0.99-1.01 (not
+checked: at D/10 the drag is ~20% high, as the steady case's is 10-13%)."""
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import plots  # noqa: E402
+from metrics_csv import read_metrics  # noqa: E402
+from snapshots import argument_parser  # noqa: E402
+
+CD_ST96, CL_ST96 = 5.58, 0.0106          # 2D-1, Re = 20
+ST_ST96, CDMAX_ST96, CLMAX_ST96 = 0.300, 3.23, 1.00   # 2D-2, Re = 100
+
+
+def mean_between(t, integral, a, b):
+    """(I(b) - I(a)) / (b - a) with the outputs nearest a and b."""
+    i = min(range(len(t)), key=lambda k: abs(t[k] - a))
+    j = min(range(len(t)), key=lambda k: abs(t[k] - b))
+    if t[j] <= t[i]:
+        return float("nan")
+    return (integral[j] - integral[i]) / (t[j] - t[i])
+
+
+def main():
+    ap = argument_parser(__doc__, "the solver's output directory", "cylinder.png")
+    ap.add_argument("--t-start", type=float, default=1.0,
+                    help="end of the start-up transient (default 1.0: 2 D / Ubar)")
+    ap.add_argument("--cd-tol", type=float, default=0.15)
+    ap.add_argument("--cl-tol", type=float, default=0.1)
+    ap.add_argument("--drift-tol", type=float, default=0.03)
+    ap.add_argument("--count-tol", type=float, default=0.10)
+    ap.add_argument("--shedding", action="store_true")
+    ap.add_argument("--st-tol", type=float, default=0.10)
+    ap.add_argument("--smooth", type=float, default=0.2,
+                    help="--shedding: the window the lift is averaged over (default 0.2)")
+    ap.add_argument("--D", type=float, default=0.1)
+    ap.add_argument("--Ubar", type=float, default=0.2)
+    args = ap.parse_args()
+    m = read_metrics(args.outdir, "cylinder.py", ("t", "cd", "cl", "cd_int", "cl_int", "nfluid"))
+    if m is None:
+        return 2
+    t, cd, cl = m["t"], m["cd"], m["cl"]
+    failures = []
+    for name in ("cd", "cl", "cd_int", "cl_int", "nfluid"):
+        bad = [t[k] for k, v in enumerate(m[name]) if not math.isfinite(v)]
+        if bad:
+            failures.append("%s is not finite at t = %g" % (name, bad[0]))
+    n0 = m["nfluid"][0]
+    lo, hi = min(m["nfluid"]), max(m["nfluid"])
+    print("fluid particles: %d to %d over %d outputs (start %d)" % (lo, hi, len(t), n0))
+    if lo < (1 - args.count_tol) * n0 or hi > (1 + args.count_tol) * n0:
+        failures.append("the fluid's particle count left %d +- %.0f%%: %d to %d"
+                        % (n0, 100 * args.count_tol, lo, hi))
+    t_end = t[-1]
+    if t_end <= args.t_start:
+        sys.stderr.write("cylinder.py: the run ends at t = %g, before --t-start %g\n"
+                         % (t_end, args.t_start))
+        return 2
+    cd_mean = mean_between(t, m["cd_int"], args.t_start, t_end)
+    cl_mean = mean_between(t, m["cl_int"], args.t_start, t_end)
+    mid = 0.5 * (args.t_start + t_end)
+    cd_1 = mean_between(t, m["cd_int"], args.t_start, mid)
+    cd_2 = mean_between(t, m["cd_int"], mid, t_end)
+    print("mean over t = %g to %g (from the force integrals): Cd = %.4f, Cl = %.4f"
+          % (args.t_start, t_end, cd_mean, cl_mean))
+    print("   first half Cd = %.4f, second half Cd = %.4f (drift %+.2f%%)"
+          % (cd_1, cd_2, 100 * (cd_2 / cd_1 - 1)))
+    if not args.shedding:
+        err = cd_mean / CD_ST96 - 1
+        print("Cd vs Schaefer & Turek 2D-1 (5.58): %+.2f%% (tolerance %.0f%%); Cl vs 0.0106: "
+              "%+.4f (tolerance %.3f)" % (100 * err, 100 * args.cd_tol, cl_mean - CL_ST96,
+                                         args.cl_tol))
+        if not abs(err) <= args.cd_tol:
+            failures.append("Cd %.4f is %+.1f%% from 5.58" % (cd_mean, 100 * err))
+        if not abs(cl_mean - CL_ST96) <= args.cl_tol:
+            failures.append("Cl %.4f is %+.4f from 0.0106" % (cl_mean, cl_mean - CL_ST96))
+        if not abs(cd_2 / cd_1 - 1) <= args.drift_tol:
+            failures.append("Cd still drifts: %.4f then %.4f" % (cd_1, cd_2))
+    else:
+        # The lift averaged over windows of --smooth (from its time integral: the sampled
+        # snapshots carry the step-to-step pressure noise), its mean removed, Hann-windowed;
+        # the shedding frequency is the peak of its spectrum (zero-padded 16 times).
+        import numpy as np
+        tt, ii = np.array(t), np.array(m["cl_int"])
+        w = max(1, int(round(0.5 * args.smooth / (tt[1] - tt[0]))))
+        cls = (ii[2 * w:] - ii[:-2 * w]) / (tt[2 * w:] - tt[:-2 * w])
+        tm = tt[w:-w]
+        sel = tm >= args.t_start
+        sig, ts = cls[sel] - cls[sel].mean(), tm[sel]
+        if len(sig) < 8:
+            failures.append("too few outputs after t = %g for a spectrum" % args.t_start)
+        else:
+            n = 16 * len(sig)
+            freq = np.fft.rfftfreq(n, ts[1] - ts[0])
+            amp = abs(np.fft.rfft(sig * np.hanning(len(sig)), n))
+            k = int(np.argmax(amp[1:])) + 1
+            st = freq[k] * args.D / args.Ubar
+            periods = freq[k] * (ts[-1] - ts[0])
+            cl_amp = float(sig.std() * math.sqrt(2.0))
+            print("shedding: %.1f periods after t = %g, St = %.4f (Schaefer & Turek 2D-2: "
+                  "0.295-0.305), mean Cd = %.3f (their Cd_max %.2f), lift amplitude %.3f "
+                  "(averaged over %g; their Cl_max %.2f)"
+                  % (periods, args.t_start, st, cd_mean, CDMAX_ST96, cl_amp, args.smooth,
+                     CLMAX_ST96))
+            if periods < 3:
+                failures.append("fewer than 3 shedding periods after t = %g" % args.t_start)
+            if not abs(st / ST_ST96 - 1) <= args.st_tol:
+                failures.append("St %.4f is %+.1f%% from %.3f" % (st, 100 * (st / ST_ST96 - 1),
+                                                                  ST_ST96))
+
+    def draw(plt):
+        fig, ax = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+        ax[0].plot(t, cd, lw=0.8, label="Cd (sampled at outputs)")
+        ax[0].axhline(CDMAX_ST96 if args.shedding else CD_ST96, color="k", ls="--",
+                      label="Schaefer & Turek 1996")
+        ax[0].axhline(cd_mean, color="r", label="SPH, mean after t = %g" % args.t_start)
+        ax[0].set_ylim(0, 2 * (CD_ST96 if not args.shedding else CDMAX_ST96))
+        ax[0].set_ylabel("Cd")
+        ax[0].legend(fontsize=8)
+        ax[1].plot(t, cl, lw=0.8)
+        ax[1].set_ylabel("Cl")
+        ax[1].set_xlabel("t")
+        return fig
+
+    plots.write(args, draw, failures)
+    for f in failures:
+        print("FAILED: " + f)
+    if failures:
+        return 1
+    print("OK")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
