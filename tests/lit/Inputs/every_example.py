@@ -20,7 +20,7 @@ A new example is covered by being in examples/: nothing to register. A case that
 cannot run yet is named with --skip SCENE[:CHOICE]:BACKEND and reported as skipped, so the
 exclusions are visible in the RUN line of the test that calls this script; likewise
 --rtol CASE=R widens the OpenCL tolerance of one case, and --scale CASE:NAME=S gives a
-dataset of one case a physical scale (h5close.py --scale; the test says why).
+dataset of one case (an example's name: each choice of its options) a physical scale (h5close.py --scale; the test says why).
 
 usage: every_example.py --sphc SPHC --examples DIR --out DIR [--opencl] [--steps N]
                         [--precision double|single]
@@ -140,7 +140,8 @@ def main():
                         ref = os.path.join(outs['serial'], s)
                         cmp = (['h5diff', ref, mine] if b == 'openmp' else
                                [sys.executable, os.path.join(HERE, 'h5close.py'), ref, mine,
-                                '--rtol', rtol.get(case, '1e-10')] + scales.get(case, []))
+                                '--rtol', rtol.get(case, '1e-10')] +
+                                scales.get(case, scales.get(case.split(':')[0], [])))
                         r = subprocess.run(cmp, capture_output=True, text=True)
                         if r.returncode != 0:
                             bad.append(s + ': ' + (r.stdout + r.stderr).strip()[-400:])
