@@ -7,6 +7,7 @@
 #include "llvm/Support/Path.h"
 #include "llvm/Support/Process.h"
 #include "llvm/Support/Program.h"
+#include "llvm/Support/Host.h"
 #include "llvm/Support/SHA1.h"
 #include "llvm/Support/raw_ostream.h"
 
@@ -126,6 +127,19 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
     for (fs::directory_iterator it(install.includeDir + "/sphc/mpi", ec), end; it != end && !ec;
          it.increment(ec))
       addFileToHash(sha, it->path());
+  }
+  // -march=native builds for this machine's CPU: a cache directory shared by machines with
+  // other CPUs must not hand out a binary built for another instruction set.
+  if (flags.find("-march=native") != std::string::npos) {
+    sha.update(llvm::sys::getHostCPUName());
+    llvm::StringMap<bool> features;
+    if (llvm::sys::getHostCPUFeatures(features)) {
+      std::vector<std::string> on;
+      for (const auto& f : features)
+        if (f.second) on.push_back(f.first().str());
+      std::sort(on.begin(), on.end());
+      for (const auto& f : on) sha.update(f + ",");
+    }
   }
   std::string key = llvm::toHex(sha.final()).substr(0, 24);
 

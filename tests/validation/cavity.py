@@ -45,7 +45,12 @@ Also checked: the flow is steady: the mean kinetic energy of the last --steady-t
 (default 1 L/U) differs from that of the interval before by less than --steady-tol (default
 2%; means, since the weakly compressible fluid carries an acoustic oscillation of 1-2% of the
 kinetic energy from snapshot to snapshot). A drift of 2% in kinetic energy per L/U moves the
-velocities by ~1%, i.e. <= 0.003 U on the centre lines, a tenth of the tolerances. In
+velocities by ~1%, i.e. <= 0.003 U on the centre lines, a tenth of the tolerances. At
+nx <= 35 the default is 5%: seven runs of nx = 30 that differ only in round-off (Re times
+1 + 1e-12 ... 1e-8, or the neighbour loop's summation order changed) gave changes of 0.33,
+0.62, 0.79, 0.85, 1.67, 2.21 and 2.33% (and largest errors 0.018-0.046 U): the particle-level
+noise of 900 particles, not a drift; 5% is twice the largest and still fails the unfinished
+run above (11%). In
 every snapshot: all values finite, the number of fluid particles and their mass unchanged,
 every fluid particle inside the cavity.
 
@@ -58,7 +63,7 @@ profiles and the reference points into OUTPUT_DIR/cavity.png (--plot PATH: elsew
 tests/validation/plots.py).
 
 Usage: cavity.py OUTPUT_DIR [--data DIR] [--L 1] [--U 1] [--avg-time 1.0]
-                 [--max-tol T] [--rms-tol T] [--steady-tol 0.02] [--plot out.png]
+                 [--max-tol T] [--rms-tol T] [--steady-tol 0.05|0.02] [--plot out.png]
 """
 
 import os
@@ -122,9 +127,10 @@ def main():
                     help="largest |error| / U (default 0.06 for nx <= 35, else 0.04)")
     ap.add_argument("--rms-tol", type=float, default=None,
                     help="rms error / U (default 0.03 for nx <= 35, else 0.02)")
-    ap.add_argument("--steady-tol", type=float, default=0.02,
+    ap.add_argument("--steady-tol", type=float, default=None,
                     help="largest relative change of the mean kinetic energy between the two "
-                         "halves of the last --steady-time (default 0.02)")
+                         "halves of the last --steady-time (default 0.05 for nx <= 35, "
+                         "else 0.02)")
     ap.add_argument("--steady-time", type=float, default=2.0,
                     help="window of the steadiness check (default 2)")
     args = ap.parse_args()
@@ -171,6 +177,8 @@ def main():
     avg = [s for s in snaps if s[0] >= tf - args.avg_time - 1e-9]
     max_tol = args.max_tol if args.max_tol is not None else (0.06 if nx <= 35 else 0.04)
     rms_tol = args.rms_tol if args.rms_tol is not None else (0.03 if nx <= 35 else 0.02)
+    if args.steady_tol is None:
+        args.steady_tol = 0.05 if nx <= 35 else 0.02
 
     # Reference points without the wall rows.
     yu = ref_u[(ref_u[:, 0] > 0) & (ref_u[:, 0] < 1), :]
