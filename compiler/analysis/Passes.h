@@ -27,5 +27,9 @@ bool selectPairQuantities(Plan& plan, DiagnosticEngine& diags);
 // analysis/Ghosts.cpp: with a periodic or mirror domain, the properties ghost copies of each
 // source array carry (PlanArray::ghostProps).
 bool selectGhostProperties(Plan& plan, DiagnosticEngine& diags);
+// analysis/DtBound.cpp: the stable bound of the time step from the scene's sound_speed,
+// av_alpha, viscosity and body_force at the parameters' defaults: a --report note, and a
+// warning at `dt =` for a fixed step above it; Plan::dtBoundH for the solver's own check.
+bool boundTimeStep(Plan& plan, DiagnosticEngine& diags);
 
 }  // namespace sphc

@@ -2,6 +2,7 @@
 // stepper bodies, the scene's parameters and set-up, the functions of groups and phases
 // (their per-destination work is the backend's), iteration and convergence, the integrator's
 // step, the adaptive time step's combination, struct Scene and `main`.
+#include "codegen/DtBoundCpp.h"
 #include "codegen/Printer.h"
 #include "sema/Geometry.h"
 
@@ -198,6 +199,7 @@ void ScenePrinter::emitSetup() {
   auto pn = [&](const std::string& n) { return paramRef(n); };
   scene_ << "    times.tf = " << exprCpp(*plan_.tf, pn) << ";\n";
   scene_ << "    times.dt = " << exprCpp(*plan_.dt, pn) << ";\n";
+  scene_ << dtBoundSetupCpp(plan_, pn, "    ");
   if (plan_.outputEvery)
     scene_ << "    times.output_every = " << exprCpp(*plan_.outputEvery, pn) << ";\n";
   for (const auto& t : plan_.outputAt)

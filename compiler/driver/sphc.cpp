@@ -240,6 +240,7 @@ int main(int argc, char** argv) {
   if (dump(Pass::Pairs)) return 0;
   if (!selectGhostProperties(*plan, diags)) return fail();
   if (dump(Pass::Ghosts)) return 0;
+  if (!boundTimeStep(*plan, diags)) return fail();
   log("analysis");
   if (diags.hasErrors()) return fail();
 

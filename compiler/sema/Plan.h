@@ -196,6 +196,10 @@ struct Plan {
   bool adaptiveDt = false;
   ast::ExprPtr cfl, forceFactor;
   ast::ExprPtr viscousFactor, nu;  // viscous limit: viscousFactor * h^2 / nu (if nu is given)
+  // What bounds a fixed step (scene settings sound_speed, av_alpha, viscosity, body_force;
+  // analysis/DtBound.cpp), and the smallest initial h of the moving arrays it found (null:
+  // none known before the run, no bound).
+  ast::ExprPtr soundSpeed, avAlpha, viscosity, bodyForce, dtBoundH;
   ast::ExprPtr outputEvery;
   std::vector<ast::ExprPtr> outputAt;
   bool outputNearestStep = false;  // output_landing = nearest_step

@@ -14,8 +14,9 @@ namespace sphc::sema_detail {
 void SemaImpl::buildScene() {
   const ast::SceneDecl& s = *plan_->scene;
   std::set<std::string> seen;
-  static const std::vector<std::string> known = {"dim", "kernel", "tf", "dt", "integrator",
-                                                 "output_landing"};
+  static const std::vector<std::string> known = {
+      "dim",         "kernel",   "tf",        "dt",        "integrator", "output_landing",
+      "sound_speed", "av_alpha", "viscosity", "body_force"};
   for (const auto& set : s.settings) {
     const std::string& k = set.key.name;
     if (!seen.insert(k).second) {
@@ -42,6 +43,16 @@ void SemaImpl::buildScene() {
       if (checkSceneExpr(set.value, "tf")) plan_->tf = set.value;
     } else if (k == "dt") {
       if (checkSceneExpr(set.value, "dt")) plan_->dt = set.value;
+    } else if (k == "sound_speed" || k == "av_alpha" || k == "viscosity" ||
+               k == "body_force") {
+      // What bounds a fixed time step (analysis/DtBound.cpp, docs/language.md "Time-step
+      // bound"): the reference sound speed, Monaghan's artificial-viscosity alpha, the
+      // kinematic viscosity and the magnitude of the body force per unit mass.
+      if (!checkSceneExpr(set.value, k)) continue;
+      (k == "sound_speed" ? plan_->soundSpeed
+       : k == "av_alpha"  ? plan_->avAlpha
+       : k == "viscosity" ? plan_->viscosity
+                          : plan_->bodyForce) = set.value;
     } else if (k == "output_landing") {
       // exact: steps shortened to land on output times (the default, PySPH's rule);
       // nearest_step: whole steps, outputs at the nearest step end (docs/language.md).

@@ -9,6 +9,7 @@
 // normal (away from the fluid); length: the zone's depth along it; width: its extent across.
 // u, v, w: the inlet velocity, expressions of params, x, y, z and t.
 #include "sema/Zones.h"
+#include "sema/ConstEval.h"
 #include "sema/Sema.h"
 
 #include "llvm/Support/Format.h"
@@ -31,89 +32,6 @@ std::string num(double v) {
   return buf;
 }
 
-// The value of a scene expression with every parameter at its default (nothing if it names
-// anything else or a parameter's default cannot be computed).
-class DefaultValues {
- public:
-  explicit DefaultValues(const Plan& plan) {
-    for (const auto* p : plan.params) decls_[p->name.name] = p->value.get();
-  }
-  std::optional<double> operator()(const ast::Expr& e, int depth = 0) {
-    if (depth > 64) return std::nullopt;
-    auto sub = [&](size_t i) { return (*this)(*e.args[i], depth + 1); };
-    switch (e.kind) {
-      case ast::Expr::Number: return e.number;
-      case ast::Expr::Name: {
-        if (e.text == "pi") return M_PI;
-        if (e.text == "e") return M_E;
-        if (e.text == "true") return 1.0;
-        if (e.text == "false") return 0.0;
-        auto it = decls_.find(e.text);
-        if (it == decls_.end() || !it->second) return std::nullopt;
-        return (*this)(*it->second, depth + 1);
-      }
-      case ast::Expr::Unary: {
-        auto v = sub(0);
-        if (!v) return v;
-        if (e.op == "-") return -*v;
-        if (e.op == "!") return *v == 0.0 ? 1.0 : 0.0;
-        return v;
-      }
-      case ast::Expr::Binary: {
-        auto a = sub(0), b = sub(1);
-        if (!a || !b) return std::nullopt;
-        const std::string& o = e.op;
-        if (o == "+") return *a + *b;
-        if (o == "-") return *a - *b;
-        if (o == "*") return *a * *b;
-        if (o == "/") return *a / *b;
-        if (o == "%") return std::fmod(*a, *b);
-        if (o == "<") return double(*a < *b);
-        if (o == "<=") return double(*a <= *b);
-        if (o == ">") return double(*a > *b);
-        if (o == ">=") return double(*a >= *b);
-        if (o == "==") return double(*a == *b);
-        if (o == "!=") return double(*a != *b);
-        if (o == "&&") return double(*a != 0 && *b != 0);
-        if (o == "||") return double(*a != 0 || *b != 0);
-        return std::nullopt;
-      }
-      case ast::Expr::Ternary: {
-        auto c = sub(0);
-        if (!c) return c;
-        return *c != 0 ? sub(1) : sub(2);
-      }
-      case ast::Expr::Call: {
-        std::vector<double> v;
-        for (size_t i = 0; i < e.args.size(); ++i) {
-          auto x = sub(i);
-          if (!x) return x;
-          v.push_back(*x);
-        }
-        static const std::map<std::string, double (*)(double)> one = {
-            {"sqrt", std::sqrt}, {"exp", std::exp},   {"log", std::log},   {"sin", std::sin},
-            {"cos", std::cos},   {"tan", std::tan},   {"fabs", std::fabs}, {"abs", std::fabs},
-            {"floor", std::floor}, {"ceil", std::ceil}, {"round", std::round},
-            {"cbrt", std::cbrt}, {"log10", std::log10}, {"tanh", std::tanh}};
-        if (v.size() == 1 && one.count(e.text)) return one.at(e.text)(v[0]);
-        if (v.size() == 2) {
-          if (e.text == "pow") return std::pow(v[0], v[1]);
-          if (e.text == "fmin" || e.text == "min") return std::fmin(v[0], v[1]);
-          if (e.text == "fmax" || e.text == "max") return std::fmax(v[0], v[1]);
-          if (e.text == "atan2") return std::atan2(v[0], v[1]);
-          if (e.text == "hypot") return std::hypot(v[0], v[1]);
-          if (e.text == "fmod") return std::fmod(v[0], v[1]);
-        }
-        return std::nullopt;
-      }
-    }
-    return std::nullopt;
-  }
-
- private:
-  std::map<std::string, const ast::Expr*> decls_;
-};
-
 struct Box {
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   llvm::SMLoc loc;
@@ -125,7 +43,7 @@ struct Box {
 
 // The boxes of an array's `block` and `tank` geometry, with the default parameters (others
 // are skipped: the checks are about what can be known before the run).
-std::vector<Box> geometryBoxes(const ast::ArrayDecl& a, int dim, DefaultValues& eval) {
+std::vector<Box> geometryBoxes(const ast::ArrayDecl& a, int dim, ConstEval& eval) {
   std::vector<Box> boxes;
   for (const auto& g : a.geometry) {
     if (g.builder.name != "block" && g.builder.name != "tank") continue;
@@ -208,7 +126,7 @@ struct ZoneValues {
 
 bool buildZones(const ast::SceneDecl& scene, Plan& plan, DiagnosticEngine& diags) {
   const unsigned errorsBefore = diags.errorCount();
-  DefaultValues eval(plan);
+  ConstEval eval(plan);
   std::set<std::string> params;
   for (const auto* p : plan.params) params.insert(p->name.name);
   const int dim = plan.dim;

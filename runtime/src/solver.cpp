@@ -597,6 +597,7 @@ class Simulation {
     prog_.setup(parameter_values(), times);
     phase_.clear();
     apply_overrides(times);
+    check_fixed_dt(times);
     arrays_ = prog_.arrays ? prog_.arrays() : std::vector<ParticleArray*>{};
     set_up_limits();
     const std::string dir =
@@ -728,6 +729,18 @@ class Simulation {
     require(std::isfinite(times.dt) && times.dt > 0, "time step dt", times.dt);
     require(std::isfinite(times.output_every) && times.output_every >= 0,
             "output interval", times.output_every);
+  }
+
+  // A fixed step (no adaptive_dt) above the stable bound the scene states (SceneTimes::
+  // dt_bound, with the actual parameters and --dt): said before the first step, once.
+  void check_fixed_dt(const SceneTimes& times) const {
+    if (prog_.adaptive_dt || prog_.rank > 0 || !(times.dt > times.dt_bound * (1.0 + 1e-9)))
+      return;
+    fmt::print(stderr,
+               "warning: the fixed time step dt = {:.4g} is {:.3g} times the stable bound "
+               "{:.4g} of the {}: expect the run to blow up; take a smaller --dt (or build "
+               "the scene with adaptive_dt)\n",
+               times.dt, times.dt / times.dt_bound, times.dt_bound, times.dt_bound_term);
   }
 
   // Brings device data to the host (device backends) and looks for NaN or Inf in it: the

@@ -10,6 +10,9 @@
 // sphc/sanity.h, or the adaptive time step collapsed).
 #pragma once
 
+#include <cmath>
+#include <cstdio>
+#include <initializer_list>
 #include <chrono>
 #include <functional>
 #include <string>
@@ -57,7 +60,33 @@ struct SceneTimes {
   // and each output (and the end) is taken at the end of the step nearest to its time, with
   // the time actually reached; for schemes whose result depends on the step (IISPH).
   bool output_nearest_step = false;
+  // The stable bound of a fixed step (the compiler's analysis/DtBound.cpp, computed by the
+  // scene's set-up with the actual parameters) and its limiting term; HUGE_VAL: none stated.
+  // A fixed dt above it is reported at start-up (bound_dt, check_fixed_dt).
+  double dt_bound = HUGE_VAL;
+  std::string dt_bound_term;
 };
+
+// A term's description: "acoustic limit ... (h = 0.039, c0 = 62.64, alpha = 0.1; SOURCE)".
+inline std::string dt_bound_text(const char* formula, const char* source, double h,
+                                 std::initializer_list<std::pair<const char*, double>> values) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.4g", h);
+  std::string s = std::string(formula) + " (h = " + buf;
+  for (const auto& [name, v] : values) {
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+    s += std::string(", ") + name + " = " + buf;
+  }
+  return s + "; " + source + ")";
+}
+
+// One term of the bound: keeps the smallest positive finite one.
+inline void bound_dt(SceneTimes& times, double dt, const std::string& term) {
+  if (std::isfinite(dt) && dt > 0 && dt < times.dt_bound) {
+    times.dt_bound = dt;
+    times.dt_bound_term = term;
+  }
+}
 
 // The wall time of one top-level group of the equations (--timing).
 struct GroupSeconds {
