@@ -15,7 +15,10 @@
 #   -D NAME=CHOICE  compile-time options of the scene
 #   RUN OPTIONS passed to the solver; "--dt-factor F" (not a solver option) runs a fixed step
 #               of F x DT0, with DT0 given by "--dt0 EXPR" (an awk expression of dx: the
-#               scene's fixed step), and "--set dx=V" sets dx for it
+#               scene's fixed step), and "--set dx=V" sets dx for it; "--expect-dt-warning
+#               yes|no" (not a solver option either) requires the solver's start-up warning
+#               of a fixed step above the stable bound (docs/language.md, Time-step bound)
+#               on its standard error, or its absence
 #   CHECK OPTIONS passed to check_run.py after the output directory
 # Environment: EXPECT_RC (comma-separated accepted exit codes, default 0); SPHC_PYTHON.
 # A run that stops as a blow-up (exit 3) must say on its standard error which output is "the
@@ -42,10 +45,12 @@ RUN_OPTS=""
 DX=""
 FACTOR=""
 DT0=""
+DTWARN=""
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do
   case "$1" in
     --dt-factor) FACTOR=$2; shift 2; continue ;;
     --dt0) DT0=$2; shift 2; continue ;;
+    --expect-dt-warning) DTWARN=$2; shift 2; continue ;;
     dx=*) DX=${1#dx=} ;;
   esac
   RUN_OPTS="$RUN_OPTS $1"
@@ -81,6 +86,16 @@ case ",${EXPECT_RC:-0}," in
   *",$rc,"*) ;;
   *) echo "FAILED: the run exited $rc (accepted: ${EXPECT_RC:-0})"; exit 1 ;;
 esac
+if [ -n "$DTWARN" ]; then
+  warned=no
+  grep -qF "warning: the fixed time step" "$OUT.stderr" && warned=yes
+  if [ "$warned" != "$DTWARN" ]; then
+    echo "FAILED: the solver's warning of a fixed step above the stable bound: expected" \
+         "$DTWARN, got $warned"
+    exit 1
+  fi
+  echo "   start-up warning of a fixed step above the stable bound: $warned (as expected)"
+fi
 if [ "$rc" = 3 ] && ! grep -qF "the last good output is" "$OUT.stderr"; then
   echo "FAILED: the run stopped (exit 3) without naming the last good output"
   exit 1
