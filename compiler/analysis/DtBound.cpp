@@ -69,9 +69,12 @@ bool boundTimeStep(Plan& plan, DiagnosticEngine& diags) {
     if (arr.stepper < 0 || !movesParticles(plan, a)) continue;
     const PlanProperty* p = arr.find("h");
     std::optional<double> v = p && p->init ? eval(*p->init) : std::nullopt;
-    if (!v || !(*v > 0)) {
-      plan.notes.push_back("time-step bound: not known before the run (the initial h of "
-                           "array '" + arr.name + "' is not an expression of params)");
+    if (!v || !(*v > 0) || !std::isfinite(*v)) {
+      plan.notes.push_back(
+          "time-step bound: not known before the run (array '" + arr.name + "' " +
+          (!p ? std::string("has no h") : !p->init ? std::string("has no initial h")
+                : !v ? std::string("has an initial h that is not an expression of params")
+                     : "has the initial h " + num(*v)) + ")");
       return true;
     }
     if (!h || *v < *h) hFrom = arr.name;
@@ -96,7 +99,10 @@ bool boundTimeStep(Plan& plan, DiagnosticEngine& diags) {
   bool unknown = false;
   auto value = [&](const ast::ExprPtr& e) {
     std::optional<double> v = eval(e);
-    if (e && !v) unknown = true;
+    if (e && (!v || !std::isfinite(*v))) {
+      unknown = true;
+      return std::optional<double>();
+    }
     return v;
   };
   if (auto c0 = value(plan.soundSpeed)) {
@@ -114,7 +120,7 @@ bool boundTimeStep(Plan& plan, DiagnosticEngine& diags) {
                      dt_bound::kForceSource, dt_bound::kForce * std::sqrt(*h / std::fabs(*g))});
   if (unknown) {
     plan.notes.push_back("time-step bound: not known before the run (a sound_speed, av_alpha, "
-                         "viscosity or body_force that is not an expression of params)");
+                         "viscosity or body_force that is not a finite expression of params)");
     return true;
   }
   if (terms.empty()) {
@@ -136,7 +142,7 @@ bool boundTimeStep(Plan& plan, DiagnosticEngine& diags) {
   plan.notes.push_back(line);
 
   std::optional<double> dt = eval(*plan.dt);
-  if (!dt) {
+  if (!dt || !std::isfinite(*dt)) {
     plan.notes.push_back("time step: dt is not an expression of params; the solver checks it "
                          "against the bound at start-up");
     return true;
