@@ -63,3 +63,15 @@ for _py in ('python3', '/usr/bin/python3'):
             break
     except OSError:
         pass
+# `REQUIRES: h5py`: a Python here imports numpy and h5py (Debian python3-numpy, python3-h5py,
+# installed by scripts/setup-deps.sh), for checks that read snapshots with them (the PySPH
+# comparisons in tests/lit/ported); %h5py_python is that Python.
+for _py in ('python3', '/usr/bin/python3'):
+    try:
+        if _sp.run([_py, '-c', 'import numpy, h5py'], stdout=_sp.DEVNULL,
+                   stderr=_sp.DEVNULL).returncode == 0:
+            config.available_features.add('h5py')
+            config.substitutions.append(('%h5py_python', _py))
+            break
+    except OSError:
+        pass
