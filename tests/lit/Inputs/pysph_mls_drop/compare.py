@@ -17,9 +17,12 @@ Tolerance 1e-9 of each scale. The two codes do the same arithmetic except the or
 neighbours are summed in, the 3x3 solve (PySPH's Gauss-Jordan helper, this port's Gaussian
 elimination with pivoting: both exact but for round-off) and the last bits of the last dt,
 so they differ by round-off amplified over 400 steps; measured on the committed reference
-(2026-12-02): <= ~1e-13 of each scale (compare.py prints the figures). Any difference of
-scheme is far above it: the run without the filter (--set t_on=1) or with the window opened
-half a step later differs by >= 1e-6 (test pysph-mls-drop.sph checks that both fail).
+(2026-12-02, serial): positions <= 4.7e-13 dx (the last bits of the final t, times u), velocities
+<= 5.1e-14 v0, pressure <= 7.3e-13 of max |p|, density <= 4.2e-15 (this script prints them).
+Any difference of scheme is far above the tolerance: without the filter (--set t_on=1) the
+positions differ by 1.1e-2 dx and the pressure by 0.71 max |p|; with the window opened half a
+step later (--set t_on=0.00050375) by 6.1e-5 dx and 4.4e-3 max |p| (pysph-mls-drop.sph checks
+that both fail).
 
 usage:
   compare.py SPHC_OUT --reference REF.npz          # against the stored reference
