@@ -1,4 +1,5 @@
 #include "sphc/opencl.h"
+#include "sphc/kernels.h"
 
 #include <algorithm>
 #include <chrono>
@@ -925,11 +926,26 @@ void DeviceGhosts::release() {
   capacity = 0;
 }
 
+namespace {
+
+// The shape functions of every kernel as OpenCL C: the text of sphc/kernel_shapes.h, which
+// the CPU backends compile as C++ (kernels.h).
+#define SPHC_KERNEL_SHAPES(...) #__VA_ARGS__
+const char* const kKernelShapesSource =
+#include "sphc/kernel_shapes.h"
+    ;
+#undef SPHC_KERNEL_SHAPES
+
+}  // namespace
+
 std::string kernel_function_source(const std::string& kernel, int dim) {
-  // sigma, radius scale, f(q) and df(q) as in sphc/kernels.h (same formulas, same order of
-  // operations).
-  const double pi = 3.14159265358979323846;
-  std::string sigma, f, df, rs;
+  // sigma and the radius scale from sphc/kernels.h, f(q) and df(q) from sphc/kernel_shapes.h:
+  // the CPU kernels' numbers and text.
+  KernelKind kind;
+  if (!parse_kernel_kind(kernel, kind)) {
+    throw std::invalid_argument("sphc::ocl: unknown kernel '" + kernel + "'");
+  }
+  const AnyKernel any{kind, dim};
   char buf[64];
   auto num = [&](double v) {
     std::snprintf(buf, sizeof buf, "%.17g", v);
@@ -937,95 +953,30 @@ std::string kernel_function_source(const std::string& kernel, int dim) {
     if (s.find_first_of(".e") == std::string::npos) s += ".0";
     return s;
   };
-  if (kernel == "CubicSpline") {
-    rs = "2.0";
-    sigma = num(dim == 1 ? 2.0 / 3.0 : dim == 2 ? 10.0 / (7.0 * pi) : 1.0 / pi);
-    f = "  if (q < 1.0) return 1.0 - 1.5 * q * q * (1.0 - 0.5 * q);\n"
-        "  if (q < 2.0) { const real t = 2.0 - q; return 0.25 * t * t * t; }\n"
-        "  return 0.0;\n";
-    df = "  if (q < 1.0) return q * (2.25 * q - 3.0);\n"
-         "  if (q < 2.0) { const real t = 2.0 - q; return -0.75 * t * t; }\n"
-         "  return 0.0;\n";
-  } else if (kernel == "QuinticSpline") {
-    rs = "3.0";
-    sigma = num(dim == 1 ? 1.0 / 120.0 : dim == 2 ? 7.0 / (478.0 * pi) : 1.0 / (120.0 * pi));
-    f = "  if (q >= 3.0) return 0.0;\n"
-        "  const real t3 = 3.0 - q, t2 = 2.0 - q, t1 = 1.0 - q;\n"
-        "  real v = t3 * t3 * t3 * t3 * t3;\n"
-        "  if (q < 2.0) v -= 6.0 * t2 * t2 * t2 * t2 * t2;\n"
-        "  if (q < 1.0) v += 15.0 * t1 * t1 * t1 * t1 * t1;\n"
-        "  return v;\n";
-    df = "  if (q >= 3.0) return 0.0;\n"
-         "  const real t3 = 3.0 - q, t2 = 2.0 - q, t1 = 1.0 - q;\n"
-         "  real v = -5.0 * t3 * t3 * t3 * t3;\n"
-         "  if (q < 2.0) v += 30.0 * t2 * t2 * t2 * t2;\n"
-         "  if (q < 1.0) v -= 75.0 * t1 * t1 * t1 * t1;\n"
-         "  return v;\n";
-  } else if (kernel == "WendlandQuintic") {
-    rs = "2.0";
-    if (dim == 1) {
-      sigma = num(5.0 / 8.0);
-      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n"
-          "  return t * t * t * (1.5 * q + 1.0);\n";
-      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n"
-           "  return -3.0 * q * t * t;\n";
-    } else {
-      sigma = num(dim == 2 ? 7.0 / (4.0 * pi) : 21.0 / (16.0 * pi));
-      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
-          "  return t2 * t2 * (2.0 * q + 1.0);\n";
-      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q;\n"
-           "  return -5.0 * q * t * t * t;\n";
-    }
-  } else if (kernel == "Gaussian") {
-    rs = "3.0";
-    sigma = num(dim == 1 ? 1.0 / std::sqrt(pi) : dim == 2 ? 1.0 / pi : std::pow(pi, -1.5));
-    f = "  return q < 3.0 ? exp(-q * q) : 0.0;\n";
-    df = "  return q < 3.0 ? -2.0 * q * exp(-q * q) : 0.0;\n";
-  } else if (kernel == "WendlandQuinticC4") {
-    rs = "2.0";
-    if (dim == 1) {
-      sigma = num(0.75);
-      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
-          "  return t2 * t2 * t * (2.0 * q * q + 2.5 * q + 1.0);\n";
-      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
-           "  return -3.5 * q * (2.0 * q + 1.0) * t2 * t2;\n";
-    } else {
-      sigma = num(dim == 2 ? 9.0 / (4.0 * pi) : 495.0 / (256.0 * pi));
-      f = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
-          "  return t2 * t2 * t2 * ((35.0 / 12.0) * q * q + 3.0 * q + 1.0);\n";
-      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
-           "  return (-14.0 / 3.0) * q * (1.0 + 2.5 * q) * t2 * t2 * t;\n";
-    }
-  } else if (kernel == "WendlandQuinticC6") {
-    rs = "2.0";
-    if (dim == 1) {
-      sigma = num(55.0 / 64.0);
-      f = "  if (q >= 2.0) return 0.0;\n"
-          "  const real t = 1.0 - 0.5 * q, t2 = t * t, t4 = t2 * t2;\n"
-          "  return t4 * t2 * t * (((2.625 * q + 4.75) * q + 3.5) * q + 1.0);\n";
-      df = "  if (q >= 2.0) return 0.0;\n  const real t = 1.0 - 0.5 * q, t2 = t * t;\n"
-           "  return -0.5 * q * ((26.25 * q + 27.0) * q + 9.0) * t2 * t2 * t2;\n";
-    } else {
-      sigma = num(dim == 2 ? 78.0 / (28.0 * pi) : 1365.0 / (512.0 * pi));
-      f = "  if (q >= 2.0) return 0.0;\n"
-          "  const real t = 1.0 - 0.5 * q, t2 = t * t, t4 = t2 * t2;\n"
-          "  return t4 * t4 * (((4.0 * q + 6.25) * q + 4.0) * q + 1.0);\n";
-      df = "  if (q >= 2.0) return 0.0;\n"
-           "  const real t = 1.0 - 0.5 * q, t2 = t * t, t4 = t2 * t2;\n"
-           "  return -5.5 * q * ((4.0 * q + 3.5) * q + 1.0) * t4 * t2 * t;\n";
-    }
-  } else if (kernel == "SuperGaussian") {
-    rs = "3.0";
-    sigma = num(dim == 1 ? 1.0 / std::sqrt(pi) : dim == 2 ? 1.0 / pi : std::pow(pi, -1.5));
-    f = "  if (q >= 3.0) return 0.0;\n  const real q2 = q * q;\n  return exp(-q2) * (" +
-        num(1.0 + 0.5 * dim) + " - q2);\n";
-    df = "  if (q >= 3.0) return 0.0;\n  const real q2 = q * q;\n  return q * (2.0 * q2 - " +
-         num(dim + 4.0) + ") * exp(-q2);\n";
-  } else {
-    throw std::invalid_argument("sphc::ocl: unknown kernel '" + kernel + "'");
+  const std::string sigma = num(any.sigma()), rs = num(any.radius_scale());
+  // The shape functions of this kernel and dimension (kernels.h's Shape<Dim>::f, df).
+  std::string fn, fargs = "q", dfargs = "q";
+  switch (kind) {
+    case KernelKind::CubicSpline: fn = "sphc_cubic"; break;
+    case KernelKind::QuinticSpline: fn = "sphc_quintic"; break;
+    case KernelKind::WendlandQuintic: fn = dim == 1 ? "sphc_wendland_c2_1d" : "sphc_wendland_c2"; break;
+    case KernelKind::Gaussian: fn = "sphc_gaussian"; break;
+    case KernelKind::WendlandQuinticC4: fn = dim == 1 ? "sphc_wendland_c4_1d" : "sphc_wendland_c4"; break;
+    case KernelKind::WendlandQuinticC6: fn = dim == 1 ? "sphc_wendland_c6_1d" : "sphc_wendland_c6"; break;
+    case KernelKind::SuperGaussian:
+      fn = "sphc_super_gaussian";
+      fargs = "q, " + num(1 + 0.5 * dim);
+      dfargs = "q, " + num(dim + 4.0);
+      break;
   }
+  const std::string f = "  return " + fn + "_f(" + fargs + ");\n";
+  const std::string df = "  return " + fn + "_df(" + dfargs + ");\n";
+  const std::string shapes = std::string("#define SPHC_SHAPE_FN inline real\n"
+                                         "#define SPHC_R(x) ((real)(x))\n"
+                                         "#define SPHC_EXP(x) exp(x)\n") +
+                             kKernelShapesSource + "\n";
   std::string ih = dim == 1 ? "ih" : dim == 2 ? "(ih * ih)" : "(ih * ih * ih)";
-  return "#line 1 \"sphc-kernel.cl\"\n#define RADIUS_SCALE " + rs +
+  return "#line 1 \"sphc-kernel.cl\"\n" + shapes + "#define RADIUS_SCALE " + rs +
          "\n#define RADIUS2 (RADIUS_SCALE * RADIUS_SCALE)\n"
          "inline real kernel_f(real q) {\n" +
          f + "}\n" + "inline real kernel_df(real q) {\n" + df + "}\n" +

@@ -51,15 +51,27 @@ config.substitutions.append(('%precision_compare', 'python3 ' + os.path.join(
 # ('=V', '<V', '>V'; tests/lit/Inputs/h5consts.py).
 config.substitutions.append(('%h5consts', 'python3 ' + os.path.join(
     config.sphc_src_root, 'tests', 'lit', 'Inputs', 'h5consts.py')))
-# `REQUIRES: pysph`: a Python here imports PySPH (Debian python3-pysph), for the tests of
-# `sphc study --pysph`; %pysph_python is that Python.
 import subprocess as _sp
-for _py in ('python3', '/usr/bin/python3'):
-    try:
-        if _sp.run([_py, '-c', 'import pysph'], stdout=_sp.DEVNULL,
-                   stderr=_sp.DEVNULL).returncode == 0:
-            config.available_features.add('pysph')
-            config.substitutions.append(('%pysph_python', _py))
-            break
-    except OSError:
-        pass
+
+
+def _python_feature(feature, imports):
+    """Adds the feature FEATURE and the substitution %FEATURE_python (the first of python3,
+    /usr/bin/python3 that can `import IMPORTS`) where there is one."""
+    for py in ('python3', '/usr/bin/python3'):
+        try:
+            if _sp.run([py, '-c', 'import ' + imports], stdout=_sp.DEVNULL,
+                       stderr=_sp.DEVNULL).returncode == 0:
+                config.available_features.add(feature)
+                config.substitutions.append(('%' + feature + '_python', py))
+                return
+        except OSError:
+            pass
+
+
+# `REQUIRES: pysph`: a Python here imports PySPH (Debian python3-pysph), for the tests of
+# `sphc study --pysph` and the live PySPH comparisons; %pysph_python is that Python.
+_python_feature('pysph', 'pysph')
+# `REQUIRES: h5py`: a Python here imports numpy and h5py (Debian python3-numpy, python3-h5py,
+# installed by scripts/setup-deps.sh), for checks that read snapshots with them (the PySPH
+# comparisons in tests/lit/ported); %h5py_python is that Python.
+_python_feature('h5py', 'numpy, h5py')

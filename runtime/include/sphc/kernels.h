@@ -85,6 +85,20 @@ inline T inv_h_pow(T h) {
   }
 }
 
+// The shape functions f(q), f'(q) of every kernel, as templates on the floating point type
+// (sphc/kernel_shapes.h: the same text is the OpenCL program's, see runtime/src/opencl.cpp).
+namespace shapes {
+#define SPHC_KERNEL_SHAPES(...) __VA_ARGS__
+#define SPHC_SHAPE_FN template <class real> inline real
+#define SPHC_R(x) real(x)
+#define SPHC_EXP(x) std::exp(x)
+#include "sphc/kernel_shapes.h"
+#undef SPHC_EXP
+#undef SPHC_R
+#undef SPHC_SHAPE_FN
+#undef SPHC_KERNEL_SHAPES
+}  // namespace shapes
+
 // The part common to all kernels: W, dW/dq and the gradient from a shape `S` providing
 // `S::sigma` (normalisation for the dimension), `S::radius_scale`, `S::f(q)` and `S::df(q)`.
 // f and df must return 0 for q >= radius_scale.
@@ -92,6 +106,7 @@ template <class S, int Dim>
 struct RadialKernel {
   static constexpr int dim = Dim;
   static constexpr double radius_scale = S::radius_scale;
+  static constexpr double sigma = S::sigma;  // W = sigma / h^d f(r / h)
 
   template <class T>
   static inline T w(T rij, T h) {
@@ -117,23 +132,9 @@ struct CubicShape {
   static constexpr double sigma =
       Dim == 1 ? 2.0 / 3.0 : Dim == 2 ? 10.0 / (7.0 * kPi) : 1.0 / kPi;
   template <class T>
-  static inline T f(T q) {
-    if (q < T(1)) return T(1) - T(1.5) * q * q * (T(1) - T(0.5) * q);
-    if (q < T(2)) {
-      const T t = T(2) - q;
-      return T(0.25) * t * t * t;
-    }
-    return T(0);
-  }
+  static inline T f(T q) { return shapes::sphc_cubic_f(q); }
   template <class T>
-  static inline T df(T q) {
-    if (q < T(1)) return q * (T(2.25) * q - T(3));  // -3q + 9/4 q^2
-    if (q < T(2)) {
-      const T t = T(2) - q;
-      return T(-0.75) * t * t;
-    }
-    return T(0);
-  }
+  static inline T df(T q) { return shapes::sphc_cubic_df(q); }
 };
 
 template <int Dim>
@@ -142,23 +143,9 @@ struct QuinticShape {
   static constexpr double sigma =
       Dim == 1 ? 1.0 / 120.0 : Dim == 2 ? 7.0 / (478.0 * kPi) : 1.0 / (120.0 * kPi);
   template <class T>
-  static inline T f(T q) {
-    if (q >= T(3)) return T(0);
-    const T t3 = T(3) - q, t2 = T(2) - q, t1 = T(1) - q;
-    T v = t3 * t3 * t3 * t3 * t3;
-    if (q < T(2)) v -= T(6) * t2 * t2 * t2 * t2 * t2;
-    if (q < T(1)) v += T(15) * t1 * t1 * t1 * t1 * t1;
-    return v;
-  }
+  static inline T f(T q) { return shapes::sphc_quintic_f(q); }
   template <class T>
-  static inline T df(T q) {
-    if (q >= T(3)) return T(0);
-    const T t3 = T(3) - q, t2 = T(2) - q, t1 = T(1) - q;
-    T v = T(-5) * t3 * t3 * t3 * t3;
-    if (q < T(2)) v += T(30) * t2 * t2 * t2 * t2;
-    if (q < T(1)) v -= T(75) * t1 * t1 * t1 * t1;
-    return v;
-  }
+  static inline T df(T q) { return shapes::sphc_quintic_df(q); }
 };
 
 // Wendland C2 for d = 2, 3: (1 - q/2)^4 (2q + 1).
@@ -167,18 +154,9 @@ struct WendlandC2Shape {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = Dim == 2 ? 7.0 / (4.0 * kPi) : 21.0 / (16.0 * kPi);
   template <class T>
-  static inline T f(T q) {
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q, t2 = t * t;
-    return t2 * t2 * (T(2) * q + T(1));
-  }
+  static inline T f(T q) { return shapes::sphc_wendland_c2_f(q); }
   template <class T>
-  static inline T df(T q) {
-    // d/dq [t^4 (2q+1)] = -2 t^3 (2q+1) + 2 t^4 = -5 q t^3
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q;
-    return T(-5) * q * t * t * t;
-  }
+  static inline T df(T q) { return shapes::sphc_wendland_c2_df(q); }
 };
 
 // Wendland C2 for d = 1: (1 - q/2)^3 (1.5q + 1).
@@ -187,18 +165,9 @@ struct WendlandC2Shape<1> {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = 5.0 / 8.0;
   template <class T>
-  static inline T f(T q) {
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q;
-    return t * t * t * (T(1.5) * q + T(1));
-  }
+  static inline T f(T q) { return shapes::sphc_wendland_c2_1d_f(q); }
   template <class T>
-  static inline T df(T q) {
-    // d/dq [t^3 (1.5q+1)] = -1.5 t^2 (1.5q+1) + 1.5 t^3 = -3 q t^2
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q;
-    return T(-3) * q * t * t;
-  }
+  static inline T df(T q) { return shapes::sphc_wendland_c2_1d_df(q); }
 };
 
 template <int Dim>
@@ -206,9 +175,9 @@ struct GaussianShape {
   static constexpr double radius_scale = 3.0;
   static constexpr double sigma = Dim == 1 ? kInvSqrtPi : Dim == 2 ? 1.0 / kPi : kInvPi32;
   template <class T>
-  static inline T f(T q) { return q < T(3) ? std::exp(-q * q) : T(0); }
+  static inline T f(T q) { return shapes::sphc_gaussian_f(q); }
   template <class T>
-  static inline T df(T q) { return q < T(3) ? T(-2) * q * std::exp(-q * q) : T(0); }
+  static inline T df(T q) { return shapes::sphc_gaussian_df(q); }
 };
 
 // Wendland C4 for d = 2, 3: (1 - q/2)^6 (35/12 q^2 + 3q + 1).
@@ -217,18 +186,9 @@ struct WendlandC4Shape {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = Dim == 2 ? 9.0 / (4.0 * kPi) : 495.0 / (256.0 * kPi);
   template <class T>
-  static inline T f(T q) {
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q, t2 = t * t;
-    return t2 * t2 * t2 * ((T(35) / T(12)) * q * q + T(3) * q + T(1));
-  }
+  static inline T f(T q) { return shapes::sphc_wendland_c4_f(q); }
   template <class T>
-  static inline T df(T q) {
-    // d/dq [t^6 p] = -3 t^5 p + t^6 p' = t^5 (-3 p + t p') = -14/3 q (1 + 5/2 q) t^5
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q, t2 = t * t;
-    return (T(-14) / T(3)) * q * (T(1) + T(2.5) * q) * t2 * t2 * t;
-  }
+  static inline T df(T q) { return shapes::sphc_wendland_c4_df(q); }
 };
 
 // Wendland C4 for d = 1: (1 - q/2)^5 (2q^2 + 2.5q + 1).
@@ -237,18 +197,9 @@ struct WendlandC4Shape<1> {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = 0.75;
   template <class T>
-  static inline T f(T q) {
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q, t2 = t * t;
-    return t2 * t2 * t * (T(2) * q * q + T(2.5) * q + T(1));
-  }
+  static inline T f(T q) { return shapes::sphc_wendland_c4_1d_f(q); }
   template <class T>
-  static inline T df(T q) {
-    // d/dq [t^5 p] = t^4 (-5/2 p + t p') = -7/2 q (2q + 1) t^4
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q, t2 = t * t;
-    return T(-3.5) * q * (T(2) * q + T(1)) * t2 * t2;
-  }
+  static inline T df(T q) { return shapes::sphc_wendland_c4_1d_df(q); }
 };
 
 // Wendland C6 for d = 2, 3: (1 - q/2)^8 (4q^3 + 6.25q^2 + 4q + 1).
@@ -257,18 +208,9 @@ struct WendlandC6Shape {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = Dim == 2 ? 78.0 / (28.0 * kPi) : 1365.0 / (512.0 * kPi);
   template <class T>
-  static inline T f(T q) {
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q, t2 = t * t, t4 = t2 * t2;
-    return t4 * t4 * (((T(4) * q + T(6.25)) * q + T(4)) * q + T(1));
-  }
+  static inline T f(T q) { return shapes::sphc_wendland_c6_f(q); }
   template <class T>
-  static inline T df(T q) {
-    // d/dq [t^8 p] = t^7 (-4 p + t p') = -11/2 q (4q^2 + 3.5q + 1) t^7
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q, t2 = t * t, t4 = t2 * t2;
-    return T(-5.5) * q * ((T(4) * q + T(3.5)) * q + T(1)) * t4 * t2 * t;
-  }
+  static inline T df(T q) { return shapes::sphc_wendland_c6_df(q); }
 };
 
 // Wendland C6 for d = 1: (1 - q/2)^7 (21/8 q^3 + 19/4 q^2 + 3.5q + 1).
@@ -277,18 +219,9 @@ struct WendlandC6Shape<1> {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = 55.0 / 64.0;
   template <class T>
-  static inline T f(T q) {
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q, t2 = t * t, t4 = t2 * t2;
-    return t4 * t2 * t * (((T(2.625) * q + T(4.75)) * q + T(3.5)) * q + T(1));
-  }
+  static inline T f(T q) { return shapes::sphc_wendland_c6_1d_f(q); }
   template <class T>
-  static inline T df(T q) {
-    // d/dq [t^7 p] = t^6 (-7/2 p + t p') = -1/2 q (105/4 q^2 + 27q + 9) t^6
-    if (q >= T(2)) return T(0);
-    const T t = T(1) - T(0.5) * q, t2 = t * t;
-    return T(-0.5) * q * ((T(26.25) * q + T(27)) * q + T(9)) * t2 * t2 * t2;
-  }
+  static inline T df(T q) { return shapes::sphc_wendland_c6_1d_df(q); }
 };
 
 // Super-Gaussian: exp(-q^2) (1 + d/2 - q^2), truncated at 3h.
@@ -297,18 +230,9 @@ struct SuperGaussianShape {
   static constexpr double radius_scale = 3.0;
   static constexpr double sigma = GaussianShape<Dim>::sigma;
   template <class T>
-  static inline T f(T q) {
-    if (q >= T(3)) return T(0);
-    const T q2 = q * q;
-    return std::exp(-q2) * (T(1 + 0.5 * Dim) - q2);
-  }
+  static inline T f(T q) { return shapes::sphc_super_gaussian_f(q, T(1 + 0.5 * Dim)); }
   template <class T>
-  static inline T df(T q) {
-    // d/dq [e^(-q^2) (a - q^2)] = q e^(-q^2) (2q^2 - 2a - 2), 2a + 2 = d + 4
-    if (q >= T(3)) return T(0);
-    const T q2 = q * q;
-    return q * (T(2) * q2 - T(Dim + 4)) * std::exp(-q2);
-  }
+  static inline T df(T q) { return shapes::sphc_super_gaussian_df(q, T(Dim + 4)); }
 };
 
 }  // namespace detail
@@ -409,6 +333,9 @@ struct AnyKernel {
   }
   double radius_scale() const {
     return visit([](auto k) { return decltype(k)::radius_scale; });
+  }
+  double sigma() const {
+    return visit([](auto k) { return decltype(k)::sigma; });
   }
   const char* name() const { return kernel_name(kind); }
 
