@@ -8,7 +8,10 @@ an effect that is off is absent from the solver), timed over --steps steps of th
 (`--max-steps N --no-output --timing`, best of --repeat runs). Memory: the bytes per particle
 of the fluid array that `sphc --report` prints (double precision). Time: microseconds per
 particle per step, and the ratio to the scene's default build, which is what stays meaningful
-on a loaded machine (all variants run in one sitting, interleaved when --repeat > 1).
+on a loaded machine (all variants run in one sitting, interleaved when --repeat > 1), and the
+share of the time loop in post_step groups (shifting's), from --timing. The default build is
+the one of the effects the scene lists; "minimal" has every effect off, "every effect on"
+all of the WCSPH scheme's effects listed in WCSPH.
 The dam break runs with its fixed time step (-D timestep=fixed), so every variant takes the
 same steps.
 
@@ -26,7 +29,7 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 WCSPH = ["gravity", "artificial_viscosity", "laminar_viscosity", "xsph", "density_gradient",
-         "delta_sph"]
+         "delta_sph", "density_diffusion", "shifting"]
 
 
 def variants(defaults):
@@ -45,6 +48,12 @@ def variants(defaults):
     return out
 
 
+def scene_effects(scene):
+    """The effects a scene lists (`effects = [...]`): its default build."""
+    m = re.search(r"^\s*effects\s*=\s*\[([^\]]*)\]", open(scene).read(), re.M)
+    return [e.strip() for e in m.group(1).split(",") if e.strip()] if m else []
+
+
 def defines(d):
     return [a for e, v in d.items() for a in ("-D", f"{e}={v}")]
 
@@ -57,10 +66,14 @@ def bytes_per_particle(sphc, scene, extra):
 
 
 def time_per_step(exe, steps, args):
+    """(microseconds per particle per step, share of wall_s in post_step groups) of a run."""
     out = subprocess.run([exe, "--max-steps", str(steps), "--no-output", "--timing", "--quiet"]
                          + args, capture_output=True, text=True, check=True)
-    m = re.search(r"us_per_particle_step=([0-9.eE+-]+)", out.stdout + out.stderr)
-    return float(m.group(1))
+    text = out.stdout + out.stderr
+    m = re.search(r"us_per_particle_step=([0-9.eE+-]+)", text)
+    post = sum(float(g) for g in re.findall(r"^timing-group: .* share=([0-9.]+) .*when=post_step",
+                                            text, re.M))
+    return float(m.group(1)), post
 
 
 def bench(sphc, scene, base, defaults, steps, repeat, tmp, run_args):
@@ -73,14 +86,14 @@ def bench(sphc, scene, base, defaults, steps, repeat, tmp, run_args):
     for _ in range(repeat):
         for r in rows:
             r[4].append(time_per_step(r[2], steps, run_args))
-    t0 = min(rows[0][4])
+    t0 = min(rows[0][4])[0]
     b0 = rows[0][3][0]
     print(f"\n{os.path.relpath(scene, ROOT)}: {steps} steps, best of {repeat}")
     print(f"{'build':34s} {'props':>5s} {'B/particle':>10s} {'mem ratio':>9s} "
-          f"{'us/particle/step':>16s} {'time ratio':>10s}")
+          f"{'us/particle/step':>16s} {'time ratio':>10s} {'post_step share':>15s}")
     for label, _, _, (b, n), ts in rows:
-        t = min(ts)
-        print(f"{label:34s} {n:5d} {b:10d} {b / b0:9.2f} {t:16.3f} {t / t0:10.2f}")
+        t, post = min(ts)
+        print(f"{label:34s} {n:5d} {b:10d} {b / b0:9.2f} {t:16.3f} {t / t0:10.2f} {post:15.2f}")
 
 
 def main():
@@ -101,11 +114,12 @@ def main():
     print(f"sphc effects benchmark on {cpu} (serial, double)")
     with tempfile.TemporaryDirectory() as tmp:
         if a.only != "taylor_green":
-            bench(a.sphc, os.path.join(ROOT, "examples", "dambreak.sph"), ["-D", "timestep=fixed"],
-                  ["gravity", "artificial_viscosity", "xsph"], a.steps, a.repeat, tmp, [])
+            scene = os.path.join(ROOT, "examples", "dambreak.sph")
+            bench(a.sphc, scene, ["-D", "timestep=fixed"], scene_effects(scene), a.steps,
+                  a.repeat, tmp, [])
         if a.only != "dambreak":
-            bench(a.sphc, os.path.join(ROOT, "examples", "taylor_green.sph"), [],
-                  ["laminar_viscosity", "xsph"], a.steps, a.repeat, tmp, [])
+            scene = os.path.join(ROOT, "examples", "taylor_green.sph")
+            bench(a.sphc, scene, [], scene_effects(scene), a.steps, a.repeat, tmp, [])
 
 
 if __name__ == "__main__":

@@ -271,20 +271,20 @@ void ScenePrinter::emitGroup(const ScheduleGroup& sg) {
   emitIteration(sg);
 }
 
+// The live equations of a group and its subgroups, comma-separated (--timing's labels).
+static void liveEquationNames(const Plan& plan, const ScheduleGroup& g, std::string& names) {
+  for (const auto& m : g.members) {
+    if (!m.isPhase) {
+      liveEquationNames(plan, *g.subgroups[m.index], names);
+      continue;
+    }
+    for (int e : g.phases[m.index].equations)
+      if (plan.equations[e].live) names += (names.empty() ? "" : ",") + plan.equations[e].name;
+  }
+}
+
 std::vector<std::pair<std::string, std::string>> ScenePrinter::topGroupLabels() const {
   std::vector<std::pair<std::string, std::string>> labels;
-  std::function<void(const ScheduleGroup&, std::string&)> collect = [&](const ScheduleGroup& g,
-                                                                        std::string& names) {
-    for (const auto& m : g.members) {
-      if (!m.isPhase) {
-        collect(*g.subgroups[m.index], names);
-        continue;
-      }
-      for (int e : g.phases[m.index].equations)
-        if (plan_.equations[e].live)
-          names += (names.empty() ? "" : ",") + plan_.equations[e].name;
-    }
-  };
   const ScheduleGroup& root = sched_.equations;
   for (const auto& m : root.members) {
     std::string names;
@@ -300,9 +300,22 @@ std::vector<std::pair<std::string, std::string>> ScenePrinter::topGroupLabels() 
     }
     const ScheduleGroup& sub = *root.subgroups[m.index];
     if (sub.group->postStep) continue;  // runs in step(), not in equations()
-    collect(sub, names);
+    liveEquationNames(plan_, sub, names);
     labels.push_back({loc(sub.group->loc), names});
   }
+  return labels;
+}
+
+std::vector<std::pair<std::string, std::string>> ScenePrinter::postStepLabels() const {
+  std::vector<std::pair<std::string, std::string>> labels;
+  const ScheduleGroup& root = sched_.equations;
+  for (const auto& ps : sched_.postStep)
+    for (const auto& m : root.members)
+      if (!m.isPhase && root.subgroups[m.index]->group == ps.group) {
+        std::string names;
+        liveEquationNames(plan_, *root.subgroups[m.index], names);
+        labels.push_back({loc(ps.group->loc), names});
+      }
   return labels;
 }
 
@@ -480,8 +493,21 @@ void ScenePrinter::emitStep() {
              << (sched_.postStep[i].group->every ? sched_.postStep[i].function + "_due()"
                                                  : std::string("true"));
     scene_ << ")) return;\n";
-    scene_ << (hasDomain() ? "    update_domain();\n" : "") << "    update_neighbours();\n";
-    for (const auto& ps : sched_.postStep) scene_ << "    " << ps.function << "(t, dt);\n";
+    scene_ << (hasDomain() ? "    update_domain();\n" : "");
+    if (timesGroups())
+      timedNeighbourUpdate();
+    else
+      scene_ << "    update_neighbours();\n";
+    if (timesGroups()) {
+      // --timing: each post_step group's wall time, after the equations' in group_seconds;
+      // the neighbour update before them counts as neighbour search.
+      for (std::size_t i = 0; i < sched_.postStep.size(); ++i)
+        scene_ << "    {\n      const double t0 = sphc::wall_seconds();\n      "
+               << sched_.postStep[i].function << "(t, dt);\n      group_seconds["
+               << sched_.equations.calls.size() + i << "] += sphc::wall_seconds() - t0;\n    }\n";
+    } else {
+      for (const auto& ps : sched_.postStep) scene_ << "    " << ps.function << "(t, dt);\n";
+    }
     if (hasDomain()) scene_ << removeGhosts();
     scene_ << "  }\n\n";
   }
@@ -632,6 +658,10 @@ void ScenePrinter::emitMain() {
       for (std::size_t k = 0; k < labels.size(); ++k)
         out_ << (k ? "," : "") << "\n        {\"" << labels[k].first << "\", \""
              << labels[k].second << "\", scene.group_seconds[" << k << "]}";
+      const auto post = postStepLabels();
+      for (std::size_t i = 0; i < post.size(); ++i)
+        out_ << ",\n        {\"" << post[i].first << "\", \"" << post[i].second
+             << "\", scene.group_seconds[" << labels.size() + i << "], true}";
       out_ << "};\n  };\n";
     }
   }
@@ -792,7 +822,8 @@ void ScenePrinter::emitSceneMembers() {
   if (timesNeighbourSearch()) out_ << "  double nnps_seconds = 0.0;  // in update_neighbours, for --timing\n";
   if (timesGroups())
     out_ << "  std::vector<double> group_seconds = std::vector<double>("
-         << sched_.equations.calls.size() << ", 0.0);  // per top-level group, for --timing\n";
+         << sched_.equations.calls.size() + sched_.postStep.size()
+         << ", 0.0);  // per top-level group, then per post_step group, for --timing\n";
   if (!sourceArrays_.empty()) {
     out_ << "  static constexpr long REORDER_EVERY = 50;\n";
     out_ << "  long builds = 0;\n";

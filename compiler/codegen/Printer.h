@@ -163,6 +163,8 @@ class ScenePrinter {
   // --timing: (FILE:LINE, live equations comma-separated) of each call of the top-level
   // group `equations`, in call order.
   std::vector<std::pair<std::string, std::string>> topGroupLabels() const;
+  // The same for the groups with post_step = true, in sched_.postStep order.
+  std::vector<std::pair<std::string, std::string>> postStepLabels() const;
   // The convergence test of an iterated group's equation (inside the iteration loop).
   void emitConverged(const PlanEquation& eq);
   // `reduce { }` (PySPH's reduce(dst, t, dt)) of a destination's equations, on the host,

@@ -1028,9 +1028,10 @@ class Simulation {
   }
 
   // --timing, serial and OpenMP: the time loop's wall time by part. One line per top-level
-  // group of the equations (all its evaluations in the time loop), then the split of wall_s:
-  // groups_s (their sum), nnps_s (the neighbour search), integrator_s (the rest of the time
-  // steps: steppers, periodic wraps, ghosts, post_step groups, inlets/outlets) and
+  // group of the equations (all its evaluations in the time loop) and per post_step group
+  // (marked when=post_step), then the split of wall_s: groups_s (their sum), nnps_s (the
+  // neighbour search), integrator_s (the rest of the time steps: steppers, periodic wraps,
+  // ghosts, inlets/outlets) and
   // outside_steps_s (output, blow-up and limit checks, metrics, progress); the four add up
   // to wall_s.
   void report_groups(double wall_s) {
@@ -1039,8 +1040,9 @@ class Simulation {
     for (std::size_t k = 0; k < now.size(); ++k) {
       const double s = now[k].seconds - (k < group_start_.size() ? group_start_[k].seconds : 0.0);
       groups += s;
-      fmt::print("timing-group: name={} s={:.6g} share={:.4f} equations={}\n", now[k].name, s,
-                 wall_s > 0 ? s / wall_s : 0.0, now[k].equations);
+      fmt::print("timing-group: name={} s={:.6g} share={:.4f} equations={}{}\n", now[k].name, s,
+                 wall_s > 0 ? s / wall_s : 0.0, now[k].equations,
+                 now[k].post_step ? " when=post_step" : "");
     }
     const double nnps = prog_.neighbour_seconds ? prog_.neighbour_seconds() - nnps_start_ : 0.0;
     fmt::print("timing-split: wall_s={:.6g} groups_s={:.6g} nnps_s={:.6g} integrator_s={:.6g} "

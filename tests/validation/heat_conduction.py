@@ -15,10 +15,8 @@ conserved within --heat-tol (relative); no non-finite values."""
 import math
 import sys
 
-import h5py
 import numpy as np
 
-import plots
 import snapshots
 
 WHO = "heat_conduction.py"
@@ -49,25 +47,19 @@ def main():
     ap.add_argument("--heat-tol", type=float, default=1e-12)
     args = ap.parse_args()
 
-    files = snapshots.snapshots(args.outdir, WHO)
-    if files is None:
+    got = snapshots.read_series(args.outdir, ["x", "T", "m"], WHO)
+    if got is None:
         return 2
+    series, failures = got
     scale = abs(args.T1 - args.T2)
-    failures = []
     heat0 = None
     rows = []
     last = None
-    for name in files:
-        with h5py.File(name, "r") as f:
-            got = snapshots.read_fluid(f, name, ["x", "T", "m"], WHO, failures)
-            if got is None:
-                return 2
-            t, (x, T, m) = got
+    for _, t, (x, T, m) in series:
         heat = float((m * T).sum())
         if heat0 is None:
             heat0 = heat
-        if abs(heat - heat0) > args.heat_tol * abs(heat0):
-            failures.append("t = %g: heat %.15g, at the start %.15g" % (t, heat, heat0))
+        snapshots.check_conserved("heat", t, heat, heat0, args.heat_tol, failures)
         if t <= 0:
             continue
         err = np.abs(T - exact(x, t, args)) / scale
@@ -99,12 +91,7 @@ def main():
         ax.legend()
         return fig
 
-    if last is not None:
-        plots.write(args, draw, failures)
-    if snapshots.report_failures(failures, limit=20):
-        return 1
-    print("OK")
-    return 0
+    return snapshots.finish(args, draw if last is not None else None, failures)
 
 
 if __name__ == "__main__":

@@ -128,3 +128,43 @@ def report_failures(failures, limit=None):
     for msg in failures[:limit]:
         print("  " + msg)
     return True
+
+
+def read_series(directory, keys, who, at_least=2):
+    """Every snapshot of an output directory in step order (snapshots()), read with
+    read_fluid: ([(file name, t, [arrays of `keys`])], failures), the failures listing the
+    non-finite values found; None after an error on stderr naming `who` (too few snapshots,
+    or a snapshot without the fluid or one of the keys)."""
+    import h5py  # here: the other helpers serve scripts that read no HDF5
+
+    files = snapshots(directory, who, at_least)
+    if files is None:
+        return None
+    failures = []
+    series = []
+    for name in files:
+        with h5py.File(name, "r") as f:
+            got = read_fluid(f, name, keys, who, failures)
+        if got is None:
+            return None
+        series.append((name, got[0], got[1]))
+    return series, failures
+
+
+def check_conserved(what, t, value, start, tol, failures):
+    """Appends to `failures` a line when `value` (of the quantity `what` at time t) differs
+    from `start` by more than tol relative to |start|."""
+    if abs(value - start) > tol * abs(start):
+        failures.append("t = %g: %s %.15g, at the start %.15g" % (t, what, value, start))
+
+
+def finish(args, draw, failures, limit=20, **plot_options):
+    """The end of a check: its plot (plots.write(args, draw, failures, **plot_options); draw
+    None: no plot), then the failures (report_failures) or OK. Returns the exit status: 1
+    with failures, else 0."""
+    if draw is not None:
+        plots.write(args, draw, failures, **plot_options)
+    if report_failures(failures, limit):
+        return 1
+    print("OK")
+    return 0

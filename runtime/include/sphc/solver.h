@@ -88,11 +88,13 @@ inline void bound_dt(SceneTimes& times, double dt, const std::string& term) {
   }
 }
 
-// The wall time of one top-level group of the equations (--timing).
+// The wall time of one top-level group of the equations, or of one group with
+// post_step = true (run after each time step), for --timing.
 struct GroupSeconds {
   std::string name;     // FILE:LINE of the group
   std::string equations;  // its live equations, comma-separated
   double seconds = 0.0;
+  bool post_step = false;  // a post_step group (after the time step, in prog.step)
 };
 
 // How many iterations the evaluations of one iterated group took (group (iterate = true)):
