@@ -33,6 +33,12 @@ void ScenePrinter::emitZoneSetup() {
       scene_ << "      zn.outlet = &" << A << ";\n      zn.from = &" << O << ";\n";
     if (!z.inlet && z.type == "mirror")  // properties interpolated at the image points
       scene_ << "      zn.kind = sphc::OutletKind::Mirror;\n";
+    if (!z.inlet && z.type == "characteristic") {  // mirror interpolation + characteristics
+      scene_ << "      zn.kind = sphc::OutletKind::Characteristic;\n";
+      scene_ << "      zn.c = " << exprCpp(*z.c, pn) << ";\n";
+      if (z.pRef) scene_ << "      zn.p_ref = " << exprCpp(*z.pRef, pn) << ";\n";
+      if (z.tau) scene_ << "      zn.tau = " << exprCpp(*z.tau, pn) << ";\n";
+    }
     if (!z.copy.empty()) {
       scene_ << "      zn.copy = {";
       for (size_t i = 0; i < z.copy.size(); ++i)
@@ -75,7 +81,7 @@ void ScenePrinter::emitInletOutlet() {
   scene_ << "  void inlet_outlet(double t) {\n";
   scene_ << "    const double start = sphc::wall_seconds();\n";
   bool mirror = false;  // a mirror outlet sets its particles every step: no shortcut
-  for (const PlanZone& z : plan_.zones) mirror |= !z.inlet && z.type == "mirror";
+  for (const PlanZone& z : plan_.zones) mirror |= !z.inlet && z.type != "do_nothing";
   if (checksZonesFirst() && !mirror) {
     std::vector<int> inlets;
     for (const PlanZone& z : plan_.zones)

@@ -235,6 +235,13 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
       if (*sep == ' ') os << " kept";
     } else {
       os << "; type " << z.type;
+      if (z.c) {
+        os << " (c = ";
+        ex(z.c);
+        if (z.pRef) os << ", p_ref = ", ex(z.pRef);
+        if (z.tau) os << ", tau = ", ex(z.tau);
+        os << ")";
+      }
     }
     os << "; copies ";
     if (z.copy.empty()) os << "every common property";

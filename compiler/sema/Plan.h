@@ -178,6 +178,7 @@ struct PlanZone {
   ast::ExprPtr velocity[3];  // inlet: u, v, w (null: not prescribed on that axis: 0)
   std::vector<std::string> copy;  // empty: every property both arrays have
   std::string type = "do_nothing";  // outlet condition
+  ast::ExprPtr c, pRef, tau;        // characteristic outlet: sound speed, p_ref, averaging time
 };
 
 struct PlanStepper {

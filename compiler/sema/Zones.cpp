@@ -155,7 +155,7 @@ bool buildZones(const ast::SceneDecl& scene, Plan& plan, DiagnosticEngine& diags
     std::set<std::string> known = {"array", otherKey, "x", "y", "z", "nx", "ny", "nz",
                                    "length", "width", "copy"};
     if (z.inlet) known.insert({"u", "v", "w"});
-    else known.insert("type");
+    else known.insert({"type", "c", "p_ref", "tau"});
     bool ok = true;
     for (const auto& kw : z.args) {
       if (!known.count(kw.name.name)) {
@@ -235,16 +235,32 @@ bool buildZones(const ast::SceneDecl& scene, Plan& plan, DiagnosticEngine& diags
     if (auto it = args.find("type"); it != args.end()) {
       const ast::KwArg& kw = *it->second;
       const std::string t = kw.value && kw.value->kind == ast::Expr::Name ? kw.value->text : "";
-      if (t == "do_nothing" || t == "mirror") {
+      if (t == "do_nothing" || t == "mirror" || t == "characteristic") {
         pz.type = t;
-      } else if (t == "hybrid" || t == "characteristic") {
-        diags.error(kw.value->loc, "outlet type '" + t + "' (Negi et al. 2019) is not "
-                                   "implemented yet; use type = do_nothing or mirror");
+      } else if (t == "hybrid") {
+        diags.error(kw.value->loc, "outlet type 'hybrid' (Negi et al. 2019) is not "
+                                   "implemented yet; use type = do_nothing, mirror or "
+                                   "characteristic");
         ok = false;
       } else {
-        diags.error(kw.name.loc, "outlet type is do_nothing or mirror (hybrid and "
-                                 "characteristic are not implemented yet)");
+        diags.error(kw.name.loc, "outlet type is do_nothing, mirror or characteristic (hybrid "
+                                 "is not implemented yet)");
         ok = false;
+      }
+    }
+    if (!z.inlet) {
+      // The characteristic outlet's sound speed (required), reference pressure, averaging time.
+      const bool characteristic = pz.type == "characteristic";
+      for (const char* key : {"c", "p_ref", "tau"})
+        if (auto it = args.find(key); it != args.end() && !characteristic) {
+          diags.error(it->second->name.loc, "'" + std::string(key) + "' of " + what +
+                                                " is for type = characteristic only");
+          ok = false;
+        }
+      if (characteristic) {
+        pz.c = expr("c", true, false);
+        pz.pRef = expr("p_ref", false, false);
+        pz.tau = expr("tau", false, false);
       }
     }
     if (pz.array < 0 || pz.other < 0 || !ok) continue;

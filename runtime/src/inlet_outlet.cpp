@@ -187,12 +187,20 @@ void init_inlet_outlet(InletOutlet& io, const std::vector<ParticleArray*>& all, 
   }
 }
 
-std::size_t mirror_outlet(OutletZone& out) {
-  ParticleArray& o = *out.outlet;
+namespace {
+// The mirror interpolation: for every outlet particle, the properties of out.mirrored
+// interpolated from the source at its image across the face into vals[i * np + k] (np =
+// out.mirrored.to.size()), found[i] = 0 where no source particle lies within the support.
+std::size_t interpolate_images(const OutletZone& out, std::vector<double>& vals,
+                               std::vector<std::uint8_t>& found) {
+  const ParticleArray& o = *out.outlet;
   const ParticleArray& src = *out.from;
   const Zone& z = out.zone;
   const double R = out.support;
-  if (!(R > 0.0) || out.mirrored.to.empty()) return 0;
+  const std::size_t np = out.mirrored.to.size();
+  vals.assign(o.n * np, 0.0);
+  found.assign(o.n, 0);
+  if (!(R > 0.0) || np == 0) return 0;
   // The source particles an image point can reach: depth in [-(2 length + R), 0].
   std::vector<std::size_t> near;
   const Positions sp(src);
@@ -203,8 +211,6 @@ std::size_t mirror_outlet(OutletZone& out) {
     if (s <= 0.0 && s >= -(2.0 * z.length + R)) near.push_back(j);
   }
   const Positions op(o);
-  const std::size_t np = out.mirrored.to.size();
-  std::vector<double> acc(np);
   std::size_t lonely = 0;
   for (std::size_t i = 0; i < o.n; ++i) {
     double p[3];
@@ -213,7 +219,7 @@ std::size_t mirror_outlet(OutletZone& out) {
     double img[3];
     for (int k = 0; k < 3; ++k) img[k] = p[k] - 2.0 * s * z.normal[k];
     double wsum = 0.0;
-    std::fill(acc.begin(), acc.end(), 0.0);
+    double* acc = vals.data() + i * np;
     for (std::size_t j : near) {
       double q[3];
       sp.at(j, q);
@@ -229,7 +235,129 @@ std::size_t mirror_outlet(OutletZone& out) {
       ++lonely;
       continue;
     }
-    for (std::size_t k = 0; k < np; ++k) o.props[out.mirrored.to[k]].f64[i] = acc[k] / wsum;
+    found[i] = 1;
+    for (std::size_t k = 0; k < np; ++k) acc[k] /= wsum;
+  }
+  return lonely;
+}
+
+// Tangential coordinates of p on the face (2D: one, 3D: two; orthonormal to the normal).
+void tangential(const Zone& z, const double p[3], double t[2]) {
+  double d[3];
+  for (int k = 0; k < 3; ++k) d[k] = k < z.dim ? p[k] - z.point[k] : 0.0;
+  const double* n = z.normal;
+  if (z.dim == 2) {
+    t[0] = -d[0] * n[1] + d[1] * n[0];
+    t[1] = 0.0;
+    return;
+  }
+  // a = the unit vector of the axis least aligned with n, made orthogonal to n; b = n x a.
+  int m = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::fabs(n[k]) < std::fabs(n[m])) m = k;
+  double a[3] = {0, 0, 0};
+  a[m] = 1.0;
+  double an = a[0] * n[0] + a[1] * n[1] + a[2] * n[2], al = 0.0;
+  for (int k = 0; k < 3; ++k) a[k] -= an * n[k], al += a[k] * a[k];
+  for (int k = 0; k < 3; ++k) a[k] /= std::sqrt(al);
+  const double b[3] = {n[1] * a[2] - n[2] * a[1], n[2] * a[0] - n[0] * a[2],
+                       n[0] * a[1] - n[1] * a[0]};
+  t[0] = d[0] * a[0] + d[1] * a[1] + d[2] * a[2];
+  t[1] = d[0] * b[0] + d[1] * b[1] + d[2] * b[2];
+}
+}  // namespace
+
+std::size_t mirror_outlet(OutletZone& out) {
+  std::vector<double> vals;
+  std::vector<std::uint8_t> found;
+  const std::size_t lonely = interpolate_images(out, vals, found);
+  ParticleArray& o = *out.outlet;
+  const std::size_t np = out.mirrored.to.size();
+  for (std::size_t i = 0; i < o.n; ++i)
+    if (found[i])
+      for (std::size_t k = 0; k < np; ++k) o.props[out.mirrored.to[k]].f64[i] = vals[i * np + k];
+  return lonely;
+}
+
+std::size_t characteristic_outlet(OutletZone& out, double t) {
+  ParticleArray& o = *out.outlet;
+  const Zone& z = out.zone;
+  if (!(out.c > 0.0))
+    throw std::invalid_argument(z.name + ": the characteristic outlet needs the sound speed "
+                                "c > 0 (got " + num(out.c) + ")");
+  // Where p, rho and the velocity components sit among the interpolated values.
+  const std::size_t np = out.mirrored.to.size();
+  auto slot = [&](const char* name) {
+    for (std::size_t k = 0; k < np; ++k)
+      if (o.props[out.mirrored.to[k]].name == name) return static_cast<int>(k);
+    return -1;
+  };
+  const int kp = slot("p"), krho = slot("rho");
+  int kv[3] = {slot("u"), slot("v"), slot("w")};
+  if (kp < 0) throw std::invalid_argument(z.name + ": the characteristic outlet needs 'p' "
+                                          "in both arrays (and copied)");
+  for (int k = 0; k < z.dim; ++k)
+    if (kv[k] < 0)
+      throw std::invalid_argument(z.name + ": the characteristic outlet needs the velocity "
+                                  "'" + std::string(1, "uvw"[k]) + "' in both arrays (and copied)");
+  std::vector<double> vals;
+  std::vector<std::uint8_t> found;
+  const std::size_t lonely = interpolate_images(out, vals, found);
+
+  // Bins across the face (width support / 2) for the mean normal velocity u_ref.
+  const double bw = 0.5 * out.support;
+  const int nb1 = z.dim > 1 ? std::max(1, static_cast<int>(std::ceil(z.width / bw))) : 1;
+  const int nb2 = z.dim > 2 ? nb1 : 1;
+  const std::size_t nb = static_cast<std::size_t>(nb1) * static_cast<std::size_t>(nb2);
+  if (out.uref.size() != nb) {
+    out.uref.assign(nb, 0.0);
+    out.uref_set.assign(nb, 0);
+  }
+  const Positions op(o);
+  std::vector<std::size_t> bin(o.n, 0);
+  std::vector<double> sum(nb, 0.0);
+  std::vector<std::size_t> cnt(nb, 0);
+  std::vector<double> un(o.n, 0.0);
+  for (std::size_t i = 0; i < o.n; ++i) {
+    double p[3], tc[2];
+    op.at(i, p);
+    tangential(z, p, tc);
+    auto idx = [&](double c) {
+      const int b = static_cast<int>(std::floor((c + 0.5 * z.width) / bw));
+      return std::min(std::max(b, 0), nb1 - 1);
+    };
+    bin[i] = static_cast<std::size_t>(idx(tc[0])) +
+             (z.dim > 2 ? static_cast<std::size_t>(idx(tc[1])) * nb1 : 0);
+    if (!found[i]) continue;
+    for (int k = 0; k < z.dim; ++k) un[i] += vals[i * np + kv[k]] * z.normal[k];
+    sum[bin[i]] += un[i];
+    ++cnt[bin[i]];
+  }
+  const double tau = out.tau > 0.0 ? out.tau : 20.0 * z.length / out.c;
+  const double f = out.started ? std::min(1.0, std::max(0.0, t - out.t_last) / tau) : 1.0;
+  for (std::size_t b = 0; b < nb; ++b) {
+    if (!cnt[b]) continue;
+    const double mean = sum[b] / static_cast<double>(cnt[b]);
+    if (!out.uref_set[b]) {
+      out.uref[b] = mean;
+      out.uref_set[b] = 1;
+    } else {
+      out.uref[b] += f * (mean - out.uref[b]);
+    }
+  }
+  out.started = true;
+  out.t_last = t;
+
+  for (std::size_t i = 0; i < o.n; ++i) {
+    if (!found[i]) continue;
+    double* v = vals.data() + i * np;
+    const double rho = krho >= 0 && v[krho] > 0.0 ? v[krho] : 1.0;
+    const double ur = out.uref[bin[i]];
+    const double j2 = rho * out.c * (un[i] - ur) + (v[kp] - out.p_ref);
+    v[kp] = out.p_ref + 0.5 * j2;
+    const double dn = ur + 0.5 * j2 / (rho * out.c) - un[i];  // new minus image normal velocity
+    for (int k = 0; k < z.dim; ++k) v[kv[k]] += dn * z.normal[k];
+    for (std::size_t k = 0; k < np; ++k) o.props[out.mirrored.to[k]].f64[i] = v[k];
   }
   return lonely;
 }
@@ -316,7 +444,7 @@ bool inlet_outlet_due(const InletOutlet& io) {
     }
   }
   for (const auto& out : io.outlets) {
-    if (out.kind == OutletKind::Mirror) return true;  // sets the outlet every step
+    if (out.kind != OutletKind::DoNothing) return true;  // sets the outlet every step
     const Positions pos(*out.outlet);
     for (std::size_t i = 0; i < out.outlet->n; ++i) {
       pos.at(i, p);
@@ -342,6 +470,7 @@ bool update_inlet_outlet(InletOutlet& io, double t) {
   for (auto& out : io.outlets) {
     changed |= update_outlet(out);
     if (out.kind == OutletKind::Mirror) mirror_outlet(out);
+    if (out.kind == OutletKind::Characteristic) characteristic_outlet(out, t);
   }
   return changed;
 }

@@ -301,3 +301,88 @@ TEST(InletOutlet, MirrorOutletInterpolatesAtTheImage) {
     }
   }
 }
+
+// The characteristic outlet: a wave leaving the fluid (u - u_ref = (p - p_ref) / (rho c))
+// passes into the outlet unchanged; one that would come in through it
+// (u - u_ref = -(p - p_ref) / (rho c)) is removed (p = p_ref, u = u_ref); a steady pressure is
+// halved towards p_ref. u_ref is set from the first call, then moves by dt / tau per call.
+TEST(InletOutlet, CharacteristicOutletPassesOutgoingWavesOnly) {
+  const double dx = 0.1, c = 10.0, rho = 1.0, U = 1.0, P = 0.3;
+  auto fill = [&](ParticleArray& a, double x0, double x1) {
+    for (double x = x0 + dx / 2; x < x1; x += dx)
+      for (double y = dx / 2; y < 1.0; y += dx) {
+        a.resize(a.n + 1);
+        a.f64("x")[a.n - 1] = x;
+        a.f64("y")[a.n - 1] = y;
+        a.f64("m")[a.n - 1] = 1.0;
+        a.f64("rho")[a.n - 1] = rho;
+        a.f64("u")[a.n - 1] = x < 1.0 ? U : -7.0;
+        a.f64("v")[a.n - 1] = x < 1.0 ? 0.25 : -7.0;
+        a.f64("p")[a.n - 1] = x < 1.0 ? 0.0 : -7.0;
+      }
+  };
+  auto props = [](ParticleArray& a) {
+    a.add_property("rho");
+    a.add_property("p");
+  };
+  // sign = +1: outgoing wave, -1: incoming, 0: a steady pressure P (velocity unchanged).
+  for (const int sign : {1, -1, 0}) {
+    ParticleArray fluid = make_array("fluid", 0), outlet = make_array("outlet", 0);
+    props(fluid);
+    props(outlet);
+    fill(fluid, 0.0, 1.0);
+    fill(outlet, 1.0, 1.2);
+    sphc::InletOutlet io;
+    sphc::OutletZone out;
+    out.zone.name = "outlet";
+    out.zone.point[0] = 1.0;
+    out.zone.point[1] = 0.5;
+    out.zone.normal[0] = 1.0;
+    out.zone.length = 0.2;
+    out.zone.width = 1.0;
+    out.outlet = &outlet;
+    out.from = &fluid;
+    out.copy = {"x", "y", "u", "v", "m", "rho", "p"};
+    out.kind = sphc::OutletKind::Characteristic;
+    out.c = c;
+    out.tau = 1e9;  // u_ref stays the first call's
+    io.outlets.push_back(out);
+    sphc::init_inlet_outlet(io, {&fluid, &outlet}, 0.2, 0.0);
+    EXPECT_TRUE(sphc::inlet_outlet_due(io));
+    sphc::update_inlet_outlet(io, 0.0);  // u_ref = U
+    for (std::size_t i = 0; i < outlet.n; ++i) {
+      EXPECT_NEAR(outlet.f64("p")[i], 0.0, 1e-12) << i;
+      EXPECT_NEAR(outlet.f64("u")[i], U, 1e-12) << i;
+      EXPECT_NEAR(outlet.f64("v")[i], 0.25, 1e-12) << i;
+    }
+    for (std::size_t j = 0; j < fluid.n; ++j) {
+      fluid.f64("p")[j] = P;
+      fluid.f64("u")[j] = U + sign * P / (rho * c);
+    }
+    sphc::update_inlet_outlet(io, 0.01);
+    for (std::size_t i = 0; i < outlet.n; ++i) {
+      const double p = outlet.f64("p")[i], u = outlet.f64("u")[i];
+      if (sign > 0) {
+        EXPECT_NEAR(p, P, 1e-9) << i;
+        EXPECT_NEAR(u, U + P / (rho * c), 1e-9) << i;
+      } else if (sign < 0) {
+        EXPECT_NEAR(p, 0.0, 1e-9) << i;
+        EXPECT_NEAR(u, U, 1e-9) << i;
+      } else {
+        EXPECT_NEAR(p, 0.5 * P, 1e-9) << i;
+        EXPECT_NEAR(u, U + 0.5 * P / (rho * c), 1e-9) << i;
+      }
+      EXPECT_NEAR(outlet.f64("v")[i], 0.25, 1e-12) << i;  // tangential: the image's
+    }
+  }
+  // Without a sound speed it refuses to run.
+  ParticleArray fluid = make_array("fluid", 0), outlet = make_array("outlet", 0);
+  props(fluid);
+  props(outlet);
+  sphc::OutletZone out;
+  out.zone.name = "outlet 'o'";
+  out.outlet = &outlet;
+  out.from = &fluid;
+  out.kind = sphc::OutletKind::Characteristic;
+  EXPECT_THROW(sphc::characteristic_outlet(out, 0.0), std::invalid_argument);
+}

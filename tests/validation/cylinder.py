@@ -11,7 +11,12 @@ sampled snapshots), must lie within --cd-tol (relative) of Cd = 5.58 and within 
 the channel, D/H = 0.24, is part of the benchmark). The mean over the second half of that
 window must differ from the mean over the first half by less than --drift-tol (relative):
 the flow has settled. At every output the fluid's particle count stays within --count-tol of
-its start (the inlet feeds what the outlet removes) and every metric is finite.
+its start (the inlet feeds what the outlet removes) and every metric is finite. With
+--flux-tol (needs the snapshots with gids): the mass that entered the fluid from the inlet
+and the mass that left it into the outlet after --t-start, from following each particle's
+gid from one snapshot to the next, agree within --flux-tol (relative); the mean inflow is
+also printed against rho Ubar H. With --count-end-tol: the count at the end is within that
+of the count at --t-start (no slow drift that the wide --count-tol would hide).
 
 Shedding case (--shedding: Re = 100, [ST96] case 2D-2): the Strouhal number St = f D / Ubar,
 f the peak of the spectrum of the lift after --t-start (averaged over --smooth), within
@@ -40,6 +45,50 @@ def mean_between(t, integral, a, b):
     return (integral[j] - integral[i]) / (t[j] - t[i])
 
 
+def crossing_flux(outdir, t_start):
+    """(mean mass flux into the fluid, out of it, time span) after t_start, from the gids of
+    consecutive snapshots: a gid in the inlet then in the fluid came in; a gid in the fluid
+    then not (in the outlet or removed) went out, one in the outlet then back in the fluid
+    counts against that. None without snapshots or gids."""
+    import glob
+    try:
+        import h5py
+        import numpy as np
+    except ImportError:
+        return None
+    files = sorted(glob.glob(os.path.join(outdir, "*_[0-9]*.h5")))
+    prev = None
+    m_in = m_out = 0.0
+    t0 = None
+    t_last = None
+    for path in files:
+        with h5py.File(path, "r") as f:
+            t = float(f.attrs["t"])
+            if "fluid" not in f or "gid" not in f["fluid"]:
+                return None
+            cur = {a: (np.asarray(f[a]["gid"][()]), np.asarray(f[a]["m"][()]))
+                   for a in ("fluid", "inlet", "outlet") if a in f and "gid" in f[a]}
+        if prev is not None and prev[0] >= t_start - 1e-9:
+            if t0 is None:
+                t0 = prev[0]
+            pf_g, pf_m = prev[1]["fluid"]
+            cf_g = cur["fluid"][0]
+            left = ~np.isin(pf_g, cf_g)
+            m_out += float(np.sum(pf_m[left]))
+            came = ~np.isin(cf_g, pf_g)
+            cm = cur["fluid"][1]
+            if "outlet" in prev[1]:
+                back = came & np.isin(cf_g, prev[1]["outlet"][0])
+                m_out -= float(np.sum(cm[back]))
+                came &= ~back
+            m_in += float(np.sum(cm[came]))
+            t_last = t
+        prev = (t, cur)
+    if t0 is None or t_last is None or t_last <= t0:
+        return None
+    return m_in / (t_last - t0), m_out / (t_last - t0), t_last - t0
+
+
 def main():
     ap = argument_parser(__doc__, "the solver's output directory", "cylinder.png")
     ap.add_argument("--t-start", type=float, default=1.0,
@@ -48,6 +97,9 @@ def main():
     ap.add_argument("--cl-tol", type=float, default=0.1)
     ap.add_argument("--drift-tol", type=float, default=0.03)
     ap.add_argument("--count-tol", type=float, default=0.10)
+    ap.add_argument("--flux-tol", type=float, default=None)
+    ap.add_argument("--count-end-tol", type=float, default=None)
+    ap.add_argument("--H", type=float, default=0.41)
     ap.add_argument("--shedding", action="store_true")
     ap.add_argument("--st-tol", type=float, default=0.10)
     ap.add_argument("--smooth", type=float, default=0.2,
@@ -71,6 +123,28 @@ def main():
         failures.append("the fluid's particle count left %d +- %.0f%%: %d to %d"
                         % (n0, 100 * args.count_tol, lo, hi))
     t_end = t[-1]
+    if args.count_end_tol is not None:
+        k0 = min(range(len(t)), key=lambda k: abs(t[k] - args.t_start))
+        drift = m["nfluid"][-1] / m["nfluid"][k0] - 1
+        print("fluid particles at t = %g: %d, at the end: %d (%+.2f%%, tolerance %.1f%%)"
+              % (t[k0], m["nfluid"][k0], m["nfluid"][-1], 100 * drift, 100 * args.count_end_tol))
+        if not abs(drift) <= args.count_end_tol:
+            failures.append("the fluid count drifts by %+.2f%% from t = %g to the end"
+                            % (100 * drift, t[k0]))
+    if args.flux_tol is not None:
+        fl = crossing_flux(args.outdir, args.t_start)
+        if fl is None:
+            failures.append("no snapshots with gids for the mass flux")
+        else:
+            q_in, q_out, span = fl
+            rel = abs(q_in - q_out) / q_in if q_in > 0 else float("inf")
+            print("mass flux over t = %g to %g (gids): in %.6f, out %.6f (rho Ubar H = %.6f); "
+                  "in/out differ by %.3f%% (tolerance %.1f%%)"
+                  % (args.t_start, args.t_start + span, q_in, q_out, args.Ubar * args.H,
+                     100 * rel, 100 * args.flux_tol))
+            if not rel <= args.flux_tol:
+                failures.append("mass flux in %.6f and out %.6f differ by %.3f%%"
+                                % (q_in, q_out, 100 * rel))
     if t_end <= args.t_start:
         sys.stderr.write("cylinder.py: the run ends at t = %g, before --t-start %g\n"
                          % (t_end, args.t_start))

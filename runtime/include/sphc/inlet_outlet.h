@@ -32,6 +32,23 @@
 //     the fluid's velocity profile and pressure instead of the values frozen when each
 //     particle left. A particle whose image has no source particle within the support keeps
 //     its values. Serial and in particle order, as everything here.
+//   - characteristic (the method of characteristics of Lastiwka, Basa & Quinlan 2009, one of
+//     the outlets compared by Negi et al. 2019): the image interpolation of `mirror` gives
+//     each outlet particle the fluid's p_f, u_f, rho_f at its image; of the three
+//     characteristic variables of the 1D Euler equations along the normal (reference state
+//     p_ref, u_ref), the incoming one, J3 = -rho c (u_n - u_ref) + (p - p_ref), is set to 0
+//     (no wave comes in through the outlet) and the outgoing acoustic one,
+//     J2 = rho c (u_n - u_ref) + (p - p_ref), is the fluid's: p = p_ref + J2 / 2,
+//     u_n = u_ref + J2 / (2 rho c); the tangential velocity and the density are the image's
+//     (J1, the entropy wave, would only change rho, which an EDAC scheme does not read).
+//     u_ref is the image's normal velocity averaged in time (exponentially, time scale `tau`,
+//     default 20 length / c) in bins across the face of width support / 2: the mean outflow,
+//     from which an acoustic wave leaving the fluid (u_n - u_ref = (p - p_ref) / (rho c))
+//     passes unchanged. p_ref (default 0) pins the pressure level at the outlet: a steady
+//     fluid pressure p gives the outlet (p + p_ref) / 2, so the level cannot drift as it can
+//     with the other outlets under EDAC, where no equation of state fixes it. (Tried and
+//     dropped: J2 sampled half a support inside the face and delayed by the travel time to
+//     each outlet particle: the channel's pulse reflected more, R = -0.13 against +0.08.)
 //
 // Arrays change size only here, between time steps, never during an evaluation: the neighbour
 // search, ghosts and cell lists are rebuilt from the current sizes at every evaluation. All
@@ -92,7 +109,7 @@ struct InletZone {
   std::size_t created = 0;         // particles that entered the fed array so far
 };
 
-enum class OutletKind : std::uint8_t { DoNothing, Mirror };
+enum class OutletKind : std::uint8_t { DoNothing, Mirror, Characteristic };
 
 struct OutletZone {
   Zone zone;
@@ -104,6 +121,13 @@ struct OutletZone {
   std::size_t entered = 0, returned = 0, removed = 0;
   double support = 0.0;             // mirror: the interpolation radius (set by init)
   CopyMap mirrored;                 // mirror: outlet <- from, the interpolated properties
+  // characteristic: the sound speed, reference pressure, averaging time (0: 20 length / c),
+  // and the state: the mean normal velocity per bin across the face, the last time seen.
+  double c = 0.0, p_ref = 0.0, tau = 0.0;
+  std::vector<double> uref;
+  std::vector<std::uint8_t> uref_set;
+  double t_last = 0.0;
+  bool started = false;
 };
 
 struct InletOutlet {
@@ -135,6 +159,10 @@ bool update_outlet(OutletZone& out);
 // particle's image point. Returns the number of particles that found no source near their
 // image (and kept their values).
 std::size_t mirror_outlet(OutletZone& out);
+// The characteristic condition (OutletKind::Characteristic) at time t: the mirror
+// interpolation, then p and the normal velocity from the outgoing characteristic (above).
+// Throws std::invalid_argument unless c > 0 and the outlet array has p and u (v, w in 2D/3D).
+std::size_t characteristic_outlet(OutletZone& out, double t);
 bool update_inlet_outlet(InletOutlet& io, double t);
 
 }  // namespace sphc
