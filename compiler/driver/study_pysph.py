@@ -310,6 +310,15 @@ def write_metrics(path, rows, wall, cpu):
             f.write(",".join(cells) + "\n")
 
 
+def scale_dambreak(mod, dx):
+    """PySPH's dam_break_2d (the module `mod`) builds its particles with the module's h and m,
+    fixed for dx = 0.03 whatever --dx says: make them follow dx, as the example's own hdx and
+    ro define them (nothing else of the example changes). Also used by bench/."""
+    mod.dx = dx
+    mod.h = mod.hdx * dx
+    mod.m = mod.ro * dx * dx
+
+
 def drive(spec_path):
     with open(spec_path) as f:
         spec = json.load(f)
@@ -318,12 +327,7 @@ def drive(spec_path):
     mod = importlib.import_module(case["module"])
     dx = spec["ctx"].get("dx")
     if case["metrics"] == "dambreak" and dx is not None:
-        # dam_break_2d builds its particles with the module's h and m, fixed for dx = 0.03
-        # whatever --dx says: make them follow dx, as the example's own hdx and ro define
-        # them (nothing else of the example changes).
-        mod.dx = dx
-        mod.h = mod.hdx * dx
-        mod.m = mod.ro * dx * dx
+        scale_dambreak(mod, dx)
     app = getattr(mod, case["app"])()
     outdir = spec["outdir"]
     argv = spec["args"] + ["-d", outdir, "--pfreq", "100000000", "-q"]
