@@ -26,12 +26,12 @@ builds and runs (a minute), the figures mean little.
 import argparse
 import os
 import re
-import shutil
 import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from dambreak_vs_pysph import ROOT, DEFAULT_DX, cpu_model, run, serial_env  # noqa: E402
+from common import (ROOT, DEFAULT_DX, cpu_model, remove_tmp, run,  # noqa: E402
+                    serial_env)
 
 TIMING_RE = re.compile(r"timing: steps=(\d+) particles=(\d+) wall_s=([0-9.eE+-]+) "
                        r"us_per_particle_step=([0-9.eE+-]+) backend=(\w+) threads=(\d+) "
@@ -123,10 +123,7 @@ def main():
                     return 1
                 res[(backend, precision, key)] = r
     finally:
-        if args.keep:
-            print("kept %s" % tmp)
-        else:
-            shutil.rmtree(tmp, ignore_errors=True)
+        remove_tmp(tmp, args.keep)
 
     print()
     print("2D dam break (examples/dambreak.sph), %s, %d cores; openmp: %d threads"

@@ -32,18 +32,14 @@ Usage:
 The Python running it must have PySPH (Debian: python3-pysph) unless --skip-pysph.
 """
 
-import argparse
 import os
 import re
-import resource
-import shutil
-import subprocess
 import sys
 import tempfile
-import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-DEFAULT_DX = 0.03
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from common import (ROOT, DEFAULT_DX, argument_parser, cpu_model, fmt, run,  # noqa: E402,F401
+                    remove_tmp, scale_dambreak, serial_env)
 
 
 def pysph_driver(argv):
@@ -51,52 +47,10 @@ def pysph_driver(argv):
     dx = float(argv[0])
     sys.argv = [sys.argv[0]] + ["--dx", repr(dx)] + argv[1:]
     import pysph.examples.dam_break_2d as db
-    db.dx = dx
-    db.h = db.hdx * dx
-    db.m = db.ro * dx * dx
+    scale_dambreak(db, dx)
     app = db.DamBreak2D()
     app.run()
     return 0
-
-
-def cpu_model():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return "unknown CPU"
-
-
-def children_cpu():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
-
-
-def run(cmd, env=None, cwd=None):
-    """Runs cmd; returns (wall seconds, combined output). Exits on failure. The CPU seconds
-    (user + system) of cmd and its children are in run.cpu afterwards."""
-    t0 = time.perf_counter()
-    c0 = children_cpu()
-    p = subprocess.run(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE,
-                       stderr=subprocess.STDOUT, universal_newlines=True)
-    wall = time.perf_counter() - t0
-    run.cpu = children_cpu() - c0
-    if p.returncode != 0:
-        sys.stderr.write("command failed (exit %d): %s\n%s\n"
-                         % (p.returncode, " ".join(cmd), p.stdout[-3000:]))
-        raise SystemExit(1)
-    return wall, p.stdout
-
-
-def serial_env(extra=None):
-    env = dict(os.environ)
-    env["OMP_NUM_THREADS"] = "1"
-    if extra:
-        env.update(extra)
-    return env
 
 
 # ---- sphc ---------------------------------------------------------------------------------
@@ -207,22 +161,6 @@ def pysph_all(python, tmp, dx_large, steps, steps_large, repeat):
 
 # ---- report -------------------------------------------------------------------------------
 
-def fmt(v, spec="%.2f"):
-    return "-" if v is None else spec % v
-
-
-def argument_parser(doc):
-    """The options every sphc-against-PySPH benchmark takes."""
-    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
-    ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
-    ap.add_argument("--pysph-python", default=sys.executable,
-                    help="Python with PySPH (default: this one)")
-    ap.add_argument("--skip-pysph", action="store_true")
-    ap.add_argument("--skip-sphc", action="store_true")
-    ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
-    return ap
-
-
 def main():
     if len(sys.argv) > 1 and sys.argv[1] == "--pysph-driver":
         return pysph_driver(sys.argv[2:])
@@ -272,10 +210,7 @@ def main():
                                            args.steps_large, args.threads).items():
                     p["omp_" + k] = v
     finally:
-        if args.keep:
-            print("kept %s" % tmp)
-        else:
-            shutil.rmtree(tmp, ignore_errors=True)
+        remove_tmp(tmp, args.keep)
 
     def g(d, k, f):
         return d[k][f] if k in d else None

@@ -34,8 +34,6 @@ import argparse
 import glob
 import os
 import re
-import resource
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -43,6 +41,8 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+from common import children_cpu, remove_tmp  # noqa: E402
 TIMING_RE = re.compile(r"timing: steps=(\d+) particles=(\d+) wall_s=([0-9.eE+-]+)")
 
 # name: (source, defines, h at the scene's default parameters, kernel support in h,
@@ -58,11 +58,6 @@ SCENES = {
 }
 DUALSPHYSICS = {"2D (CaseDambreakVal2D)": 32e6,
                 "3D (CaseDambreak, 163 nb)": 163 / 5.9e-6}
-
-
-def children_cpu():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
 
 
 def run(cmd, env=None):
@@ -254,10 +249,7 @@ def main():
         if args.scaling or args.scaling_only:
             scaling(args, tmp)
     finally:
-        if args.keep:
-            print("kept %s" % tmp)
-        else:
-            shutil.rmtree(tmp, ignore_errors=True)
+        remove_tmp(tmp, args.keep)
     print()
     print("%s, %d cores; load average before: %s, after: %s" % (
         cpu_model(), os.cpu_count() or 0, load0, load_average()))

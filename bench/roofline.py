@@ -38,7 +38,6 @@ import argparse
 import collections
 import os
 import re
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -49,6 +48,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import pair_rate  # noqa: E402
 from pair_rate import SCENES, last_positions, pairs_per_step, run  # noqa: E402
+from common import remove_tmp  # noqa: E402
 
 # scene: (parameters of the counted run, parameters of the timed run, steps S1, S2, timed
 # steps, h of the counted run, h of the timed run)
@@ -261,10 +261,7 @@ def main():
                              pairs=pairs, nb=nb, steps=steps, loop=loop, share=share,
                              t_loop=t_loop, gflops=gflops, nbytes=nbytes, rw=rw))
     finally:
-        if args.keep:
-            print("kept %s" % tmp)
-        else:
-            shutil.rmtree(tmp, ignore_errors=True)
+        remove_tmp(tmp, args.keep)
 
     print()
     print("%s, %.3f GHz nominal; FP64 peak per core (2 FMA units x 2 flops x lanes x clock):"

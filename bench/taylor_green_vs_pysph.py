@@ -40,15 +40,14 @@ The Python running it needs numpy and h5py, and PySPH (Debian: python3-pysph) un
 import glob
 import os
 import re
-import shutil
 import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "validation"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from dambreak_vs_pysph import (argument_parser, cpu_model, fmt, run,  # noqa: E402 (shared)
-                               serial_env)
+from common import (argument_parser, cpu_model, fmt, load_average, remove_tmp,  # noqa: E402
+                    run, serial_env)
 
 
 def pysph_driver(argv):
@@ -62,13 +61,6 @@ def pysph_driver(argv):
 
     TaylorGreenNoPlots().run()
     return 0
-
-
-def load_average():
-    try:
-        return "%.2f %.2f %.2f" % os.getloadavg()
-    except OSError:
-        return "unknown"
 
 
 def last_file(directory, pattern):
@@ -181,10 +173,7 @@ def main():
                   % (args.nx, args.tf), flush=True)
             p = pysph_all(args.pysph_python, tmp, args.nx, args.tf)
     finally:
-        if args.keep:
-            print("kept %s" % tmp)
-        else:
-            shutil.rmtree(tmp, ignore_errors=True)
+        remove_tmp(tmp, args.keep)
 
     def g(d, k):
         return None if d is None else d[k]

@@ -47,7 +47,6 @@ stops after N steps; accuracy then not judged).
 
 import os
 import re
-import shutil
 import sys
 import tempfile
 
@@ -55,7 +54,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "tests", "validation"))
 sys.path.insert(0, HERE)
-from dambreak_vs_pysph import argument_parser, cpu_model, fmt, run  # noqa: E402
+from common import (argument_parser, cpu_model, fmt, load_average, remove_tmp,  # noqa: E402
+                    run)
 import dambreak_vs_pysph  # noqa: E402
 import taylor_green_vs_pysph  # noqa: E402
 
@@ -77,13 +77,6 @@ def pysph_driver(argv):
         print("Total: %d" % sum(pa.get_number_of_particles() for pa in app.particles))
         return 0
     raise SystemExit("unknown PySPH case %s" % case)
-
-
-def load_average():
-    try:
-        return "%.2f %.2f %.2f" % os.getloadavg()
-    except OSError:
-        return "unknown"
 
 
 def environment(threads, wait):
@@ -437,10 +430,7 @@ def main():
             report(case, run_case(args, case, tmp, home), args.threads)
             sys.stdout.flush()
     finally:
-        if args.keep:
-            print("kept %s" % tmp)
-        else:
-            shutil.rmtree(tmp, ignore_errors=True)
+        remove_tmp(tmp, args.keep)
     print()
     print("load average before: %s, after: %s; best of %d round(s), runs interleaved"
           % (load0, load_average(), args.repeat))

@@ -60,6 +60,10 @@ void ScenePrinter::emitMetrics() {
         scene_ << (i ? ", " : "") << number(m.refValue[i]);
       scene_ << "}};\n";
     }
+    if (m.isProfile()) {
+      emitProfile(m, k);
+      continue;
+    }
     scene_ << "      " << (m.isNorm() ? "sphc::NormSums" : "sphc::ScalarSums") << " acc;\n";
     // The particle's values as locals q_NAME; coordinates the scene has not: 0.
     std::vector<std::string> locals;
@@ -112,6 +116,63 @@ void ScenePrinter::emitMetrics() {
     scene_ << "    }\n";
   }
   scene_ << "    return r;\n  }\n\n";
+}
+
+// A profile (a norm with a reference table sampled at points): the points of the table's rows,
+// one least-squares fit per point over the real particles, the mean over the time window, and
+// the norm of the differences from the rows' values. Inside the metric's block, after `ref`.
+void ScenePrinter::emitProfile(const PlanMetric& m, size_t k) {
+  const int a = m.array;
+  const std::string& A = arr(a).name;
+  auto paramNames = [&](const std::string& n) { return paramRef(n); };
+  auto rowNames = [&](const std::string& n) { return n == "s" ? n : paramRef(n); };
+  scene_ << "      // a profile: the expression fitted at each row's point, radius "
+         << exprCpp(*m.radius, paramNames) << "\n";
+  scene_ << "      static sphc::ProfileHistory history;  // the samples of the latest outputs\n";
+  scene_ << "      sphc::ProfileFit fit(" << plan_.dim << ", " << exprCpp(*m.radius, paramNames)
+         << ");\n";
+  scene_ << "      for (std::size_t row = 0; row < ref.at.size(); ++row) {\n";
+  scene_ << "        const double s = ref.at[row];\n";
+  scene_ << "        (void)s;\n";
+  if (m.rows) scene_ << "        if (!(" << exprCpp(*m.rows, rowNames) << ")) continue;\n";
+  scene_ << "        fit.add_point(row";
+  for (int d = 0; d < 3; ++d)
+    scene_ << ", " << (m.point[d] ? "static_cast<double>(" + exprCpp(*m.point[d], rowNames) + ")"
+                                  : std::string("0.0"));
+  scene_ << ");\n      }\n";
+  std::vector<std::string> locals;
+  for (const auto& p : m.reads)
+    if (constIndex(a, p) < 0 && propIndex(a, p) >= 0) locals.push_back(p);
+  auto particleNames = [&](const std::string& n) -> std::string {
+    if (n == "t") return "t";
+    if (constIndex(a, n) >= 0) return A + ".constant(" + std::to_string(constIndex(a, n)) + ")[0]";
+    for (const auto& l : locals)
+      if (l == n) return "q_" + n;
+    if (n == "x" || n == "y" || n == "z") return "0.0";
+    return paramRef(n);
+  };
+  for (const auto& p : locals)
+    scene_ << "      const auto* p_" << p << " = " << hostPtr(a, p) << ";\n";
+  scene_ << "      for (std::size_t i = 0; i < " << A << ".n; ++i) {  // real particles\n";
+  for (const auto& p : locals) {
+    const int stride = arr(a).props[propIndex(a, p)].stride;
+    scene_ << "        const double q_" << p << " = static_cast<double>(p_" << p << "[i"
+           << (stride > 1 ? " * " + std::to_string(stride) : std::string("")) << "]);\n";
+  }
+  if (m.where)
+    scene_ << "        if (!(" << exprCpp(*m.where, particleNames) << ")) continue;\n";
+  scene_ << "        sphc::add(fit, " << particleNames("x") << ", " << particleNames("y") << ", "
+         << particleNames("z") << ", " << exprCpp(*m.expr, particleNames) << ");\n";
+  scene_ << "      }\n";
+  if (mpi_) scene_ << "      sphc::mpi::all_reduce(fit);  // over every rank's particles\n";
+  scene_ << "      const std::vector<double> mean = sphc::average(history, t, sphc::solve(fit), "
+         << (m.average ? exprCpp(*m.average, paramNames) : std::string("0.0")) << ");\n";
+  scene_ << "      sphc::NormSums acc;\n";
+  scene_ << "      for (std::size_t p = 0; p < mean.size(); ++p)\n";
+  scene_ << "        sphc::add(acc, mean[p], ref.value[fit.row[p]]);\n";
+  scene_ << "      r[" << k << "].value = sphc::norm(acc, " << normKind(m.kind) << ", "
+         << (m.relative ? "true" : "false") << ");\n";
+  scene_ << "    }\n";
 }
 
 // In main: what each metric is (for the CSV header and the progress line) and how to

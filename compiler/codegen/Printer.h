@@ -179,6 +179,7 @@ class ScenePrinter {
   // metrics { } (MetricsPrinter.cpp): Scene::metrics(t), and their descriptions in main.
   void emitMetrics();
   void emitMetricsMain();
+  void emitProfile(const PlanMetric& m, size_t k);  // a profile metric (MetricsPrinter.cpp)
 
   // ---- Inlets and outlets (InletOutletPrinter.cpp) ----
   bool hasZones() const { return !plan_.zones.empty(); }

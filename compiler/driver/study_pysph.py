@@ -101,8 +101,89 @@ def metrics_elliptical_drop(a, t, ctx):
             ("drho", max(abs(r / ctx["ro"] - 1.0) for r in a["rho"]))]
 
 
+def _quintic_shape(q):
+    w = (3.0 - q) ** 5 if q < 3.0 else 0.0
+    if q < 2.0:
+        w -= 6.0 * (2.0 - q) ** 5
+    if q < 1.0:
+        w += 15.0 * (1.0 - q) ** 5
+    return w
+
+
+def profile_fit(px, py, x, y, f, radius):
+    """The value at (px, py) of the weighted least-squares linear fit of f to the particles
+    within `radius` (weights: the quintic spline's shape at q = 3 r / radius), as the solver's
+    profile metrics (runtime/src/metrics.cpp): NaN with fewer than 6 particles or a singular
+    fit. Plain Python (the study's Python need not have numpy)."""
+    M = [[0.0] * 4 for _ in range(3)]  # [normal matrix | right-hand side]
+    n = 0
+    for xj, yj, fj in zip(x, y, f):
+        dx, dy = xj - px, yj - py
+        if abs(dx) >= radius or abs(dy) >= radius:
+            continue
+        r = math.hypot(dx, dy)
+        if not r < radius:
+            continue
+        w = _quintic_shape(3.0 * r / radius)
+        a = (1.0, dx, dy)
+        for i in range(3):
+            for j in range(3):
+                M[i][j] += w * a[i] * a[j]
+            M[i][3] += w * a[i] * fj
+        n += 1
+    if n < 6:
+        return float("nan")
+    for c in range(3):  # Gaussian elimination with partial pivoting
+        p = max(range(c, 3), key=lambda i: abs(M[i][c]))
+        if not abs(M[p][c]) > 1e-12 * abs(M[0][0]):
+            return float("nan")
+        M[c], M[p] = M[p], M[c]
+        for i in range(c + 1, 3):
+            l = M[i][c] / M[c][c]
+            for j in range(c, 4):
+                M[i][j] -= l * M[c][j]
+    sol = [0.0, 0.0, 0.0]
+    for i in (2, 1, 0):
+        sol[i] = (M[i][3] - sum(M[i][j] * sol[j] for j in range(i + 1, 3))) / M[i][i]
+    return sol[0]
+
+
+def metrics_cavity(a, t, ctx):
+    """u_max, u_rms, v_max, v_rms and ke of examples/cavity.sph: Ghia et al.'s centre lines
+    without their wall rows, the velocity / U fitted at each row's point from the particles
+    within 3 h (h = hdx L / nx), averaged over the outputs of the last L / U (ctx["history"]
+    keeps the earlier outputs' samples: call in time order), Linf and rms of the errors."""
+    L, U = ctx["L"], ctx["U"]
+    radius = 3.0 * ctx.get("hdx", 1.0) * L / ctx["nx"]
+    x, y = list(a["x"]), list(a["y"])
+    u, v = list(a["u"]), list(a["v"])
+    lines = []
+    for name, (at, val), f, point in (
+            ("u", ctx["ghia_u"], u, lambda s: (0.5 * L, s * L)),
+            ("v", ctx["ghia_v"], v, lambda s: (s * L, 0.5 * L))):
+        rows = [(s, r) for s, r in zip(at, val) if 0.0 < s < 1.0]
+        fu = [fj / U for fj in f]
+        sample = [profile_fit(*point(s), x, y, fu, radius) for s, _ in rows]
+        lines.append((name, [r for _, r in rows], sample))
+    hist = ctx.setdefault("history", [])
+    if hist and hist[-1][0] == t:
+        hist.pop()
+    hist.append((t, [smp for _, _, smp in lines]))
+    window = ctx.get("average", L / U)
+    hist[:] = [h for h in hist if h[0] >= t - window - 1e-9 * max(1.0, abs(t))]
+    out = []
+    for k, (name, ref, _) in enumerate(lines):
+        err = [sum(h[1][k][p] for h in hist) / len(hist) - ref[p] for p in range(len(ref))]
+        out += [(name + "_max", max(abs(e) for e in err) if all(e == e for e in err)
+                 else float("nan")),
+                (name + "_rms", math.sqrt(sum(e * e for e in err) / len(err)))]
+    out.append(("ke", math.fsum(0.5 * mj * (uj * uj + vj * vj)
+                                for mj, uj, vj in zip(a["m"], u, v))))
+    return out
+
+
 METRICS = {"dambreak": metrics_dambreak, "taylor_green": metrics_taylor_green,
-           "elliptical_drop": metrics_elliptical_drop}
+           "elliptical_drop": metrics_elliptical_drop, "cavity": metrics_cavity}
 
 
 # ---- the cases: scene -> PySPH example ---------------------------------------------------
@@ -128,6 +209,13 @@ CASES = {
                                              "tvf": "tvf"}},
                          default_options={"scheme": "wcsph"},
                          ctx=dict(U=1.0, L=1.0, Re=100.0)),
+    # PySPH's cavity: the same case and numerics (TVF, Adami walls, quintic spline, h = dx,
+    # c0 = 10 U, the same dt); its walls have 5 layers (sphc's 3: the kernel reaches 3 h).
+    "cavity": dict(metrics="cavity", module="pysph.examples.cavity", app="LidDrivenCavity",
+                   args=[], every=0.25, params={"nx": "nx", "Re": "re"},
+                   ctx=dict(L=1.0, U=1.0, nx=50.0, average=1.0,
+                            ghia_u=("../tests/data/ghia1982_re100_u.csv", "u"),
+                            ghia_v=("../tests/data/ghia1982_re100_v.csv", "v"))),
     "elliptical_drop": dict(metrics="elliptical_drop", module="pysph.examples.elliptical_drop",
                             app="EllipticalDrop", args=["--scheme", "wcsph"], every=0.0019,
                             params={"dx": "nx"}, ctx=dict(ro=1.0)),
@@ -192,7 +280,7 @@ def load_arrays(path, name="fluid"):
 
 def resolve_ctx(case, ctx, scene_dir):
     ctx = dict(ctx)
-    for k in ("surge", "mps"):
+    for k in ("surge", "mps", "ghia_u", "ghia_v"):
         if k in ctx and isinstance(ctx[k], (list, tuple)) and isinstance(ctx[k][0], str):
             ctx[k] = read_table(os.path.join(scene_dir, ctx[k][0]), ctx[k][1])
     return ctx
@@ -201,11 +289,11 @@ def resolve_ctx(case, ctx, scene_dir):
 def metric_rows(case, ctx, files, loader):
     """(step, t, dt, [(column, value)]) of each output file, in time order; loader(file) gives
     (t, step, dt, arrays) (load_arrays for PySPH's files)."""
+    loaded = sorted((loader(fn) for fn in files), key=lambda r: r[0])
     rows = []
-    for fn in files:
-        t, step, dt, a = loader(fn)
+    for t, step, dt, a in loaded:  # in time order (the cavity's metrics average over time)
         rows.append((step, t, dt, METRICS[case["metrics"]](a, t, ctx)))
-    return sorted(rows, key=lambda r: r[1])
+    return rows
 
 
 def write_metrics(path, rows, wall, cpu):
@@ -222,6 +310,15 @@ def write_metrics(path, rows, wall, cpu):
             f.write(",".join(cells) + "\n")
 
 
+def scale_dambreak(mod, dx):
+    """PySPH's dam_break_2d (the module `mod`) builds its particles with the module's h and m,
+    fixed for dx = 0.03 whatever --dx says: make them follow dx, as the example's own hdx and
+    ro define them (nothing else of the example changes). Also used by bench/."""
+    mod.dx = dx
+    mod.h = mod.hdx * dx
+    mod.m = mod.ro * dx * dx
+
+
 def drive(spec_path):
     with open(spec_path) as f:
         spec = json.load(f)
@@ -230,12 +327,7 @@ def drive(spec_path):
     mod = importlib.import_module(case["module"])
     dx = spec["ctx"].get("dx")
     if case["metrics"] == "dambreak" and dx is not None:
-        # dam_break_2d builds its particles with the module's h and m, fixed for dx = 0.03
-        # whatever --dx says: make them follow dx, as the example's own hdx and ro define
-        # them (nothing else of the example changes).
-        mod.dx = dx
-        mod.h = mod.hdx * dx
-        mod.m = mod.ro * dx * dx
+        scale_dambreak(mod, dx)
     app = getattr(mod, case["app"])()
     outdir = spec["outdir"]
     argv = spec["args"] + ["-d", outdir, "--pfreq", "100000000", "-q"]

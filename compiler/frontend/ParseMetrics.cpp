@@ -36,7 +36,8 @@ bool Parser::parseMetricItem(ast::MetricsDecl& metrics) {
   while (consumeIf(Token::Comma)) {
     ast::MetricArg arg;
     if (!parseIdent(arg.name, "expected an argument of " + head +
-                                  " (exact, relative, where, reference, column, at)") ||
+                                  " (exact, relative, where, reference, column, abscissa, at, "
+                                  "x, y, z, rows, radius, average)") ||
         !expect(Token::Assign, "after '" + arg.name.name + "' in " + head))
       return false;
     arg.loc = cur().loc;

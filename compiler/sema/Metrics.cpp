@@ -55,6 +55,10 @@ class MetricsBuilder {
                     std::set<std::string>& props);
   bool readReference(PlanMetric& m, const ast::MetricArg& file, const ast::MetricArg* column,
                      const ast::MetricArg* abscissa);
+  // A profile's points, rows, radius and time window.
+  bool profileArgs(PlanMetric& m, const ast::MetricItem& it, const std::string& head,
+                   const std::function<const ast::MetricArg*(const char*)>& arg,
+                   std::set<std::string>& props);
 
   Plan& plan_;
   DiagnosticEngine& diags_;
@@ -100,6 +104,72 @@ bool MetricsBuilder::readReference(PlanMetric& m, const ast::MetricArg& file,
   return true;
 }
 
+bool MetricsBuilder::profileArgs(PlanMetric& m, const ast::MetricItem& it,
+                                 const std::string& head,
+                                 const std::function<const ast::MetricArg*(const char*)>& arg,
+                                 std::set<std::string>& props) {
+  bool ok = true;
+  if (const auto* at = arg("at")) {
+    diags_.error(at->name.loc, "'at' of the profile " + head + ": a profile's table is read at "
+                               "its rows' points (x = , y = , z = , of s, the row's abscissa), "
+                               "not at a time");
+    ok = false;
+  }
+  static const char* kCoord[3] = {"x", "y", "z"};
+  const auto ofRow = [&](const std::string& n) { return n == "s" || isParam_(n); };
+  std::string missing;
+  for (int d = 0; d < 3; ++d) {
+    const auto* p = arg(kCoord[d]);
+    if (d >= plan_.dim) {
+      if (p) {
+        diags_.error(p->name.loc, std::string("'") + kCoord[d] + "' of the profile " + head +
+                                      ": the scene is " + std::to_string(plan_.dim) + "D");
+        ok = false;
+      }
+      continue;
+    }
+    props.insert(kCoord[d]);  // the fit reads the particles' positions
+    if (!p) {
+      missing += (missing.empty() ? "" : ", ") + std::string(kCoord[d]) + " = ";
+      continue;
+    }
+    m.point[d] = p->value;
+    ok &= checkExpr(*p->value, ofRow,
+                    std::string("the point '") + kCoord[d] + "' of " + head +
+                        " (it may use s, the row's abscissa, and params)",
+                    diags_);
+  }
+  if (!missing.empty()) {
+    diags_.error(it.kind.loc, "the profile " + head + " needs the point of each row of its "
+                              "table: " + missing + "(expressions of s, the row's abscissa, "
+                              "and params)");
+    ok = false;
+  }
+  if (const auto* r = arg("rows")) {
+    m.rows = r->value;
+    ok &= checkExpr(*r->value, ofRow,
+                    "the 'rows' of " + head + " (it may use s, the row's abscissa, and params)",
+                    diags_);
+  }
+  const auto params = [&](const std::string& n) { return isParam_(n); };
+  if (const auto* r = arg("radius")) {
+    m.radius = r->value;
+    ok &= checkExpr(*r->value, params, "the 'radius' of " + head + " (it may use params)",
+                    diags_);
+  } else {
+    diags_.error(it.kind.loc, "the profile " + head + " needs 'radius = R': the particles "
+                              "within R of a row's point are fitted (e.g. the kernel's "
+                              "support)");
+    ok = false;
+  }
+  if (const auto* w = arg("average")) {
+    m.average = w->value;
+    ok &= checkExpr(*w->value, params, "the 'average' of " + head + " (it may use params)",
+                    diags_);
+  }
+  return ok;
+}
+
 void MetricsBuilder::item(const ast::MetricItem& it) {
   PlanMetric m;
   m.loc = it.name.loc;
@@ -140,12 +210,15 @@ void MetricsBuilder::item(const ast::MetricItem& it) {
 
   std::map<std::string, const ast::MetricArg*> args;
   for (const auto& a : it.args) {
-    static const std::set<std::string> known = {"exact", "relative", "where", "reference",
-                                                "column", "abscissa", "at"};
+    static const std::set<std::string> known = {"exact",  "relative", "where", "reference",
+                                                "column", "abscissa", "at",    "x",
+                                                "y",      "z",        "rows",  "radius",
+                                                "average"};
     if (!known.count(a.name.name)) {
       diags_.error(a.name.loc, "unknown argument '" + a.name.name + "' of " + head +
                                    "; arguments are exact, relative, where, reference, "
-                                   "column, abscissa and at");
+                                   "column, abscissa, at, and for a profile x, y, z, rows, "
+                                   "radius and average");
       ok = false;
       continue;
     }
@@ -189,19 +262,22 @@ void MetricsBuilder::item(const ast::MetricItem& it) {
     diags_.error(reference->name.loc, head + " has both 'exact' and 'reference'; give one");
     return;
   }
-  if (m.isNorm()) {
-    if (!exact) {
-      diags_.error(it.kind.loc, "the norm " + head + " needs 'exact = EXPR' (an expression of "
-                                "x, y, z, t, params and properties)");
-      return;
-    }
-    if (reference) {
-      diags_.error(reference->name.loc, "the norm " + head + " compares particles with "
-                                        "'exact'; a reference table is for scalars (max, min, "
-                                        "sum, mean)");
-      return;
-    }
+  if (m.isNorm() && !exact && !reference) {
+    diags_.error(it.kind.loc, "the norm " + head + " needs 'exact = EXPR' (an expression of "
+                              "x, y, z, t, params and properties), or a 'reference' table "
+                              "sampled at points (a profile)");
+    return;
   }
+  const bool profile = m.isNorm() && reference;
+  if (!profile)
+    for (const char* n : {"x", "y", "z", "rows", "radius", "average"})
+      if (arg(n)) {
+        diags_.error(arg(n)->name.loc,
+                     std::string("'") + n + "' of " + head + " belongs to a profile (a norm "
+                         "L1, L2 or Linf with a 'reference' table sampled at points)");
+        ok = false;
+      }
+  if (profile) ok &= profileArgs(m, it, head, arg, props);
   if (exact) {
     m.exact = exact->value;
     // Norms: per particle, like the measured expression (x, y, z, t, params and the array's
@@ -220,7 +296,7 @@ void MetricsBuilder::item(const ast::MetricItem& it) {
                                          " belongs to a 'reference' table, which it has not");
       ok = false;
     }
-  if (const auto* at = arg("at")) {
+  if (const auto* at = arg("at"); at && !profile) {
     m.at = at->value;
     ok &= checkExpr(
         *m.at, [&](const std::string& n) { return n == "t" || isParam_(n); },

@@ -299,7 +299,8 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
     os << "metrics:";
     for (const auto& m : plan.metrics) {
       os << " " << m.name << " = " << kKinds[m.kind] << "(" << plan.arrays[m.array].name << ")";
-      if (!m.reference.empty()) os << " vs \"" << m.reference << "\"";
+      if (m.isProfile()) os << " profile vs \"" << m.reference << "\"";
+      else if (!m.reference.empty()) os << " vs \"" << m.reference << "\"";
       else if (m.exact) os << " vs exact";
       os << (m.relative ? " relative;" : ";");
     }

@@ -162,7 +162,13 @@ struct PlanMetric {
   std::string column, abscissa;               // its columns
   std::vector<double> refAt, refValue;        // the table, read at compile time
   std::vector<std::string> reads;             // the array's properties it reads
+  // A profile (a norm with a reference): the expression fitted at one point per table row.
+  ast::ExprPtr point[3];                      // x, y, z of a row's point, of s and params
+  ast::ExprPtr rows;                          // which rows (of s and params); null: all
+  ast::ExprPtr radius;                        // the fit's radius (params)
+  ast::ExprPtr average;                       // the time window of the mean (params); null: 0
   bool isNorm() const { return kind == L1 || kind == L2 || kind == Linf; }
+  bool isProfile() const { return isNorm() && !reference.empty(); }
   bool compared() const { return !isNorm() && (exact || !reference.empty()); }
 };
 

@@ -69,6 +69,109 @@ double interpolate(const ReferenceTable& table, double at) {
   return table.value[k - 1] + w * (table.value[k] - table.value[k - 1]);
 }
 
+void ProfileFit::add_point(std::size_t table_row, double x, double y, double z) {
+  row.push_back(table_row);
+  px.push_back(x);
+  py.push_back(y);
+  pz.push_back(z);
+  sums.resize(sums.size() + stride(), 0.0);
+}
+
+namespace {
+
+// The quintic spline's shape (unnormalised: a least-squares fit does not need the constant).
+double quintic_shape(double q) {
+  double w = 0;
+  if (q < 3.0) w += std::pow(3.0 - q, 5);
+  if (q < 2.0) w -= 6.0 * std::pow(2.0 - q, 5);
+  if (q < 1.0) w += 15.0 * std::pow(1.0 - q, 5);
+  return w;
+}
+
+}  // namespace
+
+void add(ProfileFit& f, double x, double y, double z, double value) {
+  const int n = f.dim + 1;
+  const std::size_t st = f.stride();
+  for (std::size_t k = 0; k < f.px.size(); ++k) {
+    const double d[3] = {x - f.px[k], f.dim > 1 ? y - f.py[k] : 0.0,
+                         f.dim > 2 ? z - f.pz[k] : 0.0};
+    const double r = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    if (!(r < f.radius)) continue;
+    const double w = quintic_shape(3.0 * r / f.radius);
+    double a[4] = {1.0, d[0], d[1], d[2]};
+    double* s = f.sums.data() + k * st;
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) s[i * n + j] += w * a[i] * a[j];
+      s[n * n + i] += w * a[i] * value;
+    }
+    s[n * n + n] += 1.0;
+  }
+}
+
+std::vector<double> solve(const ProfileFit& f) {
+  const int n = f.dim + 1;
+  const std::size_t st = f.stride();
+  std::vector<double> out(f.px.size(), kNoValue);
+  for (std::size_t k = 0; k < f.px.size(); ++k) {
+    const double* s = f.sums.data() + k * st;
+    if (s[n * n + n] < 2.0 * n) continue;  // too few particles within the radius
+    // Gaussian elimination with partial pivoting on [M | b].
+    double M[4][5];
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) M[i][j] = s[i * n + j];
+      M[i][n] = s[n * n + i];
+    }
+    bool singular = false;
+    for (int c = 0; c < n && !singular; ++c) {
+      int p = c;
+      for (int i = c + 1; i < n; ++i)
+        if (std::fabs(M[i][c]) > std::fabs(M[p][c])) p = i;
+      if (!(std::fabs(M[p][c]) > 1e-12 * std::fabs(M[0][0]))) {
+        singular = true;
+        break;
+      }
+      if (p != c)
+        for (int j = 0; j <= n; ++j) std::swap(M[c][j], M[p][j]);
+      for (int i = c + 1; i < n; ++i) {
+        const double l = M[i][c] / M[c][c];
+        for (int j = c; j <= n; ++j) M[i][j] -= l * M[c][j];
+      }
+    }
+    if (singular) continue;
+    double x[4] = {0, 0, 0, 0};
+    for (int i = n - 1; i >= 0; --i) {
+      double v = M[i][n];
+      for (int j = i + 1; j < n; ++j) v -= M[i][j] * x[j];
+      x[i] = v / M[i][i];
+    }
+    out[k] = x[0];
+  }
+  return out;
+}
+
+std::vector<double> average(ProfileHistory& h, double t, std::vector<double> samples,
+                            double window) {
+  if (!h.t.empty() && h.t.back() == t) {
+    h.samples.back() = std::move(samples);
+  } else {
+    h.t.push_back(t);
+    h.samples.push_back(std::move(samples));
+  }
+  // Keep the outputs within the window (a relative tolerance for output times that are sums
+  // of steps).
+  const double from = t - window - 1e-9 * std::max(1.0, std::fabs(t));
+  std::size_t first = 0;
+  while (first + 1 < h.t.size() && h.t[first] < from) ++first;
+  h.t.erase(h.t.begin(), h.t.begin() + static_cast<std::ptrdiff_t>(first));
+  h.samples.erase(h.samples.begin(), h.samples.begin() + static_cast<std::ptrdiff_t>(first));
+  std::vector<double> mean(h.samples.back().size(), 0.0);
+  for (const auto& s : h.samples)
+    for (std::size_t k = 0; k < mean.size() && k < s.size(); ++k) mean[k] += s[k];
+  for (double& m : mean) m /= static_cast<double>(h.samples.size());
+  return mean;
+}
+
 MetricValue compare(double value, double reference, bool relative) {
   MetricValue m;
   m.value = value;

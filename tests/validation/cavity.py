@@ -77,6 +77,7 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.exit(2)
 
 import plots  # noqa: E402  (tests/validation/plots.py)
+from metrics_csv import metrics_file, read_metrics, row_at  # noqa: E402
 from snapshots import (argument_parser, read_fluid, report_failures,  # noqa: E402
                        snapshots)
 
@@ -183,24 +184,69 @@ def main():
     # Reference points without the wall rows.
     yu = ref_u[(ref_u[:, 0] > 0) & (ref_u[:, 0] < 1), :]
     xv = ref_v[(ref_v[:, 0] > 0) & (ref_v[:, 0] < 1), :]
-    us = np.zeros(len(yu))
-    vs = np.zeros(len(xv))
-    for (_, x, y, u, v) in avg:
-        for k, yy in enumerate(yu[:, 0]):
-            us[k] += linear_fit(0.5 * L, yy * L, x, y, [u], h)[0] / U
-        for k, xx in enumerate(xv[:, 0]):
-            vs[k] += linear_fit(xx * L, 0.5 * L, x, y, [v], h)[0] / U
-    us /= len(avg)
-    vs /= len(avg)
-    eu = us - yu[:, 1]
-    ev = vs - xv[:, 1]
+    # The samples at the reference points in every snapshot, and for every snapshot the
+    # errors of their mean over the window of --avg-time ending there: the scene's metrics
+    # (u_max, u_rms, v_max, v_rms) at every output, recomputed here.
+    samples = []
+    for (_, x, y, u, v) in snaps:
+        samples.append((np.array([linear_fit(0.5 * L, yy * L, x, y, [u], h)[0] / U
+                                  for yy in yu[:, 0]]),
+                        np.array([linear_fit(xx * L, 0.5 * L, x, y, [v], h)[0] / U
+                                  for xx in xv[:, 0]])))
+
+    def window_errors(j):
+        tj = snaps[j][0]
+        win = [k for k in range(j + 1) if snaps[k][0] >= tj - args.avg_time - 1e-9]
+        mu = np.mean([samples[k][0] for k in win], axis=0)
+        mv = np.mean([samples[k][1] for k in win], axis=0)
+        return mu, mv, mu - yu[:, 1], mv - xv[:, 1]
+
+    us, vs, eu, ev = window_errors(len(snaps) - 1)
     err = np.concatenate([eu, ev])
     emax = float(np.max(np.abs(err)))
     erms = float(np.sqrt(np.mean(err ** 2)))
 
+    # The solver's metric file (not with PySPH's snapshots, *.hdf5): the figures judged are
+    # the solver's own; this script's recomputation must agree with them at every output.
+    metrics = None
+    if metrics_file(args.outdir) is not None or not files[0].endswith(".hdf5"):
+        metrics = read_metrics(args.outdir, "cavity.py",
+                               ("u_max", "u_rms", "v_max", "v_rms", "ke"))
+        if metrics is None:
+            return 2
+        checked = 0
+        for j, (tj, _, _, _, _) in enumerate(snaps):
+            k = row_at(metrics, tj)
+            if k is None:
+                failures.append("t = %.3f: no row of the metric file at this time" % tj)
+                continue
+            _, _, euj, evj = window_errors(j)
+            mine = {"u_max": float(np.max(np.abs(euj))),
+                    "u_rms": float(np.sqrt(np.mean(euj ** 2))),
+                    "v_max": float(np.max(np.abs(evj))),
+                    "v_rms": float(np.sqrt(np.mean(evj ** 2))),
+                    "ke": hist[j][1]}
+            for c, want in mine.items():
+                got = metrics[c][k]
+                scale = max(1.0, abs(want)) if c == "ke" else 1.0
+                if not abs(got - want) <= 1e-9 * scale:
+                    failures.append("t = %.3f: the solver's metric %s %.12g differs from the "
+                                    "one recomputed here, %.12g" % (tj, c, got, want))
+            checked += 1
+        k = row_at(metrics, tf)
+        if k is not None:
+            # Both lines have the same number of points: the rms over the 30 points is the
+            # root of the mean of the two lines' squared rms.
+            emax = max(metrics["u_max"][k], metrics["v_max"][k])
+            erms = float(np.sqrt((len(yu) * metrics["u_rms"][k] ** 2 +
+                                  len(xv) * metrics["v_rms"][k] ** 2) / (len(yu) + len(xv))))
+
     # Steadiness: the mean kinetic energy of the last steady-time/2 against that of the
     # steady-time/2 before (means, because the weakly compressible fluid carries an acoustic
     # oscillation of the kinetic energy of ~1-2% from snapshot to snapshot).
+    if metrics is not None:  # the solver's kinetic energy (checked against hist above)
+        hist = [(tj, metrics["ke"][row_at(metrics, tj)], vm) for (tj, _, vm) in hist
+                if row_at(metrics, tj) is not None]
     h_arr = np.array(hist)
     half = 0.5 * args.steady_time
     late = h_arr[h_arr[:, 0] > tf - half + 1e-9]
@@ -231,6 +277,12 @@ def main():
     for k in range(len(xv)):
         print("%8.4f %10.5f %10.5f %+9.4f" % (xv[k, 0], xv[k, 1], vs[k], ev[k]))
     print()
+    if metrics is not None:
+        print("the solver's metrics (%s): u_max %.4f, u_rms %.4f, v_max %.4f, v_rms %.4f U at "
+              "t = %.3f; recomputed here at all %d outputs"
+              % (os.path.basename(metrics_file(args.outdir)), metrics["u_max"][-1],
+                 metrics["u_rms"][-1], metrics["v_max"][-1], metrics["v_rms"][-1],
+                 metrics["t"][-1], checked))
     print("error over the %d points: max %.4f U (u: %.4f, v: %.4f), rms %.4f U; "
           "tolerances max %.3f U, rms %.3f U"
           % (len(err), emax, float(np.max(np.abs(eu))), float(np.max(np.abs(ev))), erms,

@@ -10,12 +10,16 @@
 //   - scalars of an array (max, min, sum, mean of an expression) in ScalarSums, reduce();
 //     compared, where the scene gives a reference (an exact expression of t, or a table
 //     interpolated in t: ReferenceTable), by compare(): the error is value - reference, or
-//     value / reference - 1 when relative.
+//     value / reference - 1 when relative;
+//   - profiles: a norm over the rows of a table whose abscissa is a coordinate (Ghia's
+//     centre lines of the cavity): the expression fitted at each row's point (ProfileFit),
+//     averaged over a time window (ProfileHistory), against the row's value.
 // The run loop (solver.cpp) prints them on the progress line and at the end, and writes one
 // row per evaluation to a CSV file (metrics_csv_header, metrics_csv_row): the step, t, dt, the
 // wall and CPU seconds of the time loop so far, then every metric.
 #pragma once
 
+#include <cstddef>
 #include <limits>
 #include <string>
 #include <vector>
@@ -57,6 +61,38 @@ struct ReferenceTable {
 };
 // Linear interpolation; NaN outside [at.front(), at.back()] (a reference does not extrapolate).
 double interpolate(const ReferenceTable& table, double at);
+
+// A profile (a norm with a reference table whose abscissa is a coordinate, not t): the
+// measured expression is sampled at one point per row of the table by a weighted
+// least-squares fit of a linear field, value ~ a + b . (x_j - x_k), to the particles j within
+// `radius` of the point x_k, weighted by the quintic spline's shape at q = 3 r / radius
+// (first-order consistent: not biased next to a wall, where every neighbour lies on one
+// side); the fitted a is the sample. A point with fewer than 2 (dim + 1) particles within the
+// radius, or whose fit is singular, samples NaN.
+struct ProfileFit {
+  int dim = 2;
+  double radius = 0;
+  std::vector<double> px, py, pz;    // the points (unused coordinates 0)
+  std::vector<std::size_t> row;      // the table row of each point
+  std::vector<double> sums;          // per point: (dim+1)^2 normal matrix, dim+1 rhs, count
+  ProfileFit(int dim_, double radius_) : dim(dim_), radius(radius_) {}
+  void add_point(std::size_t table_row, double x, double y, double z);
+  std::size_t stride() const { return static_cast<std::size_t>((dim + 1) * (dim + 2) + 1); }
+};
+void add(ProfileFit& f, double x, double y, double z, double value);
+// The fitted value at every point.
+std::vector<double> solve(const ProfileFit& f);
+
+// The samples of a profile over the outputs of the last `window` time units: mean(t) is the
+// mean of the samples of the outputs at t' >= t - window (a window of 0: the latest alone),
+// which takes the acoustic oscillation of a weakly compressible steady flow out of the
+// comparison. An evaluation at the time of the latest replaces it.
+struct ProfileHistory {
+  std::vector<double> t;
+  std::vector<std::vector<double>> samples;
+};
+std::vector<double> average(ProfileHistory& h, double t, std::vector<double> samples,
+                            double window);
 
 // One metric as the run loop sees it.
 struct MetricInfo {

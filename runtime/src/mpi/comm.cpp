@@ -105,6 +105,15 @@ void all_reduce(ScalarSums& s) {
   s = r;
 }
 
+void all_reduce(ProfileFit& f) {
+  const std::size_t n = f.sums.size();
+  if (n == 0) return;
+  const std::vector<double> all = all_gather(f.sums.data(), static_cast<int>(n));
+  std::fill(f.sums.begin(), f.sums.end(), 0.0);
+  for (std::size_t k = 0; k + n <= all.size(); k += n)
+    for (std::size_t i = 0; i < n; ++i) f.sums[i] += all[k + i];
+}
+
 int finish(int rc) {
   if (rc == 0) {
     MPI_Barrier(MPI_COMM_WORLD);

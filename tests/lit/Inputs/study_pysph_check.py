@@ -92,6 +92,44 @@ m = dict(sp.metrics_elliptical_drop({"y": [-1.5, 0.5], "rho": [1.01, 0.98]}, 0.0
 check("elliptical_drop b_tip, y2, drho", close(m["b_tip"], 1.5) and close(m["y2"], 1.25) and
       close(m["drho"], 0.02), m)
 
+# The cavity: nx and Re map; on a linear field the fit is exact, so the samples at Ghia's points
+# are the field there; a second output averages with the first (window L/U = 1).
+cv = sp.case_of("examples/cavity.sph")
+args, cctx, skipped = sp.pysph_args(cv, [("nx", "20"), ("kernel", "WendlandQuintic")],
+                                   [("Re", "100")])
+check("cavity: nx and Re map", args == ["--re", "100.0", "--nx", "20"] and cctx["nx"] == 20.0 and
+      skipped == ["kernel"], (args, skipped))
+ghia = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(
+    __file__)))), "data")  # tests/data
+cctx.update(ghia_u=sp.read_table(os.path.join(ghia, "ghia1982_re100_u.csv"), "u"),
+           ghia_v=sp.read_table(os.path.join(ghia, "ghia1982_re100_v.csv"), "v"))
+n = 20
+xs = [(i + 0.5) / n for i in range(n) for _ in range(n)]
+ys = [(j + 0.5) / n for _ in range(n) for j in range(n)]
+def field(c):
+    return {"x": xs, "y": ys, "u": [c * (y - 0.5) for y in ys], "v": [c * (x - 0.5) for x in xs],
+            "m": [1.0 / n / n] * (n * n)}
+def expect(c):
+    out = {}
+    for name, tab in (("u", cctx["ghia_u"]), ("v", cctx["ghia_v"])):
+        e = [c * (s - 0.5) - r for s, r in zip(*tab) if 0 < s < 1]
+        out[name + "_max"] = max(abs(v) for v in e)
+        out[name + "_rms"] = math.sqrt(sum(v * v for v in e) / len(e))
+    return out
+m = dict(sp.metrics_cavity(field(0.4), 0.0, cctx))
+want = expect(0.4)
+check("cavity: Ghia's centre lines without the wall rows, exact on a linear field",
+      all(close(m[k], want[k], 1e-9) for k in want), (m, want))
+check("cavity: ke", close(m["ke"], sum(0.5 / n / n * 0.16 * ((x - 0.5) ** 2 + (y - 0.5) ** 2)
+                                      for x, y in zip(xs, ys)), 1e-12), m)
+m = dict(sp.metrics_cavity(field(0.2), 0.5, cctx))
+want = expect(0.3)  # the mean of the two outputs' samples
+check("cavity: averaged over the outputs of the last L/U",
+      all(close(m[k], want[k], 1e-9) for k in want), (m, want))
+m = dict(sp.metrics_cavity(field(0.2), 2.0, cctx))
+check("cavity: outputs older than L/U leave the average",
+      all(close(m[k], expect(0.2)[k], 1e-9) for k in want), m)
+
 # ---- a synthetic PySPH output through the metric file the study reads ---------------------
 outputs = {"f0": (0.0, 0, 1e-3, {"x": [0.015, 0.985]}),
            "f2": (t, 200, 1e-3, {"x": [0.015, 3.315]}),

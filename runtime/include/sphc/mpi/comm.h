@@ -47,6 +47,8 @@ bool all(bool x);
 // only by the order of its sums. Collective.
 void all_reduce(NormSums& s);
 void all_reduce(ScalarSums& s);
+// A profile's least-squares sums at its points, added over the ranks in rank order.
+void all_reduce(ProfileFit& f);
 
 // The exit of a rank's run_main: 0 returns 0 (after a barrier); any other code prints a line
 // naming the rank and ends every rank of the job with MPI_Abort(code) (does not return).

@@ -1,0 +1,89 @@
+"""Helpers shared by the benchmarks of bench/ (running commands and timing them, the machine's
+description, the options of the sphc-against-PySPH scripts), and the one place where a
+benchmark's PySPH set-up is shared with `sphc study --pysph` (compiler/driver/study_pysph.py:
+how PySPH's dam_break_2d is made consistent at a dx other than its own)."""
+
+import argparse
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_DX = 0.03
+
+sys.path.insert(0, os.path.join(ROOT, "compiler", "driver"))
+from study_pysph import scale_dambreak  # noqa: E402,F401  (shared with sphc study --pysph)
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return "unknown CPU"
+
+
+def load_average():
+    try:
+        return "%.2f %.2f %.2f" % os.getloadavg()
+    except OSError:
+        return "unknown"
+
+
+def children_cpu():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def run(cmd, env=None, cwd=None):
+    """Runs cmd; returns (wall seconds, combined output). Exits on failure. The CPU seconds
+    (user + system) of cmd and its children are in run.cpu afterwards."""
+    t0 = time.perf_counter()
+    c0 = children_cpu()
+    p = subprocess.run(cmd, env=env, cwd=cwd, stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, universal_newlines=True)
+    wall = time.perf_counter() - t0
+    run.cpu = children_cpu() - c0
+    if p.returncode != 0:
+        sys.stderr.write("command failed (exit %d): %s\n%s\n"
+                         % (p.returncode, " ".join(cmd), p.stdout[-3000:]))
+        raise SystemExit(1)
+    return wall, p.stdout
+
+
+def serial_env(extra=None):
+    env = dict(os.environ)
+    env["OMP_NUM_THREADS"] = "1"
+    if extra:
+        env.update(extra)
+    return env
+
+
+def fmt(v, spec="%.2f"):
+    return "-" if v is None else spec % v
+
+
+def argument_parser(doc):
+    """The options every sphc-against-PySPH benchmark takes."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
+    ap.add_argument("--pysph-python", default=sys.executable,
+                    help="Python with PySPH (default: this one)")
+    ap.add_argument("--skip-pysph", action="store_true")
+    ap.add_argument("--skip-sphc", action="store_true")
+    ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
+    return ap
+
+
+def remove_tmp(tmp, keep):
+    """The end of a benchmark: its temporary directory removed, or named with --keep."""
+    if keep:
+        print("kept %s" % tmp)
+    else:
+        shutil.rmtree(tmp, ignore_errors=True)
