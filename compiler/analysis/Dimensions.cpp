@@ -10,11 +10,22 @@
 // awhat, wg, wf: PySPH's names of rates, saved values, transport velocities and wall
 // velocities); in dim 1 also the y-components. A property a scene asks for by name (an
 // output, a limit, a `property` declaration) is kept as written.
+//
+// Strided properties get the same treatment per component: a declared `double[3]` is a
+// spatial vector and a `double[9]` a 3x3 tensor stored row-major (d_L[9 d_idx + 3 i + j]),
+// as the stdlib writes them. In a 1D or 2D scene such a property is stored with `dim`
+// (resp. dim x dim) components per particle when every indexing of it in every body names
+// its component by a literal, `d_gradc[3 * d_idx + 1]`: the left-out components read as 0
+// and their writes go to the sink, the others are renumbered (`d_gradc[2 * d_idx + 1]`;
+// tensor entry (i, j) at dim i + j). A property indexed otherwise (`+ k`, a loop variable)
+// or output, limited, measured, loaded or copied by a zone keeps its 3D layout.
 #include "analysis/Passes.h"
 
 #include "llvm/ADT/StringRef.h"
 
 #include <algorithm>
+#include <iterator>
+#include <map>
 #include <regex>
 
 namespace sphc {
@@ -48,12 +59,93 @@ void erase(std::vector<PropAccess>& list, const std::string& prop) {
              list.end());
 }
 
+
+// The 2D (1D) layout of strided properties: for each qualifying property, its new stride.
+struct StridedSite {
+  int stride = 0;    // 3 or 9
+  int comp = 0;      // the literal component
+  char prefix = 'd';
+};
+
+// `3 * d_idx + 1`, `9 * s_idx + 4`, `3 * d_idx` -> stride, component; false otherwise.
+bool literalComponent(llvm::StringRef site, StridedSite& out) {
+  size_t open = site.find('[');
+  if (open == llvm::StringRef::npos || !site.endswith("]")) return false;
+  std::string index = site.substr(open + 1, site.size() - open - 2).str();
+  static const std::regex form(R"(^\s*(3|9)\s*\*\s*([ds])_idx\s*(?:\+\s*(\d+)\s*)?$)");
+  std::smatch m;
+  if (!std::regex_match(index, m, form)) return false;
+  out.stride = std::stoi(m[1].str());
+  out.prefix = m[2].str()[0];
+  out.comp = m[3].matched ? std::stoi(m[3].str()) : 0;
+  return out.comp < out.stride && site.startswith(std::string(1, out.prefix) + "_");
+}
+
+// The new index of a kept component, or -1 for a left-out one.
+int reducedComponent(int stride, int comp, int dim) {
+  if (stride == 3) return comp < dim ? comp : -1;
+  int i = comp / 3, j = comp % 3;
+  return (i < dim && j < dim) ? i * dim + j : -1;
+}
+
+std::map<std::string, int> reducedStrides(const Plan& plan) {
+  std::map<std::string, int> stride;  // declared strided properties (3 or 9), by name
+  std::set<std::string> keep;
+  for (const auto& a : plan.arrays) {
+    for (const auto& p : a.props) {
+      if (p.stride != 3 && p.stride != 9) continue;
+      auto it = stride.find(p.name);
+      if (it != stride.end() && it->second != p.stride) keep.insert(p.name);
+      stride[p.name] = p.stride;
+      if (a.decl && !a.decl->loads.empty()) keep.insert(p.name);
+    }
+    for (const auto* list : {&a.outputProps, &a.limitProps, &a.metricProps, &a.zoneProps})
+      keep.insert(list->begin(), list->end());
+  }
+  for (const auto& b : plan.bodies) {
+    for (const auto& s : b.facts.sites) {
+      auto it = stride.find(s.prop);
+      if (it == stride.end()) continue;
+      StridedSite site;
+      if (!b.facts.ok || s.end > b.source.text.size() ||
+          !literalComponent(llvm::StringRef(b.source.text).slice(s.begin, s.end), site) ||
+          site.stride != it->second)
+        keep.insert(s.prop);
+    }
+    // An indexing the site list does not hold (the text would still name it): keep.
+    for (const auto& [name, st] : stride) {
+      size_t listed = 0;
+      for (const auto& s : b.facts.sites) listed += s.prop == name;
+      std::regex any("\\b[ds]_" + name + "\\s*\\[");
+      auto n = std::distance(std::sregex_iterator(b.source.text.begin(), b.source.text.end(), any),
+                             std::sregex_iterator());
+      if (static_cast<size_t>(n) != listed) keep.insert(name);
+    }
+  }
+  std::map<std::string, int> out;
+  for (const auto& [name, st] : stride)
+    if (!keep.count(name)) out[name] = st == 3 ? plan.dim : plan.dim * plan.dim;
+  return out;
+}
+
+// The replacement of one strided site (reducedStrides checked it is literal).
+std::string stridedReplacement(llvm::StringRef siteText, const PropSite& s, int newStride,
+                               int dim) {
+  StridedSite site;
+  literalComponent(siteText, site);
+  int c = reducedComponent(site.stride, site.comp, dim);
+  if (c < 0) return s.write ? "sphc_sink" : "0.0";
+  return std::string(1, site.prefix) + "_" + s.prop + "[" + std::to_string(newStride) + " * " +
+         site.prefix + "_idx + " + std::to_string(c) + "]";
+}
+
 // Rewrites one body; false (unchanged) if some indexing of a left-out property was not
 // found by the body analysis (the text would still name it).
-bool rewrite(PlanBody& b, const std::set<std::string>& leftOut) {
+bool rewrite(PlanBody& b, const std::set<std::string>& leftOut,
+             const std::map<std::string, int>& reduced, int dim) {
   std::vector<PropSite> sites;
   for (const auto& s : b.facts.sites)
-    if (leftOut.count(s.prop)) sites.push_back(s);
+    if (leftOut.count(s.prop) || reduced.count(s.prop)) sites.push_back(s);
   if (sites.empty()) return true;
   std::sort(sites.begin(), sites.end(),
             [](const PropSite& x, const PropSite& y) { return x.begin > y.begin; });
@@ -64,8 +156,14 @@ bool rewrite(PlanBody& b, const std::set<std::string>& leftOut) {
     if (s.end > last || s.end > text.size()) return false;  // overlapping: leave it
     llvm::StringRef site(text.data() + s.begin, s.end - s.begin);
     if (site.contains('\n')) return false;
-    text.replace(s.begin, s.end - s.begin, s.write ? "sphc_sink" : "0.0");
-    sink |= s.write;
+    std::string repl;
+    if (leftOut.count(s.prop)) {
+      repl = s.write ? "sphc_sink" : "0.0";
+    } else {
+      repl = stridedReplacement(site, s, reduced.at(s.prop), dim);
+    }
+    sink |= repl == "sphc_sink";
+    text.replace(s.begin, s.end - s.begin, repl);
     last = s.begin;
   }
   for (const auto& p : leftOut) {
@@ -80,9 +178,17 @@ bool rewrite(PlanBody& b, const std::set<std::string>& leftOut) {
     erase(b.facts.dWrites, p);
     erase(b.facts.sReads, p);
   }
+  // The offsets of the remaining sites are stale after the replacements: nothing after this
+  // pass reads them (the strided properties' sites are dropped with the left-out ones).
   b.facts.sites.erase(std::remove_if(b.facts.sites.begin(), b.facts.sites.end(),
-                                     [&](const PropSite& s) { return leftOut.count(s.prop); }),
+                                     [&](const PropSite& s) {
+                                       return leftOut.count(s.prop) || reduced.count(s.prop);
+                                     }),
                       b.facts.sites.end());
+  for (auto& [name, shape] : b.source.props) {
+    auto it = reduced.find(name);
+    if (it != reduced.end()) shape.stride = it->second;
+  }
   return true;
 }
 
@@ -91,19 +197,41 @@ bool rewrite(PlanBody& b, const std::set<std::string>& leftOut) {
 bool dropAbsentComponents(Plan& plan, DiagnosticEngine& diags) {
   if (plan.dim >= 3) return true;
   std::set<std::string> leftOut = componentsLeftOut(plan);
+  std::map<std::string, int> reduced = reducedStrides(plan);
   std::set<std::string> dropped;
   for (auto& b : plan.bodies) {
     if (!b.facts.ok) continue;
     std::set<std::string> here;
     for (const auto& s : b.facts.sites)
       if (leftOut.count(s.prop)) here.insert(s.prop);
-    if (rewrite(b, leftOut)) {
+    bool strided = false;
+    for (const auto& s : b.facts.sites) strided |= reduced.count(s.prop) > 0;
+    if (rewrite(b, leftOut, reduced, plan.dim)) {
       dropped.insert(here.begin(), here.end());
+    } else if (strided) {
+      // Its strided properties are stored with fewer components now: the text must follow.
+      diags.error(b.source.start, "internal: " + b.source.label + ": the strided properties' " +
+                                      std::to_string(plan.dim) +
+                                      "D layout could not be applied to it");
+      return false;
     } else {
       diags.warning(b.source.start, "internal: " + b.source.label + ": the components a " +
                                         std::to_string(plan.dim) +
                                         "D scene leaves out could not be removed from it");
     }
+  }
+  if (!reduced.empty()) {
+    for (auto& a : plan.arrays)
+      for (auto& p : a.props) {
+        auto it = reduced.find(p.name);
+        if (it != reduced.end()) p.stride = it->second;
+      }
+    std::string list;
+    for (const auto& [name, st] : reduced)
+      list += (list.empty() ? "" : " ") + name + "[" + std::to_string(st) + "]";
+    plan.notes.push_back("dim " + std::to_string(plan.dim) +
+                         ": strided properties stored without their left-out components: " +
+                         list);
   }
   if (!dropped.empty()) {
     std::string list;
