@@ -13,8 +13,6 @@ void ScenePrinter::emitRestart() {
   if (!sourceArrays_.empty())  // neighbour builds: every REORDER_EVERY-th reorders
     out_ << "    s.emplace_back(\"builds\", static_cast<double>(scene.builds));\n";
   if (hasZones()) out_ << "    sphc::inlet_outlet_state(scene.io, s);\n";
-  if (mpi_)  // the re-balance schedule (a restart re-balances at once anyway)
-    out_ << "    s.emplace_back(\"mpi.evaluations\", static_cast<double>(scene.decomposition.evaluations));\n";
   out_ << "    return s;\n  };\n";
   out_ << "  prog.restore = [](const sphc::RunState& s) {\n";
   out_ << "    scene.step_count = static_cast<long>(sphc::state_value(s, \"step_count\"));\n";
@@ -23,8 +21,8 @@ void ScenePrinter::emitRestart() {
   if (hasZones()) out_ << "    sphc::restore_inlet_outlet(scene.io, s);\n";
   out_ << restoreData();
   if (mpi_) {
-    out_ << "    scene.decomposition.evaluations = static_cast<long>(\n"
-            "        sphc::state_value(s, \"mpi.evaluations\", 0.0));\n";
+    // The files of serial and distributed runs carry the same state: the re-balance schedule
+    // (Decomposition::evaluations) is not in it, and restarts at 0.
     out_ << "    // Each rank read a block of the file: cut space anew and migrate.\n";
     out_ << "    sphc::mpi::rebalance(scene.decomposition, " << allArrays("scene.")
          << ");\n";

@@ -63,3 +63,17 @@ for _py in ('python3', '/usr/bin/python3'):
             break
     except OSError:
         pass
+# `REQUIRES: h5py`: a Python here imports h5py and numpy; %h5py_python is that Python, and
+# %restart_bitwise UNINTERRUPTED_DIR RESTARTED_DIR checks that every file of a restarted run is
+# bitwise the uninterrupted run's (tests/lit/Inputs/restart_bitwise.py).
+for _py in ('python3', '/usr/bin/python3'):
+    try:
+        if _sp.run([_py, '-c', 'import h5py, numpy'], stdout=_sp.DEVNULL,
+                   stderr=_sp.DEVNULL).returncode == 0:
+            config.available_features.add('h5py')
+            config.substitutions.append(('%h5py_python', _py))
+            config.substitutions.append(('%restart_bitwise', _py + ' ' + os.path.join(
+                config.sphc_src_root, 'tests', 'lit', 'Inputs', 'restart_bitwise.py')))
+            break
+    except OSError:
+        pass
