@@ -659,6 +659,34 @@ XdmfEntry make_xdmf_entry(const std::string& h5_file, double t,
   return e;
 }
 
+XdmfEntry read_xdmf_entry_hdf5(const std::string& path, const std::string& h5_file) {
+  XdmfEntry e;
+  e.h5_file = h5_file;
+  e.t = read_meta_hdf5(path).t;
+  const H5File f(path);
+  Hid file = open_file(f);
+  for (const std::string& array : list_arrays_hdf5(path)) {
+    const std::string where = "/" + array;
+    Hid group = f.own(H5Gopen2(file.get(), array.c_str(), H5P_DEFAULT), H5Gclose, where,
+                      "cannot open group");
+    const std::vector<double> n = read_double_attribute(f, group.get(), where, "n");
+    if (n.size() != 1 || n[0] < 0) f.fail(where + "@n", "particle count is not a count");
+    e.arrays.emplace_back(array, static_cast<std::size_t>(n[0]));
+    auto& props = e.props.emplace_back();
+    for (const std::string& name : child_names(f, group.get(), where, H5O_TYPE_DATASET)) {
+      const std::string at = child_path(where, name);
+      Hid dset = f.own(H5Dopen2(group.get(), name.c_str(), H5P_DEFAULT), H5Dclose, at,
+                       "cannot open dataset");
+      Hid space = f.own(H5Dget_space(dset.get()), H5Sclose, at, "cannot read dataset shape");
+      hsize_t dims[2] = {0, 1};
+      if (H5Sget_simple_extent_dims(space.get(), dims, nullptr) < 0)
+        f.fail(at, "cannot read dataset shape");
+      props.emplace_back(name, static_cast<int>(dims[1]));
+    }
+  }
+  return e;
+}
+
 void write_xdmf(const std::string& xdmf_path, const std::vector<XdmfEntry>& series, int dim) {
   const std::string text = xdmf_document(series, dim);
   write_atomically(xdmf_path, [&](const std::string& tmp) {

@@ -406,6 +406,25 @@ class OutputWriter {
   const std::string& newest() const { return newest_; }
   // --restartable: every property of every array, whatever the scene's output selection.
   void write_all_properties() { all_properties_ = true; }
+  // A restarted run: its index starts with the files of the run up to the restart step
+  // (SCENE_NNNNNN.h5 in the output directory, NNNNNN <= step), where they are there.
+  void continue_series(long step) {
+    if (!enabled_ || prog_.rank > 0 || !std::filesystem::is_directory(dir_)) return;
+    std::vector<std::pair<long, std::string>> files;
+    const std::string prefix = scene_ + "_";
+    for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+      const std::string name = entry.path().filename().string();
+      if (name.size() != prefix.size() + 9 || name.rfind(prefix, 0) != 0 ||
+          name.substr(name.size() - 3) != ".h5")
+        continue;
+      const std::string digits = name.substr(prefix.size(), 6);
+      if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      const long k = std::stol(digits);
+      if (k <= step) files.emplace_back(k, name);
+    }
+    std::sort(files.begin(), files.end());
+    for (const auto& [k, name] : files) series_.push_back(read_xdmf_entry_hdf5(in_dir(name), name));
+  }
 
   void write(const std::vector<ParticleArray*>& arrays, const OutputMeta& meta) {
     if (!enabled_) return;
@@ -625,6 +644,7 @@ class Simulation {
                         !opt_.no_output && (prog_.rank <= 0 || prog_.write_particles != nullptr));
     writer_ = &writer;
     if (opt_.restartable) writer.write_all_properties();
+    if (!opt_.restart.empty()) writer.continue_series(read_meta_hdf5(opt_.restart).step);
     open_metrics(dir);
 
     const double tf = times.tf;
@@ -830,9 +850,29 @@ class Simulation {
     if (path.empty() && !opt_.no_output)
       path = (std::filesystem::path(dir) / (scene_name(prog_) + "_metrics.csv")).string();
     if (path.empty() || prog_.rank > 0) return;  // a distributed run: rank 0 writes it
+    // A restart continues the file: the rows up to the restart step are kept (a run that went
+    // on past it wrote rows the restarted run writes again).
+    std::vector<std::string> kept;
+    if (!opt_.restart.empty()) kept = metrics_rows_until(path, read_meta_hdf5(opt_.restart).step);
     metrics_csv_.open(path, std::ios::trunc);
     if (!metrics_csv_) throw std::runtime_error("cannot write the metrics to '" + path + "'");
-    metrics_csv_ << metrics_csv_header(prog_.metrics) << "\n" << std::flush;
+    metrics_csv_ << metrics_csv_header(prog_.metrics) << "\n";
+    for (const std::string& row : kept) metrics_csv_ << row << "\n";
+    metrics_csv_ << std::flush;
+  }
+
+  // The rows of an existing metrics CSV (of this scene's header) whose step is at most `step`.
+  std::vector<std::string> metrics_rows_until(const std::string& path, long step) const {
+    std::vector<std::string> rows;
+    std::ifstream in(path);
+    std::string line;
+    if (!in || !std::getline(in, line) || line != metrics_csv_header(prog_.metrics)) return rows;
+    while (std::getline(in, line)) {
+      char* end = nullptr;
+      const long row_step = std::strtol(line.c_str(), &end, 10);
+      if (end != line.c_str() && *end == ',' && row_step <= step) rows.push_back(line);
+    }
+    return rows;
   }
 
   void record_metrics() {

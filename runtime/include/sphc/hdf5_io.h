@@ -78,6 +78,10 @@ struct XdmfEntry {
 XdmfEntry make_xdmf_entry(const std::string& h5_file, double t,
                           const std::vector<OutputArray>& arrays);
 
+// The entry of an existing output file `path` (named `h5_file` in the index): its t, arrays,
+// particle counts and datasets. A restarted run indexes the files before its restart so.
+XdmfEntry read_xdmf_entry_hdf5(const std::string& path, const std::string& h5_file);
+
 // Writes the XDMF index of a time series for ParaView (rewritten whole and atomically: tmp +
 // rename): a temporal collection of spatial collections, one Polyvertex grid per array with
 // X_Y_Z geometry and one attribute per property of stride 1 (Scalar), 3 (Vector) or
