@@ -9,15 +9,6 @@
 namespace sphc {
 namespace {
 
-std::size_t value_count(const Property& p) {
-  switch (p.type) {
-    case PropType::F64: return p.f64.size();
-    case PropType::I32: return p.i32.size();
-    case PropType::U32: return p.u32.size();
-  }
-  return 0;
-}
-
 // The solver's array `a` takes the particles and constants of the file's `f`.
 void take(ParticleArray& a, ParticleArray& f, const std::string& path) {
   const std::string hint =
@@ -42,9 +33,7 @@ void take(ParticleArray& a, ParticleArray& f, const std::string& path) {
           "solver's is {} with {}",
           path, p.name, a.name, prop_type_name(q.type), q.stride, prop_type_name(p.type),
           p.stride));
-    if (value_count(q) != f.n * static_cast<std::size_t>(q.stride))
-      throw std::runtime_error(fmt::format("restart file '{}': property '{}' of array '{}' has "
-                                           "the wrong number of values", path, p.name, a.name));
+    // read_particles_hdf5 checked the rows: n x stride values of the property's type.
     p.f64 = std::move(q.f64);
     p.i32 = std::move(q.i32);
     p.u32 = std::move(q.u32);

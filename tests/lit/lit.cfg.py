@@ -51,29 +51,31 @@ config.substitutions.append(('%precision_compare', 'python3 ' + os.path.join(
 # ('=V', '<V', '>V'; tests/lit/Inputs/h5consts.py).
 config.substitutions.append(('%h5consts', 'python3 ' + os.path.join(
     config.sphc_src_root, 'tests', 'lit', 'Inputs', 'h5consts.py')))
+import subprocess as _sp
+
+# The first Python here that imports `modules` (python3 on PATH, then /usr/bin/python3), or None.
+def _python_with(modules):
+    for py in ('python3', '/usr/bin/python3'):
+        try:
+            if _sp.run([py, '-c', 'import ' + modules], stdout=_sp.DEVNULL,
+                       stderr=_sp.DEVNULL).returncode == 0:
+                return py
+        except OSError:
+            pass
+    return None
+
 # `REQUIRES: pysph`: a Python here imports PySPH (Debian python3-pysph), for the tests of
 # `sphc study --pysph`; %pysph_python is that Python.
-import subprocess as _sp
-for _py in ('python3', '/usr/bin/python3'):
-    try:
-        if _sp.run([_py, '-c', 'import pysph'], stdout=_sp.DEVNULL,
-                   stderr=_sp.DEVNULL).returncode == 0:
-            config.available_features.add('pysph')
-            config.substitutions.append(('%pysph_python', _py))
-            break
-    except OSError:
-        pass
+_py = _python_with('pysph')
+if _py:
+    config.available_features.add('pysph')
+    config.substitutions.append(('%pysph_python', _py))
 # `REQUIRES: h5py`: a Python here imports h5py and numpy; %h5py_python is that Python, and
 # %restart_bitwise UNINTERRUPTED_DIR RESTARTED_DIR checks that every file of a restarted run is
 # bitwise the uninterrupted run's (tests/lit/Inputs/restart_bitwise.py).
-for _py in ('python3', '/usr/bin/python3'):
-    try:
-        if _sp.run([_py, '-c', 'import h5py, numpy'], stdout=_sp.DEVNULL,
-                   stderr=_sp.DEVNULL).returncode == 0:
-            config.available_features.add('h5py')
-            config.substitutions.append(('%h5py_python', _py))
-            config.substitutions.append(('%restart_bitwise', _py + ' ' + os.path.join(
-                config.sphc_src_root, 'tests', 'lit', 'Inputs', 'restart_bitwise.py')))
-            break
-    except OSError:
-        pass
+_py = _python_with('h5py, numpy')
+if _py:
+    config.available_features.add('h5py')
+    config.substitutions.append(('%h5py_python', _py))
+    config.substitutions.append(('%restart_bitwise', _py + ' ' + os.path.join(
+        config.sphc_src_root, 'tests', 'lit', 'Inputs', 'restart_bitwise.py')))

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "scratch_dir.h"
+
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -13,14 +15,7 @@ using namespace sphc;
 
 namespace {
 
-fs::path fresh_dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir =
-      fs::path("tmp_io") / (std::string(info->test_suite_name()) + "_" + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir() { return fresh_test_dir("tmp_io"); }
 
 // 7 particles: x = i, a 3-component tensor, an int and the gid; a constant.
 ParticleArray make_array(std::size_t n = 7) {
