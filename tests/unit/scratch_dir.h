@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-// `root`/<suite>_<test> under the working directory, emptied (git ignores tmp_*).
+// `root`/<suite>_<test> under the working directory (ctest: the build tree), emptied.
 inline std::filesystem::path fresh_test_dir(const std::string& root) {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   const std::filesystem::path dir =
