@@ -68,6 +68,9 @@ class CpuPrinter : public ScenePrinter {
     return cpuSingle_ ? "    if (!sphc::counting_particles()) scene.to_single();\n" : "";
   }
   bool hasToHost() const override { return cpuSingle_; }
+  std::string restoreData() const override {
+    return cpuSingle_ ? "    scene.to_single();  // the float copies of the restored arrays\n" : "";
+  }
   // --precision=single: the manager works on the host doubles; the float copies follow.
   void arraysToHost(const std::vector<int>& arrays) override {
     if (!cpuSingle_) return;

@@ -114,6 +114,7 @@ std::string ScenePrinter::distributedReport() const {
 void ScenePrinter::distributedMain() {
   if (!mpi_) return;
   out_ << "  prog.rank = sphc::mpi::rank();  // rank 0 writes the files and the progress line\n";
+  out_ << "  prog.ranks = sphc::mpi::size();  // a restart reads one block of the file per rank\n";
   out_ << "  // Output: collective parallel HDF5, or gathered to rank 0 (sphc/mpi/output.h).\n";
   out_ << "  sphc::mpi::set_output(prog, [] {\n";
   out_ << "    return std::vector<sphc::ParticleArray*>" << allArrays("scene.") << ";\n  });\n";

@@ -649,6 +649,7 @@ void ScenePrinter::emitMain() {
                   : "  prog.adaptive_dt = [] { return scene.adaptive_dt(); };\n");
   if (!sched_.iteratedGroups.empty())
     out_ << "  prog.iterations = [] { return scene.iteration_stats; };\n";
+  emitRestart();
   if (timesNeighbourSearch()) out_ << "  prog.neighbour_seconds = [] { return scene.nnps_seconds; };\n";
   if (hasZones()) out_ << "  prog.inlet_outlet_seconds = [] { return scene.io_seconds; };\n";
   if (timesGroups() && !sched_.equations.group->iterate) {
@@ -708,6 +709,7 @@ std::string ScenePrinter::run() {
   if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
   if (!plan_.metrics.empty()) out_ << "#include \"sphc/metrics.h\"\n";
   if (hasZones()) out_ << "#include \"sphc/inlet_outlet.h\"\n";
+  out_ << "#include \"sphc/restart.h\"\n";
   if (globalIds_) out_ << "#include \"sphc/global_ids.h\"\n";
   if (mpi_)
     out_ << "#include \"sphc/mpi/comm.h\"\n#include \"sphc/mpi/decomposition.h\"\n"

@@ -68,6 +68,9 @@ class OpenCLPrinter : public ScenePrinter {
     return "    if (!sphc::counting_particles()) scene.to_device();\n";
   }
   bool hasToHost() const override { return true; }
+  std::string restoreData() const override {
+    return "    scene.from_host();  // the restored arrays to the device\n";
+  }
   // The manager works on the host arrays: down before it, up after (DeviceArray::upload
   // grows the buffers' capacity by at least a quarter when an array outgrows it).
   void arraysToHost(const std::vector<int>& arrays) override {
@@ -172,6 +175,11 @@ void OpenCLPrinter::dataMovement() {
   scene_ << "  void to_host() {\n";
   for (const auto& a : plan_.arrays)
     scene_ << "    dev_" << a.name << ".download(ocl, " << a.name << ");\n";
+  scene_ << "  }\n\n";
+  scene_ << "  // --restart: the host arrays (read from a file) up again, after to_device.\n";
+  scene_ << "  void from_host() {\n";
+  for (const auto& a : plan_.arrays)
+    scene_ << "    dev_" << a.name << ".upload(ocl, " << a.name << ");\n";
   scene_ << "  }\n\n";
 }
 

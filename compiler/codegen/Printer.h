@@ -90,6 +90,9 @@ class ScenePrinter {
   virtual void mainBackendOptions() {}              // prog.set_threads, device selection
   virtual std::string afterSetup() const { return ""; }  // "    if (!sphc::counting_particles()) scene.to_device();\n"
   virtual bool hasToHost() const { return false; }
+  // --restart: the statements that move the restored host arrays to where the scene computes
+  // on them (OpenCL: uploads; --precision=single: the float copies); "" where they are it.
+  virtual std::string restoreData() const { return ""; }
   // The inlet/outlet step runs on the host: the arrays it resizes come to the host before
   // it and go back to where the scene computes after it (their new sizes included).
   virtual void arraysToHost(const std::vector<int>& arrays) {}
@@ -203,6 +206,8 @@ class ScenePrinter {
   std::string afterSetupDistributed() const;
   void distributedMain();
   std::string distributedReport() const;  // after run_main: halo volumes (SPHC_MPI_STATS)
+  // In main: prog.run_state and prog.restore (--restart, sphc/restart.h; RestartPrinter.cpp).
+  void emitRestart();
   // The array list `{&a, &b}` of every array (prefix: "" inside Scene, "scene." in main).
   std::string allArrays(const std::string& prefix) const;
 

@@ -15,6 +15,8 @@
 
 #include <fmt/format.h>
 
+#include "hdf5_types.h"
+
 namespace sphc {
 namespace {
 
@@ -200,15 +202,6 @@ std::vector<double> read_double_attribute(const H5File& f, hid_t obj, const std:
 // ---------------------------------------------------------------------------------------------
 // Properties.
 
-hid_t native_type(PropType t) {
-  switch (t) {
-    case PropType::F64: return H5T_NATIVE_DOUBLE;
-    case PropType::I32: return H5T_NATIVE_INT32;
-    case PropType::U32: return H5T_NATIVE_UINT32;
-  }
-  return H5T_NATIVE_DOUBLE;
-}
-
 std::size_t value_count(const Property& p) {
   switch (p.type) {
     case PropType::F64: return p.f64.size();
@@ -336,8 +329,10 @@ void write_array(const H5File& f, hid_t file, const OutputArray& out) {
 }
 
 // Reads one dataset as a property; its first dimension must be n (n < 0: not known yet, set).
+// With parts > 1 only the rows [n part / parts, n (part + 1) / parts).
 Property read_property(const H5File& f, hid_t group, const std::string& group_path,
-                       const std::string& name, long long& n) {
+                       const std::string& name, long long& n, std::size_t part = 0,
+                       std::size_t parts = 1) {
   const std::string where = child_path(group_path, name);
   Hid dset = f.own(H5Dopen2(group, name.c_str(), H5P_DEFAULT), H5Dclose, where,
                    "cannot open dataset");
@@ -361,11 +356,21 @@ Property read_property(const H5File& f, hid_t group, const std::string& group_pa
     f.fail(where, fmt::format("dataset has {} rows, the array has {} particles", dims[0], n));
   }
   p.stride = static_cast<int>(dims[1]);
-  resize_values(p, dims[0] * dims[1]);
-  if (value_count(p) > 0) {
+  const hsize_t begin = dims[0] * part / parts, end = dims[0] * (part + 1) / parts;
+  resize_values(p, (end - begin) * dims[1]);
+  if (value_count(p) == 0) return p;
+  if (parts == 1) {
     f.check(H5Dread(dset.get(), native_type(p.type), H5S_ALL, H5S_ALL, H5P_DEFAULT, values_of(p)),
             where, "cannot read dataset");
+    return p;
   }
+  const hsize_t start[2] = {begin, 0}, count[2] = {end - begin, dims[1]};
+  f.check(H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, start, nullptr, count, nullptr), where,
+          "cannot select rows");
+  Hid memory = f.space(rank, count, where);
+  f.check(H5Dread(dset.get(), native_type(p.type), memory.get(), space.get(), H5P_DEFAULT,
+                  values_of(p)),
+          where, "cannot read dataset");
   return p;
 }
 
@@ -555,12 +560,18 @@ void write_particles_hdf5(const std::string& path, const std::vector<OutputArray
     write_scalar_attribute(f, file.get(), "/", "dim", H5T_NATIVE_INT32,
                            static_cast<std::int32_t>(meta.dim));
     write_string_attribute(f, file.get(), "/", "scene", meta.scene);
+    for (const auto& [name, value] : meta.state)
+      write_scalar_attribute(f, file.get(), "/", (kRunStatePrefix + name).c_str(),
+                             H5T_NATIVE_DOUBLE, value);
     for (const OutputArray& out : arrays) write_array(f, file.get(), out);
     f.check(file.close(), "/", "cannot close file");
   });
 }
 
-ParticleArray read_particles_hdf5(const std::string& path, const std::string& array_name) {
+ParticleArray read_particles_hdf5(const std::string& path, const std::string& array_name,
+                                  std::size_t part, std::size_t parts) {
+  if (parts == 0 || part >= parts)
+    throw std::invalid_argument(fmt::format("read_particles_hdf5: part {} of {}", part, parts));
   const H5File f(path);
   Hid file = open_file(f);
   const std::string where = "/" + array_name;
@@ -580,15 +591,52 @@ ParticleArray read_particles_hdf5(const std::string& path, const std::string& ar
   }
   std::vector<Property> props;
   for (const std::string& name : child_names(f, group.get(), where, H5O_TYPE_DATASET)) {
-    props.push_back(read_property(f, group.get(), where, name, n));
+    props.push_back(read_property(f, group.get(), where, name, n, part, parts));
   }
 
   ParticleArray a;
   a.name = array_name;
-  a.n = static_cast<std::size_t>(std::max(n, 0LL));
+  const std::size_t total = static_cast<std::size_t>(std::max(n, 0LL));
+  a.n = total * (part + 1) / parts - total * part / parts;
   a.props = std::move(props);
   if (H5Lexists(group.get(), kConstantsGroup, H5P_DEFAULT) > 0) read_constants(f, group.get(), where, a);
   return a;
+}
+
+OutputMeta read_meta_hdf5(const std::string& path) {
+  const H5File f(path);
+  Hid file = open_file(f);
+  Hid root = f.own(H5Gopen2(file.get(), "/", H5P_DEFAULT), H5Gclose, "/", "cannot open group");
+  OutputMeta meta;
+  auto number = [&](const char* name) {
+    if (H5Aexists(root.get(), name) <= 0) f.fail(std::string("/@") + name, "no such attribute");
+    const std::vector<double> v = read_double_attribute(f, root.get(), "/", name);
+    if (v.size() != 1) f.fail(std::string("/@") + name, "not a single number");
+    return v[0];
+  };
+  meta.t = number("t");
+  meta.dt = number("dt");
+  meta.step = static_cast<long>(number("step"));
+  meta.dim = static_cast<int>(number("dim"));
+  if (H5Aexists(root.get(), "scene") > 0) {
+    Hid attr = f.own(H5Aopen(root.get(), "scene", H5P_DEFAULT), H5Aclose, "/@scene",
+                     "cannot open attribute");
+    Hid type = f.own(H5Aget_type(attr.get()), H5Tclose, "/@scene", "cannot read its type");
+    if (H5Tget_class(type.get()) == H5T_STRING && H5Tis_variable_str(type.get()) > 0) {
+      char* text = nullptr;
+      f.check(H5Aread(attr.get(), type.get(), &text), "/@scene", "cannot read attribute");
+      meta.scene = text ? text : "";
+      H5free_memory(text);
+    }
+  }
+  const std::string prefix = kRunStatePrefix;
+  for (const std::string& name : attribute_names(f, root.get(), "/")) {
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::vector<double> v = read_double_attribute(f, root.get(), "/", name.c_str());
+    if (v.size() != 1) f.fail("/@" + name, "not a single number");
+    meta.state.emplace_back(name.substr(prefix.size()), v[0]);
+  }
+  return meta;
 }
 
 std::vector<std::string> list_arrays_hdf5(const std::string& path) {
@@ -607,6 +655,34 @@ XdmfEntry make_xdmf_entry(const std::string& h5_file, double t,
     e.arrays.emplace_back(out.array->name, out.array->n);
     auto& props = e.props.emplace_back();
     for (const Property* p : selected_properties(out)) props.emplace_back(p->name, p->stride);
+  }
+  return e;
+}
+
+XdmfEntry read_xdmf_entry_hdf5(const std::string& path, const std::string& h5_file) {
+  XdmfEntry e;
+  e.h5_file = h5_file;
+  e.t = read_meta_hdf5(path).t;
+  const H5File f(path);
+  Hid file = open_file(f);
+  for (const std::string& array : list_arrays_hdf5(path)) {
+    const std::string where = "/" + array;
+    Hid group = f.own(H5Gopen2(file.get(), array.c_str(), H5P_DEFAULT), H5Gclose, where,
+                      "cannot open group");
+    const std::vector<double> n = read_double_attribute(f, group.get(), where, "n");
+    if (n.size() != 1 || n[0] < 0) f.fail(where + "@n", "particle count is not a count");
+    e.arrays.emplace_back(array, static_cast<std::size_t>(n[0]));
+    auto& props = e.props.emplace_back();
+    for (const std::string& name : child_names(f, group.get(), where, H5O_TYPE_DATASET)) {
+      const std::string at = child_path(where, name);
+      Hid dset = f.own(H5Dopen2(group.get(), name.c_str(), H5P_DEFAULT), H5Dclose, at,
+                       "cannot open dataset");
+      Hid space = f.own(H5Dget_space(dset.get()), H5Sclose, at, "cannot read dataset shape");
+      hsize_t dims[2] = {0, 1};
+      if (H5Sget_simple_extent_dims(space.get(), dims, nullptr) < 0)
+        f.fail(at, "cannot read dataset shape");
+      props.emplace_back(name, static_cast<int>(dims[1]));
+    }
   }
   return e;
 }

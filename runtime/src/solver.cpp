@@ -21,6 +21,7 @@
 
 #include "sphc/hdf5_io.h"
 #include "sphc/memory.h"
+#include "sphc/restart.h"
 
 namespace sphc {
 namespace {
@@ -70,6 +71,8 @@ struct Options {
   std::vector<std::string> limit_settings;  // --limit ARRAY.QUANTITY.warn|stop=LO:HI
   std::vector<std::pair<std::string, double>> sets;
   std::string metrics_file;  // --metrics FILE (default: DIR/<scene>_metrics.csv)
+  std::string restart;       // --restart FILE: continue the run from this output file
+  bool restartable = false;  // --restartable: outputs carry every property (restart.h)
 };
 
 double parse_number(const std::string& text, const std::string& what) {
@@ -202,6 +205,13 @@ Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
                          v + "'");
     }
     else if (option == "--estimate-memory") flag(o.estimate_memory);
+    else if (option == "--restartable") flag(o.restartable);
+    else if (option == "--restart") {
+      o.restart = value();
+      if (o.restart.empty()) throw UsageError("--restart expects an output file");
+      if (!prog.restore)
+        throw UsageError("--restart: this solver was built without restart support");
+    }
     else if (option == "--limits") {
       o.limits = value();
       if (o.limits != "on" && o.limits != "warn" && o.limits != "off")
@@ -270,6 +280,12 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        array A (an end may be empty: unbounded; =off removes it)\n"
       "  --quiet               no progress line and no summary\n"
       "  --no-output           write no snapshots (benchmarks)\n"
+      "  --restartable         write every property of every array into each output, so\n"
+      "                        that a run can restart from it (--restart)\n"
+      "  --restart FILE        continue the run from the output FILE (written with\n"
+      "                        --restartable): its particles, time, step and run state;\n"
+      "                        outputs follow from the next output time on; --max-steps\n"
+      "                        counts the steps of the whole run\n"
       "  --metrics FILE        write the scene's metrics (metrics {{ }}) to FILE, also with\n"
       "                        --no-output (default: DIR/{1}_metrics.csv)\n"
       "  --timing              print at the end, for the time loop:\n"
@@ -388,6 +404,27 @@ class OutputWriter {
 
   bool enabled() const { return enabled_; }
   const std::string& newest() const { return newest_; }
+  // --restartable: every property of every array, whatever the scene's output selection.
+  void write_all_properties() { all_properties_ = true; }
+  // A restarted run: its index starts with the files of the run up to the restart step
+  // (SCENE_NNNNNN.h5 in the output directory, NNNNNN <= step), where they are there.
+  void continue_series(long step) {
+    if (!enabled_ || prog_.rank > 0 || !std::filesystem::is_directory(dir_)) return;
+    std::vector<std::pair<long, std::string>> files;
+    const std::string prefix = scene_ + "_";
+    for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+      const std::string name = entry.path().filename().string();
+      if (name.size() != prefix.size() + 9 || name.rfind(prefix, 0) != 0 ||
+          name.substr(name.size() - 3) != ".h5")
+        continue;
+      const std::string digits = name.substr(prefix.size(), 6);
+      if (digits.find_first_not_of("0123456789") != std::string::npos) continue;
+      const long k = std::stol(digits);
+      if (k <= step) files.emplace_back(k, name);
+    }
+    std::sort(files.begin(), files.end());
+    for (const auto& [k, name] : files) series_.push_back(read_xdmf_entry_hdf5(in_dir(name), name));
+  }
 
   void write(const std::vector<ParticleArray*>& arrays, const OutputMeta& meta) {
     if (!enabled_) return;
@@ -422,7 +459,7 @@ class OutputWriter {
 
   std::vector<OutputArray> selected(const std::vector<ParticleArray*>& arrays) const {
     std::vector<OutputArray> out;
-    if (prog_.output.empty()) {
+    if (prog_.output.empty() || all_properties_) {
       for (const ParticleArray* a : arrays) out.push_back(OutputArray{a, {}});
       return out;
     }
@@ -444,6 +481,7 @@ class OutputWriter {
   bool enabled_;
   std::vector<XdmfEntry> series_;
   std::string newest_;
+  bool all_properties_ = false;
 };
 
 // Requested times: the outputs (multiples of output_every, the output_at times) and tf.
@@ -606,18 +644,24 @@ class Simulation {
     OutputWriter writer(prog_, dir,
                         !opt_.no_output && (prog_.rank <= 0 || prog_.write_particles != nullptr));
     writer_ = &writer;
+    if (opt_.restartable) writer.write_all_properties();
+    if (!opt_.restart.empty()) writer.continue_series(read_meta_hdf5(opt_.restart).step);
     open_metrics(dir);
 
     const double tf = times.tf;
     const double slack = kTimeSlack * tf;
     OutputSchedule schedule(times, slack);
     dt_ = times.dt;
-    // As PySPH: the equations run once before the first output, so the t = 0 snapshot holds
-    // computed quantities (pressures, summation densities) and not zeros.
-    if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
-    if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
-    if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
-    write_output();
+    if (!opt_.restart.empty()) {
+      restart(schedule);  // the state at the end of the step that wrote the file
+    } else {
+      // As PySPH: the equations run once before the first output, so the t = 0 snapshot
+      // holds computed quantities (pressures, summation densities) and not zeros.
+      if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
+      if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
+      if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
+      write_output();
+    }
 
     const long check_every = prog_.to_host ? kCheckEveryDevice : kCheckEvery;
     const auto loop_start = Clock::now();
@@ -758,7 +802,35 @@ class Simulation {
     return n;
   }
 
-  OutputMeta meta() const { return OutputMeta{t_, step_, dt_, prog_.dim, scene_name(prog_)}; }
+  OutputMeta meta() const {
+    OutputMeta m{t_, step_, dt_, prog_.dim, scene_name(prog_), {}};
+    // The run state a restart needs (restart.h): the time loop's, then the scene's.
+    m.state = {{"landed_t", landed_t_}, {"landed_step", static_cast<double>(landed_step_)}};
+    if (prog_.run_state)
+      for (auto& kv : prog_.run_state()) m.state.push_back(std::move(kv));
+    return m;
+  }
+
+  // --restart FILE: the particles, constants, time, step and run state of the file (each rank
+  // of a distributed run reads its block), then the output times up to t marked as written,
+  // as the run that wrote the file had them after that step. No t = 0 evaluation, no output
+  // of the restart state (the file is it).
+  void restart(OutputSchedule& schedule) {
+    const std::size_t parts = static_cast<std::size_t>(std::max(prog_.ranks, 1));
+    const std::size_t part = static_cast<std::size_t>(std::max(prog_.rank, 0));
+    phase_ = "reading the restart file";
+    const OutputMeta m = read_restart(opt_.restart, arrays_, scene_name(prog_), prog_.dim, part,
+                                      parts);
+    t_ = m.t;
+    dt_ = m.dt;
+    step_ = m.step;
+    landed_t_ = state_value(m.state, "landed_t");
+    landed_step_ = static_cast<long>(state_value(m.state, "landed_step"));
+    prog_.restore(m.state);
+    phase_.clear();
+    schedule.due(t_, dt_);
+    last_output_step_ = step_;
+  }
 
   // t after a step: the requested time it landed on, exactly; else, with a fixed dt, the
   // last landing plus steps * dt (so rounding errors do not accumulate), with an adaptive dt
@@ -791,9 +863,29 @@ class Simulation {
     if (path.empty() && !opt_.no_output)
       path = (std::filesystem::path(dir) / (scene_name(prog_) + "_metrics.csv")).string();
     if (path.empty() || prog_.rank > 0) return;  // a distributed run: rank 0 writes it
+    // A restart continues the file: the rows up to the restart step are kept (a run that went
+    // on past it wrote rows the restarted run writes again).
+    std::vector<std::string> kept;
+    if (!opt_.restart.empty()) kept = metrics_rows_until(path, read_meta_hdf5(opt_.restart).step);
     metrics_csv_.open(path, std::ios::trunc);
     if (!metrics_csv_) throw std::runtime_error("cannot write the metrics to '" + path + "'");
-    metrics_csv_ << metrics_csv_header(prog_.metrics) << "\n" << std::flush;
+    metrics_csv_ << metrics_csv_header(prog_.metrics) << "\n";
+    for (const std::string& row : kept) metrics_csv_ << row << "\n";
+    metrics_csv_ << std::flush;
+  }
+
+  // The rows of an existing metrics CSV (of this scene's header) whose step is at most `step`.
+  std::vector<std::string> metrics_rows_until(const std::string& path, long step) const {
+    std::vector<std::string> rows;
+    std::ifstream in(path);
+    std::string line;
+    if (!in || !std::getline(in, line) || line != metrics_csv_header(prog_.metrics)) return rows;
+    while (std::getline(in, line)) {
+      char* end = nullptr;
+      const long row_step = std::strtol(line.c_str(), &end, 10);
+      if (end != line.c_str() && *end == ',' && row_step <= step) rows.push_back(line);
+    }
+    return rows;
   }
 
   void record_metrics() {

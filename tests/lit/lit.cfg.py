@@ -53,25 +53,31 @@ config.substitutions.append(('%h5consts', 'python3 ' + os.path.join(
     config.sphc_src_root, 'tests', 'lit', 'Inputs', 'h5consts.py')))
 import subprocess as _sp
 
-
-def _python_feature(feature, imports):
-    """Adds the feature FEATURE and the substitution %FEATURE_python (the first of python3,
-    /usr/bin/python3 that can `import IMPORTS`) where there is one."""
+# The first Python here that imports `modules` (python3 on PATH, then /usr/bin/python3), or None.
+def _python_with(modules):
     for py in ('python3', '/usr/bin/python3'):
         try:
-            if _sp.run([py, '-c', 'import ' + imports], stdout=_sp.DEVNULL,
+            if _sp.run([py, '-c', 'import ' + modules], stdout=_sp.DEVNULL,
                        stderr=_sp.DEVNULL).returncode == 0:
-                config.available_features.add(feature)
-                config.substitutions.append(('%' + feature + '_python', py))
-                return
+                return py
         except OSError:
             pass
-
+    return None
 
 # `REQUIRES: pysph`: a Python here imports PySPH (Debian python3-pysph), for the tests of
 # `sphc study --pysph` and the live PySPH comparisons; %pysph_python is that Python.
-_python_feature('pysph', 'pysph')
-# `REQUIRES: h5py`: a Python here imports numpy and h5py (Debian python3-numpy, python3-h5py,
-# installed by scripts/setup-deps.sh), for checks that read snapshots with them (the PySPH
-# comparisons in tests/lit/ported); %h5py_python is that Python.
-_python_feature('h5py', 'numpy, h5py')
+_py = _python_with('pysph')
+if _py:
+    config.available_features.add('pysph')
+    config.substitutions.append(('%pysph_python', _py))
+# `REQUIRES: h5py`: a Python here imports h5py and numpy (Debian python3-h5py, installed by
+# scripts/setup-deps.sh; the PySPH comparisons in tests/lit/ported read snapshots with it);
+# %h5py_python is that Python, and
+# %restart_bitwise UNINTERRUPTED_DIR RESTARTED_DIR checks that every file of a restarted run is
+# bitwise the uninterrupted run's (tests/lit/Inputs/restart_bitwise.py).
+_py = _python_with('h5py, numpy')
+if _py:
+    config.available_features.add('h5py')
+    config.substitutions.append(('%h5py_python', _py))
+    config.substitutions.append(('%restart_bitwise', _py + ' ' + os.path.join(
+        config.sphc_src_root, 'tests', 'lit', 'Inputs', 'restart_bitwise.py')))

@@ -4,6 +4,8 @@
 #include "sphc/memory.h"
 
 #include <gtest/gtest.h>
+
+#include "scratch_dir.h"
 #include <hdf5.h>
 
 #include <algorithm>
@@ -21,14 +23,7 @@ using namespace sphc;
 
 namespace {
 
-// A fresh directory named after the running test, under the working directory.
-fs::path fresh_dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir = fs::path("tmp_io") / (std::string(info->test_suite_name()) + "_" + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir() { return fresh_test_dir("tmp_io"); }
 
 ParticleArray sample_array() {
   ParticleArray a;

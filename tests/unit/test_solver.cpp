@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "scratch_dir.h"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -21,14 +23,7 @@ using namespace sphc;
 
 namespace {
 
-fs::path fresh_dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir =
-      fs::path("tmp_solver") / (std::string(info->test_suite_name()) + "_" + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path fresh_dir() { return fresh_test_dir("tmp_solver"); }
 
 // The scene "mover": params u (speed) and tf; dt = 0.01, output every 0.25.
 struct Mover {

@@ -2,7 +2,9 @@
 //
 // HDF5 layout (plain enough for h5py):
 //   /                   attributes t (double), step (int64), dt (double), dim (int32),
-//                       scene (UTF-8 string)
+//                       scene (UTF-8 string), and the run state a restart needs beyond the
+//                       particles (OutputMeta::state): one double attribute restart_NAME
+//                       each (sphc/solver.h, --restart; docs/design.md, "Restart")
 //   /<array>            one group per array, attribute n (int64, particle count)
 //   /<array>/<prop>     one dataset per property, native type (double / int32 / uint32),
 //                       shape (n,) for stride 1, else (n, stride)
@@ -38,15 +40,27 @@ struct OutputMeta {
   double dt = 0.0;
   int dim = 2;
   std::string scene;
+  // The run state beyond the particles (the time loop's and the scene's counters), written as
+  // root attributes restart_NAME (double; integers below 2^53 exactly); empty: none.
+  std::vector<std::pair<std::string, double>> state;
 };
+
+// The root attributes of an output file (read_meta_hdf5): OutputMeta's, with `state` holding
+// every numeric root attribute whose name starts with restart_ (the prefix removed).
+OutputMeta read_meta_hdf5(const std::string& path);
+// The prefix of the run-state attributes.
+inline constexpr const char* kRunStatePrefix = "restart_";
 
 // Writes `path + ".tmp"` and renames it to `path`, so `path` is never half written.
 void write_particles_hdf5(const std::string& path, const std::vector<OutputArray>& arrays,
                           const OutputMeta& meta);
 
 // Reads every property (type and stride preserved) and constant of group `array_name`. The
-// returned array is named `array_name`.
-ParticleArray read_particles_hdf5(const std::string& path, const std::string& array_name);
+// returned array is named `array_name`. With parts > 1, only the block of particles
+// [n part / parts, n (part + 1) / parts) is read (each rank of a distributed restart reads
+// one block of the file; the constants whole).
+ParticleArray read_particles_hdf5(const std::string& path, const std::string& array_name,
+                                  std::size_t part = 0, std::size_t parts = 1);
 
 // Names of the array groups in a file, in creation order (name order for files written by
 // other tools).
@@ -63,6 +77,10 @@ struct XdmfEntry {
 // The entry describing what write_particles_hdf5(…, arrays, …) writes into `h5_file`.
 XdmfEntry make_xdmf_entry(const std::string& h5_file, double t,
                           const std::vector<OutputArray>& arrays);
+
+// The entry of an existing output file `path` (named `h5_file` in the index): its t, arrays,
+// particle counts and datasets. A restarted run indexes the files before its restart so.
+XdmfEntry read_xdmf_entry_hdf5(const std::string& path, const std::string& h5_file);
 
 // Writes the XDMF index of a time series for ParaView (rewritten whole and atomically: tmp +
 // rename): a temporal collection of spatial collections, one Polyvertex grid per array with

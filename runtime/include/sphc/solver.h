@@ -179,6 +179,17 @@ struct SceneProgram {
   std::function<XdmfEntry(const std::string& path, const std::string& file,
                           const std::vector<OutputArray>& selection, const OutputMeta& meta)>
       write_particles;
+  // Restart (--restart FILE; docs/design.md, "Restart"). run_state: the scene's state beyond
+  // its particles and constants (completed steps, neighbour builds, global-id counters), as
+  // named numbers; every output file carries it (root attributes restart_NAME) with the
+  // time loop's. restore: after the run loop has replaced the particles and constants of
+  // `arrays` by the file's, sets that state again and moves the data where the scene
+  // computes on it (device, float copies; a distributed run re-balances). Empty restore: the
+  // solver cannot restart (--restart is refused).
+  std::function<std::vector<std::pair<std::string, double>>()> run_state;
+  std::function<void(const std::vector<std::pair<std::string, double>>& state)> restore;
+  // Distributed runs: the number of ranks (rank r of a restart reads block r of the file).
+  int ranks = 1;
   // The default box limits (sanity.h), when not those of `arrays` after the set-up
   // (distributed: the box of the whole set-up, taken before each rank kept its particles).
   std::function<std::vector<Limit>()> default_limits;

@@ -4,7 +4,11 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 #include "sphc/mpi/comm.h"
 #include "sphc/mpi/decomposition.h"
@@ -25,7 +29,15 @@ void gather_arrays(const std::vector<ParticleArray*>& arrays, std::vector<Partic
     std::vector<double> send;
     send.reserve(a.n * w);
     for (std::size_t i = 0; i < a.n; ++i) pack_particle(a, i, send);
-    const int mine = static_cast<int>(send.size());
+    // Counted in particles (an MPI type of w doubles): MPI's int counts and displacements
+    // then hold up to 2^31 - 1 particles per array in all; beyond, a clear error.
+    const std::size_t limit = static_cast<std::size_t>(std::numeric_limits<int>::max());
+    const long whole = sum(static_cast<long>(a.n));
+    if (static_cast<std::size_t>(whole) > limit)
+      throw std::runtime_error(fmt::format(
+          "gathered output of array '{}': {} particles, more than MPI's int counts hold ({}); "
+          "write collectively (parallel HDF5) instead", a.name, whole, limit));
+    const int mine = static_cast<int>(a.n);
     std::vector<int> counts(P), displ(P);
     MPI_Gather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD);
     int total = 0;
@@ -33,9 +45,13 @@ void gather_arrays(const std::vector<ParticleArray*>& arrays, std::vector<Partic
       displ[r] = total;
       total += counts[r];
     }
-    std::vector<double> recv(me == 0 ? static_cast<std::size_t>(total) : 0);
-    MPI_Gatherv(send.data(), mine, MPI_DOUBLE, recv.data(), counts.data(), displ.data(),
-                MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    std::vector<double> recv(me == 0 ? static_cast<std::size_t>(total) * w : 0);
+    MPI_Datatype particle;
+    MPI_Type_contiguous(static_cast<int>(std::max<std::size_t>(w, 1)), MPI_DOUBLE, &particle);
+    MPI_Type_commit(&particle);
+    MPI_Gatherv(send.data(), mine, particle, recv.data(), counts.data(), displ.data(), particle, 0,
+                MPI_COMM_WORLD);
+    MPI_Type_free(&particle);
     if (me != 0) {
       o.resize(0);
       continue;

@@ -22,6 +22,8 @@
 
 #ifdef SPHC_PARALLEL_HDF5
 #include <hdf5.h>
+
+#include "../hdf5_types.h"  // native_type
 #endif
 
 namespace sphc::mpi {
@@ -30,6 +32,15 @@ namespace sphc::mpi {
 namespace {
 
 constexpr const char* kPositions[] = {"x", "y", "z"};
+
+// A count or displacement for MPI (an int), or a clear error where it does not fit.
+int checked_count(std::size_t count, const std::string& what) {
+  if (count > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw std::runtime_error(fmt::format(
+        "{}: {} particles to exchange between two ranks, more than MPI's int counts hold "
+        "({}); run on more ranks", what, count, std::numeric_limits<int>::max()));
+  return static_cast<int>(count);
+}
 
 // One dataset of an array's group: a property, or zeros for a position the scene has not.
 struct Column {
@@ -74,15 +85,6 @@ double value_at(const Property& p, std::size_t k) {
     case PropType::U32: return static_cast<double>(p.u32[k]);
   }
   return 0.0;
-}
-
-hid_t native_type(PropType t) {
-  switch (t) {
-    case PropType::F64: return H5T_NATIVE_DOUBLE;
-    case PropType::I32: return H5T_NATIVE_INT32;
-    case PropType::U32: return H5T_NATIVE_UINT32;
-  }
-  return H5T_NATIVE_DOUBLE;
 }
 
 // HDF5 identifiers closed at scope exit; failures throw naming the file and object (every
@@ -210,24 +212,34 @@ Slab slab_of(const ParticleArray& a, const std::vector<Column>& cols) {
     b.push_back(static_cast<double>(pos));
     pack(i, b);
   }
+  // Counted in particles (an MPI type of w doubles), not in doubles: MPI's int counts and
+  // displacements then hold up to 2^31 - 1 particles per rank and array (any number of
+  // values), and past that the output stops with a message instead of overflowing.
+  const std::size_t w = width + 1;
   std::vector<int> scount(P), rcount(P), sdisp(P), rdisp(P);
   std::vector<double> send;
+  const auto int_count = [&](std::size_t particles) {
+    return checked_count(particles, fmt::format("parallel output of array '{}'", a.name));
+  };
   for (int r = 0; r < P; ++r) {
-    sdisp[r] = static_cast<int>(send.size());
-    scount[r] = static_cast<int>(out[r].size());
+    sdisp[r] = int_count(send.size() / w);
+    scount[r] = int_count(out[r].size() / w);
     send.insert(send.end(), out[r].begin(), out[r].end());
   }
   MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, MPI_COMM_WORLD);
-  int total = 0;
+  std::size_t total = 0;
   for (int r = 0; r < P; ++r) {
-    rdisp[r] = total;
-    total += rcount[r];
+    rdisp[r] = int_count(total);
+    total += static_cast<std::size_t>(rcount[r]);
   }
-  std::vector<double> recv(static_cast<std::size_t>(total));
-  MPI_Alltoallv(send.data(), scount.data(), sdisp.data(), MPI_DOUBLE, recv.data(), rcount.data(),
-                rdisp.data(), MPI_DOUBLE, MPI_COMM_WORLD);
+  std::vector<double> recv(total * w);
+  MPI_Datatype particle;
+  MPI_Type_contiguous(int_count(w), MPI_DOUBLE, &particle);
+  MPI_Type_commit(&particle);
+  MPI_Alltoallv(send.data(), scount.data(), sdisp.data(), particle, recv.data(), rcount.data(),
+                rdisp.data(), particle, MPI_COMM_WORLD);
+  MPI_Type_free(&particle);
   size_columns();
-  const std::size_t w = width + 1;
   if (recv.size() != s.count * w)
     throw std::runtime_error(fmt::format("parallel output of '{}': rank {} received {} particles "
                                          "for a block of {}", a.name, me, recv.size() / w, s.count));
@@ -309,6 +321,11 @@ XdmfEntry write_particles_parallel(const std::string& path, const std::string& f
     f.check(H5Tset_cset(str, H5T_CSET_UTF8), "string type");
     const char* scene = meta.scene.c_str();
     attribute(f, h5, "scene", str, &scene, 1, true);
+    for (const auto& [name, value] : meta.state) {  // the run state (--restart), rank 0's
+      double v = value;
+      MPI_Bcast(&v, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+      attribute(f, h5, (kRunStatePrefix + name).c_str(), H5T_NATIVE_DOUBLE, &v, 1, true);
+    }
     for (std::size_t k = 0; k < arrays.size(); ++k) {
       const ParticleArray& a = *arrays[k].array;
       const std::vector<Column> cols = columns_of(arrays[k]);
