@@ -202,7 +202,7 @@ def main():
             print("%s: counting flops under callgrind (%d and %d steps) ..." % (scene, s1, s2),
                   flush=True)
             run([args.sphc, src, "-o", exe, "--cxxflags",
-                 "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -no-pie"] + SCENES[scene][1],
+                 "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -no-pie"] + SCENES[scene][1],
                 env)
             table = disassemble(exe)
             funcs = {}

@@ -295,10 +295,17 @@ void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const 
 // The pair quantities of one candidate, from the table (analysis/PairQuantityTable): those
 // before the neighbour test (XIJ, R2IJ), the test, then every-neighbour and used ones.
 void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::string>& q,
-                                      const Dialect& dl) {
+                                      const Dialect& dl, bool test) {
   const std::string indent = "            ";
-  emitNeighbourTest(os, dl, dl.skipCandidate, indent);
   const PairDialect dialect = pairDialectOf(dl);
+  if (test) {
+    emitNeighbourTest(os, dl, dl.skipCandidate, indent);
+  } else {  // a neighbour: what the test computes, without the test
+    os << indent << "const " << dl.real << " hj = sj_h[s_idx];\n";
+    for (const PairQuantity& pq : pairQuantityTable())
+      if (pq.when == PairWhen::BeforeTest)
+        os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
+  }
   for (const PairQuantity& pq : pairQuantityTable())
     if (pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name)))
       os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
@@ -306,8 +313,8 @@ void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::stri
 
 void ScenePrinter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
                                  const std::vector<const PlanEquation*>& loopers, int d,
-                                 const Dialect& dl) {
-  emitPairQuantities(os, q, dl);
+                                 const Dialect& dl, bool test) {
+  emitPairQuantities(os, q, dl, test);
   for (const auto* eq : loopers)
     os << "            "
        << callBody(bodyFunctionName(eq->name, "loop"), methodBody(*eq, ast::Method::Loop), d,

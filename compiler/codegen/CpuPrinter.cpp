@@ -31,11 +31,9 @@ class CpuPrinter : public ScenePrinter {
   void extraMembers() override {
     if (openmp_)
       out_ << "  std::vector<" << real_ << "> reduce_scratch;  // reduce sum/mean, OpenMP\n";
-    bool loopAll = false;
-    for (const auto& eq : plan_.equations)
-      loopAll |= eq.live && plan_.equationDecls[eq.declIndex].methods.count(ast::Method::LoopAll);
-    if (loopAll)
-      out_ << "  std::vector<std::vector<std::uint32_t>> nbrs_lists;  // loop_all, per thread\n";
+    // The neighbour list of the destination particle in hand (pair loops, loop_all), one per
+    // thread, reused from particle to particle (CellList::gather_neighbours).
+    out_ << "  std::vector<std::vector<std::uint32_t>> nbrs_lists;\n";
   }
   bool timesNeighbourSearch() const override { return true; }
   void dataMovement() override;
@@ -185,9 +183,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       continue;
     }
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
-    if (!pass.loopAll.empty())
-      scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
-             << (openmp_ ? "omp_get_max_threads()" : "1") << "));\n";
+    scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
+           << (openmp_ ? "omp_get_max_threads()" : "1") << "));\n";
     // Each thread works on its own copies of the array pointers and scalars
     // (default(firstprivate)): shared, the outlined loop reads them through the
     // captured frame at every neighbour, ~4% slower than the serial build (dam break,
@@ -196,20 +193,19 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
            << "; ++d_idx) {\n";
     emitDestLocals(scene_, "          ", q, host_);
+    // The neighbour list first (in candidate order; CellList::gather_neighbours), then every
+    // loop_all with it, then the loops over the same neighbours.
+    scene_ << "          std::vector<std::uint32_t>& nbrs_list = nbrs_lists["
+           << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
+    scene_ << "          const int n_nbrs = static_cast<int>(cells.gather_neighbours(xi, yi, zi, "
+              "nbrs_list, [&](std::uint32_t j) {\n";
+    scene_ << "            const int s_idx = static_cast<int>(j);\n";
+    emitNeighbourTest(scene_, host_, "return false;", "            ");
+    scene_ << "            return true;\n          }));\n";
+    scene_ << "          const std::uint32_t* NBRS = nbrs_list.data();\n";
     if (!pass.loopAll.empty()) {
-      // PySPH's loop_all: the neighbour list first (in candidate order), every loop_all
-      // with it, then the loops over the same neighbours.
-      // loop_all's neighbour list: one per thread, reused from particle to particle.
-      scene_ << "          std::vector<std::uint32_t>& nbrs_list = nbrs_lists["
-             << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
-      scene_ << "          nbrs_list.clear();\n";
-      scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
-      scene_ << "            const int s_idx = static_cast<int>(j);\n";
-      emitNeighbourTest(scene_, host_, "return;", "            ");
-      scene_ << "            nbrs_list.push_back(j);\n          });\n";
       scene_ << "          {\n";
-      scene_ << "            const std::uint32_t* NBRS = nbrs_list.data();\n";
-      scene_ << "            const int N_NBRS = static_cast<int>(nbrs_list.size());\n";
+      scene_ << "            const int N_NBRS = n_nbrs;\n";
       for (const auto* eq : pass.loopAll)
         scene_ << "            "
                << callBody(bodyFunctionName(eq->name, "loop_all"),
@@ -218,10 +214,10 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          }\n";
     }
     if (!pass.equations.empty()) {
-      scene_ << "          cells.for_each_candidate(xi, yi, zi, [&](std::uint32_t j) {\n";
-      scene_ << "            const int s_idx = static_cast<int>(j);\n";
-      emitCandidate(scene_, q, pass.equations, d, host_);
-      scene_ << "          });\n";
+      scene_ << "          for (int k_nbr = 0; k_nbr < n_nbrs; ++k_nbr) {\n";
+      scene_ << "            const int s_idx = static_cast<int>(NBRS[k_nbr]);\n";
+      emitCandidate(scene_, q, pass.equations, d, host_, /*test=*/false);
+      scene_ << "          }\n";
     }
     scene_ << "        }\n      }\n";
   }

@@ -128,15 +128,18 @@ class ScenePrinter {
                       const std::set<std::string>& q, const Dialect& d) const;
   // The body of the neighbour loop for one candidate s_idx: the pair quantities and the
   // neighbour criterion (emitPairQuantities), then every loop body. Shared by the C++ loop
-  // and the OpenCL kernel.
+  // and the OpenCL kernel. test = false: for a neighbour already tested (the CPU loops over a
+  // gathered neighbour list), the quantities without the cut-off test.
   void emitCandidate(std::ostream& os, const std::set<std::string>& q,
-                     const std::vector<const PlanEquation*>& loopers, int d, const Dialect& dl);
+                     const std::vector<const PlanEquation*>& loopers, int d, const Dialect& dl,
+                     bool test = true);
   // loop_all: the neighbour test of one candidate s_idx (hj, XIJ, R2IJ and the cut-off,
   // leaving with `skip`), before it joins the neighbour list.
   void emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
                          const std::string& indent);
   // The pair quantities of one candidate (XIJ, R2IJ, the cut-off test, HIJ, RIJ, ...).
-  void emitPairQuantities(std::ostream& os, const std::set<std::string>& q, const Dialect& dl);
+  void emitPairQuantities(std::ostream& os, const std::set<std::string>& q, const Dialect& dl,
+                          bool test = true);
   void emitLineDirective(std::ostringstream& os, llvm::SMLoc l) const;
   void resetLineDirective(std::ostringstream& os, const Dialect& d) const;
   // A property's type in a dialect (constants and floating properties: its real).

@@ -392,7 +392,11 @@ void Context::init(const Selection& sel, bool double_precision, const std::strin
   queue_ = clCreateCommandQueue(context_, pick->did, 0, &err);
   check(err, "clCreateCommandQueue");
 
-  std::string source = std::string(dp_ ? "#pragma OPENCL EXTENSION cl_khr_fp64 : enable\n"
+  // No FMA contraction on the device either (the host solvers are built with
+  // -ffp-contract=off): + - * / and sqrt then round as on the host, so a pair at exactly the
+  // cut-off is decided alike on both (docs/performance.md, "Rounding").
+  std::string source = std::string("#pragma OPENCL FP_CONTRACT OFF\n") +
+                       std::string(dp_ ? "#pragma OPENCL EXTENSION cl_khr_fp64 : enable\n"
                                          "typedef double real;\n"
                                        // Single: the bodies' `double` locals are float too.
                                        : "typedef float real;\n#define double float\n") +

@@ -133,6 +133,59 @@ TEST_P(NnpsModes, ParticlesMovedOutsideTheDomain) {
   }
 }
 
+// gather_neighbours (what the generated pair loops use) keeps exactly the candidates its test
+// accepts, in candidate order (the order every sum over neighbours follows), for any test and
+// any number of candidates: a pile of particles in one cell makes the list grow mid-query.
+TEST_P(NnpsModes, GatherNeighboursIsTheFilteredCandidateOrder) {
+  for (int dim : {1, 2, 3}) {
+    SCOPED_TRACE("dim " + std::to_string(dim));
+    ParticleArray pa = random_array(dim == 1 ? 300 : 1500, dim, 5.0, dim == 1 ? 0.05 : 0.25,
+                                    11 + dim);
+    double* x = pa.f64("x");
+    double* y = pa.f64("y");
+    double* z = pa.f64("z");
+    for (std::size_t i = 1; i < pa.n; i += 5) {  // a fifth of the particles in one cell
+      x[i] = 2.5 + 1e-4 * static_cast<double>(i % 7);
+      y[i] = dim >= 2 ? 2.5 : 0.0;
+      z[i] = dim == 3 ? 2.5 : 0.0;
+    }
+    const double* h = pa.f64("h");
+    CellList cl;
+    cl.set_mode(GetParam());
+    build(cl, domain_of(pa, dim), pa);
+    std::vector<std::uint32_t> list;  // starts empty: grows as needed
+    std::size_t pairs = 0, grown_at_least_to = 0;
+    for (std::size_t i = 0; i < pa.n; ++i) {
+      auto is_nbr = [&](std::uint32_t j) {
+        const double dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+        const double rmax = kRadiusScale * std::max(h[i], h[j]);
+        return dx * dx + dy * dy + dz * dz < rmax * rmax;
+      };
+      std::vector<std::uint32_t> want, candidates;
+      cl.for_each_candidate(x[i], y[i], z[i], [&](std::uint32_t j) {
+        candidates.push_back(j);
+        if (is_nbr(j)) want.push_back(j);
+      });
+      const std::size_t count = cl.gather_neighbours(x[i], y[i], z[i], list, is_nbr);
+      ASSERT_EQ(count, want.size()) << "particle " << i;
+      ASSERT_GE(list.size(), count);
+      EXPECT_TRUE(std::equal(want.begin(), want.end(), list.begin())) << "particle " << i;
+      // Every candidate accepted: the candidate order itself.
+      const std::size_t all =
+          cl.gather_neighbours(x[i], y[i], z[i], list, [](std::uint32_t) { return true; });
+      ASSERT_EQ(all, candidates.size());
+      EXPECT_TRUE(std::equal(candidates.begin(), candidates.end(), list.begin()));
+      EXPECT_EQ(cl.gather_neighbours(x[i], y[i], z[i], list, [](std::uint32_t) { return false; }),
+                0u);
+      pairs += count;
+      grown_at_least_to = std::max(grown_at_least_to, candidates.size());
+    }
+    EXPECT_GT(pairs, 2 * pa.n);           // more than self-pairs
+    EXPECT_GE(grown_at_least_to, pa.n / 5);  // the pile was a query's candidates
+    EXPECT_GE(list.size(), grown_at_least_to);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(AllModes, NnpsModes,
                          ::testing::Values(CellList::Mode::Auto, CellList::Mode::Dense,
                                            CellList::Mode::Hash),

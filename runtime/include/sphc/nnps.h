@@ -91,6 +91,17 @@ class CellList {
   template <class F>
   inline void for_each_candidate(double xi, double yi, double zi, F&& f) const;
 
+  // The neighbour list of a point: writes to out[0..count) the candidates j (in the order of
+  // for_each_candidate) for which keep(j) is true, and returns count. out grows as needed
+  // (never shrinks: one vector per thread, reused from particle to particle; its size is not
+  // the count). The generated pair loops filter first, with a keep() that only computes the
+  // distance (small, inlined, branch-free: every candidate is written, the count advances
+  // only for neighbours), then run the equations over out[0..count) in a plain loop: no
+  // unpredictable branch or call per candidate, a third of which are neighbours in 2D.
+  template <class Keep>
+  inline std::size_t gather_neighbours(double xi, double yi, double zi,
+                                       std::vector<std::uint32_t>& out, Keep&& keep) const;
+
   std::size_t size() const { return n_; }
 
   // Convenience for tests and tools, not for the hot loop: out = the indices j (in candidate
@@ -225,6 +236,48 @@ inline void CellList::for_each_candidate(double xi, double yi, double zi, F&& f)
       }
     }
   }
+}
+
+template <class Keep>
+inline std::size_t CellList::gather_neighbours(double xi, double yi, double zi,
+                                               std::vector<std::uint32_t>& out,
+                                               Keep&& keep) const {
+  int c[3];
+  cell_coords(xi, yi, zi, c);
+  int lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = c[a] > 0 ? c[a] - 1 : 0;
+    hi[a] = c[a] + 1 < ncell_[a] ? c[a] + 1 : c[a];
+  }
+  const std::uint32_t* order = order_.data();
+  const std::uint32_t* start = start_.data();
+  std::size_t count = 0;
+  auto range = [&](std::uint32_t k0, std::uint32_t k1) {
+    if (out.size() < count + (k1 - k0)) out.resize(2 * (count + (k1 - k0)) + 64);
+    std::uint32_t* o = out.data();
+    for (std::uint32_t k = k0; k < k1; ++k) {
+      const std::uint32_t j = order[k];
+      o[count] = j;
+      count += keep(j) ? 1 : 0;
+    }
+  };
+  if (dense_) {
+    for (int cz = lo[2]; cz <= hi[2]; ++cz)
+      for (int cy = lo[1]; cy <= hi[1]; ++cy) {
+        const std::size_t row =
+            (static_cast<std::size_t>(cz) * ncell_[1] + static_cast<std::size_t>(cy)) *
+            ncell_[0];
+        range(start[row + lo[0]], start[row + hi[0] + 1]);
+      }
+  } else {
+    for (int cz = lo[2]; cz <= hi[2]; ++cz)
+      for (int cy = lo[1]; cy <= hi[1]; ++cy)
+        for (int cx = lo[0]; cx <= hi[0]; ++cx) {
+          const std::uint32_t cell = find_cell(pack(cx, cy, cz));
+          if (cell != kNoCell) range(start[cell], start[cell + 1]);
+        }
+  }
+  return count;
 }
 
 }  // namespace sphc
