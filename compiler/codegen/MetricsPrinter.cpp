@@ -6,6 +6,7 @@
 #include "codegen/Printer.h"
 
 #include <cstdio>
+#include <functional>
 
 namespace sphc {
 
@@ -39,6 +40,37 @@ std::string number(double v) {
 }  // namespace
 
 // Scene::metrics(t): one block per metric, a loop over the real particles of its array.
+// The loop over a metric's real particles, opened: pointers to the properties it reads, the
+// particle's values as locals q_NAME, its `where`. Returns the names of the loop body's scope
+// (coordinates the scene has not: 0). The caller writes the body and closes the loop.
+std::function<std::string(const std::string&)> ScenePrinter::emitMetricParticleLoop(
+    const PlanMetric& m) {
+  const int a = m.array;
+  const std::string A = arr(a).name;
+  std::vector<std::string> locals;
+  for (const auto& p : m.reads)
+    if (constIndex(a, p) < 0 && propIndex(a, p) >= 0) locals.push_back(p);
+  std::function<std::string(const std::string&)> particleNames =
+      [this, a, A, locals](const std::string& n) -> std::string {
+    if (n == "t") return "t";
+    if (constIndex(a, n) >= 0) return A + ".constant(" + std::to_string(constIndex(a, n)) + ")[0]";
+    for (const auto& l : locals)
+      if (l == n) return "q_" + n;
+    if (n == "x" || n == "y" || n == "z") return "0.0";
+    return paramRef(n);
+  };
+  for (const auto& p : locals)
+    scene_ << "      const auto* p_" << p << " = " << hostPtr(a, p) << ";\n";
+  scene_ << "      for (std::size_t i = 0; i < " << A << ".n; ++i) {  // real particles\n";
+  for (const auto& p : locals) {
+    const int stride = arr(a).props[propIndex(a, p)].stride;
+    scene_ << "        const double q_" << p << " = static_cast<double>(p_" << p << "[i"
+           << (stride > 1 ? " * " + std::to_string(stride) : std::string("")) << "]);\n";
+  }
+  if (m.where) scene_ << "        if (!(" << exprCpp(*m.where, particleNames) << ")) continue;\n";
+  return particleNames;
+}
+
 void ScenePrinter::emitMetrics() {
   if (plan_.metrics.empty()) return;
   scene_ << "  // metrics { }: evaluated on the host at every output (sphc/metrics.h)\n";
@@ -65,28 +97,7 @@ void ScenePrinter::emitMetrics() {
       continue;
     }
     scene_ << "      " << (m.isNorm() ? "sphc::NormSums" : "sphc::ScalarSums") << " acc;\n";
-    // The particle's values as locals q_NAME; coordinates the scene has not: 0.
-    std::vector<std::string> locals;
-    for (const auto& p : m.reads)
-      if (constIndex(a, p) < 0 && propIndex(a, p) >= 0) locals.push_back(p);
-    auto particleNames = [&](const std::string& n) -> std::string {
-      if (n == "t") return "t";
-      if (constIndex(a, n) >= 0) return A + ".constant(" + std::to_string(constIndex(a, n)) + ")[0]";
-      for (const auto& l : locals)
-        if (l == n) return "q_" + n;
-      if (n == "x" || n == "y" || n == "z") return "0.0";
-      return paramRef(n);
-    };
-    for (const auto& p : locals)
-      scene_ << "      const auto* p_" << p << " = " << hostPtr(a, p) << ";\n";
-    scene_ << "      for (std::size_t i = 0; i < " << A << ".n; ++i) {  // real particles\n";
-    for (const auto& p : locals) {
-      const int stride = arr(a).props[propIndex(a, p)].stride;
-      scene_ << "        const double q_" << p << " = static_cast<double>(p_" << p << "[i"
-             << (stride > 1 ? " * " + std::to_string(stride) : std::string("")) << "]);\n";
-    }
-    if (m.where)
-      scene_ << "        if (!(" << exprCpp(*m.where, particleNames) << ")) continue;\n";
+    const auto particleNames = emitMetricParticleLoop(m);
     const std::string value = exprCpp(*m.expr, particleNames);
     if (m.isNorm())
       scene_ << "        sphc::add(acc, " << value << ", " << exprCpp(*m.exact, particleNames)
@@ -140,27 +151,7 @@ void ScenePrinter::emitProfile(const PlanMetric& m, size_t k) {
     scene_ << ", " << (m.point[d] ? "static_cast<double>(" + exprCpp(*m.point[d], rowNames) + ")"
                                   : std::string("0.0"));
   scene_ << ");\n      }\n";
-  std::vector<std::string> locals;
-  for (const auto& p : m.reads)
-    if (constIndex(a, p) < 0 && propIndex(a, p) >= 0) locals.push_back(p);
-  auto particleNames = [&](const std::string& n) -> std::string {
-    if (n == "t") return "t";
-    if (constIndex(a, n) >= 0) return A + ".constant(" + std::to_string(constIndex(a, n)) + ")[0]";
-    for (const auto& l : locals)
-      if (l == n) return "q_" + n;
-    if (n == "x" || n == "y" || n == "z") return "0.0";
-    return paramRef(n);
-  };
-  for (const auto& p : locals)
-    scene_ << "      const auto* p_" << p << " = " << hostPtr(a, p) << ";\n";
-  scene_ << "      for (std::size_t i = 0; i < " << A << ".n; ++i) {  // real particles\n";
-  for (const auto& p : locals) {
-    const int stride = arr(a).props[propIndex(a, p)].stride;
-    scene_ << "        const double q_" << p << " = static_cast<double>(p_" << p << "[i"
-           << (stride > 1 ? " * " + std::to_string(stride) : std::string("")) << "]);\n";
-  }
-  if (m.where)
-    scene_ << "        if (!(" << exprCpp(*m.where, particleNames) << ")) continue;\n";
+  const auto particleNames = emitMetricParticleLoop(m);
   scene_ << "        sphc::add(fit, " << particleNames("x") << ", " << particleNames("y") << ", "
          << particleNames("z") << ", " << exprCpp(*m.expr, particleNames) << ");\n";
   scene_ << "      }\n";

@@ -186,6 +186,8 @@ class ScenePrinter {
   void emitMetrics();
   void emitMetricsMain();
   void emitProfile(const PlanMetric& m, size_t k);  // a profile metric (MetricsPrinter.cpp)
+  // Opens the loop over a metric's particles; the names in its scope (MetricsPrinter.cpp).
+  std::function<std::string(const std::string&)> emitMetricParticleLoop(const PlanMetric& m);
 
   // ---- Inlets and outlets (InletOutletPrinter.cpp) ----
   bool hasZones() const { return !plan_.zones.empty(); }
