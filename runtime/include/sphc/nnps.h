@@ -90,6 +90,10 @@ class CellList {
   // ascending j. Valid (calls nothing) before the first build.
   template <class F>
   inline void for_each_candidate(double xi, double yi, double zi, F&& f) const;
+  // The same candidates as ranges [k0, k1) of the cell order: range(k0, k1) per stencil row
+  // (dense) or cell (hashed); both traversals are built on it.
+  template <class R>
+  inline void for_each_candidate_range(double xi, double yi, double zi, R&& range) const;
 
   // The neighbour list of a point: writes to out[0..count) the candidates j (in the order of
   // for_each_candidate) for which keep(j) is true, and returns count. out grows as needed
@@ -201,8 +205,10 @@ class CellList {
   int hash_shift_ = 64;
 };
 
-template <class F>
-inline void CellList::for_each_candidate(double xi, double yi, double zi, F&& f) const {
+// The candidates' stencil (the particle's cell and its neighbours, clipped to the grid) as
+// ranges [k0, k1) of order_, in the order both traversals below visit them.
+template <class R>
+inline void CellList::for_each_candidate_range(double xi, double yi, double zi, R&& range) const {
   int c[3];
   cell_coords(xi, yi, zi, c);
   // Stencil bounds, clipped to the grid (axes beyond dim have one cell, so they give 0..0).
@@ -211,7 +217,6 @@ inline void CellList::for_each_candidate(double xi, double yi, double zi, F&& f)
     lo[a] = c[a] > 0 ? c[a] - 1 : 0;
     hi[a] = c[a] + 1 < ncell_[a] ? c[a] + 1 : c[a];
   }
-  const std::uint32_t* order = order_.data();
   const std::uint32_t* start = start_.data();
   if (dense_) {
     for (int cz = lo[2]; cz <= hi[2]; ++cz) {
@@ -220,8 +225,7 @@ inline void CellList::for_each_candidate(double xi, double yi, double zi, F&& f)
         const std::size_t row =
             (static_cast<std::size_t>(cz) * ncell_[1] + static_cast<std::size_t>(cy)) *
             ncell_[0];
-        const std::uint32_t end = start[row + hi[0] + 1];
-        for (std::uint32_t k = start[row + lo[0]]; k < end; ++k) f(order[k]);
+        range(start[row + lo[0]], start[row + hi[0] + 1]);
       }
     }
   } else {
@@ -229,30 +233,28 @@ inline void CellList::for_each_candidate(double xi, double yi, double zi, F&& f)
       for (int cy = lo[1]; cy <= hi[1]; ++cy) {
         for (int cx = lo[0]; cx <= hi[0]; ++cx) {
           const std::uint32_t cell = find_cell(pack(cx, cy, cz));
-          if (cell == kNoCell) continue;
-          const std::uint32_t end = start[cell + 1];
-          for (std::uint32_t k = start[cell]; k < end; ++k) f(order[k]);
+          if (cell != kNoCell) range(start[cell], start[cell + 1]);
         }
       }
     }
   }
 }
 
+template <class F>
+inline void CellList::for_each_candidate(double xi, double yi, double zi, F&& f) const {
+  const std::uint32_t* order = order_.data();
+  for_each_candidate_range(xi, yi, zi, [&](std::uint32_t k0, std::uint32_t k1) {
+    for (std::uint32_t k = k0; k < k1; ++k) f(order[k]);
+  });
+}
+
 template <class Keep>
 inline std::size_t CellList::gather_neighbours(double xi, double yi, double zi,
                                                std::vector<std::uint32_t>& out,
                                                Keep&& keep) const {
-  int c[3];
-  cell_coords(xi, yi, zi, c);
-  int lo[3], hi[3];
-  for (int a = 0; a < 3; ++a) {
-    lo[a] = c[a] > 0 ? c[a] - 1 : 0;
-    hi[a] = c[a] + 1 < ncell_[a] ? c[a] + 1 : c[a];
-  }
   const std::uint32_t* order = order_.data();
-  const std::uint32_t* start = start_.data();
   std::size_t count = 0;
-  auto range = [&](std::uint32_t k0, std::uint32_t k1) {
+  for_each_candidate_range(xi, yi, zi, [&](std::uint32_t k0, std::uint32_t k1) {
     if (out.size() < count + (k1 - k0)) out.resize(2 * (count + (k1 - k0)) + 64);
     std::uint32_t* o = out.data();
     for (std::uint32_t k = k0; k < k1; ++k) {
@@ -260,23 +262,7 @@ inline std::size_t CellList::gather_neighbours(double xi, double yi, double zi,
       o[count] = j;
       count += keep(j) ? 1 : 0;
     }
-  };
-  if (dense_) {
-    for (int cz = lo[2]; cz <= hi[2]; ++cz)
-      for (int cy = lo[1]; cy <= hi[1]; ++cy) {
-        const std::size_t row =
-            (static_cast<std::size_t>(cz) * ncell_[1] + static_cast<std::size_t>(cy)) *
-            ncell_[0];
-        range(start[row + lo[0]], start[row + hi[0] + 1]);
-      }
-  } else {
-    for (int cz = lo[2]; cz <= hi[2]; ++cz)
-      for (int cy = lo[1]; cy <= hi[1]; ++cy)
-        for (int cx = lo[0]; cx <= hi[0]; ++cx) {
-          const std::uint32_t cell = find_cell(pack(cx, cy, cz));
-          if (cell != kNoCell) range(start[cell], start[cell + 1]);
-        }
-  }
+  });
   return count;
 }
 
