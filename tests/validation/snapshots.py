@@ -168,3 +168,41 @@ def finish(args, draw, failures, limit=20, **plot_options):
         return 1
     print("OK")
     return 0
+
+
+def pysph_comparison(description, load_run, read_reference, write_reference, extra=()):
+    """The command line shared by the checks against a PySPH run (SPHC_OUT with --reference
+    FILE or --pysph-dir DIR; --write-reference FILE --pysph-dir DIR stores PySPH's run), and
+    the checks every such comparison starts with: the same number of snapshots and the same
+    initial particles (the run's and the reference's "ij" lattice indices). Returns
+    (args, run, ref) to compare, or (args, None, exit code) when done or failed. EXTRA: more
+    (flag, help) options."""
+    ap = argparse.ArgumentParser(description=description)
+    ap.add_argument("sphc_out", nargs="?")
+    ap.add_argument("--reference")
+    ap.add_argument("--pysph-dir")
+    ap.add_argument("--write-reference")
+    ap.add_argument("--tol", type=float, default=1e-9)
+    for flag, text in extra:
+        ap.add_argument(flag, help=text)
+    a = ap.parse_args()
+    if a.write_reference:
+        if not a.pysph_dir:
+            ap.error("--write-reference needs --pysph-dir")
+        write_reference(load_run(a.pysph_dir), a.write_reference)
+        print("wrote %s" % a.write_reference)
+        return a, None, 0
+    if not a.sphc_out or bool(a.reference) == bool(a.pysph_dir):
+        ap.error("give SPHC_OUT and one of --reference, --pysph-dir")
+    run = load_run(a.sphc_out)
+    ref = read_reference(a.reference) if a.reference else load_run(a.pysph_dir)
+    failures = []
+    if len(run["t"]) != len(ref["t"]):
+        failures.append("%d snapshots, PySPH has %d" % (len(run["t"]), len(ref["t"])))
+    if run["ij"].shape != ref["ij"].shape or np.any(run["ij"] != ref["ij"]):
+        failures.append("the initial particles differ from PySPH's (%d, PySPH %d)"
+                        % (len(run["ij"]), len(ref["ij"])))
+    if failures:
+        report_failures(failures)
+        return a, None, 1
+    return a, run, ref

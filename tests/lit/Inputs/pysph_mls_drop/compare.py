@@ -29,7 +29,6 @@ usage:
   compare.py SPHC_OUT --pysph-dir PYSPH_OUT        # against a PySPH output directory
   compare.py --pysph-dir PYSPH_OUT --write-reference REF.npz   (make_reference.sh)
 """
-import argparse
 import os
 import sys
 
@@ -94,33 +93,11 @@ def read_reference(path):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("sphc_out", nargs="?")
-    ap.add_argument("--reference")
-    ap.add_argument("--pysph-dir")
-    ap.add_argument("--write-reference")
-    ap.add_argument("--tol", type=float, default=1e-9)
-    a = ap.parse_args()
-    if a.write_reference:
-        if not a.pysph_dir:
-            ap.error("--write-reference needs --pysph-dir")
-        write_reference(load_run(a.pysph_dir), a.write_reference)
-        print("wrote %s" % a.write_reference)
-        return 0
-    if not a.sphc_out or bool(a.reference) == bool(a.pysph_dir):
-        ap.error("give SPHC_OUT and one of --reference, --pysph-dir")
-
-    run = load_run(a.sphc_out)
-    ref = read_reference(a.reference) if a.reference else load_run(a.pysph_dir)
+    a, run, ref = S.pysph_comparison(__doc__.split("\n\n")[0], load_run, read_reference,
+                                     write_reference)
+    if run is None:
+        return ref
     failures = []
-    if len(run["t"]) != len(ref["t"]):
-        failures.append("%d snapshots, PySPH has %d" % (len(run["t"]), len(ref["t"])))
-    if run["ij"].shape != ref["ij"].shape or np.any(run["ij"] != ref["ij"]):
-        failures.append("the initial particles differ from PySPH's (%d, PySPH %d)"
-                        % (len(run["ij"]), len(ref["ij"])))
-    if failures:
-        S.report_failures(failures)
-        return 1
     dx = ref["dx"]
     worst = dict.fromkeys(("position", "velocity", "pressure", "density"), 0.0)
     for t, tr, d, r in zip(run["t"], ref["t"], run["fields"], ref["fields"]):
