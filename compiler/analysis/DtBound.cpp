@@ -21,6 +21,7 @@
 // --set and reports a fixed step beyond it before it runs (codegen/DtBoundCpp.cpp).
 #include "analysis/DtBound.h"
 #include "analysis/Passes.h"
+#include "frontend/FormatNumber.h"
 #include "sema/ConstEval.h"
 
 #include "llvm/Support/Format.h"
@@ -34,11 +35,8 @@ namespace sphc {
 
 namespace {
 
-std::string num(double v) {
-  char buf[32];
-  snprintf(buf, sizeof buf, "%.4g", v);
-  return buf;
-}
+// Four significant digits: a bound is an estimate.
+std::string num(double v) { return formatNumber(v, 4); }
 
 struct Term {
   std::string name;     // acoustic, viscous, force

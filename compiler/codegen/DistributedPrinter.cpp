@@ -3,8 +3,7 @@
 // and the host program add, calling the MPI runtime (runtime/include/sphc/mpi/). Kept in its
 // own file so that the serial printers read as before.
 #include "codegen/Printer.h"
-
-#include <cstdio>
+#include "frontend/FormatNumber.h"
 
 namespace sphc {
 
@@ -76,11 +75,7 @@ void ScenePrinter::distributedFunctions() {
     scene_ << "    // Work per particle of each array (1 + neighbour passes as destination).\n";
     scene_ << "    sphc::mpi::set_weights(decomposition, {";
     for (size_t a = 0; a < d.weights.size(); ++a)
-    {
-      char w[32];
-      std::snprintf(w, sizeof w, "%.17g", d.weights[a]);
-      scene_ << (a ? ", " : "") << w;
-    }
+      scene_ << (a ? ", " : "") << exactNumber(d.weights[a]);
     scene_ << "});\n";
     scene_ << "    default_limits = sphc::bounding_box_limits(" << allArrays("") << ", DIM);\n";
     scene_ << "    sphc::mpi::distribute(decomposition, " << allArrays("") << ");\n";

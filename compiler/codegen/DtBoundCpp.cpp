@@ -3,16 +3,11 @@
 #include "codegen/DtBoundCpp.h"
 
 #include "analysis/DtBound.h"
+#include "frontend/FormatNumber.h"
 
 namespace sphc {
 
 namespace {
-
-std::string lit(double v) {
-  char buf[32];
-  snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 
@@ -33,19 +28,22 @@ std::string dtBoundSetupCpp(const Plan& plan, const NameMap& names, const std::s
     std::string alpha = plan.avAlpha ? exprCpp(*plan.avAlpha, names) : "0.0";
     s += in + "const double c0 = " + c0 + ", alpha = " + alpha + ";\n";
     term(dt_bound::kAcousticText, dt_bound::kAcousticSource,
-         lit(dt_bound::kAcoustic) + " * h / (c0 * (1.0 + " + lit(dt_bound::kAlpha) + " * alpha))",
+         exactNumber(dt_bound::kAcoustic) + " * h / (c0 * (1.0 + " +
+             exactNumber(dt_bound::kAlpha) + " * alpha))",
          "{\"c0\", c0}, {\"alpha\", alpha}");
   }
   const ast::ExprPtr nu = plan.viscosity ? plan.viscosity : plan.nu;
   if (nu) {
     s += in + "const double nu = " + exprCpp(*nu, names) + ";\n";
     term(dt_bound::kViscousText, dt_bound::kViscousSource,
-         "nu > 0 ? " + lit(dt_bound::kViscous) + " * h * h / nu : HUGE_VAL", "{\"nu\", nu}");
+         "nu > 0 ? " + exactNumber(dt_bound::kViscous) + " * h * h / nu : HUGE_VAL",
+         "{\"nu\", nu}");
   }
   if (plan.bodyForce) {
     s += in + "const double g = std::fabs(" + exprCpp(*plan.bodyForce, names) + ");\n";
     term(dt_bound::kForceText, dt_bound::kForceSource,
-         "g > 0 ? " + lit(dt_bound::kForce) + " * std::sqrt(h / g) : HUGE_VAL", "{\"|g|\", g}");
+         "g > 0 ? " + exactNumber(dt_bound::kForce) + " * std::sqrt(h / g) : HUGE_VAL",
+         "{\"|g|\", g}");
   }
   s += indent + "}\n";
   return s;

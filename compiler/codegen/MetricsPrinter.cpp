@@ -4,8 +4,8 @@
 // in `main` (sphc/metrics.h). Shared by every backend; under --mpi each metric's sums are
 // combined over the ranks before it is finished (a collective call on every rank).
 #include "codegen/Printer.h"
+#include "frontend/FormatNumber.h"
 
-#include <cstdio>
 #include <functional>
 
 namespace sphc {
@@ -29,12 +29,6 @@ const char* reduceKind(PlanMetric::Kind k) {
     case PlanMetric::Mean: return "sphc::ReduceKind::Mean";
     default: return "";
   }
-}
-
-std::string number(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
 }
 
 }  // namespace
@@ -86,10 +80,10 @@ void ScenePrinter::emitMetrics() {
              << m.column << " (" << m.refAt.size() << " rows, read by sphc)\n";
       scene_ << "      static const sphc::ReferenceTable ref{{";
       for (size_t i = 0; i < m.refAt.size(); ++i)
-        scene_ << (i ? ", " : "") << number(m.refAt[i]);
+        scene_ << (i ? ", " : "") << exactNumber(m.refAt[i]);
       scene_ << "},\n                                           {";
       for (size_t i = 0; i < m.refValue.size(); ++i)
-        scene_ << (i ? ", " : "") << number(m.refValue[i]);
+        scene_ << (i ? ", " : "") << exactNumber(m.refValue[i]);
       scene_ << "}};\n";
     }
     if (m.isProfile()) {

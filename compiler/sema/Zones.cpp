@@ -9,6 +9,7 @@
 // normal (away from the fluid); length: the zone's depth along it; width: its extent across.
 // u, v, w: the inlet velocity, expressions of params, x, y, z and t.
 #include "sema/Zones.h"
+#include "frontend/FormatNumber.h"
 #include "sema/ConstEval.h"
 #include "sema/Sema.h"
 
@@ -25,12 +26,6 @@
 namespace sphc {
 
 namespace {
-
-std::string num(double v) {
-  char buf[32];
-  snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 struct Box {
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
@@ -295,16 +290,17 @@ bool buildZones(const ast::SceneDecl& scene, Plan& plan, DiagnosticEngine& diags
       }
       for (int k = 0; k < dim; ++k) v.normal[k] /= std::sqrt(n2);
       if (!(v.length > 0) || (dim > 1 && !(v.width > 0))) {
-        diags.error(z.name.loc, what + ": length " + num(v.length) + " and width " +
-                                    num(v.width) + " must be positive");
+        diags.error(z.name.loc, what + ": length " + formatNumber(v.length) + " and width " +
+                                    formatNumber(v.width) + " must be positive");
         continue;
       }
       if (support && v.length < *support) {
         diags.error(args.at("length")->name.loc,
-                    what + " is " + num(v.length) + " deep, narrower than the kernel support " +
-                        num(*support) + " (" + num(plan.kernelRadiusScale) + " x h = " +
-                        num(*hmax) + "): particles near its face would miss neighbours; "
-                        "make length at least " + num(*support));
+                    what + " is " + formatNumber(v.length) +
+                        " deep, narrower than the kernel support " + formatNumber(*support) + " (" +
+                        formatNumber(plan.kernelRadiusScale) + " x h = " + formatNumber(*hmax) +
+                        "): particles near its face would miss neighbours; "
+                        "make length at least " + formatNumber(*support));
       }
       const Box zb = v.box(dim);
       if (z.inlet) {
@@ -324,12 +320,12 @@ bool buildZones(const ast::SceneDecl& scene, Plan& plan, DiagnosticEngine& diags
             if (overlap > 1e-9 * std::fmax(v.length, v.width)) {
               std::string range;
               for (int k = 0; k < dim; ++k)
-                range += std::string(k ? " x " : "") + "[" + num(zb.lo[k]) + ", " +
-                         num(zb.hi[k]) + "]";
+                range += std::string(k ? " x " : "") + "[" + formatNumber(zb.lo[k]) + ", " +
+                         formatNumber(zb.hi[k]) + "]";
               std::string brange;
               for (int k = 0; k < dim; ++k)
-                brange += std::string(k ? " x " : "") + "[" + num(b.lo[k]) + ", " +
-                          num(b.hi[k]) + "]";
+                brange += std::string(k ? " x " : "") + "[" + formatNumber(b.lo[k]) + ", " +
+                          formatNumber(b.hi[k]) + "]";
               diags.error(z.name.loc, what + " (" + range + ") overlaps array '" +
                                           plan.arrays[a].name + "' (" + brange +
                                           "): its particles would be inside the inlet");
@@ -367,13 +363,14 @@ bool buildZones(const ast::SceneDecl& scene, Plan& plan, DiagnosticEngine& diags
           if (beside) {
             diags.error(z.name.loc, what + ": no particle of '" + plan.arrays[pz.other].name +
                                         "' can reach it: its cross-section (width " +
-                                        num(v.width) + " around the point) lies beside them");
+                                        formatNumber(v.width) +
+                                        " around the point) lies beside them");
           } else if (smax < -reach) {
             diags.error(z.name.loc,
                         what + ": no particle of '" + plan.arrays[pz.other].name +
-                            "' can reach it: the nearest is " + num(-smax) +
-                            " from its face, farther than the kernel support " + num(reach) +
-                            " (is the normal pointing away from the fluid?)");
+                            "' can reach it: the nearest is " + formatNumber(-smax) +
+                            " from its face, farther than the kernel support " +
+                            formatNumber(reach) + " (is the normal pointing away from the fluid?)");
           }
         }
       }
