@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -24,6 +25,37 @@ ParticleArray make_array(const std::string& name, std::size_t n) {
   a.add_property("tag", PropType::I32);
   a.resize(n);
   return a;
+}
+
+// The channel of the inlet/outlet tests: a lattice of spacing dx (cell centres) over
+// [x0, x1] x [0, 1] appended to a, every particle of mass 1, then `set(i, x, y)` for any
+// other value of particle i at (x, y).
+void fill_lattice(ParticleArray& a, double x0, double x1, double dx,
+                  const std::function<void(std::size_t, double, double)>& set = {}) {
+  for (double x = x0 + dx / 2; x < x1; x += dx)
+    for (double y = dx / 2; y < 1.0; y += dx) {
+      a.resize(a.n + 1);
+      a.f64("x")[a.n - 1] = x;
+      a.f64("y")[a.n - 1] = y;
+      a.f64("m")[a.n - 1] = 1.0;
+      if (set) set(a.n - 1, x, y);
+    }
+}
+
+// The outlet zone of that channel: its face at x = 1 (normal +x) across the channel's width
+// 1, 0.2 deep, filled by `from`'s particles that cross into it; a do-nothing outlet that
+// copies every property both arrays have unless the test lists some.
+sphc::OutletZone channel_outlet(ParticleArray& from, ParticleArray& outlet) {
+  sphc::OutletZone out;
+  out.zone.name = "outlet";
+  out.zone.point[0] = 1.0;
+  out.zone.point[1] = 0.5;
+  out.zone.normal[0] = 1.0;
+  out.zone.length = 0.2;
+  out.zone.width = 1.0;
+  out.outlet = &outlet;
+  out.from = &from;
+  return out;
 }
 
 TEST(RemoveParticles, CompactsStablyEveryPropertyAndStride) {
@@ -118,17 +150,8 @@ TEST(InletOutlet, UniformFlowThroughAChannel) {
   const double dx = 0.1, dt = 0.025;
   ParticleArray fluid = make_array("fluid", 0), inlet = make_array("inlet", 0),
                 outlet = make_array("outlet", 0);
-  auto fill = [&](ParticleArray& a, double x0, double x1) {
-    for (double x = x0 + dx / 2; x < x1; x += dx)
-      for (double y = dx / 2; y < 1.0; y += dx) {
-        a.resize(a.n + 1);
-        a.f64("x")[a.n - 1] = x;
-        a.f64("y")[a.n - 1] = y;
-        a.f64("m")[a.n - 1] = 1.0;
-      }
-  };
-  fill(fluid, 0.0, 1.0);
-  fill(inlet, -0.2, 0.0);
+  fill_lattice(fluid, 0.0, 1.0, dx);
+  fill_lattice(inlet, -0.2, 0.0, dx);
   sphc::InletOutlet io;
   sphc::InletZone in;
   in.zone.name = "inlet";
@@ -141,14 +164,7 @@ TEST(InletOutlet, UniformFlowThroughAChannel) {
   in.copy = {"x", "y", "u", "v", "m"};
   in.velocity = [](const double*, double, double* v) { v[0] = 1.0; };
   io.inlets.push_back(in);
-  sphc::OutletZone out;
-  out.zone = in.zone;
-  out.zone.name = "outlet";
-  out.zone.point[0] = 1.0;
-  out.zone.normal[0] = 1.0;
-  out.outlet = &outlet;
-  out.from = &fluid;
-  io.outlets.push_back(out);
+  io.outlets.push_back(channel_outlet(fluid, outlet));
   sphc::init_inlet_outlet(io, {&fluid, &inlet, &outlet}, 0.15, 0.0);
   EXPECT_EQ(fluid.n, 100u);
   EXPECT_EQ(inlet.f64("u")[0], 1.0);
@@ -197,16 +213,9 @@ TEST(InletOutlet, BackflowReturnsToTheSource) {
   ParticleArray fluid = make_array("fluid", 1), outlet = make_array("outlet", 1);
   fluid.f64("x")[0] = 0.95;
   outlet.f64("x")[0] = 1.05;
+  fluid.f64("y")[0] = outlet.f64("y")[0] = 0.5;  // mid-channel
   sphc::InletOutlet io;
-  sphc::OutletZone out;
-  out.zone.name = "outlet";
-  out.zone.point[0] = 1.0;
-  out.zone.normal[0] = 1.0;
-  out.zone.length = 0.2;
-  out.zone.width = 1.0;
-  out.outlet = &outlet;
-  out.from = &fluid;
-  io.outlets.push_back(out);
+  io.outlets.push_back(channel_outlet(fluid, outlet));
   sphc::init_inlet_outlet(io, {&fluid, &outlet}, 0.1, 0.0);
   EXPECT_FALSE(sphc::inlet_outlet_due(io));
   EXPECT_FALSE(sphc::update_inlet_outlet(io, 0.05));
@@ -236,15 +245,10 @@ TEST(InletOutlet, BackflowReturnsToTheSource) {
 TEST(InletOutlet, MirrorOutletInterpolatesAtTheImage) {
   const double dx = 0.1;
   auto fill = [&](ParticleArray& a, double x0, double x1) {
-    for (double x = x0 + dx / 2; x < x1; x += dx)
-      for (double y = dx / 2; y < 1.0; y += dx) {
-        a.resize(a.n + 1);
-        a.f64("x")[a.n - 1] = x;
-        a.f64("y")[a.n - 1] = y;
-        a.f64("m")[a.n - 1] = 1.0;
-        a.f64("u")[a.n - 1] = x < 1.0 ? 1.0 + 0.5 * y : -7.0;
-        a.f64("v")[a.n - 1] = x < 1.0 ? 0.2 * x : -7.0;
-      }
+    fill_lattice(a, x0, x1, dx, [&](std::size_t i, double x, double y) {
+      a.f64("u")[i] = x < 1.0 ? 1.0 + 0.5 * y : -7.0;
+      a.f64("v")[i] = x < 1.0 ? 0.2 * x : -7.0;
+    });
   };
   for (const sphc::OutletKind kind : {sphc::OutletKind::Mirror, sphc::OutletKind::DoNothing}) {
     for (const double support : {0.2, 0.01}) {
@@ -253,15 +257,7 @@ TEST(InletOutlet, MirrorOutletInterpolatesAtTheImage) {
       fill(outlet, 1.0, 1.2);
       outlet.f64("y")[0] += 0.03;  // off the lattice: its image is 0.03 from any particle
       sphc::InletOutlet io;
-      sphc::OutletZone out;
-      out.zone.name = "outlet";
-      out.zone.point[0] = 1.0;
-      out.zone.point[1] = 0.5;
-      out.zone.normal[0] = 1.0;
-      out.zone.length = 0.2;
-      out.zone.width = 1.0;
-      out.outlet = &outlet;
-      out.from = &fluid;
+      sphc::OutletZone out = channel_outlet(fluid, outlet);
       out.copy = {"x", "y", "u", "v", "m"};
       out.kind = kind;
       io.outlets.push_back(out);
@@ -309,17 +305,12 @@ TEST(InletOutlet, MirrorOutletInterpolatesAtTheImage) {
 TEST(InletOutlet, CharacteristicOutletPassesOutgoingWavesOnly) {
   const double dx = 0.1, c = 10.0, rho = 1.0, U = 1.0, P = 0.3;
   auto fill = [&](ParticleArray& a, double x0, double x1) {
-    for (double x = x0 + dx / 2; x < x1; x += dx)
-      for (double y = dx / 2; y < 1.0; y += dx) {
-        a.resize(a.n + 1);
-        a.f64("x")[a.n - 1] = x;
-        a.f64("y")[a.n - 1] = y;
-        a.f64("m")[a.n - 1] = 1.0;
-        a.f64("rho")[a.n - 1] = rho;
-        a.f64("u")[a.n - 1] = x < 1.0 ? U : -7.0;
-        a.f64("v")[a.n - 1] = x < 1.0 ? 0.25 : -7.0;
-        a.f64("p")[a.n - 1] = x < 1.0 ? 0.0 : -7.0;
-      }
+    fill_lattice(a, x0, x1, dx, [&](std::size_t i, double x, double) {
+      a.f64("rho")[i] = rho;
+      a.f64("u")[i] = x < 1.0 ? U : -7.0;
+      a.f64("v")[i] = x < 1.0 ? 0.25 : -7.0;
+      a.f64("p")[i] = x < 1.0 ? 0.0 : -7.0;
+    });
   };
   auto props = [](ParticleArray& a) {
     a.add_property("rho");
@@ -333,15 +324,7 @@ TEST(InletOutlet, CharacteristicOutletPassesOutgoingWavesOnly) {
     fill(fluid, 0.0, 1.0);
     fill(outlet, 1.0, 1.2);
     sphc::InletOutlet io;
-    sphc::OutletZone out;
-    out.zone.name = "outlet";
-    out.zone.point[0] = 1.0;
-    out.zone.point[1] = 0.5;
-    out.zone.normal[0] = 1.0;
-    out.zone.length = 0.2;
-    out.zone.width = 1.0;
-    out.outlet = &outlet;
-    out.from = &fluid;
+    sphc::OutletZone out = channel_outlet(fluid, outlet);
     out.copy = {"x", "y", "u", "v", "m", "rho", "p"};
     out.kind = sphc::OutletKind::Characteristic;
     out.c = c;
