@@ -25,22 +25,13 @@
 # last good output".
 set -eu
 
-if [ $# -lt 5 ]; then
-  echo "usage: $0 SPHC SOURCE_DIR SCENE EXE OUT_DIR [-D NAME=CHOICE...] [RUN OPTIONS...]" \
-       "[-- CHECK OPTIONS...]" >&2
-  exit 2
-fi
-SPHC=$1
-SRC=$2
-SCENE=$3
-EXE=$4
-OUT=$5
+. "$(dirname "$0")/../validation/common.sh"
+scene_args "SPHC SOURCE_DIR SCENE EXE OUT_DIR [-D NAME=CHOICE...] [RUN OPTIONS...] \
+[-- CHECK OPTIONS...]" "$@"
+SCENE=$CASE
 shift 5
-SPHC_OPTS=""
-while [ $# -gt 1 ] && [ "$1" = "-D" ]; do
-  SPHC_OPTS="$SPHC_OPTS -D $2"
-  shift 2
-done
+sphc_options "$@"
+shift "$NARGS"
 RUN_OPTS=""
 DX=""
 FACTOR=""
@@ -67,7 +58,6 @@ if [ -n "$FACTOR" ]; then
   RUN_OPTS="$RUN_OPTS --dt $DT"
 fi
 
-. "$SRC/tests/validation/common.sh"
 find_python run_case.sh
 fresh_output "$EXE" "$OUT"
 

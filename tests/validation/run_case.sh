@@ -8,8 +8,7 @@
 # Cases: elliptical_drop (exact solution, Monaghan 1994), taylor_green (exact solution,
 # periodic), cavity (Ghia et al. 1982), hydrostatic_tank (hydrostatics, Adami et al. 2012),
 # the same tank with other schemes (hydrostatic_tank_edac:hydrostatic_tank, ...), dam breaks with other schemes
-# against the experiments (dambreak_edac:dambreak_front, ...). The WCSPH dam break has its
-# own script, run_dambreak.sh.
+# against the experiments (dambreak:dambreak_front, dambreak_edac:dambreak_front, ...).
 #
 # Usage: run_case.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [-D NAME=CHOICE...] [RUN OPTIONS...]
 #                    [-- CHECK OPTIONS...]
@@ -29,38 +28,17 @@
 # that has numpy and h5py.
 set -eu
 
-if [ $# -lt 5 ]; then
-  echo "usage: $0 SPHC SOURCE_DIR CASE EXE OUT_DIR [-D NAME=CHOICE...] [RUN OPTIONS...]" \
-       "[-- CHECK OPTIONS...]" >&2
-  exit 2
-fi
-SPHC=$1
-SRC=$2
-CASE=${3%%:*}
-CHECK=${3#*:}
-EXE=$4
-OUT=$5
+. "$(dirname "$0")/common.sh"
+scene_args "SPHC SOURCE_DIR CASE EXE OUT_DIR [-D NAME=CHOICE...] [RUN OPTIONS...] \
+[-- CHECK OPTIONS...]" "$@"
 shift 5
 # Compile-time options first (-D NAME=CHOICE, for sphc), then run options up to "--", check
 # options after it.
-SPHC_OPTS=""
-while [ $# -gt 0 ] && { [ "$1" = "-D" ] || [ "$1" = "--global-ids" ]; }; do
-  if [ "$1" = "-D" ]; then
-    SPHC_OPTS="$SPHC_OPTS -D $2"
-    shift 2
-  else
-    SPHC_OPTS="$SPHC_OPTS $1"
-    shift
-  fi
-done
-RUN_OPTS=""
-while [ $# -gt 0 ] && [ "$1" != "--" ]; do
-  RUN_OPTS="$RUN_OPTS $1"
-  shift
-done
-[ $# -gt 0 ] && shift
+sphc_options "$@"
+shift "$NARGS"
+run_options "$@"
+shift "$NARGS"
 
-. "$(dirname "$0")/common.sh"
 find_python run_case.sh
 fresh_output "$EXE" "$OUT"
 

@@ -6,18 +6,16 @@
 # (the tank's default before docs/stability.md's fix, h = 1.4 dx): the test is about the
 # noise delta-SPH removes, and with h = 1.4 dx there is little left to remove (measured at
 # t = 1 s: noise rms 0.142% of rho0 g H without delta-SPH, 0.085% with it, 0.6x).
-# Usage: run_delta_tank.sh SPHC SOURCE_DIR EXE OUT_DIR
+# Usage: run_delta_tank.sh SPHC SOURCE_DIR CASE EXE OUT_DIR
+#   CASE        the scene, examples/CASE.sph: hydrostatic_tank
 set -eu
-SPHC=$1
-SRC=$2
-EXE=$3
-OUT=$4
 . "$(dirname "$0")/common.sh"
+scene_args "SPHC SOURCE_DIR CASE EXE OUT_DIR" "$@"
 find_python run_delta_tank.sh
 fresh_output "$EXE" "$OUT"
 echo "== 1. compile: without delta-SPH (the default) and with it (its effects, docs/effects.md)"
-"$SPHC" "$SRC/examples/hydrostatic_tank.sph" -o "$EXE"
-"$SPHC" "$SRC/examples/hydrostatic_tank.sph" -D density_gradient=on -D delta_sph=on -o "$EXE.delta"
+"$SPHC" "$SRC/examples/$CASE.sph" -o "$EXE"
+"$SPHC" "$SRC/examples/$CASE.sph" -D density_gradient=on -D delta_sph=on -o "$EXE.delta"
 echo "== 2. run without delta-SPH (alpha = 0.1)"
 "$EXE" --quiet --timing -d "$OUT/without" --set alpha=0.1 --set hdx=1.3
 echo "== 3. run with delta-SPH (alpha = 0.1, delta = 0.1)"

@@ -1,31 +1,26 @@
 #!/bin/sh
 # The outlets' reflection of a pressure pulse (tests/validation/outlet_pulse.py): the
-# straight channel (examples/channel_inlet_outlet.sph, ny = 10, started with the developed
-# profile) built with each outlet type, run with and without the pulse to t = 0.3 (2.25 L / c0),
-# the probe pressure every 0.005; the check compares the reflection coefficients.
+# straight channel (examples/CASE.sph, CASE = channel_inlet_outlet: ny = 10, started with the
+# developed profile) built with each outlet type, run with and without the pulse to t = 0.3
+# (2.25 L / c0), the probe pressure every 0.005; the check compares the reflection
+# coefficients.
 #
 # Usage: run_outlet_pulse.sh SPHC SOURCE_DIR CASE EXE OUT_DIR [-- CHECK OPTIONS...]
-#   (CASE is ignored: always channel_inlet_outlet; EXE the stem of the solvers' names)
+#   (CASE: a scene with the option outlet_type and the parameters ny, start, pulse and
+#   dtout, as channel_inlet_outlet; EXE the stem of the solvers' names)
 set -eu
-if [ $# -lt 5 ]; then
-  echo "usage: $0 SPHC SOURCE_DIR CASE EXE OUT_DIR [-- CHECK OPTIONS...]" >&2
-  exit 2
-fi
-SPHC=$1
-SRC=$2
-EXE=$4
-OUT=$5
+. "$(dirname "$0")/common.sh"
+scene_args "SPHC SOURCE_DIR CASE EXE OUT_DIR [-- CHECK OPTIONS...]" "$@"
 shift 5
 [ $# -gt 0 ] && [ "$1" = "--" ] && shift
 
-. "$(dirname "$0")/common.sh"
 find_python run_outlet_pulse.sh
 fresh_output "$EXE" "$OUT"
 
 RUNS=""
 for TYPE in do_nothing mirror characteristic; do
-  echo "== compile: $SPHC $SRC/examples/channel_inlet_outlet.sph -D outlet_type=$TYPE"
-  "$SPHC" "$SRC/examples/channel_inlet_outlet.sph" -D outlet_type=$TYPE -o "${EXE}_$TYPE"
+  echo "== compile: $SPHC $SRC/examples/$CASE.sph -D outlet_type=$TYPE"
+  "$SPHC" "$SRC/examples/$CASE.sph" -D outlet_type=$TYPE -o "${EXE}_$TYPE"
   for P in 1 0; do
     echo "== run: ${EXE}_$TYPE --set pulse=$P"
     "${EXE}_$TYPE" --quiet -d "$OUT/${TYPE}_$P" --set ny=10 --set start=1 --set pulse=$P \
