@@ -126,15 +126,23 @@ struct RadialKernel {
   }
 };
 
+// The members f(q) and df(q) of a shape: the functions NAME_f and NAME_df of kernel_shapes.h.
+#define SPHC_SHAPE_FUNCTIONS(NAME)                   \
+  template <class T>                                 \
+  static inline T f(T q) {                           \
+    return shapes::NAME##_f(q);                      \
+  }                                                  \
+  template <class T>                                 \
+  static inline T df(T q) {                          \
+    return shapes::NAME##_df(q);                     \
+  }
+
 template <int Dim>
 struct CubicShape {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma =
       Dim == 1 ? 2.0 / 3.0 : Dim == 2 ? 10.0 / (7.0 * kPi) : 1.0 / kPi;
-  template <class T>
-  static inline T f(T q) { return shapes::sphc_cubic_f(q); }
-  template <class T>
-  static inline T df(T q) { return shapes::sphc_cubic_df(q); }
+  SPHC_SHAPE_FUNCTIONS(sphc_cubic)
 };
 
 template <int Dim>
@@ -142,10 +150,7 @@ struct QuinticShape {
   static constexpr double radius_scale = 3.0;
   static constexpr double sigma =
       Dim == 1 ? 1.0 / 120.0 : Dim == 2 ? 7.0 / (478.0 * kPi) : 1.0 / (120.0 * kPi);
-  template <class T>
-  static inline T f(T q) { return shapes::sphc_quintic_f(q); }
-  template <class T>
-  static inline T df(T q) { return shapes::sphc_quintic_df(q); }
+  SPHC_SHAPE_FUNCTIONS(sphc_quintic)
 };
 
 // Wendland C2 for d = 2, 3: (1 - q/2)^4 (2q + 1).
@@ -153,10 +158,7 @@ template <int Dim>
 struct WendlandC2Shape {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = Dim == 2 ? 7.0 / (4.0 * kPi) : 21.0 / (16.0 * kPi);
-  template <class T>
-  static inline T f(T q) { return shapes::sphc_wendland_c2_f(q); }
-  template <class T>
-  static inline T df(T q) { return shapes::sphc_wendland_c2_df(q); }
+  SPHC_SHAPE_FUNCTIONS(sphc_wendland_c2)
 };
 
 // Wendland C2 for d = 1: (1 - q/2)^3 (1.5q + 1).
@@ -164,20 +166,14 @@ template <>
 struct WendlandC2Shape<1> {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = 5.0 / 8.0;
-  template <class T>
-  static inline T f(T q) { return shapes::sphc_wendland_c2_1d_f(q); }
-  template <class T>
-  static inline T df(T q) { return shapes::sphc_wendland_c2_1d_df(q); }
+  SPHC_SHAPE_FUNCTIONS(sphc_wendland_c2_1d)
 };
 
 template <int Dim>
 struct GaussianShape {
   static constexpr double radius_scale = 3.0;
   static constexpr double sigma = Dim == 1 ? kInvSqrtPi : Dim == 2 ? 1.0 / kPi : kInvPi32;
-  template <class T>
-  static inline T f(T q) { return shapes::sphc_gaussian_f(q); }
-  template <class T>
-  static inline T df(T q) { return shapes::sphc_gaussian_df(q); }
+  SPHC_SHAPE_FUNCTIONS(sphc_gaussian)
 };
 
 // Wendland C4 for d = 2, 3: (1 - q/2)^6 (35/12 q^2 + 3q + 1).
@@ -185,10 +181,7 @@ template <int Dim>
 struct WendlandC4Shape {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = Dim == 2 ? 9.0 / (4.0 * kPi) : 495.0 / (256.0 * kPi);
-  template <class T>
-  static inline T f(T q) { return shapes::sphc_wendland_c4_f(q); }
-  template <class T>
-  static inline T df(T q) { return shapes::sphc_wendland_c4_df(q); }
+  SPHC_SHAPE_FUNCTIONS(sphc_wendland_c4)
 };
 
 // Wendland C4 for d = 1: (1 - q/2)^5 (2q^2 + 2.5q + 1).
@@ -196,10 +189,7 @@ template <>
 struct WendlandC4Shape<1> {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = 0.75;
-  template <class T>
-  static inline T f(T q) { return shapes::sphc_wendland_c4_1d_f(q); }
-  template <class T>
-  static inline T df(T q) { return shapes::sphc_wendland_c4_1d_df(q); }
+  SPHC_SHAPE_FUNCTIONS(sphc_wendland_c4_1d)
 };
 
 // Wendland C6 for d = 2, 3: (1 - q/2)^8 (4q^3 + 6.25q^2 + 4q + 1).
@@ -207,10 +197,7 @@ template <int Dim>
 struct WendlandC6Shape {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = Dim == 2 ? 78.0 / (28.0 * kPi) : 1365.0 / (512.0 * kPi);
-  template <class T>
-  static inline T f(T q) { return shapes::sphc_wendland_c6_f(q); }
-  template <class T>
-  static inline T df(T q) { return shapes::sphc_wendland_c6_df(q); }
+  SPHC_SHAPE_FUNCTIONS(sphc_wendland_c6)
 };
 
 // Wendland C6 for d = 1: (1 - q/2)^7 (21/8 q^3 + 19/4 q^2 + 3.5q + 1).
@@ -218,10 +205,7 @@ template <>
 struct WendlandC6Shape<1> {
   static constexpr double radius_scale = 2.0;
   static constexpr double sigma = 55.0 / 64.0;
-  template <class T>
-  static inline T f(T q) { return shapes::sphc_wendland_c6_1d_f(q); }
-  template <class T>
-  static inline T df(T q) { return shapes::sphc_wendland_c6_1d_df(q); }
+  SPHC_SHAPE_FUNCTIONS(sphc_wendland_c6_1d)
 };
 
 // Super-Gaussian: exp(-q^2) (1 + d/2 - q^2), truncated at 3h.
@@ -234,6 +218,8 @@ struct SuperGaussianShape {
   template <class T>
   static inline T df(T q) { return shapes::sphc_super_gaussian_df(q, T(Dim + 4)); }
 };
+
+#undef SPHC_SHAPE_FUNCTIONS
 
 }  // namespace detail
 
