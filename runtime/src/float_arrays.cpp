@@ -1,6 +1,8 @@
 // sphc runtime: single-precision copies of particle arrays. See float_arrays.h.
 #include "sphc/float_arrays.h"
 
+#include "permute_values.h"
+
 #include <stdexcept>
 #include <string>
 
@@ -17,21 +19,6 @@ void convert(const std::vector<From>& from, std::vector<To>& to) {
   To* out = to.data();
 #pragma omp parallel for schedule(static) if (m > 16384)
   for (std::size_t i = 0; i < m; ++i) out[i] = static_cast<To>(in[i]);
-}
-
-template <class T>
-void permute_values(std::vector<T>& v, const std::vector<std::uint32_t>& order, int stride,
-                    std::vector<T>& scratch) {
-  const std::size_t s = static_cast<std::size_t>(stride);
-  const std::size_t n = order.size();
-  scratch.resize(v.size());
-  T* out = scratch.data();
-  const T* in = v.data();
-  const std::uint32_t* o = order.data();
-#pragma omp parallel for schedule(static) if (n > 16384)
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t k = 0; k < s; ++k) out[i * s + k] = in[o[i] * s + k];
-  v.swap(scratch);
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 
 #include "sphc/memory.h"
 
+#include "permute_values.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -189,29 +191,6 @@ std::size_t ParticleArray::remove_particles(const std::vector<std::uint8_t>& rem
   n -= removed;
   return removed;
 }
-
-namespace {
-template <class T>
-void permute_values(std::vector<T>& v, const std::vector<std::uint32_t>& order, int stride,
-                    std::vector<T>& scratch) {
-  const std::size_t s = static_cast<std::size_t>(stride);
-  const std::size_t n = order.size();
-  scratch.resize(v.size());
-  T* out = scratch.data();
-  const T* in = v.data();
-  const std::uint32_t* o = order.data();
-  // Each i writes its own slots: parallel in the OpenMP runtime, same result.
-  if (s == 1) {
-#pragma omp parallel for schedule(static) if (n > 16384)
-    for (std::size_t i = 0; i < n; ++i) out[i] = in[o[i]];
-  } else {
-#pragma omp parallel for schedule(static) if (n > 16384)
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t k = 0; k < s; ++k) out[i * s + k] = in[o[i] * s + k];
-  }
-  v.swap(scratch);
-}
-}  // namespace
 
 bool is_permutation_of(const std::vector<std::uint32_t>& order, std::size_t n) {
   if (order.size() != n) return false;
