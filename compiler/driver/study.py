@@ -13,7 +13,8 @@ steps, wall and CPU seconds of the time loop, the peak memory and every metric o
     through sphc's build cache);
   - a compile-time option of the scene (`option NAME in [...]`): sphc -D NAME=v (a rebuild,
     through the cache);
-  - threads: the solver's --threads;
+  - threads: the solver's --threads, for the variants built for OpenMP (the only backend
+    with threads); the others run once, shown with threads "-";
   - otherwise a parameter of the scene: the solver's --set NAME=v (no rebuild).
 
 Output in DIR: study.csv (one row per run; a study started again with the same DIR reuses the
@@ -54,6 +55,10 @@ import time
 
 COST = "wall_s"  # --cost
 SPHC_FLAGS = {"backend": "--backend", "precision": "--precision", "kernel": "--kernel"}
+# The backends whose solvers take --threads (the OpenMP one; a serial or OpenCL solver refuses
+# the option: runtime/src/solver.cpp). sphc's default backend is serial.
+THREADED_BACKENDS = ("openmp",)
+DEFAULT_BACKEND = "serial"
 
 
 def fail(msg, code=2):
@@ -74,7 +79,8 @@ def parse_args(argv):
     ap.add_argument("--tf", type=float, help="final time of every run")
     ap.add_argument("--repeat", type=int, default=1, help="runs per variant (default 1; the "
                     "summary takes the fastest wall time)")
-    ap.add_argument("--threads", type=int, help="threads of every run (OpenMP backends)")
+    ap.add_argument("--threads", type=int, help="threads of every run built for OpenMP "
+                    "(--vary backend=openmp); the other solvers run on one thread")
     ap.add_argument("--budget", action="append", default=[], metavar="METRIC<=VALUE",
                     help="the cheapest variant with METRIC <= VALUE, and how far the others "
                          "miss it")
@@ -176,6 +182,36 @@ def classify(varies, options, params):
 
 # ---- runs --------------------------------------------------------------------------------
 
+def takes_threads(variant, kinds):
+    """Whether the solver of a variant takes --threads: built for an OpenMP backend."""
+    backend = next((v for n, v in variant if n == "backend" and kinds.get(n) == "sphc"),
+                   DEFAULT_BACKEND)
+    return backend in THREADED_BACKENDS
+
+
+def thread_runs(runs, kinds, fixed_threads):
+    """The runs with threads only where they apply: a varied `threads` of a variant whose
+    solver runs on one thread (not OpenMP) is shown as "-" and that variant is run once, not
+    once per thread count. Warns when --threads or a varied threads applies to no run."""
+    varied = "threads" in kinds.values()
+    out, seen = [], set()
+    for variant, rep in runs:
+        if varied and not takes_threads(variant, kinds):
+            variant = [(n, "-" if kinds.get(n) == "threads" else v) for n, v in variant]
+        key = (tuple(variant), rep)
+        if key not in seen:
+            seen.add(key)
+            out.append((variant, rep))
+    if (fixed_threads is not None or varied) and \
+            not any(takes_threads(v, kinds) for v, _ in out):
+        what = "--threads %d" % fixed_threads if fixed_threads is not None else \
+            "--vary threads"
+        sys.stderr.write("sphc study: %s: no variant is built for a multi-threaded backend "
+                         "(%s; --vary backend=openmp): every run is on one thread\n"
+                         % (what, ", ".join(THREADED_BACKENDS)))
+    return out
+
+
 def build(args, variant, kinds, bindir, cache):
     """The solver of a variant's compile-time settings (built once per study, through sphc's
     build cache)."""
@@ -228,14 +264,15 @@ def run_one(args, exe, variant, kinds, rundir):
     cmd = [exe, "--quiet", "--timing", "--no-output", "--metrics", mfile]
     if args.tf is not None:
         cmd += ["--tf", repr(args.tf)]
-    if args.threads is not None:
+    threaded = takes_threads(variant, kinds)
+    if args.threads is not None and threaded:
         cmd += ["--threads", str(args.threads)]
     for s in args.set:
         cmd += ["--set", s]
     for name, value in variant:
         if kinds.get(name) == "param":
             cmd += ["--set", "%s=%s" % (name, value)]
-        elif kinds.get(name) == "threads":
+        elif kinds.get(name) == "threads" and threaded:
             cmd += ["--threads", value]
     start = time.time()
     with open(os.path.join(rundir, "stdout.txt"), "w") as so, \
@@ -711,6 +748,7 @@ def main(argv):
         fail("--resolution %s: not a varied name" % resolution)
     runs = [(list(zip(names, combo)), rep) for combo in itertools.product(*[v for _, v in varies])
             for rep in range(args.repeat)]
+    runs = thread_runs(runs, kinds, args.threads)
     fixed = names + ["code", "repeat", "status", "particles", "steps", "wall_s", "cpu_s", "t_end",
                      "peak_rss_mb", "process_s", "command"]
     csv_path = os.path.join(out, "study.csv")

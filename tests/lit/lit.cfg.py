@@ -81,3 +81,7 @@ if _py:
     config.substitutions.append(('%h5py_python', _py))
     config.substitutions.append(('%restart_bitwise', _py + ' ' + os.path.join(
         config.sphc_src_root, 'tests', 'lit', 'Inputs', 'restart_bitwise.py')))
+# `REQUIRES: matplotlib`: a Python here imports matplotlib, so `sphc study` (which looks for
+# it among the same two, compiler/driver/Study.cpp) draws its plots.
+if _python_with('matplotlib'):
+    config.available_features.add('matplotlib')

@@ -36,6 +36,11 @@ Blanket invariants (every case):
                 --ke-from T starts the check at T, for a start that holds energy of its own
                 (a perturbed lattice under tension releases it; the case says so).
   density       rho / rho0 of the fluid within [--rho-min, --rho-max] (when rho is written).
+                --eos edac (the EDAC scheme, which evolves the pressure p and uses its
+                summation density rho only as the particle volume): rho is the density the
+                written p stands for, rho0 + p / c0^2 (its artificial-compressibility
+                equation of state; --c0 and --rho0 required, p must be written), and the
+                compression energy below is that of this linear law (Tait at gamma = 1).
   energy        (--energy-tol F, with --c0) once gravity is constant (t >= --tdamp), the
                 total mechanical energy KE + g sum m y + compression energy does not rise in
                 an interval by more than F times the initial potential energy above the
@@ -168,6 +173,21 @@ def elastic_energy(m, rho, rho0, c0, gamma):
     return float(np.sum(m * e))
 
 
+def eos_density(fl, args):
+    """The fluid's density as the checks judge it (None when the snapshot has none): the
+    written rho (--eos tait), or with --eos edac the density the EDAC pressure stands for.
+    EDAC (Ramachandran & Puri 2019) evolves the pressure p, not the density, and its rho is a
+    summation density used only as the particle volume (short of rho0 at a free surface by
+    design); its pressure equation dp/dt = -rho c0^2 div(u) is that of artificial
+    compressibility with the linear equation of state p = c0^2 (rho - rho0), so the density
+    it implies is rho0 + p / c0^2, and the compression energy is the Tait one at gamma = 1."""
+    if args.eos == "edac":
+        if "p" not in fl:
+            return None
+        return args.rho0 + fl["p"].astype(float) / (args.c0 * args.c0)
+    return fl["rho"].astype(float) if "rho" in fl else None
+
+
 def gravity_at(t, g, tdamp):
     if tdamp > 0 and t < tdamp:
         return g * 0.5 * (math.sin(math.pi * (t / tdamp - 0.5)) + 1.0)
@@ -207,6 +227,10 @@ def main():
     ap.add_argument("--tdamp", type=float, default=0.0, help="gravity ramp time")
     ap.add_argument("--c0", type=float, default=None, help="sound speed of the Tait EOS")
     ap.add_argument("--gamma", type=float, default=7.0, help="exponent of the Tait EOS")
+    ap.add_argument("--eos", choices=("tait", "edac"), default="tait",
+                    help="where the fluid's density and compression energy come from: the "
+                         "written rho with the Tait EOS (default), or the written EDAC "
+                         "pressure p (rho0 + p / c0^2, gamma = 1)")
     ap.add_argument("--energy-tol", type=float, default=None)
     ap.add_argument("--ke-jump", type=float, default=0.10)
     ap.add_argument("--ke-floor", type=float, default=0.0, help="speed below which KE is noise")
@@ -230,6 +254,11 @@ def main():
     ap.add_argument("--scheme", default="?")
     ap.add_argument("--show", type=int, default=3, help="particles named per violation")
     args = ap.parse_args()
+
+    if args.eos == "edac" and (args.c0 is None or args.rho0 is None):
+        sys.stderr.write("%s: --eos edac needs --c0 and --rho0\n" % WHO)
+        return 2
+    gamma = 1.0 if args.eos == "edac" else args.gamma
 
     files = snapshots(args.outdir, WHO)
     if files is None:
@@ -293,6 +322,10 @@ def main():
                 sys.stderr.write("%s: %s has no /%s/%s\n" % (WHO, name, args.fluid, k))
                 return 2
         vert = "z" if dim == 3 else "y"
+        if args.eos == "edac" and "p" not in fl:
+            sys.stderr.write("%s: --eos edac: %s has no /%s/p (the EDAC pressure)\n"
+                             % (WHO, name, args.fluid))
+            return 2
 
         # no-nan: name the particles of every dataset with non-finite values.
         bad_here = 0
@@ -327,9 +360,10 @@ def main():
         ke = 0.5 * float(np.sum(m * v2)) if v2 is not None else None
         msum = float(np.sum(m))
         pe_h = float(np.sum(m * fl[vert].astype(float)))  # sum m * height
+        rho = eos_density(fl, args)
         eint = None
-        if args.c0 is not None and "rho" in fl and args.rho0 is not None:
-            eint = elastic_energy(m, fl["rho"].astype(float), args.rho0, args.c0, args.gamma)
+        if args.c0 is not None and rho is not None and args.rho0 is not None:
+            eint = elastic_energy(m, rho, args.rho0, args.c0, gamma)
         if first is None:
             first = {"t": t, "n": {a: len(p["x"]) for a, p in data.items() if "x" in p},
                      "m": {a: float(np.sum(p["m"])) for a, p in data.items() if "m" in p},
@@ -365,9 +399,9 @@ def main():
                             prev["t"], work, floor_e, where(args.fluid, i, pos),
                             math.sqrt(v2[i])))
         # density
-        if dens is not None and "rho" in fl and \
+        if dens is not None and rho is not None and \
                 (args.density_after is None or t > args.density_after):
-            r = fl["rho"].astype(float) / args.rho0
+            r = rho / args.rho0
             lo, hi = float(r.min()), float(r.max())
             dens.worst = (lo, hi) if dens.worst is None else \
                 (min(dens.worst[0], lo), max(dens.worst[1], hi))

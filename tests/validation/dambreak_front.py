@@ -17,10 +17,20 @@ files <name>_NNNNN.hdf5 with /particles/fluid/arrays/x and the time in /solver_d
          T = t sqrt(2 g / L),   Z/L = front position / column width L,
      both against their experiment (tests/data/koshizuka_oka_1996_surge.csv) and against
      their MPS calculation of the same idealised problem (tests/data/koshizuka_oka_1996_mps.csv).
-     The front is the largest x among fluid particles that have at least MIN_NEIGHBOURS other
-     fluid particles within 2 dx (distances in 2D, or 3D in 3D): this ignores isolated splash
-     droplets thrown ahead of the surge, which an experiment's front tracking would not see
-     either.
+     The front of an sphc run is the solver's own metric: the scene's `metrics { front =
+     max(fluid, x / L, reference = ".../koshizuka_oka_1996_surge.csv", ...) }`, the largest
+     x / L of the water at every output, read from the metric file the solver writes beside
+     its snapshots (OUTPUT_DIR/<scene>_metrics.csv; docs/language.md, Metrics). An sphc run
+     without that file or without the column `front` is an error. The script checks that the
+     metric is what it says, at every snapshot: `front` L is the largest x of the snapshot's
+     water (to 1e-9), and the scene's reference `front_ref`, where defined, is the K&O
+     experiment this script interpolates (to 1e-9), so the scene and the test judge against
+     the same data. The metric is a plain max: a splash droplet thrown ahead of the surge
+     counts (the table shows, for information, the largest x of the water particles that
+     have at least MIN_NEIGHBOURS others within 2 dx, which ignores such droplets, as an
+     experiment's front tracking would).
+     PySPH's output (no metric file) has its front recomputed from the snapshots, with that
+     filter (the front of the comparisons made before the metric existed).
      Each reference curve is interpolated linearly at every snapshot time with T inside its
      range and its Z/L below 3.8 (before the surge reaches the far wall at Z/L = 4).
      Snapshots with T < 1 are shown but not judged: the front has then moved less than 0.5 L
@@ -83,6 +93,7 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.exit(2)
 
 import plots  # noqa: E402  (tests/validation/plots.py)
+from metrics_csv import metrics_file, read_metrics, row_at  # noqa: E402
 from snapshots import (argument_parser, lattice_spacing, particle_arrays,  # noqa: E402
                        report_failures, scan_finite, snapshots)
 
@@ -179,11 +190,18 @@ def main():
         series.append(("M&M 1952 a=%g in" % a, mm["T"][sel], mm["Z_L"][sel]))
     tscale = np.sqrt(2.0 * args.g / args.L)
 
+    # sphc's runs write the solver's metrics beside the snapshots; PySPH's (.hdf5) do not.
+    metrics = None
+    if metrics_file(args.outdir) is not None or not files[0].endswith(".hdf5"):
+        metrics = read_metrics(args.outdir, "dambreak_front.py", ("front", "front_ref"))
+        if metrics is None:
+            return 2
+
     failures = []
     dx = args.dx
     dim = args.dim
     channel = None  # 3D: (ymin, ymax) of the channel
-    times, fronts, nfluid = [], [], None
+    times, fronts, filtered, nfluid = [], [], [], None
     for path in files:
         name = os.path.basename(path)
         with h5py.File(path, "r") as f:
@@ -233,25 +251,54 @@ def main():
                             % (t, int(np.count_nonzero(out)),
                                ", ".join("%.4f" % c[i] for c in pos)))
         times.append(t)
-        fronts.append(front_position(pos, dx) if len(x) else float("nan"))
+        filtered.append(front_position(pos, dx) / args.L if len(x) else float("nan"))
+        if metrics is None:
+            fronts.append(filtered[-1])
+            continue
+        # The solver's metric at this output: its value, and that it is what it says.
+        k = row_at(metrics, t)
+        if k is None:
+            failures.append("t = %.4f: the metric file has no row at this output time" % t)
+            fronts.append(float("nan"))
+            continue
+        z = metrics["front"][k]
+        fronts.append(z)
+        xmax = float(x.max()) if len(x) else float("nan")
+        if not abs(z * args.L - xmax) <= 1e-9 * max(1.0, abs(xmax)):
+            failures.append("t = %.4f: the metric front = %.10g, but the largest x / L of the "
+                            "snapshot's water is %.10g" % (t, z, xmax / args.L))
+        zr, Ti = metrics["front_ref"][k], t * tscale
+        if np.isfinite(zr) and t_exp.min() <= Ti <= t_exp.max():
+            mine = float(np.interp(Ti, t_exp, z_exp))
+            if abs(zr - mine) > 1e-9 * max(1.0, abs(mine)):
+                failures.append("t = %.4f: the scene's front_ref = %.10g is not %s "
+                                "interpolated at T = %.6g (%.10g)"
+                                % (t, zr, os.path.basename(args.data), Ti, mine))
 
     times = np.array(times)
-    fronts = np.array(fronts) / args.L
+    fronts = np.array(fronts)
+    filtered = np.array(filtered)
     T = times * tscale
 
     print("dam break surge front vs Koshizuka & Oka (1996): %d snapshots in %s (%s)"
           % (len(files), args.outdir, args.label))
-    print("dx = %.5g, front = max x of fluid particles with >= %d neighbours within 2 dx"
-          % (dx, MIN_NEIGHBOURS))
+    if metrics is not None:
+        print("dx = %.5g, front = the solver's metric `front` (max x / L of the water, %s); "
+              "filt. = max x / L of the particles with >= %d neighbours within 2 dx (shown, "
+              "not judged)" % (dx, os.path.basename(metrics_file(args.outdir)),
+                               MIN_NEIGHBOURS))
+    else:
+        print("dx = %.5g, front = max x of fluid particles with >= %d neighbours within 2 dx"
+              " (recomputed from the snapshots: no metric file)" % (dx, MIN_NEIGHBOURS))
     if dim == 3:
         print("3D: vertical z, channel %.4g <= y <= %.4g" % channel)
     print("judged where T >= %.1f (T = t sqrt(2g/L)) and the reference Z/L < %.1f;"
           " tolerance %.0f%% vs experiment, %.0f%% vs MPS"
           % (T_JUDGE_MIN, Z_WALL_LIMIT, 100 * args.tol, 100 * args.tol_mps))
     print()
-    print("%8s %8s %9s | %9s | %9s | %9s | %9s | %s"
-          % ("t [s]", "T", "Z/L sim", "K&O 1996", "M&M 1.125", "M&M 2.25", "K&O MPS",
-             "verdict"))
+    print("%8s %8s %9s %9s | %9s | %9s | %9s | %9s | %s"
+          % ("t [s]", "T", "Z/L sim", "filt.", "K&O 1996", "M&M 1.125", "M&M 2.25",
+             "K&O MPS", "verdict"))
     judged = {"experiments": 0, "experiment": 0, "MPS": 0}
     worst = {"experiments": 0.0, "experiment": 0.0, "MPS": 0.0}
 
@@ -276,7 +323,7 @@ def main():
     def fmt(e):
         return "%+8.1f%%" % (100 * e) if e is not None else "%9s" % "-"
 
-    for ti, Ti, zi in zip(times, T, fronts):
+    for ti, Ti, zi, zf in zip(times, T, fronts, filtered):
         errs = [rel_err(Ti, zi, ts, zs) for _, ts, zs in series]
         emps = rel_err(Ti, zi, t_mps, z_mps)
         if Ti < T_JUDGE_MIN:
@@ -294,7 +341,7 @@ def main():
             if emps is not None:
                 ok &= judge("MPS", emps, args.tol_mps, ti, Ti, zi, "K&O MPS")
             verdict = "ok" if ok else "FAIL"
-        print("%8.4f %8.4f %9.4f | %s | %s | %s" % (ti, Ti, zi,
+        print("%8.4f %8.4f %9.4f %9.4f | %s | %s | %s" % (ti, Ti, zi, zf,
               " | ".join(fmt(e) for e in errs), fmt(emps), verdict))
 
     print()
@@ -305,8 +352,9 @@ def main():
 
     def draw(plt):
         fig, ax = plt.subplots(figsize=(6.4, 4.8))
-        ax.plot(T, fronts, "-", label="%s (front, >= %d neighbours)"
-                % (args.label, MIN_NEIGHBOURS))
+        ax.plot(T, fronts, "-", label="%s (front, %s)" % (
+            args.label, "the solver's metric: max x" if metrics is not None
+            else ">= %d neighbours" % MIN_NEIGHBOURS))
         for (label, ts, zs), mk in zip(series, "o^v"):
             ax.plot(ts, zs, mk, label=label + ", experiment")
         ax.plot(t_mps, z_mps, "s", mfc="none", label="Koshizuka & Oka (1996), MPS")
