@@ -50,6 +50,7 @@ import os
 import re
 import shlex
 import subprocess
+import threading
 import sys
 import time
 
@@ -99,6 +100,10 @@ def parse_args(argv):
     ap.add_argument("--pysph-python", default=os.environ.get("SPHC_PYSPH_PYTHON"),
                     help="the Python that has PySPH (default: the first of python3 and "
                          "/usr/bin/python3 that imports it)")
+    ap.add_argument("--progress-every", type=float, default=10.0, metavar="S",
+                    help="while a run goes on, how far it is (its t, percent and ETA, from "
+                         "the solver's progress line) every S seconds of wall time (default "
+                         "10; 0: every new progress line)")
     ap.add_argument("-o", "--output", required=True, help="the study's directory")
     ap.add_argument("--sphc", default=os.environ.get("SPHC", "sphc"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -261,7 +266,7 @@ def read_metric_file(path):
 def run_one(args, exe, variant, kinds, rundir):
     os.makedirs(rundir, exist_ok=True)
     mfile = os.path.join(rundir, "metrics.csv")
-    cmd = [exe, "--quiet", "--timing", "--no-output", "--metrics", mfile]
+    cmd = [exe, "--timing", "--no-output", "--metrics", mfile]
     if args.tf is not None:
         cmd += ["--tf", repr(args.tf)]
     threaded = takes_threads(variant, kinds)
@@ -278,7 +283,8 @@ def run_one(args, exe, variant, kinds, rundir):
     with open(os.path.join(rundir, "stdout.txt"), "w") as so, \
             open(os.path.join(rundir, "stderr.txt"), "w") as se:
         p = subprocess.Popen(cmd, stdout=so, stderr=se)
-        _, status, usage = os.wait4(p.pid, 0)
+        status, usage = wait_reporting(p, os.path.join(rundir, "stderr.txt"),
+                                       args.progress_every)
     elapsed = time.time() - start
     code = os.waitstatus_to_exitcode(status) if hasattr(os, "waitstatus_to_exitcode") else status
     row = {"status": "ok" if code == 0 else "exit %d" % code,
@@ -287,6 +293,51 @@ def run_one(args, exe, variant, kinds, rundir):
            "command": " ".join(map(shlex.quote, cmd))}
     parse_run(row, os.path.join(rundir, "stdout.txt"), mfile)
     return row
+
+
+# The solver's progress line (on stderr when that is not a terminal):
+#   t=0.0600/0.2000  step 132  dt=0.00045  particles 2500  30.0% ETA 0m02s  ...
+PROGRESS_LINE = re.compile(r"^t=(\S+)/(\S+)\s.*?\s(\d+(?:\.\d+)?)% ETA (\S+)")
+
+
+def last_progress(path):
+    """(t, tf, percent, ETA) of the last progress line the solver wrote to path, or None."""
+    try:
+        with open(path, "rb") as f:
+            f.seek(0, os.SEEK_END)
+            f.seek(max(0, f.tell() - 4096))
+            lines = f.read().decode("utf-8", "replace").splitlines()
+    except OSError:
+        return None
+    for line in reversed(lines):
+        m = PROGRESS_LINE.match(line)
+        if m:
+            return m.groups()
+    return None
+
+
+def wait_reporting(p, stderr_path, every):
+    """Waits for the solver p while a second thread says how far it is, every `every` seconds
+    (0: each new progress line). Returns (wait status, resource usage) as os.wait4 does."""
+    done = threading.Event()
+
+    def report():
+        said = None
+        while not done.wait(max(every, 0.05)):
+            now = last_progress(stderr_path)
+            if now and now != said:
+                sys.stderr.write("    t=%s of %s (%s%%, this run's ETA %s)\n" % now)
+                sys.stderr.flush()
+                said = now
+
+    reporter = threading.Thread(target=report, daemon=True)
+    reporter.start()
+    try:
+        _, status, usage = os.wait4(p.pid, 0)
+    finally:
+        done.set()
+        reporter.join()
+    return status, usage
 
 
 def parse_run(row, stdout_path, mfile):
