@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "sphc/mpi/comm.h"
+#include "sphc/mpi/comm.h"  // size
 
 namespace sphc::mpi {
 
@@ -44,10 +44,17 @@ void sum_over_ranks(std::vector<double>& x) {
                 MPI_COMM_WORLD);
 }
 
-// A counter after this rank changed it by (now - before): before + the change of every rank.
-void count_over_ranks(std::size_t& counter, std::size_t before) {
-  const long change = sum(static_cast<long>(counter - before));
-  counter = before + static_cast<std::size_t>(change);
+// Counters after this rank changed them (now - before): before + the changes of every rank
+// (one MPI_Allreduce for all of them).
+void count_over_ranks(const std::vector<std::size_t*>& counters,
+                      const std::vector<std::size_t>& before) {
+  std::vector<long> change(counters.size());
+  for (std::size_t k = 0; k < counters.size(); ++k)
+    change[k] = static_cast<long>(*counters[k] - before[k]);
+  MPI_Allreduce(MPI_IN_PLACE, change.data(), static_cast<int>(change.size()), MPI_LONG, MPI_SUM,
+                MPI_COMM_WORLD);
+  for (std::size_t k = 0; k < counters.size(); ++k)
+    *counters[k] = before[k] + static_cast<std::size_t>(change[k]);
 }
 
 }  // namespace
@@ -79,11 +86,9 @@ bool update_inlet_outlet(InletOutlet& io, double t) {
     changed |= !crossed.empty();
   }
   for (OutletZone& out : io.outlets) {
-    const std::size_t entered = out.entered, returned = out.returned, removed = out.removed;
+    const std::vector<std::size_t> before{out.entered, out.returned, out.removed};
     changed |= update_outlet(out);
-    count_over_ranks(out.entered, entered);
-    count_over_ranks(out.returned, returned);
-    count_over_ranks(out.removed, removed);
+    count_over_ranks({&out.entered, &out.returned, &out.removed}, before);
     if (out.kind == OutletKind::DoNothing) continue;
     const ImageBand band = all_band(image_band(out));
     ImageValues iv = interpolate_images(out, band);
