@@ -709,6 +709,7 @@ std::string ScenePrinter::run() {
   if (hasDomain()) out_ << "#include \"sphc/domain.h\"\n";
   if (!plan_.metrics.empty()) out_ << "#include \"sphc/metrics.h\"\n";
   if (hasZones()) out_ << "#include \"sphc/inlet_outlet.h\"\n";
+  if (hasZones() && mpi_) out_ << "#include \"sphc/mpi/zones.h\"\n";
   out_ << "#include \"sphc/restart.h\"\n";
   if (globalIds_) out_ << "#include \"sphc/global_ids.h\"\n";
   if (mpi_)

@@ -82,7 +82,8 @@ void ScenePrinter::emitInletOutlet() {
   scene_ << "    const double start = sphc::wall_seconds();\n";
   bool mirror = false;  // a mirror outlet sets its particles every step: no shortcut
   for (const PlanZone& z : plan_.zones) mirror |= !z.inlet && z.type != "do_nothing";
-  if (checksZonesFirst() && !mirror) {
+  // The shortcut is a rank's own decision: a distributed run always takes the collective path.
+  if (checksZonesFirst() && !mirror && !mpi_) {
     std::vector<int> inlets;
     for (const PlanZone& z : plan_.zones)
       if (z.inlet) inlets.push_back(z.array);
@@ -93,7 +94,10 @@ void ScenePrinter::emitInletOutlet() {
     scene_ << "      io_seconds += sphc::wall_seconds() - start;\n      return;\n    }\n";
   }
   arraysToHost(sched_.resized);
-  scene_ << "    sphc::update_inlet_outlet(io, t);\n";
+  if (mpi_)  // --mpi: the same steps with collectives between them (sphc/mpi/zones.h)
+    scene_ << "    sphc::mpi::update_inlet_outlet(io, t);\n";
+  else
+    scene_ << "    sphc::update_inlet_outlet(io, t);\n";
   arraysFromHost(sched_.resized);
   scene_ << "    io_seconds += sphc::wall_seconds() - start;  // for --timing\n";
   scene_ << "  }\n\n";

@@ -201,13 +201,8 @@ int main(int argc, char** argv) {
     }
   }
   plan->distributed = Mpi;
-  // Not distributed yet: inlets and outlets (arrays that grow and shrink on one rank).
-  // Metrics are: their sums are combined over the ranks (sphc/mpi/comm.h, all_reduce).
-  if (Mpi && !plan->zones.empty()) {
-    diags.error(plan->zones.front().loc, "--mpi does not support inlets and outlets yet: "
-                                         "build this scene without --mpi");
-    return fail();
-  }
+  // Inlets and outlets are distributed (sphc/mpi/zones.h), metrics too: their sums are
+  // combined over the ranks (sphc/mpi/comm.h, all_reduce).
   auto dump = [&](Pass pass) {
     if (DumpAfter != pass) return false;
     printPlan(*plan, llvm::outs(), false);

@@ -10,6 +10,14 @@ std::uint32_t GlobalIds::take() {
   return next++;
 }
 
+std::uint32_t GlobalIds::take(std::size_t count) {
+  if (count > static_cast<std::size_t>(UINT32_MAX - next))
+    throw std::overflow_error("global particle ids exhausted (2^32 - 1 used)");
+  const std::uint32_t first = next;
+  next += static_cast<std::uint32_t>(count);
+  return first;
+}
+
 void assign_global_ids(const std::vector<ParticleArray*>& arrays, GlobalIds& ids) {
   for (ParticleArray* a : arrays) {
     const int g = a->add_property("gid", PropType::U32, 1);

@@ -131,8 +131,7 @@ void append_particle(ParticleArray& to, const ParticleArray& from, std::size_t i
   }
 }
 
-namespace {
-void set_velocity(InletZone& in, double t) {
+void set_inlet_velocity(InletZone& in, double t) {
   if (!in.velocity) return;
   ParticleArray& a = *in.inlet;
   const Positions pos(a);
@@ -149,7 +148,6 @@ void set_velocity(InletZone& in, double t) {
       if (vel[k]) vel[k][i] = v[k];
   }
 }
-}  // namespace
 
 double largest_h(const std::vector<ParticleArray*>& arrays) {
   double h = 0.0;
@@ -169,7 +167,7 @@ void init_inlet_outlet(InletOutlet& io, const std::vector<ParticleArray*>& all, 
   assign_global_ids(all, io.ids);
   for (auto& in : io.inlets) {
     in.map = make_copy_map(*in.feeds, *in.inlet, in.copy);
-    set_velocity(in, t);
+    set_inlet_velocity(in, t);
   }
   for (auto& out : io.outlets) {
     out.in = make_copy_map(*out.outlet, *out.from, out.copy);
@@ -187,31 +185,57 @@ void init_inlet_outlet(InletOutlet& io, const std::vector<ParticleArray*>& all, 
   }
 }
 
-namespace {
-// The mirror interpolation: for every outlet particle, the properties of out.mirrored
-// interpolated from the source at its image across the face into vals[i * np + k] (np =
-// out.mirrored.to.size()), found[i] = 0 where no source particle lies within the support.
-std::size_t interpolate_images(const OutletZone& out, std::vector<double>& vals,
-                               std::vector<std::uint8_t>& found) {
-  const ParticleArray& o = *out.outlet;
+ImageBand image_band(const OutletZone& out) {
   const ParticleArray& src = *out.from;
   const Zone& z = out.zone;
-  const double R = out.support;
-  const std::size_t np = out.mirrored.to.size();
-  vals.assign(o.n * np, 0.0);
-  found.assign(o.n, 0);
-  if (!(R > 0.0) || np == 0) return 0;
-  // The source particles an image point can reach: depth in [-(2 length + R), 0].
-  std::vector<std::size_t> near;
+  ImageBand band;
+  band.np = out.mirrored.to.size();
+  if (!(out.support > 0.0) || band.np == 0) return band;
+  const int g = src.find("gid");
   const Positions sp(src);
   for (std::size_t j = 0; j < src.n; ++j) {
     double q[3];
     sp.at(j, q);
     const double s = z.depth(q);
-    if (s <= 0.0 && s >= -(2.0 * z.length + R)) near.push_back(j);
+    if (!(s <= 0.0 && s >= -(2.0 * z.length + out.support))) continue;
+    band.pos.insert(band.pos.end(), q, q + 3);
+    for (std::size_t k = 0; k < band.np; ++k)
+      band.vals.push_back(src.props[out.mirrored.from[k]].f64[j]);
+    band.gid.push_back(g >= 0 ? src.props[static_cast<std::size_t>(g)].u32[j]
+                              : static_cast<std::uint32_t>(j));
   }
+  return band;
+}
+
+void sort_band(ImageBand& band) {
+  const std::size_t n = band.size(), np = band.np;
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return band.gid[a] < band.gid[b]; });
+  ImageBand s;
+  s.np = np;
+  s.pos.reserve(band.pos.size());
+  s.vals.reserve(band.vals.size());
+  s.gid.reserve(n);
+  for (std::size_t i : order) {
+    s.pos.insert(s.pos.end(), band.pos.begin() + 3 * i, band.pos.begin() + 3 * i + 3);
+    s.vals.insert(s.vals.end(), band.vals.begin() + np * i, band.vals.begin() + np * (i + 1));
+    s.gid.push_back(band.gid[i]);
+  }
+  band = std::move(s);
+}
+
+ImageValues interpolate_images(const OutletZone& out, const ImageBand& band) {
+  const ParticleArray& o = *out.outlet;
+  const Zone& z = out.zone;
+  const double R = out.support;
+  const std::size_t np = out.mirrored.to.size();
+  ImageValues iv;
+  iv.vals.assign(o.n * np, 0.0);
+  iv.found.assign(o.n, 0);
+  if (!(R > 0.0) || np == 0) return iv;
   const Positions op(o);
-  std::size_t lonely = 0;
   for (std::size_t i = 0; i < o.n; ++i) {
     double p[3];
     op.at(i, p);
@@ -219,28 +243,29 @@ std::size_t interpolate_images(const OutletZone& out, std::vector<double>& vals,
     double img[3];
     for (int k = 0; k < 3; ++k) img[k] = p[k] - 2.0 * s * z.normal[k];
     double wsum = 0.0;
-    double* acc = vals.data() + i * np;
-    for (std::size_t j : near) {
-      double q[3];
-      sp.at(j, q);
+    double* acc = iv.vals.data() + i * np;
+    for (std::size_t j = 0; j < band.size(); ++j) {
+      const double* q = band.pos.data() + 3 * j;
       double r2 = 0.0;
       for (int k = 0; k < z.dim; ++k) r2 += (q[k] - img[k]) * (q[k] - img[k]);
       if (r2 >= R * R) continue;
       const double x = std::sqrt(r2) / R, a = 1.0 - x;
       const double w = a * a * a * a * (1.0 + 4.0 * x);  // Wendland C2 (unnormalised)
       wsum += w;
-      for (std::size_t k = 0; k < np; ++k) acc[k] += w * src.props[out.mirrored.from[k]].f64[j];
+      const double* v = band.vals.data() + np * j;
+      for (std::size_t k = 0; k < np; ++k) acc[k] += w * v[k];
     }
     if (!(wsum > 0.0)) {
-      ++lonely;
+      ++iv.lonely;
       continue;
     }
-    found[i] = 1;
+    iv.found[i] = 1;
     for (std::size_t k = 0; k < np; ++k) acc[k] /= wsum;
   }
-  return lonely;
+  return iv;
 }
 
+namespace {
 // Tangential coordinates of p on the face (2D: one, 3D: two; orthonormal to the normal).
 void tangential(const Zone& z, const double p[3], double t[2]) {
   double d[3];
@@ -267,105 +292,145 @@ void tangential(const Zone& z, const double p[3], double t[2]) {
 }
 }  // namespace
 
-std::size_t mirror_outlet(OutletZone& out) {
-  std::vector<double> vals;
-  std::vector<std::uint8_t> found;
-  const std::size_t lonely = interpolate_images(out, vals, found);
+void apply_mirror(OutletZone& out, const ImageValues& iv) {
   ParticleArray& o = *out.outlet;
   const std::size_t np = out.mirrored.to.size();
   for (std::size_t i = 0; i < o.n; ++i)
-    if (found[i])
-      for (std::size_t k = 0; k < np; ++k) o.props[out.mirrored.to[k]].f64[i] = vals[i * np + k];
-  return lonely;
+    if (iv.found[i])
+      for (std::size_t k = 0; k < np; ++k)
+        o.props[out.mirrored.to[k]].f64[i] = iv.vals[i * np + k];
 }
 
-std::size_t characteristic_outlet(OutletZone& out, double t) {
-  ParticleArray& o = *out.outlet;
+std::size_t mirror_outlet(OutletZone& out) {
+  ImageBand band = image_band(out);
+  sort_band(band);
+  const ImageValues iv = interpolate_images(out, band);
+  apply_mirror(out, iv);
+  return iv.lonely;
+}
+
+namespace {
+// Where p, rho and the velocity components sit among the interpolated values (the
+// characteristic condition's needs checked).
+struct Slots {
+  int p = -1, rho = -1, v[3] = {-1, -1, -1};
+};
+Slots characteristic_slots(const OutletZone& out) {
+  const ParticleArray& o = *out.outlet;
   const Zone& z = out.zone;
   if (!(out.c > 0.0))
     throw std::invalid_argument(z.name + ": the characteristic outlet needs the sound speed "
                                 "c > 0 (got " + num(out.c) + ")");
-  // Where p, rho and the velocity components sit among the interpolated values.
   const std::size_t np = out.mirrored.to.size();
   auto slot = [&](const char* name) {
     for (std::size_t k = 0; k < np; ++k)
       if (o.props[out.mirrored.to[k]].name == name) return static_cast<int>(k);
     return -1;
   };
-  const int kp = slot("p"), krho = slot("rho");
-  int kv[3] = {slot("u"), slot("v"), slot("w")};
-  if (kp < 0) throw std::invalid_argument(z.name + ": the characteristic outlet needs 'p' "
-                                          "in both arrays (and copied)");
+  Slots s;
+  s.p = slot("p");
+  s.rho = slot("rho");
+  s.v[0] = slot("u");
+  s.v[1] = slot("v");
+  s.v[2] = slot("w");
+  if (s.p < 0) throw std::invalid_argument(z.name + ": the characteristic outlet needs 'p' "
+                                           "in both arrays (and copied)");
   for (int k = 0; k < z.dim; ++k)
-    if (kv[k] < 0)
+    if (s.v[k] < 0)
       throw std::invalid_argument(z.name + ": the characteristic outlet needs the velocity "
                                   "'" + std::string(1, "uvw"[k]) + "' in both arrays (and copied)");
-  std::vector<double> vals;
-  std::vector<std::uint8_t> found;
-  const std::size_t lonely = interpolate_images(out, vals, found);
+  return s;
+}
+}  // namespace
 
+NormalBins normal_bins(const OutletZone& out, const ImageValues& iv) {
+  const ParticleArray& o = *out.outlet;
+  const Zone& z = out.zone;
+  const Slots sl = characteristic_slots(out);
+  const std::size_t np = out.mirrored.to.size();
   // Bins across the face (width support / 2) for the mean normal velocity u_ref.
   const double bw = 0.5 * out.support;
   const int nb1 = z.dim > 1 ? std::max(1, static_cast<int>(std::ceil(z.width / bw))) : 1;
   const int nb2 = z.dim > 2 ? nb1 : 1;
   const std::size_t nb = static_cast<std::size_t>(nb1) * static_cast<std::size_t>(nb2);
-  if (out.uref.size() != nb) {
-    out.uref.assign(nb, 0.0);
-    out.uref_set.assign(nb, 0);
-  }
+  NormalBins b;
+  b.bin.assign(o.n, 0);
+  b.un.assign(o.n, 0.0);
+  b.sum.assign(nb, 0.0);
+  b.count.assign(nb, 0.0);
   const Positions op(o);
-  std::vector<std::size_t> bin(o.n, 0);
-  std::vector<double> sum(nb, 0.0);
-  std::vector<std::size_t> cnt(nb, 0);
-  std::vector<double> un(o.n, 0.0);
   for (std::size_t i = 0; i < o.n; ++i) {
     double p[3], tc[2];
     op.at(i, p);
     tangential(z, p, tc);
     auto idx = [&](double c) {
-      const int b = static_cast<int>(std::floor((c + 0.5 * z.width) / bw));
-      return std::min(std::max(b, 0), nb1 - 1);
+      const int k = static_cast<int>(std::floor((c + 0.5 * z.width) / bw));
+      return std::min(std::max(k, 0), nb1 - 1);
     };
-    bin[i] = static_cast<std::size_t>(idx(tc[0])) +
-             (z.dim > 2 ? static_cast<std::size_t>(idx(tc[1])) * nb1 : 0);
-    if (!found[i]) continue;
-    for (int k = 0; k < z.dim; ++k) un[i] += vals[i * np + kv[k]] * z.normal[k];
-    sum[bin[i]] += un[i];
-    ++cnt[bin[i]];
+    b.bin[i] = static_cast<std::size_t>(idx(tc[0])) +
+               (z.dim > 2 ? static_cast<std::size_t>(idx(tc[1])) * nb1 : 0);
+    if (!iv.found[i]) continue;
+    for (int k = 0; k < z.dim; ++k) b.un[i] += iv.vals[i * np + sl.v[k]] * z.normal[k];
+    b.sum[b.bin[i]] += b.un[i];
+    b.count[b.bin[i]] += 1.0;
   }
-  const double tau = out.tau > 0.0 ? out.tau : 20.0 * z.length / out.c;
+  return b;
+}
+
+void advance_reference(OutletZone& out, const NormalBins& b, double t) {
+  const std::size_t nb = b.sum.size();
+  if (out.uref.size() != nb) {
+    out.uref.assign(nb, 0.0);
+    out.uref_set.assign(nb, 0);
+  }
+  const double tau = out.tau > 0.0 ? out.tau : 20.0 * out.zone.length / out.c;
   const double f = out.started ? std::min(1.0, std::max(0.0, t - out.t_last) / tau) : 1.0;
-  for (std::size_t b = 0; b < nb; ++b) {
-    if (!cnt[b]) continue;
-    const double mean = sum[b] / static_cast<double>(cnt[b]);
-    if (!out.uref_set[b]) {
-      out.uref[b] = mean;
-      out.uref_set[b] = 1;
+  for (std::size_t k = 0; k < nb; ++k) {
+    if (!(b.count[k] > 0.0)) continue;
+    const double mean = b.sum[k] / b.count[k];
+    if (!out.uref_set[k]) {
+      out.uref[k] = mean;
+      out.uref_set[k] = 1;
     } else {
-      out.uref[b] += f * (mean - out.uref[b]);
+      out.uref[k] += f * (mean - out.uref[k]);
     }
   }
   out.started = true;
   out.t_last = t;
-
-  for (std::size_t i = 0; i < o.n; ++i) {
-    if (!found[i]) continue;
-    double* v = vals.data() + i * np;
-    const double rho = krho >= 0 && v[krho] > 0.0 ? v[krho] : 1.0;
-    const double ur = out.uref[bin[i]];
-    const double j2 = rho * out.c * (un[i] - ur) + (v[kp] - out.p_ref);
-    v[kp] = out.p_ref + 0.5 * j2;
-    const double dn = ur + 0.5 * j2 / (rho * out.c) - un[i];  // new minus image normal velocity
-    for (int k = 0; k < z.dim; ++k) v[kv[k]] += dn * z.normal[k];
-    for (std::size_t k = 0; k < np; ++k) o.props[out.mirrored.to[k]].f64[i] = v[k];
-  }
-  return lonely;
 }
 
-bool update_inlet(InletZone& in, GlobalIds& ids, double t) {
+void apply_characteristic(OutletZone& out, ImageValues& iv, const NormalBins& b) {
+  ParticleArray& o = *out.outlet;
+  const Zone& z = out.zone;
+  const Slots sl = characteristic_slots(out);
+  const std::size_t np = out.mirrored.to.size();
+  for (std::size_t i = 0; i < o.n; ++i) {
+    if (!iv.found[i]) continue;
+    double* v = iv.vals.data() + i * np;
+    const double rho = sl.rho >= 0 && v[sl.rho] > 0.0 ? v[sl.rho] : 1.0;
+    const double ur = out.uref[b.bin[i]];
+    const double j2 = rho * out.c * (b.un[i] - ur) + (v[sl.p] - out.p_ref);
+    v[sl.p] = out.p_ref + 0.5 * j2;
+    const double dn = ur + 0.5 * j2 / (rho * out.c) - b.un[i];  // new minus image normal velocity
+    for (int k = 0; k < z.dim; ++k) v[sl.v[k]] += dn * z.normal[k];
+    for (std::size_t k = 0; k < np; ++k) o.props[out.mirrored.to[k]].f64[i] = v[k];
+  }
+}
+
+std::size_t characteristic_outlet(OutletZone& out, double t) {
+  characteristic_slots(out);  // the checks, before anything changes
+  ImageBand band = image_band(out);
+  sort_band(band);
+  ImageValues iv = interpolate_images(out, band);
+  const NormalBins b = normal_bins(out, iv);
+  advance_reference(out, b, t);
+  apply_characteristic(out, iv, b);
+  return iv.lonely;
+}
+
+std::vector<std::size_t> enter_fluid(InletZone& in) {
   ParticleArray& a = *in.inlet;
-  const int gid = a.find("gid");
-  bool changed = false;
+  std::vector<std::size_t> crossed;
   for (std::size_t i = 0; i < a.n; ++i) {
     double p[3];
     Positions(a).at(i, p);
@@ -373,16 +438,47 @@ bool update_inlet(InletZone& in, GlobalIds& ids, double t) {
     // enters once, and moves back as often as needed.
     if (in.zone.depth(p) >= 0.0) continue;
     append_particle(*in.feeds, a, i, in.map);
-    ++in.created;
-    changed = true;
+    crossed.push_back(i);
     while (in.zone.depth(p) < 0.0) {
       shift(a, i, in.zone.normal, in.zone.length);
       Positions(a).at(i, p);
     }
-    if (gid >= 0) a.u32(gid)[i] = ids.take();
   }
-  set_velocity(in, t);
-  return changed;
+  return crossed;
+}
+
+std::vector<std::uint32_t> old_ids(const InletZone& in, const std::vector<std::size_t>& crossed) {
+  std::vector<std::uint32_t> ids;
+  const int gid = in.inlet->find("gid");
+  if (gid < 0) return ids;
+  ids.reserve(crossed.size());
+  for (std::size_t i : crossed) ids.push_back(in.inlet->u32(gid)[i]);
+  return ids;
+}
+
+void give_fresh_ids(InletZone& in, const std::vector<std::size_t>& crossed,
+                    const std::vector<std::uint32_t>& entering, std::uint32_t first) {
+  ParticleArray& a = *in.inlet;
+  const int gid = a.find("gid");
+  if (gid < 0) return;
+  std::uint32_t* g = a.u32(gid);
+  for (std::size_t i : crossed) {
+    const auto it = std::lower_bound(entering.begin(), entering.end(), g[i]);
+    if (it == entering.end() || *it != g[i])
+      throw std::logic_error(in.zone.name + ": particle gid " + std::to_string(g[i]) +
+                             " crossed the face but is not among the entering ids");
+    g[i] = first + static_cast<std::uint32_t>(it - entering.begin());
+  }
+}
+
+bool update_inlet(InletZone& in, GlobalIds& ids, double t) {
+  const std::vector<std::size_t> crossed = enter_fluid(in);
+  std::vector<std::uint32_t> entering = old_ids(in, crossed);
+  std::sort(entering.begin(), entering.end());
+  give_fresh_ids(in, crossed, entering, ids.take(crossed.size()));
+  in.created += crossed.size();
+  set_inlet_velocity(in, t);
+  return !crossed.empty();
 }
 
 bool update_outlet(OutletZone& out) {
@@ -461,7 +557,7 @@ bool inlet_outlet_due(const InletOutlet& io) {
 }
 
 void set_inlet_velocities(InletOutlet& io, double t) {
-  for (auto& in : io.inlets) set_velocity(in, t);
+  for (auto& in : io.inlets) set_inlet_velocity(in, t);
 }
 
 bool update_inlet_outlet(InletOutlet& io, double t) {

@@ -12,7 +12,7 @@ worst difference per property over all files and exits 1 if any exceeds T or any
 missing.
 
 The files must also have the reference's layout: the same root attributes (step, dim and scene
-equal, t and dt within T), the same array groups and datasets in the same order with the same
+equal, t, dt and the run state restart_NAME of --restartable files within T), the same array groups and datasets in the same order with the same
 types and shapes; with --gid-order, the other run's particles in gid order (the order a
 distributed run writes, whatever the rank count; a serial run may have reordered its own).
 
@@ -54,8 +54,12 @@ def layout_problems(fr, fo, tol, gid_order):
         for k in ("step", "dim", "scene"):
             if k in a.attrs and k in b.attrs and a.attrs[k] != b.attrs[k]:
                 out.append(f"root attribute {k} = {b.attrs[k]}, expected {a.attrs[k]}")
-        for k in ("t", "dt"):
-            if k in a.attrs and k in b.attrs and abs(a.attrs[k] - b.attrs[k]) > tol * max(abs(a.attrs[k]), 1e-300):
+        # t, dt and the run state of --restartable files (restart_NAME: step counts, the
+        # inlet/outlet manager's next id, counters and running mean) within tol.
+        for k in a.attrs:
+            if k not in ("t", "dt") and not k.startswith("restart_"):
+                continue
+            if k in b.attrs and abs(a.attrs[k] - b.attrs[k]) > tol * max(abs(a.attrs[k]), 1e-300):
                 out.append(f"root attribute {k} = {b.attrs[k]}, expected {a.attrs[k]}")
         if list(a.keys()) != list(b.keys()):
             out.append(f"groups {list(b.keys())}, expected {list(a.keys())}")

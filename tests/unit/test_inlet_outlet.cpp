@@ -2,9 +2,13 @@
 // (sphc/global_ids.h) and the inlet/outlet manager (sphc/inlet_outlet.h).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <set>
+#include <utility>
+#include <vector>
 #include <stdexcept>
 #include <string>
 
@@ -368,4 +372,113 @@ TEST(InletOutlet, CharacteristicOutletPassesOutgoingWavesOnly) {
   out.from = &fluid;
   out.kind = sphc::OutletKind::Characteristic;
   EXPECT_THROW(sphc::characteristic_outlet(out, 0.0), std::invalid_argument);
+}
+
+// Fresh ids in (inlet, old id) order: an inlet's particles split over 1, 2 and 4 "ranks" (each
+// its own inlet array holding a share in another order, as migration and reorders leave them)
+// get, through the steps a distributed run takes (enter_fluid on each share, the old ids of
+// every share gathered and sorted, give_fresh_ids with one first id: sphc/mpi/zones.h),
+// exactly the ids the serial update_inlet gives the whole array, particle by particle (matched
+// by position); and those are next, next + 1, ... in the order of the old ids.
+TEST(InletOutlet, FreshIdsInOldIdOrderOverRanks) {
+  const double dx = 0.1;
+  auto with_gid = [](const std::string& name) {
+    ParticleArray a = make_array(name, 0);
+    a.add_property("gid", PropType::U32, 1);
+    return a;
+  };
+  // A 4 x 10 lattice at x = -0.15, -0.05, 0.05, 0.15 (the inlet face at x = 0, normal -x: the
+  // two columns at x > 0 crossed), particle k with old id 100 + 7 k mod 40 (place and id
+  // orders differ).
+  auto lattice = [&](ParticleArray& a, const std::vector<std::size_t>& which) {
+    for (std::size_t k : which) {
+      const std::size_t i = a.n;
+      a.resize(i + 1);
+      a.f64("x")[i] = dx * static_cast<double>(k % 4) - 0.15;
+      a.f64("y")[i] = dx * (static_cast<double>(k / 4) + 0.5);
+      a.u32(a.find("gid"))[i] = static_cast<std::uint32_t>(100 + (7 * k) % 40);
+    }
+  };
+  auto zone = [&](ParticleArray& inlet, ParticleArray& fluid) {
+    sphc::InletZone in;
+    in.zone.name = "inlet";
+    in.zone.dim = 2;
+    in.zone.normal[0] = -1.0;
+    in.zone.length = 0.4;
+    in.zone.width = 1.0;
+    in.zone.point[1] = 0.5;
+    in.inlet = &inlet;
+    in.feeds = &fluid;
+    in.map = sphc::make_copy_map(fluid, inlet, {"x", "y"});
+    return in;
+  };
+  // A position as integers (half dx units).
+  auto key = [&](double x, double y) {
+    return std::make_pair(std::lround(x / dx * 2), std::lround(y / dx * 2));
+  };
+  std::vector<std::size_t> all(40);
+  for (std::size_t k = 0; k < 40; ++k) all[k] = (13 * k + 5) % 40;  // a scrambled order
+  ParticleArray inlet = with_gid("inlet"), fluid = with_gid("fluid");
+  lattice(inlet, all);
+  sphc::InletZone in = zone(inlet, fluid);
+  sphc::GlobalIds ids;
+  ids.next = 500;
+  EXPECT_TRUE(sphc::update_inlet(in, ids, 0.0));
+  ASSERT_EQ(fluid.n, 20u);
+  EXPECT_EQ(ids.next, 520u);
+  EXPECT_EQ(in.created, 20u);
+  std::map<std::pair<long, long>, std::uint32_t> want;  // serial: position -> id
+  for (std::size_t i = 0; i < inlet.n; ++i)
+    want[key(inlet.f64("x")[i], inlet.f64("y")[i])] = inlet.u32(inlet.find("gid"))[i];
+  ASSERT_EQ(want.size(), 40u);
+  // The fed particles kept their old ids; the inlet particle that replaced each (moved back by
+  // the zone length, 0.4 in -x) has 500 + the place of that old id among the 20.
+  const std::uint32_t* fg = fluid.u32(fluid.find("gid"));
+  std::vector<std::uint32_t> old(fg, fg + fluid.n);
+  std::sort(old.begin(), old.end());
+  for (std::size_t j = 0; j < fluid.n; ++j) {
+    const auto k = std::lower_bound(old.begin(), old.end(), fg[j]) - old.begin();
+    EXPECT_EQ(want.at(key(fluid.f64("x")[j] - 0.4, fluid.f64("y")[j])), 500u + k)
+        << "old id " << fg[j];
+  }
+  for (int ranks : {1, 2, 4}) {
+    std::vector<ParticleArray> inl, flu;
+    for (int r = 0; r < ranks; ++r) {
+      inl.push_back(with_gid("inlet"));
+      flu.push_back(with_gid("fluid"));
+      std::vector<std::size_t> share;  // every ranks-th particle, in reverse: another order
+      for (std::size_t k = 0; k < 40; ++k)
+        if (static_cast<int>(k % ranks) == r) share.push_back(all[39 - k]);
+      lattice(inl[r], share);
+    }
+    std::vector<sphc::InletZone> zones;
+    for (int r = 0; r < ranks; ++r) zones.push_back(zone(inl[r], flu[r]));
+    std::vector<std::vector<std::size_t>> crossed(ranks);
+    std::vector<std::uint32_t> entering;  // what all_entering gathers
+    for (int r = 0; r < ranks; ++r) {
+      crossed[r] = sphc::enter_fluid(zones[r]);
+      const auto ids_r = sphc::old_ids(zones[r], crossed[r]);
+      entering.insert(entering.end(), ids_r.begin(), ids_r.end());
+    }
+    std::sort(entering.begin(), entering.end());
+    ASSERT_EQ(entering.size(), 20u);
+    sphc::GlobalIds rank_ids;
+    rank_ids.next = 500;
+    const std::uint32_t first = rank_ids.take(entering.size());
+    for (int r = 0; r < ranks; ++r) sphc::give_fresh_ids(zones[r], crossed[r], entering, first);
+    EXPECT_EQ(rank_ids.next, ids.next);
+    std::size_t seen = 0, fed = 0;
+    for (int r = 0; r < ranks; ++r) {
+      for (std::size_t i = 0; i < inl[r].n; ++i, ++seen)
+        EXPECT_EQ(inl[r].u32(inl[r].find("gid"))[i],
+                  want.at(key(inl[r].f64("x")[i], inl[r].f64("y")[i])))
+            << ranks << " ranks, rank " << r << ", particle " << i;
+      fed += flu[r].n;
+    }
+    EXPECT_EQ(seen, 40u);
+    EXPECT_EQ(fed, 20u);
+  }
+  // A crossing particle whose old id is not among the entering ones is an error.
+  std::vector<std::size_t> one{0};
+  EXPECT_THROW(sphc::give_fresh_ids(in, one, {}, 0), std::logic_error);
 }

@@ -9,6 +9,7 @@
 // the particles crossing a section).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -21,6 +22,8 @@ struct GlobalIds {
   std::uint32_t next = 0;
   // A fresh id; throws std::overflow_error when 2^32 ids have been used.
   std::uint32_t take();
+  // The first of `count` consecutive fresh ids (next moves on by count); the same overflow.
+  std::uint32_t take(std::size_t count);
 };
 
 // Adds the property gid (uint32) to every array (if absent) and numbers their particles

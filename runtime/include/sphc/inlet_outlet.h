@@ -31,7 +31,7 @@
 //     (the kernel support). A zero normal gradient at the face: the outflow continues with
 //     the fluid's velocity profile and pressure instead of the values frozen when each
 //     particle left. A particle whose image has no source particle within the support keeps
-//     its values. Serial and in particle order, as everything here.
+//     its values. The fluid particles are added in gid order (ImageBand).
 //   - characteristic (the method of characteristics of Lastiwka, Basa & Quinlan 2009, one of
 //     the outlets compared by Negi et al. 2019): the image interpolation of `mirror` gives
 //     each outlet particle the fluid's p_f, u_f, rho_f at its image; of the three
@@ -52,7 +52,10 @@
 //
 // Arrays change size only here, between time steps, never during an evaluation: the neighbour
 // search, ghosts and cell lists are rebuilt from the current sizes at every evaluation. All
-// of it is serial and in particle order, so every backend produces the same arrays.
+// of it is serial and in particle order, so every backend produces the same arrays. A
+// distributed run (sphc --mpi) does the same steps on each rank's particles with the few
+// collectives of sphc/mpi/zones.h between them: fresh ids in old-id order, the image band
+// gathered from every rank, the characteristic outlet's bin sums added over the ranks.
 #pragma once
 
 #include <cstddef>
@@ -164,5 +167,60 @@ std::size_t mirror_outlet(OutletZone& out);
 // Throws std::invalid_argument unless c > 0 and the outlet array has p and u (v, w in 2D/3D).
 std::size_t characteristic_outlet(OutletZone& out, double t);
 bool update_inlet_outlet(InletOutlet& io, double t);
+
+// ---- The steps these are made of (a distributed run, sphc/mpi/zones.h, puts collectives
+// between them; a serial run calls them in a row). ----
+
+// Fresh ids. The inlet particles that crossed the face get fresh ids in the order of their
+// old ids (not of their places in the array, which depend on reorders and, in a distributed
+// run, on the ranks), so every run numbers them alike. enter_fluid appends every inlet
+// particle that crossed to the fed array and moves it back by the zone length; it returns
+// their places in the inlet array (ids untouched, `created` unchanged).
+std::vector<std::size_t> enter_fluid(InletZone& in);
+// The old gids of the inlet particles at `crossed`.
+std::vector<std::uint32_t> old_ids(const InletZone& in, const std::vector<std::size_t>& crossed);
+// `entering`: the old gids of every particle that crossed this inlet (all ranks), ascending;
+// the particle at crossed[k] gets first + (the place of its old gid in `entering`). Throws
+// std::logic_error if its old gid is not there.
+void give_fresh_ids(InletZone& in, const std::vector<std::size_t>& crossed,
+                    const std::vector<std::uint32_t>& entering, std::uint32_t first);
+// The inlet particles' prescribed velocities at time t (update_inlet's last step).
+void set_inlet_velocity(InletZone& in, double t);
+
+// The band of the source array an outlet's image points can reach (depth in
+// [-(2 length + support), 0]): positions (3 per particle), the values of out.mirrored
+// (np per particle) and gid, in gid order (so the interpolation adds them in an order that
+// does not depend on reorders or ranks).
+struct ImageBand {
+  std::size_t np = 0;
+  std::vector<double> pos, vals;
+  std::vector<std::uint32_t> gid;
+  std::size_t size() const { return gid.size(); }
+};
+// This array's particles in the band (unsorted); sort_band puts a band in gid order.
+ImageBand image_band(const OutletZone& out);
+void sort_band(ImageBand& band);
+// The interpolation at every outlet particle's image from the band: vals[i * np + k],
+// found[i] = 0 where no band particle lies within the support (lonely counts them).
+struct ImageValues {
+  std::vector<double> vals;
+  std::vector<std::uint8_t> found;
+  std::size_t lonely = 0;
+};
+ImageValues interpolate_images(const OutletZone& out, const ImageBand& band);
+// The mirror condition from interpolated values.
+void apply_mirror(OutletZone& out, const ImageValues& iv);
+// The characteristic condition in three steps: the image normal velocity of every outlet
+// particle and its sums per bin across the face (sum, count: this array's particles; a
+// distributed run adds them over the ranks), the running mean u_ref updated from the sums at
+// time t, and p and u_n set from the outgoing characteristic.
+struct NormalBins {
+  std::vector<std::size_t> bin;  // per outlet particle
+  std::vector<double> un;        // per outlet particle: the image's normal velocity
+  std::vector<double> sum, count;  // per bin
+};
+NormalBins normal_bins(const OutletZone& out, const ImageValues& iv);
+void advance_reference(OutletZone& out, const NormalBins& b, double t);
+void apply_characteristic(OutletZone& out, ImageValues& iv, const NormalBins& b);
 
 }  // namespace sphc

@@ -43,8 +43,9 @@ double state_value(const RunState& state, const std::string& name);
 // The same, or `otherwise` when the file has none (state a restart can do without).
 double state_value(const RunState& state, const std::string& name, double otherwise);
 
-// The inlet/outlet manager's state (sphc/inlet_outlet.h): the next global id and each zone's
-// counters, appended to `state` as io.NAME; restore_inlet_outlet sets them from a file's.
+// The inlet/outlet manager's state (sphc/inlet_outlet.h): the next global id, each zone's
+// counters and a characteristic outlet's running mean u_ref (per bin, with t_last), appended
+// to `state` as io.NAME; restore_inlet_outlet sets them from a file's.
 void inlet_outlet_state(const InletOutlet& io, RunState& state);
 void restore_inlet_outlet(InletOutlet& io, const RunState& state);
 

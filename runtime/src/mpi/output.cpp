@@ -160,7 +160,6 @@ Slab slab_of(const ParticleArray& a, const std::vector<Column>& cols) {
   MPI_Allreduce(&lo, &glo, 1, MPI_UNSIGNED_LONG, MPI_MIN, MPI_COMM_WORLD);
   MPI_Allreduce(&hi, &ghi, 1, MPI_UNSIGNED_LONG, MPI_MAX, MPI_COMM_WORLD);
   s.total = static_cast<std::size_t>(N);
-  const bool contiguous = N == 0 || ghi - glo + 1 == static_cast<unsigned long>(N);
   std::size_t width = 0;
   for (const Column& c : cols) width += static_cast<std::size_t>(c.stride);
   auto pack = [&](std::size_t i, std::vector<double>& buf) {
@@ -177,39 +176,24 @@ Slab slab_of(const ParticleArray& a, const std::vector<Column>& cols) {
     for (std::size_t c = 0; c < cols.size(); ++c)
       s.values[c].assign(s.count * static_cast<std::size_t>(cols[c].stride), 0.0);
   };
-  if (!contiguous) {
-    // Rank order: this rank's particles sorted by gid, after those of lower ranks.
-    long before = 0;
-    MPI_Exscan(&n, &before, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
-    s.start = me == 0 ? 0 : static_cast<std::size_t>(before);
-    s.count = a.n;
-    std::vector<std::size_t> order(a.n);
-    std::iota(order.begin(), order.end(), std::size_t{0});
-    std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return gid[x] < gid[y]; });
-    size_columns();
-    std::vector<double> buf;
-    for (std::size_t j = 0; j < order.size(); ++j) {
-      buf.clear();
-      pack(order[j], buf);
-      unpack(j, buf.data());
-    }
-    return s;
-  }
-  // gid order: the particle of gid g goes to the rank whose block holds g - glo.
-  auto block_start = [&](int r) {
-    return static_cast<std::size_t>(static_cast<unsigned long>(N) * static_cast<unsigned long>(r) /
-                                    static_cast<unsigned long>(P));
+  // gid order: rank r writes the particles whose gid lies in the r-th of P equal ranges of
+  // [glo, ghi]. Where an array's gids are a contiguous range (set-up order, nothing created
+  // or removed) these are equal blocks of particles; with inlets and outlets the ranges hold
+  // what particles they hold. Either way the file is in gid order whatever the number of ranks.
+  const unsigned long span = N == 0 ? 1 : ghi - glo + 1;
+  auto range_start = [&](int r) {  // the first gid offset (from glo) of rank r's range
+    return static_cast<unsigned long>(
+        static_cast<unsigned __int128>(span) * static_cast<unsigned long>(r) /
+        static_cast<unsigned long>(P));
   };
-  s.start = block_start(me);
-  s.count = block_start(me + 1) - s.start;
   std::vector<std::vector<double>> out(static_cast<std::size_t>(P));
   for (std::size_t i = 0; i < a.n; ++i) {
-    const std::size_t pos = gid[i] - glo;
-    int r = static_cast<int>(pos * static_cast<std::size_t>(P) / static_cast<std::size_t>(N));
-    while (r > 0 && pos < block_start(r)) --r;
-    while (r + 1 < P && pos >= block_start(r + 1)) ++r;
+    const unsigned long pos = gid[i] - glo;
+    int r = static_cast<int>(static_cast<unsigned __int128>(pos) * static_cast<unsigned long>(P) / span);
+    while (r > 0 && pos < range_start(r)) --r;
+    while (r + 1 < P && pos >= range_start(r + 1)) ++r;
     auto& b = out[static_cast<std::size_t>(r)];
-    b.push_back(static_cast<double>(pos));
+    b.push_back(static_cast<double>(gid[i]));
     pack(i, b);
   }
   // Counted in particles (an MPI type of w doubles), not in doubles: MPI's int counts and
@@ -239,16 +223,17 @@ Slab slab_of(const ParticleArray& a, const std::vector<Column>& cols) {
   MPI_Alltoallv(send.data(), scount.data(), sdisp.data(), particle, recv.data(), rcount.data(),
                 rdisp.data(), particle, MPI_COMM_WORLD);
   MPI_Type_free(&particle);
+  // This rank's slab: its range's particles in gid order, after those of the lower ranges.
+  s.count = total;
+  long mine = static_cast<long>(total), before = 0;
+  MPI_Exscan(&mine, &before, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  s.start = me == 0 ? 0 : static_cast<std::size_t>(before);
   size_columns();
-  if (recv.size() != s.count * w)
-    throw std::runtime_error(fmt::format("parallel output of '{}': rank {} received {} particles "
-                                         "for a block of {}", a.name, me, recv.size() / w, s.count));
-  for (std::size_t k = 0; k < s.count; ++k) {
-    const double* v = &recv[k * w];
-    const std::size_t j = static_cast<std::size_t>(v[0]) - s.start;
-    if (j >= s.count) throw std::runtime_error("parallel output: a gid outside this rank's block");
-    unpack(j, v + 1);
-  }
+  std::vector<std::size_t> order(total);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t x, std::size_t y) { return recv[x * w] < recv[y * w]; });
+  for (std::size_t j = 0; j < total; ++j) unpack(j, &recv[order[j] * w + 1]);
   return s;
 }
 

@@ -7,12 +7,12 @@
 //     (libhdf5-openmpi-dev): every rank opens the file, the groups, datasets and attributes
 //     are created by all together, and each rank writes one contiguous slab of every dataset.
 //     The particles are in gid order, as the gathered output and a serial run that does not
-//     reorder: the slab of rank r is the gid block [r N / P, (r + 1) N / P) of the array, so
-//     before writing, the selected properties of each particle go to the rank of its block
-//     (one MPI_Alltoallv per array). This needs an array's gids to be a contiguous range
-//     (so they are: set-up order, no particle created or removed under --mpi); otherwise
-//     each rank writes its own particles, sorted by gid, at its offset in rank order (the
-//     file is then in rank order and gid tells which particle is which).
+//     reorder: the gids of an array, [glo, ghi], are cut into P equal ranges, the selected
+//     properties of each particle go to the rank of its range (one MPI_Alltoallv per array),
+//     and rank r writes its range's particles, sorted by gid, after those of the lower
+//     ranges. Where the gids are contiguous (set-up order) the ranges are equal blocks; with
+//     inlets and outlets (particles created and removed, sphc/mpi/zones.h) they hold what they
+//     hold, and the file is still in gid order, the same whatever the number of ranks.
 //   - gathered to rank 0 (sphc/mpi/gather.h), which writes with the serial code: the fallback
 //     when sphc was built without parallel HDF5, or chosen with SPHC_MPI_OUTPUT=gather in the
 //     environment of the run (rank 0 then holds a copy of the whole scene at each output).
