@@ -10,6 +10,12 @@ namespace sphc {
 
 namespace {
 
+// Moves the items of a chosen `when` branch to the end of what it is part of.
+template <class T>
+void append(std::vector<T>& to, std::vector<T>& from) {
+  for (auto& x : from) to.push_back(std::move(x));
+}
+
 std::string joined(const std::vector<std::string>& names) {
   std::string s;
   for (size_t i = 0; i < names.size(); ++i) s += (i ? ", " : "") + names[i];
@@ -346,9 +352,6 @@ class OptionSelector {
       ast::ArrayDecl* part = choose(*w, ok);
       if (!part) continue;
       array(*part, ok);
-      auto append = [](auto& to, auto& from) {
-        for (auto& x : from) to.push_back(std::move(x));
-      };
       append(a.geometry, part->geometry);
       append(a.loads, part->loads);
       append(a.properties, part->properties);
@@ -371,9 +374,6 @@ class OptionSelector {
         ok = false;
       }
       scene(*part, ok, /*top=*/false);
-      auto append = [](auto& to, auto& from) {
-        for (auto& x : from) to.push_back(std::move(x));
-      };
       append(s.schemes, part->schemes);
       append(s.settings, part->settings);
       append(s.steppers, part->steppers);
