@@ -141,13 +141,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << parallelFor("      ", w.perParticle);
     scene_ << "      for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
            << "; ++d_idx) {  // " << what << "\n";
-    for (const auto* eq : with) {
-      const auto& pd = plan_.equationDecls[eq->declIndex];
-      const PlanBody& b = plan_.bodies[pd.methods.at(kind)];
-      scene_ << "        "
-             << callBody(bodyFunctionName(eq->name, what), b, d, eqStruct(*eq), "t")
-             << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
-    }
+    for (const auto* eq : with) scene_ << "        " << equationCall(*eq, kind, d);
     scene_ << "      }\n";
   };
   perParticle(ast::Method::Initialize, "initialize");
@@ -172,10 +166,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
              << "; ++d_idx) {  // initialize_pair\n";
       for (const auto* eq : pass.initializePair)
-        scene_ << "          "
-               << callBody(bodyFunctionName(eq->name, "initialize_pair"),
-                           methodBody(*eq, ast::Method::InitializePair), d, eqStruct(*eq), "t")
-               << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+        scene_ << "          " << equationCall(*eq, ast::Method::InitializePair, d);
       scene_ << "        }\n";
     }
     if (!pass.searches()) {
@@ -207,10 +198,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          {\n";
       scene_ << "            const int N_NBRS = n_nbrs;\n";
       for (const auto* eq : pass.loopAll)
-        scene_ << "            "
-               << callBody(bodyFunctionName(eq->name, "loop_all"),
-                           methodBody(*eq, ast::Method::LoopAll), d, eqStruct(*eq), "t")
-               << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+        scene_ << "            " << equationCall(*eq, ast::Method::LoopAll, d);
       scene_ << "          }\n";
     }
     if (!pass.equations.empty()) {
