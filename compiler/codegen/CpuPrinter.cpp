@@ -452,19 +452,19 @@ void CpuPrinter::adaptiveDtArray(int a) {
       scene_ << "      const " << real_ << "* " << acc[k] << " = " << propPtr(a, acc[k]) << ";\n";
   scene_ << parallelFor("      ", ad.order, "reduction(min : dt_cfl, dt_force, h2min)");
   scene_ << "      for (std::size_t i = 0; i < " << arr(a).name << ".n; ++i) {\n";
+  // |v| or |a| of particle i: "std::sqrt(u[i] * u[i] + v[i] * v[i])".
+  auto magnitude = [&](const std::vector<std::string>& c) {
+    std::string s = "std::sqrt(";
+    for (int k = 0; k < plan_.dim; ++k) s += (k ? " + " : "") + c[k] + "[i] * " + c[k] + "[i]";
+    return s + ")";
+  };
   if (ad.cfl) {
-    scene_ << "        const double vmag = std::sqrt(";
-    for (int k = 0; k < plan_.dim; ++k)
-      scene_ << (k ? " + " : "") << vel[k] << "[i] * " << vel[k] << "[i]";
-    scene_ << ");\n";
+    scene_ << "        const double vmag = " << magnitude(vel) << ";\n";
     scene_ << "        dt_cfl = std::fmin(dt_cfl, h[i] / (cs[i] + vmag));\n";
   }
   if (ad.viscous) scene_ << "        h2min = std::fmin(h2min, h[i] * h[i]);\n";
   if (ad.force) {
-    scene_ << "        const double amag = std::sqrt(";
-    for (int k = 0; k < plan_.dim; ++k)
-      scene_ << (k ? " + " : "") << acc[k] << "[i] * " << acc[k] << "[i]";
-    scene_ << ");\n";
+    scene_ << "        const double amag = " << magnitude(acc) << ";\n";
     scene_ << "        if (amag > 0) dt_force = std::fmin(dt_force, std::sqrt(h[i] / amag));\n";
   }
   scene_ << "      }\n    }\n";
