@@ -9,31 +9,20 @@ std::vector<std::string> positionProps(int dim) {
 }
 
 static void addBodyAccesses(std::vector<Access>& out, const BodyFacts& f, int dest,
-                            const std::vector<int>& sources, Access proto) {
-  for (const auto& r : f.dReads) {
+                            const std::vector<int>& sources, const Access& proto) {
+  auto add = [&](int array, const auto& ref, bool write, bool viaSource) {
     Access a = proto;
-    a.array = dest;
-    a.prop = r.prop;
-    a.loc = r.loc;
+    a.array = array;
+    a.prop = ref.prop;
+    a.loc = ref.loc;
+    a.write = write;
+    a.viaSource = viaSource;
     out.push_back(a);
-  }
-  for (const auto& w : f.dWrites) {
-    Access a = proto;
-    a.array = dest;
-    a.prop = w.prop;
-    a.loc = w.loc;
-    a.write = true;
-    out.push_back(a);
-  }
+  };
+  for (const auto& r : f.dReads) add(dest, r, false, false);
+  for (const auto& w : f.dWrites) add(dest, w, true, false);
   for (int s : sources)
-    for (const auto& r : f.sReads) {
-      Access a = proto;
-      a.array = s;
-      a.prop = r.prop;
-      a.loc = r.loc;
-      a.viaSource = true;
-      out.push_back(a);
-    }
+    for (const auto& r : f.sReads) add(s, r, false, true);
 }
 
 std::vector<Access> equationAccesses(const Plan& plan, const PlanEquation& eq) {

@@ -253,14 +253,20 @@ void Batch::synthesise() {
       state[i].blanked = true;
     }
 
-    if (b.kind == BodyKind::Function) {
-      // A helper function is its own C definition, copied as written.
+    // The body's text where it stands in its file (#line, then blanks up to its column), so
+    // that Clang's locations map back to the .sph file.
+    auto appendText = [&](const char* unnamed) {
       DiagnosticEngine::Position pos = diags_.position(b.start);
       unit_ += "#line " + std::to_string(pos.line ? pos.line : 1) + " " +
-               quoted(pos.file.empty() ? "<function>" : pos.file) + "\n";
+               quoted(pos.file.empty() ? unnamed : pos.file) + "\n";
       unit_ += std::string(pos.col ? pos.col - 1 : 0, ' ');
       regions_[i].textBegin = unit_.size();
       unit_ += text;
+    };
+
+    if (b.kind == BodyKind::Function) {
+      // A helper function is its own C definition, copied as written.
+      appendText("<function>");
       regions_[i].end = unit_.size() ? unit_.size() - 1 : 0;
       unit_ += "\n";
       continue;
@@ -302,13 +308,7 @@ void Batch::synthesise() {
     unit_ += std::string(ret) + " " + kFunctionPrefix.str() + std::to_string(i) + "(";
     for (size_t k = 0; k < params.size(); ++k) unit_ += (k ? ", " : "") + params[k];
     unit_ += ") {\n";
-
-    DiagnosticEngine::Position pos = diags_.position(b.start);
-    unit_ += "#line " + std::to_string(pos.line ? pos.line : 1) + " " +
-             quoted(pos.file.empty() ? "<body>" : pos.file) + "\n";
-    unit_ += std::string(pos.col ? pos.col - 1 : 0, ' ');
-    regions_[i].textBegin = unit_.size();
-    unit_ += text;
+    appendText("<body>");
     regions_[i].end = unit_.size();
     unit_ += "}\n";
   }

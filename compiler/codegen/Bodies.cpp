@@ -316,10 +316,14 @@ void ScenePrinter::emitCandidate(std::ostream& os, const std::set<std::string>& 
                                  const Dialect& dl, bool test) {
   emitPairQuantities(os, q, dl, test);
   for (const auto* eq : loopers)
-    os << "            "
-       << callBody(bodyFunctionName(eq->name, "loop"), methodBody(*eq, ast::Method::Loop), d,
-                   eqStruct(*eq), "t", dl.scalarSep)
-       << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+    os << "            " << equationCall(*eq, ast::Method::Loop, d, dl.scalarSep);
+}
+
+std::string ScenePrinter::equationCall(const PlanEquation& eq, ast::Method::Kind kind, int d,
+                                       const std::string& sep) const {
+  return callBody(bodyFunctionName(eq.name, ast::methodKeyword(kind)), methodBody(eq, kind), d,
+                  eqStruct(eq), "t", sep) +
+         ";  // " + eq.name + ", from " + loc(eq.loc) + "\n";
 }
 
 std::string ScenePrinter::propIndexList(int a, const std::vector<std::string>& props) const {

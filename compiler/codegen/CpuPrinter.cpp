@@ -141,13 +141,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << parallelFor("      ", w.perParticle);
     scene_ << "      for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
            << "; ++d_idx) {  // " << what << "\n";
-    for (const auto* eq : with) {
-      const auto& pd = plan_.equationDecls[eq->declIndex];
-      const PlanBody& b = plan_.bodies[pd.methods.at(kind)];
-      scene_ << "        "
-             << callBody(bodyFunctionName(eq->name, what), b, d, eqStruct(*eq), "t")
-             << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
-    }
+    for (const auto* eq : with) scene_ << "        " << equationCall(*eq, kind, d);
     scene_ << "      }\n";
   };
   perParticle(ast::Method::Initialize, "initialize");
@@ -172,10 +166,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
              << "; ++d_idx) {  // initialize_pair\n";
       for (const auto* eq : pass.initializePair)
-        scene_ << "          "
-               << callBody(bodyFunctionName(eq->name, "initialize_pair"),
-                           methodBody(*eq, ast::Method::InitializePair), d, eqStruct(*eq), "t")
-               << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+        scene_ << "          " << equationCall(*eq, ast::Method::InitializePair, d);
       scene_ << "        }\n";
     }
     if (!pass.searches()) {
@@ -207,10 +198,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          {\n";
       scene_ << "            const int N_NBRS = n_nbrs;\n";
       for (const auto* eq : pass.loopAll)
-        scene_ << "            "
-               << callBody(bodyFunctionName(eq->name, "loop_all"),
-                           methodBody(*eq, ast::Method::LoopAll), d, eqStruct(*eq), "t")
-               << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+        scene_ << "            " << equationCall(*eq, ast::Method::LoopAll, d);
       scene_ << "          }\n";
     }
     if (!pass.equations.empty()) {
@@ -464,19 +452,19 @@ void CpuPrinter::adaptiveDtArray(int a) {
       scene_ << "      const " << real_ << "* " << acc[k] << " = " << propPtr(a, acc[k]) << ";\n";
   scene_ << parallelFor("      ", ad.order, "reduction(min : dt_cfl, dt_force, h2min)");
   scene_ << "      for (std::size_t i = 0; i < " << arr(a).name << ".n; ++i) {\n";
+  // |v| or |a| of particle i: "std::sqrt(u[i] * u[i] + v[i] * v[i])".
+  auto magnitude = [&](const std::vector<std::string>& c) {
+    std::string s = "std::sqrt(";
+    for (int k = 0; k < plan_.dim; ++k) s += (k ? " + " : "") + c[k] + "[i] * " + c[k] + "[i]";
+    return s + ")";
+  };
   if (ad.cfl) {
-    scene_ << "        const double vmag = std::sqrt(";
-    for (int k = 0; k < plan_.dim; ++k)
-      scene_ << (k ? " + " : "") << vel[k] << "[i] * " << vel[k] << "[i]";
-    scene_ << ");\n";
+    scene_ << "        const double vmag = " << magnitude(vel) << ";\n";
     scene_ << "        dt_cfl = std::fmin(dt_cfl, h[i] / (cs[i] + vmag));\n";
   }
   if (ad.viscous) scene_ << "        h2min = std::fmin(h2min, h[i] * h[i]);\n";
   if (ad.force) {
-    scene_ << "        const double amag = std::sqrt(";
-    for (int k = 0; k < plan_.dim; ++k)
-      scene_ << (k ? " + " : "") << acc[k] << "[i] * " << acc[k] << "[i]";
-    scene_ << ");\n";
+    scene_ << "        const double amag = " << magnitude(acc) << ";\n";
     scene_ << "        if (amag > 0) dt_force = std::fmin(dt_force, std::sqrt(h[i] / amag));\n";
   }
   scene_ << "      }\n    }\n";

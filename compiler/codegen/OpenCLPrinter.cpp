@@ -281,12 +281,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     rangeArg(w, ka);
     beginKernel(k, ka);
     rangeGuard(w);
-    for (const auto* eq : with) {
-      const auto& pd = plan_.equationDecls[eq->declIndex];
-      const PlanBody& b = plan_.bodies[pd.methods.at(kind)];
-      cl_ << "  " << callBody(bodyFunctionName(eq->name, what), b, d, eqStruct(*eq), "t", "_")
-          << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
-    }
+    for (const auto* eq : with) cl_ << "  " << equationCall(*eq, kind, d, "_");
     cl_ << "}\n\n";
     scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // " << what << "\n";
   };
@@ -305,10 +300,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
       beginKernel(k, ia);
       rangeGuard(w);
       for (const auto* eq : pass.initializePair)
-        cl_ << "  "
-            << callBody(bodyFunctionName(eq->name, "initialize_pair"),
-                        methodBody(*eq, ast::Method::InitializePair), d, eqStruct(*eq), "t", "_")
-            << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+        cl_ << "  " << equationCall(*eq, ast::Method::InitializePair, d, "_");
       cl_ << "}\n\n";
       scene_ << "      " << launch(k, rangeEnd(w), ia) << "  // initialize_pair: " << D
              << " <- " << S << "\n";
@@ -368,10 +360,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
       cl_ << "  nbrs_count[d_idx] = (real)found;  // checked on the host\n";
       cl_ << "  const int N_NBRS = min(found, SPHC_MAX_NBRS);\n";
       for (const auto* eq : pass.loopAll)
-        cl_ << "  "
-            << callBody(bodyFunctionName(eq->name, "loop_all"),
-                        methodBody(*eq, ast::Method::LoopAll), d, eqStruct(*eq), "t", "_")
-            << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n";
+        cl_ << "  " << equationCall(*eq, ast::Method::LoopAll, d, "_");
     }
     if (!pass.equations.empty()) {
       cl_ << cellLoops;
@@ -402,9 +391,8 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     ka.add("__global real* reduce_values", "ocl.scratch(" + nReal + ")", "reduce_values");
     std::string k = name + "_" + D + "_reduce_" + std::to_string(eq->id);
     beginKernel(k, ka);
-    cl_ << "  reduce_values[d_idx] = "
-        << callBody(bodyFunctionName(eq->name, "reduce"), b, d, eqStruct(*eq), "t", "_")
-        << ";  // " << eq->name << ", from " << loc(eq->loc) << "\n}\n\n";
+    cl_ << "  reduce_values[d_idx] = " << equationCall(*eq, ast::Method::Reduce, d, "_")
+        << "}\n\n";
     int c = constIndex(d, pd.reduceTarget);
     std::string op = pd.reduceOp == "sum" || pd.reduceOp == "mean" ? "Sum"
                      : pd.reduceOp == "max"                         ? "Max"

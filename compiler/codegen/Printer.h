@@ -256,6 +256,10 @@ class ScenePrinter {
   const PlanBody& methodBody(const PlanEquation& eq, ast::Method::Kind kind) const {
     return plan_.bodies[plan_.equationDecls[eq.declIndex].methods.at(kind)];
   }
+  // The statement that calls equation eq's method `kind` for destination array d, with its
+  // provenance: "CALL;  // NAME, from FILE:LINE\n" (sep: as callBody's).
+  std::string equationCall(const PlanEquation& eq, ast::Method::Kind kind, int d,
+                           const std::string& sep = ".") const;
 
   const Schedule& sched_;
   const Plan& plan_;

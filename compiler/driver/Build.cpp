@@ -232,43 +232,48 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   return deliver();
 }
 
-bool mpiAvailable(const Install& install, std::string& why) {
+namespace {
+
+// Whether this build of sphc has an optional runtime: CMake found what it needs (buildinfo.txt's
+// `key` is set; else `why` is `notFound`) and its library `lib` (of `what`: MPI, OpenCL) is in
+// place.
+bool optionalRuntime(const Install& install, const char* key, const char* notFound,
+                     const char* what, const char* lib, std::string& why) {
   std::string err;
   auto info = readBuildInfo(install.buildInfo, err);
   if (!err.empty()) {
     why = err;
     return false;
   }
-  if (info["mpi_libs"].empty()) {
-    why = "CMake did not find MPI and Zoltan when sphc was built (scripts/setup-deps.sh "
-          "installs them: libopenmpi-dev openmpi-bin libtrilinos-zoltan-dev; then reconfigure)";
+  if (info[key].empty()) {
+    why = notFound;
     return false;
   }
-  if (!fs::exists(install.libDir + "/libsphc_mpi.a")) {
-    why = "the MPI runtime library '" + install.libDir + "/libsphc_mpi.a' is missing";
+  const std::string path = install.libDir + "/" + lib;
+  if (!fs::exists(path)) {
+    why = std::string("the ") + what + " runtime library '" + path + "' is missing";
     return false;
   }
   return true;
 }
 
+}  // namespace
+
+bool mpiAvailable(const Install& install, std::string& why) {
+  return optionalRuntime(
+      install, "mpi_libs",
+      "CMake did not find MPI and Zoltan when sphc was built (scripts/setup-deps.sh "
+      "installs them: libopenmpi-dev openmpi-bin libtrilinos-zoltan-dev; then reconfigure)",
+      "MPI", "libsphc_mpi.a", why);
+}
+
 bool openclAvailable(const Install& install, std::string& why) {
-  std::string err;
-  auto info = readBuildInfo(install.buildInfo, err);
-  if (!err.empty()) {
-    why = err;
-    return false;
-  }
-  if (info["opencl_libs"].empty()) {
-    why = "CMake did not find OpenCL when sphc was built (install an OpenCL loader and "
-          "headers, e.g. ocl-icd-opencl-dev opencl-headers, plus a driver such as "
-          "pocl-opencl-icd, and reconfigure)";
-    return false;
-  }
-  if (!fs::exists(install.libDir + "/libsphc_runtime_ocl.a")) {
-    why = "the OpenCL runtime library '" + install.libDir + "/libsphc_runtime_ocl.a' is missing";
-    return false;
-  }
-  return true;
+  return optionalRuntime(
+      install, "opencl_libs",
+      "CMake did not find OpenCL when sphc was built (install an OpenCL loader and "
+      "headers, e.g. ocl-icd-opencl-dev opencl-headers, plus a driver such as "
+      "pocl-opencl-icd, and reconfigure)",
+      "OpenCL", "libsphc_runtime_ocl.a", why);
 }
 
 }  // namespace sphc

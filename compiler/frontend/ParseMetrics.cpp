@@ -11,12 +11,7 @@
 namespace sphc {
 
 bool Parser::parseMetrics(ast::SceneDecl& scene) {
-  ast::MetricsDecl metrics;
-  metrics.loc = cur().loc;
-  advance();
-  bool ok = parseBlock("metrics", [&] { return parseMetricItem(metrics); });
-  scene.metrics.push_back(std::move(metrics));
-  return ok;
+  return parseSceneBlock("metrics", scene.metrics, &Parser::parseMetricItem);
 }
 
 bool Parser::parseMetricItem(ast::MetricsDecl& metrics) {

@@ -155,12 +155,7 @@ bool Parser::parseOutputItem(ast::OutputDecl& out) {
 }
 
 bool Parser::parseDomain(ast::SceneDecl& scene) {
-  ast::DomainDecl domain;
-  domain.loc = cur().loc;
-  advance();
-  bool ok = parseBlock("domain", [&] { return parseDomainItem(domain); });
-  scene.domains.push_back(std::move(domain));
-  return ok;
+  return parseSceneBlock("domain", scene.domains, &Parser::parseDomainItem);
 }
 
 // periodic AXIS in [lo, hi];  mirror AXIS in [lo, hi];  mirror AXIS >= lo;  mirror AXIS <= hi;
@@ -201,12 +196,7 @@ bool Parser::parseDomainItem(ast::DomainDecl& domain) {
 }
 
 bool Parser::parseLimits(ast::SceneDecl& scene) {
-  ast::LimitsDecl limits;
-  limits.loc = cur().loc;
-  advance();
-  bool ok = parseBlock("limits", [&] { return parseLimitItem(limits); });
-  scene.limits.push_back(std::move(limits));
-  return ok;
+  return parseSceneBlock("limits", scene.limits, &Parser::parseLimitItem);
 }
 
 // ARRAY.QUANTITY (warn BOUND)? (stop BOUND)?;  at least one of warn and stop.

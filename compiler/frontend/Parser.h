@@ -57,6 +57,19 @@ class Parser {
   // start of a top-level stepper.
   bool parseBlock(const std::string& what, llvm::function_ref<bool()> parseItem,
                   bool sceneStepper = false);
+  // A block of the scene, `KEYWORD { item* }` at its keyword (domain, limits, metrics): one
+  // Decl located at the keyword, its items parsed by `parseItem`, appended to `into` (as far
+  // as it got, after an error).
+  template <class Decl>
+  bool parseSceneBlock(const char* keyword, std::vector<Decl>& into,
+                       bool (Parser::*parseItem)(Decl&)) {
+    Decl decl;
+    decl.loc = cur().loc;
+    advance();
+    bool ok = parseBlock(keyword, [&] { return (this->*parseItem)(decl); });
+    into.push_back(std::move(decl));
+    return ok;
+  }
 
   // Declarations.
   bool parseItem(ast::Module& mod);

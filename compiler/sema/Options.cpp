@@ -10,6 +10,12 @@ namespace sphc {
 
 namespace {
 
+// Moves the items of a chosen `when` branch to the end of what it is part of.
+template <class T>
+void append(std::vector<T>& to, std::vector<T>& from) {
+  for (auto& x : from) to.push_back(std::move(x));
+}
+
 std::string joined(const std::vector<std::string>& names) {
   std::string s;
   for (size_t i = 0; i < names.size(); ++i) s += (i ? ", " : "") + names[i];
@@ -26,8 +32,7 @@ class OptionSelector {
     for (const auto& mod : modules) {
       for (const auto& o : mod->options) {
         if (auto it = decls_.find(o.name.name); it != decls_.end()) {
-          diags_.error(o.name.loc, "option '" + o.name.name + "' is declared twice");
-          diags_.note(it->second->name.loc, "first declared here");
+          repeated("option '" + o.name.name + "'", "declared", o.name.loc, it->second->name.loc);
           ok = false;
           continue;
         }
@@ -59,8 +64,7 @@ class OptionSelector {
     for (const auto& mod : modules) {
       for (const auto& e : mod->effects) {
         if (auto it = effectDecls_.find(e.name.name); it != effectDecls_.end()) {
-          diags_.error(e.name.loc, "effect '" + e.name.name + "' is declared twice");
-          diags_.note(it->second->name.loc, "first declared here");
+          repeated("effect '" + e.name.name + "'", "declared", e.name.loc, it->second->name.loc);
           ok = false;
           continue;
         }
@@ -91,6 +95,19 @@ class OptionSelector {
     return ok;
   }
 
+  // `what` (option 'x', ...) declared or listed (`verb`) a second time, at `again`.
+  void repeated(const std::string& what, const char* verb, llvm::SMLoc again, llvm::SMLoc first) {
+    diags_.error(again, what + " is " + verb + " twice");
+    diags_.note(first, std::string("first ") + verb + " here");
+  }
+
+  // The names of every option and effect, in declaration order.
+  std::vector<std::string> optionNames() const {
+    std::vector<std::string> names;
+    for (const auto& o : chosen_) names.push_back(o.name);
+    return names;
+  }
+
   std::string knownEffects() const {
     std::vector<std::string> names;
     for (const auto& c : chosen_)
@@ -113,8 +130,7 @@ class OptionSelector {
         continue;
       }
       if (auto it = seen.find(e.name); it != seen.end()) {
-        diags_.error(e.loc, "effect '" + e.name + "' is listed twice");
-        diags_.note(it->second, "first listed here");
+        repeated("effect '" + e.name + "'", "listed", e.loc, it->second);
         ok = false;
         continue;
       }
@@ -196,8 +212,7 @@ class OptionSelector {
       }
       ChosenOption* c = find(name.str());
       if (!c) {
-        std::vector<std::string> names;
-        for (const auto& o : chosen_) names.push_back(o.name);
+        const std::vector<std::string> names = optionNames();
         diags_.error("-D " + d + ": the scene has no option '" + name.str() + "'" +
                      (names.empty() ? std::string(" (it declares no options)")
                                     : " (its options: " + joined(names) + ")"));
@@ -241,8 +256,7 @@ class OptionSelector {
       return c->on() != cond.negated;
     }
     if (!c) {
-      std::vector<std::string> names;
-      for (const auto& o : chosen_) names.push_back(o.name);
+      const std::vector<std::string> names = optionNames();
       diags_.error(cond.option.loc,
                    "unknown option '" + cond.option.name + "' in 'when'" +
                        (names.empty() ? std::string(": declare it first, as in 'option " +
@@ -338,9 +352,6 @@ class OptionSelector {
       ast::ArrayDecl* part = choose(*w, ok);
       if (!part) continue;
       array(*part, ok);
-      auto append = [](auto& to, auto& from) {
-        for (auto& x : from) to.push_back(std::move(x));
-      };
       append(a.geometry, part->geometry);
       append(a.loads, part->loads);
       append(a.properties, part->properties);
@@ -363,9 +374,6 @@ class OptionSelector {
         ok = false;
       }
       scene(*part, ok, /*top=*/false);
-      auto append = [](auto& to, auto& from) {
-        for (auto& x : from) to.push_back(std::move(x));
-      };
       append(s.schemes, part->schemes);
       append(s.settings, part->settings);
       append(s.steppers, part->steppers);

@@ -111,6 +111,15 @@ int bytesPerParticle(const PlanArray& a) {
   return bytes;
 }
 
+// A line of a --report's array or effect: "    LABEL: a b c", nothing when there is nothing.
+template <class Names>
+void printList(llvm::raw_ostream& os, const char* label, const Names& names) {
+  if (names.empty()) return;
+  os << "    " << label << ":";
+  for (const auto& n : names) os << " " << n;
+  os << "\n";
+}
+
 // The scene's effects (docs/effects.md): on or off, and what an effect that is off left out.
 void printEffects(const Plan& plan, llvm::raw_ostream& os) {
   bool any = false;
@@ -130,16 +139,8 @@ void printEffects(const Plan& plan, llvm::raw_ostream& os) {
         os << (i ? ", " : "") << o.droppedEquations[i];
       os << "\n";
     }
-    if (!o.droppedProperties.empty()) {
-      os << "    properties left out:";
-      for (const auto& p : o.droppedProperties) os << " " << p;
-      os << "\n";
-    }
-    if (!o.params.empty()) {
-      os << "    params left out (--set is an error naming the effect):";
-      for (const auto& p : o.params) os << " " << p;
-      os << "\n";
-    }
+    printList(os, "properties left out", o.droppedProperties);
+    printList(os, "params left out (--set is an error naming the effect)", o.params);
   }
 }
 
@@ -153,16 +154,8 @@ void printArrayEffects(const Plan& plan, const PlanArray& a, llvm::raw_ostream& 
     for (const auto& e : eq.effects)
       if (std::find(effects.begin(), effects.end(), e) == effects.end()) effects.push_back(e);
   }
-  if (!effects.empty()) {
-    os << "    effects simulated:";
-    for (const auto& e : effects) os << " " << e;
-    os << "\n";
-  }
-  if (!kept.empty()) {
-    os << "    equations kept:";
-    for (const auto& e : kept) os << " " << e;
-    os << "\n";
-  }
+  printList(os, "effects simulated", effects);
+  printList(os, "equations kept", kept);
 }
 
 }  // namespace
@@ -274,16 +267,8 @@ void printPlan(const Plan& plan, llvm::raw_ostream& os, bool report) {
     }
     os << "\n";
     if (report) printArrayEffects(plan, a, os);
-    if (!a.ghostProps.empty()) {
-      os << "    ghosts carry:";
-      for (const auto& p : a.ghostProps) os << " " << p;
-      os << "\n";
-    }
-    if (!a.constants.empty()) {
-      os << "    constants:";
-      for (const auto& c : a.constants) os << " " << c;
-      os << "\n";
-    }
+    printList(os, "ghosts carry", a.ghostProps);
+    printList(os, "constants", a.constants);
   }
   os << "equations:\n";
   printGroup(plan, plan.root, os, 1, report);

@@ -23,20 +23,67 @@ void check_dim(int dim, const char* who) {
   }
 }
 
+// What a search domain is made from, gathered array by array (make_search_domain and its
+// float form): the box of the finite coordinates and the largest finite h.
+struct Extent {
+  int dim;
+  double radius_scale;
+  double lo[3], hi[3];
+  double hmax = 0.0;
+
+  Extent(int dim_, double radius_scale_) : dim(dim_), radius_scale(radius_scale_) {
+    check_dim(dim, "sphc::make_search_domain");
+    if (!(radius_scale > 0.0) || !std::isfinite(radius_scale)) {
+      throw std::invalid_argument("sphc::make_search_domain: radius_scale must be > 0 (got " +
+                                  std::to_string(radius_scale) + ")");
+    }
+    const double inf = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) lo[a] = inf, hi[a] = -inf;
+  }
+
+  // Axis a of n particles, every stride-th value of v; v null: the array has no such
+  // coordinate, which reads as 0.
+  template <class T>
+  void add_axis(int a, const T* v, std::size_t n, std::size_t stride) {
+    if (v == nullptr) {
+      lo[a] = std::min(lo[a], 0.0);
+      hi[a] = std::max(hi[a], 0.0);
+      return;
+    }
+    double l = lo[a], u = hi[a];
+    // The OpenMP build of the runtime (libsphc_runtime_omp) runs these loops in parallel;
+    // min and max do not depend on the order, so the result is the serial one.
+#pragma omp parallel for reduction(min : l) reduction(max : u) schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      const double w = v[i * stride];
+      if (!std::isfinite(w)) continue;
+      l = std::min(l, w);
+      u = std::max(u, w);
+    }
+    lo[a] = l;
+    hi[a] = u;
+  }
+
+  template <class T>
+  void add_h(const T* v, std::size_t n, std::size_t stride) {
+    double m = hmax;
+#pragma omp parallel for reduction(max : m) schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      const double w = v[i * stride];
+      if (std::isfinite(w) && w > m) m = w;
+    }
+    hmax = m;
+  }
+
+  SearchDomain domain() const { return search_domain_of_box(lo, hi, hmax, dim, radius_scale); }
+};
+
 }  // namespace
 
 SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays, int dim,
                                 double radius_scale) {
-  check_dim(dim, "sphc::make_search_domain");
-  if (!(radius_scale > 0.0) || !std::isfinite(radius_scale)) {
-    throw std::invalid_argument("sphc::make_search_domain: radius_scale must be > 0 (got " +
-                                std::to_string(radius_scale) + ")");
-  }
-  const double inf = std::numeric_limits<double>::infinity();
-  double lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
-  double hmax = 0.0;
+  Extent e(dim, radius_scale);
   static const char* const kAxis[3] = {"x", "y", "z"};
-
   for (const ParticleArray* pa : arrays) {
     if (pa == nullptr || pa->n == 0) continue;
     for (const char* need : {"x", "h"}) {
@@ -49,76 +96,30 @@ SearchDomain make_search_domain(const std::vector<const ParticleArray*>& arrays,
     for (int a = 0; a < dim; ++a) {
       const int idx = pa->find(kAxis[a]);
       if (idx < 0 || pa->props[idx].type != PropType::F64) {
-        // A missing y or z reads as 0.
-        lo[a] = std::min(lo[a], 0.0);
-        hi[a] = std::max(hi[a], 0.0);
+        e.add_axis<double>(a, nullptr, 0, 1);
         continue;
       }
       const Property& p = pa->props[idx];
-      double l = lo[a], u = hi[a];
-      // The OpenMP build of the runtime (libsphc_runtime_omp) runs these loops in parallel;
-      // min and max do not depend on the order, so the result is the serial one.
-#pragma omp parallel for reduction(min : l) reduction(max : u) schedule(static)
-      for (std::size_t i = 0; i < pa->n; ++i) {
-        const double v = p.f64[i * p.stride];
-        if (!std::isfinite(v)) continue;
-        l = std::min(l, v);
-        u = std::max(u, v);
-      }
-      lo[a] = l;
-      hi[a] = u;
+      e.add_axis(a, p.f64.data(), pa->n, static_cast<std::size_t>(p.stride));
     }
     const Property& h = pa->props[pa->find("h")];
-#pragma omp parallel for reduction(max : hmax) schedule(static)
-    for (std::size_t i = 0; i < pa->n; ++i) {
-      const double v = h.f64[i * h.stride];
-      if (std::isfinite(v) && v > hmax) hmax = v;
-    }
+    e.add_h(h.f64.data(), pa->n, static_cast<std::size_t>(h.stride));
   }
-
-  return search_domain_of_box(lo, hi, hmax, dim, radius_scale);
+  return e.domain();
 }
 
 SearchDomain make_search_domain_float(const std::vector<FloatCoords>& arrays, int dim,
                                       double radius_scale) {
-  check_dim(dim, "sphc::make_search_domain");
-  if (!(radius_scale > 0.0) || !std::isfinite(radius_scale)) {
-    throw std::invalid_argument("sphc::make_search_domain: radius_scale must be > 0 (got " +
-                                std::to_string(radius_scale) + ")");
-  }
-  const double inf = std::numeric_limits<double>::infinity();
-  double lo[3] = {inf, inf, inf}, hi[3] = {-inf, -inf, -inf};
-  double hmax = 0.0;
+  Extent e(dim, radius_scale);
   for (const FloatCoords& c : arrays) {
     if (c.n == 0) continue;
     if (c.x == nullptr || c.h == nullptr)
       throw std::invalid_argument("sphc::make_search_domain: an array has no x or no h");
     const float* axis[3] = {c.x, c.y, c.z};
-    for (int a = 0; a < dim; ++a) {
-      if (axis[a] == nullptr) {
-        lo[a] = std::min(lo[a], 0.0);
-        hi[a] = std::max(hi[a], 0.0);
-        continue;
-      }
-      const float* v = axis[a];
-      double l = lo[a], u = hi[a];
-#pragma omp parallel for reduction(min : l) reduction(max : u) schedule(static)
-      for (std::size_t i = 0; i < c.n; ++i) {
-        const double w = v[i];
-        if (!std::isfinite(w)) continue;
-        l = std::min(l, w);
-        u = std::max(u, w);
-      }
-      lo[a] = l;
-      hi[a] = u;
-    }
-#pragma omp parallel for reduction(max : hmax) schedule(static)
-    for (std::size_t i = 0; i < c.n; ++i) {
-      const double w = c.h[i];
-      if (std::isfinite(w) && w > hmax) hmax = w;
-    }
+    for (int a = 0; a < dim; ++a) e.add_axis(a, axis[a], c.n, 1);
+    e.add_h(c.h, c.n, 1);
   }
-  return search_domain_of_box(lo, hi, hmax, dim, radius_scale);
+  return e.domain();
 }
 
 SearchDomain search_domain_of_box(const double lo[3], const double hi[3], double hmax, int dim,

@@ -669,6 +669,29 @@ namespace {
 std::size_t value_size(const Context& ctx, const Property& p) {
   return p.type == PropType::F64 ? ctx.real_size() : 4;
 }
+
+// Writes the values of the first n particles of p into buf, doubles as floats on a
+// single-precision device (through tmp).
+void write_property(Context& ctx, cl_mem buf, const Property& p, std::size_t n,
+                    std::vector<float>& tmp) {
+  const std::size_t count = n * static_cast<std::size_t>(p.stride);
+  if (count == 0) return;
+  const void* data = nullptr;
+  std::size_t bytes = count * 4;
+  if (p.type == PropType::F64) {
+    if (ctx.double_precision()) {
+      data = p.f64.data();
+      bytes = count * sizeof(double);
+    } else {
+      tmp.assign(p.f64.begin(), p.f64.begin() + count);
+      data = tmp.data();
+    }
+  } else {
+    data = p.type == PropType::I32 ? static_cast<const void*>(p.i32.data()) : p.u32.data();
+  }
+  check(clEnqueueWriteBuffer(ctx.queue(), buf, CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
+        "clEnqueueWriteBuffer (property)");
+}
 }  // namespace
 
 void DeviceArray::upload(Context& ctx, const ParticleArray& a) {
@@ -686,27 +709,8 @@ void DeviceArray::upload(Context& ctx, const ParticleArray& a) {
   std::vector<float> tmp;
   for (std::size_t i = 0; i < a.props.size(); ++i) {
     const Property& p = a.props[i];
-    const std::size_t count = n * static_cast<std::size_t>(p.stride);
-    const void* data = nullptr;
-    std::size_t bytes = 0;
-    if (p.type == PropType::F64) {
-      if (ctx.double_precision()) {
-        data = p.f64.data();
-        bytes = count * sizeof(double);
-      } else {
-        tmp.assign(p.f64.begin(), p.f64.begin() + count);
-        data = tmp.data();
-        bytes = count * sizeof(float);
-      }
-    } else {
-      data = p.type == PropType::I32 ? static_cast<const void*>(p.i32.data()) : p.u32.data();
-      bytes = count * 4;
-    }
     if (realloc) props.push_back(ctx.alloc(capacity * p.stride * value_size(ctx, p)));
-    if (bytes)
-      check(
-          clEnqueueWriteBuffer(ctx.queue(), props[i], CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
-          "clEnqueueWriteBuffer (property)");
+    write_property(ctx, props[i], p, n, tmp);
   }
   if (constants.size() != a.constants.size()) {
     for (cl_mem m : constants) clReleaseMemObject(m);
@@ -735,26 +739,7 @@ void DeviceArray::download(Context& ctx, ParticleArray& a) {
 
 void DeviceArray::upload(Context& ctx, const ParticleArray& a, const std::vector<int>& which) {
   std::vector<float> tmp;
-  for (int i : which) {
-    const Property& p = a.props[i];
-    const std::size_t count = n * static_cast<std::size_t>(p.stride);
-    if (count == 0) continue;
-    const void* data = nullptr;
-    std::size_t bytes = count * 4;
-    if (p.type == PropType::F64) {
-      if (ctx.double_precision()) {
-        data = p.f64.data();
-        bytes = count * sizeof(double);
-      } else {
-        tmp.assign(p.f64.begin(), p.f64.begin() + count);
-        data = tmp.data();
-      }
-    } else {
-      data = p.type == PropType::I32 ? static_cast<const void*>(p.i32.data()) : p.u32.data();
-    }
-    check(clEnqueueWriteBuffer(ctx.queue(), props[i], CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
-          "clEnqueueWriteBuffer (property)");
-  }
+  for (int i : which) write_property(ctx, props[i], a.props[i], n, tmp);
 }
 
 void DeviceArray::download(Context& ctx, ParticleArray& a, const std::vector<int>& which) {

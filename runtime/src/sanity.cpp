@@ -123,26 +123,20 @@ LimitCheck check_limit(const Limit& limit, const ParticleArray& a, int dim) {
   LimitCheck c;
   double worst_warn = 0, worst_stop = 0;
   std::size_t at_warn = 0, at_stop = 0;
+  // Particle i against one bound: counted if outside, kept if the furthest outside so far.
+  auto against = [](const std::optional<Bounds>& b, double v, std::size_t i,
+                    std::size_t& outside, double& worst, std::size_t& at) {
+    if (!b) return;
+    const double e = b->excess(v);
+    if (e > 0 && (outside++ == 0 || e > worst)) {
+      worst = e;
+      at = i;
+    }
+  };
   for (std::size_t i = 0; i < a.n; ++i) {
     const double v = q(i);
-    if (limit.warn) {
-      const double e = limit.warn->excess(v);
-      if (e > 0) {
-        if (c.outside_warn++ == 0 || e > worst_warn) {
-          worst_warn = e;
-          at_warn = i;
-        }
-      }
-    }
-    if (limit.stop) {
-      const double e = limit.stop->excess(v);
-      if (e > 0) {
-        if (c.outside_stop++ == 0 || e > worst_stop) {
-          worst_stop = e;
-          at_stop = i;
-        }
-      }
-    }
+    against(limit.warn, v, i, c.outside_warn, worst_warn, at_warn);
+    against(limit.stop, v, i, c.outside_stop, worst_stop, at_stop);
   }
   if (c.outside_stop > 0) {
     c.worst = at_stop;
