@@ -232,8 +232,9 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     const clang::BinaryOperatorKind opc = op->getOpcode();
     const bool compound = opc == clang::BO_AddAssign || opc == clang::BO_SubAssign;
     if (opc != clang::BO_Add && opc != clang::BO_Sub && !compound) return;
+    if (op->containsErrors()) return;  // reported; the body is not printed
     const clang::QualType type = op->getType();
-    if (!type->isRealFloatingType()) return;
+    if (type.isNull() || !type->isRealFloatingType()) return;
     auto product = [&](clang::Expr* e) -> clang::BinaryOperator* {
       auto* m = llvm::dyn_cast<clang::BinaryOperator>(e->IgnoreParens());
       return m && m->getOpcode() == clang::BO_Mul && sameType(m->getType(), type) ? m : nullptr;
@@ -284,7 +285,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   }
 
   bool sameType(clang::QualType x, clang::QualType y) const {
-    return ctx_->hasSameUnqualifiedType(x, y);
+    return !x.isNull() && !y.isNull() && ctx_->hasSameUnqualifiedType(x, y);
   }
 
   // An operand that a unary minus in front of it negates as a whole: `-x`, `-d_p[d_idx]`.
