@@ -26,6 +26,9 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     if (body_.kind == BodyKind::Function) checkSignature(fn);
     TraverseStmt(fn->getBody());
     if (returnsValue(body_.kind) && !returnsValue_) batch_.reportMissingReturn(i_);
+    // A name `fma` of the body's own (a local, a scalar) would hide OpenCL's fma: as written.
+    for (clang::ParmVarDecl* p : fn->parameters()) namesFma_ |= p->getName() == "fma";
+    if (namesFma_) facts_.multiplyAdds.clear();
   }
 
   // --- facts ---
@@ -155,6 +158,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   }
 
   bool VisitVarDecl(clang::VarDecl* v) {
+    namesFma_ |= v->getName() == "fma";
     if (v->isStaticLocal())
       error(v->getLocation(), "'static' local variables are not allowed in bodies: a body keeps "
                               "no state between calls; use a property");
@@ -378,6 +382,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   BodyFacts& facts_;
   bool returnsValue_ = false;
   int recovering_ = 0;  // depth of RecoveryExprs being traversed
+  bool namesFma_ = false;  // the body declares something named `fma`
   std::map<const clang::ArraySubscriptExpr*, bool> written_;  // -> also read
   std::set<const clang::DeclRefExpr*> indexed_;  // d_/s_ references that are subscripted
   std::set<const clang::DeclRefExpr*> callees_;  // function references that are called

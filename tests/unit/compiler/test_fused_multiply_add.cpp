@@ -89,6 +89,10 @@ TEST_F(FusedMultiplyAddTest, OnlyOneFloatingTypeAsWritten) {
                            " float f = R2IJ; d_a[d_idx] = f * f + R2IJ; ",
                            " int i = d_idx; d_a[i++] += R2IJ * R2IJ; "})
     EXPECT_EQ(fused(text), text) << text;
+  // A body that names something `fma` (it would hide OpenCL's): as written.
+  EXPECT_EQ(fused(" double fma = 2.0; d_a[d_idx] = fma * R2IJ + 1.0; "),
+            " double fma = 2.0; d_a[d_idx] = fma * R2IJ + 1.0; ");
+  EXPECT_EQ(fused(" d_a[d_idx] = fma * R2IJ + 1.0; ", {"fma"}), " d_a[d_idx] = fma * R2IJ + 1.0; ");
   EXPECT_EQ(fused(" float f = R2IJ; f = f * f + f; d_a[d_idx] = f; "),
             " float f = R2IJ; f = fma(f, f, f); d_a[d_idx] = f; ");
   EXPECT_EQ(fused(" d_a[d_idx] = M_PI * R2IJ + 1.0; "), " d_a[d_idx] = fma(M_PI, R2IJ, 1.0); ");
