@@ -20,6 +20,7 @@
 // tensor entry (i, j) at dim i + j). A property indexed otherwise (`+ k`, a loop variable)
 // or output, limited, measured, loaded or copied by a zone keeps its 3D layout.
 #include "analysis/Passes.h"
+#include "body/TextEdits.h"
 
 #include "llvm/ADT/StringRef.h"
 
@@ -143,18 +144,12 @@ std::string stridedReplacement(llvm::StringRef siteText, const PropSite& s, int 
 // found by the body analysis (the text would still name it).
 bool rewrite(PlanBody& b, const std::set<std::string>& leftOut,
              const std::map<std::string, int>& reduced, int dim) {
-  std::vector<PropSite> sites;
-  for (const auto& s : b.facts.sites)
-    if (leftOut.count(s.prop) || reduced.count(s.prop)) sites.push_back(s);
-  if (sites.empty()) return true;
-  std::sort(sites.begin(), sites.end(),
-            [](const PropSite& x, const PropSite& y) { return x.begin > y.begin; });
-  std::string text = b.source.text;
+  std::vector<TextEdit> edits;
   bool sink = false;
-  unsigned last = ~0u;
-  for (const auto& s : sites) {
-    if (s.end > last || s.end > text.size()) return false;  // overlapping: leave it
-    llvm::StringRef site(text.data() + s.begin, s.end - s.begin);
+  for (const auto& s : b.facts.sites) {
+    if (!leftOut.count(s.prop) && !reduced.count(s.prop)) continue;
+    if (s.end > b.source.text.size()) return false;
+    llvm::StringRef site(b.source.text.data() + s.begin, s.end - s.begin);
     if (site.contains('\n')) return false;
     std::string repl;
     if (leftOut.count(s.prop)) {
@@ -163,23 +158,27 @@ bool rewrite(PlanBody& b, const std::set<std::string>& leftOut,
       repl = stridedReplacement(site, s, reduced.at(s.prop), dim);
     }
     sink |= repl == "sphc_sink";
-    text.replace(s.begin, s.end - s.begin, repl);
-    last = s.begin;
+    edits.push_back({s.begin, s.end, repl});
   }
+  if (edits.empty()) return true;
+  // On the first line, so the #line mapping of the lines below is unchanged.
+  if (sink) edits.push_back({0, 0, " double sphc_sink = 0.0; (void)sphc_sink;"});
+  // The other sites and the multiply-add sites move with the text (body/TextEdits.h).
+  std::string text = b.source.text;
+  BodyFacts facts = b.facts;
+  if (!applyTextEdits(text, edits, facts)) return false;  // overlapping: leave it
   for (const auto& p : leftOut) {
     std::regex still("\\b[ds]_" + p + "\\s*\\[");
     if (std::regex_search(text, still)) return false;
   }
-  // On the first line, so the #line mapping of the lines below is unchanged.
-  if (sink) text = " double sphc_sink = 0.0; (void)sphc_sink;" + text;
   b.source.text = text;
+  b.facts = facts;
   for (const auto& p : leftOut) {
     erase(b.facts.dReads, p);
     erase(b.facts.dWrites, p);
     erase(b.facts.sReads, p);
   }
-  // The offsets of the remaining sites are stale after the replacements: nothing after this
-  // pass reads them (the strided properties' sites are dropped with the left-out ones).
+  // What the rewritten sites named is gone (a 0.0, the sink) or renumbered: drop them.
   b.facts.sites.erase(std::remove_if(b.facts.sites.begin(), b.facts.sites.end(),
                                      [&](const PropSite& s) {
                                        return leftOut.count(s.prop) || reduced.count(s.prop);

@@ -81,6 +81,26 @@ struct PropSite {
   unsigned begin = 0, end = 0;       // offsets into BodySource::text
 };
 
+// Where a body adds a product to a value in floating point: `a * b + c`, `c + a * b`,
+// `a * b - c`, `c - a * b`, `x += a * b`, `x -= a * b`, with a, b, c (x) and the result all of
+// the same floating type as written (no conversion between the product and the sum). The
+// printers write each as one fused multiply-add, `fma(a, b, c)` (codegen/FusedMultiplyAdd.cpp):
+// rounded once, the same on every backend, where the C++ compiler would otherwise choose per
+// inlining context (or, with contraction off, not at all). Offsets are into BodySource::text;
+// the dimension pass keeps them up to date when it edits the text (body/TextEdits.h).
+struct MultiplyAddSite {
+  enum Form { ProductPlus, PlusProduct, ProductMinus, MinusProduct, AddAssign, SubAssign };
+  Form form = ProductPlus;
+  unsigned begin = 0, end = 0;       // the whole sum, difference or compound assignment
+  unsigned productBegin = 0, productEnd = 0;  // a * b, with its parentheses if any
+  unsigned aBegin = 0, aEnd = 0;     // the factors
+  unsigned bBegin = 0, bEnd = 0;
+  unsigned cBegin = 0, cEnd = 0;     // the addend (x of a compound assignment)
+  unsigned mulOp = 0, addOp = 0;     // the `*` and the `+`, `-`, `+=` or `-=`
+  bool parenthesizeNegated = false;  // the negated operand (c of a*b - c, a of c - a*b and
+                                     // x -= a*b) is not a primary expression: -(...)
+};
+
 struct BodyFacts {
   bool ok = false;                   // false: errors were reported for this body
   std::vector<PropAccess> dReads;    // d_ properties read (incl. read in `+=`)
@@ -92,6 +112,7 @@ struct BodyFacts {
   std::set<std::string> scalarsUsed;     // which of BodySource::scalars appear
   std::set<std::string> statesWritten;   // which of BodySource::states it assigns
   std::vector<PropSite> sites;           // every indexing of a property
+  std::vector<MultiplyAddSite> multiplyAdds;  // every product added to a value (floating)
 };
 
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given

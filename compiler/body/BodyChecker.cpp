@@ -4,6 +4,7 @@
 
 #include "clang/AST/ASTContext.h"
 #include "clang/AST/RecursiveASTVisitor.h"
+#include "clang/Lex/Lexer.h"
 #include "llvm/ADT/StringRef.h"
 
 #include <map>
@@ -20,16 +21,21 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
       : batch_(batch), i_(index), sm_(sm), body_(batch.body(index)), facts_(batch.facts[index]) {}
 
   void check(clang::FunctionDecl* fn) {
+    ctx_ = &fn->getASTContext();
     batch_.state[i_].checked = true;
     if (body_.kind == BodyKind::Function) checkSignature(fn);
     TraverseStmt(fn->getBody());
     if (returnsValue(body_.kind) && !returnsValue_) batch_.reportMissingReturn(i_);
+    // A name `fma` of the body's own (a local, a scalar) would hide OpenCL's fma: as written.
+    for (clang::ParmVarDecl* p : fn->parameters()) namesFma_ |= p->getName() == "fma";
+    if (namesFma_) facts_.multiplyAdds.clear();
   }
 
   // --- facts ---
 
   bool VisitBinaryOperator(clang::BinaryOperator* op) {
     if (op->isAssignmentOp()) markWritten(op->getLHS(), op->isCompoundAssignmentOp());
+    if (recovering_ == 0) recordMultiplyAdd(op);
     return true;
   }
 
@@ -152,6 +158,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   }
 
   bool VisitVarDecl(clang::VarDecl* v) {
+    namesFma_ |= v->getName() == "fma";
     if (v->isStaticLocal())
       error(v->getLocation(), "'static' local variables are not allowed in bodies: a body keeps "
                               "no state between calls; use a property");
@@ -221,6 +228,98 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     }
   }
 
+  // --- fused multiply-adds (codegen/FusedMultiplyAdd.cpp prints them) ---
+
+  // A product added to or subtracted from a value, everything of one floating type as written
+  // (so that fma(a, b, c) computes in the type the sum did, in C++ and in OpenCL C alike).
+  void recordMultiplyAdd(clang::BinaryOperator* op) {
+    const clang::BinaryOperatorKind opc = op->getOpcode();
+    const bool compound = opc == clang::BO_AddAssign || opc == clang::BO_SubAssign;
+    if (opc != clang::BO_Add && opc != clang::BO_Sub && !compound) return;
+    if (op->containsErrors()) return;  // reported; the body is not printed
+    const clang::QualType type = op->getType();
+    if (type.isNull() || !type->isRealFloatingType()) return;
+    auto product = [&](clang::Expr* e) -> clang::BinaryOperator* {
+      auto* m = llvm::dyn_cast<clang::BinaryOperator>(e->IgnoreParens());
+      return m && m->getOpcode() == clang::BO_Mul && sameType(m->getType(), type) ? m : nullptr;
+    };
+    MultiplyAddSite s;
+    clang::BinaryOperator* mul = nullptr;
+    clang::Expr* productExpr = nullptr;
+    clang::Expr* c = nullptr;
+    if (compound) {
+      auto* ca = llvm::cast<clang::CompoundAssignOperator>(op);
+      if (!sameType(ca->getComputationLHSType(), type) ||
+          !sameType(ca->getComputationResultType(), type) ||
+          op->getLHS()->HasSideEffects(*ctx_))
+        return;  // x is written twice in x = fma(a, b, x): it must be a plain place
+      mul = product(op->getRHS());
+      productExpr = op->getRHS();
+      c = op->getLHS();
+      s.form = opc == clang::BO_AddAssign ? MultiplyAddSite::AddAssign : MultiplyAddSite::SubAssign;
+    } else if ((mul = product(op->getLHS()))) {
+      productExpr = op->getLHS();
+      c = op->getRHS();
+      s.form = opc == clang::BO_Add ? MultiplyAddSite::ProductPlus : MultiplyAddSite::ProductMinus;
+    } else if ((mul = product(op->getRHS()))) {
+      productExpr = op->getRHS();
+      c = op->getLHS();
+      s.form = opc == clang::BO_Add ? MultiplyAddSite::PlusProduct : MultiplyAddSite::MinusProduct;
+    }
+    if (!mul) return;
+    clang::Expr* a = mul->getLHS();
+    clang::Expr* b = mul->getRHS();
+    for (clang::Expr* e : {a, b, c})
+      if (!sameType(e->IgnoreImpCasts()->getType(), type)) return;  // e.g. `2 * x + y`
+    if (!textRange(op, s.begin, s.end) || !textRange(productExpr, s.productBegin, s.productEnd) ||
+        !textRange(a, s.aBegin, s.aEnd) || !textRange(b, s.bBegin, s.bEnd) ||
+        !textRange(c, s.cBegin, s.cEnd) || !textOffset(mul->getOperatorLoc(), s.mulOp) ||
+        !textOffset(op->getOperatorLoc(), s.addOp))
+      return;
+    llvm::StringRef text(body_.text);
+    llvm::StringRef opText = clang::BinaryOperator::getOpcodeStr(opc);
+    if (text.substr(s.mulOp, 1) != "*" || text.substr(s.addOp, opText.size()) != opText) return;
+    clang::Expr* negated = s.form == MultiplyAddSite::ProductMinus ? c
+                           : s.form == MultiplyAddSite::MinusProduct ||
+                                   s.form == MultiplyAddSite::SubAssign
+                               ? a
+                               : nullptr;
+    if (negated) s.parenthesizeNegated = !isPrimary(negated);
+    facts_.multiplyAdds.push_back(s);
+  }
+
+  bool sameType(clang::QualType x, clang::QualType y) const {
+    return !x.isNull() && !y.isNull() && ctx_->hasSameUnqualifiedType(x, y);
+  }
+
+  // An operand that a unary minus in front of it negates as a whole: `-x`, `-d_p[d_idx]`.
+  static bool isPrimary(const clang::Expr* e) {
+    e = e->IgnoreImpCasts();
+    return llvm::isa<clang::DeclRefExpr>(e) || llvm::isa<clang::ArraySubscriptExpr>(e) ||
+           llvm::isa<clang::CallExpr>(e) || llvm::isa<clang::ParenExpr>(e) ||
+           llvm::isa<clang::FloatingLiteral>(e) || llvm::isa<clang::IntegerLiteral>(e);
+  }
+
+  // The offset in the body's text of a location in it (a macro such as M_PI: where it is
+  // written).
+  bool textOffset(clang::SourceLocation loc, unsigned& off) const {
+    if (loc.isInvalid() || !body_.start.isValid()) return false;
+    loc = sm_.getExpansionLoc(loc);
+    if (batch_.bodyAt(sm_, loc) != i_) return false;
+    llvm::SMLoc at = sph(loc);
+    if (!at.isValid() || at.getPointer() < body_.start.getPointer()) return false;
+    off = static_cast<unsigned>(at.getPointer() - body_.start.getPointer());
+    return off < body_.text.size();
+  }
+
+  // text[begin, end) is the expression, from its first token to the end of its last.
+  bool textRange(const clang::Expr* e, unsigned& begin, unsigned& end) const {
+    clang::SourceLocation last = sm_.getExpansionLoc(e->getEndLoc());
+    if (!textOffset(e->getBeginLoc(), begin) || !textOffset(last, end)) return false;
+    end += clang::Lexer::MeasureTokenLength(last, sm_, ctx_->getLangOpts());
+    return begin < end && end <= body_.text.size();
+  }
+
   llvm::SMLoc sph(clang::SourceLocation loc) const { return batch_.toSph(sm_, loc, i_); }
   void error(clang::SourceLocation loc, const llvm::Twine& msg) { batch_.error(i_, sph(loc), msg); }
 
@@ -278,10 +377,12 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   Batch& batch_;
   int i_;
   const clang::SourceManager& sm_;
+  const clang::ASTContext* ctx_ = nullptr;
   const BodySource& body_;
   BodyFacts& facts_;
   bool returnsValue_ = false;
   int recovering_ = 0;  // depth of RecoveryExprs being traversed
+  bool namesFma_ = false;  // the body declares something named `fma`
   std::map<const clang::ArraySubscriptExpr*, bool> written_;  // -> also read
   std::set<const clang::DeclRefExpr*> indexed_;  // d_/s_ references that are subscripted
   std::set<const clang::DeclRefExpr*> callees_;  // function references that are called

@@ -4,6 +4,7 @@
 #include "analysis/Access.h"
 #include "analysis/PairQuantityTable.h"
 #include "body/BodyAnalysis.h"
+#include "codegen/FusedMultiplyAdd.h"
 #include "codegen/Printer.h"
 
 #include <algorithm>
@@ -25,6 +26,10 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   device_ = {"real",     "int",          "uint",          "__global ", "inline ",
              "kernel_w", "kernel_gradient", "sqrt",     "continue;", "_",
              false,      false,          true,            plan_.sceneName + ".cl"};
+  if (opts.fma) {
+    host_.fma = "std::fma";
+    device_.fma = "fma";
+  }
   for (int a : sched.cellLists) sourceArrays_.push_back(arr(a).name);
   for (int a : sched.searchArrays) loopArrays_.insert(arr(a).name);
   mpi_ = sched.distribution.enabled;
@@ -116,13 +121,21 @@ void ScenePrinter::emitBodyFunction(const PlanBody& b, const std::string& name,
   os << d.functionPrefix << (ret == "double" ? d.real : ret) << " " << name << "(";
   for (size_t i = 0; i < params.size(); ++i) os << (i ? ", " : "") << params[i].decl;
   os << ") {";
-  // The body exactly as written; its first line continues after the opening brace.
-  std::string text = d.floatBodies ? singlePrecisionBody(b.source.text) : b.source.text;
+  // The body as written (its multiply-adds fused); its first line continues after the
+  // opening brace.
+  std::string text = bodyText(b, d);
   os << text;
   if (text.empty() || text.back() != '\n') os << "\n";
   os << "}\n";
   if (d.lineDirectives) resetLineDirective(os, d);
   os << "\n";
+}
+
+// A body's or helper's text in a dialect: its multiply-adds fused, in float for
+// --precision=single on the CPU.
+std::string ScenePrinter::bodyText(const PlanBody& b, const Dialect& d) const {
+  std::string text = fuseMultiplyAdds(b.source.text, b.facts.multiplyAdds, d.fma);
+  return d.floatBodies ? singlePrecisionBody(text) : text;
 }
 
 // A helper function (`function double f(...) { }`), as written after `function`: a plain C
@@ -131,8 +144,7 @@ void ScenePrinter::emitHelperFunction(const PlanBody& f, const Dialect& d,
                                       std::ostringstream& os) {
   os << "// " << f.source.label << ", from " << loc(f.source.start) << "\n";
   if (d.lineDirectives) emitLineDirective(os, f.source.start);
-  std::string text = d.floatBodies ? singlePrecisionBody(f.source.text) : f.source.text;
-  os << d.functionPrefix << text << "\n";
+  os << d.functionPrefix << bodyText(f, d) << "\n";
   if (d.lineDirectives) resetLineDirective(os, d);
   os << "\n";
 }

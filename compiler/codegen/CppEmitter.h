@@ -26,6 +26,9 @@ struct EmitOptions {
   // Every particle gets a global id `gid` (unique over the arrays, in set-up order), written with the output, so runs
   // can be compared particle by particle (--global-ids; always with --mpi).
   bool globalIds = false;
+  // Products added to values in bodies are printed as explicit fused multiply-adds (std::fma,
+  // OpenCL fma): rounded once and alike on every backend (--fma=off: as written).
+  bool fma = true;
 };
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.

@@ -40,6 +40,9 @@ struct Dialect {
   // as the build names it: scene.cpp in the build cache, <scene>.cl for the kernels).
   bool lineDirectives = false;
   std::string lineFile;
+  // The fused multiply-add that bodies' products added to values are printed as
+  // (codegen/FusedMultiplyAdd.h): std::fma / fma; empty: printed as written (--fma=off).
+  std::string fma;
   std::string lit(const std::string& v) const { return floatLiterals ? v + "f" : v; }
 };
 
@@ -116,6 +119,7 @@ class ScenePrinter {
   std::vector<BodyParam> bodyParams(const PlanBody& b, int destArray, const Dialect& d) const;
   void emitBodyFunction(const PlanBody& b, const std::string& name, const std::string& ret,
                         int destArray, const Dialect& d, std::ostringstream& os);
+  std::string bodyText(const PlanBody& b, const Dialect& d) const;
   void emitKernelFunctions();
   void emitHelperFunction(const PlanBody& f, const Dialect& d, std::ostringstream& os);
   // eqValues + sep + scalar: "eq3.rho0" on the host, "eq3_rho0" (a kernel argument) on the

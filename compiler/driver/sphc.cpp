@@ -60,6 +60,15 @@ static cl::opt<sphc::Precision, false, NamedValues<sphc::Precision>> PrecisionOp
                           "double (default; on OpenCL it needs fp64)"),
                clEnumValN(sphc::Precision::Single, "single", "float")),
     cl::cat(SphcCat));
+enum class OnOff { On, Off };
+static cl::opt<OnOff, false, NamedValues<OnOff>> FmaOpt(
+    "fma", cl::desc("Products added to values in bodies (a * b + c, x += a * b):"),
+    cl::init(OnOff::On),
+    cl::values(clEnumValN(OnOff::On, "on",
+                          "fused multiply-adds, fma(a, b, c): rounded once, alike on every "
+                          "backend (default)"),
+               clEnumValN(OnOff::Off, "off", "a multiply and an add, each rounded")),
+    cl::cat(SphcCat));
 enum class EmitKind { Exe, Cpp, OpenCL, Plan, Ast };
 static cl::opt<std::string> KernelOpt(
     "kernel", cl::desc("Replace the scene's smoothing kernel (CubicSpline, QuinticSpline, "
@@ -252,7 +261,7 @@ int main(int argc, char** argv) {
     printSchedule(*schedule, diags, llvm::outs());
     return 0;
   }
-  EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi};
+  EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On};
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;
