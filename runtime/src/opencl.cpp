@@ -670,26 +670,33 @@ std::size_t value_size(const Context& ctx, const Property& p) {
   return p.type == PropType::F64 ? ctx.real_size() : 4;
 }
 
+// The host side of a transfer of count values of p: p's own storage, or tmp (floats) for
+// doubles on a single-precision device (staged: the caller converts into or out of tmp).
+struct HostSide {
+  void* data;
+  std::size_t bytes;
+  bool staged;
+};
+
+HostSide host_side(Context& ctx, Property& p, std::size_t count, std::vector<float>& tmp) {
+  if (p.type != PropType::F64)
+    return {p.type == PropType::I32 ? static_cast<void*>(p.i32.data()) : p.u32.data(),
+            count * 4, false};
+  if (ctx.double_precision()) return {p.f64.data(), count * sizeof(double), false};
+  tmp.resize(count);
+  return {tmp.data(), count * sizeof(float), true};
+}
+
 // Writes the values of the first n particles of p into buf, doubles as floats on a
 // single-precision device (through tmp).
 void write_property(Context& ctx, cl_mem buf, const Property& p, std::size_t n,
                     std::vector<float>& tmp) {
   const std::size_t count = n * static_cast<std::size_t>(p.stride);
   if (count == 0) return;
-  const void* data = nullptr;
-  std::size_t bytes = count * 4;
-  if (p.type == PropType::F64) {
-    if (ctx.double_precision()) {
-      data = p.f64.data();
-      bytes = count * sizeof(double);
-    } else {
-      tmp.assign(p.f64.begin(), p.f64.begin() + count);
-      data = tmp.data();
-    }
-  } else {
-    data = p.type == PropType::I32 ? static_cast<const void*>(p.i32.data()) : p.u32.data();
-  }
-  check(clEnqueueWriteBuffer(ctx.queue(), buf, CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
+  // host_side only locates the values: nothing is written through it here.
+  const HostSide h = host_side(ctx, const_cast<Property&>(p), count, tmp);
+  if (h.staged) std::copy(p.f64.begin(), p.f64.begin() + count, tmp.begin());
+  check(clEnqueueWriteBuffer(ctx.queue(), buf, CL_TRUE, 0, h.bytes, h.data, 0, nullptr, nullptr),
         "clEnqueueWriteBuffer (property)");
 }
 }  // namespace
@@ -748,23 +755,11 @@ void DeviceArray::download(Context& ctx, ParticleArray& a, const std::vector<int
     Property& p = a.props[i];
     const std::size_t count = n * static_cast<std::size_t>(p.stride);
     if (count == 0) continue;
-    void* data = nullptr;
-    std::size_t bytes = count * 4;
-    if (p.type == PropType::F64) {
-      if (ctx.double_precision()) {
-        data = p.f64.data();
-        bytes = count * sizeof(double);
-      } else {
-        tmp.resize(count);
-        data = tmp.data();
-      }
-    } else {
-      data = p.type == PropType::I32 ? static_cast<void*>(p.i32.data()) : p.u32.data();
-    }
-    check(clEnqueueReadBuffer(ctx.queue(), props[i], CL_TRUE, 0, bytes, data, 0, nullptr, nullptr),
+    const HostSide h = host_side(ctx, p, count, tmp);
+    check(clEnqueueReadBuffer(ctx.queue(), props[i], CL_TRUE, 0, h.bytes, h.data, 0, nullptr,
+                              nullptr),
           "clEnqueueReadBuffer (property)");
-    if (p.type == PropType::F64 && !ctx.double_precision())
-      for (std::size_t k = 0; k < count; ++k) p.f64[k] = tmp[k];
+    if (h.staged) std::copy(tmp.begin(), tmp.begin() + count, p.f64.begin());
   }
 }
 
