@@ -33,8 +33,11 @@ void ScenePrinter::emitZoneSetup() {
       scene_ << "      zn.outlet = &" << A << ";\n      zn.from = &" << O << ";\n";
     if (!z.inlet && z.type == "mirror")  // properties interpolated at the image points
       scene_ << "      zn.kind = sphc::OutletKind::Mirror;\n";
-    if (!z.inlet && z.type == "characteristic") {  // mirror interpolation + characteristics
+    if (!z.inlet && z.type == "characteristic")  // mirror interpolation + characteristics
       scene_ << "      zn.kind = sphc::OutletKind::Characteristic;\n";
+    if (!z.inlet && z.type == "hybrid")  // time average + outgoing characteristic's fluctuation
+      scene_ << "      zn.kind = sphc::OutletKind::Hybrid;\n";
+    if (!z.inlet && (z.type == "characteristic" || z.type == "hybrid")) {
       scene_ << "      zn.c = " << exprCpp(*z.c, pn) << ";\n";
       if (z.pRef) scene_ << "      zn.p_ref = " << exprCpp(*z.pRef, pn) << ";\n";
       if (z.tau) scene_ << "      zn.tau = " << exprCpp(*z.tau, pn) << ";\n";

@@ -3,7 +3,8 @@
 //   inlet NAME(array = A, feeds = F, x = X, y = Y, z = Z, nx = NX, ny = NY, nz = NZ,
 //              length = L, width = W, u = U, v = V, w = W, copy = [p, q, ...]);
 //   outlet NAME(array = A, from = F, x = .., nx = .., length = .., width = .., copy = [..],
-//               type = do_nothing | mirror);
+//               type = do_nothing | mirror | characteristic | hybrid,
+//               c = C, p_ref = P, tau = T);   // c: characteristic and hybrid; p_ref: characteristic
 //
 // (x, y, z): a point on the face between the fluid and the zone; (nx, ny, nz): the outward
 // normal (away from the fluid); length: the zone's depth along it; width: its extent across.
@@ -230,32 +231,49 @@ bool buildZones(const ast::SceneDecl& scene, Plan& plan, DiagnosticEngine& diags
     if (auto it = args.find("type"); it != args.end()) {
       const ast::KwArg& kw = *it->second;
       const std::string t = kw.value && kw.value->kind == ast::Expr::Name ? kw.value->text : "";
-      if (t == "do_nothing" || t == "mirror" || t == "characteristic") {
+      if (t == "do_nothing" || t == "mirror" || t == "characteristic" || t == "hybrid") {
         pz.type = t;
-      } else if (t == "hybrid") {
-        diags.error(kw.value->loc, "outlet type 'hybrid' (Negi et al. 2019) is not "
-                                   "implemented yet; use type = do_nothing, mirror or "
-                                   "characteristic");
-        ok = false;
       } else {
-        diags.error(kw.name.loc, "outlet type is do_nothing, mirror or characteristic (hybrid "
-                                 "is not implemented yet)");
+        diags.error(kw.value ? kw.value->loc : kw.name.loc,
+                    "outlet type is do_nothing, mirror, characteristic or hybrid" +
+                        (t.empty() ? std::string() : " (found '" + t + "')"));
         ok = false;
       }
     }
     if (!z.inlet) {
-      // The characteristic outlet's sound speed (required), reference pressure, averaging time.
+      // The sound speed (characteristic and hybrid, required), the averaging time (both) and
+      // the reference pressure (characteristic only: the hybrid outlet's is the fluid's mean).
       const bool characteristic = pz.type == "characteristic";
-      for (const char* key : {"c", "p_ref", "tau"})
-        if (auto it = args.find(key); it != args.end() && !characteristic) {
+      const bool hybrid = pz.type == "hybrid";
+      for (const char* key : {"c", "tau"})
+        if (auto it = args.find(key); it != args.end() && !characteristic && !hybrid) {
           diags.error(it->second->name.loc, "'" + std::string(key) + "' of " + what +
-                                                " is for type = characteristic only");
+                                                " is for type = characteristic or hybrid only");
           ok = false;
         }
-      if (characteristic) {
+      if (auto it = args.find("p_ref"); it != args.end() && !characteristic) {
+        diags.error(it->second->name.loc,
+                    "'p_ref' of " + what + " is for type = characteristic only" +
+                        (hybrid ? std::string(" (the hybrid outlet's reference pressure is the "
+                                              "fluid's running mean at the face)")
+                                : std::string()));
+        ok = false;
+      }
+      if (characteristic || hybrid) {
         pz.c = expr("c", true, false);
-        pz.pRef = expr("p_ref", false, false);
+        if (characteristic) pz.pRef = expr("p_ref", false, false);
         pz.tau = expr("tau", false, false);
+        // Sound speed and averaging time must be positive (the defaults of the params).
+        for (const auto& [key, e] : {std::pair<const char*, ast::ExprPtr>{"c", pz.c},
+                                     std::pair<const char*, ast::ExprPtr>{"tau", pz.tau}}) {
+          if (!e) continue;
+          if (auto x = eval(*e); x && !(*x > 0.0)) {
+            diags.error(e->loc, "'" + std::string(key) + "' of " + what + " must be positive (" +
+                                    (std::string(key) == "c" ? "the sound speed" : "the averaging time") +
+                                    "; it is " + formatNumber(*x) + ")");
+            ok = false;
+          }
+        }
       }
     }
     if (pz.array < 0 || pz.other < 0 || !ok) continue;

@@ -318,8 +318,10 @@ struct Slots {
 Slots characteristic_slots(const OutletZone& out) {
   const ParticleArray& o = *out.outlet;
   const Zone& z = out.zone;
+  const std::string what =
+      out.kind == OutletKind::Hybrid ? "the hybrid outlet" : "the characteristic outlet";
   if (!(out.c > 0.0))
-    throw std::invalid_argument(z.name + ": the characteristic outlet needs the sound speed "
+    throw std::invalid_argument(z.name + ": " + what + " needs the sound speed "
                                 "c > 0 (got " + num(out.c) + ")");
   const std::size_t np = out.mirrored.to.size();
   auto slot = [&](const char* name) {
@@ -333,14 +335,41 @@ Slots characteristic_slots(const OutletZone& out) {
   s.v[0] = slot("u");
   s.v[1] = slot("v");
   s.v[2] = slot("w");
-  if (s.p < 0) throw std::invalid_argument(z.name + ": the characteristic outlet needs 'p' "
+  if (s.p < 0) throw std::invalid_argument(z.name + ": " + what + " needs 'p' "
                                            "in both arrays (and copied)");
   for (int k = 0; k < z.dim; ++k)
     if (s.v[k] < 0)
-      throw std::invalid_argument(z.name + ": the characteristic outlet needs the velocity "
+      throw std::invalid_argument(z.name + ": " + what + " needs the velocity "
                                   "'" + std::string(1, "uvw"[k]) + "' in both arrays (and copied)");
   return s;
 }
+}  // namespace
+
+namespace {
+// Bins across the face (width support / 2) for the running means: how many per tangential
+// axis, and the bin of a position.
+struct FaceBins {
+  double bw = 0.0;
+  int nb1 = 1, nb2 = 1;
+  explicit FaceBins(const OutletZone& out) : bw(0.5 * out.support) {
+    const Zone& z = out.zone;
+    nb1 = z.dim > 1 ? std::max(1, static_cast<int>(std::ceil(z.width / bw))) : 1;
+    nb2 = z.dim > 2 ? nb1 : 1;
+  }
+  std::size_t size() const {
+    return static_cast<std::size_t>(nb1) * static_cast<std::size_t>(nb2);
+  }
+  std::size_t of(const Zone& z, const double p[3]) const {
+    double tc[2];
+    tangential(z, p, tc);
+    auto idx = [&](double c) {
+      const int k = static_cast<int>(std::floor((c + 0.5 * z.width) / bw));
+      return std::min(std::max(k, 0), nb1 - 1);
+    };
+    return static_cast<std::size_t>(idx(tc[0])) +
+           (z.dim > 2 ? static_cast<std::size_t>(idx(tc[1])) * static_cast<std::size_t>(nb1) : 0);
+  }
+};
 }  // namespace
 
 NormalBins normal_bins(const OutletZone& out, const ImageValues& iv) {
@@ -348,11 +377,8 @@ NormalBins normal_bins(const OutletZone& out, const ImageValues& iv) {
   const Zone& z = out.zone;
   const Slots sl = characteristic_slots(out);
   const std::size_t np = out.mirrored.to.size();
-  // Bins across the face (width support / 2) for the mean normal velocity u_ref.
-  const double bw = 0.5 * out.support;
-  const int nb1 = z.dim > 1 ? std::max(1, static_cast<int>(std::ceil(z.width / bw))) : 1;
-  const int nb2 = z.dim > 2 ? nb1 : 1;
-  const std::size_t nb = static_cast<std::size_t>(nb1) * static_cast<std::size_t>(nb2);
+  const FaceBins fb(out);
+  const std::size_t nb = fb.size();
   NormalBins b;
   b.bin.assign(o.n, 0);
   b.un.assign(o.n, 0.0);
@@ -360,15 +386,9 @@ NormalBins normal_bins(const OutletZone& out, const ImageValues& iv) {
   b.count.assign(nb, 0.0);
   const Positions op(o);
   for (std::size_t i = 0; i < o.n; ++i) {
-    double p[3], tc[2];
+    double p[3];
     op.at(i, p);
-    tangential(z, p, tc);
-    auto idx = [&](double c) {
-      const int k = static_cast<int>(std::floor((c + 0.5 * z.width) / bw));
-      return std::min(std::max(k, 0), nb1 - 1);
-    };
-    b.bin[i] = static_cast<std::size_t>(idx(tc[0])) +
-               (z.dim > 2 ? static_cast<std::size_t>(idx(tc[1])) * nb1 : 0);
+    b.bin[i] = fb.of(z, p);
     if (!iv.found[i]) continue;
     for (int k = 0; k < z.dim; ++k) b.un[i] += iv.vals[i * np + sl.v[k]] * z.normal[k];
     b.sum[b.bin[i]] += b.un[i];
@@ -377,22 +397,49 @@ NormalBins normal_bins(const OutletZone& out, const ImageValues& iv) {
   return b;
 }
 
+void face_sums(const OutletZone& out, const ImageBand& band, NormalBins& b) {
+  const Zone& z = out.zone;
+  const Slots sl = characteristic_slots(out);
+  const std::size_t np = band.np;
+  const FaceBins fb(out);
+  const std::size_t nb = fb.size();
+  b.sum.assign(nb, 0.0);
+  b.count.assign(nb, 0.0);
+  b.psum.assign(nb, 0.0);
+  for (std::size_t j = 0; j < band.size(); ++j) {  // gid order: the same sums on every rank
+    const double* q = band.pos.data() + 3 * j;
+    if (!(z.depth(q) >= -out.support) || !z.across(q)) continue;
+    const double* v = band.vals.data() + np * j;
+    double un = 0.0;
+    for (int k = 0; k < z.dim; ++k) un += v[sl.v[k]] * z.normal[k];
+    const std::size_t k = fb.of(z, q);
+    b.sum[k] += un;
+    b.psum[k] += v[sl.p];
+    b.count[k] += 1.0;
+  }
+}
+
 void advance_reference(OutletZone& out, const NormalBins& b, double t) {
   const std::size_t nb = b.sum.size();
+  const bool hybrid = !b.psum.empty();  // the mean pressure too
   if (out.uref.size() != nb) {
     out.uref.assign(nb, 0.0);
     out.uref_set.assign(nb, 0);
   }
+  if (hybrid && out.pref.size() != nb) out.pref.assign(nb, 0.0);
   const double tau = out.tau > 0.0 ? out.tau : 20.0 * out.zone.length / out.c;
   const double f = out.started ? std::min(1.0, std::max(0.0, t - out.t_last) / tau) : 1.0;
   for (std::size_t k = 0; k < nb; ++k) {
     if (!(b.count[k] > 0.0)) continue;
     const double mean = b.sum[k] / b.count[k];
+    const double pmean = hybrid ? b.psum[k] / b.count[k] : 0.0;
     if (!out.uref_set[k]) {
       out.uref[k] = mean;
+      if (hybrid) out.pref[k] = pmean;
       out.uref_set[k] = 1;
     } else {
       out.uref[k] += f * (mean - out.uref[k]);
+      if (hybrid) out.pref[k] += f * (pmean - out.pref[k]);
     }
   }
   out.started = true;
@@ -409,8 +456,10 @@ void apply_characteristic(OutletZone& out, ImageValues& iv, const NormalBins& b)
     double* v = iv.vals.data() + i * np;
     const double rho = sl.rho >= 0 && v[sl.rho] > 0.0 ? v[sl.rho] : 1.0;
     const double ur = out.uref[b.bin[i]];
-    const double j2 = rho * out.c * (b.un[i] - ur) + (v[sl.p] - out.p_ref);
-    v[sl.p] = out.p_ref + 0.5 * j2;
+    // The reference pressure: p_ref, or (hybrid) the bin's mean pressure p_ta.
+    const double pr = out.kind == OutletKind::Hybrid ? out.pref[b.bin[i]] : out.p_ref;
+    const double j2 = rho * out.c * (b.un[i] - ur) + (v[sl.p] - pr);
+    v[sl.p] = pr + 0.5 * j2;
     const double dn = ur + 0.5 * j2 / (rho * out.c) - b.un[i];  // new minus image normal velocity
     for (int k = 0; k < z.dim; ++k) v[sl.v[k]] += dn * z.normal[k];
     for (std::size_t k = 0; k < np; ++k) o.props[out.mirrored.to[k]].f64[i] = v[k];
@@ -423,6 +472,18 @@ std::size_t characteristic_outlet(OutletZone& out, double t) {
   sort_band(band);
   ImageValues iv = interpolate_images(out, band);
   const NormalBins b = normal_bins(out, iv);
+  advance_reference(out, b, t);
+  apply_characteristic(out, iv, b);
+  return iv.lonely;
+}
+
+std::size_t hybrid_outlet(OutletZone& out, double t) {
+  characteristic_slots(out);  // the checks, before anything changes
+  ImageBand band = image_band(out);
+  sort_band(band);
+  ImageValues iv = interpolate_images(out, band);
+  NormalBins b = normal_bins(out, iv);
+  face_sums(out, band, b);  // the means from the fluid at the face
   advance_reference(out, b, t);
   apply_characteristic(out, iv, b);
   return iv.lonely;
@@ -567,6 +628,7 @@ bool update_inlet_outlet(InletOutlet& io, double t) {
     changed |= update_outlet(out);
     if (out.kind == OutletKind::Mirror) mirror_outlet(out);
     if (out.kind == OutletKind::Characteristic) characteristic_outlet(out, t);
+    if (out.kind == OutletKind::Hybrid) hybrid_outlet(out, t);
   }
   return changed;
 }

@@ -102,15 +102,18 @@ void inlet_outlet_state(const InletOutlet& io, RunState& state) {
     state.emplace_back(fmt::format("io.outlet{}.entered", k), static_cast<double>(o.entered));
     state.emplace_back(fmt::format("io.outlet{}.returned", k), static_cast<double>(o.returned));
     state.emplace_back(fmt::format("io.outlet{}.removed", k), static_cast<double>(o.removed));
-    if (o.kind != OutletKind::Characteristic || !o.started) continue;
-    // The characteristic outlet's running mean u_ref per bin (and which bins have one) and
-    // when it was last updated: a restart goes on averaging as the uninterrupted run does.
+    const bool hybrid = o.kind == OutletKind::Hybrid;
+    if ((o.kind != OutletKind::Characteristic && !hybrid) || !o.started) continue;
+    // The characteristic outlet's running mean u_ref per bin (and which bins have one; the
+    // hybrid outlet's also its mean pressure) and when it was last updated: a restart goes
+    // on averaging as the uninterrupted run does.
     state.emplace_back(fmt::format("io.outlet{}.t_last", k), o.t_last);
     state.emplace_back(fmt::format("io.outlet{}.bins", k), static_cast<double>(o.uref.size()));
     for (std::size_t b = 0; b < o.uref.size(); ++b) {
       state.emplace_back(fmt::format("io.outlet{}.uref{}", k, b), o.uref[b]);
       state.emplace_back(fmt::format("io.outlet{}.uref_set{}", k, b),
                          static_cast<double>(o.uref_set[b]));
+      if (hybrid) state.emplace_back(fmt::format("io.outlet{}.pref{}", k, b), o.pref[b]);
     }
   }
 }
@@ -129,14 +132,17 @@ void restore_inlet_outlet(InletOutlet& io, const RunState& state) {
     // The characteristic outlet's running mean (absent: not started, or a file of a build
     // that did not save it; the mean then starts afresh).
     const double bins = state_value(state, fmt::format("io.outlet{}.bins", k), -1.0);
-    if (o.kind != OutletKind::Characteristic || bins < 0.0) continue;
+    const bool hybrid = o.kind == OutletKind::Hybrid;
+    if ((o.kind != OutletKind::Characteristic && !hybrid) || bins < 0.0) continue;
     o.started = true;
     o.t_last = state_value(state, fmt::format("io.outlet{}.t_last", k));
     o.uref.assign(static_cast<std::size_t>(bins), 0.0);
     o.uref_set.assign(o.uref.size(), 0);
+    if (hybrid) o.pref.assign(o.uref.size(), 0.0);
     for (std::size_t b = 0; b < o.uref.size(); ++b) {
       o.uref[b] = state_value(state, fmt::format("io.outlet{}.uref{}", k, b));
       o.uref_set[b] = state_value(state, fmt::format("io.outlet{}.uref_set{}", k, b)) != 0.0;
+      if (hybrid) o.pref[b] = state_value(state, fmt::format("io.outlet{}.pref{}", k, b));
     }
   }
 }

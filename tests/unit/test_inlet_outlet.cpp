@@ -15,6 +15,7 @@
 #include "sphc/global_ids.h"
 #include "sphc/inlet_outlet.h"
 #include "sphc/particle_array.h"
+#include "sphc/restart.h"
 
 namespace {
 
@@ -372,6 +373,105 @@ TEST(InletOutlet, CharacteristicOutletPassesOutgoingWavesOnly) {
   out.from = &fluid;
   out.kind = sphc::OutletKind::Characteristic;
   EXPECT_THROW(sphc::characteristic_outlet(out, 0.0), std::invalid_argument);
+}
+
+// The hybrid outlet (Negi et al. 2019): the mean (u_ta, p_ta) is the fluid's at the face,
+// averaged in time; the fluctuation is the outgoing characteristic from that mean at the
+// image. With the mean held (tau huge) it acts as the characteristic outlet around it: an
+// outgoing wave passes, an incoming one is removed, a step in the pressure is halved. With
+// the mean following at once (tau below the time step) a steady pressure P in the fluid
+// leaves unchanged (the level is the fluid's, not pinned to p_ref as the characteristic
+// outlet's). The means are per bin across the face, from the fluid within the support of it
+// (set at the first call, before any particle is in the outlet), and they are in the restart
+// state.
+TEST(InletOutlet, HybridOutletMeanPlusOutgoingFluctuation) {
+  const double dx = 0.1, c = 10.0, rho = 1.0, U = 1.0, P = 0.3, P0 = 0.05;
+  auto props = [](ParticleArray& a) {
+    a.add_property("rho");
+    a.add_property("p");
+  };
+  // sign = +1: outgoing wave, -1: incoming, 0: a step in the pressure (velocity unchanged).
+  for (const double tau : {1e9, 1e-6})
+    for (const int sign : {1, -1, 0}) {
+      ParticleArray fluid = make_array("fluid", 0), outlet = make_array("outlet", 0);
+      props(fluid);
+      props(outlet);
+      fill_lattice(fluid, 0.0, 1.0, dx, [&](std::size_t i, double, double) {
+        fluid.f64("rho")[i] = rho;
+        fluid.f64("u")[i] = U;
+        fluid.f64("v")[i] = 0.25;
+        fluid.f64("p")[i] = P0;
+      });
+      sphc::InletOutlet io;
+      sphc::OutletZone out = channel_outlet(fluid, outlet);
+      out.copy = {"x", "y", "u", "v", "m", "rho", "p"};
+      out.kind = sphc::OutletKind::Hybrid;
+      out.c = c;
+      out.tau = tau;
+      io.outlets.push_back(out);
+      sphc::init_inlet_outlet(io, {&fluid, &outlet}, 0.2, 0.0);
+      EXPECT_TRUE(sphc::inlet_outlet_due(io));
+      sphc::update_inlet_outlet(io, 0.0);  // no outlet particle yet: the means are set
+      const sphc::OutletZone& o = io.outlets[0];
+      ASSERT_EQ(o.uref.size(), 10u);  // width 1 / (support 0.2 / 2)
+      for (std::size_t b = 0; b < o.uref.size(); ++b) {
+        EXPECT_NEAR(o.uref[b], U, 1e-12) << b;
+        EXPECT_NEAR(o.pref[b], P0, 1e-12) << b;
+      }
+      fill_lattice(outlet, 1.0, 1.2, dx, [&](std::size_t i, double, double) {
+        outlet.f64("u")[i] = outlet.f64("v")[i] = outlet.f64("p")[i] = -7.0;
+        outlet.f64("rho")[i] = rho;
+      });
+      for (std::size_t j = 0; j < fluid.n; ++j) {
+        fluid.f64("p")[j] = P0 + P;
+        fluid.f64("u")[j] = U + sign * P / (rho * c);
+      }
+      sphc::update_inlet_outlet(io, 0.01);
+      ASSERT_EQ(outlet.n, 20u);
+      for (std::size_t i = 0; i < outlet.n; ++i) {
+        const double p = outlet.f64("p")[i], u = outlet.f64("u")[i];
+        if (tau < 1.0) {  // the mean is the fluid's now: J2 = 0, the fluid's state leaves
+          EXPECT_NEAR(p, P0 + P, 1e-9) << i;
+          EXPECT_NEAR(u, U + sign * P / (rho * c), 1e-9) << i;
+        } else if (sign > 0) {
+          EXPECT_NEAR(p, P0 + P, 1e-9) << i;
+          EXPECT_NEAR(u, U + P / (rho * c), 1e-9) << i;
+        } else if (sign < 0) {
+          EXPECT_NEAR(p, P0, 1e-9) << i;
+          EXPECT_NEAR(u, U, 1e-9) << i;
+        } else {
+          EXPECT_NEAR(p, P0 + 0.5 * P, 1e-9) << i;
+          EXPECT_NEAR(u, U + 0.5 * P / (rho * c), 1e-9) << i;
+        }
+        EXPECT_NEAR(outlet.f64("v")[i], 0.25, 1e-12) << i;  // tangential: the image's
+      }
+      // The running means are restart state (with the counters): restored, they are equal.
+      sphc::RunState state;
+      sphc::inlet_outlet_state(io, state);
+      sphc::InletOutlet back;
+      back.outlets.push_back(out);
+      sphc::restore_inlet_outlet(back, state);
+      EXPECT_EQ(back.outlets[0].pref, o.pref);
+      EXPECT_EQ(back.outlets[0].uref, o.uref);
+      EXPECT_EQ(back.outlets[0].t_last, o.t_last);
+      EXPECT_TRUE(back.outlets[0].started);
+    }
+  // Without a sound speed it refuses to run, naming the hybrid outlet.
+  ParticleArray fluid = make_array("fluid", 0), outlet = make_array("outlet", 0);
+  props(fluid);
+  props(outlet);
+  sphc::OutletZone out;
+  out.zone.name = "outlet 'o'";
+  out.outlet = &outlet;
+  out.from = &fluid;
+  out.kind = sphc::OutletKind::Hybrid;
+  try {
+    sphc::hybrid_outlet(out, 0.0);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("the hybrid outlet needs the sound speed"),
+              std::string::npos) << e.what();
+  }
 }
 
 // Fresh ids in (inlet, old id) order: an inlet's particles split over 1, 2 and 4 "ranks" (each

@@ -49,13 +49,33 @@
 //     with the other outlets under EDAC, where no equation of state fixes it. (Tried and
 //     dropped: J2 sampled half a support inside the face and delayed by the travel time to
 //     each outlet particle: the channel's pulse reflected more, R = -0.13 against +0.08.)
+//   - hybrid (the hybrid outlet of Negi, Ramachandran & Haftu 2019: the mean flow of the
+//     frozen-particle outlet plus the fluctuation of the characteristic one): the outlet's
+//     velocity and pressure are a time average plus a fluctuation. The average, per bin across
+//     the face (the bins of u_ref), is the running mean in time (time scale `tau`, default
+//     20 length / c, from the first step on) of the fluid's mean normal velocity u_ta and
+//     pressure p_ta over its particles within a kernel support of the face, in that bin. The
+//     fluctuation is the outgoing characteristic measured from that average at each outlet
+//     particle's image, J2 = rho c (u_n - u_ta) + (p - p_ta) (u_n, p: the mirror
+//     interpolation), the incoming one set to 0: p = p_ta + J2 / 2, u_n = u_ta + J2 / (2 rho c)
+//     (the paper's outlet velocity and pressure from J2 and the time averages); the
+//     tangential velocity and the density are the image's. The characteristic outlet with
+//     p_ref replaced by the fluid's own mean pressure at the face: a steady flow leaves with
+//     the fluid's pressure (zero normal gradient, as mirror), a wave leaving the fluid passes
+//     (u_n - u_ta = (p - p_ta) / (rho c): J2 = 2 (p - p_ta)), one coming in is removed, the
+//     pressure level is the fluid's and not pinned. Not as in the paper: the average is a
+//     running mean per bin of the fluid at the face, not each fluid particle's average of its
+//     last 6 samples taken while the acoustic intensity is low, frozen into the particle when
+//     it leaves; every sample counts, so a wave of duration T moves the average by about
+//     T / tau of its amplitude (in u_ta and p_ta alike, which J2 then cancels).
 //
 // Arrays change size only here, between time steps, never during an evaluation: the neighbour
 // search, ghosts and cell lists are rebuilt from the current sizes at every evaluation. All
 // of it is serial and in particle order, so every backend produces the same arrays. A
 // distributed run (sphc --mpi) does the same steps on each rank's particles with the few
 // collectives of sphc/mpi/zones.h between them: fresh ids in old-id order, the image band
-// gathered from every rank, the characteristic outlet's bin sums added over the ranks.
+// gathered from every rank, the characteristic and hybrid outlets' bin sums added over the
+// ranks.
 #pragma once
 
 #include <cstddef>
@@ -112,7 +132,7 @@ struct InletZone {
   std::size_t created = 0;         // particles that entered the fed array so far
 };
 
-enum class OutletKind : std::uint8_t { DoNothing, Mirror, Characteristic };
+enum class OutletKind : std::uint8_t { DoNothing, Mirror, Characteristic, Hybrid };
 
 struct OutletZone {
   Zone zone;
@@ -124,10 +144,11 @@ struct OutletZone {
   std::size_t entered = 0, returned = 0, removed = 0;
   double support = 0.0;             // mirror: the interpolation radius (set by init)
   CopyMap mirrored;                 // mirror: outlet <- from, the interpolated properties
-  // characteristic: the sound speed, reference pressure, averaging time (0: 20 length / c),
-  // and the state: the mean normal velocity per bin across the face, the last time seen.
+  // characteristic and hybrid: the sound speed, reference pressure (characteristic), averaging
+  // time (0: 20 length / c), and the state: the mean normal velocity per bin across the face
+  // (hybrid: and the mean pressure, pref), the last time seen.
   double c = 0.0, p_ref = 0.0, tau = 0.0;
-  std::vector<double> uref;
+  std::vector<double> uref, pref;
   std::vector<std::uint8_t> uref_set;
   double t_last = 0.0;
   bool started = false;
@@ -166,6 +187,9 @@ std::size_t mirror_outlet(OutletZone& out);
 // interpolation, then p and the normal velocity from the outgoing characteristic (above).
 // Throws std::invalid_argument unless c > 0 and the outlet array has p and u (v, w in 2D/3D).
 std::size_t characteristic_outlet(OutletZone& out, double t);
+// The hybrid condition (OutletKind::Hybrid) at time t: as characteristic_outlet, with the
+// running mean pressure per bin in place of p_ref (above). The same checks.
+std::size_t hybrid_outlet(OutletZone& out, double t);
 bool update_inlet_outlet(InletOutlet& io, double t);
 
 // ---- The steps these are made of (a distributed run, sphc/mpi/zones.h, puts collectives
@@ -210,16 +234,21 @@ struct ImageValues {
 ImageValues interpolate_images(const OutletZone& out, const ImageBand& band);
 // The mirror condition from interpolated values.
 void apply_mirror(OutletZone& out, const ImageValues& iv);
-// The characteristic condition in three steps: the image normal velocity of every outlet
-// particle and its sums per bin across the face (sum, count: this array's particles; a
-// distributed run adds them over the ranks), the running mean u_ref updated from the sums at
-// time t, and p and u_n set from the outgoing characteristic.
+// The characteristic and hybrid conditions in three steps: the image normal velocity of every
+// outlet particle and its sums per bin across the face (sum, count: this array's particles; a
+// distributed run adds them over the ranks), the running means (u_ref; hybrid: and p_ta)
+// updated from the sums at time t, and p and u_n set from the outgoing characteristic.
 struct NormalBins {
   std::vector<std::size_t> bin;  // per outlet particle
   std::vector<double> un;        // per outlet particle: the image's normal velocity
   std::vector<double> sum, count;  // per bin
+  std::vector<double> psum;        // per bin, hybrid only (empty otherwise)
 };
 NormalBins normal_bins(const OutletZone& out, const ImageValues& iv);
+// The hybrid outlet's sums instead: sum (normal velocity), psum (pressure) and count per bin
+// over the band's particles within a kernel support of the face (and within its width), in
+// the band's order (a gathered band: the same sums on every rank, nothing to add up).
+void face_sums(const OutletZone& out, const ImageBand& band, NormalBins& b);
 void advance_reference(OutletZone& out, const NormalBins& b, double t);
 void apply_characteristic(OutletZone& out, ImageValues& iv, const NormalBins& b);
 

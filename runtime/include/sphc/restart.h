@@ -44,8 +44,9 @@ double state_value(const RunState& state, const std::string& name);
 double state_value(const RunState& state, const std::string& name, double otherwise);
 
 // The inlet/outlet manager's state (sphc/inlet_outlet.h): the next global id, each zone's
-// counters and a characteristic outlet's running mean u_ref (per bin, with t_last), appended
-// to `state` as io.NAME; restore_inlet_outlet sets them from a file's.
+// counters and a characteristic or hybrid outlet's running means (u_ref; hybrid: and the
+// pressure's; per bin, with t_last), appended to `state` as io.NAME; restore_inlet_outlet
+// sets them from a file's.
 void inlet_outlet_state(const InletOutlet& io, RunState& state);
 void restore_inlet_outlet(InletOutlet& io, const RunState& state);
 

@@ -96,8 +96,12 @@ bool update_inlet_outlet(InletOutlet& io, double t) {
       apply_mirror(out, iv);
     } else {
       NormalBins b = normal_bins(out, iv);
-      sum_over_ranks(b.sum);
-      sum_over_ranks(b.count);
+      if (out.kind == OutletKind::Hybrid) {
+        face_sums(out, band, b);  // from the gathered band: the same on every rank
+      } else {
+        sum_over_ranks(b.sum);
+        sum_over_ranks(b.count);
+      }
       advance_reference(out, b, t);
       apply_characteristic(out, iv, b);
     }

@@ -13,11 +13,13 @@
 //   - the counters (created, entered, returned, removed) count every rank's particles
 //     (this rank's changes summed over the ranks), as a serial run's do, so restart files and
 //     the progress line say the same whatever the number of ranks;
-//   - mirror and characteristic outlets: the band of the source array their image points can
+//   - mirror, characteristic and hybrid outlets: the band of the source array their image points can
 //     reach is gathered from every rank and put in gid order (the order a serial run adds it
 //     in), so each outlet particle is interpolated from the same particles in the same order
 //     wherever it lives; the characteristic outlet's per-bin sums of the normal velocity are
-//     added over the ranks (MPI_Allreduce), so every rank holds the same running mean u_ref.
+//     added over the ranks (MPI_Allreduce), so every rank holds the same running mean u_ref;
+//     the hybrid outlet's means are of the fluid at the face, in the gathered band: every
+//     rank adds the same particles in the same order.
 // Collective: every rank calls it at the same time with the same zones.
 #pragma once
 
