@@ -18,7 +18,7 @@ find_python run_outlet_pulse.sh
 fresh_output "$EXE" "$OUT"
 
 RUNS=""
-for TYPE in do_nothing mirror characteristic; do
+for TYPE in do_nothing mirror characteristic hybrid; do
   echo "== compile: $SPHC $SRC/examples/$CASE.sph -D outlet_type=$TYPE"
   "$SPHC" "$SRC/examples/$CASE.sph" -D outlet_type=$TYPE -o "${EXE}_$TYPE"
   for P in 1 0; do
