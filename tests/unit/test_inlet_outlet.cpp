@@ -363,16 +363,26 @@ TEST(InletOutlet, CharacteristicOutletPassesOutgoingWavesOnly) {
       EXPECT_NEAR(outlet.f64("v")[i], 0.25, 1e-12) << i;  // tangential: the image's
     }
   }
-  // Without a sound speed it refuses to run.
+  // Without a sound speed it refuses to run, as the hybrid outlet does, each by its name.
   ParticleArray fluid = make_array("fluid", 0), outlet = make_array("outlet", 0);
   props(fluid);
   props(outlet);
-  sphc::OutletZone out;
-  out.zone.name = "outlet 'o'";
-  out.outlet = &outlet;
-  out.from = &fluid;
-  out.kind = sphc::OutletKind::Characteristic;
-  EXPECT_THROW(sphc::characteristic_outlet(out, 0.0), std::invalid_argument);
+  for (const auto kind : {sphc::OutletKind::Characteristic, sphc::OutletKind::Hybrid}) {
+    sphc::OutletZone out;
+    out.zone.name = "outlet 'o'";
+    out.outlet = &outlet;
+    out.from = &fluid;
+    out.kind = kind;
+    const bool hybrid = kind == sphc::OutletKind::Hybrid;
+    try {
+      hybrid ? sphc::hybrid_outlet(out, 0.0) : sphc::characteristic_outlet(out, 0.0);
+      ADD_FAILURE() << "no exception";
+    } catch (const std::invalid_argument& e) {
+      const std::string want = std::string("the ") + (hybrid ? "hybrid" : "characteristic") +
+                               " outlet needs the sound speed";
+      EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    }
+  }
 }
 
 // The hybrid outlet (Negi et al. 2019): the mean (u_ta, p_ta) is the fluid's at the face,
@@ -456,22 +466,6 @@ TEST(InletOutlet, HybridOutletMeanPlusOutgoingFluctuation) {
       EXPECT_EQ(back.outlets[0].t_last, o.t_last);
       EXPECT_TRUE(back.outlets[0].started);
     }
-  // Without a sound speed it refuses to run, naming the hybrid outlet.
-  ParticleArray fluid = make_array("fluid", 0), outlet = make_array("outlet", 0);
-  props(fluid);
-  props(outlet);
-  sphc::OutletZone out;
-  out.zone.name = "outlet 'o'";
-  out.outlet = &outlet;
-  out.from = &fluid;
-  out.kind = sphc::OutletKind::Hybrid;
-  try {
-    sphc::hybrid_outlet(out, 0.0);
-    ADD_FAILURE() << "no exception";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("the hybrid outlet needs the sound speed"),
-              std::string::npos) << e.what();
-  }
 }
 
 // Fresh ids in (inlet, old id) order: an inlet's particles split over 1, 2 and 4 "ranks" (each
