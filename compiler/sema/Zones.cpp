@@ -4,7 +4,7 @@
 //              length = L, width = W, u = U, v = V, w = W, copy = [p, q, ...]);
 //   outlet NAME(array = A, from = F, x = .., nx = .., length = .., width = .., copy = [..],
 //               type = do_nothing | mirror | characteristic | hybrid,
-//               c = C, p_ref = P, tau = T);   // c: characteristic and hybrid; p_ref: characteristic
+//               c = C, p_ref = P, tau = T);   // c, p_ref, tau: characteristic and hybrid
 //
 // (x, y, z): a point on the face between the fluid and the zone; (nx, ny, nz): the outward
 // normal (away from the fluid); length: the zone's depth along it; width: its extent across.
@@ -241,27 +241,19 @@ bool buildZones(const ast::SceneDecl& scene, Plan& plan, DiagnosticEngine& diags
       }
     }
     if (!z.inlet) {
-      // The sound speed (characteristic and hybrid, required), the averaging time (both) and
-      // the reference pressure (characteristic only: the hybrid outlet's is the fluid's mean).
+      // The sound speed (characteristic and hybrid, required), the reference pressure and the
+      // averaging time.
       const bool characteristic = pz.type == "characteristic";
       const bool hybrid = pz.type == "hybrid";
-      for (const char* key : {"c", "tau"})
+      for (const char* key : {"c", "p_ref", "tau"})
         if (auto it = args.find(key); it != args.end() && !characteristic && !hybrid) {
           diags.error(it->second->name.loc, "'" + std::string(key) + "' of " + what +
                                                 " is for type = characteristic or hybrid only");
           ok = false;
         }
-      if (auto it = args.find("p_ref"); it != args.end() && !characteristic) {
-        diags.error(it->second->name.loc,
-                    "'p_ref' of " + what + " is for type = characteristic only" +
-                        (hybrid ? std::string(" (the hybrid outlet's reference pressure is the "
-                                              "fluid's running mean at the face)")
-                                : std::string()));
-        ok = false;
-      }
       if (characteristic || hybrid) {
         pz.c = expr("c", true, false);
-        if (characteristic) pz.pRef = expr("p_ref", false, false);
+        pz.pRef = expr("p_ref", false, false);
         pz.tau = expr("tau", false, false);
         // Sound speed and averaging time must be positive (the defaults of the params).
         for (const auto& [key, e] : {std::pair<const char*, ast::ExprPtr>{"c", pz.c},

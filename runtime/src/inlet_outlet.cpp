@@ -406,6 +406,7 @@ void face_sums(const OutletZone& out, const ImageBand& band, NormalBins& b) {
   b.sum.assign(nb, 0.0);
   b.count.assign(nb, 0.0);
   b.psum.assign(nb, 0.0);
+  b.rsum.assign(nb, 0.0);
   for (std::size_t j = 0; j < band.size(); ++j) {  // gid order: the same sums on every rank
     const double* q = band.pos.data() + 3 * j;
     if (!(z.depth(q) >= -out.support) || !z.across(q)) continue;
@@ -415,6 +416,7 @@ void face_sums(const OutletZone& out, const ImageBand& band, NormalBins& b) {
     const std::size_t k = fb.of(z, q);
     b.sum[k] += un;
     b.psum[k] += v[sl.p];
+    b.rsum[k] += sl.rho >= 0 ? v[sl.rho] : 1.0;
     b.count[k] += 1.0;
   }
 }
@@ -429,6 +431,15 @@ void advance_reference(OutletZone& out, const NormalBins& b, double t) {
   if (hybrid && out.pref.size() != nb) out.pref.assign(nb, 0.0);
   const double tau = out.tau > 0.0 ? out.tau : 20.0 * out.zone.length / out.c;
   const double f = out.started ? std::min(1.0, std::max(0.0, t - out.t_last) / tau) : 1.0;
+  // Hybrid: a bin's pressure sample counts only while quiet, its acoustic intensity
+  // (p - p_ref)^2 / (2 rho c) below I_min = (rho U^2 / 2)^2 / (2 rho c), i.e.
+  // |p - p_ref| < rho U^2 / 2, with U and rho the face's mean normal velocity and density now.
+  double quiet = 0.0;
+  if (hybrid) {
+    double su = 0.0, sr = 0.0, n = 0.0;
+    for (std::size_t k = 0; k < nb; ++k) su += b.sum[k], sr += b.rsum[k], n += b.count[k];
+    if (n > 0.0) quiet = 0.5 * (sr / n) * (su / n) * (su / n);
+  }
   for (std::size_t k = 0; k < nb; ++k) {
     if (!(b.count[k] > 0.0)) continue;
     const double mean = b.sum[k] / b.count[k];
@@ -439,7 +450,7 @@ void advance_reference(OutletZone& out, const NormalBins& b, double t) {
       out.uref_set[k] = 1;
     } else {
       out.uref[k] += f * (mean - out.uref[k]);
-      if (hybrid) out.pref[k] += f * (pmean - out.pref[k]);
+      if (hybrid && std::fabs(pmean - out.p_ref) < quiet) out.pref[k] += f * (pmean - out.pref[k]);
     }
   }
   out.started = true;

@@ -52,22 +52,26 @@
 //   - hybrid (the hybrid outlet of Negi, Ramachandran & Haftu 2019: the mean flow of the
 //     frozen-particle outlet plus the fluctuation of the characteristic one): the outlet's
 //     velocity and pressure are a time average plus a fluctuation. The average, per bin across
-//     the face (the bins of u_ref), is the running mean in time (time scale `tau`, default
-//     20 length / c, from the first step on) of the fluid's mean normal velocity u_ta and
-//     pressure p_ta over its particles within a kernel support of the face, in that bin. The
-//     fluctuation is the outgoing characteristic measured from that average at each outlet
+//     the face (the bins of u_ref), is a running mean in time (time scale `tau`, default
+//     20 length / c) of the fluid's mean normal velocity u_ta and pressure p_ta over its
+//     particles within a kernel support of the face, in that bin, set from the first step.
+//     Pressure samples count only while quiet (Negi et al.'s criterion): their acoustic
+//     intensity (p - p_ref)^2 / (2 rho c) below I_min = (rho U^2 / 2)^2 / (2 rho c), i.e.
+//     |p - p_ref| < rho U^2 / 2, U and rho the face's mean normal velocity and density at that
+//     step (p_ref default 0: the outlet's intended pressure); the velocity's always count.
+//     The fluctuation is the outgoing characteristic measured from that average at each outlet
 //     particle's image, J2 = rho c (u_n - u_ta) + (p - p_ta) (u_n, p: the mirror
 //     interpolation), the incoming one set to 0: p = p_ta + J2 / 2, u_n = u_ta + J2 / (2 rho c)
 //     (the paper's outlet velocity and pressure from J2 and the time averages); the
-//     tangential velocity and the density are the image's. The characteristic outlet with
-//     p_ref replaced by the fluid's own mean pressure at the face: a steady flow leaves with
-//     the fluid's pressure (zero normal gradient, as mirror), a wave leaving the fluid passes
-//     (u_n - u_ta = (p - p_ta) / (rho c): J2 = 2 (p - p_ta)), one coming in is removed, the
-//     pressure level is the fluid's and not pinned. Not as in the paper: the average is a
-//     running mean per bin of the fluid at the face, not each fluid particle's average of its
-//     last 6 samples taken while the acoustic intensity is low, frozen into the particle when
-//     it leaves; every sample counts, so a wave of duration T moves the average by about
-//     T / tau of its amplitude (in u_ta and p_ta alike, which J2 then cancels).
+//     tangential velocity and the density are the image's. While the fluid's pressure at the
+//     face stays within rho U^2 / 2 of p_ref, steady flow leaves with it (zero normal
+//     gradient, as mirror); beyond, p_ta holds and the outlet acts as the characteristic one
+//     around it (pulling the level back towards p_ta: the level does not drift as with the
+//     do-nothing and mirror outlets). A wave leaving the fluid passes (u_n - u_ta =
+//     (p - p_ta) / (rho c): J2 = 2 (p - p_ta)), one coming in is removed. Not as in the paper:
+//     the average is a running mean per bin of the fluid at the face, not each fluid
+//     particle's average of its last 6 quiet samples frozen into it when it leaves, and the
+//     quiet test is on the bin's mean pressure (U: the face's mean now, not a given speed).
 //
 // Arrays change size only here, between time steps, never during an evaluation: the neighbour
 // search, ghosts and cell lists are rebuilt from the current sizes at every evaluation. All
@@ -144,9 +148,9 @@ struct OutletZone {
   std::size_t entered = 0, returned = 0, removed = 0;
   double support = 0.0;             // mirror: the interpolation radius (set by init)
   CopyMap mirrored;                 // mirror: outlet <- from, the interpolated properties
-  // characteristic and hybrid: the sound speed, reference pressure (characteristic), averaging
-  // time (0: 20 length / c), and the state: the mean normal velocity per bin across the face
-  // (hybrid: and the mean pressure, pref), the last time seen.
+  // characteristic and hybrid: the sound speed, reference pressure (hybrid: of the quiet test),
+  // averaging time (0: 20 length / c), and the state: the mean normal velocity per bin across
+  // the face (hybrid: and the mean pressure, pref), the last time seen.
   double c = 0.0, p_ref = 0.0, tau = 0.0;
   std::vector<double> uref, pref;
   std::vector<std::uint8_t> uref_set;
@@ -242,7 +246,7 @@ struct NormalBins {
   std::vector<std::size_t> bin;  // per outlet particle
   std::vector<double> un;        // per outlet particle: the image's normal velocity
   std::vector<double> sum, count;  // per bin
-  std::vector<double> psum;        // per bin, hybrid only (empty otherwise)
+  std::vector<double> psum, rsum;  // per bin, hybrid only (empty otherwise): p and rho
 };
 NormalBins normal_bins(const OutletZone& out, const ImageValues& iv);
 // The hybrid outlet's sums instead: sum (normal velocity), psum (pressure) and count per bin
