@@ -15,7 +15,7 @@ Arguments: pairs TYPE=PULSE_DIR,BASE_DIR. Checks: the characteristic outlet (if 
 reflects less than --tol-char (|R|) and the hybrid outlet (if given) less than --tol-hybrid,
 each less than half of what the mirror outlet (if given) reflects: the difference between
 the outlets is the point of the test. (Measured, ny = 10: characteristic +0.088, hybrid
--0.138, mirror -0.341.) The do-nothing
+-0.141, mirror -0.341.) The do-nothing
 outlet's R is printed, not checked: for a pulse much shorter than the time a particle takes
 to cross the zone its outlet particles keep the pressure they left with, which passes the
 pulse about as well (measured: R = +0.10 against the characteristic's +0.08, ny = 10)."""

@@ -55,7 +55,9 @@
 //     the face (the bins of u_ref), is a running mean in time (time scale `tau`, default
 //     20 length / c) of the fluid's mean normal velocity u_ta and pressure p_ta over its
 //     particles within a kernel support of the face, in that bin, set from the first step.
-//     Pressure samples count only while quiet (Negi et al.'s criterion): their acoustic
+//     Pressure samples count only while quiet (Negi et al.'s criterion, as their PySPH
+//     implementation, pysph/sph/bc/hybrid, applies it; the formulas here are in this file's
+//     notation, the paper's equation numbers not checked): their acoustic
 //     intensity (p - p_ref)^2 / (2 rho c) below I_min = (rho U^2 / 2)^2 / (2 rho c), i.e.
 //     |p - p_ref| < rho U^2 / 2, U and rho the face's mean normal velocity and density at that
 //     step (p_ref default 0: the outlet's intended pressure); the velocity's always count.
@@ -71,7 +73,9 @@
 //     (p - p_ta) / (rho c): J2 = 2 (p - p_ta)), one coming in is removed. Not as in the paper:
 //     the average is a running mean per bin of the fluid at the face, not each fluid
 //     particle's average of its last 6 quiet samples frozen into it when it leaves, and the
-//     quiet test is on the bin's mean pressure (U: the face's mean now, not a given speed).
+//     quiet test is on the bin's mean pressure (U: the face's mean now, not a given speed) and
+//     gates the pressure only (gating the velocity too would keep u_ta = 0 in a flow started
+//     from rest, where U = 0: nothing is quiet).
 //
 // Arrays change size only here, between time steps, never during an evaluation: the neighbour
 // search, ghosts and cell lists are rebuilt from the current sizes at every evaluation. All
