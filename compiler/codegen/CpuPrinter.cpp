@@ -180,7 +180,13 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     // (default(firstprivate)): shared, the outlined loop reads them through the
     // captured frame at every neighbour, ~4% slower than the serial build (dam break,
     // ~100k particles, 1 thread). The cell list stays shared: a copy would be a waste.
-    scene_ << parallelFor("        ", pass.order, "default(firstprivate) shared(cells)");
+    // --mpi: the pass counts its work, neighbour pairs x loops over them, for the weights
+    // of the decomposition (sphc/mpi/decomposition.h, count_work).
+    const size_t loops = pass.equations.size() + pass.loopAll.size();
+    if (mpi_) scene_ << "        long pair_work = 0;  // neighbour pairs of this pass (--mpi)\n";
+    scene_ << parallelFor("        ", pass.order,
+                          std::string("default(firstprivate) shared(cells)") +
+                              (mpi_ ? " reduction(+ : pair_work)" : ""));
     scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
            << "; ++d_idx) {\n";
     emitDestLocals(scene_, "          ", q, host_);
@@ -194,6 +200,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     emitNeighbourTest(scene_, host_, "return false;", "            ");
     scene_ << "            return true;\n          }));\n";
     scene_ << "          const std::uint32_t* NBRS = nbrs_list.data();\n";
+    if (mpi_) scene_ << "          pair_work += n_nbrs;\n";
     if (!pass.loopAll.empty()) {
       scene_ << "          {\n";
       scene_ << "            const int N_NBRS = n_nbrs;\n";
@@ -207,7 +214,11 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       emitCandidate(scene_, q, pass.equations, d, host_, /*test=*/false);
       scene_ << "          }\n";
     }
-    scene_ << "        }\n      }\n";
+    scene_ << "        }\n";
+    if (mpi_)
+      scene_ << "        sphc::mpi::count_work(decomposition, " << d << ", pair_work * " << loops
+             << ");  // " << loops << " loop(s) over the pairs\n";
+    scene_ << "      }\n";
   }
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions over the destination array into its constants.

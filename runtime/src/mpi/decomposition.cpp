@@ -7,6 +7,7 @@
 #include <zoltan.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
@@ -16,6 +17,8 @@
 namespace sphc::mpi {
 
 namespace {
+
+std::vector<double> measured_weights(const Decomposition& d, std::size_t arrays);
 
 // What Zoltan's callbacks see: every particle of every array, numbered in array order.
 struct Objects {
@@ -129,8 +132,17 @@ void init_decomposition(Decomposition& d, int dim, const std::string& method) {
 }
 
 void set_weights(Decomposition& d, const std::vector<double>& per_array) {
-  // SPHC_MPI_UNWEIGHTED=1: every particle weighs 1 (to measure what the weights change).
-  d.weights = std::getenv("SPHC_MPI_UNWEIGHTED") ? std::vector<double>{} : per_array;
+  // SPHC_MPI_WEIGHTS=measured|estimated|none; SPHC_MPI_UNWEIGHTED=1: none (every particle
+  // weighs 1; to measure what the weights change).
+  const char* mode = std::getenv("SPHC_MPI_WEIGHTS");
+  const std::string m = mode ? mode : "measured";
+  if (std::getenv("SPHC_MPI_UNWEIGHTED") || m == "none") d.mode = Weights::None;
+  else if (m == "estimated") d.mode = Weights::Estimated;
+  else if (m == "measured") d.mode = Weights::Measured;
+  else
+    abort_job(2, "SPHC_MPI_WEIGHTS must be measured, estimated or none, not '" + m + "'");
+  d.estimate = per_array;
+  d.weights = d.mode == Weights::None ? std::vector<double>{} : per_array;
   Zoltan_Set_Param(d.zz, "OBJ_WEIGHT_DIM", d.weights.empty() ? "0" : "1");
 }
 
@@ -251,6 +263,13 @@ std::size_t migrate(Decomposition& d, const std::vector<ParticleArray*>& arrays)
 }
 
 void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
+  // Measured weights: what the particles of each array cost since the last re-balance (none
+  // counted yet: the estimate, set_weights); the count starts again.
+  if (d.mode == Weights::Measured && d.evaluations_counted > 0)
+    d.weights = measured_weights(d, arrays.size());
+  std::fill(d.pairs_since.begin(), d.pairs_since.end(), 0);
+  std::fill(d.particles_since.begin(), d.particles_since.end(), 0);
+  d.evaluations_counted = 0;
   Objects o;
   o.arrays = &arrays;
   o.weights = &d.weights;
@@ -326,11 +345,95 @@ double imbalance(const Decomposition& d, const std::vector<ParticleArray*>& arra
   return mean > 0 ? most / mean : 1.0;
 }
 
+long counted_work(const Decomposition& d, const std::vector<ParticleArray*>& arrays) {
+  long w = 0;
+  for (std::size_t k = 0; k < arrays.size(); ++k)
+    w += d.particle_work * static_cast<long>(arrays[k]->n) +
+         (k < d.pairs_now.size() ? d.pairs_now[k] : 0);
+  return w;
+}
+
+namespace {
+
+// MPI_Allreduce of longs (exact: every rank gets the same sums).
+void all_reduce(std::vector<long>& v, MPI_Op op) {
+  MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_LONG, op,
+                MPI_COMM_WORLD);
+}
+
+// max / mean of one value per rank, exact sums.
+double max_over_mean(long x) {
+  std::vector<long> s = {x}, m = {x};
+  all_reduce(s, MPI_SUM);
+  all_reduce(m, MPI_MAX);
+  return s[0] > 0 ? static_cast<double>(m[0]) * size() / static_cast<double>(s[0]) : 1.0;
+}
+
+// The measured weight of each array: its particles' counted work over every rank since the
+// last re-balance over their number (the estimate where an array had no particles).
+std::vector<double> measured_weights(const Decomposition& d, std::size_t arrays) {
+  std::vector<long> v(2 * arrays, 0);
+  for (std::size_t k = 0; k < arrays; ++k) {
+    v[k] = k < d.pairs_since.size() ? d.pairs_since[k] : 0;
+    v[arrays + k] = k < d.particles_since.size() ? d.particles_since[k] : 0;
+  }
+  all_reduce(v, MPI_SUM);
+  std::vector<double> w(arrays);
+  for (std::size_t k = 0; k < arrays; ++k)
+    w[k] = v[arrays + k] > 0
+               ? d.particle_work + static_cast<double>(v[k]) / static_cast<double>(v[arrays + k])
+               : (k < d.estimate.size() ? d.estimate[k] : 1.0);
+  return w;
+}
+
+// max / mean of the particles of `arrays` weighted by w, exact (weights rounded to 1/1024).
+double weighted_imbalance(const std::vector<double>& w,
+                          const std::vector<ParticleArray*>& arrays) {
+  long x = 0;
+  for (std::size_t k = 0; k < arrays.size(); ++k)
+    x += static_cast<long>(arrays[k]->n) * std::lround(1024.0 * (k < w.size() ? w[k] : 1.0));
+  return max_over_mean(x);
+}
+
+}  // namespace
+
 void update(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   ++d.evaluations;
+  // Close the last evaluation's count (the arrays still hold its particles).
+  const std::size_t K = arrays.size();
+  d.pairs_now.resize(K, 0);
+  d.pairs_since.resize(K, 0);
+  d.particles_since.resize(K, 0);
+  const bool counted = d.evaluations > 1;  // the first call precedes every pass
+  const long work = counted_work(d, arrays);
+  if (counted) {
+    for (std::size_t k = 0; k < K; ++k) {
+      d.pairs_since[k] += d.pairs_now[k];
+      d.particles_since[k] += static_cast<long>(arrays[k]->n);
+    }
+    ++d.evaluations_counted;
+  }
+  std::fill(d.pairs_now.begin(), d.pairs_now.end(), 0);
   migrate(d, arrays);
   const bool scheduled = d.rebalance_every > 0 && d.evaluations % d.rebalance_every == 0;
-  if (scheduled || imbalance(d, arrays) > d.imbalance_limit) rebalance(d, arrays);
+  bool unbalanced = false;
+  if (d.mode == Weights::Measured && counted) {
+    // The counted work of the last evaluation; a re-cut with the measured weights only where
+    // it can help (the current particles unbalanced in those weights).
+    d.work_imbalance = max_over_mean(work);
+    d.work_imbalance_sum += d.work_imbalance;
+    ++d.work_imbalance_count;
+    if (!scheduled && d.work_imbalance > d.imbalance_limit) {
+      const std::vector<double> w = measured_weights(d, K);
+      unbalanced = weighted_imbalance(w, arrays) > d.imbalance_limit;
+    }
+  } else if (!scheduled) {
+    unbalanced = imbalance(d, arrays) > d.imbalance_limit;
+  }
+  if (scheduled || unbalanced) {
+    if (unbalanced) ++d.imbalance_rebalances;
+    rebalance(d, arrays);
+  }
 }
 
 }  // namespace sphc::mpi

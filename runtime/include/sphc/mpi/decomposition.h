@@ -18,11 +18,30 @@
 // index, the same on every rank and in a serial run) and keeps a block of them per rank, and
 // rebalance() cuts space and migrates. Between re-balances particles move and migrate() sends
 // the leavers to their owners; a re-balance happens every `rebalance_every` evaluations and
-// whenever the imbalance (largest rank's particle count over the mean) exceeds
-// `imbalance_limit`.
+// whenever the imbalance (largest rank's work over the mean) exceeds `imbalance_limit`.
+//
+// Work (the weights of RCB). Three modes (Weights):
+//   - Measured (the default): the generated neighbour passes count their work into the
+//     decomposition (count_work: per destination array, the neighbour pairs of the pass times
+//     the loops run over them), and every particle counts `particle_work` more (its steppers,
+//     initialize loops, cell lists, halo and migration tests, in the same unit). A rank's work
+//     in an evaluation is that count: an integer, the same on every run, whatever the
+//     machine's load (unlike a timing). The weight of a particle of array k is the work of
+//     k's particles over every rank since the last re-balance divided by their number (the
+//     ranks agree by an exact integer MPI_Allreduce). A re-balance happens when the counted
+//     work of the last evaluation is unbalanced (max/mean above the limit) and a re-cut can
+//     help: with the measured weights, the current particles are unbalanced too (a cut can
+//     only balance the mean cost of an array's particles, not which of them are busier). The
+//     first cut (distribute: nothing counted yet) uses the compiler's estimate.
+//   - Estimated (SPHC_MPI_WEIGHTS=estimated): the compiler's estimate only (1 + neighbour
+//     passes as destination per particle), the imbalance in the same weights.
+//   - None (SPHC_MPI_UNWEIGHTED=1, or SPHC_MPI_WEIGHTS=none): every particle weighs 1, the
+//     imbalance is the particle count's.
+// The work is counted in every mode (SPHC_MPI_STATS prints it), so the modes can be compared.
 //
 // Order. Migration keeps the staying particles in their order and appends the arrivals by
-// sending rank, each in the sender's order: for a given rank count, runs are deterministic.
+// sending rank, each in the sender's order; the decisions (when to re-balance, the weights)
+// come from counts, not timings: for a given rank count, runs are deterministic.
 #pragma once
 
 #include <cstddef>
@@ -36,6 +55,8 @@ struct Zoltan_Struct;
 
 namespace sphc::mpi {
 
+enum class Weights { Measured, Estimated, None };
+
 struct Decomposition {
   Zoltan_Struct* zz = nullptr;
   int dim = 2;
@@ -47,8 +68,20 @@ struct Decomposition {
   long migrated = 0;              // particles this rank sent by migration, all arrays
   bool cut = false;               // Zoltan has cuts (after the first rebalance)
   // Per array (in the order the arrays are passed): the work of one particle, Zoltan's object
-  // weight (set_weights); empty: every particle weighs 1.
+  // weight (set_weights; measured ones after a re-balance); empty: every particle weighs 1.
   std::vector<double> weights;
+  Weights mode = Weights::Measured;
+  std::vector<double> estimate;  // the compiler's estimate (set_weights)
+  // Counted work (Measured; counted in every mode). Unit: one neighbour pair of one loop.
+  long particle_work = 20;           // a particle's work outside the pair loops, in that unit
+  std::vector<long> pairs_now;       // per array: this evaluation's pair work so far
+  std::vector<long> pairs_since;     // per array: since the last re-balance (completed evaluations)
+  std::vector<long> particles_since; // per array: particles of those evaluations
+  long evaluations_counted = 0;      // evaluations in pairs_since
+  double work_imbalance = 0;         // max/mean counted work of the last completed evaluation
+  double work_imbalance_sum = 0;     // sum of work_imbalance over the evaluations (stats)
+  long work_imbalance_count = 0;
+  long imbalance_rebalances = 0;     // re-balances triggered by imbalance (not scheduled)
   // RCB: this rank's region, a box (Zoltan_RCB_Box; infinite on outer sides). A point strictly
   // inside it is this rank's without asking Zoltan, and a particle whose interaction box lies
   // strictly inside it is in no other rank's halo (the fast path of migrate and the halo).
@@ -65,11 +98,22 @@ struct Decomposition {
 // std::invalid_argument).
 void init_decomposition(Decomposition& d, int dim, const std::string& method = "RCB");
 
-// Weights the particles of each array by `per_array` (the compiler's work estimate: RCB then
-// gives each rank about equal work, not equal particle counts; the imbalance that triggers a
-// re-balance is measured in the same weights). Before distribute. SPHC_MPI_UNWEIGHTED=1 in
-// the environment leaves the weights out (a measurement switch).
+// The compiler's work estimate per array (`per_array`): the weights of the first cut, and of
+// every cut with SPHC_MPI_WEIGHTS=estimated. Before distribute. The environment chooses the
+// mode: SPHC_MPI_WEIGHTS=measured (the default), estimated or none; SPHC_MPI_UNWEIGHTED=1 is
+// none (measurement switches).
 void set_weights(Decomposition& d, const std::vector<double>& per_array);
+
+// A neighbour pass of the generated code with destination array `array` (index in the order
+// the arrays are passed) did `pairs` pair-loop evaluations (neighbour pairs x loops).
+inline void count_work(Decomposition& d, std::size_t array, long pairs) {
+  if (array >= d.pairs_now.size()) d.pairs_now.resize(array + 1, 0);
+  d.pairs_now[array] += pairs;
+}
+
+// This rank's counted work in the evaluation since the last update (pairs counted so far plus
+// particle_work per particle). Not collective.
+long counted_work(const Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
 // After a replicated set-up: adds `gid` (U32, unique over the arrays in set-up order:
 // sphc/global_ids.h) to every array, keeps the block [r n / P, (r + 1) n / P) of each array
@@ -83,8 +127,9 @@ void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 // arrivals. Returns the number of particles this rank sent.
 std::size_t migrate(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
-// The step of an evaluation: migrate, then rebalance when due (every rebalance_every
-// evaluations, or the imbalance above the limit). Collective.
+// The step of an evaluation: closes the count of the last one, migrates, then re-balances
+// when due (every rebalance_every evaluations, or the imbalance above the limit: see the
+// modes above). Collective.
 void update(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
 // Largest particle count of a rank over the mean (1 = perfect balance). Collective.
