@@ -52,7 +52,7 @@ void printDistribution(const Schedule& s, llvm::raw_ostream& os) {
   for (size_t a = 0; a < d.weights.size(); ++a)
     os << " " << p.arrays[a].name << "=" << llvm::format("%g", d.weights[a]);
   os << "\n";
-  os << "  then measured: each neighbour pass counts pairs x loops per destination array "
+  os << "  then measured: each neighbour pass counts candidates, pairs x loops per destination array "
         "(sphc/mpi/decomposition.h, count_work)\n";
   os << "  update_neighbours starts with: migrate";
   for (int a : d.migrate) os << " " << p.arrays[a].name;

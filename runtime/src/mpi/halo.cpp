@@ -201,10 +201,13 @@ void report_stats(const Decomposition& dec, const std::vector<const ParticleArra
   // weights of the last cut.
   long work = 0;
   for (std::size_t k = 0; k < all.size(); ++k) {
-    const long w = dec.particle_work * static_cast<long>(all[k]->n) +
-                   (k < dec.pairs_now.size() ? dec.pairs_now[k] : 0);
+    const long w = array_work(dec, k, all[k]->n);
     work += w;
     sizes += " work_" + all[k]->name + "=" + std::to_string(w);
+    sizes += " pairs_" + all[k]->name + "=" +
+             std::to_string(k < dec.pairs_now.size() ? dec.pairs_now[k] : 0);
+    sizes += " candidates_" + all[k]->name + "=" +
+             std::to_string(k < dec.candidates_now.size() ? dec.candidates_now[k] : 0);
   }
   sizes += " work=" + std::to_string(work);
   for (std::size_t k = 0; k < all.size() && k < dec.weights.size(); ++k)

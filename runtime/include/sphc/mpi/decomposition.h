@@ -22,17 +22,20 @@
 //
 // Work (the weights of RCB). Three modes (Weights):
 //   - Measured (the default): the generated neighbour passes count their work into the
-//     decomposition (count_work: per destination array, the neighbour pairs of the pass times
-//     the loops run over them), and every particle counts `particle_work` more (its steppers,
-//     initialize loops, cell lists, halo and migration tests, in the same unit). A rank's work
-//     in an evaluation is that count: an integer, the same on every run, whatever the
-//     machine's load (unlike a timing). The weight of a particle of array k is the work of
-//     k's particles over every rank since the last re-balance divided by their number (the
-//     ranks agree by an exact integer MPI_Allreduce). A re-balance happens when the counted
-//     work of the last evaluation is unbalanced (max/mean above the limit) and a re-cut can
-//     help: with the measured weights, the current particles are unbalanced too (a cut can
-//     only balance the mean cost of an array's particles, not which of them are busier). The
-//     first cut (distribute: nothing counted yet) uses the compiler's estimate.
+//     decomposition (pass_work, count_work): per destination particle, the candidates it
+//     tested and its neighbour pairs times the loops run over them; every particle counts
+//     `particle_cost` more (its steppers, initialize loops, cell lists, halo and migration
+//     tests); each at a fixed cost in about instructions (fitted to callgrind counts). A
+//     rank's work in an evaluation is that count: an integer, the same on every run, whatever
+//     the machine's load (unlike a timing). A re-balance on imbalance happens when the
+//     counted work of the last evaluation is unbalanced (largest rank's over the mean, an
+//     exact integer MPI_Allreduce, above the limit), at least min_rebalance_gap evaluations
+//     after the last one; it happens before that evaluation's particles migrate, and RCB
+//     weighs each particle by its own count (a wall next to the water tests many candidates,
+//     one far from it none). Where an array changed since the passes (inlets, outlets), its
+//     particles weigh the measured mean of its particles since the last re-balance instead,
+//     as in the scheduled re-balances after a migration. The first cut (distribute, restart:
+//     nothing counted yet) uses the compiler's estimate.
 //   - Estimated (SPHC_MPI_WEIGHTS=estimated): the compiler's estimate only (1 + neighbour
 //     passes as destination per particle), the imbalance in the same weights.
 //   - None (SPHC_MPI_UNWEIGHTED=1, or SPHC_MPI_WEIGHTS=none): every particle weighs 1, the
@@ -72,12 +75,24 @@ struct Decomposition {
   std::vector<double> weights;
   Weights mode = Weights::Measured;
   std::vector<double> estimate;  // the compiler's estimate (set_weights)
-  // Counted work (Measured; counted in every mode). Unit: one neighbour pair of one loop.
-  long particle_work = 20;           // a particle's work outside the pair loops, in that unit
-  std::vector<long> pairs_now;       // per array: this evaluation's pair work so far
-  std::vector<long> pairs_since;     // per array: since the last re-balance (completed evaluations)
+  // Counted work (Measured; counted in every mode), in about instructions: the costs of one
+  // particle outside the neighbour passes, of one candidate of a pass (the distance test) and
+  // of one neighbour pair of one loop, fitted to callgrind counts of the 3D dam break
+  // (docs/scaling.md, "Measured weights").
+  long particle_cost = 1300;
+  long candidate_cost = 30;
+  long pair_cost = 10;
+  std::vector<long> pairs_now;       // per array: pair loops of this evaluation so far
+  std::vector<long> candidates_now;  // per array: candidates of this evaluation so far
+  std::vector<long> work_since;      // per array: counted work since the last re-balance
   std::vector<long> particles_since; // per array: particles of those evaluations
-  long evaluations_counted = 0;      // evaluations in pairs_since
+  // Per array, per particle (in the order of the passes: the real particles, then the halo):
+  // what the passes counted this evaluation (pass_work); pass_n: the real count then.
+  std::vector<std::vector<long>> particle_work;
+  std::vector<std::size_t> pass_n;
+  long min_rebalance_gap = 10;       // evaluations between re-balances on imbalance (Measured)
+  long last_rebalance = -(1L << 40);  // the evaluation of the last re-balance on counts
+  long evaluations_counted = 0;      // evaluations in work_since
   double work_imbalance = 0;         // max/mean counted work of the last completed evaluation
   double work_imbalance_sum = 0;     // sum of work_imbalance over the evaluations (stats)
   long work_imbalance_count = 0;
@@ -105,14 +120,39 @@ void init_decomposition(Decomposition& d, int dim, const std::string& method = "
 void set_weights(Decomposition& d, const std::vector<double>& per_array);
 
 // A neighbour pass of the generated code with destination array `array` (index in the order
-// the arrays are passed) did `pairs` pair-loop evaluations (neighbour pairs x loops).
-inline void count_work(Decomposition& d, std::size_t array, long pairs) {
-  if (array >= d.pairs_now.size()) d.pairs_now.resize(array + 1, 0);
-  d.pairs_now[array] += pairs;
+// the arrays are passed) tested `candidates` candidates and ran `pair_loops` pair-loop
+// bodies (neighbour pairs x loops).
+inline void count_work(Decomposition& d, std::size_t array, long pair_loops, long candidates) {
+  if (array >= d.pairs_now.size()) {
+    d.pairs_now.resize(array + 1, 0);
+    d.candidates_now.resize(array + 1, 0);
+  }
+  d.pairs_now[array] += pair_loops;
+  d.candidates_now[array] += candidates;
 }
 
-// This rank's counted work in the evaluation since the last update (pairs counted so far plus
-// particle_work per particle). Not collective.
+// The per-particle counts of a pass over array `array`'s particles [0, count) (n real ones,
+// then the halo): grown to count (zeros), for the pass to add each particle's work to.
+inline long* pass_work(Decomposition& d, std::size_t array, std::size_t n, std::size_t count) {
+  if (array >= d.particle_work.size()) {
+    d.particle_work.resize(array + 1);
+    d.pass_n.resize(array + 1, 0);
+  }
+  std::vector<long>& w = d.particle_work[array];
+  if (w.size() < count) w.resize(count, 0);
+  d.pass_n[array] = n;
+  return w.data();
+}
+
+// The counted work of array k's n particles in this evaluation so far. Not collective.
+inline long array_work(const Decomposition& d, std::size_t k, std::size_t n) {
+  return d.particle_cost * static_cast<long>(n) +
+         (k < d.pairs_now.size() ? d.pair_cost * d.pairs_now[k] : 0) +
+         (k < d.candidates_now.size() ? d.candidate_cost * d.candidates_now[k] : 0);
+}
+
+// This rank's counted work in the evaluation since the last update (array_work summed).
+// Not collective.
 long counted_work(const Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
 // After a replicated set-up: adds `gid` (U32, unique over the arrays in set-up order:
