@@ -180,7 +180,19 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     // (default(firstprivate)): shared, the outlined loop reads them through the
     // captured frame at every neighbour, ~4% slower than the serial build (dam break,
     // ~100k particles, 1 thread). The cell list stays shared: a copy would be a waste.
-    scene_ << parallelFor("        ", pass.order, "default(firstprivate) shared(cells)");
+    // --mpi: the pass counts its work, candidates and neighbour pairs x loops over them,
+    // for the weights of the decomposition (sphc/mpi/decomposition.h, count_work).
+    const size_t loops = pass.equations.size() + pass.loopAll.size();
+    if (mpi_) {
+      scene_ << "        long n_pairs = 0, n_candidates = 0;  // this pass's work (--mpi)\n";
+      scene_ << "        long* const pass_work = sphc::mpi::pass_work(decomposition, " << d << ", "
+             << D << ".n, " << rangeEnd(w) << ");  // per particle\n";
+      scene_ << "        const long candidate_cost = decomposition.candidate_cost;\n";
+      scene_ << "        const long pair_cost = " << loops << " * decomposition.pair_cost;\n";
+    }
+    scene_ << parallelFor("        ", pass.order,
+                          std::string("default(firstprivate) shared(cells)") +
+                              (mpi_ ? " reduction(+ : n_pairs, n_candidates)" : ""));
     scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
            << "; ++d_idx) {\n";
     emitDestLocals(scene_, "          ", q, host_);
@@ -188,12 +200,18 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     // loop_all with it, then the loops over the same neighbours.
     scene_ << "          std::vector<std::uint32_t>& nbrs_list = nbrs_lists["
            << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
+    if (mpi_) scene_ << "          long candidates = 0;\n";
     scene_ << "          const int n_nbrs = static_cast<int>(cells.gather_neighbours(xi, yi, zi, "
               "nbrs_list, [&](std::uint32_t j) {\n";
+    if (mpi_) scene_ << "            ++candidates;\n";
     scene_ << "            const int s_idx = static_cast<int>(j);\n";
     emitNeighbourTest(scene_, host_, "return false;", "            ");
     scene_ << "            return true;\n          }));\n";
     scene_ << "          const std::uint32_t* NBRS = nbrs_list.data();\n";
+    if (mpi_)
+      scene_ << "          n_pairs += n_nbrs;\n"
+                "          n_candidates += candidates;\n"
+                "          pass_work[d_idx] += candidate_cost * candidates + pair_cost * n_nbrs;\n";
     if (!pass.loopAll.empty()) {
       scene_ << "          {\n";
       scene_ << "            const int N_NBRS = n_nbrs;\n";
@@ -207,7 +225,11 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       emitCandidate(scene_, q, pass.equations, d, host_, /*test=*/false);
       scene_ << "          }\n";
     }
-    scene_ << "        }\n      }\n";
+    scene_ << "        }\n";
+    if (mpi_)
+      scene_ << "        sphc::mpi::count_work(decomposition, " << d << ", n_pairs * " << loops
+             << ", n_candidates);  // " << loops << " loop(s) over the pairs\n";
+    scene_ << "      }\n";
   }
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions over the destination array into its constants.

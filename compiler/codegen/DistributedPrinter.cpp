@@ -102,8 +102,8 @@ std::string ScenePrinter::distributedReport() const {
     halos += (halos.empty() ? "&scene.ghosts_" : ", &scene.ghosts_") + S;
     arrays += (arrays.empty() ? "&scene." : ", &scene.") + S;
   }
-  return "  sphc::mpi::report_stats(scene.decomposition, {" + arrays + "}, {" + halos +
-         "});  // SPHC_MPI_STATS=1\n";
+  return "  sphc::mpi::report_stats(scene.decomposition, {" + arrays + "}, {" + halos + "}, " +
+         allArrays("scene.") + ");  // SPHC_MPI_STATS=1\n";
 }
 
 void ScenePrinter::distributedMain() {

@@ -10,9 +10,11 @@ namespace sphc {
 
 namespace {
 
-// The work of a particle of each array, estimated from the equations: 1 (its per-particle
-// work: steppers, initialize) plus one per neighbour pass it is the destination of (each live
-// equation with a loop or loop_all, once per source array it lists). A wall that only sums
+// The work of a particle of each array, estimated from the equations (the first cut's
+// weights; later cuts use the work the passes count, unless SPHC_MPI_WEIGHTS=estimated): 1
+// (its per-particle work: steppers, initialize) plus one per neighbour pass it is the
+// destination of (each live equation with a loop or loop_all, once per source array it
+// lists). A wall that only sums
 // a density from the fluid weighs little next to a fluid particle with pressure, viscosity
 // and diffusion loops over fluid and walls, so RCB splits the work, not the particle count.
 std::vector<double> workWeights(const Plan& plan) {
@@ -50,6 +52,8 @@ void printDistribution(const Schedule& s, llvm::raw_ostream& os) {
   for (size_t a = 0; a < d.weights.size(); ++a)
     os << " " << p.arrays[a].name << "=" << llvm::format("%g", d.weights[a]);
   os << "\n";
+  os << "  then measured: each neighbour pass counts candidates, pairs x loops per destination array "
+        "(sphc/mpi/decomposition.h, count_work)\n";
   os << "  update_neighbours starts with: migrate";
   for (int a : d.migrate) os << " " << p.arrays[a].name;
   os << " (every property, global id gid)\n";

@@ -7,6 +7,7 @@
 #include <zoltan.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
@@ -17,10 +18,17 @@ namespace sphc::mpi {
 
 namespace {
 
+std::vector<double> measured_weights(const Decomposition& d, std::size_t arrays);
+void rebalance_with(Decomposition& d, const std::vector<ParticleArray*>& arrays,
+                    bool per_particle);
+
 // What Zoltan's callbacks see: every particle of every array, numbered in array order.
 struct Objects {
   const std::vector<ParticleArray*>* arrays = nullptr;
   const std::vector<double>* weights = nullptr;  // per array; empty: none
+  // Measured: each particle's own counted work where its array's counts are of its
+  // particles (the passes' order, nothing created or removed since), else weights.
+  const Decomposition* counts = nullptr;
   int dim = 2;
   unsigned long first = 0;  // global number of this rank's first object
 };
@@ -47,8 +55,16 @@ void obj_list(void* data, int, int, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int 
   if (wdim == 1 && wgts && o.weights && !o.weights->empty()) {
     std::size_t i = 0;
     for (std::size_t k = 0; k < o.arrays->size(); ++k) {
+      const std::size_t n = (*o.arrays)[k]->n;
+      const Decomposition* c = o.counts;
+      if (c && k < c->particle_work.size() && c->pass_n[k] == n &&
+          c->particle_work[k].size() >= n) {
+        for (std::size_t j = 0; j < n; ++j)
+          wgts[i++] = static_cast<float>(c->particle_cost + c->particle_work[k][j]);
+        continue;
+      }
       const float w = static_cast<float>(k < o.weights->size() ? (*o.weights)[k] : 1.0);
-      for (std::size_t j = 0; j < (*o.arrays)[k]->n; ++j) wgts[i++] = w;
+      for (std::size_t j = 0; j < n; ++j) wgts[i++] = w;
     }
   }
   *ierr = ZOLTAN_OK;
@@ -129,8 +145,17 @@ void init_decomposition(Decomposition& d, int dim, const std::string& method) {
 }
 
 void set_weights(Decomposition& d, const std::vector<double>& per_array) {
-  // SPHC_MPI_UNWEIGHTED=1: every particle weighs 1 (to measure what the weights change).
-  d.weights = std::getenv("SPHC_MPI_UNWEIGHTED") ? std::vector<double>{} : per_array;
+  // SPHC_MPI_WEIGHTS=measured|estimated|none; SPHC_MPI_UNWEIGHTED=1: none (every particle
+  // weighs 1; to measure what the weights change).
+  const char* mode = std::getenv("SPHC_MPI_WEIGHTS");
+  const std::string m = mode ? mode : "measured";
+  if (std::getenv("SPHC_MPI_UNWEIGHTED") || m == "none") d.mode = Weights::None;
+  else if (m == "estimated") d.mode = Weights::Estimated;
+  else if (m == "measured") d.mode = Weights::Measured;
+  else
+    abort_job(2, "SPHC_MPI_WEIGHTS must be measured, estimated or none, not '" + m + "'");
+  d.estimate = per_array;
+  d.weights = d.mode == Weights::None ? std::vector<double>{} : per_array;
   Zoltan_Set_Param(d.zz, "OBJ_WEIGHT_DIM", d.weights.empty() ? "0" : "1");
 }
 
@@ -251,9 +276,27 @@ std::size_t migrate(Decomposition& d, const std::vector<ParticleArray*>& arrays)
 }
 
 void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
+  rebalance_with(d, arrays, false);
+}
+
+namespace {
+
+// rebalance; per_particle: the particles are those of the last evaluation's passes, each
+// weighs its own counted work (Measured).
+void rebalance_with(Decomposition& d, const std::vector<ParticleArray*>& arrays,
+                    bool per_particle) {
+  // Measured weights: what the particles of each array cost since the last re-balance (none
+  // counted yet: the estimate, set_weights); the count starts again.
+  if (d.mode == Weights::Measured && d.evaluations_counted > 0)
+    d.weights = measured_weights(d, arrays.size());
+  std::fill(d.work_since.begin(), d.work_since.end(), 0);
+  std::fill(d.particles_since.begin(), d.particles_since.end(), 0);
+  d.evaluations_counted = 0;
+  if (per_particle) d.last_rebalance = d.evaluations;
   Objects o;
   o.arrays = &arrays;
   o.weights = &d.weights;
+  if (per_particle && d.mode == Weights::Measured) o.counts = &d;
   o.dim = d.dim;
   const unsigned long n = local_count(arrays);
   MPI_Exscan(&n, &o.first, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
@@ -293,6 +336,8 @@ void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   migrate(d, arrays);
 }
 
+}  // namespace
+
 void distribute(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   const std::size_t P = static_cast<std::size_t>(size()), r = static_cast<std::size_t>(rank());
   GlobalIds ids;  // sphc/global_ids.h: unique over all arrays, in set-up order (as --global-ids)
@@ -326,11 +371,85 @@ double imbalance(const Decomposition& d, const std::vector<ParticleArray*>& arra
   return mean > 0 ? most / mean : 1.0;
 }
 
+long counted_work(const Decomposition& d, const std::vector<ParticleArray*>& arrays) {
+  long w = 0;
+  for (std::size_t k = 0; k < arrays.size(); ++k) w += array_work(d, k, arrays[k]->n);
+  return w;
+}
+
+namespace {
+
+// MPI_Allreduce of longs (exact: every rank gets the same sums).
+void all_reduce(std::vector<long>& v, MPI_Op op) {
+  MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_LONG, op,
+                MPI_COMM_WORLD);
+}
+
+// max / mean of one value per rank, exact sums.
+double max_over_mean(long x) {
+  std::vector<long> s = {x}, m = {x};
+  all_reduce(s, MPI_SUM);
+  all_reduce(m, MPI_MAX);
+  return s[0] > 0 ? static_cast<double>(m[0]) * size() / static_cast<double>(s[0]) : 1.0;
+}
+
+// The measured weight of each array: its particles' counted work over every rank since the
+// last re-balance over their number (the estimate where an array had no particles).
+std::vector<double> measured_weights(const Decomposition& d, std::size_t arrays) {
+  std::vector<long> v(2 * arrays, 0);
+  for (std::size_t k = 0; k < arrays; ++k) {
+    v[k] = k < d.work_since.size() ? d.work_since[k] : 0;
+    v[arrays + k] = k < d.particles_since.size() ? d.particles_since[k] : 0;
+  }
+  all_reduce(v, MPI_SUM);
+  std::vector<double> w(arrays);
+  for (std::size_t k = 0; k < arrays; ++k)
+    w[k] = v[arrays + k] > 0 ? static_cast<double>(v[k]) / static_cast<double>(v[arrays + k])
+                             : (k < d.estimate.size() ? d.estimate[k] * d.particle_cost : 1.0);
+  return w;
+}
+
+}  // namespace
+
 void update(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   ++d.evaluations;
-  migrate(d, arrays);
+  // Close the last evaluation's count (the arrays still hold its particles).
+  const std::size_t K = arrays.size();
+  d.pairs_now.resize(K, 0);
+  d.candidates_now.resize(K, 0);
+  d.work_since.resize(K, 0);
+  d.particles_since.resize(K, 0);
+  const bool counted = d.evaluations > 1;  // the first call precedes every pass
+  const long work = counted_work(d, arrays);
+  if (counted) {
+    for (std::size_t k = 0; k < K; ++k) {
+      d.work_since[k] += array_work(d, k, arrays[k]->n);
+      d.particles_since[k] += static_cast<long>(arrays[k]->n);
+    }
+    ++d.evaluations_counted;
+  }
+  std::fill(d.pairs_now.begin(), d.pairs_now.end(), 0);
+  std::fill(d.candidates_now.begin(), d.candidates_now.end(), 0);
   const bool scheduled = d.rebalance_every > 0 && d.evaluations % d.rebalance_every == 0;
-  if (scheduled || imbalance(d, arrays) > d.imbalance_limit) rebalance(d, arrays);
+  if (d.mode == Weights::Measured) {
+    // The counted work of the last evaluation; a re-cut on the particles of that evaluation,
+    // each weighing its own count, then the migration is the re-cut's.
+    bool unbalanced = false;
+    if (counted) {
+      d.work_imbalance = max_over_mean(work);
+      d.work_imbalance_sum += d.work_imbalance;
+      ++d.work_imbalance_count;
+      unbalanced = !scheduled && d.work_imbalance > d.imbalance_limit &&
+                   d.evaluations - d.last_rebalance >= d.min_rebalance_gap;
+    }
+    if (unbalanced) ++d.imbalance_rebalances;
+    if (scheduled || unbalanced) rebalance_with(d, arrays, true);
+    else migrate(d, arrays);
+  } else {
+    migrate(d, arrays);
+    if (scheduled || imbalance(d, arrays) > d.imbalance_limit) rebalance(d, arrays);
+  }
+  for (std::vector<long>& w : d.particle_work) w.clear();  // the passes count anew
 }
 
 }  // namespace sphc::mpi

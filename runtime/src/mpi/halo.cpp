@@ -171,8 +171,17 @@ void remove_halo(ParticleArray& a, Halo& h) {
   h.count = 0;
 }
 
+namespace {
+std::string fmt_weight(const std::string& name, double w) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "=%.4g", w);
+  return name + buf;
+}
+}  // namespace
+
 void report_stats(const Decomposition& dec, const std::vector<const ParticleArray*>& arrays,
-                  const std::vector<const Halo*>& halos) {
+                  const std::vector<const Halo*>& halos,
+                  const std::vector<const ParticleArray*>& all) {
   if (!std::getenv("SPHC_MPI_STATS")) return;
   std::size_t bytes = 0;
   std::string sizes;
@@ -187,6 +196,29 @@ void report_stats(const Decomposition& dec, const std::vector<const ParticleArra
   for (const ParticleArray* a : arrays) {
     n += a->n;
     sizes += " n_" + a->name + "=" + std::to_string(a->n);
+  }
+  // Counted work (decomposition.h) of the last evaluation, per array and in all, and the
+  // weights of the last cut.
+  long work = 0;
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const long w = array_work(dec, k, all[k]->n);
+    work += w;
+    sizes += " work_" + all[k]->name + "=" + std::to_string(w);
+    sizes += " pairs_" + all[k]->name + "=" +
+             std::to_string(k < dec.pairs_now.size() ? dec.pairs_now[k] : 0);
+    sizes += " candidates_" + all[k]->name + "=" +
+             std::to_string(k < dec.candidates_now.size() ? dec.candidates_now[k] : 0);
+  }
+  sizes += " work=" + std::to_string(work);
+  for (std::size_t k = 0; k < all.size() && k < dec.weights.size(); ++k)
+    sizes += fmt_weight(" weight_" + all[k]->name, dec.weights[k]);
+  const char* modes[] = {"measured", "estimated", "none"};
+  sizes += std::string(" weights=") + modes[static_cast<int>(dec.mode)];
+  if (dec.work_imbalance_count > 0) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, " mean_work_imbalance=%.4f imbalance_rebalances=%ld",
+                  dec.work_imbalance_sum / dec.work_imbalance_count, dec.imbalance_rebalances);
+    sizes += buf;
   }
   std::fprintf(stderr,
                "mpi: rank=%d ranks=%d particles=%zu evaluations=%ld rebalances=%ld migrated=%ld "

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <vector>
 
@@ -118,6 +119,53 @@ TEST(MpiDecomposition, MigrationMovesLeaversWithTheirProperties) {
          a.f64("u")[i] == g && a.f64("q")[i] == std::sin(static_cast<double>(g));
   }
   EXPECT_TRUE(everywhere(ok));
+}
+
+// Measured weights (decomposition.h): one evaluation in which the particles of the band
+// x < 0.25 test 100 candidates each in a neighbour pass and the others none (as a wall next
+// to the water against one far from it), counted as the generated pass counts them (per
+// particle and in total): 4,300 units against 1,300. The next update() sees the
+// counted work unbalanced and re-cuts with each particle's own count, so every rank then
+// holds about the mean work: within 15% (RCB does not split a lattice column, and a column of
+// the band is 10% of a rank's mean work on 4 ranks). With the compiler's estimate (one weight
+// for every particle of the array) the split stays by particle count, and the counted work
+// stays unbalanced (1.37 times the mean on 2 and 4 ranks).
+double counted_work_after_update(sphc::mpi::Weights mode, long* imbalance_rebalances) {
+  sphc::ParticleArray a = lattice(80);
+  sphc::mpi::Decomposition d;
+  sphc::mpi::init_decomposition(d, 2);
+  sphc::mpi::set_weights(d, {1.0});
+  d.mode = mode;
+  sphc::mpi::distribute(d, {&a});
+  auto candidates = [&](std::size_t i) { return a.f64("x")[i] < 0.25 ? 100L : 0L; };
+  sphc::mpi::update(d, {&a});  // the first evaluation: nothing counted yet
+  long* w = sphc::mpi::pass_work(d, 0, a.n, a.n);
+  long tested = 0;
+  for (std::size_t i = 0; i < a.n; ++i) {
+    w[i] += d.candidate_cost * candidates(i);
+    tested += candidates(i);
+  }
+  sphc::mpi::count_work(d, 0, 0, tested);
+  sphc::mpi::update(d, {&a});  // the second: counted
+  *imbalance_rebalances = d.imbalance_rebalances;
+  long mine = 0;  // the same work for the particles this rank holds now
+  for (std::size_t i = 0; i < a.n; ++i) mine += d.particle_cost + d.candidate_cost * candidates(i);
+  const double total = sphc::mpi::sum(static_cast<double>(mine));
+  const double most = sphc::mpi::max(static_cast<double>(mine));
+  EXPECT_EQ(all_gids(a).size(), 6400u);
+  return most / (total / sphc::mpi::size());
+}
+
+TEST(MpiDecomposition, MeasuredWeightsBalanceCountedWork) {
+  long rebalances = 0;
+  const double measured = counted_work_after_update(sphc::mpi::Weights::Measured, &rebalances);
+  EXPECT_LT(measured, 1.15);
+  if (sphc::mpi::size() > 1) EXPECT_EQ(rebalances, 1);
+  const double estimated = counted_work_after_update(sphc::mpi::Weights::Estimated, &rebalances);
+  if (sphc::mpi::size() > 1) EXPECT_GT(estimated, 1.3);
+  EXPECT_EQ(rebalances, 0);
+  if (sphc::mpi::rank() == 0)
+    std::printf("counted work max/mean: measured %.4f, estimated %.4f\n", measured, estimated);
 }
 
 // The neighbours of every real particle among real + halo particles are exactly those of a

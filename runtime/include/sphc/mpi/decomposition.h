@@ -18,11 +18,33 @@
 // index, the same on every rank and in a serial run) and keeps a block of them per rank, and
 // rebalance() cuts space and migrates. Between re-balances particles move and migrate() sends
 // the leavers to their owners; a re-balance happens every `rebalance_every` evaluations and
-// whenever the imbalance (largest rank's particle count over the mean) exceeds
-// `imbalance_limit`.
+// whenever the imbalance (largest rank's work over the mean) exceeds `imbalance_limit`.
+//
+// Work (the weights of RCB). Three modes (Weights):
+//   - Measured (the default): the generated neighbour passes count their work into the
+//     decomposition (pass_work, count_work): per destination particle, the candidates it
+//     tested and its neighbour pairs times the loops run over them; every particle counts
+//     `particle_cost` more (its steppers, initialize loops, cell lists, halo and migration
+//     tests); each at a fixed cost in about instructions (fitted to callgrind counts). A
+//     rank's work in an evaluation is that count: an integer, the same on every run, whatever
+//     the machine's load (unlike a timing). A re-balance on imbalance happens when the
+//     counted work of the last evaluation is unbalanced (largest rank's over the mean, an
+//     exact integer MPI_Allreduce, above the limit), at least min_rebalance_gap evaluations
+//     after the last one; it happens before that evaluation's particles migrate, and RCB
+//     weighs each particle by its own count (a wall next to the water tests many candidates,
+//     one far from it none). Where an array changed since the passes (inlets, outlets), its
+//     particles weigh the measured mean of its particles since the last re-balance instead,
+//     as in the scheduled re-balances after a migration. The first cut (distribute, restart:
+//     nothing counted yet) uses the compiler's estimate.
+//   - Estimated (SPHC_MPI_WEIGHTS=estimated): the compiler's estimate only (1 + neighbour
+//     passes as destination per particle), the imbalance in the same weights.
+//   - None (SPHC_MPI_UNWEIGHTED=1, or SPHC_MPI_WEIGHTS=none): every particle weighs 1, the
+//     imbalance is the particle count's.
+// The work is counted in every mode (SPHC_MPI_STATS prints it), so the modes can be compared.
 //
 // Order. Migration keeps the staying particles in their order and appends the arrivals by
-// sending rank, each in the sender's order: for a given rank count, runs are deterministic.
+// sending rank, each in the sender's order; the decisions (when to re-balance, the weights)
+// come from counts, not timings: for a given rank count, runs are deterministic.
 #pragma once
 
 #include <cstddef>
@@ -36,6 +58,8 @@ struct Zoltan_Struct;
 
 namespace sphc::mpi {
 
+enum class Weights { Measured, Estimated, None };
+
 struct Decomposition {
   Zoltan_Struct* zz = nullptr;
   int dim = 2;
@@ -47,8 +71,32 @@ struct Decomposition {
   long migrated = 0;              // particles this rank sent by migration, all arrays
   bool cut = false;               // Zoltan has cuts (after the first rebalance)
   // Per array (in the order the arrays are passed): the work of one particle, Zoltan's object
-  // weight (set_weights); empty: every particle weighs 1.
+  // weight (set_weights; measured ones after a re-balance); empty: every particle weighs 1.
   std::vector<double> weights;
+  Weights mode = Weights::Measured;
+  std::vector<double> estimate;  // the compiler's estimate (set_weights)
+  // Counted work (Measured; counted in every mode), in about instructions: the costs of one
+  // particle outside the neighbour passes, of one candidate of a pass (the distance test) and
+  // of one neighbour pair of one loop, fitted to callgrind counts of the 3D dam break
+  // (docs/scaling.md, "Measured weights").
+  long particle_cost = 1300;
+  long candidate_cost = 30;
+  long pair_cost = 10;
+  std::vector<long> pairs_now;       // per array: pair loops of this evaluation so far
+  std::vector<long> candidates_now;  // per array: candidates of this evaluation so far
+  std::vector<long> work_since;      // per array: counted work since the last re-balance
+  std::vector<long> particles_since; // per array: particles of those evaluations
+  // Per array, per particle (in the order of the passes: the real particles, then the halo):
+  // what the passes counted this evaluation (pass_work); pass_n: the real count then.
+  std::vector<std::vector<long>> particle_work;
+  std::vector<std::size_t> pass_n;
+  long min_rebalance_gap = 10;       // evaluations between re-balances on imbalance (Measured)
+  long last_rebalance = -(1L << 40);  // the evaluation of the last re-balance on counts
+  long evaluations_counted = 0;      // evaluations in work_since
+  double work_imbalance = 0;         // max/mean counted work of the last completed evaluation
+  double work_imbalance_sum = 0;     // sum of work_imbalance over the evaluations (stats)
+  long work_imbalance_count = 0;
+  long imbalance_rebalances = 0;     // re-balances triggered by imbalance (not scheduled)
   // RCB: this rank's region, a box (Zoltan_RCB_Box; infinite on outer sides). A point strictly
   // inside it is this rank's without asking Zoltan, and a particle whose interaction box lies
   // strictly inside it is in no other rank's halo (the fast path of migrate and the halo).
@@ -65,11 +113,47 @@ struct Decomposition {
 // std::invalid_argument).
 void init_decomposition(Decomposition& d, int dim, const std::string& method = "RCB");
 
-// Weights the particles of each array by `per_array` (the compiler's work estimate: RCB then
-// gives each rank about equal work, not equal particle counts; the imbalance that triggers a
-// re-balance is measured in the same weights). Before distribute. SPHC_MPI_UNWEIGHTED=1 in
-// the environment leaves the weights out (a measurement switch).
+// The compiler's work estimate per array (`per_array`): the weights of the first cut, and of
+// every cut with SPHC_MPI_WEIGHTS=estimated. Before distribute. The environment chooses the
+// mode: SPHC_MPI_WEIGHTS=measured (the default), estimated or none; SPHC_MPI_UNWEIGHTED=1 is
+// none (measurement switches).
 void set_weights(Decomposition& d, const std::vector<double>& per_array);
+
+// A neighbour pass of the generated code with destination array `array` (index in the order
+// the arrays are passed) tested `candidates` candidates and ran `pair_loops` pair-loop
+// bodies (neighbour pairs x loops).
+inline void count_work(Decomposition& d, std::size_t array, long pair_loops, long candidates) {
+  if (array >= d.pairs_now.size()) {
+    d.pairs_now.resize(array + 1, 0);
+    d.candidates_now.resize(array + 1, 0);
+  }
+  d.pairs_now[array] += pair_loops;
+  d.candidates_now[array] += candidates;
+}
+
+// The per-particle counts of a pass over array `array`'s particles [0, count) (n real ones,
+// then the halo): grown to count (zeros), for the pass to add each particle's work to.
+inline long* pass_work(Decomposition& d, std::size_t array, std::size_t n, std::size_t count) {
+  if (array >= d.particle_work.size()) {
+    d.particle_work.resize(array + 1);
+    d.pass_n.resize(array + 1, 0);
+  }
+  std::vector<long>& w = d.particle_work[array];
+  if (w.size() < count) w.resize(count, 0);
+  d.pass_n[array] = n;
+  return w.data();
+}
+
+// The counted work of array k's n particles in this evaluation so far. Not collective.
+inline long array_work(const Decomposition& d, std::size_t k, std::size_t n) {
+  return d.particle_cost * static_cast<long>(n) +
+         (k < d.pairs_now.size() ? d.pair_cost * d.pairs_now[k] : 0) +
+         (k < d.candidates_now.size() ? d.candidate_cost * d.candidates_now[k] : 0);
+}
+
+// This rank's counted work in the evaluation since the last update (array_work summed).
+// Not collective.
+long counted_work(const Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
 // After a replicated set-up: adds `gid` (U32, unique over the arrays in set-up order:
 // sphc/global_ids.h) to every array, keeps the block [r n / P, (r + 1) n / P) of each array
@@ -83,8 +167,9 @@ void rebalance(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 // arrivals. Returns the number of particles this rank sent.
 std::size_t migrate(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
-// The step of an evaluation: migrate, then rebalance when due (every rebalance_every
-// evaluations, or the imbalance above the limit). Collective.
+// The step of an evaluation: closes the count of the last one, migrates, then re-balances
+// when due (every rebalance_every evaluations, or the imbalance above the limit: see the
+// modes above). Collective.
 void update(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
 // Largest particle count of a rank over the mean (1 = perfect balance). Collective.

@@ -57,10 +57,13 @@ void remove_halo(ParticleArray& a, Halo& h);
 
 // With SPHC_MPI_STATS set in the environment, prints one line per rank to stderr: evaluations,
 // re-balances, particles migrated away, halo bytes sent (all exchanges and refreshes) in
-// total and per evaluation, the latest halo size per array. Not collective (a measurement
-// for docs/scaling.md; generated main calls it after the run).
+// total and per evaluation, the latest halo size per array (`arrays`: the source arrays, with
+// their `halos`); for `all` the arrays (in the decomposition's order): counts, the counted
+// work of the last evaluation, the weights of the last cut (sphc/mpi/decomposition.h). Not
+// collective (a measurement for docs/scaling.md; generated main calls it after the run).
 void report_stats(const Decomposition& dec, const std::vector<const ParticleArray*>& arrays,
-                  const std::vector<const Halo*>& halos);
+                  const std::vector<const Halo*>& halos,
+                  const std::vector<const ParticleArray*>& all);
 
 // The search domain of the real particles and halos of `arrays` (positions over n + halo),
 // cells of cutoff = radius_scale * the largest h of any rank: the same cell size everywhere.
