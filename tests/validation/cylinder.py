@@ -37,6 +37,9 @@ of Liu, Zheng & Sung (1998, J. Comput. Phys. 139, 35-57, table 2: St = 0.192, Cd
 0.049, Cl +-0.69); those of Braza, Chassaing & Ha Minh (1986, J. Fluid Mech. 165, 79-130:
 St = 0.20, Cd = 1.40 +- 0.05, Cl +-0.75) are printed beside them.
 
+With --min-amplitude (shedding cases): the lift's amplitude (the standard deviation of the
+averaged lift after --t-start times sqrt 2) must exceed it: vortices are shed.
+
 Periodicity (--periodic-tol, shedding cases): the lift (averaged over --smooth) after
 --t-start is cut into cycles at its upward zero crossings; there must be at least
 --min-periods whole cycles, and the cycles' periods and amplitudes (half of max - min) must
@@ -174,6 +177,9 @@ def main():
                     help="re200: the unbounded cylinder at Re = 200 (implies --shedding)")
     ap.add_argument("--periodic-tol", type=float, default=None)
     ap.add_argument("--min-periods", type=int, default=3)
+    ap.add_argument("--min-amplitude", type=float, default=None,
+                    help="shedding cases: the lift amplitude (averaged over --smooth) must "
+                         "exceed this (vortices are shed, not noise)")
     ap.add_argument("--st-tol", type=float, default=0.10)
     ap.add_argument("--smooth", type=float, default=0.2,
                     help="--shedding: the window the lift is averaged over (default 0.2)")
@@ -318,6 +324,9 @@ def main():
                                        RE200[0][0]))
             if periods < 3:
                 failures.append("fewer than 3 shedding periods after t = %g" % args.t_start)
+            if args.min_amplitude is not None and not cl_amp >= args.min_amplitude:
+                failures.append("the lift amplitude %.3f is below %g: no shedding"
+                                % (cl_amp, args.min_amplitude))
             if not abs(st / st_ref - 1) <= args.st_tol:
                 failures.append("St %.4f is %+.1f%% from %.3f" % (st, 100 * (st / st_ref - 1),
                                                                   st_ref))
