@@ -120,13 +120,19 @@ def crossing_flux(outdir, t_start, t_end=float("inf")):
 
 
 def lift_cycles(ts, sig):
-    """[(t0, t1, amplitude)] of the whole cycles of the signal sig(ts) between consecutive
-    upward zero crossings (linearly interpolated); amplitude = (max - min) / 2 over the
-    cycle."""
+    """[(t0, t1, amplitude)] of the whole cycles of the signal sig(ts) (mean 0) between
+    consecutive upward zero crossings (linearly interpolated); amplitude = (max - min) / 2
+    over the cycle. A crossing counts only after the signal has fallen below -a/2 since the
+    last one (a = its standard deviation times sqrt 2), so that the noise left on the
+    averaged lift does not cut a cycle into pieces."""
+    low = -0.5 * math.sqrt(2.0) * float(sig.std())
     ups = []
+    armed = False
     for k in range(len(sig) - 1):
-        if sig[k] < 0 <= sig[k + 1]:
+        armed = armed or sig[k] < low
+        if armed and sig[k] < 0 <= sig[k + 1]:
             ups.append((k, ts[k] - sig[k] * (ts[k + 1] - ts[k]) / (sig[k + 1] - sig[k])))
+            armed = False
     out = []
     for (k0, t0), (k1, t1) in zip(ups, ups[1:]):
         seg = sig[k0:k1 + 2]
@@ -376,8 +382,18 @@ def main():
         ax[0].axhline(cd_mean, color="r", label="SPH, mean after t = %g" % args.t_start)
         ax[0].set_ylim(0, 2 * ref)
         ax[0].set_ylabel("Cd")
+        ax[1].plot(t, cl, lw=0.8, label="Cl (sampled at outputs)")
+        if args.shedding and len(t) > 3:
+            # The coefficients averaged over --smooth, from the integrals (as the spectrum).
+            w = max(1, int(round(0.5 * args.smooth / (t[1] - t[0]))))
+            tm = t[w:-w]
+            for a, key, name in ((ax[0], "cd_int", "Cd"), (ax[1], "cl_int", "Cl")):
+                ii = m[key]
+                a.plot(tm, [(ii[k + 2 * w] - ii[k]) / (t[k + 2 * w] - t[k])
+                            for k in range(len(tm))],
+                       color="C1", lw=1.2, label="%s averaged over %g" % (name, args.smooth))
+            ax[1].legend(fontsize=8)
         ax[0].legend(fontsize=8)
-        ax[1].plot(t, cl, lw=0.8)
         ax[1].set_ylabel("Cl")
         ax[1].set_xlabel("t")
         return fig
