@@ -28,7 +28,29 @@ Shedding case (--shedding: Re = 100, [ST96] case 2D-2): the Strouhal number St =
 f the peak of the spectrum of the lift after --t-start (averaged over --smooth), within
 --st-tol (relative) of 0.300 ([ST96]: 0.295-0.305), at least 3 periods; the mean drag and
 the lift amplitude are printed against [ST96]'s Cd_max 3.22-3.24 and Cl_max 0.99-1.01 (not
-checked: at D/10 the drag is ~20% high, as the steady case's is 10-13%)."""
+checked: at D/10 the drag is ~20% high, as the steady case's is 10-13%).
+
+Re = 200 past a nearly unbounded cylinder (--reference re200, implies --shedding: the scene
+with --set slip=1, a uniform inflow between free-slip walls far from the cylinder): St within
+--st-tol and the mean drag within --cd-tol (relative) of the mean of five published
+two-dimensional computations, St = 0.197 and Cd = 1.302 (RE200 below: St 0.192-0.202, mean Cd
+1.17-1.40, Cl amplitude 0.50-0.75): Braza, Chassaing & Ha Minh (1986, J. Fluid Mech. 165,
+79-130), Liu, Zheng & Sung (1998, J. Comput. Phys. 139, 35-57), Calhoun (2002, J. Comput.
+Phys. 176, 231-275), Russell & Wang (2003, J. Comput. Phys. 191, 177-205), Linnick & Fasel
+(2005, J. Comput. Phys. 204, 157-192). Each is printed beside the result.
+
+With --min-amplitude (shedding cases): the lift's amplitude (the standard deviation of the
+averaged lift after --t-start times sqrt 2) must exceed it: vortices are shed.
+
+Periodicity (--periodic-tol, shedding cases): the lift (averaged over --smooth) after
+--t-start is cut into cycles at its upward zero crossings; there must be at least
+--min-periods whole cycles, and the cycles' periods and amplitudes (half of max - min) must
+each scatter by at most --periodic-tol (standard deviation over mean), the mean lift over the
+whole cycles must be within --periodic-tol of 0 relative to the amplitude, and the mean drag
+of the first half of the cycles within --periodic-tol of that of the second half: a periodic
+state, not a drifting one. With --flux-tol the mass flux into the fluid over the first and the
+second half of the window must also agree within --flux-tol (no drift of the mean flow
+rate)."""
 import math
 import os
 import sys
@@ -40,6 +62,15 @@ from snapshots import argument_parser, snapshot_files  # noqa: E402
 
 CD_ST96, CL_ST96 = 5.58, 0.0106          # 2D-1, Re = 20
 ST_ST96, CDMAX_ST96, CLMAX_ST96 = 0.300, 3.23, 1.00   # 2D-2, Re = 100
+# Re = 200, unbounded, 2D computations: (St, mean Cd, Cl amplitude). The check is against
+# their mean (St 0.197, Cd 1.302; they spread by -2.6% to +2.5% and -10% to +7.5% about it).
+RE200 = (("Braza, Chassaing & Ha Minh 1986", 0.20, 1.40, 0.75),
+         ("Liu, Zheng & Sung 1998", 0.192, 1.31, 0.69),
+         ("Calhoun 2002", 0.202, 1.172, 0.668),
+         ("Russell & Wang 2003", 0.195, 1.29, 0.50),
+         ("Linnick & Fasel 2005", 0.197, 1.34, 0.69))
+ST_RE200 = sum(r[1] for r in RE200) / len(RE200)
+CD_RE200 = sum(r[2] for r in RE200) / len(RE200)
 
 
 def mean_between(t, integral, a, b):
@@ -51,7 +82,7 @@ def mean_between(t, integral, a, b):
     return (integral[j] - integral[i]) / (t[j] - t[i])
 
 
-def crossing_flux(outdir, t_start):
+def crossing_flux(outdir, t_start, t_end=float("inf")):
     """(mean mass flux into the fluid, out of it, time span) after t_start, from the gids of
     consecutive snapshots: a gid in the inlet then in the fluid came in; a gid in the fluid
     then not (in the outlet or removed) went out, one in the outlet then back in the fluid
@@ -73,6 +104,8 @@ def crossing_flux(outdir, t_start):
                 return None
             cur = {a: (np.asarray(f[a]["gid"][()]), np.asarray(f[a]["m"][()]))
                    for a in ("fluid", "inlet", "outlet") if a in f and "gid" in f[a]}
+        if t > t_end + 1e-9:
+            break
         if prev is not None and prev[0] >= t_start - 1e-9:
             if t0 is None:
                 t0 = prev[0]
@@ -92,6 +125,27 @@ def crossing_flux(outdir, t_start):
     if t0 is None or t_last is None or t_last <= t0:
         return None
     return m_in / (t_last - t0), m_out / (t_last - t0), t_last - t0
+
+
+def lift_cycles(ts, sig):
+    """[(t0, t1, amplitude)] of the whole cycles of the signal sig(ts) (mean 0) between
+    consecutive upward zero crossings (linearly interpolated); amplitude = (max - min) / 2
+    over the cycle. A crossing counts only after the signal has fallen below -a/2 since the
+    last one (a = its standard deviation times sqrt 2), so that the noise left on the
+    averaged lift does not cut a cycle into pieces."""
+    low = -0.5 * math.sqrt(2.0) * float(sig.std())
+    ups = []
+    armed = False
+    for k in range(len(sig) - 1):
+        armed = armed or sig[k] < low
+        if armed and sig[k] < 0 <= sig[k + 1]:
+            ups.append((k, ts[k] - sig[k] * (ts[k + 1] - ts[k]) / (sig[k + 1] - sig[k])))
+            armed = False
+    out = []
+    for (k0, t0), (k1, t1) in zip(ups, ups[1:]):
+        seg = sig[k0:k1 + 2]
+        out.append((t0, t1, 0.5 * (max(seg) - min(seg))))
+    return out
 
 
 def wake_symmetry(outdir, t_start, cx, cy, D):
@@ -133,12 +187,21 @@ def main():
     ap.add_argument("--cx", type=float, default=0.2)
     ap.add_argument("--cy", type=float, default=0.2)
     ap.add_argument("--shedding", action="store_true")
+    ap.add_argument("--reference", choices=("st96", "re200"), default="st96",
+                    help="re200: the unbounded cylinder at Re = 200 (implies --shedding)")
+    ap.add_argument("--periodic-tol", type=float, default=None)
+    ap.add_argument("--min-periods", type=int, default=3)
+    ap.add_argument("--min-amplitude", type=float, default=None,
+                    help="shedding cases: the lift amplitude (averaged over --smooth) must "
+                         "exceed this (vortices are shed, not noise)")
     ap.add_argument("--st-tol", type=float, default=0.10)
     ap.add_argument("--smooth", type=float, default=0.2,
                     help="--shedding: the window the lift is averaged over (default 0.2)")
     ap.add_argument("--D", type=float, default=0.1)
     ap.add_argument("--Ubar", type=float, default=0.2)
     args = ap.parse_args()
+    if args.reference == "re200":
+        args.shedding = True
     m = read_metrics(args.outdir, "cylinder.py", ("t", "cd", "cl", "cd_int", "cl_int", "nfluid"))
     if m is None:
         return 2
@@ -177,6 +240,24 @@ def main():
             if not rel <= args.flux_tol:
                 failures.append("mass flux in %.6f and out %.6f differ by %.3f%%"
                                 % (q_in, q_out, 100 * rel))
+            if args.periodic_tol is not None:
+                # The mean flow rate over the two halves of the window.
+                tm = args.t_start + 0.5 * span
+                h1 = crossing_flux(args.outdir, args.t_start, tm)
+                h2 = crossing_flux(args.outdir, tm)
+                if h1 is None or h2 is None:
+                    failures.append("too few snapshots for the flux over each half")
+                else:
+                    d_in = h2[0] / h1[0] - 1
+                    d_out = h2[1] / h1[1] - 1
+                    print("mass flux, first / second half of the window: in %.6f / %.6f "
+                          "(%+.3f%%), out %.6f / %.6f (%+.3f%%; tolerance %.1f%%)"
+                          % (h1[0], h2[0], 100 * d_in, h1[1], h2[1], 100 * d_out,
+                             100 * args.flux_tol))
+                    if not (abs(d_in) <= args.flux_tol and abs(d_out) <= args.flux_tol):
+                        failures.append("the mean flow rate drifts: in %+.3f%%, out %+.3f%% "
+                                        "from the first half to the second"
+                                        % (100 * d_in, 100 * d_out))
     if args.symmetry_tol is not None:
         sym = wake_symmetry(args.outdir, args.t_start, args.cx, args.cy, args.D)
         if sym is None:
@@ -235,27 +316,95 @@ def main():
             st = freq[k] * args.D / args.Ubar
             periods = freq[k] * (ts[-1] - ts[0])
             cl_amp = float(sig.std() * math.sqrt(2.0))
-            print("shedding: %.1f periods after t = %g, St = %.4f (Schaefer & Turek 2D-2: "
-                  "0.295-0.305), mean Cd = %.3f (their Cd_max %.2f), lift amplitude %.3f "
-                  "(averaged over %g; their Cl_max %.2f)"
-                  % (periods, args.t_start, st, cd_mean, CDMAX_ST96, cl_amp, args.smooth,
-                     CLMAX_ST96))
+            if args.reference == "st96":
+                st_ref = ST_ST96
+                print("shedding: %.1f periods after t = %g, St = %.4f (Schaefer & Turek 2D-2: "
+                      "0.295-0.305), mean Cd = %.3f (their Cd_max %.2f), lift amplitude %.3f "
+                      "(averaged over %g; their Cl_max %.2f)"
+                      % (periods, args.t_start, st, cd_mean, CDMAX_ST96, cl_amp, args.smooth,
+                         CLMAX_ST96))
+            else:
+                st_ref, cd_ref = ST_RE200, CD_RE200
+                print("shedding: %.1f periods after t = %g, St = %.4f, mean Cd = %.4f, lift "
+                      "amplitude %.3f (averaged over %g)"
+                      % (periods, args.t_start, st, cd_mean, cl_amp, args.smooth))
+                for name, st_r, cd_r, cl_r in RE200:
+                    print("   vs %s: St %.3f (%+.1f%%), Cd %.3f (%+.1f%%), Cl amplitude %.3f"
+                          % (name, st_r, 100 * (st / st_r - 1), cd_r, 100 * (cd_mean / cd_r - 1),
+                             cl_r))
+                print("   vs their mean: St %.4f (%+.1f%%, tolerance %.0f%%), Cd %.4f (%+.1f%%, "
+                      "tolerance %.0f%%)" % (st_ref, 100 * (st / st_ref - 1), 100 * args.st_tol,
+                                             cd_ref, 100 * (cd_mean / cd_ref - 1),
+                                             100 * args.cd_tol))
+                if not abs(cd_mean / cd_ref - 1) <= args.cd_tol:
+                    failures.append("mean Cd %.4f is %+.1f%% from %.3f (the published mean)"
+                                    % (cd_mean, 100 * (cd_mean / cd_ref - 1), cd_ref))
             if periods < 3:
                 failures.append("fewer than 3 shedding periods after t = %g" % args.t_start)
-            if not abs(st / ST_ST96 - 1) <= args.st_tol:
-                failures.append("St %.4f is %+.1f%% from %.3f" % (st, 100 * (st / ST_ST96 - 1),
-                                                                  ST_ST96))
+            if args.min_amplitude is not None and not cl_amp >= args.min_amplitude:
+                failures.append("the lift amplitude %.3f is below %g: no shedding"
+                                % (cl_amp, args.min_amplitude))
+            if not abs(st / st_ref - 1) <= args.st_tol:
+                failures.append("St %.4f is %+.1f%% from %.3f" % (st, 100 * (st / st_ref - 1),
+                                                                  st_ref))
+            if args.periodic_tol is not None:
+                cyc = lift_cycles(ts, sig)
+                print("lift cycles after t = %g: %d" % (args.t_start, len(cyc)))
+                if len(cyc) < args.min_periods:
+                    failures.append("%d whole lift cycles after t = %g, fewer than %d"
+                                    % (len(cyc), args.t_start, args.min_periods))
+                if len(cyc) >= 2:
+                    per = np.array([b - a for a, b, _ in cyc])
+                    amp_c = np.array([c for _, _, c in cyc])
+                    t0c, t1c = cyc[0][0], cyc[-1][1]
+                    cl_c = mean_between(t, m["cl_int"], t0c, t1c)
+                    half = cyc[len(cyc) // 2][0]
+                    cd_a = mean_between(t, m["cd_int"], t0c, half)
+                    cd_b = mean_between(t, m["cd_int"], half, t1c)
+                    sp, sa = per.std() / per.mean(), amp_c.std() / amp_c.mean()
+                    rl, rd = abs(cl_c) / amp_c.mean(), cd_b / cd_a - 1
+                    print("   period %.4f (%.3f to %.3f, scatter %.2f%%), amplitude %.4f (%.4f to "
+                          "%.4f, scatter %.2f%%), mean lift %.4f (%.2f%% of the amplitude), mean "
+                          "Cd first / second half of the cycles %.4f / %.4f (%+.2f%%); tolerance "
+                          "%.1f%%" % (per.mean(), per.min(), per.max(), 100 * sp, amp_c.mean(),
+                                      amp_c.min(), amp_c.max(), 100 * sa, cl_c, 100 * rl, cd_a,
+                                      cd_b, 100 * rd, 100 * args.periodic_tol))
+                    for what, v in (("periods", sp), ("amplitudes", sa)):
+                        if not v <= args.periodic_tol:
+                            failures.append("the lift cycles' %s scatter by %.2f%%"
+                                            % (what, 100 * v))
+                    if not rl <= args.periodic_tol:
+                        failures.append("the mean lift over the cycles is %.2f%% of the "
+                                        "amplitude" % (100 * rl))
+                    if not abs(rd) <= args.periodic_tol:
+                        failures.append("the mean drag drifts by %+.2f%% over the cycles"
+                                        % (100 * rd))
 
     def draw(plt):
         fig, ax = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
         ax[0].plot(t, cd, lw=0.8, label="Cd (sampled at outputs)")
-        ax[0].axhline(CDMAX_ST96 if args.shedding else CD_ST96, color="k", ls="--",
-                      label="Schaefer & Turek 1996")
+        if args.reference == "re200":
+            ref, ref_label = CD_RE200, "mean of 5 published 2D computations"
+        elif args.shedding:
+            ref, ref_label = CDMAX_ST96, "Schaefer & Turek 1996 (Cd_max)"
+        else:
+            ref, ref_label = CD_ST96, "Schaefer & Turek 1996"
+        ax[0].axhline(ref, color="k", ls="--", label=ref_label)
         ax[0].axhline(cd_mean, color="r", label="SPH, mean after t = %g" % args.t_start)
-        ax[0].set_ylim(0, 2 * (CD_ST96 if not args.shedding else CDMAX_ST96))
+        ax[0].set_ylim(0, 2 * ref)
         ax[0].set_ylabel("Cd")
+        ax[1].plot(t, cl, lw=0.8, label="Cl (sampled at outputs)")
+        if args.shedding and len(t) > 3:
+            # The coefficients averaged over --smooth, from the integrals (as the spectrum).
+            w = max(1, int(round(0.5 * args.smooth / (t[1] - t[0]))))
+            tm = t[w:-w]
+            for a, key, name in ((ax[0], "cd_int", "Cd"), (ax[1], "cl_int", "Cl")):
+                ii = m[key]
+                a.plot(tm, [(ii[k + 2 * w] - ii[k]) / (t[k + 2 * w] - t[k])
+                            for k in range(len(tm))],
+                       color="C1", lw=1.2, label="%s averaged over %g" % (name, args.smooth))
+            ax[1].legend(fontsize=8)
         ax[0].legend(fontsize=8)
-        ax[1].plot(t, cl, lw=0.8)
         ax[1].set_ylabel("Cl")
         ax[1].set_xlabel("t")
         return fig
