@@ -20,12 +20,13 @@ colour gradient's radial part, int |n| dr, within --static-tol of 1, and of sigm
 from the particles as sum_a V_a (F_a . -r^_a) / (2 pi r_a).
 
 With --oscillation (a run of --set circle=1 --set amp=A: the circle's radius perturbed by
-A cos(2 theta)), the frequency of the n = 2 capillary oscillation instead: the drop's
-deformation D = (Ixx - Iyy) / (Ixx + Iyy) (second moments of its particles about the
-centroid) fitted by C + exp(-g t) (a cos(w t) + b sin(w t)) over every snapshot, and
-sqrt(w^2 + g^2) (the undamped frequency of the fitted damped oscillator) within
---omega-tol of Rayleigh's (Lamb, Hydrodynamics, art. 275, for a cylinder, with the fluid
-outside of equal density rho taking part in the motion):
+A cos(2 theta)), the n = 2 capillary oscillation instead: the drop's deformation
+D = (Ixx - Iyy) / (Ixx + Iyy) (second moments of its particles about the centroid) fitted by
+C + exp(-g t) (a cos(w t) + b sin(w t)) over the snapshots (up to --t-fit-end), and the
+fitted frequency w and damping rate g within --omega-tol and --gamma-tol of the viscous
+theory's (capillary_2d.py: the normal mode of a 2D drop of viscosity --nu in a fluid of the
+same density and viscosity, in the periodic box of side --box). Printed too: w against
+Rayleigh's inviscid frequency for two fluids without the box (Lamb, Hydrodynamics, art. 275),
 
     omega^2 = (n^3 - n) sigma / ((rho_in + rho_out) R^3) = 6 sigma / (2 rho R^3)   (n = 2).
 """
