@@ -20,12 +20,13 @@ colour gradient's radial part, int |n| dr, within --static-tol of 1, and of sigm
 from the particles as sum_a V_a (F_a . -r^_a) / (2 pi r_a).
 
 With --oscillation (a run of --set circle=1 --set amp=A: the circle's radius perturbed by
-A cos(2 theta)), the frequency of the n = 2 capillary oscillation instead: the drop's
-deformation D = (Ixx - Iyy) / (Ixx + Iyy) (second moments of its particles about the
-centroid) fitted by C + exp(-g t) (a cos(w t) + b sin(w t)) over every snapshot, and
-sqrt(w^2 + g^2) (the undamped frequency of the fitted damped oscillator) within
---omega-tol of Rayleigh's (Lamb, Hydrodynamics, art. 275, for a cylinder, with the fluid
-outside of equal density rho taking part in the motion):
+A cos(2 theta)), the n = 2 capillary oscillation instead: the drop's deformation
+D = (Ixx - Iyy) / (Ixx + Iyy) (second moments of its particles about the centroid) fitted by
+C + exp(-g t) (a cos(w t) + b sin(w t)) over the snapshots (up to --t-fit-end), and the
+fitted frequency w and damping rate g within --omega-tol and --gamma-tol of the viscous
+theory's (capillary_2d.py: the normal mode of a 2D drop of viscosity --nu in a fluid of the
+same density and viscosity, in the periodic box of side --box). Printed too: w against
+Rayleigh's inviscid frequency for two fluids without the box (Lamb, Hydrodynamics, art. 275),
 
     omega^2 = (n^3 - n) sigma / ((rho_in + rho_out) R^3) = 6 sigma / (2 rho R^3)   (n = 2).
 """
@@ -33,6 +34,7 @@ import sys
 
 import numpy as np
 
+import capillary_2d
 import snapshots
 
 WHO = "square_droplet.py"
@@ -71,6 +73,14 @@ def fit_oscillation(t, d, omega0):
     return w, g, resid(w, g)[1]
 
 
+def fit_curve(t, d, w, g):
+    """The fitted curve C + exp(-g t) (a cos w t + b sin w t) at the times t."""
+    e = np.exp(-g * t)
+    A = np.column_stack([np.ones_like(t), e * np.cos(w * t), e * np.sin(w * t)])
+    coef, *_ = np.linalg.lstsq(A, d, rcond=None)
+    return A @ coef
+
+
 def main():
     ap = snapshots.argument_parser(__doc__, "the scene's output directory", "square_droplet.png")
     ap.add_argument("--side", type=float, default=0.5, help="side of the initial square")
@@ -93,8 +103,14 @@ def main():
     ap.add_argument("--static-tol", type=float, default=0.02)
     ap.add_argument("--oscillation", action="store_true",
                     help="check the frequency of the n = 2 oscillation instead")
-    ap.add_argument("--omega-tol", type=float, default=0.15,
+    ap.add_argument("--nu", type=float, default=0.05,
+                    help="kinematic viscosity of the run (both colours)")
+    ap.add_argument("--omega-tol", type=float, default=0.05,
                     help="relative tolerance of the oscillation's frequency")
+    ap.add_argument("--gamma-tol", type=float, default=0.25,
+                    help="relative tolerance of the oscillation's damping rate")
+    ap.add_argument("--t-fit-end", type=float, default=None,
+                    help="fit the oscillation over the snapshots up to this time (default: all)")
     args = ap.parse_args()
 
     keys = ["x", "y", "p", "m", "rho", "color", "kappa", "cgrad"]
@@ -167,21 +183,34 @@ def main():
         print("static: int |n| dr = %.4f, force integral %.4f = (1 %+.2f%%) sigma / R"
               % (nint, fint, 100 * (fint / exact - 1)))
     elif args.oscillation:
-        omega0 = np.sqrt(6 * args.sigma / (2 * args.rho * R ** 3))
+        w0 = capillary_2d.omega0(2, R, args.sigma, args.rho)
+        wv, gv = capillary_2d.mode(2, R, args.sigma, args.rho, args.nu, args.box)
         ts = np.array([row[0] for row in rows])
         ds = np.array([row[7] for row in rows])
-        w, g, c = fit_oscillation(ts, ds, omega0)
+        if args.t_fit_end is not None:
+            ds = ds[ts <= args.t_fit_end + 1e-9]
+            ts = ts[ts <= args.t_fit_end + 1e-9]
+        w, g, c = fit_oscillation(ts, ds, w0)
         fit = (w, g, c)
-        omega = np.sqrt(w * w + g * g)
-        err = omega / omega0 - 1
-        print("n = 2 oscillation over %d snapshots: damped frequency %.4f, damping rate %.4f,"
-              " undamped %.4f; Rayleigh (two fluids) %.4f: error %+.2f%% (tolerance %g%%)"
-              % (len(ts), w, g, omega, omega0, 100 * err, 100 * args.omega_tol))
+        werr = w / wv - 1
+        gerr = g / gv - 1
+        print("n = 2 oscillation over %d snapshots (t = 0-%g, %.2f periods): fitted frequency"
+              " %.4f, damping rate %.4f" % (len(ts), ts[-1], ts[-1] * w / (2 * np.pi), w, g))
+        print("  viscous theory (capillary_2d.py, nu = %g, periodic box %g): frequency %.4f,"
+              " damping rate %.4f; inviscid (Rayleigh, two fluids, no box) %.4f"
+              % (args.nu, args.box, wv, gv, w0))
+        print("  error: frequency %+.2f%% (tolerance %g%%), damping rate %+.2f%% (tolerance %g%%);"
+              " the frequency against Rayleigh's inviscid %+.2f%%"
+              % (100 * werr, 100 * args.omega_tol, 100 * gerr, 100 * args.gamma_tol,
+                 100 * (w / w0 - 1)))
         if ts[-1] * w < 4 * np.pi:
             failures.append("the run covers %.2f periods, fewer than 2" % (ts[-1] * w / (2 * np.pi)))
-        if not abs(err) <= args.omega_tol:
-            failures.append("oscillation frequency %.4f: %+.2f%% from Rayleigh's %.4f"
-                            % (omega, 100 * err, omega0))
+        if not abs(werr) <= args.omega_tol:
+            failures.append("oscillation frequency %.4f: %+.2f%% from the viscous theory's %.4f"
+                            % (w, 100 * werr, wv))
+        if not abs(gerr) <= args.gamma_tol:
+            failures.append("damping rate %.4f: %+.2f%% from the viscous theory's %.4f"
+                            % (g, 100 * gerr, gv))
     else:
         settled = [row for row in rows if row[0] >= args.t_settled - 1e-9]
         if len(settled) < 2:
@@ -216,8 +245,10 @@ def main():
             w, g, c = fit
             a1.plot(ts, [row[7] for row in rows], ".", label="SPH: D = (Ixx - Iyy) / (Ixx + Iyy)")
             a1.axhline(c, color="0.6", lw=0.8)
-            a1.set_title("fit: omega %.3f, Rayleigh %.3f" % (np.sqrt(w * w + g * g),
-                                                          np.sqrt(3 * args.sigma / (args.rho * R ** 3))))
+            a1.plot(ts, fit_curve(ts, np.array([row[7] for row in rows]), w, g), "-", lw=0.8,
+                    label="fit: omega %.3f, gamma %.3f" % (w, g))
+            wv, gv = capillary_2d.mode(2, R, args.sigma, args.rho, args.nu, args.box)
+            a1.set_title("viscous theory: omega %.3f, gamma %.3f" % (wv, gv))
             a1.set_ylabel("deformation")
         a1.set_xlabel("t")
         a1.legend(fontsize=8)
