@@ -508,7 +508,12 @@ void ScenePrinter::emitStep() {
     } else {
       for (const auto& ps : sched_.postStep) scene_ << "    " << ps.function << "(t, dt);\n";
     }
-    if (hasDomain()) scene_ << removeGhosts();
+    if (hasDomain()) {
+      scene_ << removeGhosts();
+      // A group that moves particles (a shift) can move one out of a periodic box: wrap it
+      // now, so that an output written after this step holds positions in the box.
+      scene_ << "    update_domain();\n";
+    }
     scene_ << "  }\n\n";
   }
   // The integrator's time step; after stage k of m the time is t + k/m dt.
