@@ -31,5 +31,8 @@ bool selectGhostProperties(Plan& plan, DiagnosticEngine& diags);
 // av_alpha, viscosity and body_force at the parameters' defaults: a --report note, and a
 // warning at `dt =` for a fixed step above it; Plan::dtBoundH for the solver's own check.
 bool boundTimeStep(Plan& plan, DiagnosticEngine& diags);
+// analysis/InternalFlow.cpp: a warning at the scheme's use when a scene periodic along every
+// axis (an internal flow) leaves off the effect its scheme names in internal_flow_needs.
+bool checkInternalFlow(Plan& plan, DiagnosticEngine& diags);
 
 }  // namespace sphc

@@ -245,6 +245,7 @@ int main(int argc, char** argv) {
   if (!selectGhostProperties(*plan, diags)) return fail();
   if (dump(Pass::Ghosts)) return 0;
   if (!boundTimeStep(*plan, diags)) return fail();
+  if (!checkInternalFlow(*plan, diags)) return fail();
   log("analysis");
   if (diags.hasErrors()) return fail();
 

@@ -207,6 +207,10 @@ struct Plan {
   // analysis/DtBound.cpp), and the smallest initial h of the moving arrays it found (null:
   // none known before the run, no bound).
   ast::ExprPtr soundSpeed, avAlpha, viscosity, bodyForce, dtBoundH;
+  // The effect a scheme needs in an internal flow (setting internal_flow_needs, a Name;
+  // analysis/InternalFlow.cpp), and where it is set: the scheme's use in the scene.
+  ast::ExprPtr internalFlowNeeds;
+  llvm::SMLoc internalFlowNeedsLoc;
   ast::ExprPtr outputEvery;
   std::vector<ast::ExprPtr> outputAt;
   bool outputNearestStep = false;  // output_landing = nearest_step

@@ -16,8 +16,8 @@ struct Binding {
 
 class Expander {
  public:
-  Expander(DiagnosticEngine& diags, const std::map<std::string, Binding>& b)
-      : diags_(diags), bind_(b) {}
+  Expander(DiagnosticEngine& diags, const std::map<std::string, Binding>& b, llvm::SMLoc use)
+      : diags_(diags), bind_(b), use_(use) {}
 
   bool ok = true;
 
@@ -141,6 +141,9 @@ class Expander {
     for (const auto& s : from.settings) {
       ast::SceneSetting c = s;
       c.value = expr(s.value);
+      // internal_flow_needs is about the scene that uses the scheme (analysis/InternalFlow):
+      // its key is placed at the use, its value stays where the scheme names the effect.
+      if (c.key.name == "internal_flow_needs") c.key.loc = use_;
       to.settings.push_back(std::move(c));
     }
     for (const auto& st : from.steppers)
@@ -172,6 +175,7 @@ class Expander {
  private:
   DiagnosticEngine& diags_;
   const std::map<std::string, Binding>& bind_;
+  llvm::SMLoc use_;  // the scheme's use in the scene (`scheme NAME(...)`)
 };
 
 // What a scheme may hold: the items a scheme decides, not those of one scene.
@@ -263,7 +267,7 @@ bool expandSchemes(const std::vector<std::unique_ptr<ast::Module>>& modules, ast
       ok = false;
       continue;
     }
-    Expander ex(diags, bind);
+    Expander ex(diags, bind, use.scheme.loc);
     ex.scene(*decl->body, scene);
     ok = ex.ok && ok;
   }

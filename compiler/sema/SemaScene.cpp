@@ -16,7 +16,7 @@ void SemaImpl::buildScene() {
   std::set<std::string> seen;
   static const std::vector<std::string> known = {
       "dim",         "kernel",   "tf",        "dt",        "integrator", "output_landing",
-      "sound_speed", "av_alpha", "viscosity", "body_force"};
+      "sound_speed", "av_alpha", "viscosity", "body_force", "internal_flow_needs"};
   for (const auto& set : s.settings) {
     const std::string& k = set.key.name;
     if (!seen.insert(k).second) {
@@ -53,6 +53,15 @@ void SemaImpl::buildScene() {
        : k == "av_alpha"  ? plan_->avAlpha
        : k == "viscosity" ? plan_->viscosity
                           : plan_->bodyForce) = set.value;
+    } else if (k == "internal_flow_needs") {
+      // The effect without which the scheme is unstable in an internal flow (a scene periodic
+      // along every axis): analysis/InternalFlow.cpp warns when it is off.
+      if (v.kind != ast::Expr::Name)
+        diags_.error(v.loc, "internal_flow_needs must name an effect (e.g. shifting)");
+      else {
+        plan_->internalFlowNeeds = set.value;
+        plan_->internalFlowNeedsLoc = set.key.loc;
+      }
     } else if (k == "output_landing") {
       // exact: steps shortened to land on output times (the default, PySPH's rule);
       // nearest_step: whole steps, outputs at the nearest step end (docs/language.md).

@@ -64,6 +64,11 @@ Case invariants (options):
                 20 in a full 2D neighbourhood, 5-9 in a jet or spray one or two particles
                 thick, where the pressure is zero and nothing pushes a pair apart or together:
                 its distance is that with which it left an impact).
+  --wall-rho-min ARRAY F   wall density: rho / rho0 of the particles of ARRAY (dynamic
+                boundary particles, whose density follows the continuity equation) >= F at
+                every snapshot that writes it. Such a wall's pressure is clamped at zero below
+                rho0, so a wall density far below rho0 is no tension but a deficit the wall
+                remembers: it must be compressed back before it pushes returning water.
   --quiet-after T, --v-max V    after time T, max |v| of the fluid <= V (m/s).
   --ke-no-growth-after T        with no physical source after T (constant gravity, nothing
                 moving): the kinetic energy must not grow. The window [T, tf] is split in
@@ -243,6 +248,7 @@ def main():
     ap.add_argument("--min-pair", type=float, default=None)
     ap.add_argument("--pair-bulk", type=int, default=0)
     ap.add_argument("--pair-skip", type=float, nargs=2, action="append", default=[])
+    ap.add_argument("--wall-rho-min", nargs=2, default=None, metavar=("ARRAY", "F"))
     ap.add_argument("--quiet-after", type=float, default=None)
     ap.add_argument("--v-max", type=float, default=None)
     ap.add_argument("--ke-no-growth-after", type=float, default=None)
@@ -292,6 +298,13 @@ def main():
     box = add("wall", args.box_tol, "largest distance outside the walls [dx]") if args.box else None
     pair = add("min-pair", args.min_pair, "smallest fluid pair distance [dx]") \
         if args.min_pair is not None else None
+    wall_rho = None
+    if args.wall_rho_min is not None:
+        if args.rho0 is None:
+            sys.stderr.write("%s: --wall-rho-min needs --rho0\n" % WHO)
+            return 2
+        wall_arr, wall_min = args.wall_rho_min[0], float(args.wall_rho_min[1])
+        wall_rho = add("wall-density", wall_min, "smallest rho / rho0 of %s" % wall_arr)
     quiet = add("v-max", args.v_max, "largest speed after t = %g [m/s]" % args.quiet_after) \
         if args.quiet_after is not None else None
     drift = add("surface-drift", args.surface_drift,
@@ -417,6 +430,19 @@ def main():
                           % (int(badr.sum()), args.rho_min, args.rho_max,
                              ", ".join("%s rho/rho0 = %.4g" % (where(args.fluid, i, pos), r[i])
                                        for i in idx)))
+        # wall density
+        if wall_rho is not None and wall_arr in data and "rho" in data[wall_arr]:
+            wa = data[wall_arr]
+            wr = wa["rho"].astype(float) / args.rho0
+            wall_rho.record(float(wr.min()), lambda a, b: a < b)
+            badw = np.flatnonzero(wr < wall_min)
+            if len(badw):
+                wpos = [wa[c].astype(float) for c in ("x", "y", "z")[:dim]]
+                idx = badw[np.argsort(wr[badw])][:args.show]
+                wall_rho.fail(t, "%d particles of %s with rho / rho0 below %s: %s"
+                              % (len(badw), wall_arr, wall_min,
+                                 ", ".join("%s rho/rho0 = %.4g" % (where(wall_arr, i, wpos), wr[i])
+                                           for i in idx)))
         # dt-drop
         if prev is not None and step is not None and prev["step"] is not None \
                 and step > prev["step"]:

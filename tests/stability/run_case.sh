@@ -18,7 +18,10 @@
 #               scene's fixed step), and "--set dx=V" sets dx for it; "--expect-dt-warning
 #               yes|no" (not a solver option either) requires the solver's start-up warning
 #               of a fixed step above the stable bound (docs/language.md, Time-step bound)
-#               on its standard error, or its absence
+#               on its standard error, or its absence; "--no-limit-warnings" (nor that)
+#               fails the case when the run warns that a quantity left a warn bound of
+#               the scene's limits (docs/language.md, Limits): a bundled scene at its
+#               defaults must not warn a user
 #   CHECK OPTIONS passed to check_run.py after the output directory
 # Environment: EXPECT_RC (comma-separated accepted exit codes, default 0); SPHC_PYTHON.
 # A run that stops as a blow-up (exit 3) must say on its standard error which output is "the
@@ -37,11 +40,13 @@ DX=""
 FACTOR=""
 DT0=""
 DTWARN=""
+NOLIMITWARN=""
 while [ $# -gt 0 ] && [ "$1" != "--" ]; do
   case "$1" in
     --dt-factor) FACTOR=$2; shift 2; continue ;;
     --dt0) DT0=$2; shift 2; continue ;;
     --expect-dt-warning) DTWARN=$2; shift 2; continue ;;
+    --no-limit-warnings) NOLIMITWARN=yes; shift; continue ;;
     dx=*) DX=${1#dx=} ;;
   esac
   RUN_OPTS="$RUN_OPTS $1"
@@ -85,6 +90,11 @@ if [ -n "$DTWARN" ]; then
     exit 1
   fi
   echo "   start-up warning of a fixed step above the stable bound: $warned (as expected)"
+fi
+if [ -n "$NOLIMITWARN" ] && grep -q "^warning: .*limit '" "$OUT.stderr"; then
+  echo "FAILED: the run warned that it left a warn bound of the scene's limits:"
+  grep "^warning: .*limit '" "$OUT.stderr"
+  exit 1
 fi
 if [ "$rc" = 3 ] && ! grep -qF "the last good output is" "$OUT.stderr"; then
   echo "FAILED: the run stopped (exit 3) without naming the last good output"
