@@ -6,6 +6,10 @@
 // give the serial result bit for bit.
 #include "codegen/Printer.h"
 
+#include <cstdio>
+#include <functional>
+#include <set>
+
 namespace sphc {
 
 namespace {
@@ -13,7 +17,11 @@ namespace {
 class CpuPrinter : public ScenePrinter {
  public:
   CpuPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
-      : ScenePrinter(sched, diags, opts), openmp_(opts.backend == Backend::OpenMP) {}
+      : ScenePrinter(sched, diags, opts),
+        openmp_(opts.backend == Backend::OpenMP),
+        verletSkin_(opts.verletSkin > 0 && !cpuSingle_ && !mpi_ && !hasDomain() && !hasZones()
+                        ? opts.verletSkin
+                        : 0.0) {}
 
  private:
   std::string backendComment() const override {
@@ -22,6 +30,7 @@ class CpuPrinter : public ScenePrinter {
   }
   void runtimeIncludes() override {
     if (cpuSingle_) out_ << "#include \"sphc/float_arrays.h\"\n";
+    if (verlet()) out_ << "#include \"sphc/verlet.h\"\n";
   }
   void systemIncludes() override {
     if (openmp_) out_ << "\n#include <omp.h>\n";
@@ -34,6 +43,14 @@ class CpuPrinter : public ScenePrinter {
     // The neighbour list of the destination particle in hand (pair loops, loop_all), one per
     // thread, reused from particle to particle (CellList::gather_neighbours).
     out_ << "  std::vector<std::vector<std::uint32_t>> nbrs_lists;\n";
+    if (verlet()) verletMembers();
+  }
+  // --verlet-skin: the lists are kept across evaluations (sphc/verlet.h).
+  bool verlet() const { return verletSkin_ > 0; }
+  void verletMembers();
+  // The members holding the lists of the pass of destination d over source s.
+  std::string verletLists(int d, int s) const {
+    return "verlet_" + arr(d).name + "_" + arr(s).name;
   }
   bool timesNeighbourSearch() const override { return true; }
   void dataMovement() override;
@@ -103,7 +120,34 @@ class CpuPrinter : public ScenePrinter {
   std::string cellListBuild(const std::string& S, const std::string& count) const;
 
   bool openmp_ = false;
+  double verletSkin_ = 0.0;  // --verlet-skin (0: lists gathered at every evaluation)
 };
+
+// --verlet-skin: the skin, the rebuild decision of this evaluation and, per (destination,
+// source) pair of a pair loop, each destination particle's candidate list.
+void CpuPrinter::verletMembers() {
+  char skin[64];
+  std::snprintf(skin, sizeof skin, "%.17g", verletSkin_);
+  out_ << "  // --verlet-skin: candidates within (1 + VERLET_SKIN) times the support, kept across\n"
+          "  // evaluations and rebuilt when particles moved too far (sphc/verlet.h).\n";
+  out_ << "  static constexpr double VERLET_SKIN = " << skin << ";\n";
+  out_ << "  static constexpr double VERLET_RADIUS2 = RADIUS2 * (1.0 + VERLET_SKIN) * "
+          "(1.0 + VERLET_SKIN);\n";
+  out_ << "  sphc::VerletSkin verlet{VERLET_SKIN};\n";
+  out_ << "  bool verlet_rebuild = true;  // this evaluation builds the lists\n";
+  std::set<std::pair<int, int>> pairs;
+  std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+    for (const Phase& ph : g.phases)
+      for (const DestinationWork& w : ph.destinations)
+        for (const NeighbourPass& pass : w.passes)
+          if (pass.searches()) pairs.insert({w.array, pass.source});
+    for (const auto& sub : g.subgroups) walk(*sub);
+  };
+  walk(sched_.equations);
+  for (const auto& [d, s] : pairs)
+    out_ << "  std::vector<std::vector<std::uint32_t>> " << verletLists(d, s) << ";  // "
+         << arr(d).name << " <- " << arr(s).name << ", per " << arr(d).name << " particle\n";
+}
 
 void CpuPrinter::searchMembers() {
   out_ << "  sphc::SearchDomain domain;\n";
@@ -174,6 +218,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       continue;
     }
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
+    if (verlet())
+      scene_ << "        if (verlet_rebuild) " << verletLists(d, s) << ".resize(" << D << ".n);\n";
     scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
            << (openmp_ ? "omp_get_max_threads()" : "1") << "));\n";
     // Each thread works on its own copies of the array pointers and scalars
@@ -201,8 +247,26 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "          std::vector<std::uint32_t>& nbrs_list = nbrs_lists["
            << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
     if (mpi_) scene_ << "          long candidates = 0;\n";
-    scene_ << "          const int n_nbrs = static_cast<int>(cells.gather_neighbours(xi, yi, zi, "
-              "nbrs_list, [&](std::uint32_t j) {\n";
+    if (verlet()) {
+      // The list of d_idx: rebuilt from the cell lists (within the skin) when due, then
+      // filtered with the support's test below.
+      scene_ << "          std::vector<std::uint32_t>& candidates = " << verletLists(d, s)
+             << "[d_idx];\n";
+      // Gathered in the thread's scratch list, kept at its exact size.
+      scene_ << "          if (verlet_rebuild) {\n";
+      scene_ << "            const std::size_t n_candidates = cells.gather_neighbours(xi, yi, zi, "
+                "nbrs_list, [&](std::uint32_t j) {\n";
+      scene_ << "              const int s_idx = static_cast<int>(j);\n";
+      emitNeighbourTest(scene_, host_, "return false;", "              ", "VERLET_RADIUS2");
+      scene_ << "              return true;\n            });\n";
+      scene_ << "            candidates.assign(nbrs_list.data(), nbrs_list.data() + n_candidates);\n";
+      scene_ << "          }\n";
+      scene_ << "          const int n_nbrs = static_cast<int>(sphc::filter_neighbours("
+                "candidates.data(), candidates.size(), nbrs_list, [&](std::uint32_t j) {\n";
+    } else {
+      scene_ << "          const int n_nbrs = static_cast<int>(cells.gather_neighbours(xi, yi, zi, "
+                "nbrs_list, [&](std::uint32_t j) {\n";
+    }
     if (mpi_) scene_ << "            ++candidates;\n";
     scene_ << "            const int s_idx = static_cast<int>(j);\n";
     emitNeighbourTest(scene_, host_, "return false;", "            ");
@@ -377,6 +441,13 @@ void CpuPrinter::searchDomain() {
     first = false;
   }
   scene_ << "};\n";
+  if (verlet()) {
+    // Cells as large as the lists' radius; the lists are rebuilt when particles moved too far.
+    scene_ << "    verlet_rebuild = verlet.must_rebuild(all, Kernel::radius_scale);\n";
+    scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale * (1.0 + "
+              "VERLET_SKIN));\n";
+    return;
+  }
   scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
 }
 
@@ -430,7 +501,9 @@ void CpuPrinter::updateNeighbours() {
   if (anyReorders()) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
-    scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+    // --verlet-skin: only when the lists are rebuilt (they hold particle indices).
+    scene_ << (verlet() ? "    const bool reorder = verlet_rebuild && builds++ % REORDER_EVERY == 0;\n"
+                        : "    const bool reorder = builds++ % REORDER_EVERY == 0;\n");
   }
   for (const auto& S : sourceArrays_) {
     const std::string build = cellListBuild(S, S + ".n");
@@ -439,6 +512,8 @@ void CpuPrinter::updateNeighbours() {
     scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build
            << "\n    }\n";
   }
+  // --verlet-skin: the positions the lists of this evaluation are built from.
+  if (verlet() && !loopArrays_.empty()) scene_ << "    if (verlet_rebuild) verlet.mark(all);\n";
 }
 
 // The call of update_neighbours() in compute_accelerations, timed for --timing.
