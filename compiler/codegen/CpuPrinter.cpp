@@ -48,9 +48,9 @@ class CpuPrinter : public ScenePrinter {
   // --verlet-skin: the lists are kept across evaluations (sphc/verlet.h).
   bool verlet() const { return verletSkin_ > 0; }
   void verletMembers();
-  // The members holding the lists of the pass of destination d over source s.
-  std::string verletLists(int d, int s) const {
-    return "verlet_" + arr(d).name + "_" + arr(s).name;
+  // The member holding the lists of the pass of destination d over source s in a phase.
+  std::string verletLists(const std::string& phase, int d, int s) const {
+    return "verlet_" + phase + "_" + arr(d).name + "_" + arr(s).name;
   }
   bool timesNeighbourSearch() const override { return true; }
   void dataMovement() override;
@@ -135,18 +135,16 @@ void CpuPrinter::verletMembers() {
           "(1.0 + VERLET_SKIN);\n";
   out_ << "  sphc::VerletSkin verlet{VERLET_SKIN};\n";
   out_ << "  bool verlet_rebuild = true;  // this evaluation builds the lists\n";
-  std::set<std::pair<int, int>> pairs;
   std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
     for (const Phase& ph : g.phases)
       for (const DestinationWork& w : ph.destinations)
         for (const NeighbourPass& pass : w.passes)
-          if (pass.searches()) pairs.insert({w.array, pass.source});
+          if (pass.searches())
+            out_ << "  sphc::VerletLists " << verletLists(ph.name, w.array, pass.source)
+                 << ";  // " << arr(w.array).name << " <- " << arr(pass.source).name << "\n";
     for (const auto& sub : g.subgroups) walk(*sub);
   };
   walk(sched_.equations);
-  for (const auto& [d, s] : pairs)
-    out_ << "  std::vector<std::vector<std::uint32_t>> " << verletLists(d, s) << ";  // "
-         << arr(d).name << " <- " << arr(s).name << ", per " << arr(d).name << " particle\n";
 }
 
 void CpuPrinter::searchMembers() {
@@ -218,8 +216,14 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       continue;
     }
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
-    if (verlet())
-      scene_ << "        if (verlet_rebuild) " << verletLists(d, s) << ".resize(" << D << ".n);\n";
+    const std::string lists = verlet() ? verletLists(phase, d, s) : "";
+    if (verlet()) {
+      // 1: the kept lists; 2: built now (the evaluation that rebuilds); 0: not built since
+      // the last rebuild (the group did not run then), the cell lists as without lists.
+      scene_ << "        const int verlet_use = " << lists << ".built == verlet.generation() ? 1 "
+             << ": verlet_rebuild ? 2 : 0;\n";
+      scene_ << "        if (verlet_use == 2) " << lists << ".lists.resize(" << D << ".n);\n";
+    }
     scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
            << (openmp_ ? "omp_get_max_threads()" : "1") << "));\n";
     // Each thread works on its own copies of the array pointers and scalars
@@ -248,21 +252,24 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
            << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
     if (mpi_) scene_ << "          long candidates = 0;\n";
     if (verlet()) {
-      // The list of d_idx: rebuilt from the cell lists (within the skin) when due, then
-      // filtered with the support's test below.
-      scene_ << "          std::vector<std::uint32_t>& candidates = " << verletLists(d, s)
-             << "[d_idx];\n";
-      // Gathered in the thread's scratch list, kept at its exact size.
-      scene_ << "          if (verlet_rebuild) {\n";
-      scene_ << "            const std::size_t n_candidates = cells.gather_neighbours(xi, yi, zi, "
+      // The kept list of d_idx (built first if due, in the thread's scratch list, kept at its
+      // exact size), filtered with the support's test below; or the cells' candidates.
+      scene_ << "          const std::uint32_t* candidates = nullptr;\n";
+      scene_ << "          std::size_t n_candidates = 0;\n";
+      scene_ << "          if (verlet_use != 0) {\n";
+      scene_ << "            std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+      scene_ << "            if (verlet_use == 2) {\n";
+      scene_ << "              const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
                 "nbrs_list, [&](std::uint32_t j) {\n";
-      scene_ << "              const int s_idx = static_cast<int>(j);\n";
-      emitNeighbourTest(scene_, host_, "return false;", "              ", "VERLET_RADIUS2");
-      scene_ << "              return true;\n            });\n";
-      scene_ << "            candidates.assign(nbrs_list.data(), nbrs_list.data() + n_candidates);\n";
+      scene_ << "                const int s_idx = static_cast<int>(j);\n";
+      emitNeighbourTest(scene_, host_, "return false;", "                ", "VERLET_RADIUS2");
+      scene_ << "                return true;\n              });\n";
+      scene_ << "              kept.assign(nbrs_list.data(), nbrs_list.data() + n_kept);\n";
+      scene_ << "            }\n";
+      scene_ << "            candidates = kept.data();\n";
+      scene_ << "            n_candidates = kept.size();\n";
       scene_ << "          }\n";
-      scene_ << "          const int n_nbrs = static_cast<int>(sphc::filter_neighbours("
-                "candidates.data(), candidates.size(), nbrs_list, [&](std::uint32_t j) {\n";
+      scene_ << "          auto keep = [&](std::uint32_t j) {\n";
     } else {
       scene_ << "          const int n_nbrs = static_cast<int>(cells.gather_neighbours(xi, yi, zi, "
                 "nbrs_list, [&](std::uint32_t j) {\n";
@@ -270,7 +277,14 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     if (mpi_) scene_ << "            ++candidates;\n";
     scene_ << "            const int s_idx = static_cast<int>(j);\n";
     emitNeighbourTest(scene_, host_, "return false;", "            ");
-    scene_ << "            return true;\n          }));\n";
+    if (verlet()) {
+      scene_ << "            return true;\n          };\n";
+      scene_ << "          const int n_nbrs = static_cast<int>(verlet_use != 0\n"
+                "              ? sphc::filter_neighbours(candidates, n_candidates, nbrs_list, keep)\n"
+                "              : cells.gather_neighbours(xi, yi, zi, nbrs_list, keep));\n";
+    } else {
+      scene_ << "            return true;\n          }));\n";
+    }
     scene_ << "          const std::uint32_t* NBRS = nbrs_list.data();\n";
     if (mpi_)
       scene_ << "          n_pairs += n_nbrs;\n"
@@ -290,6 +304,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          }\n";
     }
     scene_ << "        }\n";
+    if (verlet())
+      scene_ << "        if (verlet_use == 2) " << lists << ".built = verlet.generation();\n";
     if (mpi_)
       scene_ << "        sphc::mpi::count_work(decomposition, " << d << ", n_pairs * " << loops
              << ", n_candidates);  // " << loops << " loop(s) over the pairs\n";

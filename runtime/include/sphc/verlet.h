@@ -31,6 +31,8 @@ class VerletSkin {
   explicit VerletSkin(double skin) : skin_(skin) {}
 
   double skin() const { return skin_; }
+  // Counts the mark() calls: lists built after the last one carry its value (VerletLists).
+  long generation() const { return generation_; }
 
   // Whether the lists built at the last mark() may miss a pair now (see above): true before
   // the first mark(), when the arrays or their counts differ, or when the particles moved
@@ -63,6 +65,7 @@ class VerletSkin {
 
   // Records the positions and h of the arrays the lists are built from now.
   void mark(const std::vector<const ParticleArray*>& arrays) {
+    ++generation_;
     saved_.resize(arrays.size());
     hmin_ = HUGE_VAL;
     for (std::size_t a = 0; a < arrays.size(); ++a) {
@@ -94,8 +97,19 @@ class VerletSkin {
     std::vector<double> x, y, z, h;
   };
   double skin_;
+  long generation_ = 0;
   double hmin_ = 0.0;
   std::vector<Saved> saved_;
+};
+
+// The kept lists of one pair loop: per destination particle its candidates, and the
+// VerletSkin::generation() they were built in (-1: never). A loop uses them while that is the
+// current generation; it builds them only in the evaluation that called mark() (the
+// positions the skin is measured from), and otherwise (a group that did not run then, e.g.
+// with `every` or a condition) gathers from the cell lists as without lists.
+struct VerletLists {
+  std::vector<std::vector<std::uint32_t>> lists;
+  long built = -1;
 };
 
 // out[0, count) = the candidates j of cand[0, n) with keep(j), in their order; returns count.
