@@ -123,8 +123,8 @@ class CpuPrinter : public ScenePrinter {
   double verletSkin_ = 0.0;  // --verlet-skin (0: lists gathered at every evaluation)
 };
 
-// --verlet-skin: the skin, the rebuild decision of this evaluation and, per (destination,
-// source) pair of a pair loop, each destination particle's candidate list.
+// --verlet-skin: the skin and, per pair loop (phase, destination, source), each destination
+// particle's candidate list with the positions it was built from.
 void CpuPrinter::verletMembers() {
   char skin[64];
   std::snprintf(skin, sizeof skin, "%.17g", verletSkin_);
@@ -133,15 +133,14 @@ void CpuPrinter::verletMembers() {
   out_ << "  static constexpr double VERLET_SKIN = " << skin << ";\n";
   out_ << "  static constexpr double VERLET_RADIUS2 = RADIUS2 * (1.0 + VERLET_SKIN) * "
           "(1.0 + VERLET_SKIN);\n";
-  out_ << "  sphc::VerletSkin verlet{VERLET_SKIN};\n";
-  out_ << "  bool verlet_rebuild = true;  // this evaluation builds the lists\n";
   std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
     for (const Phase& ph : g.phases)
       for (const DestinationWork& w : ph.destinations)
         for (const NeighbourPass& pass : w.passes)
           if (pass.searches())
             out_ << "  sphc::VerletLists " << verletLists(ph.name, w.array, pass.source)
-                 << ";  // " << arr(w.array).name << " <- " << arr(pass.source).name << "\n";
+                 << "{VERLET_SKIN};  // " << arr(w.array).name << " <- "
+                 << arr(pass.source).name << "\n";
     for (const auto& sub : g.subgroups) walk(*sub);
   };
   walk(sched_.equations);
@@ -218,11 +217,14 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, d, s) : "";
     if (verlet()) {
-      // 1: the kept lists; 2: built now (the evaluation that rebuilds); 0: not built since
-      // the last rebuild (the group did not run then), the cell lists as without lists.
-      scene_ << "        const int verlet_use = " << lists << ".built == verlet.generation() ? 1 "
-             << ": verlet_rebuild ? 2 : 0;\n";
-      scene_ << "        if (verlet_use == 2) " << lists << ".lists.resize(" << D << ".n);\n";
+      // Rebuilt when particles of either array moved too far since this loop's last build.
+      const std::string arrays = d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}";
+      scene_ << "        const bool verlet_build = " << lists << ".skin.must_rebuild(" << arrays
+             << ", Kernel::radius_scale);\n";
+      scene_ << "        if (verlet_build) {\n";
+      scene_ << "          " << lists << ".skin.mark(" << arrays << ");\n";
+      scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
+      scene_ << "        }\n";
     }
     scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
            << (openmp_ ? "omp_get_max_threads()" : "1") << "));\n";
@@ -253,23 +255,18 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     if (mpi_) scene_ << "          long candidates = 0;\n";
     if (verlet()) {
       // The kept list of d_idx (built first if due, in the thread's scratch list, kept at its
-      // exact size), filtered with the support's test below; or the cells' candidates.
-      scene_ << "          const std::uint32_t* candidates = nullptr;\n";
-      scene_ << "          std::size_t n_candidates = 0;\n";
-      scene_ << "          if (verlet_use != 0) {\n";
-      scene_ << "            std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
-      scene_ << "            if (verlet_use == 2) {\n";
-      scene_ << "              const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
+      // exact size), filtered with the support's test.
+      scene_ << "          std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+      scene_ << "          if (verlet_build) {\n";
+      scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
                 "nbrs_list, [&](std::uint32_t j) {\n";
-      scene_ << "                const int s_idx = static_cast<int>(j);\n";
-      emitNeighbourTest(scene_, host_, "return false;", "                ", "VERLET_RADIUS2");
-      scene_ << "                return true;\n              });\n";
-      scene_ << "              kept.assign(nbrs_list.data(), nbrs_list.data() + n_kept);\n";
-      scene_ << "            }\n";
-      scene_ << "            candidates = kept.data();\n";
-      scene_ << "            n_candidates = kept.size();\n";
+      scene_ << "              const int s_idx = static_cast<int>(j);\n";
+      emitNeighbourTest(scene_, host_, "return false;", "              ", "VERLET_RADIUS2");
+      scene_ << "              return true;\n            });\n";
+      scene_ << "            kept.assign(nbrs_list.data(), nbrs_list.data() + n_kept);\n";
       scene_ << "          }\n";
-      scene_ << "          auto keep = [&](std::uint32_t j) {\n";
+      scene_ << "          const int n_nbrs = static_cast<int>(sphc::filter_neighbours(kept.data(), "
+                "kept.size(), nbrs_list, [&](std::uint32_t j) {\n";
     } else {
       scene_ << "          const int n_nbrs = static_cast<int>(cells.gather_neighbours(xi, yi, zi, "
                 "nbrs_list, [&](std::uint32_t j) {\n";
@@ -277,14 +274,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     if (mpi_) scene_ << "            ++candidates;\n";
     scene_ << "            const int s_idx = static_cast<int>(j);\n";
     emitNeighbourTest(scene_, host_, "return false;", "            ");
-    if (verlet()) {
-      scene_ << "            return true;\n          };\n";
-      scene_ << "          const int n_nbrs = static_cast<int>(verlet_use != 0\n"
-                "              ? sphc::filter_neighbours(candidates, n_candidates, nbrs_list, keep)\n"
-                "              : cells.gather_neighbours(xi, yi, zi, nbrs_list, keep));\n";
-    } else {
-      scene_ << "            return true;\n          }));\n";
-    }
+    scene_ << "            return true;\n          }));\n";
     scene_ << "          const std::uint32_t* NBRS = nbrs_list.data();\n";
     if (mpi_)
       scene_ << "          n_pairs += n_nbrs;\n"
@@ -304,8 +294,6 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          }\n";
     }
     scene_ << "        }\n";
-    if (verlet())
-      scene_ << "        if (verlet_use == 2) " << lists << ".built = verlet.generation();\n";
     if (mpi_)
       scene_ << "        sphc::mpi::count_work(decomposition, " << d << ", n_pairs * " << loops
              << ", n_candidates);  // " << loops << " loop(s) over the pairs\n";
@@ -458,8 +446,7 @@ void CpuPrinter::searchDomain() {
   }
   scene_ << "};\n";
   if (verlet()) {
-    // Cells as large as the lists' radius; the lists are rebuilt when particles moved too far.
-    scene_ << "    verlet_rebuild = verlet.must_rebuild(all, Kernel::radius_scale);\n";
+    // Cells as large as the lists' radius (each pair loop rebuilds its lists when due).
     scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale * (1.0 + "
               "VERLET_SKIN));\n";
     return;
@@ -517,9 +504,9 @@ void CpuPrinter::updateNeighbours() {
   if (anyReorders()) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
-    // --verlet-skin: only when the lists are rebuilt (they hold particle indices).
-    scene_ << (verlet() ? "    const bool reorder = verlet_rebuild && builds++ % REORDER_EVERY == 0;\n"
-                        : "    const bool reorder = builds++ % REORDER_EVERY == 0;\n");
+    // (--verlet-skin: a permutation moves the particles under the kept lists, which are
+    // then rebuilt.)
+    scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
   }
   for (const auto& S : sourceArrays_) {
     const std::string build = cellListBuild(S, S + ".n");
@@ -528,8 +515,6 @@ void CpuPrinter::updateNeighbours() {
     scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build
            << "\n    }\n";
   }
-  // --verlet-skin: the positions the lists of this evaluation are built from.
-  if (verlet() && !loopArrays_.empty()) scene_ << "    if (verlet_rebuild) verlet.mark(all);\n";
 }
 
 // The call of update_neighbours() in compute_accelerations, timed for --timing.

@@ -14,7 +14,9 @@
 // radius_scale * g, g the largest growth of any h; its skin at the build was at least
 // F * radius_scale * h_min (h_min the smallest h at the build). So the lists are rebuilt
 // when 2 d + radius_scale * g > F * radius_scale * h_min, when an array's particle count
-// changed, and at the first evaluation (VerletSkin::must_rebuild).
+// changed, and at the first evaluation (VerletSkin::must_rebuild). Each pair loop keeps its
+// own lists and positions (VerletLists), so a loop that does not run at every evaluation
+// (a group with `every` or a condition, post_step) measures from its own build.
 #pragma once
 
 #include <cmath>
@@ -31,8 +33,6 @@ class VerletSkin {
   explicit VerletSkin(double skin) : skin_(skin) {}
 
   double skin() const { return skin_; }
-  // Counts the mark() calls: lists built after the last one carry its value (VerletLists).
-  long generation() const { return generation_; }
 
   // Whether the lists built at the last mark() may miss a pair now (see above): true before
   // the first mark(), when the arrays or their counts differ, or when the particles moved
@@ -65,7 +65,6 @@ class VerletSkin {
 
   // Records the positions and h of the arrays the lists are built from now.
   void mark(const std::vector<const ParticleArray*>& arrays) {
-    ++generation_;
     saved_.resize(arrays.size());
     hmin_ = HUGE_VAL;
     for (std::size_t a = 0; a < arrays.size(); ++a) {
@@ -97,19 +96,18 @@ class VerletSkin {
     std::vector<double> x, y, z, h;
   };
   double skin_;
-  long generation_ = 0;
   double hmin_ = 0.0;
   std::vector<Saved> saved_;
 };
 
 // The kept lists of one pair loop: per destination particle its candidates, and the
-// VerletSkin::generation() they were built in (-1: never). A loop uses them while that is the
-// current generation; it builds them only in the evaluation that called mark() (the
-// positions the skin is measured from), and otherwise (a group that did not run then, e.g.
-// with `every` or a condition) gathers from the cell lists as without lists.
+// positions they were built from. The loop checks them at every evaluation (skin.must_rebuild
+// over its destination and source arrays) and rebuilds them from the cell lists when due; a
+// permutation of the particles into cell order moves them far and so rebuilds them too.
 struct VerletLists {
+  explicit VerletLists(double skin_fraction) : skin(skin_fraction) {}
+  VerletSkin skin;
   std::vector<std::vector<std::uint32_t>> lists;
-  long built = -1;
 };
 
 // out[0, count) = the candidates j of cand[0, n) with keep(j), in their order; returns count.
