@@ -219,10 +219,13 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     if (verlet()) {
       // Rebuilt when particles of either array moved too far since this loop's last build.
       const std::string arrays = d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}";
-      scene_ << "        const bool verlet_build = " << lists << ".skin.must_rebuild(" << arrays
-             << ", Kernel::radius_scale);\n";
+      const std::string range = rangeBegin(w) + ", " + rangeEnd(w);
+      scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ") || "
+             << lists << ".skin.must_rebuild(" << arrays << ", Kernel::radius_scale);\n";
       scene_ << "        if (verlet_build) {\n";
       scene_ << "          " << lists << ".skin.mark(" << arrays << ");\n";
+      scene_ << "          " << lists << ".begin = " << rangeBegin(w) << ";\n";
+      scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
       scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
       scene_ << "        }\n";
     }

@@ -108,6 +108,10 @@ struct VerletLists {
   explicit VerletLists(double skin_fraction) : skin(skin_fraction) {}
   VerletSkin skin;
   std::vector<std::vector<std::uint32_t>> lists;
+  // The destination particles [begin, end) the lists were built for (a group with start_idx
+  // or stop_idx builds its range only; another range rebuilds them).
+  long begin = 0, end = -1;
+  bool built_for(long b, long e) const { return b == begin && e == end; }
 };
 
 // out[0, count) = the candidates j of cand[0, n) with keep(j), in their order; returns count.
