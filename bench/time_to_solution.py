@@ -207,7 +207,7 @@ def sphc_build(args, case, tmp, backend):
     env = environment(1, "passive")
     env["SPHC_CACHE_DIR"] = cache
     exe = os.path.join(tmp, "%s_%s" % (case.name, backend))
-    cmd = [args.sphc, case.source, "--backend=" + backend] + case.sphc_defines
+    cmd = [args.sphc, case.source, "--backend=" + backend] + case.sphc_defines + args.sphc_flag
     cold, _ = run(cmd + ["-o", exe], env=env)
     cached, _ = run(cmd + ["-o", exe + "_cached"], env=env)
     return exe, cold, cached
@@ -376,6 +376,9 @@ def main():
     ap.add_argument("--quick", action="store_true",
                     help="a few minutes: dam break to 0.3 s, cube to 1e-3, tg nx = 50 to 0.2")
     ap.add_argument("--cases", default="dambreak,cube,tg")
+    ap.add_argument("--sphc-flag", action="append", default=[],
+                    help="a flag for every sphc build (repeatable), e.g. "
+                         "--sphc-flag=--verlet-skin=0.1")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--skip-omp", action="store_true", help="serial runs only")
     ap.add_argument("--omp-wait", default="passive", choices=("passive", "active"),

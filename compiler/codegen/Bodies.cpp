@@ -293,7 +293,7 @@ static PairDialect pairDialectOf(const Dialect& dl) {
 }
 
 void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
-                                     const std::string& indent) {
+                                     const std::string& indent, const std::string& radius2) {
   const std::string& R = dl.real;
   const PairDialect dialect = pairDialectOf(dl);
   os << indent << "const " << R << " hj = sj_h[s_idx];\n";
@@ -301,7 +301,8 @@ void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const 
     if (pq.when == PairWhen::BeforeTest)
       os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
   os << indent << "const " << R << " hmax = hi > hj ? hi : hj;\n";
-  os << indent << "if (R2IJ >= RADIUS2 * hmax * hmax) " << skip << "  // not a neighbour\n";
+  os << indent << "if (R2IJ >= " << radius2 << " * hmax * hmax) " << skip
+     << (radius2 == "RADIUS2" ? "  // not a neighbour\n" : "  // beyond the list's radius\n");
 }
 
 // The pair quantities of one candidate, from the table (analysis/PairQuantityTable): those

@@ -29,6 +29,10 @@ struct EmitOptions {
   // Products added to values in bodies are printed as explicit fused multiply-adds (std::fma,
   // OpenCL fma): rounded once and alike on every backend (--fma=off: as written).
   bool fma = true;
+  // --verlet-skin=F: the CPU pair loops keep their neighbour candidates within (1 + F) times
+  // the support across steps (sphc/verlet.h); 0: gathered from the cell lists every
+  // evaluation.
+  double verletSkin = 0.0;
 };
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.

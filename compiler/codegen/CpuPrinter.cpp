@@ -6,6 +6,10 @@
 // give the serial result bit for bit.
 #include "codegen/Printer.h"
 
+#include <cstdio>
+#include <functional>
+#include <set>
+
 namespace sphc {
 
 namespace {
@@ -13,7 +17,11 @@ namespace {
 class CpuPrinter : public ScenePrinter {
  public:
   CpuPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
-      : ScenePrinter(sched, diags, opts), openmp_(opts.backend == Backend::OpenMP) {}
+      : ScenePrinter(sched, diags, opts),
+        openmp_(opts.backend == Backend::OpenMP),
+        verletSkin_(opts.verletSkin > 0 && !cpuSingle_ && !mpi_ && !hasDomain() && !hasZones()
+                        ? opts.verletSkin
+                        : 0.0) {}
 
  private:
   std::string backendComment() const override {
@@ -22,6 +30,7 @@ class CpuPrinter : public ScenePrinter {
   }
   void runtimeIncludes() override {
     if (cpuSingle_) out_ << "#include \"sphc/float_arrays.h\"\n";
+    if (verlet()) out_ << "#include \"sphc/verlet.h\"\n";
   }
   void systemIncludes() override {
     if (openmp_) out_ << "\n#include <omp.h>\n";
@@ -34,6 +43,14 @@ class CpuPrinter : public ScenePrinter {
     // The neighbour list of the destination particle in hand (pair loops, loop_all), one per
     // thread, reused from particle to particle (CellList::gather_neighbours).
     out_ << "  std::vector<std::vector<std::uint32_t>> nbrs_lists;\n";
+    if (verlet()) verletMembers();
+  }
+  // --verlet-skin: the lists are kept across evaluations (sphc/verlet.h).
+  bool verlet() const { return verletSkin_ > 0; }
+  void verletMembers();
+  // The member holding the lists of the pass of destination d over source s in a phase.
+  std::string verletLists(const std::string& phase, int d, int s) const {
+    return "verlet_" + phase + "_" + arr(d).name + "_" + arr(s).name;
   }
   bool timesNeighbourSearch() const override { return true; }
   void dataMovement() override;
@@ -103,7 +120,31 @@ class CpuPrinter : public ScenePrinter {
   std::string cellListBuild(const std::string& S, const std::string& count) const;
 
   bool openmp_ = false;
+  double verletSkin_ = 0.0;  // --verlet-skin (0: lists gathered at every evaluation)
 };
+
+// --verlet-skin: the skin and, per pair loop (phase, destination, source), each destination
+// particle's candidate list with the positions it was built from.
+void CpuPrinter::verletMembers() {
+  char skin[64];
+  std::snprintf(skin, sizeof skin, "%.17g", verletSkin_);
+  out_ << "  // --verlet-skin: candidates within (1 + VERLET_SKIN) times the support, kept across\n"
+          "  // evaluations and rebuilt when particles moved too far (sphc/verlet.h).\n";
+  out_ << "  static constexpr double VERLET_SKIN = " << skin << ";\n";
+  out_ << "  static constexpr double VERLET_RADIUS2 = RADIUS2 * (1.0 + VERLET_SKIN) * "
+          "(1.0 + VERLET_SKIN);\n";
+  std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+    for (const Phase& ph : g.phases)
+      for (const DestinationWork& w : ph.destinations)
+        for (const NeighbourPass& pass : w.passes)
+          if (pass.searches())
+            out_ << "  sphc::VerletLists " << verletLists(ph.name, w.array, pass.source)
+                 << "{VERLET_SKIN};  // " << arr(w.array).name << " <- "
+                 << arr(pass.source).name << "\n";
+    for (const auto& sub : g.subgroups) walk(*sub);
+  };
+  walk(sched_.equations);
+}
 
 void CpuPrinter::searchMembers() {
   out_ << "  sphc::SearchDomain domain;\n";
@@ -174,6 +215,20 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       continue;
     }
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
+    const std::string lists = verlet() ? verletLists(phase, d, s) : "";
+    if (verlet()) {
+      // Rebuilt when particles of either array moved too far since this loop's last build.
+      const std::string arrays = d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}";
+      const std::string range = rangeBegin(w) + ", " + rangeEnd(w);
+      scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ") || "
+             << lists << ".skin.must_rebuild(" << arrays << ", Kernel::radius_scale);\n";
+      scene_ << "        if (verlet_build) {\n";
+      scene_ << "          " << lists << ".skin.mark(" << arrays << ");\n";
+      scene_ << "          " << lists << ".begin = " << rangeBegin(w) << ";\n";
+      scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
+      scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
+      scene_ << "        }\n";
+    }
     scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
            << (openmp_ ? "omp_get_max_threads()" : "1") << "));\n";
     // Each thread works on its own copies of the array pointers and scalars
@@ -201,8 +256,24 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "          std::vector<std::uint32_t>& nbrs_list = nbrs_lists["
            << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
     if (mpi_) scene_ << "          long candidates = 0;\n";
-    scene_ << "          const int n_nbrs = static_cast<int>(cells.gather_neighbours(xi, yi, zi, "
-              "nbrs_list, [&](std::uint32_t j) {\n";
+    if (verlet()) {
+      // The kept list of d_idx (built first if due, in the thread's scratch list, kept at its
+      // exact size), filtered with the support's test.
+      scene_ << "          std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+      scene_ << "          if (verlet_build) {\n";
+      scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
+                "nbrs_list, [&](std::uint32_t j) {\n";
+      scene_ << "              const int s_idx = static_cast<int>(j);\n";
+      emitNeighbourTest(scene_, host_, "return false;", "              ", "VERLET_RADIUS2");
+      scene_ << "              return true;\n            });\n";
+      scene_ << "            kept.assign(nbrs_list.data(), nbrs_list.data() + n_kept);\n";
+      scene_ << "          }\n";
+      scene_ << "          const int n_nbrs = static_cast<int>(sphc::filter_neighbours(kept.data(), "
+                "kept.size(), nbrs_list, [&](std::uint32_t j) {\n";
+    } else {
+      scene_ << "          const int n_nbrs = static_cast<int>(cells.gather_neighbours(xi, yi, zi, "
+                "nbrs_list, [&](std::uint32_t j) {\n";
+    }
     if (mpi_) scene_ << "            ++candidates;\n";
     scene_ << "            const int s_idx = static_cast<int>(j);\n";
     emitNeighbourTest(scene_, host_, "return false;", "            ");
@@ -377,6 +448,12 @@ void CpuPrinter::searchDomain() {
     first = false;
   }
   scene_ << "};\n";
+  if (verlet()) {
+    // Cells as large as the lists' radius (each pair loop rebuilds its lists when due).
+    scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale * (1.0 + "
+              "VERLET_SKIN));\n";
+    return;
+  }
   scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
 }
 
@@ -430,6 +507,8 @@ void CpuPrinter::updateNeighbours() {
   if (anyReorders()) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
+    // (--verlet-skin: a permutation moves the particles under the kept lists, which are
+    // then rebuilt.)
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
   }
   for (const auto& S : sourceArrays_) {

@@ -138,9 +138,10 @@ class ScenePrinter {
                      const std::vector<const PlanEquation*>& loopers, int d, const Dialect& dl,
                      bool test = true);
   // loop_all: the neighbour test of one candidate s_idx (hj, XIJ, R2IJ and the cut-off,
-  // leaving with `skip`), before it joins the neighbour list.
+  // leaving with `skip`), before it joins the neighbour list. `radius2`: the squared radius
+  // in units of hmax (RADIUS2, the support; VERLET_RADIUS2 for the lists of --verlet-skin).
   void emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
-                         const std::string& indent);
+                         const std::string& indent, const std::string& radius2 = "RADIUS2");
   // The pair quantities of one candidate (XIJ, R2IJ, the cut-off test, HIJ, RIJ, ...).
   void emitPairQuantities(std::ostream& os, const std::set<std::string>& q, const Dialect& dl,
                           bool test = true);

@@ -69,6 +69,13 @@ static cl::opt<OnOff, false, NamedValues<OnOff>> FmaOpt(
                           "backend (default)"),
                clEnumValN(OnOff::Off, "off", "a multiply and an add, each rounded")),
     cl::cat(SphcCat));
+static cl::opt<double> VerletSkin(
+    "verlet-skin",
+    cl::desc("Keep each pair loop's neighbour candidates within (1 + F) times the support "
+             "across time steps, rebuilt when particles moved too far (F > 0; serial and "
+             "openmp, double precision, no periodic/mirror domain, inlets, outlets or --mpi). "
+             "Sums over neighbours may round differently. Default 0: off"),
+    cl::value_desc("F"), cl::init(0.0), cl::cat(SphcCat));
 enum class EmitKind { Exe, Cpp, OpenCL, Plan, Ast };
 static cl::opt<std::string> KernelOpt(
     "kernel", cl::desc("Replace the scene's smoothing kernel (CubicSpline, QuinticSpline, "
@@ -164,6 +171,18 @@ int main(int argc, char** argv) {
   if (Mpi && (Backend == sphc::Backend::OpenCL || PrecisionOpt == sphc::Precision::Single)) {
     llvm::errs() << "sphc: error: --mpi works with --backend=serial or openmp in double "
                     "precision (not with --backend=opencl or --precision=single yet)\n";
+    return fail();
+  }
+  // --verlet-skin: the host pair loops of one process, in double precision.
+  if (!(VerletSkin >= 0.0 && VerletSkin <= 1.0)) {
+    llvm::errs() << "sphc: error: --verlet-skin=" << llvm::format("%g", VerletSkin.getValue())
+                 << ": the skin is a fraction of the support radius, from 0 (off) to 1\n";
+    return fail();
+  }
+  if (VerletSkin > 0.0 && (Mpi || Backend == sphc::Backend::OpenCL ||
+                           PrecisionOpt == sphc::Precision::Single)) {
+    llvm::errs() << "sphc: error: --verlet-skin works with --backend=serial or openmp in double "
+                    "precision (not with --backend=opencl, --precision=single or --mpi)\n";
     return fail();
   }
   if (Mpi && Emit == EmitKind::Exe) {
@@ -262,7 +281,15 @@ int main(int argc, char** argv) {
     printSchedule(*schedule, diags, llvm::outs());
     return 0;
   }
-  EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On};
+  if (VerletSkin > 0.0 && (schedule->domain || !plan->zones.empty())) {
+    llvm::errs() << "sphc: error: --verlet-skin: " << InputFile << " has "
+                 << (schedule->domain ? "a periodic or mirror domain" : "inlets or outlets")
+                 << ", whose ghosts or particle changes renumber the neighbours at every step "
+                    "(not supported)\n";
+    return fail();
+  }
+  EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
+                       VerletSkin};
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;

@@ -1,0 +1,134 @@
+// sphc runtime: neighbour lists kept across time steps (Verlet lists with a skin; header only).
+//
+// `sphc --verlet-skin=F` (F > 0): each pair loop keeps, per destination particle, the
+// candidates within (1 + F) times the support radius, radius_scale * max(h_i, h_j), found
+// with the cell lists when the lists are built, in the cell lists' candidate order. Every
+// evaluation then filters that list with the loop's usual cut-off test (the same
+// R2IJ >= RADIUS2 * hmax * hmax as without lists), so the set of interacting pairs is the
+// same; their order is the candidate order of the build, not of the current step (sums over
+// neighbours may round differently from a run without lists).
+//
+// The lists stay complete while no pair can have come from beyond (1 + F) times its radius
+// at the build to within its radius now. A pair's distance shrank by at most 2 d, d the
+// largest displacement of any particle since the build, and its radius grew by at most
+// radius_scale * g, g the largest growth of any h; its skin at the build was at least
+// F * radius_scale * h_min (h_min the smallest h at the build). So the lists are rebuilt
+// when 2 d + radius_scale * g > F * radius_scale * h_min, when an array's particle count
+// changed, and at the first evaluation (VerletSkin::must_rebuild). Each pair loop keeps its
+// own lists and positions (VerletLists), so a loop that does not run at every evaluation
+// (a group with `every` or a condition, post_step) measures from its own build.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "sphc/particle_array.h"
+
+namespace sphc {
+
+class VerletSkin {
+ public:
+  explicit VerletSkin(double skin) : skin_(skin) {}
+
+  double skin() const { return skin_; }
+
+  // Whether the lists built at the last mark() may miss a pair now (see above): true before
+  // the first mark(), when the arrays or their counts differ, or when the particles moved
+  // (or h grew) too far. NaN positions also give true.
+  bool must_rebuild(const std::vector<const ParticleArray*>& arrays, double radius_scale) const {
+    if (saved_.size() != arrays.size()) return true;
+    double d2max = 0.0, growth = 0.0;
+    for (std::size_t a = 0; a < arrays.size(); ++a) {
+      const ParticleArray& pa = *arrays[a];
+      const Saved& s = saved_[a];
+      if (pa.n != s.n) return true;
+      const double* x = coordinate(pa, "x");
+      const double* y = coordinate(pa, "y");
+      const double* z = coordinate(pa, "z");
+      const double* h = pa.f64("h");
+      for (std::size_t i = 0; i < pa.n; ++i) {
+        const double dx = (x ? x[i] : 0.0) - s.x[i];
+        const double dy = (y ? y[i] : 0.0) - s.y[i];
+        const double dz = (z ? z[i] : 0.0) - s.z[i];
+        const double d2 = dx * dx + dy * dy + dz * dz;
+        const double dh = h[i] - s.h[i];
+        d2max = d2 > d2max ? d2 : d2max;
+        growth = dh > growth ? dh : growth;
+        if (d2 != d2 || dh != dh) return true;  // NaN
+      }
+    }
+    const double moved = 2.0 * std::sqrt(d2max) + radius_scale * growth;
+    return !(moved <= skin_ * radius_scale * hmin_);
+  }
+
+  // Records the positions and h of the arrays the lists are built from now.
+  void mark(const std::vector<const ParticleArray*>& arrays) {
+    saved_.resize(arrays.size());
+    hmin_ = HUGE_VAL;
+    for (std::size_t a = 0; a < arrays.size(); ++a) {
+      const ParticleArray& pa = *arrays[a];
+      Saved& s = saved_[a];
+      s.n = pa.n;
+      const char* axes[3] = {"x", "y", "z"};
+      std::vector<double>* to[3] = {&s.x, &s.y, &s.z};
+      for (int k = 0; k < 3; ++k) {
+        const double* c = coordinate(pa, axes[k]);
+        if (c)
+          to[k]->assign(c, c + pa.n);
+        else
+          to[k]->assign(pa.n, 0.0);
+      }
+      s.h.assign(pa.f64("h"), pa.f64("h") + pa.n);
+      for (double h : s.h) hmin_ = h < hmin_ ? h : hmin_;
+    }
+  }
+
+ private:
+  // A coordinate array, nullptr if the array has none (y and z below 3D may be absent).
+  static const double* coordinate(const ParticleArray& pa, const char* axis) {
+    const int k = pa.find(axis);
+    return k < 0 ? nullptr : pa.f64(k);
+  }
+  struct Saved {
+    std::size_t n = 0;
+    std::vector<double> x, y, z, h;
+  };
+  double skin_;
+  double hmin_ = 0.0;
+  std::vector<Saved> saved_;
+};
+
+// The kept lists of one pair loop: per destination particle its candidates, and the
+// positions they were built from. The loop checks them at every evaluation (skin.must_rebuild
+// over its destination and source arrays) and rebuilds them from the cell lists when due; a
+// permutation of the particles into cell order moves them far and so rebuilds them too.
+struct VerletLists {
+  explicit VerletLists(double skin_fraction) : skin(skin_fraction) {}
+  VerletSkin skin;
+  std::vector<std::vector<std::uint32_t>> lists;
+  // The destination particles [begin, end) the lists were built for (a group with start_idx
+  // or stop_idx builds its range only; another range rebuilds them).
+  long begin = 0, end = -1;
+  bool built_for(long b, long e) const { return b == begin && e == end; }
+};
+
+// out[0, count) = the candidates j of cand[0, n) with keep(j), in their order; returns count.
+// Branch-free like CellList::gather_neighbours: every candidate is written, the count
+// advances only for those kept.
+template <class Keep>
+inline std::size_t filter_neighbours(const std::uint32_t* cand, std::size_t n,
+                                     std::vector<std::uint32_t>& out, Keep&& keep) {
+  if (out.size() < n) out.resize(2 * n + 64);
+  std::uint32_t* o = out.data();
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t j = cand[k];
+    o[count] = j;
+    count += keep(j) ? 1 : 0;
+  }
+  return count;
+}
+
+}  // namespace sphc
