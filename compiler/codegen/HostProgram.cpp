@@ -122,10 +122,16 @@ void ScenePrinter::emitArraySetup(const PlanArray& a) {
       scene_ << "      " << A << ".add_constant(\"" << c << "\", 1, 0.0);  // reduce target\n";
   }
   scene_ << "      " << A << ".resize(pts.size());\n";
-  // Initial values, particle by particle, in declaration order.
-  std::vector<const PlanProperty*> inits;
-  for (const auto& p : a.props)
-    if (p.init) inits.push_back(&p);
+  // Initial values, particle by particle, in declaration order: those of the allocated
+  // properties and of the unallocated ones they read (computed, not stored).
+  std::set<std::string> initInputs =
+      initialValueInputs(*a.decl, [&](const std::string& n) { return a.find(n) != nullptr; });
+  std::vector<const ast::PropertyDecl*> inits;
+  for (const auto& p : a.decl->properties) {
+    const PlanProperty* kept = a.find(p.name.name);
+    if (p.init && ((kept && kept->declared) || initInputs.count(p.name.name)))
+      inits.push_back(&p);
+  }
   scene_ << "      for (std::size_t i = 0; i < pts.size(); ++i) {\n";
   // The coordinates the positions and initial values use.
   std::vector<std::string> coords;
@@ -146,13 +152,18 @@ void ScenePrinter::emitArraySetup(const PlanArray& a) {
     return paramRef(n);
   };
   for (const auto* p : inits) {
-    scene_ << "        const double v_" << p->name << " = " << exprCpp(*p->init, initNames)
-           << ";  // from " << loc(p->declLoc) << "\n";
-    for (int k = 0; k < p->stride; ++k)
-      scene_ << "        " << hostPtr(plan_.arrayIndex(A), p->name) << "[i * " << p->stride
-             << " + " << k << "] = static_cast<" << cppType(p->type) << ">(v_" << p->name
-             << ");\n";
-    locals.insert(p->name);
+    const std::string& n = p->name.name;
+    // A later initial value reads the value as stored (an int property's, truncated).
+    std::string value = exprCpp(*p->init, initNames);
+    if (p->type != "double") value = "static_cast<" + cppType(p->type) + ">(" + value + ")";
+    scene_ << "        const double v_" << n << " = " << value << ";  // from "
+           << loc(p->name.loc) << (a.find(n) ? "" : ", read by initial values only") << "\n";
+    if (a.find(n))
+      for (int k = 0; k < p->stride; ++k)
+        scene_ << "        " << hostPtr(plan_.arrayIndex(A), n) << "[i * " << p->stride
+               << " + " << k << "] = static_cast<" << cppType(p->type) << ">(v_" << n
+               << ");\n";
+    locals.insert(n);
   }
   scene_ << "      }\n";
   if (!a.decl->loads.empty())
