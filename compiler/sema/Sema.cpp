@@ -367,7 +367,7 @@ void SemaImpl::buildArrays() {
 }
 
 // An initial value may name x, y, z, params and the properties of its array declared before
-// it (a property shadows a param of its name). A property named at or after its own
+// it (not a name that is both). A property named at or after its own
 // declaration, an array constant or another array's property gets an error saying so.
 void SemaImpl::checkPropertyInit(const ast::ArrayDecl& a, const ast::PropertyDecl& p,
                                  const std::set<std::string>& before) {
@@ -402,6 +402,16 @@ void SemaImpl::checkPropertyInit(const ast::ArrayDecl& a, const ast::PropertyDec
     return std::nullopt;
   };
   std::function<void(const ast::Expr&)> walk = [&](const ast::Expr& e) {
+    // A name both a param and an earlier property would be read as one here and as the other
+    // where the compiler evaluates initial values (h's, for the time-step bound).
+    if (e.kind == ast::Expr::Name && before.count(e.text) && isParam(e.text))
+      for (const auto& q : a.properties)
+        if (q.name.name == e.text) {
+          diags_.error(e.loc, what + " names '" + e.text + "', both a param and a property of "
+                                  "array '" + a.name.name + "' declared before it; rename one");
+          diags_.note(q.name.loc, "property '" + e.text + "' is declared here");
+          break;
+        }
     if (e.kind == ast::Expr::Name)
       if (auto m = misplaced(e.text)) {
         diags_.error(e.loc, m->first);

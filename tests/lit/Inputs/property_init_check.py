@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Checks the snapshot of tests/lit/sema/property-init-reads-property.sph against the initial
 values computed here from the positions: q = 2 x + c + k with k = int(10 x) (truncated, as
-the int property stores it) and c = 0.5 (the param), shadow = x + 1 (the property c = x
-shadows the param), base = 0 and two = 2 (properties without an initial value read as 0).
+the int property stores it) and c = 0.5 (the param), shadow = x + 1 (read through the
+unallocated property shift = x), base = 0 and two = 2 (properties without an initial value
+read as 0).
 Prints the particle count and 'exact' (to 1e-12), else fails."""
 import sys
 
