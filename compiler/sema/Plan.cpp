@@ -26,15 +26,11 @@ PlanProperty* PlanArray::find(const std::string& p) {
   return nullptr;
 }
 
-namespace {
-
 void namesOf(const ast::Expr& e, std::set<std::string>& out) {
   if (e.kind == ast::Expr::Name) out.insert(e.text);
   for (const auto& a : e.args)
     if (a) namesOf(*a, out);
 }
-
-}  // namespace
 
 std::set<std::string> initialValueInputs(
     const ast::ArrayDecl& a, const std::function<bool(const std::string&)>& allocated) {

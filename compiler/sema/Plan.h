@@ -54,6 +54,9 @@ struct PlanArray {
   PlanProperty* find(const std::string& p);
 };
 
+// Adds the names an expression mentions to `out`.
+void namesOf(const ast::Expr& e, std::set<std::string>& out);
+
 // The declared properties of array `a` that are not allocated (`allocated` is false for them)
 // but that the initial values of allocated ones read, directly or through other initial values
 // (`property ui = x; property q = 2 * ui;` with only q used): the set-up computes them per
