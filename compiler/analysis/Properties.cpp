@@ -233,10 +233,15 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
       props.push_back(pp);
     }
     auto isPosition = [](const std::string& p) { return p == "x" || p == "y" || p == "z"; };
+    auto usedProp = [&](const std::string& p) {
+      return firstRead.count(p) || firstWrite.count(p) || readByOthers.count(p);
+    };
+    // Those only the initial values of used ones read: computed at set-up, not allocated.
+    std::set<std::string> initInputs;
+    if (arr.decl) initInputs = initialValueInputs(*arr.decl, usedProp);
     for (const auto& d : arr.props) {
-      bool used = firstRead.count(d.name) || firstWrite.count(d.name) ||
-                  readByOthers.count(d.name);
-      if (!used) {
+      if (!usedProp(d.name)) {
+        if (initInputs.count(d.name)) continue;
         diags.warning(d.declLoc, "property '" + d.name + "' of array '" + arr.name +
                                      "' is declared but nothing uses it; it is not allocated");
         continue;

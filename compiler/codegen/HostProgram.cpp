@@ -122,16 +122,27 @@ void ScenePrinter::emitArraySetup(const PlanArray& a) {
       scene_ << "      " << A << ".add_constant(\"" << c << "\", 1, 0.0);  // reduce target\n";
   }
   scene_ << "      " << A << ".resize(pts.size());\n";
-  // Initial values, particle by particle, in declaration order.
-  std::vector<const PlanProperty*> inits;
-  for (const auto& p : a.props)
-    if (p.init) inits.push_back(&p);
+  // Initial values, particle by particle, in declaration order: those of the allocated
+  // properties and of the unallocated ones they read (computed, not stored).
+  std::set<std::string> initInputs =
+      initialValueInputs(*a.decl, [&](const std::string& n) { return a.find(n) != nullptr; });
+  // One without an initial value is 0 where a later initial value reads it.
+  std::vector<const ast::PropertyDecl*> inits;  // backwards first
+  for (auto p = a.decl->properties.rbegin(); p != a.decl->properties.rend(); ++p) {
+    const std::string& n = p->name.name;
+    bool computed = p->init ? a.find(n) || initInputs.count(n)
+                            : std::any_of(inits.begin(), inits.end(), [&](const auto* q) {
+                                return q->init && mentions(*q->init, n);
+                              });
+    if (computed) inits.push_back(&*p);
+  }
+  std::reverse(inits.begin(), inits.end());
   scene_ << "      for (std::size_t i = 0; i < pts.size(); ++i) {\n";
   // The coordinates the positions and initial values use.
   std::vector<std::string> coords;
   for (const char* c : {"x", "y", "z"}) {
     bool used = propIndex(plan_.arrayIndex(A), c) >= 0;
-    for (const auto* p : inits) used |= mentions(*p->init, c);
+    for (const auto* p : inits) used |= p->init && mentions(*p->init, c);
     if (used) coords.push_back(c);
   }
   for (size_t k = 0; k < coords.size(); ++k)
@@ -146,13 +157,21 @@ void ScenePrinter::emitArraySetup(const PlanArray& a) {
     return paramRef(n);
   };
   for (const auto* p : inits) {
-    scene_ << "        const double v_" << p->name << " = " << exprCpp(*p->init, initNames)
-           << ";  // from " << loc(p->declLoc) << "\n";
-    for (int k = 0; k < p->stride; ++k)
-      scene_ << "        " << hostPtr(plan_.arrayIndex(A), p->name) << "[i * " << p->stride
-             << " + " << k << "] = static_cast<" << cppType(p->type) << ">(v_" << p->name
-             << ");\n";
-    locals.insert(p->name);
+    const std::string& n = p->name.name;
+    // A later initial value reads the value as stored (an int property's, truncated).
+    std::string value = p->init ? exprCpp(*p->init, initNames) : "0.0";
+    if (p->type != "double") value = "static_cast<" + cppType(p->type) + ">(" + value + ")";
+    scene_ << "        const double v_" << n << " = " << value << ";  // from "
+           << loc(p->name.loc)
+           << (!p->init ? ", no initial value (0)"
+               : a.find(n) ? "" : ", read by initial values only") << "\n";
+    // Stored with the planned stride (a 2D scene keeps 2 of a double[3]'s components).
+    if (const PlanProperty* kept = a.find(n); kept && p->init)
+      for (int k = 0; k < kept->stride; ++k)
+        scene_ << "        " << hostPtr(plan_.arrayIndex(A), n) << "[i * " << kept->stride
+               << " + " << k << "] = static_cast<" << cppType(kept->type) << ">(v_" << n
+               << ");\n";
+    locals.insert(n);
   }
   scene_ << "      }\n";
   if (!a.decl->loads.empty())

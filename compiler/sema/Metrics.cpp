@@ -34,12 +34,6 @@ bool reservedColumn(const std::string& n) {
 
 bool isCoordinate(const std::string& n) { return n == "x" || n == "y" || n == "z"; }
 
-// The names an expression mentions.
-void namesOf(const ast::Expr& e, std::set<std::string>& out) {
-  if (e.kind == ast::Expr::Name) out.insert(e.text);
-  for (const auto& a : e.args) namesOf(*a, out);
-}
-
 class MetricsBuilder {
  public:
   MetricsBuilder(Plan& plan, DiagnosticEngine& diags,

@@ -26,6 +26,32 @@ PlanProperty* PlanArray::find(const std::string& p) {
   return nullptr;
 }
 
+void namesOf(const ast::Expr& e, std::set<std::string>& out) {
+  if (e.kind == ast::Expr::Name) out.insert(e.text);
+  for (const auto& a : e.args)
+    if (a) namesOf(*a, out);
+}
+
+std::set<std::string> initialValueInputs(
+    const ast::ArrayDecl& a, const std::function<bool(const std::string&)>& allocated) {
+  // Backwards through the declarations: a property whose value is needed (allocated, or read
+  // by a later needed one) needs the earlier properties its initial value names.
+  std::set<std::string> needed, inputs;
+  const auto& ps = a.properties;
+  for (size_t i = ps.size(); i-- > 0;) {
+    const auto& p = ps[i];
+    bool own = allocated(p.name.name);
+    if (!own && !needed.count(p.name.name)) continue;
+    if (!own) inputs.insert(p.name.name);
+    if (!p.init) continue;
+    std::set<std::string> names;
+    namesOf(*p.init, names);
+    for (size_t j = 0; j < i; ++j)
+      if (names.count(ps[j].name.name)) needed.insert(ps[j].name.name);
+  }
+  return inputs;
+}
+
 namespace {
 
 const char* methodName(ast::Method::Kind k) {

@@ -10,6 +10,7 @@
 #include "llvm/Support/SMLoc.h"
 #include "llvm/Support/raw_ostream.h"
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <set>
@@ -52,6 +53,17 @@ struct PlanArray {
   const PlanProperty* find(const std::string& p) const;
   PlanProperty* find(const std::string& p);
 };
+
+// Adds the names an expression mentions to `out`.
+void namesOf(const ast::Expr& e, std::set<std::string>& out);
+
+// The declared properties of array `a` that are not allocated (`allocated` is false for them)
+// but that the initial values of allocated ones read, directly or through other initial values
+// (`property ui = x; property q = 2 * ui;` with only q used): the set-up computes them per
+// particle, in declaration order, without storing them. An initial value reads the properties
+// declared before it (docs/language.md, Arrays).
+std::set<std::string> initialValueInputs(
+    const ast::ArrayDecl& a, const std::function<bool(const std::string&)>& allocated);
 
 // A body after analysis: its source and what Clang found in it.
 struct PlanBody {

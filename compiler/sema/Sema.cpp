@@ -343,12 +343,7 @@ void SemaImpl::buildArrays() {
                                    "array's geometry or load, not by a property declaration");
           continue;
         }
-        if (p.init)
-          checkExpr(*p.init,
-                    [&](const std::string& n) { return isParam(n) || seen.count(n); },
-                    "the initial value of '" + p.name.name +
-                        "' (it may use x, y, z, params and properties declared before it)",
-                    diags_);
+        if (p.init) checkPropertyInit(a, p, seen);
         if (!seen.insert(p.name.name).second) {
           diags_.error(p.name.loc, "property '" + p.name.name + "' of array '" + pa.name +
                                        "' is declared twice");
@@ -369,6 +364,68 @@ void SemaImpl::buildArrays() {
       }
       plan_->arrays.push_back(std::move(pa));
     }
+}
+
+// An initial value may name x, y, z, params and the properties of its array declared before
+// it (not a name that is both). A property named at or after its own
+// declaration, an array constant or another array's property gets an error saying so.
+void SemaImpl::checkPropertyInit(const ast::ArrayDecl& a, const ast::PropertyDecl& p,
+                                 const std::set<std::string>& before) {
+  const std::string what = "the initial value of '" + p.name.name + "'";
+  const std::string may = "an initial value may read x, y, z, params and the properties of "
+                          "its array declared before it";
+  // The error for a name that is a property or constant but not one the value may read, and
+  // where that is declared; nullopt for other names (checkExpr reports those).
+  auto misplaced = [&](const std::string& n)
+      -> std::optional<std::pair<std::string, const ast::Ident*>> {
+    if (before.count(n) || isParam(n)) return std::nullopt;
+    if (n == p.name.name)
+      return std::make_pair(what + " reads the property itself; " + may, nullptr);
+    for (const auto& q : a.properties)
+      if (q.name.name == n)
+        return std::make_pair(what + " reads property '" + n + "', declared after it; " + may +
+                                  " (declare '" + n + "' first)",
+                              &q.name);
+    for (const auto& c : a.constants)
+      if (c.name.name == n)
+        return std::make_pair(what + " reads '" + n + "', a constant of array '" +
+                                  a.name.name + "'; " + may + " (make '" + n + "' a param)",
+                              &c.name);
+    for (const auto& m : modules_)
+      for (const auto& other : m->arrays)
+        if (&other != &a)
+          for (const auto& q : other.properties)
+            if (q.name.name == n)
+              return std::make_pair(what + " reads '" + n + "', a property of array '" +
+                                        other.name.name + "'; " + may,
+                                    &q.name);
+    return std::nullopt;
+  };
+  std::function<void(const ast::Expr&)> walk = [&](const ast::Expr& e) {
+    // A name both a param and an earlier property would be read as one here and as the other
+    // where the compiler evaluates initial values (h's, for the time-step bound).
+    if (e.kind == ast::Expr::Name && before.count(e.text) && isParam(e.text))
+      for (const auto& q : a.properties)
+        if (q.name.name == e.text) {
+          diags_.error(e.loc, what + " names '" + e.text + "', both a param and a property of "
+                                  "array '" + a.name.name + "' declared before it; rename one");
+          diags_.note(q.name.loc, "property '" + e.text + "' is declared here");
+          break;
+        }
+    if (e.kind == ast::Expr::Name)
+      if (auto m = misplaced(e.text)) {
+        diags_.error(e.loc, m->first);
+        if (m->second) diags_.note(m->second->loc, "'" + e.text + "' is declared here");
+      }
+    for (const auto& arg : e.args)
+      if (arg) walk(*arg);
+  };
+  walk(*p.init);
+  checkExpr(*p.init,
+            [&](const std::string& n) {
+              return before.count(n) || isParam(n) || misplaced(n).has_value();
+            },
+            what + " (it may use x, y, z, params and properties declared before it)", diags_);
 }
 
 void SemaImpl::checkGeometry(const ast::GeometryDecl& g, const std::string& array) {

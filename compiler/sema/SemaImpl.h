@@ -42,6 +42,8 @@ class SemaImpl {
   void buildFunctions();
   void buildArrays();
   void checkGeometry(const ast::GeometryDecl& g, const std::string& array);
+  void checkPropertyInit(const ast::ArrayDecl& a, const ast::PropertyDecl& p,
+                         const std::set<std::string>& before);
   void buildScene();
   void buildDomain(const ast::DomainDecl& d);
   void buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g, int depth);
