@@ -512,8 +512,11 @@ void ScenePrinter::emitStep() {
              << (sched_.postStep[i].group->every ? sched_.postStep[i].function + "_due()"
                                                  : std::string("true"));
     scene_ << ")) return;\n";
+    const bool neighbours = sched_.postStepNeighbours;  // Schedule.h
     scene_ << (hasDomain() ? "    update_domain();\n" : "");
-    if (timesGroups())
+    if (!neighbours)
+      scene_ << "    // per-particle groups only: no neighbour search\n";
+    else if (timesGroups())
       timedNeighbourUpdate();
     else
       scene_ << "    update_neighbours();\n";
@@ -528,7 +531,7 @@ void ScenePrinter::emitStep() {
       for (const auto& ps : sched_.postStep) scene_ << "    " << ps.function << "(t, dt);\n";
     }
     if (hasDomain()) {
-      scene_ << removeGhosts();
+      if (neighbours) scene_ << removeGhosts();
       // A group that moves particles (a shift) can move one out of a periodic box: wrap it
       // now, so that an output written after this step holds positions in the box.
       scene_ << "    update_domain();\n";

@@ -20,6 +20,7 @@ class ScheduleBuilder {
   ScheduleBuilder(const Plan& plan, const DiagnosticEngine& diags)
       : plan_(plan), diags_(diags) {}
   std::unique_ptr<Schedule> run();
+  void postStepNeighbours();
 
  private:
   const PlanBody& body(const PlanEquation& eq, ast::Method::Kind kind) const {
@@ -86,10 +87,57 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
   ranged(s_->equations);
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
     if (loopNames_.count(plan_.arrays[a].name)) s_->searchArrays.push_back(a);
+  postStepNeighbours();
   step();
   adaptiveDt();
   s_->distribution = distributionOf(plan_, s_->cellLists);
   return std::move(s_);
+}
+
+namespace {
+
+ScheduleGroup* findGroup(ScheduleGroup& g, const PlanGroup* pg) {
+  if (g.group == pg) return &g;
+  for (auto& s : g.subgroups)
+    if (ScheduleGroup* f = findGroup(*s, pg)) return f;
+  return nullptr;
+}
+
+bool hasNeighbourPass(const ScheduleGroup& g) {
+  if (g.rebuildNeighbours) return true;
+  for (const auto& ph : g.phases)
+    for (const auto& d : ph.destinations)
+      if (!d.passes.empty()) return true;
+  for (const auto& s : g.subgroups)
+    if (hasNeighbourPass(*s)) return true;
+  return false;
+}
+
+void dropGhostWork(ScheduleGroup& g) {
+  for (auto& ph : g.phases)
+    for (auto& d : ph.destinations) {
+      d.ghostRefresh.clear();
+      d.onGhosts = false;
+    }
+  for (auto& s : g.subgroups) dropGhostWork(*s);
+}
+
+}  // namespace
+
+// The post_step groups rebuild the neighbour search (and with --mpi migrate, count the work
+// and exchange the halo) only when one of them has a neighbour pass: a rebuild for
+// per-particle work would cost a cell-list build per step and, with --mpi, close the work
+// count of the decomposition's weights on an evaluation without pairs.
+void ScheduleBuilder::postStepNeighbours() {
+  bool needed = false;
+  for (const auto& ps : s_->postStep) {
+    const ScheduleGroup* g = findGroup(s_->equations, ps.group);
+    needed |= !g || hasNeighbourPass(*g);
+  }
+  s_->postStepNeighbours = needed;
+  if (needed) return;
+  for (const auto& ps : s_->postStep)
+    if (ScheduleGroup* g = findGroup(s_->equations, ps.group)) dropGhostWork(*g);
 }
 
 // Runs of direct equations become fused phases; subgroups run in place, in order. A group's

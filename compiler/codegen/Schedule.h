@@ -192,6 +192,12 @@ struct Schedule {
     const PlanGroup* group = nullptr;
   };
   std::vector<PostStep> postStep;
+  // Whether the post_step groups need the neighbour search (cell lists, ghosts or the halo;
+  // with --mpi the migration and the work count): only when one has a neighbour pass or
+  // rebuilds it. Without, they are per-particle work on the real particles (e.g. the walls'
+  // density floor after each step), and their ghost refreshes are dropped: no ghost exists
+  // between the evaluation and the next.
+  bool postStepNeighbours = false;
   // Source locations of the iterated groups, by statistics index.
   std::vector<llvm::SMLoc> iteratedGroups;
   // Neighbour search: arrays in a neighbour pass as destination or source (the search
