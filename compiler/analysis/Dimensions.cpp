@@ -9,7 +9,9 @@
 // The components: in dim < 3 z, w and their conventional derivatives (az, aw, z0, w0, what,
 // awhat, wg, wf: PySPH's names of rates, saved values, transport velocities and wall
 // velocities); in dim 1 also the y-components. A property a scene asks for by name (an
-// output, a limit, a `property` declaration) is kept as written.
+// output, a limit) or gives a value (a `property` declaration with an initial value other
+// than 0, a loaded file, another initial value that reads it) is kept as written; a
+// declaration at 0 (`property w = 0.0;`, as PySPH ports write) is left out all the same.
 //
 // Strided properties get the same treatment per component: a declared `double[3]` is a
 // spatial vector and a `double[9]` a 3x3 tensor stored row-major (d_L[9 d_idx + 3 i + j]),
@@ -25,6 +27,7 @@
 #include "llvm/ADT/StringRef.h"
 
 #include <algorithm>
+#include <functional>
 #include <iterator>
 #include <map>
 #include <regex>
@@ -32,6 +35,14 @@
 namespace sphc {
 
 namespace {
+
+// No initial value (0), or a literal zero (`0`, `0.0`, `-0.0`).
+bool zeroValue(const ast::Expr* e) {
+  if (!e) return true;
+  if (e->kind == ast::Expr::Unary && e->op != "!" && e->args.size() == 1)
+    return e->args[0] && zeroValue(e->args[0].get());
+  return e->kind == ast::Expr::Number && e->number == 0.0;
+}
 
 std::set<std::string> componentsLeftOut(const Plan& plan) {
   std::set<std::string> out;
@@ -45,12 +56,27 @@ std::set<std::string> componentsLeftOut(const Plan& plan) {
   };
   if (plan.dim < 3) add("z", "w");
   if (plan.dim < 2) add("y", "v");
+  // A declared one is kept when the scene gives it a value: an initial value other than a
+  // literal 0, a file that loads the array, or another initial value that reads it. A PySPH
+  // port's `property w = 0.0;` in a 2D scene is left out like an undeclared one.
+  std::set<std::string> keep;
   for (const auto& a : plan.arrays) {
-    for (const auto& p : a.outputProps) out.erase(p);
-    for (const auto& p : a.limitProps) out.erase(p);
-    if (a.decl)
-      for (const auto& p : a.decl->properties) out.erase(p.name.name);
+    for (const auto& p : a.outputProps) keep.insert(p);
+    for (const auto& p : a.limitProps) keep.insert(p);
+    if (!a.decl) continue;
+    std::set<std::string> readByInit;
+    std::function<void(const ast::Expr&)> names = [&](const ast::Expr& e) {
+      if (e.kind == ast::Expr::Name) readByInit.insert(e.text);
+      for (const auto& arg : e.args)
+        if (arg) names(*arg);
+    };
+    for (const auto& p : a.decl->properties)
+      if (p.init) names(*p.init);
+    for (const auto& p : a.decl->properties)
+      if (!a.decl->loads.empty() || !zeroValue(p.init.get()) || readByInit.count(p.name.name))
+        keep.insert(p.name.name);
   }
+  for (const auto& p : keep) out.erase(p);
   return out;
 }
 
@@ -196,6 +222,7 @@ bool rewrite(PlanBody& b, const std::set<std::string>& leftOut,
 bool dropAbsentComponents(Plan& plan, DiagnosticEngine& diags) {
   if (plan.dim >= 3) return true;
   std::set<std::string> leftOut = componentsLeftOut(plan);
+  plan.leftOutComponents = leftOut;
   std::map<std::string, int> reduced = reducedStrides(plan);
   std::set<std::string> dropped;
   for (auto& b : plan.bodies) {

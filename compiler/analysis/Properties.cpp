@@ -242,6 +242,7 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
     for (const auto& d : arr.props) {
       if (!usedProp(d.name)) {
         if (initInputs.count(d.name)) continue;
+        if (plan.leftOutComponents.count(d.name)) continue;  // a z-component in 2D (Dimensions.cpp)
         diags.warning(d.declLoc, "property '" + d.name + "' of array '" + arr.name +
                                      "' is declared but nothing uses it; it is not allocated");
         continue;

@@ -243,6 +243,9 @@ struct Plan {
   std::vector<PlanMetric> metrics;            // what the run measures (metrics { })
   std::vector<PlanZone> zones;                // inlets and outlets, in order
   PlanGroup root;                             // the scene's equations { } as a group
+  // Dimension pass: the components a 1D/2D scene leaves out (read as 0, never stored);
+  // a declared one is not allocated and not warned about.
+  std::set<std::string> leftOutComponents;
   std::vector<std::string> notes;             // what the passes decided, for --report
   std::vector<ChosenOption> options;          // compile-time options (sema/Options.h)
   // sphc --mpi: a distributed solver. Halos of remote particles play the ghosts' part, with or
