@@ -64,6 +64,9 @@ class CpuPrinter : public ScenePrinter {
     scene_ << "    sphc::wrap_periodic(box, " << hostData(a) << ");\n";
   }
   void updateNeighbours() override;
+  void staticCellLists() override {
+    if (anyStatic()) emitStaticCells();
+  }
   void updateNeighboursWithGhosts() override;
   std::string removeGhosts() const override;
   void timedNeighbourUpdate() override;
@@ -84,7 +87,11 @@ class CpuPrinter : public ScenePrinter {
   }
   bool hasToHost() const override { return cpuSingle_; }
   std::string restoreData() const override {
-    return cpuSingle_ ? "    scene.to_single();  // the float copies of the restored arrays\n" : "";
+    std::string r =
+        cpuSingle_ ? "    scene.to_single();  // the float copies of the restored arrays\n" : "";
+    if (anyStatic())
+      r += "    scene.static_cells_built = false;  // the file's particles: their cells anew\n";
+    return r;
   }
   // --precision=single: the manager works on the host doubles; the float copies follow.
   void arraysToHost(const std::vector<int>& arrays) override {
@@ -109,15 +116,28 @@ class CpuPrinter : public ScenePrinter {
   std::string hostData(int a) const {
     return (cpuSingle_ ? "f32_" + arr(a).name + ", " : std::string()) + arr(a).name;
   }
-  // The search domain of every array in a neighbour loop, from its doubles or (single) floats.
-  void searchDomain();
+  // `domain` = the search domain of every array in a neighbour loop, from its doubles or
+  // (single) floats; with `only`, `dom` = the box of that array alone.
+  void searchDomain(const std::string& only = "", const std::string& dom = "domain");
+  // Whether source S is static: nothing moves, adds or removes its particles, nor changes h
+  // of any array in a neighbour loop (so the cell size is fixed), and it has no ghosts. Its
+  // cell list is built once (build_static_cells), on a grid of its own box.
+  bool isStatic(const std::string& S) const;
+  bool anyStatic() const {
+    for (const auto& S : sourceArrays_)
+      if (isStatic(S)) return true;
+    return false;
+  }
+  void emitStaticCells();
   // Reorders source S into the cell order of cells_S.
   std::string permuteInCellOrder(const std::string& S) const {
     return cpuSingle_ ? "f32_" + S + ".permute(cells_" + S + ".cell_order(), " + S + ");"
                       : S + ".permute(cells_" + S + ".cell_order());";
   }
-  // The statement that builds the cell list of source S over its first `count` particles.
-  std::string cellListBuild(const std::string& S, const std::string& count) const;
+  // The statement that builds the cell list of source S over its first `count` particles
+  // on the grid of search domain `dom`.
+  std::string cellListBuild(const std::string& S, const std::string& count,
+                            const std::string& dom = "domain") const;
 
   bool openmp_ = false;
   double verletSkin_ = 0.0;  // --verlet-skin (0: lists gathered at every evaluation)
@@ -148,6 +168,10 @@ void CpuPrinter::verletMembers() {
 
 void CpuPrinter::searchMembers() {
   out_ << "  sphc::SearchDomain domain;\n";
+  for (const auto& S : sourceArrays_)
+    if (isStatic(S))
+      out_ << "  sphc::SearchDomain domain_" << S << ";  // its own grid (build_static_cells)\n";
+  if (anyStatic()) out_ << "  bool static_cells_built = false;\n";
   if (cpuSingle_)
     for (const auto& a : plan_.arrays)
       out_ << "  sphc::FloatArray f32_" << a.name << ";  // what the scene computes on\n";
@@ -422,14 +446,17 @@ void CpuPrinter::steppers() {
   }
 }
 
-void CpuPrinter::searchDomain() {
+void CpuPrinter::searchDomain(const std::string& only, const std::string& dom) {
+  auto spans = [&](const std::string& a) {
+    return only.empty() ? loopArrays_.count(a) != 0 : a == only;
+  };
   if (cpuSingle_) {
     // The search domain spans every array that takes part in a neighbour loop (float data).
     const char* axes[3] = {"x", "y", "z"};
-    scene_ << "    domain = sphc::make_search_domain_float({";
+    scene_ << "    " << dom << " = sphc::make_search_domain_float({";
     bool first = true;
     for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
-      if (!loopArrays_.count(arr(a).name)) continue;
+      if (!spans(arr(a).name)) continue;
       scene_ << (first ? "" : ",\n                                             ") << "{";
       for (int k = 0; k < 3; ++k)
         scene_ << (k < plan_.dim ? propPtr(a, axes[k]) : std::string("nullptr")) << ", ";
@@ -440,6 +467,11 @@ void CpuPrinter::searchDomain() {
     return;
   }
   // The search domain spans every array that takes part in a neighbour loop.
+  if (!only.empty()) {
+    scene_ << "    " << dom << " = sphc::make_search_domain({&" << only
+           << "}, DIM, Kernel::radius_scale);\n";
+    return;
+  }
   scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
   bool first = true;
   for (const auto& a : plan_.arrays) {
@@ -457,8 +489,9 @@ void CpuPrinter::searchDomain() {
   scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
 }
 
-std::string CpuPrinter::cellListBuild(const std::string& S, const std::string& count) const {
-  return cellListBuildCall(S, count, "domain",
+std::string CpuPrinter::cellListBuild(const std::string& S, const std::string& count,
+                                      const std::string& dom) const {
+  return cellListBuildCall(S, count, dom,
                            [&](int a, const std::string& axis) { return propPtr(a, axis); });
 }
 
@@ -501,17 +534,58 @@ std::string CpuPrinter::removeGhosts() const {
   return r;
 }
 
+bool CpuPrinter::isStatic(const std::string& S) const {
+  if (hasDomain() || mpi_ || hasZones()) return false;  // ghosts, halos, inlets and outlets
+  auto written = [&](int a, const char* p) {
+    const PlanProperty* q = arr(a).find(p);
+    return q && q->written;
+  };
+  const int s = plan_.arrayIndex(S);
+  for (const char* p : {"x", "y", "z"})
+    if (written(s, p)) return false;
+  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
+    if (loopArrays_.count(arr(a).name) && written(a, "h")) return false;
+  return true;
+}
+
+// build_static_cells: each static source on a grid of its own box (padded) with the scene's
+// cell size, which h fixes: the cell list is built once, after the particles went into cell
+// order, and never again. A point outside the box lands in its nearest border cell, whose
+// stencil still holds every neighbour (sphc/nnps.h), so the moving arrays may go anywhere.
+void CpuPrinter::emitStaticCells() {
+  scene_ << "  // Sources nothing moves (no stepper or equation writes x, y, z or h, no ghosts or\n"
+            "  // zones): their cell lists are built once, on a grid of their own box with the\n"
+            "  // scene's cell size, and kept. The first update_neighbours calls it.\n";
+  scene_ << "  void build_static_cells() {\n";
+  for (const auto& S : sourceArrays_) {
+    if (!isStatic(S)) continue;
+    searchDomain(S, "domain_" + S);
+    scene_ << "    domain_" << S << ".cell_size = domain.cell_size;  // every neighbour one cell away\n";
+    const std::string build = cellListBuild(S, S + ".n", "domain_" + S);
+    scene_ << "    " << build << "\n";
+    if (reorders(S)) scene_ << "    " << permuteInCellOrder(S) << "\n    " << build << "\n";
+  }
+  scene_ << "    static_cells_built = true;\n  }\n\n";
+}
+
 // update_neighbours of a scene without periodic or mirror domain.
 void CpuPrinter::updateNeighbours() {
   if (!loopArrays_.empty()) searchDomain();
-  if (anyReorders()) {
+  if (anyStatic())
+    scene_ << "    if (!static_cells_built) build_static_cells();  // once: they never move\n";
+  bool reordersMoving = false;
+  for (const auto& S : sourceArrays_) reordersMoving |= !isStatic(S) && reorders(S);
+  if (reordersMoving) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
     // (--verlet-skin: a permutation moves the particles under the kept lists, which are
     // then rebuilt.)
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+  } else if (anyReorders()) {
+    scene_ << "    ++builds;  // counted as with moving arrays (restart state)\n";
   }
   for (const auto& S : sourceArrays_) {
+    if (isStatic(S)) continue;  // build_static_cells
     const std::string build = cellListBuild(S, S + ".n");
     scene_ << "    " << build << "\n";
     if (!reorders(S)) continue;  // a ranged group names its particles by index

@@ -494,6 +494,7 @@ void ScenePrinter::emitStep() {
     scene_ << removeGhosts();
     scene_ << "  }\n\n";
   } else {
+    staticCellLists();
     scene_ << "  // Rebuilds the neighbour search of every array that is a source.\n";
     scene_ << "  void update_neighbours() {\n";
     updateNeighbours();

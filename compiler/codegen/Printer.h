@@ -85,6 +85,7 @@ class ScenePrinter {
                            const std::function<std::string(int)>& timeAfter) = 0;
   virtual void wrapPeriodic(int a) = 0;             // update_domain, per array
   virtual void updateNeighbours() = 0;              // its body, without a domain
+  virtual void staticCellLists() {}  // members it calls, before it (CPU: build_static_cells)
   virtual void updateNeighboursWithGhosts() = 0;    // its body, with one
   virtual std::string removeGhosts() const = 0;
   virtual void timedNeighbourUpdate() = 0;

@@ -1,7 +1,8 @@
 // sphc runtime: neighbour search with a cell list.
 //
 // All arrays of a scene share one SearchDomain (bounding box and cell size); each source array
-// gets its own CellList built on it every time step. The generated loop asks for candidates
+// gets its own CellList built on it every time step (a static wall, which nothing moves: once,
+// on a grid of its own box with that cell size). The generated loop asks for candidates
 // of a destination point and applies the neighbour criterion itself:
 //
 //     j is a neighbour of i  <=>  r_ij < radius_scale * max(h_i, h_j)
