@@ -553,9 +553,10 @@ bool CpuPrinter::isStatic(const std::string& S) const {
 // order, and never again. A point outside the box lands in its nearest border cell, whose
 // stencil still holds every neighbour (sphc/nnps.h), so the moving arrays may go anywhere.
 void CpuPrinter::emitStaticCells() {
-  scene_ << "  // Sources nothing moves (no stepper or equation writes x, y, z or h, no ghosts or\n"
-            "  // zones): their cell lists are built once, on a grid of their own box with the\n"
-            "  // scene's cell size, and kept. The first update_neighbours calls it.\n";
+  scene_ << "  // Sources nothing moves (no stepper or equation writes their positions or h; no\n"
+            "  // periodic images, halo or zones): their cell lists are built once, on a grid of\n"
+            "  // their own box with the scene's cell size, and kept. The first update_neighbours\n"
+            "  // calls it.\n";
   scene_ << "  void build_static_cells() {\n";
   for (const auto& S : sourceArrays_) {
     if (!isStatic(S)) continue;
