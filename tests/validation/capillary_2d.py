@@ -97,15 +97,20 @@ def image_coefficient(n, box):
     return comb(2 * n - 1, n) * lattice_sum(n) / box ** (2 * n)
 
 
-def determinant(s, n, R, sigma, rho, nu, box=None):
-    """The determinant of the interface conditions for the complex frequency s."""
-    mu = rho * nu
+def _vortical(s, n, R, nu):
+    """The vortical solutions' wave number q (Re q >= 0) for the complex frequency s, z = q R,
+    and (F, F', F'') at z of I_n and K_n."""
     q = np.sqrt(s / nu + 0j)
     if q.real < 0:
         q = -q
     z = q * R
-    fi, di, ddi = _bessel_derivs(n, z, "i")
-    fk, dk, ddk = _bessel_derivs(n, z, "k")
+    return q, z, _bessel_derivs(n, z, "i"), _bessel_derivs(n, z, "k")
+
+
+def determinant(s, n, R, sigma, rho, nu, box=None):
+    """The determinant of the interface conditions for the complex frequency s."""
+    mu = rho * nu
+    q, z, (fi, di, ddi), (fk, dk, ddk) = _vortical(s, n, R, nu)
     r = R
     e = image_coefficient(n, box)
     # Per unknown (A, B, C, D): U_r, U_r', U_th, U_th', Phi at r = R (the cos / sin
@@ -144,12 +149,7 @@ def _amplitude_transform(s, n, R, sigma, rho, nu, box=None):
     stress row. The vortical columns are divided by I_n(qR) and K_n(qR) (the same solution,
     better conditioned for large |qR|)."""
     mu = rho * nu
-    q = np.sqrt(s / nu + 0j)
-    if q.real < 0:
-        q = -q
-    z = q * R
-    fi, di, ddi = _bessel_derivs(n, z, "i")
-    fk, dk, ddk = _bessel_derivs(n, z, "k")
+    q, z, (fi, di, ddi), (fk, dk, ddk) = _vortical(s, n, R, nu)
     di, ddi, dk, ddk = di / fi, ddi / fi, dk / fk, ddk / fk
     r = R
     e = image_coefficient(n, box)
