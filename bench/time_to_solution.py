@@ -99,13 +99,20 @@ class Case:
         self.output = output       # sphc output options, PySPH output options
 
 
-def dambreak_case(dx, tf, tag="dambreak"):
+def dambreak_case(dx, tf, tag="dambreak", pysph_numerics=False):
     # PySPH's tank: innermost wall layer at x = 0, its wall face at dx/2, 4 layers.
     def acc(outdir, who):
         return dambreak_accuracy(outdir, dx / 2 if who == "pysph" else 0.0)
     sargs = ["--tf", repr(tf)] + ([] if dx == 0.03 else ["--set", "dx=%r" % dx])
-    return Case(tag, "2D dam break, dx = %g, to t = %g s" % (dx, tf),
-                os.path.join(ROOT, "examples", "dambreak.sph"), [], sargs,
+    defines, title = [], "2D dam break, dx = %g, to t = %g s" % (dx, tf)
+    if pysph_numerics:
+        # The effects and the step of PySPH's dam_break_2d (WCSPHScheme's defaults): no
+        # density diffusion, no particle shifting, adaptive step with cfl 0.3.
+        defines = ["-D", "density_diffusion=off", "-D", "shifting=off"]
+        sargs += ["--set", "cfl=0.3"]
+        title += ", sphc with PySPH's effects and cfl (no density diffusion, no shifting)"
+    return Case(tag, title,
+                os.path.join(ROOT, "examples", "dambreak.sph"), defines, sargs,
                 ["dambreak", repr(dx), "--tf", repr(tf)], acc,
                 (["--output-every", "0.02"], ["--pfreq", "50"]))
 
@@ -375,7 +382,8 @@ def main():
     ap = argument_parser(__doc__)
     ap.add_argument("--quick", action="store_true",
                     help="a few minutes: dam break to 0.3 s, cube to 1e-3, tg nx = 50 to 0.2")
-    ap.add_argument("--cases", default="dambreak,cube,tg")
+    ap.add_argument("--cases", default="dambreak,cube,tg",
+                    help="dambreak, dambreak-pysph-numerics (sphc's dam break with the effects and cfl of PySPH's), cube, tg")
     ap.add_argument("--sphc-flag", action="append", default=[],
                     help="a flag for every sphc build (repeatable), e.g. "
                          "--sphc-flag=--verlet-skin=0.1")
@@ -410,12 +418,14 @@ def main():
             cases.append(dambreak_case(0.03, tf_db))
             if args.dambreak_large_tf > 0:
                 cases.append(dambreak_case(0.0047, args.dambreak_large_tf, "dambreak100k"))
+        elif c == "dambreak-pysph-numerics":
+            cases.append(dambreak_case(0.03, tf_db, "dambreak_pn", pysph_numerics=True))
         elif c == "cube":
             cases.append(cube_case(tf_cube))
         elif c == "tg":
             cases.append(tg_case(nx_tg, tf_tg))
         else:
-            ap.error("unknown case %s (dambreak, cube, tg)" % c)
+            ap.error("unknown case %s (dambreak, dambreak-pysph-numerics, cube, tg)" % c)
     if not args.skip_sphc and not os.access(args.sphc, os.X_OK):
         sys.stderr.write("no sphc at %s (build it, or pass --sphc)\n" % args.sphc)
         return 1
