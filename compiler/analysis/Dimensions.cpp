@@ -8,7 +8,9 @@
 //
 // The components: in dim < 3 z, w and their conventional derivatives (az, aw, z0, w0, what,
 // awhat, wg, wf: PySPH's names of rates, saved values, transport velocities and wall
-// velocities); in dim 1 also the y-components. A property a scene asks for by name (an
+// velocities), and the z-components of the vectors of scalars the modules declare
+// (`vector (ustar, vstar, wstar);`, sema's plan.vectorComponents); in dim 1 also the
+// y-components. A property a scene asks for by name (an
 // output, a limit) or gives a value (a `property` declaration with an initial value other
 // than 0, a loaded file, another initial value that reads it) is kept as written; a
 // declaration at 0 (`property w = 0.0;`, as PySPH ports write) is left out all the same.
@@ -56,6 +58,9 @@ std::set<std::string> componentsLeftOut(const Plan& plan) {
   };
   if (plan.dim < 3) add("z", "w");
   if (plan.dim < 2) add("y", "v");
+  // The components of the scalar vectors the modules declare (`vector (ustar, vstar, wstar);`).
+  for (const auto& [name, component] : plan.vectorComponents)
+    if (component >= plan.dim) out.insert(name);
   // A declared one is kept when the scene gives it a value: an initial value other than a
   // literal 0, a file that loads the array, or another initial value that reads it. A PySPH
   // port's `property w = 0.0;` in a 2D scene is left out like an undeclared one.

@@ -58,6 +58,14 @@ struct OptionDecl {
 // physical effect a scheme can simulate (docs/effects.md). An effect is a compile-time option
 // with the choices off and on: a scene's `effects = [...]` turns the listed ones on, `sphc -D
 // NAME=on|off` overrides, and `when NAME { ... }` keeps what only the effect needs.
+// `vector (ustar, vstar, wstar);`: three scalar properties are the x, y and z components
+// of one vector, so that a 2D scene leaves out the third and a 1D scene the second and third
+// as it does z, w, az, ... (analysis/Dimensions.cpp; PySPH-style names keep working).
+struct VectorDecl {
+  llvm::SMLoc loc;              // the `vector` keyword
+  std::vector<Ident> components;  // x, y, z
+};
+
 struct EffectDecl {
   Ident name;
   std::vector<Ident> needs;     // effects this one needs on
@@ -374,6 +382,7 @@ struct Module {
   std::vector<ImportDecl> imports;
   std::vector<OptionDecl> options;
   std::vector<EffectDecl> effects;
+  std::vector<VectorDecl> vectors;
   std::vector<SchemeDecl> schemes;
   std::vector<ParamDecl> params;
   std::vector<ArrayDecl> arrays;

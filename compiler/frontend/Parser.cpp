@@ -103,6 +103,7 @@ void Parser::checkErrorLimit() {
 
 bool Parser::atTopLevelItem() {
   if (!cur().is(Token::Identifier)) return false;
+  if (cur().text == "vector") return lex_.peek().is(Token::LParen);  // vector (u, v, w);
   return llvm::is_contained(kTopLevelKeywords, cur().text) &&
          lex_.peek().is(Token::Identifier);
 }
@@ -181,6 +182,7 @@ bool Parser::parseItem(ast::Module& mod) {
   if (atWord("import")) return parseImport(mod);
   if (atWord("option")) return parseOption(mod);
   if (atWord("effect")) return parseEffect(mod);
+  if (atWord("vector")) return parseVector(mod);
   if (atWord("scheme")) return parseSchemeDecl(mod);
   if (atWord("param") || atWord("let")) return parseParam(mod);
   if (atWord("array")) return parseArray(mod);
@@ -190,8 +192,8 @@ bool Parser::parseItem(ast::Module& mod) {
   if (atWord("integrator")) return parseIntegrator(mod);
   if (atWord("scene")) return parseScene(mod);
   const char* expected =
-      "import, option, effect, scheme, param, let, array, equation, function, stepper, "
-      "integrator or scene";
+      "import, option, effect, vector, scheme, param, let, array, equation, function, "
+      "stepper, integrator or scene";
   if (cur().is(Token::Identifier))
     return error(cur().loc, "unknown declaration " + quoted(cur().text) + ": expected " + expected);
   return error(cur().loc, "expected a declaration (" + llvm::Twine(expected) + "), found " +
@@ -251,6 +253,32 @@ bool Parser::parseEffect(ast::Module& mod) {
   }
   mod.effects.push_back(std::move(e));
   return expect(Token::Semi, "after effect declaration");
+}
+
+// vector (x_name, y_name, z_name);
+bool Parser::parseVector(ast::Module& mod) {
+  ast::VectorDecl v;
+  v.loc = cur().loc;
+  advance();
+  if (!expect(Token::LParen, "after 'vector' (the x, y and z components: "
+                             "'vector (u, v, w);')"))
+    return false;
+  do {
+    ast::Ident c;
+    if (!parseIdent(c, "expected a property name (a component of the vector)")) return false;
+    v.components.push_back(std::move(c));
+  } while (consumeIf(Token::Comma));
+  if (!expect(Token::RParen, "after the components of the vector")) return false;
+  if (v.components.size() != 3)
+    return error(v.loc, "a vector names 3 properties, its x, y and z components (" +
+                            std::to_string(v.components.size()) + " given)");
+  for (size_t i = 0; i < 3; ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (v.components[i].name == v.components[j].name)
+        return error(v.components[i].loc, "property " + quoted(v.components[i].name) +
+                                              " is named twice in one vector");
+  mod.vectors.push_back(std::move(v));
+  return expect(Token::Semi, "after vector declaration");
 }
 
 // scheme NAME(p, q = expr, r = [a, b]) { scene items }

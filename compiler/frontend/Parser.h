@@ -76,6 +76,7 @@ class Parser {
   bool parseImport(ast::Module& mod);
   bool parseOption(ast::Module& mod);
   bool parseEffect(ast::Module& mod);
+  bool parseVector(ast::Module& mod);
   bool parseSchemeDecl(ast::Module& mod);
   bool parseSceneEffects(ast::SceneDecl& scene);
   bool parseSchemeUse(ast::SceneDecl& scene);

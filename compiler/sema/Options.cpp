@@ -4,6 +4,7 @@
 #include "llvm/ADT/STLExtras.h"
 #include "llvm/ADT/StringRef.h"
 
+#include <algorithm>
 #include <map>
 
 namespace sphc {
@@ -408,6 +409,24 @@ class OptionSelector {
       }
     }
     if (top && !s.schemes.empty()) scene(s, ok);  // schemes a chosen branch used
+    if (top) beforeSchemeFirst(s.equations);
+  }
+
+  // `group (before_scheme = true) { }` of the scene's equations: placed first, before the
+  // groups of the schemes it uses (which expandSchemes put before the scene's own), in their
+  // order. A set-up the scheme's first evaluation must see (examples/taylor_green.sph: the
+  // particles moved off the lattice before the first density).
+  static bool beforeScheme(const ast::GroupItem& item) {
+    if (!item.group) return false;
+    for (const auto& kw : item.group->options)
+      if (kw.name.name == "before_scheme" && !kw.isList && kw.value &&
+          ((kw.value->kind == ast::Expr::Name && kw.value->text == "true") ||
+           (kw.value->kind == ast::Expr::Number && kw.value->number == 1)))
+        return true;
+    return false;
+  }
+  static void beforeSchemeFirst(std::vector<ast::GroupItem>& items) {
+    std::stable_partition(items.begin(), items.end(), beforeScheme);
   }
 
   std::vector<ChosenOption> chosen() const { return chosen_; }

@@ -246,6 +246,9 @@ struct Plan {
   // Dimension pass: the components a 1D/2D scene leaves out (read as 0, never stored);
   // a declared one is not allocated and not warned about.
   std::set<std::string> leftOutComponents;
+  // `vector (ustar, vstar, wstar);` of every module: each named scalar property and its
+  // component (0 x, 1 y, 2 z), which the dimension pass leaves out when it is >= dim.
+  std::map<std::string, int> vectorComponents;
   std::vector<std::string> notes;             // what the passes decided, for --report
   std::vector<ChosenOption> options;          // compile-time options (sema/Options.h)
   // sphc --mpi: a distributed solver. Halos of remote particles play the ghosts' part, with or

@@ -244,6 +244,7 @@ std::unique_ptr<Plan> SemaImpl::run() {
 
   buildArrays();
   buildFunctions();
+  buildVectors();
   buildScene();
   if (!diags_.hasErrors()) buildZones(*plan_->scene, *plan_, diags_);  // sema/Zones.cpp
   if (diags_.hasErrors()) return nullptr;
@@ -321,6 +322,38 @@ void SemaImpl::buildFunctions() {
       body.source.functionName = f.name.name;
       plan_->functions.push_back(std::move(body));
     }
+}
+
+// `vector (u, v, w);` declarations of every module: the component of each named property.
+// One name is one component: the same declaration twice (two modules) is fine, a name given
+// two components is an error, and so is a component an array declares with a stride (a
+// `double[3]` already is a vector: the dimension pass lays it out by itself).
+void SemaImpl::buildVectors() {
+  static const char* axis[] = {"x", "y", "z"};
+  std::map<std::string, llvm::SMLoc> where;
+  for (const auto& m : modules_)
+    for (const auto& v : m->vectors)
+      for (int k = 0; k < static_cast<int>(v.components.size()); ++k) {
+        const ast::Ident& c = v.components[k];
+        auto [it, inserted] = plan_->vectorComponents.emplace(c.name, k);
+        if (!inserted && it->second != k) {
+          diags_.error(c.loc, "property '" + c.name + "' is the " + axis[k] +
+                                  "-component of this vector and the " + axis[it->second] +
+                                  "-component of another");
+          diags_.note(where[c.name], "the other vector is declared here");
+          continue;
+        }
+        if (inserted) where[c.name] = v.loc;
+        for (const auto& mm : modules_)
+          for (const auto& a : mm->arrays)
+            for (const auto& p : a.properties)
+              if (p.name.name == c.name && p.stride != 1) {
+                diags_.error(c.loc, "property '" + c.name + "' is a component of a vector, "
+                                    "but array '" + a.name.name + "' declares it with stride " +
+                                    std::to_string(p.stride) + "; a component is a scalar");
+                diags_.note(p.loc, "declared here");
+              }
+      }
 }
 
 void SemaImpl::buildArrays() {

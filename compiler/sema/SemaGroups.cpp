@@ -65,11 +65,18 @@ void SemaImpl::buildGroup(const std::vector<ast::GroupItem>& items, PlanGroup& g
         if (sub->postStep && depth != 0)
           diags_.error(kw.name.loc, "post_step is an option of a top-level group (one directly "
                                     "in `equations`), not of a nested group");
+      } else if (k == "before_scheme") {
+        // The options pass placed it first (sema/Options.cpp); here only checked.
+        bool first = false;
+        boolValue(first);
+        if (depth != 0)
+          diags_.error(kw.name.loc, "before_scheme is an option of a top-level group (one "
+                                    "directly in `equations`), not of a nested group");
       } else
         diags_.error(kw.name.loc, "unknown group option '" + k +
                                       "'; options are: real, iterate, min_iterations, "
-                                      "max_iterations, every, post_step, start_idx, "
-                                      "stop_idx, condition, update_nnps");
+                                      "max_iterations, every, post_step, before_scheme, "
+                                      "start_idx, stop_idx, condition, update_nnps");
     }
     if ((hasMin || hasMax) && !sub->iterate)
       diags_.error(gd.loc, "min_iterations/max_iterations need `iterate = true`");

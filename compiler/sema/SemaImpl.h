@@ -40,6 +40,7 @@ class SemaImpl {
     return e && checkExpr(*e, [this](const std::string& n) { return isParam(n); }, what, diags_);
   }
   void buildFunctions();
+  void buildVectors();
   void buildArrays();
   void checkGeometry(const ast::GeometryDecl& g, const std::string& array);
   void checkPropertyInit(const ast::ArrayDecl& a, const ast::PropertyDecl& p,
