@@ -16,8 +16,9 @@ struct Binding {
 
 class Expander {
  public:
-  Expander(DiagnosticEngine& diags, const std::map<std::string, Binding>& b, llvm::SMLoc use)
-      : diags_(diags), bind_(b), use_(use) {}
+  Expander(DiagnosticEngine& diags, const std::map<std::string, Binding>& b, llvm::SMLoc use,
+           std::string scheme)
+      : diags_(diags), bind_(b), use_(use), scheme_(std::move(scheme)) {}
 
   bool ok = true;
 
@@ -136,6 +137,31 @@ class Expander {
     return out;
   }
 
+  // `property fluids ...;`: one item per list parameter, its arrays the scene's, its initial
+  // value substituted. A name that is no list parameter of the scheme is an error.
+  void arrayItem(const ast::SchemeArrayItem& in, ast::SceneDecl& to) {
+    for (const auto& id : in.arrays) {
+      auto it = bind_.find(id.name);
+      if (it == bind_.end() || !it->second.isList) {
+        diags_.error(id.loc, std::string(in.item.properties.empty() ? "a constant" : "a property") +
+                                 " of scheme '" + scheme_ + "' is declared on '" + id.name +
+                                 "', which is no array-list parameter of the scheme");
+        diags_.note(use_, "the scheme is used here");
+        ok = false;
+        continue;
+      }
+      ast::SchemeArrayItem out;
+      out.arrays = it->second.arrays;
+      out.item = in.item;
+      for (auto& p : out.item.properties) p.init = expr(p.init);
+      for (auto& c : out.item.constants) c.init = expr(c.init);
+      out.param = id;
+      out.scheme = scheme_;
+      out.use = use_;
+      to.arrayItems.push_back(std::move(out));
+    }
+  }
+
   // The scheme's scene items, substituted, added to `to`.
   void scene(const ast::SceneDecl& from, ast::SceneDecl& to) {
     for (const auto& s : from.settings) {
@@ -146,6 +172,7 @@ class Expander {
       if (c.key.name == "internal_flow_needs") c.key.loc = use_;
       to.settings.push_back(std::move(c));
     }
+    for (const auto& item : from.arrayItems) arrayItem(item, to);
     for (const auto& st : from.steppers)
       for (const auto& a : arrays(st.array)) to.steppers.push_back(ast::SceneStepper{a, st.stepper});
     if (from.hasAdaptiveDt) {
@@ -176,6 +203,7 @@ class Expander {
   DiagnosticEngine& diags_;
   const std::map<std::string, Binding>& bind_;
   llvm::SMLoc use_;  // the scheme's use in the scene (`scheme NAME(...)`)
+  std::string scheme_;
 };
 
 // What a scheme may hold: the items a scheme decides, not those of one scene.
@@ -184,7 +212,8 @@ bool checkSchemeItems(const ast::SceneDecl& body, const std::string& name,
   bool ok = true;
   auto bad = [&](const char* what) {
     diags.error(loc, "scheme '" + name + "' holds " + what +
-                         ": a scheme holds settings, steppers, adaptive_dt and equations; "
+                         ": a scheme holds settings, steppers, adaptive_dt, equations and its "
+                         "arrays' properties and constants; "
                          "outputs, domains, limits and effects belong to the scene");
     ok = false;
   };
@@ -267,9 +296,101 @@ bool expandSchemes(const std::vector<std::unique_ptr<ast::Module>>& modules, ast
       ok = false;
       continue;
     }
-    Expander ex(diags, bind, use.scheme.loc);
+    Expander ex(diags, bind, use.scheme.loc, decl->name.name);
     ex.scene(*decl->body, scene);
     ok = ex.ok && ok;
+  }
+  return ok;
+}
+
+namespace {
+
+// "double[3]", "int", "a constant", "a constant[3]": what a declaration makes of a name.
+std::string shape(const ast::ArrayDecl& one) {
+  if (!one.properties.empty()) {
+    const auto& p = one.properties.front();
+    return p.stride == 1 ? p.type : p.type + "[" + std::to_string(p.stride) + "]";
+  }
+  const auto& c = one.constants.front();
+  return c.size == 1 ? "a constant" : "a constant[" + std::to_string(c.size) + "]";
+}
+
+const ast::Ident& declaredName(const ast::ArrayDecl& one) {
+  return one.properties.empty() ? one.constants.front().name : one.properties.front().name;
+}
+
+std::string listText(const std::vector<ast::Ident>& arrays) {
+  std::string s;
+  for (const auto& a : arrays) s += (s.empty() ? "" : ", ") + a.name;
+  return "[" + s + "]";
+}
+
+}  // namespace
+
+bool addSchemeArrayItems(const std::vector<std::unique_ptr<ast::Module>>& modules,
+                         ast::SceneDecl& scene, DiagnosticEngine& diags) {
+  bool ok = true;
+  // The scheme item that added a name to an array, for the wording of a later conflict.
+  std::map<std::pair<std::string, std::string>, const ast::SchemeArrayItem*> added;
+  auto items = std::move(scene.arrayItems);
+  scene.arrayItems.clear();
+  for (const auto& item : items) {
+    const ast::Ident& name = declaredName(item.item);
+    const std::string want = shape(item.item);
+    for (const auto& arrayId : item.arrays) {
+      ast::ArrayDecl* array = nullptr;
+      for (const auto& m : modules)
+        for (auto& a : m->arrays)
+          if (!array && a.name.name == arrayId.name) array = &a;
+      if (!array) {
+        diags.error(arrayId.loc, "'" + arrayId.name + "' is no array: scheme '" + item.scheme +
+                                     "' declares '" + name.name + "' on its parameter '" +
+                                     item.param.name + "'");
+        diags.note(name.loc, "'" + name.name + "' is declared here");
+        ok = false;
+        continue;
+      }
+      // What the array already holds under the name: its own declaration or an earlier
+      // scheme item's.
+      const ast::Ident* have = nullptr;
+      std::string haveShape;
+      for (const auto& p : array->properties)
+        if (!have && p.name.name == name.name) {
+          have = &p.name;
+          ast::ArrayDecl one;
+          one.properties.push_back(p);
+          haveShape = shape(one);
+        }
+      for (const auto& c : array->constants)
+        if (!have && c.name.name == name.name) {
+          have = &c.name;
+          ast::ArrayDecl one;
+          one.constants.push_back(c);
+          haveShape = shape(one);
+        }
+      if (!have) {
+        for (const auto& p : item.item.properties) array->properties.push_back(p);
+        for (const auto& c : item.item.constants) array->constants.push_back(c);
+        added[{array->name.name, name.name}] = &item;
+        continue;
+      }
+      if (haveShape == want) continue;  // the array's declaration (or the first scheme's) wins
+      auto by = added.find({array->name.name, name.name});
+      std::string first = by == added.end()
+                              ? "array '" + array->name.name + "' declares it"
+                              : "scheme '" + by->second->scheme + "' declares it on '" +
+                                    array->name.name + "'";
+      diags.error(have->loc, "'" + name.name + "' of array '" + array->name.name + "' is " +
+                                 haveShape + " here, but scheme '" + item.scheme +
+                                 "' declares it " + want + ": " + first +
+                                 " with another type or shape (declare it as the scheme does, "
+                                 "or leave the declaration to the scheme)");
+      diags.note(name.loc, "scheme '" + item.scheme + "' declares '" + name.name + "' " + want +
+                               " here, on its parameter '" + item.param.name + "'");
+      diags.note(item.use, "the scene uses scheme '" + item.scheme + "' here, with " +
+                               item.param.name + " = " + listText(item.arrays));
+      ok = false;
+    }
   }
   return ok;
 }
