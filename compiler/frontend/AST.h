@@ -106,6 +106,7 @@ struct PropertyDecl {
   int stride = 1;
   ExprPtr init;                 // may be null: 0
   llvm::SMLoc loc;              // the `property` keyword
+  bool fromScheme = false;      // added by a scheme (sema/Schemes.cpp)
 };
 
 struct ConstDecl {

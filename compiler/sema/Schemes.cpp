@@ -369,22 +369,25 @@ bool addSchemeArrayItems(const std::vector<std::unique_ptr<ast::Module>>& module
           haveShape = shape(one);
         }
       if (!have) {
-        for (const auto& p : item.item.properties) array->properties.push_back(p);
+        for (const auto& p : item.item.properties) {
+          array->properties.push_back(p);
+          array->properties.back().fromScheme = true;
+        }
         for (const auto& c : item.item.constants) array->constants.push_back(c);
         added[{array->name.name, name.name}] = &item;
         continue;
       }
       if (haveShape == want) continue;  // the array's declaration (or the first scheme's) wins
       auto by = added.find({array->name.name, name.name});
-      std::string first = by == added.end()
-                              ? "array '" + array->name.name + "' declares it"
-                              : "scheme '" + by->second->scheme + "' declares it on '" +
-                                    array->name.name + "'";
-      diags.error(have->loc, "'" + name.name + "' of array '" + array->name.name + "' is " +
-                                 haveShape + " here, but scheme '" + item.scheme +
-                                 "' declares it " + want + ": " + first +
-                                 " with another type or shape (declare it as the scheme does, "
-                                 "or leave the declaration to the scheme)");
+      const bool byScheme = by != added.end();
+      diags.error(have->loc,
+                  "'" + name.name + "' of array '" + array->name.name + "' is declared " +
+                      haveShape + " here" +
+                      (byScheme ? " by scheme '" + by->second->scheme + "'" : std::string()) +
+                      ", and " + want + " by scheme '" + item.scheme +
+                      "': the declarations must agree in type and shape" +
+                      (byScheme ? std::string()
+                                : " (declare it as the scheme does, or leave it to the scheme)"));
       diags.note(name.loc, "scheme '" + item.scheme + "' declares '" + name.name + "' " + want +
                                " here, on its parameter '" + item.param.name + "'");
       diags.note(item.use, "the scene uses scheme '" + item.scheme + "' here, with " +
