@@ -1,6 +1,7 @@
 #include "sema/Schemes.h"
 
 #include <map>
+#include <optional>
 #include <string>
 
 namespace sphc {
@@ -319,6 +320,22 @@ const ast::Ident& declaredName(const ast::ArrayDecl& one) {
   return one.properties.empty() ? one.constants.front().name : one.properties.front().name;
 }
 
+// The array's declaration of `name`, a property or a constant, as a one-item ArrayDecl.
+std::optional<ast::ArrayDecl> declarationOf(const ast::ArrayDecl& a, const std::string& name) {
+  ast::ArrayDecl one;
+  for (const auto& p : a.properties)
+    if (p.name.name == name) {
+      one.properties.push_back(p);
+      return one;
+    }
+  for (const auto& c : a.constants)
+    if (c.name.name == name) {
+      one.constants.push_back(c);
+      return one;
+    }
+  return std::nullopt;
+}
+
 std::string listText(const std::vector<ast::Ident>& arrays) {
   std::string s;
   for (const auto& a : arrays) s += (s.empty() ? "" : ", ") + a.name;
@@ -352,22 +369,7 @@ bool addSchemeArrayItems(const std::vector<std::unique_ptr<ast::Module>>& module
       }
       // What the array already holds under the name: its own declaration or an earlier
       // scheme item's.
-      const ast::Ident* have = nullptr;
-      std::string haveShape;
-      for (const auto& p : array->properties)
-        if (!have && p.name.name == name.name) {
-          have = &p.name;
-          ast::ArrayDecl one;
-          one.properties.push_back(p);
-          haveShape = shape(one);
-        }
-      for (const auto& c : array->constants)
-        if (!have && c.name.name == name.name) {
-          have = &c.name;
-          ast::ArrayDecl one;
-          one.constants.push_back(c);
-          haveShape = shape(one);
-        }
+      std::optional<ast::ArrayDecl> have = declarationOf(*array, name.name);
       if (!have) {
         for (const auto& p : item.item.properties) {
           array->properties.push_back(p);
@@ -377,10 +379,11 @@ bool addSchemeArrayItems(const std::vector<std::unique_ptr<ast::Module>>& module
         added[{array->name.name, name.name}] = &item;
         continue;
       }
+      const std::string haveShape = shape(*have);
       if (haveShape == want) continue;  // the array's declaration (or the first scheme's) wins
       auto by = added.find({array->name.name, name.name});
       const bool byScheme = by != added.end();
-      diags.error(have->loc,
+      diags.error(declaredName(*have).loc,
                   "'" + name.name + "' of array '" + array->name.name + "' is declared " +
                       haveShape + " here" +
                       (byScheme ? " by scheme '" + by->second->scheme + "'" : std::string()) +
