@@ -42,8 +42,8 @@ bool checkInternalFlow(Plan& plan, DiagnosticEngine& diags) {
                     "accuracy (docs/stability.md, \"Internal flows\")");
   diags.note(plan.internalFlowNeedsLoc,
              "add it to the scene's effects, `effects = [..., " + name +
-                 "];` (or compile with `-D " + name + "=on`), with the properties its "
-                 "equations need: " + effect->doc);
+                 "];` (or compile with `-D " + name + "=on`): " + effect->doc +
+                 "; the scheme declares the properties its equations need");
   diags.note(plan.internalFlowNeeds->loc,
              "the scheme names '" + name + "' as needed in an internal flow here");
   return true;

@@ -243,6 +243,9 @@ bool inferProperties(Plan& plan, DiagnosticEngine& diags) {
       if (!usedProp(d.name)) {
         if (initInputs.count(d.name)) continue;
         if (plan.leftOutComponents.count(d.name)) continue;  // a z-component in 2D (Dimensions.cpp)
+        // A scheme declares what its equations of an effect may need, for every array of a
+        // list parameter: one that no kept equation uses is not the scene's doing.
+        if (d.fromScheme) continue;
         diags.warning(d.declLoc, "property '" + d.name + "' of array '" + arr.name +
                                      "' is declared but nothing uses it; it is not allocated");
         continue;

@@ -114,6 +114,7 @@ struct PropertyDecl {
   int stride = 1;
   ExprPtr init;                 // may be null: 0
   llvm::SMLoc loc;              // the `property` keyword
+  bool fromScheme = false;      // added by a scheme (sema/Schemes.cpp)
 };
 
 struct ConstDecl {
@@ -338,6 +339,19 @@ struct ZoneDecl {
   std::vector<KwArg> args;
 };
 
+// `property fluids double[3] gradc = 0;` / `const fluids umax = 0;` in a scheme: a property or
+// constant the scheme's equations need, declared on the arrays of an array-list parameter
+// (sema/Schemes.cpp). The expansion replaces the parameter with the scene's arrays; the
+// options pass adds the items of the chosen `when` branches to those arrays, where a
+// declaration of the array itself (same type and shape) wins.
+struct SchemeArrayItem {
+  std::vector<Ident> arrays;    // as written: list parameters; expanded: the scene's arrays
+  ArrayDecl item;               // one property or one constant
+  Ident param;                  // expanded: the list parameter the arrays came from
+  std::string scheme;           // expanded: the scheme that declares it
+  llvm::SMLoc use;              // expanded: the scheme's use in the scene
+};
+
 struct SceneDecl {
   Ident name;
   llvm::SMLoc effectsLoc;       // `effects = [a, b];` (invalid when the scene has none)
@@ -355,6 +369,7 @@ struct SceneDecl {
   std::vector<ZoneDecl> zones;
   llvm::SMLoc equationsLoc;
   std::vector<GroupItem> equations;
+  std::vector<SchemeArrayItem> arrayItems;  // a scheme's properties and constants
   std::vector<std::shared_ptr<When<SceneDecl>>> whens;  // the chosen branch's items are
                                                         // added after the others
 };

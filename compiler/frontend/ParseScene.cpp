@@ -30,6 +30,9 @@ bool Parser::parseSceneItem(ast::SceneDecl& scene) {
   if (atWord("effects") && lex_.peek().is(Token::Assign)) return parseSceneEffects(scene);
   if (lex_.peek().is(Token::Assign)) return parseSceneSetting(scene);
   if (atWord("scheme") && lex_.peek().is(Token::Identifier)) return parseSchemeUse(scene);
+  if ((atWord("property") || atWord("const")) &&
+      (lex_.peek().is(Token::Identifier) || lex_.peek().is(Token::LBracket)))
+    return parseSchemeArrayItem(scene);
   if (atWhen())
     return parseWhen<ast::SceneDecl>(
         scene.whens, "scene " + quoted(scene.name.name),
@@ -65,6 +68,37 @@ bool Parser::parseSceneEffects(ast::SceneDecl& scene) {
       !parseNameList(scene.effects, "the scene's effects"))
     return false;
   return expect(Token::Semi, "after the scene's effects");
+}
+
+// `property fluids double[3] gradc = 0;` or `const [fluids, solids] umax = 0;` in a scheme: the
+// arrays (list parameters), then what `property` / `const` declares in an array.
+bool Parser::parseSchemeArrayItem(ast::SceneDecl& scene) {
+  const bool isConst = atWord("const");
+  const std::string kw = isConst ? "const" : "property";
+  llvm::SMLoc loc = cur().loc;
+  if (!inScheme_)
+    return error(loc, "'" + kw + "' in a scene: declare it in its array ('array NAME { " + kw +
+                          " ...; }'); a scheme declares " +
+                          (isConst ? "constants" : "properties") +
+                          " on its array-list parameters ('" + kw + " fluids ...;')");
+  advance();
+  ast::SchemeArrayItem item;
+  if (consumeIf(Token::LBracket)) {
+    if (!parseNameList(item.arrays, "the arrays of '" + kw + "'")) return false;
+  } else {
+    ast::Ident id;
+    if (!parseIdent(id, "expected the arrays (a list parameter of the scheme) after '" + kw + "'"))
+      return false;
+    if (!isConst && (id.name == "double" || id.name == "int" || id.name == "uint"))
+      return error(id.loc, "a property of a scheme names its arrays first: 'property fluids " +
+                               id.name + " NAME = ...;' (fluids: an array-list parameter)");
+    item.arrays.push_back(id);
+  }
+  item.item.name = item.arrays.empty() ? ast::Ident{} : item.arrays.front();
+  if (!(isConst ? parseArrayConstRest(item.item) : parsePropertyRest(item.item, loc)))
+    return false;
+  scene.arrayItems.push_back(std::move(item));
+  return true;
 }
 
 // `scheme NAME(arg = value, ...);` in a scene.

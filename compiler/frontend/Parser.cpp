@@ -311,9 +311,11 @@ bool Parser::parseSchemeDecl(ast::Module& mod) {
   }
   sc.body = std::make_shared<ast::SceneDecl>();
   sc.body->name = sc.name;
+  inScheme_ = true;
   bool ok = parseBlock(
       "scheme " + quoted(sc.name.name), [&] { return parseSceneItem(*sc.body); },
       /*sceneStepper=*/true);
+  inScheme_ = false;
   mod.schemes.push_back(std::move(sc));
   return ok;
 }
@@ -463,9 +465,14 @@ bool Parser::parseLoad(ast::ArrayDecl& array) {
 }
 
 bool Parser::parseProperty(ast::ArrayDecl& array) {
-  ast::PropertyDecl prop;
-  prop.loc = cur().loc;
+  llvm::SMLoc loc = cur().loc;
   advance();
+  return parsePropertyRest(array, loc);
+}
+
+bool Parser::parsePropertyRest(ast::ArrayDecl& array, llvm::SMLoc loc) {
+  ast::PropertyDecl prop;
+  prop.loc = loc;
   // `property TYPE NAME` or `property TYPE[N] NAME`: the word before the name is a type.
   if (cur().is(Token::Identifier) &&
       (lex_.peek().is(Token::Identifier) || lex_.peek().is(Token::LBracket))) {
@@ -489,6 +496,10 @@ bool Parser::parseProperty(ast::ArrayDecl& array) {
 
 bool Parser::parseArrayConst(ast::ArrayDecl& array) {
   advance();
+  return parseArrayConstRest(array);
+}
+
+bool Parser::parseArrayConstRest(ast::ArrayDecl& array) {
   ast::ConstDecl c;
   if (!parseIdent(c.name, "expected a constant name after 'const'")) return false;
   if (consumeIf(Token::LBracket)) {

@@ -94,6 +94,11 @@ class Parser {
   bool parseLoad(ast::ArrayDecl& array);
   bool parseProperty(ast::ArrayDecl& array);
   bool parseArrayConst(ast::ArrayDecl& array);
+  // After the keyword: `[TYPE[N]] NAME [= init];` / `NAME[[N]] [= init];`; `loc` is the keyword's.
+  bool parsePropertyRest(ast::ArrayDecl& array, llvm::SMLoc loc);
+  bool parseArrayConstRest(ast::ArrayDecl& array);
+  // `property ARRAYS TYPE NAME = init;` / `const ARRAYS NAME = init;` in a scheme.
+  bool parseSchemeArrayItem(ast::SceneDecl& scene);
   std::optional<int> parseBracketedSize(const llvm::Twine& what);
   bool parseEquation(ast::Module& mod);
   bool parseEquationParams(ast::EquationDecl& eq);
@@ -151,6 +156,7 @@ class Parser {
   bool stopped_ = false;      // too many errors
   unsigned exprDepth_ = 0;
   unsigned whenDepth_ = 0;  // nesting of `when` blocks
+  bool inScheme_ = false;   // parsing a scheme's body (it may declare array properties)
 };
 
 }  // namespace sphc

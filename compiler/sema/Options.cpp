@@ -320,7 +320,12 @@ class OptionSelector {
         for (const auto& b : item.when->branches) recordDropped(b.body, c);
     }
   }
-  void recordDropped(const ast::SceneDecl& s, ChosenOption& c) { recordDropped(s.equations, c); }
+  void recordDropped(const ast::SceneDecl& s, ChosenOption& c) {
+    recordDropped(s.equations, c);
+    for (const auto& item : s.arrayItems)  // a scheme's `property fluids ...;`
+      for (const auto& p : item.item.properties)
+        for (const auto& a : item.arrays) c.droppedProperties.push_back(a.name + "." + p.name.name);
+  }
   void recordDropped(const ast::ArrayDecl& a, ChosenOption& c) {
     for (const auto& p : a.properties) c.droppedProperties.push_back(a.name.name + "." + p.name.name);
   }
@@ -376,6 +381,7 @@ class OptionSelector {
       }
       scene(*part, ok, /*top=*/false);
       append(s.schemes, part->schemes);
+      append(s.arrayItems, part->arrayItems);
       append(s.settings, part->settings);
       append(s.steppers, part->steppers);
       append(s.outputs, part->outputs);
@@ -462,6 +468,10 @@ bool selectOptions(std::vector<std::unique_ptr<ast::Module>>& modules,
     for (auto& a : mod->arrays) sel.array(a, ok);
     for (auto& s : mod->scenes) sel.scene(s, ok);
   }
+  // The properties and constants the kept branches of the scenes' schemes declare, added to
+  // their arrays once every array's own `when`s are chosen.
+  for (auto& mod : modules)
+    for (auto& s : mod->scenes) ok = addSchemeArrayItems(modules, s, diags) && ok;
   chosen = sel.chosen();
   return ok;
 }

@@ -29,6 +29,7 @@ struct PlanProperty {
   ast::ExprPtr init;               // initial value (null: 0 or set by geometry)
   llvm::SMLoc declLoc;             // `property` declaration, if any
   bool declared = false;
+  bool fromScheme = false;         // declared by a scheme the scene uses, not by the array
   bool written = false;            // by a live equation or stepper
   bool read = false;               // by a live equation, stepper, output or neighbour search
   bool output = false;

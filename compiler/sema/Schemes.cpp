@@ -1,6 +1,7 @@
 #include "sema/Schemes.h"
 
 #include <map>
+#include <optional>
 #include <string>
 
 namespace sphc {
@@ -16,8 +17,9 @@ struct Binding {
 
 class Expander {
  public:
-  Expander(DiagnosticEngine& diags, const std::map<std::string, Binding>& b, llvm::SMLoc use)
-      : diags_(diags), bind_(b), use_(use) {}
+  Expander(DiagnosticEngine& diags, const std::map<std::string, Binding>& b, llvm::SMLoc use,
+           std::string scheme)
+      : diags_(diags), bind_(b), use_(use), scheme_(std::move(scheme)) {}
 
   bool ok = true;
 
@@ -136,6 +138,31 @@ class Expander {
     return out;
   }
 
+  // `property fluids ...;`: one item per list parameter, its arrays the scene's, its initial
+  // value substituted. A name that is no list parameter of the scheme is an error.
+  void arrayItem(const ast::SchemeArrayItem& in, ast::SceneDecl& to) {
+    for (const auto& id : in.arrays) {
+      auto it = bind_.find(id.name);
+      if (it == bind_.end() || !it->second.isList) {
+        diags_.error(id.loc, std::string(in.item.properties.empty() ? "a constant" : "a property") +
+                                 " of scheme '" + scheme_ + "' is declared on '" + id.name +
+                                 "', which is no array-list parameter of the scheme");
+        diags_.note(use_, "the scheme is used here");
+        ok = false;
+        continue;
+      }
+      ast::SchemeArrayItem out;
+      out.arrays = it->second.arrays;
+      out.item = in.item;
+      for (auto& p : out.item.properties) p.init = expr(p.init);
+      for (auto& c : out.item.constants) c.init = expr(c.init);
+      out.param = id;
+      out.scheme = scheme_;
+      out.use = use_;
+      to.arrayItems.push_back(std::move(out));
+    }
+  }
+
   // The scheme's scene items, substituted, added to `to`.
   void scene(const ast::SceneDecl& from, ast::SceneDecl& to) {
     for (const auto& s : from.settings) {
@@ -146,6 +173,7 @@ class Expander {
       if (c.key.name == "internal_flow_needs") c.key.loc = use_;
       to.settings.push_back(std::move(c));
     }
+    for (const auto& item : from.arrayItems) arrayItem(item, to);
     for (const auto& st : from.steppers)
       for (const auto& a : arrays(st.array)) to.steppers.push_back(ast::SceneStepper{a, st.stepper});
     if (from.hasAdaptiveDt) {
@@ -176,6 +204,7 @@ class Expander {
   DiagnosticEngine& diags_;
   const std::map<std::string, Binding>& bind_;
   llvm::SMLoc use_;  // the scheme's use in the scene (`scheme NAME(...)`)
+  std::string scheme_;
 };
 
 // What a scheme may hold: the items a scheme decides, not those of one scene.
@@ -184,7 +213,8 @@ bool checkSchemeItems(const ast::SceneDecl& body, const std::string& name,
   bool ok = true;
   auto bad = [&](const char* what) {
     diags.error(loc, "scheme '" + name + "' holds " + what +
-                         ": a scheme holds settings, steppers, adaptive_dt and equations; "
+                         ": a scheme holds settings, steppers, adaptive_dt, equations and its "
+                         "arrays' properties and constants; "
                          "outputs, domains, limits and effects belong to the scene");
     ok = false;
   };
@@ -267,9 +297,106 @@ bool expandSchemes(const std::vector<std::unique_ptr<ast::Module>>& modules, ast
       ok = false;
       continue;
     }
-    Expander ex(diags, bind, use.scheme.loc);
+    Expander ex(diags, bind, use.scheme.loc, decl->name.name);
     ex.scene(*decl->body, scene);
     ok = ex.ok && ok;
+  }
+  return ok;
+}
+
+namespace {
+
+// "double[3]", "int", "a constant", "a constant[3]": what a declaration makes of a name.
+std::string shape(const ast::ArrayDecl& one) {
+  if (!one.properties.empty()) {
+    const auto& p = one.properties.front();
+    return p.stride == 1 ? p.type : p.type + "[" + std::to_string(p.stride) + "]";
+  }
+  const auto& c = one.constants.front();
+  return c.size == 1 ? "a constant" : "a constant[" + std::to_string(c.size) + "]";
+}
+
+const ast::Ident& declaredName(const ast::ArrayDecl& one) {
+  return one.properties.empty() ? one.constants.front().name : one.properties.front().name;
+}
+
+// The array's declaration of `name`, a property or a constant, as a one-item ArrayDecl.
+std::optional<ast::ArrayDecl> declarationOf(const ast::ArrayDecl& a, const std::string& name) {
+  ast::ArrayDecl one;
+  for (const auto& p : a.properties)
+    if (p.name.name == name) {
+      one.properties.push_back(p);
+      return one;
+    }
+  for (const auto& c : a.constants)
+    if (c.name.name == name) {
+      one.constants.push_back(c);
+      return one;
+    }
+  return std::nullopt;
+}
+
+std::string listText(const std::vector<ast::Ident>& arrays) {
+  std::string s;
+  for (const auto& a : arrays) s += (s.empty() ? "" : ", ") + a.name;
+  return "[" + s + "]";
+}
+
+}  // namespace
+
+bool addSchemeArrayItems(const std::vector<std::unique_ptr<ast::Module>>& modules,
+                         ast::SceneDecl& scene, DiagnosticEngine& diags) {
+  bool ok = true;
+  // The scheme item that added a name to an array, for the wording of a later conflict.
+  std::map<std::pair<std::string, std::string>, const ast::SchemeArrayItem*> added;
+  auto items = std::move(scene.arrayItems);
+  scene.arrayItems.clear();
+  for (const auto& item : items) {
+    const ast::Ident& name = declaredName(item.item);
+    const std::string want = shape(item.item);
+    for (const auto& arrayId : item.arrays) {
+      ast::ArrayDecl* array = nullptr;
+      for (const auto& m : modules)
+        for (auto& a : m->arrays)
+          if (!array && a.name.name == arrayId.name) array = &a;
+      if (!array) {
+        diags.error(arrayId.loc, "'" + arrayId.name + "' is no array: scheme '" + item.scheme +
+                                     "' declares '" + name.name + "' on its parameter '" +
+                                     item.param.name + "'");
+        diags.note(name.loc, "'" + name.name + "' is declared here");
+        ok = false;
+        continue;
+      }
+      // What the array already holds under the name: its own declaration or an earlier
+      // scheme item's.
+      std::optional<ast::ArrayDecl> have = declarationOf(*array, name.name);
+      if (!have) {
+        for (const auto& p : item.item.properties) {
+          array->properties.push_back(p);
+          array->properties.back().fromScheme = true;
+        }
+        for (const auto& c : item.item.constants) array->constants.push_back(c);
+        added[{array->name.name, name.name}] = &item;
+        continue;
+      }
+      const std::string haveShape = shape(*have);
+      if (haveShape == want) continue;  // the array's declaration (or the first scheme's) wins
+      auto by = added.find({array->name.name, name.name});
+      const bool byScheme = by != added.end();
+      diags.error(declaredName(*have).loc,
+                  "'" + name.name + "' of array '" + array->name.name + "' is declared " +
+                      haveShape + " here" +
+                      (byScheme ? " by scheme '" + by->second->scheme + "'" : std::string()) +
+                      ", and " + want + " by scheme '" + item.scheme +
+                      "': the declarations must agree in type and shape" +
+                      (byScheme ? std::string()
+                                : " (declare it as the scheme does, or leave it to the scheme)"));
+      diags.note(name.loc, "scheme '" + item.scheme + "' declares '" + name.name + "' " + want +
+                               " here, on its parameter '" + item.param.name + "'");
+      diags.note(item.use, "the scene uses scheme '" + item.scheme + "' here, with " +
+                               item.param.name + " = " + listText(item.arrays));
+      ok = false;
+    }
   }
   return ok;
 }

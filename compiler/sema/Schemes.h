@@ -23,4 +23,13 @@ namespace sphc {
 bool expandSchemes(const std::vector<std::unique_ptr<ast::Module>>& modules, ast::SceneDecl& scene,
                    DiagnosticEngine& diags);
 
+// Adds the properties and constants that the scene's schemes declare (`property fluids
+// double[3] gradc = 0;` in the `when` branches the options pass kept) to the arrays the
+// scheme's list parameters are bound to, after the arrays' own. Where the array declares the
+// name itself with the same type and shape, the array's declaration (its initial value) wins;
+// another type or shape, or a property against a constant, is an error at both declarations.
+// Returns false after reporting errors.
+bool addSchemeArrayItems(const std::vector<std::unique_ptr<ast::Module>>& modules,
+                         ast::SceneDecl& scene, DiagnosticEngine& diags);
+
 }  // namespace sphc

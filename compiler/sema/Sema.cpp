@@ -389,6 +389,7 @@ void SemaImpl::buildArrays() {
         prop.init = p.init;
         prop.declLoc = p.name.loc;
         prop.declared = true;
+        prop.fromScheme = p.fromScheme;
         pa.props.push_back(prop);
       }
       for (const auto& c : a.constants) {
