@@ -63,6 +63,7 @@ class OpenCLPrinter : public ScenePrinter {
   void adaptiveDtArray(int a) override;
   void mainBackendOptions() override {
     out_ << "  scene.selection = sphc::ocl::take_options(argc, argv);\n";
+    out_ << "  prog.device_launches = [] { return scene.ocl.launches(); };  // --timing\n";
   }
   std::string afterSetup() const override {
     return "    if (!sphc::counting_particles()) scene.to_device();\n";

@@ -491,6 +491,7 @@ void Context::set_arg(cl_kernel k, cl_uint& i, const CellTable& c) {
 void Context::launch(cl_kernel k, std::size_t n, const std::string& name) {
   const std::size_t local = 64;
   std::size_t global = (n + local - 1) / local * local;
+  ++launches_;
   const auto start =
       profile_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
   check(clEnqueueNDRangeKernel(queue_, k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),

@@ -172,6 +172,9 @@ class Context {
   // time per kernel name is printed to stderr at exit.
   void launch(cl_kernel k, std::size_t n, const std::string& name = "");
   bool profiling() const { return profile_; }
+  // Kernel launches so far (every launch through `launch`: the scene's kernels, the neighbour
+  // search's, reductions), for --timing's launches_per_step.
+  long launches() const { return launches_; }
   // Adds host time to the profile printed at exit (under `name`).
   void add_profile(const std::string& name, double seconds);
 
@@ -185,6 +188,7 @@ class Context {
   std::map<int, std::pair<cl_mem, std::size_t>> scratch_;
   std::vector<double> host_partial_;
   bool profile_ = false;
+  long launches_ = 0;
   std::map<std::string, std::pair<double, long>> profile_times_;
 };
 
