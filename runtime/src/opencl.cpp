@@ -44,8 +44,9 @@ __kernel void sphc_cell_keys(const uint n, __global const real* x, __global cons
   atomic_inc(&count[key]);
 }
 
-// Exclusive scan of count[0..cells) into start (and end = start + count), in three kernels:
-// G work items sum chunks, one scans the G sums, G write their chunks.
+// Exclusive scan of count[0..cells) into start (and end = start + count), in two kernels:
+// G work items sum chunks; then each of G work items adds up the sums of the chunks before its
+// own (G^2 / 2 reads in all, G = 256: cheaper than a launch) and writes its chunk.
 __kernel void sphc_scan_chunks(__global const uint* count, const uint cells,
                                __global uint* partial) {
   const uint g = get_global_id(0), G = get_global_size(0);
@@ -54,21 +55,13 @@ __kernel void sphc_scan_chunks(__global const uint* count, const uint cells,
   for (uint c = g * chunk; c < min(cells, (g + 1) * chunk); ++c) sum += count[c];
   partial[g] = sum;
 }
-__kernel void sphc_scan_partials(__global uint* partial, const uint G) {
-  if (get_global_id(0) != 0) return;
-  uint acc = 0;
-  for (uint g = 0; g < G; ++g) {
-    const uint v = partial[g];
-    partial[g] = acc;
-    acc += v;
-  }
-}
 __kernel void sphc_scan_apply(__global uint* count, const uint cells,
                               __global const uint* partial, __global uint* start,
                               __global uint* end) {
   const uint g = get_global_id(0), G = get_global_size(0);
   const uint chunk = (cells + G - 1) / G;
-  uint acc = partial[g];
+  uint acc = 0;
+  for (uint k = 0; k < g; ++k) acc += partial[k];
   for (uint c = g * chunk; c < min(cells, (g + 1) * chunk); ++c) {
     start[c] = acc;
     acc += count[c];
@@ -85,10 +78,14 @@ __kernel void sphc_scatter(const uint n, __global const uint* keys, __global con
 }
 // The scatter's order within a cell depends on timing: sort each cell by index (cells hold a
 // few particles), so the order is deterministic and the CPU's (ascending index).
+// It also zeroes the cell's count (the scatter's cursor): the counts are all zero again for
+// the next build, which then needs no fill.
 __kernel void sphc_sort_cells(const uint cells, __global const uint* start,
-                              __global const uint* end, __global uint* order) {
+                              __global const uint* end, __global uint* order,
+                              __global uint* count) {
   const uint c = get_global_id(0);
   if (c >= cells) return;
+  count[c] = 0;
   const uint b = start[c], e = end[c];
   for (uint k = b + 1; k < e; ++k) {
     const uint v = order[k];
@@ -628,7 +625,9 @@ Grid Context::grid_of(const SearchDomain& dom) const {
 
 void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem z, std::size_t n) {
   // A counting sort by cell: keys and counts, a scan into start/end, a scatter, and a sort of
-  // each cell's few indices (deterministic order). Eight launches, O(n + cells) work.
+  // each cell's few indices (deterministic order). Five launches, O(n + cells) work. The
+  // counts are zero between builds (sphc_sort_cells zeroes them): filled once, when
+  // allocated.
   if (n > padded || !keys) {
     if (keys) clReleaseMemObject(keys);
     if (order) clReleaseMemObject(order);
@@ -643,18 +642,18 @@ void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem
     start = ctx.alloc(cells * sizeof(cl_uint));
     end = ctx.alloc(cells * sizeof(cl_uint));
     count = ctx.alloc(cells * sizeof(cl_uint));
+    const unsigned all = static_cast<unsigned>(cells);
+    ctx.run("sphc_fill_uint", all, count, 0u, all);
   }
   if (!partial) partial = ctx.alloc(kScanItems * sizeof(cl_uint));
   const unsigned nc = static_cast<unsigned>(grid.cells());
   const unsigned un = static_cast<unsigned>(n);
-  ctx.run("sphc_fill_uint", nc, count, 0u, nc);
   ctx.run("sphc_cell_keys", n, un, x, y ? y : x, z ? z : x, y ? 1 : 0, z ? 1 : 0, grid, keys,
           count);
   ctx.run("sphc_scan_chunks", kScanItems, count, nc, partial);
-  ctx.run("sphc_scan_partials", 1, partial, static_cast<unsigned>(kScanItems));
   ctx.run("sphc_scan_apply", kScanItems, count, nc, partial, start, end);
   ctx.run("sphc_scatter", n, un, keys, start, count, order);
-  ctx.run("sphc_sort_cells", nc, nc, start, end, order);
+  ctx.run("sphc_sort_cells", nc, nc, start, end, order, count);
 }
 
 void CellTable::release() {
