@@ -553,14 +553,14 @@ void OpenCLPrinter::ghostRefresh(const DestinationWork& w) {
          << propIndexList(d, refresh) << ");\n";
 }
 
-// The adaptive time step's limits over one moving array: per-particle limits in a kernel,
-// their minima from device partial reductions in one round trip.
+// The adaptive time step's limits over one moving array in one launch: each of
+// Context::kPartials work items takes the minima of the limits over its particles (i = g,
+// g + G, ...), the host the minima of those (fmin, as sphc_reduce: the same values).
 void OpenCLPrinter::adaptiveDtArray(int a) {
   const AdaptiveDt& ad = sched_.adaptiveDt;
   const bool useCfl = ad.cfl;
   const std::string& A = arr(a).name;
   const std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
-  // Per-particle limits on the device, their minima from device partial reductions.
   KernelArgs ka;
   std::vector<std::string> props = {"h"};
   if (useCfl) props.push_back("cs");
@@ -569,42 +569,44 @@ void OpenCLPrinter::adaptiveDtArray(int a) {
     if (ad.force) props.push_back(acc[k]);
   }
   for (const auto& p : props) ka.add("__global const real* " + p, devBuffer(a, p), p);
-  const char* outs[3] = {"dt_cfl", "dt_force", "h2min"};
-  for (int o = 0; o < 3; ++o)
-    ka.add(std::string("__global real* out_") + outs[o],
-           "ocl.scratch(n, " + std::to_string(o + 1) + ")", outs[o]);
-  std::string k = "adaptive_dt_" + A;
-  beginKernel(k, ka);
-  cl_ << "  const int i = d_idx;\n";
+  // The limits the scene uses, in order: (name, per-particle value).
   auto mag = [&](const std::vector<std::string>& c) {
     std::string m = "sqrt(";
     for (int k = 0; k < plan_.dim; ++k) m += (k ? " + " : "") + c[k] + "[i] * " + c[k] + "[i]";
     return m + ")";
   };
-  cl_ << "  out_dt_cfl[i] = " << (useCfl ? "h[i] / (cs[i] + " + mag(vel) + ")" : "INFINITY")
-      << ";\n";
-  cl_ << "  out_h2min[i] = h[i] * h[i];\n";
-  if (ad.force)
-    cl_ << "  const real amag = " << mag(acc) << ";\n"
-        << "  out_dt_force[i] = amag > 0 ? sqrt(h[i] / amag) : INFINITY;\n";
-  else
-    cl_ << "  out_dt_force[i] = INFINITY;\n";
+  std::vector<std::pair<std::string, std::string>> limits;
+  if (useCfl) limits.push_back({"dt_cfl", "h[i] / (cs[i] + " + mag(vel) + ")"});
+  if (ad.force) limits.push_back({"dt_force", "amag > 0 ? sqrt(h[i] / amag) : INFINITY"});
+  if (ad.viscous) limits.push_back({"h2min", "h[i] * h[i]"});
+  if (limits.empty()) {
+    scene_ << "    }\n";
+    return;
+  }
+  const std::string partial =
+      "ocl.scratch(" + std::to_string(limits.size()) + " * sphc::ocl::Context::kPartials, 1)";
+  ka.add("__global real* partial", partial, "partial");
+  std::string k = "adaptive_dt_" + A;
+  cl_ << "// adaptive dt over " << A << ": partial minima per work item\n";
+  beginKernel(k, ka, /*guard=*/false);
+  cl_ << "  const int g = get_global_id(0), G = get_global_size(0);\n";
+  for (const auto& [name, v] : limits) cl_ << "  real " << name << " = INFINITY;\n";
+  cl_ << "  for (int i = g; i < n; i += G) {\n";
+  if (ad.force) cl_ << "    const real amag = " << mag(acc) << ";\n";
+  for (const auto& [name, v] : limits) cl_ << "    " << name << " = fmin(" << name << ", " << v << ");\n";
+  cl_ << "  }\n";
+  for (size_t m = 0; m < limits.size(); ++m)
+    cl_ << "  partial[" << limits.size() << " * g + " << m << "] = " << limits[m].first << ";\n";
   cl_ << "}\n\n";
   scene_ << "      const int n = static_cast<int>(" << A << ".n);\n";
   scene_ << "      const double t = 0.0, dt = 0.0;  // (kernel arguments, unused)\n";
-  scene_ << "      " << launch(k, "n", ka) << "\n";
-  // The minima in one round trip: (limit, scratch slot) for the limits the scene uses.
-  std::vector<std::pair<std::string, int>> mins;
-  if (useCfl) mins.push_back({"dt_cfl", 1});
-  if (ad.force) mins.push_back({"dt_force", 2});
-  if (ad.viscous) mins.push_back({"h2min", 3});
-  scene_ << "      const std::vector<double> mins = ocl.reduce_all({";
-  for (size_t m = 0; m < mins.size(); ++m)
-    scene_ << (m ? ", " : "") << "{ocl.scratch(n, " << mins[m].second
-           << "), static_cast<std::size_t>(n), sphc::ocl::Op::Min}";
-  scene_ << "});\n";
-  for (size_t m = 0; m < mins.size(); ++m)
-    scene_ << "      " << mins[m].first << " = std::fmin(" << mins[m].first << ", mins[" << m
+  std::string l = "ocl.run(\"" + k + "\", sphc::ocl::Context::kPartials, n, t, dt";
+  for (const auto& h : ka.host) l += ", " + h;
+  scene_ << "      " << l << ");\n";
+  scene_ << "      const std::vector<double> mins = ocl.minima(" << partial << ", "
+         << limits.size() << ");\n";
+  for (size_t m = 0; m < limits.size(); ++m)
+    scene_ << "      " << limits[m].first << " = std::fmin(" << limits[m].first << ", mins[" << m
            << "]);\n";
   scene_ << "    }\n";
 }

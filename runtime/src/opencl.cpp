@@ -538,6 +538,16 @@ std::vector<double> Context::reduce_all(const std::vector<Reduction>& rs) {
   return out;
 }
 
+std::vector<double> Context::minima(cl_mem partial, int columns) {
+  const std::size_t c = static_cast<std::size_t>(columns);
+  host_partial_.resize(kPartials * c);
+  read_reals(partial, host_partial_.data(), host_partial_.size());
+  std::vector<double> out(c, HUGE_VAL);
+  for (std::size_t g = 0; g < kPartials; ++g)
+    for (std::size_t k = 0; k < c; ++k) out[k] = std::fmin(out[k], host_partial_[g * c + k]);
+  return out;
+}
+
 double Context::reduce(cl_mem v, std::size_t n, Op op, bool finite_only) {
   return reduce_all({{v, n, op, finite_only}})[0];
 }

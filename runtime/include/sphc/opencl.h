@@ -148,6 +148,10 @@ class Context {
     bool finite_only = false;
   };
   std::vector<double> reduce_all(const std::vector<Reduction>& rs);
+  // Partial minima computed by a scene kernel itself (one launch of kPartials work items,
+  // item g writing partial[columns * g + c]): their minima per column (fmin: NaN ignored).
+  static constexpr std::size_t kPartials = 256;
+  std::vector<double> minima(cl_mem partial, int columns);
   // The search domain over every array in a neighbour loop (as sphc::make_search_domain:
   // bounding box of finite coordinates, padded, cell_size = radius_scale * max h), from
   // device data.
