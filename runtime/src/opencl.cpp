@@ -161,15 +161,13 @@ __kernel void sphc_ghost_copy8(__global ulong* v, __global const uint* source, c
   v[n * stride + i] = v[source[i / stride] * stride + i % stride];
 }
 
-// Partial extents for the search domain, one pass: work item g writes min/max of the finite
-// x, y, z (axes beyond dim: +inf/-inf) and the max of finite h over v[g], v[g + G], ...
-__kernel void sphc_extent(const uint n, const int dim, __global const real* x,
-                          __global const real* y, __global const real* z,
-                          __global const real* h, const uint offset,
-                          __global real* partial) {
+// Partial extents for the search domain, one pass over two arrays (a and b; nb = 0: a only):
+// work item g writes min/max of the finite x, y, z (axes beyond dim: +inf/-inf) and the max
+// of finite h over a[g], a[g + G], ... and b[g], b[g + G], ...
+inline void sphc_extent_of(const uint n, const int dim, __global const real* x,
+                           __global const real* y, __global const real* z,
+                           __global const real* h, real* lo, real* hi, real* hmax) {
   const uint g = get_global_id(0), G = get_global_size(0);
-  real lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  real hmax = -INFINITY;
   for (uint i = g; i < n; i += G) {
     const real v[3] = {x[i], dim > 1 ? y[i] : (real)0, dim > 2 ? z[i] : (real)0};
     for (int a = 0; a < dim; ++a)
@@ -177,8 +175,19 @@ __kernel void sphc_extent(const uint n, const int dim, __global const real* x,
         lo[a] = fmin(lo[a], v[a]);
         hi[a] = fmax(hi[a], v[a]);
       }
-    if (isfinite(h[i])) hmax = fmax(hmax, h[i]);
+    if (isfinite(h[i])) *hmax = fmax(*hmax, h[i]);
   }
+}
+__kernel void sphc_extent(const int dim, const uint na, __global const real* xa,
+                          __global const real* ya, __global const real* za,
+                          __global const real* ha, const uint nb, __global const real* xb,
+                          __global const real* yb, __global const real* zb,
+                          __global const real* hb, const uint offset, __global real* partial) {
+  const uint g = get_global_id(0);
+  real lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  real hmax = -INFINITY;
+  sphc_extent_of(na, dim, xa, ya, za, ha, lo, hi, &hmax);
+  sphc_extent_of(nb, dim, xb, yb, zb, hb, lo, hi, &hmax);
   partial += offset + 7 * g;
   for (int a = 0; a < 3; ++a) {
     partial[2 * a] = lo[a];
@@ -569,24 +578,27 @@ SearchDomain Context::search_domain(const std::vector<Extent>& arrays, int dim,
                                     double radius_scale) {
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   double hmax = -HUGE_VAL;
-  // One partial-extent kernel per array, one read of all partial results.
+  // One partial-extent kernel per two arrays, one read of all partial results.
   const std::size_t per = 7 * kReduceItems;
-  cl_mem partial = scratch(per * arrays.size(), -2);
-  for (std::size_t k = 0; k < arrays.size(); ++k) {
-    const Extent& e = arrays[k];
+  const std::size_t launches = (arrays.size() + 1) / 2;
+  cl_mem partial = scratch(per * (launches ? launches : 1), -2);
+  for (std::size_t k = 0; k < launches; ++k) {
     cl_kernel kern = kernel("sphc_extent");
     cl_uint i = 0;
-    set_arg(kern, i, static_cast<unsigned>(e.n));
     set_arg(kern, i, dim);
-    set_arg(kern, i, e.x);
-    set_arg(kern, i, e.y ? e.y : e.x);
-    set_arg(kern, i, e.z ? e.z : e.x);
-    set_arg(kern, i, e.h);
+    for (std::size_t j = 2 * k; j < 2 * k + 2; ++j) {
+      const Extent& e = arrays[j < arrays.size() ? j : 2 * k];  // none: n = 0
+      set_arg(kern, i, static_cast<unsigned>(j < arrays.size() ? e.n : 0));
+      set_arg(kern, i, e.x);
+      set_arg(kern, i, e.y ? e.y : e.x);
+      set_arg(kern, i, e.z ? e.z : e.x);
+      set_arg(kern, i, e.h);
+    }
     set_arg(kern, i, static_cast<unsigned>(k * per));
     set_arg(kern, i, partial);
     launch(kern, kReduceItems, "sphc_extent");
   }
-  std::vector<double> values(per * arrays.size());
+  std::vector<double> values(per * launches);
   read_reals(partial, values.data(), values.size());
   for (std::size_t j = 0; j < values.size(); j += 7) {
     for (int a = 0; a < dim; ++a) {
