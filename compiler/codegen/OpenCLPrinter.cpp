@@ -63,6 +63,7 @@ class OpenCLPrinter : public ScenePrinter {
   void adaptiveDtArray(int a) override;
   void mainBackendOptions() override {
     out_ << "  scene.selection = sphc::ocl::take_options(argc, argv);\n";
+    out_ << "  prog.device_launches = [] { return scene.ocl.launches(); };  // --timing\n";
   }
   std::string afterSetup() const override {
     return "    if (!sphc::counting_particles()) scene.to_device();\n";
@@ -104,6 +105,9 @@ class OpenCLPrinter : public ScenePrinter {
   // and the scratch slot of the neighbour counts that the host checks against it.
   static constexpr int kMaxNbrs = 256;
   static constexpr int kNbrsSlot = 64;
+  // The scratch slots of a destination's reductions' per-particle values (one each: the
+  // post_loop kernel may compute them all).
+  static constexpr int kReduceSlot = 8;
 
   // Kernel arguments: declarations in the kernel, expressions on the host.
   struct KernelArgs {
@@ -132,7 +136,8 @@ class OpenCLPrinter : public ScenePrinter {
   void addBodyArgs(KernelArgs& ka, const PlanBody& b, int dest, int src,
                    const std::string& eqValues) const;
   void beginKernel(const std::string& name, const KernelArgs& ka, bool guard = true);
-  std::string launch(const std::string& name, const std::string& n, const KernelArgs& ka) const;
+  std::string launch(const std::string& name, const std::string& n, const KernelArgs& ka,
+                     const std::string& time = "t") const;
   // The statement that builds the cell table of source S over its first `count` particles.
   std::string cellListBuild(const std::string& S, const std::string& count) const;
   // The extents of the arrays in neighbour loops, for ocl.search_domain / ocl.make_grid.
@@ -208,19 +213,14 @@ void OpenCLPrinter::updateNeighbours() {
   }
 }
 
-// A run of stepper statements: each statement's kernels in turn, where an array's stepper
-// has the method (runs are not fused into one kernel).
+// A run of stepper statements: its function, with each statement's time.
 void OpenCLPrinter::stepperCall(const StepStatement& st,
                                 const std::function<std::string(int)>& timeAfter) {
   const StepperRun& run = sched_.stepperRuns[st.run];
-  for (size_t j = 0; j < run.methods.size(); ++j) {
-    bool any = false;
-    for (const auto& part : run.parts)
-      for (const auto& [k, b] : part.bodies) any |= k == j;
-    if (any)
-      scene_ << "    stepper_" << run.methods[j] << "(" << timeAfter(st.stagesDone[j])
-             << ", dt);\n";
-  }
+  if (run.parts.empty()) return;
+  std::string args;
+  for (int d : st.stagesDone) args += timeAfter(d) + ", ";
+  scene_ << "    " << run.name << "(" << args << "dt);\n";
 }
 
 std::string OpenCLPrinter::devBuffer(int a, const std::string& p) const {
@@ -257,8 +257,8 @@ void OpenCLPrinter::beginKernel(const std::string& name, const KernelArgs& ka, b
 }
 
 std::string OpenCLPrinter::launch(const std::string& name, const std::string& n,
-                            const KernelArgs& ka) const {
-  std::string s = "ocl.run(\"" + name + "\", " + n + ", " + n + ", t, dt";
+                                  const KernelArgs& ka, const std::string& time) const {
+  std::string s = "ocl.run(\"" + name + "\", " + n + ", " + n + ", " + time + ", dt";
   for (const auto& h : ka.host) s += ", " + h;
   return s + ");";
 }
@@ -269,21 +269,50 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
   const int d = w.array;
   const bool onGhosts = w.onGhosts;
   const std::string& D = arr(d).name;
+  // The reductions' per-particle values: in the post_loop kernel where the schedule says so
+  // (DestinationWork::reduceInPostLoop), else a kernel each.
+  auto reduceSlot = [&](size_t i) { return std::to_string(kReduceSlot + i); };
   auto perParticle = [&](ast::Method::Kind kind, const char* what) {
-    const std::vector<const PlanEquation*>& with =
-        kind == ast::Method::Initialize ? w.initialize : w.postLoop;
+    const bool init = kind == ast::Method::Initialize;
+    const std::vector<const PlanEquation*>& with = init ? w.initialize : w.postLoop;
     if (with.empty()) return;
+    // Moved by the schedule into a later phase's initialize kernel on the same array.
+    if (init ? w.initializeMoved : w.postLoopMoved) {
+      scene_ << "      // " << what << ": fused into the next initialize kernel on " << D << "\n";
+      return;
+    }
+    const std::vector<MovedWork> none;
+    const std::vector<MovedWork>& first = init ? w.initializeFirst : none;
+    const bool reduce = !init && w.reduceInPostLoop;
     KernelArgs ka;
-    for (const auto* eq : with)
-      addBodyArgs(ka, plan_.bodies[plan_.equationDecls[eq->declIndex].methods.at(kind)], d,
-                  -1, eqStruct(*eq));
+    for (const MovedWork& mw : first) addBodyArgs(ka, methodBody(*mw.equation, mw.method), d, -1, eqStruct(*mw.equation));
+    for (const auto* eq : with) addBodyArgs(ka, methodBody(*eq, kind), d, -1, eqStruct(*eq));
+    if (reduce)
+      for (size_t i = 0; i < w.reductions.size(); ++i) {
+        const PlanEquation* eq = w.reductions[i].equation;
+        addBodyArgs(ka, methodBody(*eq, ast::Method::Reduce), d, -1, eqStruct(*eq));
+        ka.add("__global real* reduce_values_" + std::to_string(i), "ocl.scratch(n, " + reduceSlot(i) + ")",
+               "reduce_values_" + std::to_string(i));
+      }
     std::string k = name + "_" + D + "_" + what;
     rangeArg(w, ka);
+    // Provenance of the fused work: the phases it comes from.
+    for (const MovedWork& mw : first)
+      cl_ << "// fused: " << mw.equation->name << "." << (mw.method == ast::Method::Initialize ? "initialize" : "post_loop")
+          << " of " << mw.phase << " (nothing between reads or writes " << D << ")\n";
+    if (reduce) cl_ << "// fused: the reductions' values of this phase\n";
     beginKernel(k, ka);
     rangeGuard(w);
+    for (const MovedWork& mw : first) cl_ << "  " << equationCall(*mw.equation, mw.method, d, "_");
     for (const auto* eq : with) cl_ << "  " << equationCall(*eq, kind, d, "_");
+    if (reduce)
+      for (size_t i = 0; i < w.reductions.size(); ++i)
+        cl_ << "  reduce_values_" << i << "[d_idx] = "
+            << equationCall(*w.reductions[i].equation, ast::Method::Reduce, d, "_");
     cl_ << "}\n\n";
-    scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // " << what << "\n";
+    scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // " << what
+           << (first.empty() ? "" : " (with fused work of earlier phases)")
+           << (reduce ? " (with the reductions' values)" : "") << "\n";
   };
   perParticle(ast::Method::Initialize, "initialize");
   for (const NeighbourPass& pass : w.passes) {
@@ -380,29 +409,35 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions: per-particle values on the device, partial results there, the last step
   // on the host, into the host copy of the constant (uploaded again).
-  for (const Reduction& r : w.reductions) {
+  for (size_t ri = 0; ri < w.reductions.size(); ++ri) {
+    const Reduction& r = w.reductions[ri];
     const PlanEquation* eq = r.equation;
     const auto& pd = plan_.equationDecls[eq->declIndex];
     const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
-    KernelArgs ka;
-    addBodyArgs(ka, b, d, -1, eqStruct(*eq));
     // Reductions see the real particles only (never the ghosts of a non-real group).
     const std::string nReal = onGhosts ? "static_cast<int>(" + D + ".n)" : std::string("n");
-    ka.add("__global real* reduce_values", "ocl.scratch(" + nReal + ")", "reduce_values");
-    std::string k = name + "_" + D + "_reduce_" + std::to_string(eq->id);
-    beginKernel(k, ka);
-    cl_ << "  reduce_values[d_idx] = " << equationCall(*eq, ast::Method::Reduce, d, "_")
-        << "}\n\n";
+    const std::string values = "ocl.scratch(" + nReal + ", " + reduceSlot(ri) + ")";
     int c = constIndex(d, pd.reduceTarget);
     std::string op = pd.reduceOp == "sum" || pd.reduceOp == "mean" ? "Sum"
                      : pd.reduceOp == "max"                         ? "Max"
                                                                     : "Min";
     scene_ << "      {  // reduce " << pd.reduceOp << " into " << D << "." << pd.reduceTarget
            << ": " << eq->name << ", from " << loc(eq->loc) << "\n";
-    scene_ << "        " << launch(k, nReal, ka) << (onGhosts ? "  // real particles only" : "")
-           << "\n";
-    scene_ << "        " << D << ".constant(" << constSlot(d, c) << ")[0] = ocl.reduce(ocl.scratch(" << nReal
-           << "), " << nReal << ", sphc::ocl::Op::" << op << ")"
+    if (!w.reduceInPostLoop) {
+      KernelArgs ka;
+      addBodyArgs(ka, b, d, -1, eqStruct(*eq));
+      ka.add("__global real* reduce_values", values, "reduce_values");
+      std::string k = name + "_" + D + "_reduce_" + std::to_string(eq->id);
+      beginKernel(k, ka);
+      cl_ << "  reduce_values[d_idx] = " << equationCall(*eq, ast::Method::Reduce, d, "_")
+          << "}\n\n";
+      scene_ << "        " << launch(k, nReal, ka) << (onGhosts ? "  // real particles only" : "")
+             << "\n";
+    } else {
+      scene_ << "        // the values: from the post_loop kernel\n";
+    }
+    scene_ << "        " << D << ".constant(" << constSlot(d, c) << ")[0] = ocl.reduce(" << values
+           << ", " << nReal << ", sphc::ocl::Op::" << op << ")"
            << (pd.reduceOp == "mean" ? " / (" + nReal + " > 0 ? " + nReal + " : 1)" : "")
            << ";\n";
     scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << constSlot(d, c) << ");\n";
@@ -412,22 +447,47 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
   ghostRefresh(w);
 }
 
+// A run of stepper statements (the schedule's StepperRun): per array one kernel doing the
+// run's methods in turn on each particle, each at its statement's time t_<k> (steppers read
+// and write their own particle only, so this equals a kernel per method, bit for bit).
 void OpenCLPrinter::steppers() {
-  for (const auto& [m, arrays] : sched_.stepperMethods) {
-    scene_ << "  void stepper_" << m << "(double t, double dt) {\n";
-    for (int a : arrays) {
-      const PlanArray& A = arr(a);
-      const PlanStepper& st = plan_.steppers[A.stepper];
-      const PlanBody& b = plan_.bodies[st.methods.at(m)];
-      scene_ << "    {  // " << A.name << ": " << st.decl->name.name << "." << m << "\n";
+  for (const StepperRun& run : sched_.stepperRuns) {
+    if (run.parts.empty()) continue;
+    scene_ << "  void " << run.name << "(";
+    for (size_t k = 0; k < run.methods.size(); ++k) scene_ << "double t_" << k << ", ";
+    scene_ << "double dt) {\n";
+    // A statement's time is unused when no array's stepper has its method.
+    for (size_t k = 1; k < run.methods.size(); ++k) {
+      bool used = false;
+      for (const auto& part : run.parts)
+        for (const auto& [j, b] : part.bodies) used |= j == k;
+      if (!used) scene_ << "    (void)t_" << k << ";\n";
+    }
+    for (const StepperRun::Part& part : run.parts) {
+      const PlanArray& A = arr(part.array);
+      const std::string& stepper = part.stepper->decl->name.name;
+      std::string methods;
+      for (size_t i = 0; i < part.bodies.size(); ++i)
+        methods += (i ? ", " : ".") + run.methods[part.bodies[i].first];
+      scene_ << "    {  // " << A.name << ": " << stepper << methods << "\n";
       scene_ << "      const int n = static_cast<int>(" << A.name << ".n);\n";
-      std::string fn = bodyFunctionName(st.decl->name.name, m);
       KernelArgs ka;
-      addBodyArgs(ka, b, a, -1, "");
-      std::string k = "stepper_" + m + "_" + A.name;
-      beginKernel(k, ka);
-      cl_ << "  " << callBody(fn, b, a, "", "t", "_") << ";\n}\n\n";
-      scene_ << "      " << launch(k, "n", ka) << "\n    }\n";
+      for (const auto& [k, b] : part.bodies) {
+        const std::string tk = "t_" + std::to_string(k);
+        if (k > 0) ka.add("const real " + tk, tk, tk);  // t_0 is the kernel's t
+        addBodyArgs(ka, *b, part.array, -1, "");
+      }
+      std::string kn = run.name + "_" + A.name;
+      cl_ << "// " << A.name << ": " << stepper << methods << " (a run of the step)\n";
+      beginKernel(kn, ka);
+      for (const auto& [k, b] : part.bodies)
+        cl_ << "  "
+            << callBody(bodyFunctionName(stepper, run.methods[k]), *b, part.array, "",
+                        k == 0 ? std::string("t") : "t_" + std::to_string(k), "_")
+            << ";\n";
+      cl_ << "}\n\n";
+      // The kernel's t is the run's first statement's time.
+      scene_ << "      " << launch(kn, "n", ka, "t_0") << "\n    }\n";
     }
     scene_ << "  }\n\n";
   }
@@ -493,14 +553,14 @@ void OpenCLPrinter::ghostRefresh(const DestinationWork& w) {
          << propIndexList(d, refresh) << ");\n";
 }
 
-// The adaptive time step's limits over one moving array: per-particle limits in a kernel,
-// their minima from device partial reductions in one round trip.
+// The adaptive time step's limits over one moving array in one launch: each of
+// Context::kPartials work items takes the minima of the limits over its particles (i = g,
+// g + G, ...), the host the minima of those (fmin, as sphc_reduce: the same values).
 void OpenCLPrinter::adaptiveDtArray(int a) {
   const AdaptiveDt& ad = sched_.adaptiveDt;
   const bool useCfl = ad.cfl;
   const std::string& A = arr(a).name;
   const std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
-  // Per-particle limits on the device, their minima from device partial reductions.
   KernelArgs ka;
   std::vector<std::string> props = {"h"};
   if (useCfl) props.push_back("cs");
@@ -509,42 +569,44 @@ void OpenCLPrinter::adaptiveDtArray(int a) {
     if (ad.force) props.push_back(acc[k]);
   }
   for (const auto& p : props) ka.add("__global const real* " + p, devBuffer(a, p), p);
-  const char* outs[3] = {"dt_cfl", "dt_force", "h2min"};
-  for (int o = 0; o < 3; ++o)
-    ka.add(std::string("__global real* out_") + outs[o],
-           "ocl.scratch(n, " + std::to_string(o + 1) + ")", outs[o]);
-  std::string k = "adaptive_dt_" + A;
-  beginKernel(k, ka);
-  cl_ << "  const int i = d_idx;\n";
+  // The limits the scene uses, in order: (name, per-particle value).
   auto mag = [&](const std::vector<std::string>& c) {
     std::string m = "sqrt(";
     for (int k = 0; k < plan_.dim; ++k) m += (k ? " + " : "") + c[k] + "[i] * " + c[k] + "[i]";
     return m + ")";
   };
-  cl_ << "  out_dt_cfl[i] = " << (useCfl ? "h[i] / (cs[i] + " + mag(vel) + ")" : "INFINITY")
-      << ";\n";
-  cl_ << "  out_h2min[i] = h[i] * h[i];\n";
-  if (ad.force)
-    cl_ << "  const real amag = " << mag(acc) << ";\n"
-        << "  out_dt_force[i] = amag > 0 ? sqrt(h[i] / amag) : INFINITY;\n";
-  else
-    cl_ << "  out_dt_force[i] = INFINITY;\n";
+  std::vector<std::pair<std::string, std::string>> limits;
+  if (useCfl) limits.push_back({"dt_cfl", "h[i] / (cs[i] + " + mag(vel) + ")"});
+  if (ad.force) limits.push_back({"dt_force", "amag > 0 ? sqrt(h[i] / amag) : INFINITY"});
+  if (ad.viscous) limits.push_back({"h2min", "h[i] * h[i]"});
+  if (limits.empty()) {
+    scene_ << "    }\n";
+    return;
+  }
+  const std::string partial =
+      "ocl.scratch(" + std::to_string(limits.size()) + " * sphc::ocl::Context::kPartials, 1)";
+  ka.add("__global real* partial", partial, "partial");
+  std::string k = "adaptive_dt_" + A;
+  cl_ << "// adaptive dt over " << A << ": partial minima per work item\n";
+  beginKernel(k, ka, /*guard=*/false);
+  cl_ << "  const int g = get_global_id(0), G = get_global_size(0);\n";
+  for (const auto& [name, v] : limits) cl_ << "  real " << name << " = INFINITY;\n";
+  cl_ << "  for (int i = g; i < n; i += G) {\n";
+  if (ad.force) cl_ << "    const real amag = " << mag(acc) << ";\n";
+  for (const auto& [name, v] : limits) cl_ << "    " << name << " = fmin(" << name << ", " << v << ");\n";
+  cl_ << "  }\n";
+  for (size_t m = 0; m < limits.size(); ++m)
+    cl_ << "  partial[" << limits.size() << " * g + " << m << "] = " << limits[m].first << ";\n";
   cl_ << "}\n\n";
   scene_ << "      const int n = static_cast<int>(" << A << ".n);\n";
   scene_ << "      const double t = 0.0, dt = 0.0;  // (kernel arguments, unused)\n";
-  scene_ << "      " << launch(k, "n", ka) << "\n";
-  // The minima in one round trip: (limit, scratch slot) for the limits the scene uses.
-  std::vector<std::pair<std::string, int>> mins;
-  if (useCfl) mins.push_back({"dt_cfl", 1});
-  if (ad.force) mins.push_back({"dt_force", 2});
-  if (ad.viscous) mins.push_back({"h2min", 3});
-  scene_ << "      const std::vector<double> mins = ocl.reduce_all({";
-  for (size_t m = 0; m < mins.size(); ++m)
-    scene_ << (m ? ", " : "") << "{ocl.scratch(n, " << mins[m].second
-           << "), static_cast<std::size_t>(n), sphc::ocl::Op::Min}";
-  scene_ << "});\n";
-  for (size_t m = 0; m < mins.size(); ++m)
-    scene_ << "      " << mins[m].first << " = std::fmin(" << mins[m].first << ", mins[" << m
+  std::string l = "ocl.run(\"" + k + "\", sphc::ocl::Context::kPartials, n, t, dt";
+  for (const auto& h : ka.host) l += ", " + h;
+  scene_ << "      " << l << ");\n";
+  scene_ << "      const std::vector<double> mins = ocl.minima(" << partial << ", "
+         << limits.size() << ");\n";
+  for (size_t m = 0; m < limits.size(); ++m)
+    scene_ << "      " << limits[m].first << " = std::fmin(" << limits[m].first << ", mins[" << m
            << "]);\n";
   scene_ << "    }\n";
 }

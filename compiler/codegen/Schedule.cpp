@@ -91,6 +91,7 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
   step();
   adaptiveDt();
   s_->distribution = distributionOf(plan_, s_->cellLists);
+  fusePerParticleWork(*s_);
   return std::move(s_);
 }
 
@@ -379,12 +380,6 @@ void ScheduleBuilder::step() {
     for (const auto& z : plan_.zones) resized.insert({z.array, z.other});
     s_->resized.assign(resized.begin(), resized.end());
   }
-  std::map<std::string, std::vector<int>> methods;
-  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
-    if (plan_.arrays[a].stepper >= 0)
-      for (const auto& [m, b] : plan_.steppers[plan_.arrays[a].stepper].methods)
-        methods[m].push_back(a);
-  for (auto& [m, arrays] : methods) s_->stepperMethods.push_back({m, arrays});
 }
 
 void ScheduleBuilder::adaptiveDt() {

@@ -56,6 +56,15 @@ struct Reduction {
   LoopOrder combine = LoopOrder::Parallel;
 };
 
+// Per-particle work of an earlier phase that the schedule moved into a later kernel of the
+// same array (ScheduleFusion.cpp): its equation, its method (initialize or post_loop) and the
+// phase it comes from (provenance).
+struct MovedWork {
+  const PlanEquation* equation = nullptr;
+  ast::Method::Kind method = ast::Method::Initialize;
+  std::string phase;
+};
+
 // What a phase does for one destination array.
 struct DestinationWork {
   int array = -1;
@@ -74,6 +83,14 @@ struct DestinationWork {
   // after it (empty when the phase ran on the ghosts too).
   std::vector<std::string> ghostRefresh;
   LoopOrder perParticle = LoopOrder::Parallel;  // the initialize and post_loop loops
+  // Kernel fusion (ScheduleFusion.cpp; a printer may use it or run the phases as listed):
+  // per-particle work of earlier phases on this array that runs first, in order, in this
+  // destination's initialize loop; this destination's initialize (with what it took in) or
+  // post_loop moved into a later phase's initialize loop; its reductions' per-particle values
+  // computed in its post_loop loop (the last per-particle loop on it).
+  std::vector<MovedWork> initializeFirst;
+  bool initializeMoved = false, postLoopMoved = false;
+  bool reduceInPostLoop = false;
   // The group's `start_idx` / `stop_idx` (null: 0 / all particles): initialize, the
   // neighbour passes and post_loop run on destination particles start <= d_idx < stop only
   // (clamped to [0, n)); reductions on every real particle.
@@ -217,10 +234,13 @@ struct Schedule {
   // they feed or take from), in array order; empty without inlets and outlets. Their data
   // is on the host for the manager (printers: arraysToHost / arraysFromHost).
   std::vector<int> resized;
-  // Each stepper method on its own (printers that do not fuse runs): method -> arrays.
-  std::vector<std::pair<std::string, std::vector<int>>> stepperMethods;
   AdaptiveDt adaptiveDt;
 };
+
+// Kernel fusion over a built schedule (ScheduleFusion.cpp): per-particle loops of consecutive
+// phases on one array joined where nothing between them reads or writes that array (see
+// DestinationWork::initializeFirst), and reductions' values computed in the post_loop loop.
+void fusePerParticleWork(Schedule& s);
 
 // The schedule of an analysed plan (after the ghost pass). Pure: reads the plan only (and
 // the source lines of its groups, which name their functions).

@@ -44,8 +44,9 @@ __kernel void sphc_cell_keys(const uint n, __global const real* x, __global cons
   atomic_inc(&count[key]);
 }
 
-// Exclusive scan of count[0..cells) into start (and end = start + count), in three kernels:
-// G work items sum chunks, one scans the G sums, G write their chunks.
+// Exclusive scan of count[0..cells) into start (and end = start + count), in two kernels:
+// G work items sum chunks; then each of G work items adds up the sums of the chunks before its
+// own (G^2 / 2 reads in all, G = 256: cheaper than a launch) and writes its chunk.
 __kernel void sphc_scan_chunks(__global const uint* count, const uint cells,
                                __global uint* partial) {
   const uint g = get_global_id(0), G = get_global_size(0);
@@ -54,21 +55,13 @@ __kernel void sphc_scan_chunks(__global const uint* count, const uint cells,
   for (uint c = g * chunk; c < min(cells, (g + 1) * chunk); ++c) sum += count[c];
   partial[g] = sum;
 }
-__kernel void sphc_scan_partials(__global uint* partial, const uint G) {
-  if (get_global_id(0) != 0) return;
-  uint acc = 0;
-  for (uint g = 0; g < G; ++g) {
-    const uint v = partial[g];
-    partial[g] = acc;
-    acc += v;
-  }
-}
 __kernel void sphc_scan_apply(__global uint* count, const uint cells,
                               __global const uint* partial, __global uint* start,
                               __global uint* end) {
   const uint g = get_global_id(0), G = get_global_size(0);
   const uint chunk = (cells + G - 1) / G;
-  uint acc = partial[g];
+  uint acc = 0;
+  for (uint k = 0; k < g; ++k) acc += partial[k];
   for (uint c = g * chunk; c < min(cells, (g + 1) * chunk); ++c) {
     start[c] = acc;
     acc += count[c];
@@ -85,10 +78,14 @@ __kernel void sphc_scatter(const uint n, __global const uint* keys, __global con
 }
 // The scatter's order within a cell depends on timing: sort each cell by index (cells hold a
 // few particles), so the order is deterministic and the CPU's (ascending index).
+// It also zeroes the cell's count (the scatter's cursor): the counts are all zero again for
+// the next build, which then needs no fill.
 __kernel void sphc_sort_cells(const uint cells, __global const uint* start,
-                              __global const uint* end, __global uint* order) {
+                              __global const uint* end, __global uint* order,
+                              __global uint* count) {
   const uint c = get_global_id(0);
   if (c >= cells) return;
+  count[c] = 0;
   const uint b = start[c], e = end[c];
   for (uint k = b + 1; k < e; ++k) {
     const uint v = order[k];
@@ -164,15 +161,13 @@ __kernel void sphc_ghost_copy8(__global ulong* v, __global const uint* source, c
   v[n * stride + i] = v[source[i / stride] * stride + i % stride];
 }
 
-// Partial extents for the search domain, one pass: work item g writes min/max of the finite
-// x, y, z (axes beyond dim: +inf/-inf) and the max of finite h over v[g], v[g + G], ...
-__kernel void sphc_extent(const uint n, const int dim, __global const real* x,
-                          __global const real* y, __global const real* z,
-                          __global const real* h, const uint offset,
-                          __global real* partial) {
+// Partial extents for the search domain, one pass over two arrays (a and b; nb = 0: a only):
+// work item g writes min/max of the finite x, y, z (axes beyond dim: +inf/-inf) and the max
+// of finite h over a[g], a[g + G], ... and b[g], b[g + G], ...
+inline void sphc_extent_of(const uint n, const int dim, __global const real* x,
+                           __global const real* y, __global const real* z,
+                           __global const real* h, real* lo, real* hi, real* hmax) {
   const uint g = get_global_id(0), G = get_global_size(0);
-  real lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-  real hmax = -INFINITY;
   for (uint i = g; i < n; i += G) {
     const real v[3] = {x[i], dim > 1 ? y[i] : (real)0, dim > 2 ? z[i] : (real)0};
     for (int a = 0; a < dim; ++a)
@@ -180,8 +175,19 @@ __kernel void sphc_extent(const uint n, const int dim, __global const real* x,
         lo[a] = fmin(lo[a], v[a]);
         hi[a] = fmax(hi[a], v[a]);
       }
-    if (isfinite(h[i])) hmax = fmax(hmax, h[i]);
+    if (isfinite(h[i])) *hmax = fmax(*hmax, h[i]);
   }
+}
+__kernel void sphc_extent(const int dim, const uint na, __global const real* xa,
+                          __global const real* ya, __global const real* za,
+                          __global const real* ha, const uint nb, __global const real* xb,
+                          __global const real* yb, __global const real* zb,
+                          __global const real* hb, const uint offset, __global real* partial) {
+  const uint g = get_global_id(0);
+  real lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  real hmax = -INFINITY;
+  sphc_extent_of(na, dim, xa, ya, za, ha, lo, hi, &hmax);
+  sphc_extent_of(nb, dim, xb, yb, zb, hb, lo, hi, &hmax);
   partial += offset + 7 * g;
   for (int a = 0; a < 3; ++a) {
     partial[2 * a] = lo[a];
@@ -491,6 +497,7 @@ void Context::set_arg(cl_kernel k, cl_uint& i, const CellTable& c) {
 void Context::launch(cl_kernel k, std::size_t n, const std::string& name) {
   const std::size_t local = 64;
   std::size_t global = (n + local - 1) / local * local;
+  ++launches_;
   const auto start =
       profile_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
   check(clEnqueueNDRangeKernel(queue_, k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
@@ -540,6 +547,16 @@ std::vector<double> Context::reduce_all(const std::vector<Reduction>& rs) {
   return out;
 }
 
+std::vector<double> Context::minima(cl_mem partial, int columns) {
+  const std::size_t c = static_cast<std::size_t>(columns);
+  host_partial_.resize(kPartials * c);
+  read_reals(partial, host_partial_.data(), host_partial_.size());
+  std::vector<double> out(c, HUGE_VAL);
+  for (std::size_t g = 0; g < kPartials; ++g)
+    for (std::size_t k = 0; k < c; ++k) out[k] = std::fmin(out[k], host_partial_[g * c + k]);
+  return out;
+}
+
 double Context::reduce(cl_mem v, std::size_t n, Op op, bool finite_only) {
   return reduce_all({{v, n, op, finite_only}})[0];
 }
@@ -561,24 +578,27 @@ SearchDomain Context::search_domain(const std::vector<Extent>& arrays, int dim,
                                     double radius_scale) {
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   double hmax = -HUGE_VAL;
-  // One partial-extent kernel per array, one read of all partial results.
+  // One partial-extent kernel per two arrays, one read of all partial results.
   const std::size_t per = 7 * kReduceItems;
-  cl_mem partial = scratch(per * arrays.size(), -2);
-  for (std::size_t k = 0; k < arrays.size(); ++k) {
-    const Extent& e = arrays[k];
+  const std::size_t launches = (arrays.size() + 1) / 2;
+  cl_mem partial = scratch(per * (launches ? launches : 1), -2);
+  for (std::size_t k = 0; k < launches; ++k) {
     cl_kernel kern = kernel("sphc_extent");
     cl_uint i = 0;
-    set_arg(kern, i, static_cast<unsigned>(e.n));
     set_arg(kern, i, dim);
-    set_arg(kern, i, e.x);
-    set_arg(kern, i, e.y ? e.y : e.x);
-    set_arg(kern, i, e.z ? e.z : e.x);
-    set_arg(kern, i, e.h);
+    for (std::size_t j = 2 * k; j < 2 * k + 2; ++j) {
+      const Extent& e = arrays[j < arrays.size() ? j : 2 * k];  // none: n = 0
+      set_arg(kern, i, static_cast<unsigned>(j < arrays.size() ? e.n : 0));
+      set_arg(kern, i, e.x);
+      set_arg(kern, i, e.y ? e.y : e.x);
+      set_arg(kern, i, e.z ? e.z : e.x);
+      set_arg(kern, i, e.h);
+    }
     set_arg(kern, i, static_cast<unsigned>(k * per));
     set_arg(kern, i, partial);
     launch(kern, kReduceItems, "sphc_extent");
   }
-  std::vector<double> values(per * arrays.size());
+  std::vector<double> values(per * launches);
   read_reals(partial, values.data(), values.size());
   for (std::size_t j = 0; j < values.size(); j += 7) {
     for (int a = 0; a < dim; ++a) {
@@ -627,7 +647,9 @@ Grid Context::grid_of(const SearchDomain& dom) const {
 
 void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem z, std::size_t n) {
   // A counting sort by cell: keys and counts, a scan into start/end, a scatter, and a sort of
-  // each cell's few indices (deterministic order). Eight launches, O(n + cells) work.
+  // each cell's few indices (deterministic order). Five launches, O(n + cells) work. The
+  // counts are zero between builds (sphc_sort_cells zeroes them): filled once, when
+  // allocated.
   if (n > padded || !keys) {
     if (keys) clReleaseMemObject(keys);
     if (order) clReleaseMemObject(order);
@@ -642,18 +664,18 @@ void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem
     start = ctx.alloc(cells * sizeof(cl_uint));
     end = ctx.alloc(cells * sizeof(cl_uint));
     count = ctx.alloc(cells * sizeof(cl_uint));
+    const unsigned all = static_cast<unsigned>(cells);
+    ctx.run("sphc_fill_uint", all, count, 0u, all);
   }
   if (!partial) partial = ctx.alloc(kScanItems * sizeof(cl_uint));
   const unsigned nc = static_cast<unsigned>(grid.cells());
   const unsigned un = static_cast<unsigned>(n);
-  ctx.run("sphc_fill_uint", nc, count, 0u, nc);
   ctx.run("sphc_cell_keys", n, un, x, y ? y : x, z ? z : x, y ? 1 : 0, z ? 1 : 0, grid, keys,
           count);
   ctx.run("sphc_scan_chunks", kScanItems, count, nc, partial);
-  ctx.run("sphc_scan_partials", 1, partial, static_cast<unsigned>(kScanItems));
   ctx.run("sphc_scan_apply", kScanItems, count, nc, partial, start, end);
   ctx.run("sphc_scatter", n, un, keys, start, count, order);
-  ctx.run("sphc_sort_cells", nc, nc, start, end, order);
+  ctx.run("sphc_sort_cells", nc, nc, start, end, order, count);
 }
 
 void CellTable::release() {

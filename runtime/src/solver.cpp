@@ -293,6 +293,7 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        backend=B threads=T [omp_wait=W] precision=double|single\n"
       "                        [nnps_s=S nnps_share=F: time in the neighbour search]\n"
       "                        [iterations=I: of iterated groups, in all]\n"
+      "                        [launches_per_step=L: device kernel launches (OpenCL)]\n"
       "                        serial, OpenMP: per top-level group of the equations,\n"
       "                        timing-group: name=FILE:LINE s=S share=F equations=E,...\n"
       "                        and timing-split: wall_s=W groups_s=G nnps_s=N\n"
@@ -665,9 +666,11 @@ class Simulation {
 
     const long check_every = prog_.to_host ? kCheckEveryDevice : kCheckEvery;
     const auto loop_start = Clock::now();
+    first_step_ = step_;
     metrics_clock_ = {loop_start, cpu_seconds()};
     nnps_start_ = prog_.neighbour_seconds ? prog_.neighbour_seconds() : 0.0;
     io_start_ = prog_.inlet_outlet_seconds ? prog_.inlet_outlet_seconds() : 0.0;
+    launches_start_ = prog_.device_launches ? prog_.device_launches() : 0;
     if (prog_.group_seconds) group_start_ = prog_.group_seconds();
     progress_.start(!opt_.quiet && prog_.rank <= 0, tf);
     double particle_steps = 0;
@@ -1088,6 +1091,11 @@ class Simulation {
         const double s = prog_.inlet_outlet_seconds() - io_start_;
         nnps += fmt::format(" io_s={:.6g} io_share={:.4f}", s, wall_s > 0 ? s / wall_s : 0.0);
       }
+      // Device backends: kernel launches per time step (the time loop's, over its steps).
+      if (prog_.device_launches && step_ > first_step_)
+        nnps += fmt::format(" launches_per_step={:.4g}",
+                            static_cast<double>(prog_.device_launches() - launches_start_) /
+                                static_cast<double>(step_ - first_step_));
       if (prog_.iterations) {
         long total = 0;
         for (const IterationStats& s : prog_.iterations()) total += s.total;
@@ -1147,6 +1155,8 @@ class Simulation {
   Progress& progress_;
   int threads_ = 1;
   double nnps_start_ = 0.0;  // neighbour_seconds() when the time loop started
+  long launches_start_ = 0;  // device_launches() when the time loop started
+  long first_step_ = 0;      // step_ when the time loop started (a restart's step)
   double io_start_ = 0.0;    // inlet_outlet_seconds() then
   std::vector<GroupSeconds> group_start_;  // group_seconds() then
   double step_seconds_ = 0.0;  // wall seconds in prog_.step within the time loop

@@ -148,6 +148,10 @@ class Context {
     bool finite_only = false;
   };
   std::vector<double> reduce_all(const std::vector<Reduction>& rs);
+  // Partial minima computed by a scene kernel itself (one launch of kPartials work items,
+  // item g writing partial[columns * g + c]): their minima per column (fmin: NaN ignored).
+  static constexpr std::size_t kPartials = 256;
+  std::vector<double> minima(cl_mem partial, int columns);
   // The search domain over every array in a neighbour loop (as sphc::make_search_domain:
   // bounding box of finite coordinates, padded, cell_size = radius_scale * max h), from
   // device data.
@@ -172,6 +176,9 @@ class Context {
   // time per kernel name is printed to stderr at exit.
   void launch(cl_kernel k, std::size_t n, const std::string& name = "");
   bool profiling() const { return profile_; }
+  // Kernel launches so far (every launch through `launch`: the scene's kernels, the neighbour
+  // search's, reductions), for --timing's launches_per_step.
+  long launches() const { return launches_; }
   // Adds host time to the profile printed at exit (under `name`).
   void add_profile(const std::string& name, double seconds);
 
@@ -185,6 +192,7 @@ class Context {
   std::map<int, std::pair<cl_mem, std::size_t>> scratch_;
   std::vector<double> host_partial_;
   bool profile_ = false;
+  long launches_ = 0;
   std::map<std::string, std::pair<double, long>> profile_times_;
 };
 

@@ -156,6 +156,9 @@ struct SceneProgram {
   // Wall seconds spent so far in the inlet/outlet step (sphc/inlet_outlet.h, with the data
   // movement it needs), for the --timing line; empty without inlets and outlets.
   std::function<double()> inlet_outlet_seconds;
+  // Device backends: kernel launches so far (scene and runtime kernels, reductions included),
+  // for the --timing line's launches_per_step; empty where nothing is launched.
+  std::function<long()> device_launches;
   // The scene's limits { } (sphc/sanity.h), computed from the parameters after the set-up;
   // empty: none declared (the default bounding box applies).
   std::function<std::vector<Limit>()> limits;
