@@ -1,0 +1,189 @@
+// Source-only values hoisted out of the pair loops (CPU backends, double precision).
+//
+// The body analysis records the subexpressions of a loop body that depend on the source
+// particle alone and divide or call sqrt, pow, ... (body/SourceOnly.cpp: BodyFacts::
+// sourceOnly), e.g. the momentum equation's `s_p[s_idx] / (rhoj * rhoj)`. Per pair they cost
+// a division; here each is computed once per source particle and evaluation:
+//
+//   - after the loop body's function, one function per site, `PressureGradient_loop_hoisted0
+//     (s_idx, ..., s_p, s_rho)`, returning the site's value (its locals declared first, as the
+//     body declares them);
+//   - in the neighbour pass, before the destination loop, an array of the source's particles
+//     (a member of Scene, `hoist_eq5_0`: scratch, neither a property nor output nor in
+//     restarts) filled by a loop over the source particles, ghosts included;
+//   - the body reads `s_hoisted0[s_idx]` where it had the expression.
+//
+// The value is the same bit for bit: the same operations in the same order, with the same
+// fused multiply-adds (codegen/FusedMultiplyAdd.h: the sites inside the expression are fused
+// in it as they were in the body), and the solvers are built with -ffp-contract=off. The
+// source properties it reads are not written while the pass runs (analysis/Hazards.cpp), and
+// initialize, which may write them for the same array, has finished. `sphc --no-hoist` keeps
+// the bodies as written. OpenCL, --precision=single and --mpi keep the bodies as written.
+#include "body/TextEdits.h"
+#include "codegen/FusedMultiplyAdd.h"
+#include "codegen/Printer.h"
+
+#include <algorithm>
+
+namespace sphc {
+
+namespace {
+
+// text[begin, end) with the multiply-adds inside it fused (as they are in the whole body).
+std::string fusedRange(const std::string& text, const BodyFacts& f, unsigned begin, unsigned end,
+                       const std::string& fma) {
+  std::vector<MultiplyAddSite> inside;
+  for (MultiplyAddSite s : f.multiplyAdds) {
+    if (s.begin < begin || s.end > end) continue;
+    for (unsigned* o : {&s.begin, &s.end, &s.productBegin, &s.productEnd, &s.aBegin, &s.aEnd,
+                        &s.bBegin, &s.bEnd, &s.cBegin, &s.cEnd, &s.mulOp, &s.addOp})
+      *o -= begin;
+    inside.push_back(s);
+  }
+  return fuseMultiplyAdds(text.substr(begin, end - begin), inside, fma);
+}
+
+// An expression on one line, for a comment.
+std::string oneLine(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    bool blank = c == ' ' || c == '\n' || c == '\t' || c == '\r';
+    if (blank && (out.empty() || out.back() == ' ')) continue;
+    out += blank ? ' ' : c;
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out.size() > 90 ? out.substr(0, 87) + "..." : out;
+}
+
+// The end of a statement after an expression: on its own line if the expression ends in a
+// comment.
+std::string endStatement(const std::string& expr) {
+  size_t nl = expr.rfind('\n');
+  return expr.find("//", nl == std::string::npos ? 0 : nl) != std::string::npos ? "\n;" : ";";
+}
+
+bool within(unsigned b, unsigned e, unsigned begin, unsigned end) {
+  return begin <= b && e <= end;
+}
+
+// The source properties a site reads, directly or through its locals (the parameters of its
+// function, in this order).
+std::set<std::string> sourceReads(const BodyFacts& f, const SourceOnlySite& s) {
+  std::set<std::string> props;
+  for (const PropSite& p : f.sites) {
+    if (!p.source || p.write) continue;
+    bool in = within(p.begin, p.end, s.begin, s.end);
+    for (const auto& l : s.locals) in = in || within(p.begin, p.end, l.initBegin, l.initEnd);
+    if (in) props.insert(p.prop);
+  }
+  return props;
+}
+
+}  // namespace
+
+const std::vector<SourceOnlySite>& ScenePrinter::hoistedSites(const PlanBody& b,
+                                                              const Dialect& d) const {
+  static const std::vector<SourceOnlySite> none;
+  if (!d.hoist || b.source.kind != BodyKind::Loop || !b.facts.ok ||
+      b.source.text.find("s_hoisted") != std::string::npos)  // the names would clash
+    return none;
+  return b.facts.sourceOnly;
+}
+
+std::string ScenePrinter::hoistedBodyText(const PlanBody& b, const Dialect& d) const {
+  std::string text = b.source.text;
+  BodyFacts facts = b.facts;
+  std::vector<TextEdit> edits;
+  const auto& sites = hoistedSites(b, d);
+  for (size_t k = 0; k < sites.size(); ++k) {
+    const SourceOnlySite& s = sites[k];
+    // The lines after it keep their numbers (#line): its line breaks follow it.
+    long lines = std::count(text.begin() + s.begin, text.begin() + s.end, '\n');
+    edits.push_back({s.begin, s.end,
+                     "s_hoisted" + std::to_string(k) + "[s_idx]" +
+                         std::string(static_cast<size_t>(lines), '\n')});
+  }
+  if (!applyTextEdits(text, edits, facts))
+    SPHC_INTERNAL("overlapping source-only expressions in " + b.source.label);
+  return fuseMultiplyAdds(text, facts.multiplyAdds, d.fma);
+}
+
+void ScenePrinter::emitHoistFunctions(const PlanBody& b, const std::string& name, const Dialect& d,
+                                      std::ostringstream& os) const {
+  const auto& sites = hoistedSites(b, d);
+  const std::string& text = b.source.text;
+  for (size_t k = 0; k < sites.size(); ++k) {
+    const SourceOnlySite& s = sites[k];
+    const std::set<std::string> props = sourceReads(b.facts, s);
+    os << "// " << b.source.label << ", from " << loc(b.source.start)
+       << ": once per source particle (hoisted out of the pair loop; --no-hoist: per pair)\n";
+    os << "//   " << oneLine(text.substr(s.begin, s.end - s.begin)) << "\n";
+    os << d.functionPrefix << d.real << " " << name << "_hoisted" << k << "(int s_idx";
+    if (s.usesT) os << ", " << d.real << " t";
+    if (s.usesDt) os << ", " << d.real << " dt";
+    for (const auto& sc : s.scalars) os << ", " << d.real << " " << sc;
+    for (const auto& p : props) {
+      auto shape = b.source.props.find(p);
+      std::string t = shape == b.source.props.end() ? "double" : shape->second.type;
+      os << ", const " << (t == "int" ? d.intType : t == "uint" ? d.uintType : d.real) << "* s_"
+         << p;
+    }
+    os << ") {\n";
+    for (const auto& l : s.locals) {
+      std::string init = fusedRange(text, b.facts, l.initBegin, l.initEnd, d.fma);
+      os << "  const " << l.type << " " << l.name << " = " << init << endStatement(init) << "\n";
+    }
+    std::string value = fusedRange(text, b.facts, s.begin, s.end, d.fma);
+    os << "  return " << value << endStatement(value) << "\n}\n\n";
+  }
+}
+
+void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass,
+                                     const std::string& count, const std::string& pragma) const {
+  std::vector<std::string> calls;
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    const auto& sites = hoistedSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const SourceOnlySite& s = sites[k];
+      if (calls.empty())
+        os << "        // Values of the loop bodies that depend on the source particle only, once "
+              "per\n        // particle (codegen/Hoist.cpp; sphc --no-hoist: per pair).\n"
+           << "        const int n_src = static_cast<int>(" << count << ");\n";
+      const std::string K = std::to_string(k);
+      const std::string ptr = hoistArgument(eqStruct(*eq), K);
+      const std::string member = "hoist_" + eqStruct(*eq) + "_" + K;
+      os << "        " << member << ".resize(n_src);  // " << eq->name << ": "
+         << oneLine(b.source.text.substr(s.begin, s.end - s.begin)) << "\n";
+      os << "        double* const " << ptr << " = " << member << ".data();\n";
+      std::string call = ptr + "[s_idx] = " + bodyFunctionName(eq->name, "loop") + "_hoisted" +
+                         K + "(s_idx";
+      if (s.usesT) call += ", t";
+      if (s.usesDt) call += ", dt";
+      for (const auto& sc : s.scalars) call += ", " + eqStruct(*eq) + "." + sc;
+      for (const auto& p : sourceReads(b.facts, s)) call += ", s_" + p;
+      calls.push_back(call + ");");
+    }
+  }
+  if (calls.empty()) return;
+  os << pragma;
+  os << "        for (int s_idx = 0; s_idx < n_src; ++s_idx) {\n";
+  for (const auto& c : calls) os << "          " << c << "\n";
+  os << "        }\n";
+}
+
+void ScenePrinter::emitHoistMembers(std::ostream& os) const {
+  for (const PlanEquation& eq : plan_.equations) {
+    if (!eq.live) continue;
+    const auto& methods = plan_.equationDecls[eq.declIndex].methods;
+    if (!methods.count(ast::Method::Loop)) continue;
+    const PlanBody& b = methodBody(eq, ast::Method::Loop);
+    const auto& sites = hoistedSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k)
+      os << "  std::vector<double> hoist_" << eqStruct(eq) << "_" << k << ";  // " << eq.name
+         << ": " << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
+         << " per source particle\n";
+  }
+}
+
+}  // namespace sphc
