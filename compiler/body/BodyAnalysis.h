@@ -106,7 +106,8 @@ struct MultiplyAddSite {
 // once from such values and never assigned) and costs more than a load (a division, a call
 // of sqrt, pow, exp, ...): codegen/Hoist.h computes it once per source particle before the
 // neighbour pass and the loop reads it. Offsets are into BodySource::text (kept up to date
-// by body/TextEdits.h).
+// by body/TextEdits.h). BodyFacts::destinationOnly: the same with d_NAME[d_idx] (of properties
+// the body does not write), computed once per destination particle before its neighbours.
 struct SourceOnlySite {
   struct Local {                     // a local the expression reads: `type name = init;`
     std::string name, type;
@@ -131,6 +132,8 @@ struct BodyFacts {
   std::vector<PropSite> sites;           // every indexing of a property
   std::vector<MultiplyAddSite> multiplyAdds;  // every product added to a value (floating)
   std::vector<SourceOnlySite> sourceOnly;     // loop bodies: what may be hoisted
+  std::vector<SourceOnlySite> destinationOnly;  // the same of the destination (d_NAME[d_idx]
+                                                // of properties the body does not write)
 };
 
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given

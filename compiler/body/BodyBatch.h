@@ -184,5 +184,10 @@ using SourceRangeOf = std::function<bool(const clang::Expr*, unsigned&, unsigned
 // (SourceOnly.cpp; BodyFacts::sourceOnly).
 std::vector<SourceOnlySite> findSourceOnlySites(const BodySource& body, clang::FunctionDecl* fn,
                                                 const SourceRangeOf& rangeOf);
+// The destination-only ones (BodyFacts::destinationOnly), reading no d_ property in `written`.
+std::vector<SourceOnlySite> findDestinationOnlySites(const BodySource& body,
+                                                     clang::FunctionDecl* fn,
+                                                     const SourceRangeOf& rangeOf,
+                                                     const std::set<std::string>& written);
 
 }  // namespace sphc::body_detail

@@ -1,6 +1,10 @@
 // Source-only subexpressions of a loop body (BodyFacts::sourceOnly): values that depend on the
 // source particle alone and cost more than a load, so that the printer may compute them once
 // per source particle before the neighbour pass (codegen/Hoist.h) instead of once per pair.
+// Destination-only ones (BodyFacts::destinationOnly) likewise, with d_NAME[d_idx] of the
+// properties the body does not write: once per destination particle, before its neighbours.
+// (GCC does not move them out of the neighbour loop itself: the bodies' stores to d_ arrays
+// may alias the d_ arrays they read, so it reloads and divides at every pair.)
 //
 // An expression is source-only when it is built of
 //   - s_NAME[s_idx] (a source property at the pair's source index, nothing else as index),
@@ -35,8 +39,12 @@ bool isCostly(llvm::StringRef name) {
 
 class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
  public:
-  SourceOnlyFinder(const BodySource& body, const SourceRangeOf& rangeOf)
-      : body_(body), rangeOf_(rangeOf) {}
+  // side: "s" (source-only: s_NAME[s_idx]) or "d" (destination-only: d_NAME[d_idx], of
+  // properties the body does not write).
+  SourceOnlyFinder(const BodySource& body, const SourceRangeOf& rangeOf, const std::string& side,
+                   const std::set<std::string>& written)
+      : body_(body), rangeOf_(rangeOf), prefix_(side + "_"), index_(side + "_idx"),
+        written_(written) {}
 
   std::vector<SourceOnlySite> find(clang::FunctionDecl* fn) {
     TraverseStmt(fn->getBody());  // locals and what is assigned
@@ -110,9 +118,10 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
       auto* base = llvm::dyn_cast<clang::DeclRefExpr>(a->getBase()->IgnoreParenImpCasts());
       auto* idx = llvm::dyn_cast<clang::DeclRefExpr>(a->getIdx()->IgnoreParenImpCasts());
       return base && idx && llvm::isa<clang::ParmVarDecl>(base->getDecl()) &&
-             base->getDecl()->getName().startswith("s_") &&
-             isPropertyName(base->getDecl()->getName()) && isParam(idx, "s_idx") &&
-             a->getType()->isArithmeticType();
+             base->getDecl()->getName().startswith(prefix_) &&
+             isPropertyName(base->getDecl()->getName()) &&
+             !written_.count(base->getDecl()->getName().drop_front(2).str()) &&
+             isParam(idx, index_) && a->getType()->isArithmeticType();
     }
     if (auto* u = llvm::dyn_cast<clang::UnaryOperator>(e))
       return (u->getOpcode() == clang::UO_Minus || u->getOpcode() == clang::UO_Plus) &&
@@ -214,6 +223,8 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
 
   const BodySource& body_;
   const SourceRangeOf& rangeOf_;
+  const std::string prefix_, index_;        // s_ and s_idx, or d_ and d_idx
+  const std::set<std::string>& written_;    // properties of that side the body writes
   std::map<const clang::VarDecl*, size_t> order_;  // local -> order of declaration
   std::set<const clang::VarDecl*> assigned_;
   std::map<const clang::Expr*, bool> memo_;
@@ -227,7 +238,16 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
 std::vector<SourceOnlySite> findSourceOnlySites(const BodySource& body, clang::FunctionDecl* fn,
                                                 const SourceRangeOf& rangeOf) {
   if (body.kind != BodyKind::Loop || !fn->hasBody()) return {};
-  return SourceOnlyFinder(body, rangeOf).find(fn);
+  const std::set<std::string> none;
+  return SourceOnlyFinder(body, rangeOf, "s", none).find(fn);
+}
+
+std::vector<SourceOnlySite> findDestinationOnlySites(const BodySource& body,
+                                                     clang::FunctionDecl* fn,
+                                                     const SourceRangeOf& rangeOf,
+                                                     const std::set<std::string>& written) {
+  if (body.kind != BodyKind::Loop || !fn->hasBody()) return {};
+  return SourceOnlyFinder(body, rangeOf, "d", written).find(fn);
 }
 
 }  // namespace sphc::body_detail

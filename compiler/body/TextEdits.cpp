@@ -75,13 +75,15 @@ bool applyTextEdits(std::string& text, std::vector<TextEdit> edits, BodyFacts& f
   facts.multiplyAdds = kept;
   // A source-only expression (and the initial values of its locals) moves with its text; one
   // an edit cuts into is dropped (computed in the pair loop as written).
-  std::vector<SourceOnlySite> keptSourceOnly;
-  for (SourceOnlySite s : facts.sourceOnly) {
-    bool ok = map.moveRange(s.begin, s.end);
-    for (auto& l : s.locals) ok = ok && map.moveRange(l.initBegin, l.initEnd);
-    if (ok) keptSourceOnly.push_back(s);
+  for (auto* list : {&facts.sourceOnly, &facts.destinationOnly}) {
+    std::vector<SourceOnlySite> kept;
+    for (SourceOnlySite s : *list) {
+      bool ok = map.moveRange(s.begin, s.end);
+      for (auto& l : s.locals) ok = ok && map.moveRange(l.initBegin, l.initEnd);
+      if (ok) kept.push_back(s);
+    }
+    *list = kept;
   }
-  facts.sourceOnly = keptSourceOnly;
   text = out;
   return true;
 }

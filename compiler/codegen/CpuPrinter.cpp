@@ -279,6 +279,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
            << "; ++d_idx) {\n";
     emitDestLocals(scene_, "          ", q, host_);
+    emitDestinationHoisted(scene_, pass, "          ");  // codegen/Hoist.cpp
     // The neighbour list first (in candidate order; CellList::gather_neighbours), then every
     // loop_all with it, then the loops over the same neighbours.
     scene_ << "          std::vector<std::uint32_t>& nbrs_list = nbrs_lists["

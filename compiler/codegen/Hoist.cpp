@@ -66,12 +66,12 @@ bool within(unsigned b, unsigned e, unsigned begin, unsigned end) {
   return begin <= b && e <= end;
 }
 
-// The source properties a site reads, directly or through its locals (the parameters of its
-// function, in this order).
-std::set<std::string> sourceReads(const BodyFacts& f, const SourceOnlySite& s) {
+// The properties of one side (source: s_, destination: d_) a site reads, directly or through
+// its locals (the parameters of its function, in this order).
+std::set<std::string> sideReads(const BodyFacts& f, const SourceOnlySite& s, bool source) {
   std::set<std::string> props;
   for (const PropSite& p : f.sites) {
-    if (!p.source || p.write) continue;
+    if (p.source != source || p.write) continue;
     bool in = within(p.begin, p.end, s.begin, s.end);
     for (const auto& l : s.locals) in = in || within(p.begin, p.end, l.initBegin, l.initEnd);
     if (in) props.insert(p.prop);
@@ -79,62 +79,129 @@ std::set<std::string> sourceReads(const BodyFacts& f, const SourceOnlySite& s) {
   return props;
 }
 
+bool overlaps(const SourceOnlySite& x, const SourceOnlySite& y) {
+  return x.begin < y.end && y.begin < x.end;
+}
+
 }  // namespace
 
-const std::vector<SourceOnlySite>& ScenePrinter::hoistedSites(const PlanBody& b,
-                                                              const Dialect& d) const {
-  static const std::vector<SourceOnlySite> none;
+std::vector<SourceOnlySite> ScenePrinter::hoistedDestinationSites(const PlanBody& b,
+                                                                  const Dialect& d) const {
+  if (!d.hoist || b.source.kind != BodyKind::Loop || !b.facts.ok ||
+      b.source.text.find("d_hoisted") != std::string::npos)  // the names would clash
+    return {};
+  // A property some pair loop writes (an accumulator such as au) changes during the
+  // neighbour loop of its destination: not hoisted. Checked over every loop of the plan.
+  std::set<std::string> written;
+  for (const PlanBody& other : plan_.bodies)
+    if (other.source.kind == BodyKind::Loop || other.source.kind == BodyKind::LoopAll)
+      for (const PropAccess& w : other.facts.dWrites) written.insert(w.prop);
+  std::vector<SourceOnlySite> kept;
+  for (const SourceOnlySite& s : b.facts.destinationOnly) {
+    bool ok = true;
+    for (const auto& p : sideReads(b.facts, s, false)) ok = ok && !written.count(p);
+    if (ok) kept.push_back(s);
+  }
+  return kept;
+}
+
+std::vector<SourceOnlySite> ScenePrinter::hoistedSites(const PlanBody& b, const Dialect& d) const {
   if (!d.hoist || b.source.kind != BodyKind::Loop || !b.facts.ok ||
       b.source.text.find("s_hoisted") != std::string::npos)  // the names would clash
-    return none;
-  return b.facts.sourceOnly;
+    return {};
+  // An expression of scalars alone is found on both sides: it goes with the destination
+  // (a local of the destination loop rather than an array read per pair).
+  const std::vector<SourceOnlySite> dest = hoistedDestinationSites(b, d);
+  std::vector<SourceOnlySite> kept;
+  for (const SourceOnlySite& s : b.facts.sourceOnly)
+    if (std::none_of(dest.begin(), dest.end(),
+                     [&](const SourceOnlySite& x) { return overlaps(s, x); }))
+      kept.push_back(s);
+  return kept;
 }
 
 std::string ScenePrinter::hoistedBodyText(const PlanBody& b, const Dialect& d) const {
   std::string text = b.source.text;
   BodyFacts facts = b.facts;
   std::vector<TextEdit> edits;
-  const auto& sites = hoistedSites(b, d);
-  for (size_t k = 0; k < sites.size(); ++k) {
-    const SourceOnlySite& s = sites[k];
-    // The lines after it keep their numbers (#line): its line breaks follow it.
-    long lines = std::count(text.begin() + s.begin, text.begin() + s.end, '\n');
-    edits.push_back({s.begin, s.end,
-                     "s_hoisted" + std::to_string(k) + "[s_idx]" +
-                         std::string(static_cast<size_t>(lines), '\n')});
-  }
+  auto replace = [&](const std::vector<SourceOnlySite>& sites, const std::string& name,
+                     const std::string& index) {
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const SourceOnlySite& s = sites[k];
+      // The lines after it keep their numbers (#line): its line breaks follow it.
+      long lines = std::count(text.begin() + s.begin, text.begin() + s.end, '\n');
+      edits.push_back({s.begin, s.end,
+                       name + std::to_string(k) + index +
+                           std::string(static_cast<size_t>(lines), '\n')});
+    }
+  };
+  replace(hoistedSites(b, d), "s_hoisted", "[s_idx]");
+  replace(hoistedDestinationSites(b, d), "d_hoisted", "");
   if (!applyTextEdits(text, edits, facts))
-    SPHC_INTERNAL("overlapping source-only expressions in " + b.source.label);
+    SPHC_INTERNAL("overlapping hoisted expressions in " + b.source.label);
   return fuseMultiplyAdds(text, facts.multiplyAdds, d.fma);
 }
 
 void ScenePrinter::emitHoistFunctions(const PlanBody& b, const std::string& name, const Dialect& d,
                                       std::ostringstream& os) const {
-  const auto& sites = hoistedSites(b, d);
   const std::string& text = b.source.text;
-  for (size_t k = 0; k < sites.size(); ++k) {
-    const SourceOnlySite& s = sites[k];
-    const std::set<std::string> props = sourceReads(b.facts, s);
-    os << "// " << b.source.label << ", from " << loc(b.source.start)
-       << ": once per source particle (hoisted out of the pair loop; --no-hoist: per pair)\n";
-    os << "//   " << oneLine(text.substr(s.begin, s.end - s.begin)) << "\n";
-    os << d.functionPrefix << d.real << " " << name << "_hoisted" << k << "(int s_idx";
-    if (s.usesT) os << ", " << d.real << " t";
-    if (s.usesDt) os << ", " << d.real << " dt";
-    for (const auto& sc : s.scalars) os << ", " << d.real << " " << sc;
-    for (const auto& p : props) {
-      auto shape = b.source.props.find(p);
-      std::string t = shape == b.source.props.end() ? "double" : shape->second.type;
-      os << ", const " << (t == "int" ? d.intType : t == "uint" ? d.uintType : d.real) << "* s_"
-         << p;
+  auto emit = [&](const std::vector<SourceOnlySite>& sites, bool source) {
+    const std::string side = source ? "s" : "d";
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const SourceOnlySite& s = sites[k];
+      os << "// " << b.source.label << ", from " << loc(b.source.start) << ": once per "
+         << (source ? "source" : "destination")
+         << " particle (hoisted out of the pair loop; --no-hoist: per pair)\n";
+      os << "//   " << oneLine(text.substr(s.begin, s.end - s.begin)) << "\n";
+      os << d.functionPrefix << d.real << " " << name << "_" << (source ? "" : "d") << "hoisted"
+         << k << "(int " << side << "_idx";
+      if (s.usesT) os << ", " << d.real << " t";
+      if (s.usesDt) os << ", " << d.real << " dt";
+      for (const auto& sc : s.scalars) os << ", " << d.real << " " << sc;
+      for (const auto& p : sideReads(b.facts, s, source)) {
+        auto shape = b.source.props.find(p);
+        std::string t = shape == b.source.props.end() ? "double" : shape->second.type;
+        os << ", const " << (t == "int" ? d.intType : t == "uint" ? d.uintType : d.real) << "* "
+           << side << "_" << p;
+      }
+      os << ") {\n";
+      if (!source && s.locals.empty() && sideReads(b.facts, s, false).empty())
+        os << "  (void)d_idx;  // scalars only\n";
+      for (const auto& l : s.locals) {
+        std::string init = fusedRange(text, b.facts, l.initBegin, l.initEnd, d.fma);
+        os << "  const " << l.type << " " << l.name << " = " << init << endStatement(init)
+           << "\n";
+      }
+      std::string value = fusedRange(text, b.facts, s.begin, s.end, d.fma);
+      os << "  return " << value << endStatement(value) << "\n}\n\n";
     }
-    os << ") {\n";
-    for (const auto& l : s.locals) {
-      std::string init = fusedRange(text, b.facts, l.initBegin, l.initEnd, d.fma);
-      os << "  const " << l.type << " " << l.name << " = " << init << endStatement(init) << "\n";
-    }
-    std::string value = fusedRange(text, b.facts, s.begin, s.end, d.fma);
-    os << "  return " << value << endStatement(value) << "\n}\n\n";
+  };
+  emit(hoistedSites(b, d), true);
+  emit(hoistedDestinationSites(b, d), false);
+}
+
+// The arguments of a hoisted site's function after its index.
+static std::string hoistArguments(const SourceOnlySite& s, const BodyFacts& f, bool source,
+                                  const std::string& eqValues) {
+  std::string args;
+  if (s.usesT) args += ", t";
+  if (s.usesDt) args += ", dt";
+  for (const auto& sc : s.scalars) args += ", " + eqValues + "." + sc;
+  for (const auto& p : sideReads(f, s, source)) args += (source ? ", s_" : ", d_") + p;
+  return args;
+}
+
+void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass& pass,
+                                          const std::string& indent) const {
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    const auto sites = hoistedDestinationSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k)
+      os << indent << "const double " << hoistDestinationArgument(eqStruct(*eq), std::to_string(k))
+         << " = " << bodyFunctionName(eq->name, "loop") << "_dhoisted" << k << "(d_idx"
+         << hoistArguments(sites[k], b.facts, false, eqStruct(*eq)) << ");  // " << eq->name
+         << ": " << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
+         << "\n";
   }
 }
 
@@ -143,7 +210,7 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
   std::vector<std::string> calls;
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
-    const auto& sites = hoistedSites(b, host_);
+    const auto sites = hoistedSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k) {
       const SourceOnlySite& s = sites[k];
       if (calls.empty())
@@ -156,13 +223,8 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
       os << "        " << member << ".resize(n_src);  // " << eq->name << ": "
          << oneLine(b.source.text.substr(s.begin, s.end - s.begin)) << "\n";
       os << "        double* const " << ptr << " = " << member << ".data();\n";
-      std::string call = ptr + "[s_idx] = " + bodyFunctionName(eq->name, "loop") + "_hoisted" +
-                         K + "(s_idx";
-      if (s.usesT) call += ", t";
-      if (s.usesDt) call += ", dt";
-      for (const auto& sc : s.scalars) call += ", " + eqStruct(*eq) + "." + sc;
-      for (const auto& p : sourceReads(b.facts, s)) call += ", s_" + p;
-      calls.push_back(call + ");");
+      calls.push_back(ptr + "[s_idx] = " + bodyFunctionName(eq->name, "loop") + "_hoisted" + K +
+                      "(s_idx" + hoistArguments(s, b.facts, true, eqStruct(*eq)) + ");");
     }
   }
   if (calls.empty()) return;
@@ -178,7 +240,7 @@ void ScenePrinter::emitHoistMembers(std::ostream& os) const {
     const auto& methods = plan_.equationDecls[eq.declIndex].methods;
     if (!methods.count(ast::Method::Loop)) continue;
     const PlanBody& b = methodBody(eq, ast::Method::Loop);
-    const auto& sites = hoistedSites(b, host_);
+    const auto sites = hoistedSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k)
       os << "  std::vector<double> hoist_" << eqStruct(eq) << "_" << k << ";  // " << eq.name
          << ": " << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))

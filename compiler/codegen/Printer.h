@@ -115,7 +115,8 @@ class ScenePrinter {
   // Parameters of a body function, in order, as (C++ declaration, argument kind) pairs.
   struct BodyParam {
     std::string decl;  // e.g. "const double* s_m"
-    enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp, Nbrs, NNbrs, N, Hoisted } kind;
+    enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp, Nbrs, NNbrs, N, Hoisted,
+                DHoisted } kind;
     std::string name;  // property, pair quantity or scalar name; Hoisted: the site's number
   };
   // The body-parameter types: what each property, pair quantity and scalar is declared as.
@@ -154,8 +155,10 @@ class ScenePrinter {
   std::string propType(int array, const std::string& prop, const Dialect& d) const;
 
   // ---- Source-only values hoisted out of the pair loops (Hoist.cpp) ----
-  // The sites of a loop body computed once per source particle (none unless d.hoist).
-  const std::vector<SourceOnlySite>& hoistedSites(const PlanBody& b, const Dialect& d) const;
+  // The sites of a loop body computed once per source particle (none unless d.hoist), and
+  // those computed once per destination particle (of properties no pair loop writes).
+  std::vector<SourceOnlySite> hoistedSites(const PlanBody& b, const Dialect& d) const;
+  std::vector<SourceOnlySite> hoistedDestinationSites(const PlanBody& b, const Dialect& d) const;
   // The body's text with each hoisted site replaced by `s_hoistedK[s_idx]` (and its facts
   // moved with it), its multiply-adds fused.
   std::string hoistedBodyText(const PlanBody& b, const Dialect& d) const;
@@ -168,10 +171,17 @@ class ScenePrinter {
   // `pragma` before it).
   void emitHoistedValues(std::ostream& os, const NeighbourPass& pass, const std::string& count,
                          const std::string& pragma) const;
+  // In the destination loop of a pass, before the neighbours: the destination-only values,
+  // locals `dhoisted_eqN_K`.
+  void emitDestinationHoisted(std::ostream& os, const NeighbourPass& pass,
+                              const std::string& indent) const;
   // The members of struct Scene that hold them.
   void emitHoistMembers(std::ostream& os) const;
   std::string hoistArgument(const std::string& eqValues, const std::string& k) const {
     return "hoisted_" + eqValues + "_" + k;
+  }
+  std::string hoistDestinationArgument(const std::string& eqValues, const std::string& k) const {
+    return "dhoisted_" + eqValues + "_" + k;
   }
 
   // ---- The host program (HostProgram.cpp) ----
