@@ -24,7 +24,6 @@
 #include "codegen/Printer.h"
 
 #include <algorithm>
-#include <map>
 
 namespace sphc {
 
@@ -78,18 +77,6 @@ std::set<std::string> sideReads(const BodyFacts& f, const SourceOnlySite& s, boo
     if (in) props.insert(p.prop);
   }
   return props;
-}
-
-// The statements of a site's function: its locals, then `return` the value.
-std::string functionBody(const std::string& text, const BodyFacts& f, const SourceOnlySite& s,
-                         const std::string& fma) {
-  std::string out;
-  for (const auto& l : s.locals) {
-    std::string init = fusedRange(text, f, l.initBegin, l.initEnd, fma);
-    out += "  const " + l.type + " " + l.name + " = " + init + endStatement(init) + "\n";
-  }
-  std::string value = fusedRange(text, f, s.begin, s.end, fma);
-  return out + "  return " + value + endStatement(value) + "\n";
 }
 
 bool overlaps(const SourceOnlySite& x, const SourceOnlySite& y) {
@@ -180,7 +167,13 @@ void ScenePrinter::emitHoistFunctions(const PlanBody& b, const std::string& name
       os << ") {\n";
       if (!source && s.locals.empty() && sideReads(b.facts, s, false).empty())
         os << "  (void)d_idx;  // scalars only\n";
-      os << functionBody(text, b.facts, s, d.fma) << "}\n\n";
+      for (const auto& l : s.locals) {
+        std::string init = fusedRange(text, b.facts, l.initBegin, l.initEnd, d.fma);
+        os << "  const " << l.type << " " << l.name << " = " << init << endStatement(init)
+           << "\n";
+      }
+      std::string value = fusedRange(text, b.facts, s.begin, s.end, d.fma);
+      os << "  return " << value << endStatement(value) << "\n}\n\n";
     }
   };
   emit(hoistedSites(b, d), true);
@@ -215,36 +208,23 @@ void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass&
 void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass,
                                      const std::string& count, const std::string& pragma) const {
   std::vector<std::string> calls;
-  // A value another equation of the pass computes the same way (the same statements on the
-  // same arguments, e.g. m_b / rho_b) is computed once: its array is shared.
-  std::map<std::string, std::string> computed;  // function body and arguments -> array
-  bool first = true;
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     const auto sites = hoistedSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k) {
       const SourceOnlySite& s = sites[k];
-      if (first)
+      if (calls.empty())
         os << "        // Values of the loop bodies that depend on the source particle only, once "
               "per\n        // particle (codegen/Hoist.cpp; sphc --no-hoist: per pair).\n"
            << "        const int n_src = static_cast<int>(" << count << ");\n";
-      first = false;
       const std::string K = std::to_string(k);
       const std::string ptr = hoistArgument(eqStruct(*eq), K);
-      const std::string args = hoistArguments(s, b.facts, true, eqStruct(*eq));
-      const std::string key = functionBody(b.source.text, b.facts, s, host_.fma) + args;
-      if (auto same = computed.find(key); same != computed.end()) {
-        os << "        const double* const " << ptr << " = " << same->second << ";  // "
-           << eq->name << ": the same value\n";
-        continue;
-      }
-      computed[key] = ptr;
       const std::string member = "hoist_" + eqStruct(*eq) + "_" + K;
       os << "        " << member << ".resize(n_src);  // " << eq->name << ": "
          << oneLine(b.source.text.substr(s.begin, s.end - s.begin)) << "\n";
       os << "        double* const " << ptr << " = " << member << ".data();\n";
       calls.push_back(ptr + "[s_idx] = " + bodyFunctionName(eq->name, "loop") + "_hoisted" + K +
-                      "(s_idx" + args + ");");
+                      "(s_idx" + hoistArguments(s, b.facts, true, eqStruct(*eq)) + ");");
     }
   }
   if (calls.empty()) return;
