@@ -1,4 +1,4 @@
-// Source-only values hoisted out of the pair loops (CPU backends, double precision).
+// Values hoisted out of the pair loops (CPU backends, double precision, not --mpi).
 //
 // The body analysis records the subexpressions of a loop body that depend on the source
 // particle alone and divide or call sqrt, pow, ... (body/SourceOnly.cpp: BodyFacts::
@@ -12,6 +12,13 @@
 //     (a member of Scene, `hoist_eq5_0`: scratch, neither a property nor output nor in
 //     restarts) filled by a loop over the source particles, ghosts included;
 //   - the body reads `s_hoisted0[s_idx]` where it had the expression.
+//
+// Destination-only subexpressions (BodyFacts::destinationOnly, e.g. `d_p[d_idx] / (rhoi *
+// rhoi)`) of properties that no pair loop of the plan writes likewise: a function
+// `PressureGradient_loop_dhoisted0(d_idx, d_p, d_rho)`, called in the destination loop before
+// the neighbours into a local `dhoisted_eq5_0`, read by the body as `d_hoisted0`. GCC does not
+// do this itself: the bodies' stores to d_ arrays may alias the d_ arrays they read.
+// Expressions of scalars alone (found on both sides) go with the destination.
 //
 // The value is the same bit for bit: the same operations in the same order, with the same
 // fused multiply-adds (codegen/FusedMultiplyAdd.h: the sites inside the expression are fused
