@@ -101,6 +101,24 @@ struct MultiplyAddSite {
                                      // x -= a*b) is not a primary expression: -(...)
 };
 
+// A subexpression of a loop body that depends on the source particle only (s_NAME[s_idx],
+// literals, the equation's scalars, t, dt, the allowed math functions, and locals declared
+// once from such values and never assigned) and costs more than a load (a division, a call
+// of sqrt, pow, exp, ...): codegen/Hoist.h computes it once per source particle before the
+// neighbour pass and the loop reads it. Offsets are into BodySource::text (kept up to date
+// by body/TextEdits.h). BodyFacts::destinationOnly: the same with d_NAME[d_idx] (of properties
+// the body does not write), computed once per destination particle before its neighbours.
+struct SourceOnlySite {
+  struct Local {                     // a local the expression reads: `type name = init;`
+    std::string name, type;
+    unsigned initBegin = 0, initEnd = 0;
+  };
+  unsigned begin = 0, end = 0;       // the expression
+  std::vector<Local> locals;         // in order of declaration (each after those it reads)
+  std::set<std::string> scalars;     // of BodySource::scalars, through the locals too
+  bool usesT = false, usesDt = false;
+};
+
 struct BodyFacts {
   bool ok = false;                   // false: errors were reported for this body
   std::vector<PropAccess> dReads;    // d_ properties read (incl. read in `+=`)
@@ -113,6 +131,9 @@ struct BodyFacts {
   std::set<std::string> statesWritten;   // which of BodySource::states it assigns
   std::vector<PropSite> sites;           // every indexing of a property
   std::vector<MultiplyAddSite> multiplyAdds;  // every product added to a value (floating)
+  std::vector<SourceOnlySite> sourceOnly;     // loop bodies: what may be hoisted
+  std::vector<SourceOnlySite> destinationOnly;  // the same of the destination (d_NAME[d_idx]
+                                                // of properties the body does not write)
 };
 
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given

@@ -10,6 +10,7 @@
 #include "llvm/ADT/StringRef.h"
 #include "llvm/Support/SourceMgr.h"
 
+#include <functional>
 #include <set>
 #include <string>
 #include <vector>
@@ -176,5 +177,17 @@ class Batch {
 // The AST walk over body `index` of the batch (BodyChecker.cpp): facts and sphc's rules.
 void checkBodyFunction(Batch& batch, int index, const clang::SourceManager& sm,
                        clang::FunctionDecl* fn);
+
+// text[begin, end) of an expression of the body being checked; false where it has none.
+using SourceRangeOf = std::function<bool(const clang::Expr*, unsigned&, unsigned&)>;
+// The source-only subexpressions of a loop body worth computing once per source particle
+// (SourceOnly.cpp; BodyFacts::sourceOnly).
+std::vector<SourceOnlySite> findSourceOnlySites(const BodySource& body, clang::FunctionDecl* fn,
+                                                const SourceRangeOf& rangeOf);
+// The destination-only ones (BodyFacts::destinationOnly), reading no d_ property in `written`.
+std::vector<SourceOnlySite> findDestinationOnlySites(const BodySource& body,
+                                                     clang::FunctionDecl* fn,
+                                                     const SourceRangeOf& rangeOf,
+                                                     const std::set<std::string>& written);
 
 }  // namespace sphc::body_detail

@@ -29,6 +29,15 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     // A name `fma` of the body's own (a local, a scalar) would hide OpenCL's fma: as written.
     for (clang::ParmVarDecl* p : fn->parameters()) namesFma_ |= p->getName() == "fma";
     if (namesFma_) facts_.multiplyAdds.clear();
+    if (batch_.state[i_].errors == 0) {
+      SourceRangeOf range = [&](const clang::Expr* e, unsigned& b, unsigned& en) {
+        return textRange(e, b, en);
+      };
+      facts_.sourceOnly = findSourceOnlySites(body_, fn, range);
+      std::set<std::string> written;
+      for (const PropAccess& w : facts_.dWrites) written.insert(w.prop);
+      facts_.destinationOnly = findDestinationOnlySites(body_, fn, range, written);
+    }
   }
 
   // --- facts ---

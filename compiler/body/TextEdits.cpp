@@ -73,6 +73,17 @@ bool applyTextEdits(std::string& text, std::vector<TextEdit> edits, BodyFacts& f
       kept.push_back(s);
   }
   facts.multiplyAdds = kept;
+  // A source-only expression (and the initial values of its locals) moves with its text; one
+  // an edit cuts into is dropped (computed in the pair loop as written).
+  for (auto* list : {&facts.sourceOnly, &facts.destinationOnly}) {
+    std::vector<SourceOnlySite> kept;
+    for (SourceOnlySite s : *list) {
+      bool ok = map.moveRange(s.begin, s.end);
+      for (auto& l : s.locals) ok = ok && map.moveRange(l.initBegin, l.initEnd);
+      if (ok) kept.push_back(s);
+    }
+    *list = kept;
+  }
   text = out;
   return true;
 }

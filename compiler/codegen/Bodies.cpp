@@ -30,6 +30,8 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
     host_.fma = "std::fma";
     device_.fma = "fma";
   }
+  host_.hoist = opts.hoist && opts.backend != Backend::OpenCL && !singlePrecision_ &&
+                !sched.distribution.enabled;
   for (int a : sched.cellLists) sourceArrays_.push_back(arr(a).name);
   for (int a : sched.searchArrays) loopArrays_.insert(arr(a).name);
   mpi_ = sched.distribution.enabled;
@@ -108,6 +110,16 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b,
     std::string type = t == "int" ? d.intType : t == "uint" ? d.uintType : real;
     ps.push_back({global + "const " + type + "* s_" + p, BodyParam::SProp, p});
   }
+  // Values computed once per source particle (codegen/Hoist.cpp): s_hoisted0, ...
+  const auto hoisted = hoistedSites(b, d);
+  for (size_t k = 0; k < hoisted.size(); ++k)
+    ps.push_back({"const " + real + "* s_hoisted" + std::to_string(k), BodyParam::Hoisted,
+                  std::to_string(k)});
+  // ... and once per destination particle: d_hoisted0, ...
+  const auto dHoisted = hoistedDestinationSites(b, d);
+  for (size_t k = 0; k < dHoisted.size(); ++k)
+    ps.push_back({real + " d_hoisted" + std::to_string(k), BodyParam::DHoisted,
+                  std::to_string(k)});
   return ps;
 }
 
@@ -129,11 +141,14 @@ void ScenePrinter::emitBodyFunction(const PlanBody& b, const std::string& name,
   os << "}\n";
   if (d.lineDirectives) resetLineDirective(os, d);
   os << "\n";
+  emitHoistFunctions(b, name, d, os);
 }
 
 // A body's or helper's text in a dialect: its multiply-adds fused, in float for
 // --precision=single on the CPU.
 std::string ScenePrinter::bodyText(const PlanBody& b, const Dialect& d) const {
+  if (!hoistedSites(b, d).empty() || !hoistedDestinationSites(b, d).empty())
+    return hoistedBodyText(b, d);
   std::string text = fuseMultiplyAdds(b.source.text, b.facts.multiplyAdds, d.fma);
   return d.floatBodies ? singlePrecisionBody(text) : text;
 }
@@ -259,6 +274,8 @@ std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int
       case BodyParam::Nbrs: s += "NBRS"; break;
       case BodyParam::NNbrs: s += "N_NBRS"; break;
       case BodyParam::N: s += "N"; break;
+      case BodyParam::Hoisted: s += hoistArgument(eqValues, p.name); break;
+      case BodyParam::DHoisted: s += hoistDestinationArgument(eqValues, p.name); break;
     }
   }
   return s + ")";

@@ -33,6 +33,11 @@ struct EmitOptions {
   // the support across steps (sphc/verlet.h); 0: gathered from the cell lists every
   // evaluation.
   double verletSkin = 0.0;
+  // Source-only subexpressions of pair-loop bodies that divide or call sqrt, pow, ... are
+  // computed once per source particle before the neighbour pass (codegen/Hoist.cpp; CPU
+  // backends, double precision, not --mpi); false (--no-hoist): computed per pair as written.
+  // The values are the same bit for bit.
+  bool hoist = true;
 };
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.

@@ -44,6 +44,7 @@ class CpuPrinter : public ScenePrinter {
     // thread, reused from particle to particle (CellList::gather_neighbours).
     out_ << "  std::vector<std::vector<std::uint32_t>> nbrs_lists;\n";
     if (verlet()) verletMembers();
+    emitHoistMembers(out_);
   }
   // --verlet-skin: the lists are kept across evaluations (sphc/verlet.h).
   bool verlet() const { return verletSkin_ > 0; }
@@ -238,6 +239,9 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "      }\n";
       continue;
     }
+    // Source-only values of the loop bodies, once per source particle (codegen/Hoist.cpp).
+    emitHoistedValues(scene_, pass, hasDomain() ? S + ".n + ghosts_" + S + ".size()" : S + ".n",
+                      parallelFor("        ", pass.order));
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, d, s) : "";
     if (verlet()) {
@@ -275,6 +279,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
            << "; ++d_idx) {\n";
     emitDestLocals(scene_, "          ", q, host_);
+    emitDestinationHoisted(scene_, pass, "          ");  // codegen/Hoist.cpp
     // The neighbour list first (in candidate order; CellList::gather_neighbours), then every
     // loop_all with it, then the loops over the same neighbours.
     scene_ << "          std::vector<std::uint32_t>& nbrs_list = nbrs_lists["

@@ -43,6 +43,8 @@ struct Dialect {
   // The fused multiply-add that bodies' products added to values are printed as
   // (codegen/FusedMultiplyAdd.h): std::fma / fma; empty: printed as written (--fma=off).
   std::string fma;
+  // Loop bodies read their source-only values from per-particle arrays (codegen/Hoist.cpp).
+  bool hoist = false;
   std::string lit(const std::string& v) const { return floatLiterals ? v + "f" : v; }
 };
 
@@ -113,8 +115,9 @@ class ScenePrinter {
   // Parameters of a body function, in order, as (C++ declaration, argument kind) pairs.
   struct BodyParam {
     std::string decl;  // e.g. "const double* s_m"
-    enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp, Nbrs, NNbrs, N } kind;
-    std::string name;  // property, pair quantity or scalar name
+    enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp, Nbrs, NNbrs, N, Hoisted,
+                DHoisted } kind;
+    std::string name;  // property, pair quantity or scalar name; Hoisted: the site's number
   };
   // The body-parameter types: what each property, pair quantity and scalar is declared as.
   std::vector<BodyParam> bodyParams(const PlanBody& b, int destArray, const Dialect& d) const;
@@ -150,6 +153,36 @@ class ScenePrinter {
   void resetLineDirective(std::ostringstream& os, const Dialect& d) const;
   // A property's type in a dialect (constants and floating properties: its real).
   std::string propType(int array, const std::string& prop, const Dialect& d) const;
+
+  // ---- Source-only values hoisted out of the pair loops (Hoist.cpp) ----
+  // The sites of a loop body computed once per source particle (none unless d.hoist), and
+  // those computed once per destination particle (of properties no pair loop writes).
+  std::vector<SourceOnlySite> hoistedSites(const PlanBody& b, const Dialect& d) const;
+  std::vector<SourceOnlySite> hoistedDestinationSites(const PlanBody& b, const Dialect& d) const;
+  // The body's text with each hoisted site replaced by `s_hoistedK[s_idx]` (and its facts
+  // moved with it), its multiply-adds fused.
+  std::string hoistedBodyText(const PlanBody& b, const Dialect& d) const;
+  // After a loop body's function `name`: one function per hoisted site, NAME_hoistedK(s_idx,
+  // ...), returning the site's value for a source particle.
+  void emitHoistFunctions(const PlanBody& b, const std::string& name, const Dialect& d,
+                          std::ostringstream& os) const;
+  // Before a neighbour pass over source s (with `count` particles): the hoisted values of
+  // its loop equations, one array each, filled in a loop over the source particles (with
+  // `pragma` before it).
+  void emitHoistedValues(std::ostream& os, const NeighbourPass& pass, const std::string& count,
+                         const std::string& pragma) const;
+  // In the destination loop of a pass, before the neighbours: the destination-only values,
+  // locals `dhoisted_eqN_K`.
+  void emitDestinationHoisted(std::ostream& os, const NeighbourPass& pass,
+                              const std::string& indent) const;
+  // The members of struct Scene that hold them.
+  void emitHoistMembers(std::ostream& os) const;
+  std::string hoistArgument(const std::string& eqValues, const std::string& k) const {
+    return "hoisted_" + eqValues + "_" + k;
+  }
+  std::string hoistDestinationArgument(const std::string& eqValues, const std::string& k) const {
+    return "dhoisted_" + eqValues + "_" + k;
+  }
 
   // ---- The host program (HostProgram.cpp) ----
   void emitBodies();

@@ -76,6 +76,13 @@ static cl::opt<double> VerletSkin(
              "openmp, double precision, no periodic/mirror domain, inlets, outlets or --mpi). "
              "Sums over neighbours may round differently. Default 0: off"),
     cl::value_desc("F"), cl::init(0.0), cl::cat(SphcCat));
+static cl::opt<bool> NoHoist(
+    "no-hoist",
+    cl::desc("Compute every subexpression of a pair-loop body per pair, as written (default: "
+             "those that depend on the source particle only and divide or call sqrt, pow, ... "
+             "are computed once per particle before the neighbour pass; serial and openmp, "
+             "double precision; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 enum class EmitKind { Exe, Cpp, OpenCL, Plan, Ast };
 static cl::opt<std::string> KernelOpt(
     "kernel", cl::desc("Replace the scene's smoothing kernel (CubicSpline, QuinticSpline, "
@@ -289,7 +296,7 @@ int main(int argc, char** argv) {
     return fail();
   }
   EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
-                       VerletSkin};
+                       VerletSkin, !NoHoist};
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;

@@ -101,6 +101,56 @@ TEST_F(BodyAnalysisTest, WritesReadsScalarsAndTime) {
   EXPECT_TRUE(facts[0].pairQuantities.empty());
 }
 
+// What a loop body may compute once per source or destination particle (BodyFacts::
+// sourceOnly, destinationOnly; codegen/Hoist.cpp): the outermost one-sided expressions that
+// divide or call a costly math function, with the locals they read.
+TEST_F(BodyAnalysisTest, SourceAndDestinationOnlyExpressions) {
+  load("equation E(k) {\n"
+       "  loop {\n"
+       "    double rhoj = s_rho[s_idx];\n"
+       "    double q = s_m[s_idx];\n"
+       "    q = q * 2.0;\n"
+       "    int n = s_i[s_idx] / 2;\n"
+       "    d_a[d_idx] += s_p[s_idx] / (rhoj * rhoj) * WIJ;\n"
+       "    d_a[d_idx] += q / s_rho[s_idx];\n"
+       "    d_a[d_idx] += s_m[d_idx] / s_rho[s_idx];\n"
+       "    d_a[d_idx] += s_m[s_idx] * k * WIJ;\n"
+       "    d_a[d_idx] += sqrt(s_m[s_idx] + k * t) * WIJ;\n"
+       "    d_a[d_idx] += s_m[s_idx] / RIJ;\n"
+       "    d_a[d_idx] += fabs(s_m[s_idx]) + n;\n"
+       "    d_b[d_idx] = d_c[d_idx] / d_rho[d_idx];\n"
+       "    d_a[d_idx] += d_a[d_idx] / d_rho[d_idx];\n"
+       "  }\n"
+       "}\n");
+  BodySource b = body("loop", BodyKind::Loop);
+  b.scalars = {"k"};
+  b.props["i"] = PropShape{"int", 1};
+  auto facts = analyze({b});
+  EXPECT_EQ(output(), "");
+  ASSERT_TRUE(facts[0].ok);
+  auto text = [&](unsigned begin, unsigned end) { return b.text.substr(begin, end - begin); };
+  // Not: q is assigned after its declaration, s_m[d_idx] is not the source particle's, the
+  // product costs no more than a load, RIJ is a pair quantity, fabs is cheap, the int
+  // division could trap.
+  ASSERT_EQ(facts[0].sourceOnly.size(), 2u);
+  const SourceOnlySite& p = facts[0].sourceOnly[0];
+  EXPECT_EQ(text(p.begin, p.end), "s_p[s_idx] / (rhoj * rhoj)");
+  ASSERT_EQ(p.locals.size(), 1u);
+  EXPECT_EQ(p.locals[0].name, "rhoj");
+  EXPECT_EQ(p.locals[0].type, "double");
+  EXPECT_EQ(text(p.locals[0].initBegin, p.locals[0].initEnd), "s_rho[s_idx]");
+  EXPECT_TRUE(p.scalars.empty());
+  const SourceOnlySite& r = facts[0].sourceOnly[1];
+  EXPECT_EQ(text(r.begin, r.end), "sqrt(s_m[s_idx] + k * t)");
+  EXPECT_EQ(r.scalars, (std::set<std::string>{"k"}));
+  EXPECT_TRUE(r.usesT);
+  EXPECT_FALSE(r.usesDt);
+  // Of the destination: not a, which the body writes.
+  ASSERT_EQ(facts[0].destinationOnly.size(), 1u);
+  const SourceOnlySite& d = facts[0].destinationOnly[0];
+  EXPECT_EQ(text(d.begin, d.end), "d_c[d_idx] / d_rho[d_idx]");
+}
+
 TEST_F(BodyAnalysisTest, SourceWriteIsAnError) {
   load("equation E() {\n"
        "  loop { s_rho[s_idx] = 1.0; }\n"

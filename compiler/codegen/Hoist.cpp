@@ -1,0 +1,258 @@
+// Values hoisted out of the pair loops (CPU backends, double precision, not --mpi).
+//
+// The body analysis records the subexpressions of a loop body that depend on the source
+// particle alone and divide or call sqrt, pow, ... (body/SourceOnly.cpp: BodyFacts::
+// sourceOnly), e.g. the momentum equation's `s_p[s_idx] / (rhoj * rhoj)`. Per pair they cost
+// a division; here each is computed once per source particle and evaluation:
+//
+//   - after the loop body's function, one function per site, `PressureGradient_loop_hoisted0
+//     (s_idx, ..., s_p, s_rho)`, returning the site's value (its locals declared first, as the
+//     body declares them);
+//   - in the neighbour pass, before the destination loop, an array of the source's particles
+//     (a member of Scene, `hoist_eq5_0`: scratch, neither a property nor output nor in
+//     restarts) filled by a loop over the source particles, ghosts included;
+//   - the body reads `s_hoisted0[s_idx]` where it had the expression.
+//
+// Destination-only subexpressions (BodyFacts::destinationOnly, e.g. `d_p[d_idx] / (rhoi *
+// rhoi)`) of properties that no pair loop of the plan writes likewise: a function
+// `PressureGradient_loop_dhoisted0(d_idx, d_p, d_rho)`, called in the destination loop before
+// the neighbours into a local `dhoisted_eq5_0`, read by the body as `d_hoisted0`. GCC does not
+// do this itself: the bodies' stores to d_ arrays may alias the d_ arrays they read.
+// Expressions of scalars alone (found on both sides) go with the destination.
+//
+// The value is the same bit for bit: the same operations in the same order, with the same
+// fused multiply-adds (codegen/FusedMultiplyAdd.h: the sites inside the expression are fused
+// in it as they were in the body), and the solvers are built with -ffp-contract=off. The
+// source properties it reads are not written while the pass runs (analysis/Hazards.cpp), and
+// initialize, which may write them for the same array, has finished. `sphc --no-hoist` keeps
+// the bodies as written. OpenCL, --precision=single and --mpi keep the bodies as written.
+#include "body/TextEdits.h"
+#include "codegen/FusedMultiplyAdd.h"
+#include "codegen/Printer.h"
+
+#include <algorithm>
+
+namespace sphc {
+
+namespace {
+
+// text[begin, end) with the multiply-adds inside it fused (as they are in the whole body).
+std::string fusedRange(const std::string& text, const BodyFacts& f, unsigned begin, unsigned end,
+                       const std::string& fma) {
+  std::vector<MultiplyAddSite> inside;
+  for (MultiplyAddSite s : f.multiplyAdds) {
+    if (s.begin < begin || s.end > end) continue;
+    for (unsigned* o : {&s.begin, &s.end, &s.productBegin, &s.productEnd, &s.aBegin, &s.aEnd,
+                        &s.bBegin, &s.bEnd, &s.cBegin, &s.cEnd, &s.mulOp, &s.addOp})
+      *o -= begin;
+    inside.push_back(s);
+  }
+  return fuseMultiplyAdds(text.substr(begin, end - begin), inside, fma);
+}
+
+// An expression on one line, for a comment.
+std::string oneLine(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    bool blank = c == ' ' || c == '\n' || c == '\t' || c == '\r';
+    if (blank && (out.empty() || out.back() == ' ')) continue;
+    out += blank ? ' ' : c;
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out.size() > 90 ? out.substr(0, 87) + "..." : out;
+}
+
+// The end of a statement after an expression: on its own line if the expression ends in a
+// comment.
+std::string endStatement(const std::string& expr) {
+  size_t nl = expr.rfind('\n');
+  return expr.find("//", nl == std::string::npos ? 0 : nl) != std::string::npos ? "\n;" : ";";
+}
+
+bool within(unsigned b, unsigned e, unsigned begin, unsigned end) {
+  return begin <= b && e <= end;
+}
+
+// The properties of one side (source: s_, destination: d_) a site reads, directly or through
+// its locals (the parameters of its function, in this order).
+std::set<std::string> sideReads(const BodyFacts& f, const SourceOnlySite& s, bool source) {
+  std::set<std::string> props;
+  for (const PropSite& p : f.sites) {
+    if (p.source != source || p.write) continue;
+    bool in = within(p.begin, p.end, s.begin, s.end);
+    for (const auto& l : s.locals) in = in || within(p.begin, p.end, l.initBegin, l.initEnd);
+    if (in) props.insert(p.prop);
+  }
+  return props;
+}
+
+bool overlaps(const SourceOnlySite& x, const SourceOnlySite& y) {
+  return x.begin < y.end && y.begin < x.end;
+}
+
+}  // namespace
+
+std::vector<SourceOnlySite> ScenePrinter::hoistedDestinationSites(const PlanBody& b,
+                                                                  const Dialect& d) const {
+  if (!d.hoist || b.source.kind != BodyKind::Loop || !b.facts.ok ||
+      b.source.text.find("d_hoisted") != std::string::npos)  // the names would clash
+    return {};
+  // A property some pair loop writes (an accumulator such as au) changes during the
+  // neighbour loop of its destination: not hoisted. Checked over every loop of the plan.
+  std::set<std::string> written;
+  for (const PlanBody& other : plan_.bodies)
+    if (other.source.kind == BodyKind::Loop || other.source.kind == BodyKind::LoopAll)
+      for (const PropAccess& w : other.facts.dWrites) written.insert(w.prop);
+  std::vector<SourceOnlySite> kept;
+  for (const SourceOnlySite& s : b.facts.destinationOnly) {
+    bool ok = true;
+    for (const auto& p : sideReads(b.facts, s, false)) ok = ok && !written.count(p);
+    if (ok) kept.push_back(s);
+  }
+  return kept;
+}
+
+std::vector<SourceOnlySite> ScenePrinter::hoistedSites(const PlanBody& b, const Dialect& d) const {
+  if (!d.hoist || b.source.kind != BodyKind::Loop || !b.facts.ok ||
+      b.source.text.find("s_hoisted") != std::string::npos)  // the names would clash
+    return {};
+  // An expression of scalars alone is found on both sides: it goes with the destination
+  // (a local of the destination loop rather than an array read per pair).
+  const std::vector<SourceOnlySite> dest = hoistedDestinationSites(b, d);
+  std::vector<SourceOnlySite> kept;
+  for (const SourceOnlySite& s : b.facts.sourceOnly)
+    if (std::none_of(dest.begin(), dest.end(),
+                     [&](const SourceOnlySite& x) { return overlaps(s, x); }))
+      kept.push_back(s);
+  return kept;
+}
+
+std::string ScenePrinter::hoistedBodyText(const PlanBody& b, const Dialect& d) const {
+  std::string text = b.source.text;
+  BodyFacts facts = b.facts;
+  std::vector<TextEdit> edits;
+  auto replace = [&](const std::vector<SourceOnlySite>& sites, const std::string& name,
+                     const std::string& index) {
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const SourceOnlySite& s = sites[k];
+      // The lines after it keep their numbers (#line): its line breaks follow it.
+      long lines = std::count(text.begin() + s.begin, text.begin() + s.end, '\n');
+      edits.push_back({s.begin, s.end,
+                       name + std::to_string(k) + index +
+                           std::string(static_cast<size_t>(lines), '\n')});
+    }
+  };
+  replace(hoistedSites(b, d), "s_hoisted", "[s_idx]");
+  replace(hoistedDestinationSites(b, d), "d_hoisted", "");
+  if (!applyTextEdits(text, edits, facts))
+    SPHC_INTERNAL("overlapping hoisted expressions in " + b.source.label);
+  return fuseMultiplyAdds(text, facts.multiplyAdds, d.fma);
+}
+
+void ScenePrinter::emitHoistFunctions(const PlanBody& b, const std::string& name, const Dialect& d,
+                                      std::ostringstream& os) const {
+  const std::string& text = b.source.text;
+  auto emit = [&](const std::vector<SourceOnlySite>& sites, bool source) {
+    const std::string side = source ? "s" : "d";
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const SourceOnlySite& s = sites[k];
+      os << "// " << b.source.label << ", from " << loc(b.source.start) << ": once per "
+         << (source ? "source" : "destination")
+         << " particle (hoisted out of the pair loop; --no-hoist: per pair)\n";
+      os << "//   " << oneLine(text.substr(s.begin, s.end - s.begin)) << "\n";
+      os << d.functionPrefix << d.real << " " << name << "_" << (source ? "" : "d") << "hoisted"
+         << k << "(int " << side << "_idx";
+      if (s.usesT) os << ", " << d.real << " t";
+      if (s.usesDt) os << ", " << d.real << " dt";
+      for (const auto& sc : s.scalars) os << ", " << d.real << " " << sc;
+      for (const auto& p : sideReads(b.facts, s, source)) {
+        auto shape = b.source.props.find(p);
+        std::string t = shape == b.source.props.end() ? "double" : shape->second.type;
+        os << ", const " << (t == "int" ? d.intType : t == "uint" ? d.uintType : d.real) << "* "
+           << side << "_" << p;
+      }
+      os << ") {\n";
+      if (!source && s.locals.empty() && sideReads(b.facts, s, false).empty())
+        os << "  (void)d_idx;  // scalars only\n";
+      for (const auto& l : s.locals) {
+        std::string init = fusedRange(text, b.facts, l.initBegin, l.initEnd, d.fma);
+        os << "  const " << l.type << " " << l.name << " = " << init << endStatement(init)
+           << "\n";
+      }
+      std::string value = fusedRange(text, b.facts, s.begin, s.end, d.fma);
+      os << "  return " << value << endStatement(value) << "\n}\n\n";
+    }
+  };
+  emit(hoistedSites(b, d), true);
+  emit(hoistedDestinationSites(b, d), false);
+}
+
+// The arguments of a hoisted site's function after its index.
+static std::string hoistArguments(const SourceOnlySite& s, const BodyFacts& f, bool source,
+                                  const std::string& eqValues) {
+  std::string args;
+  if (s.usesT) args += ", t";
+  if (s.usesDt) args += ", dt";
+  for (const auto& sc : s.scalars) args += ", " + eqValues + "." + sc;
+  for (const auto& p : sideReads(f, s, source)) args += (source ? ", s_" : ", d_") + p;
+  return args;
+}
+
+void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass& pass,
+                                          const std::string& indent) const {
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    const auto sites = hoistedDestinationSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k)
+      os << indent << "const double " << hoistDestinationArgument(eqStruct(*eq), std::to_string(k))
+         << " = " << bodyFunctionName(eq->name, "loop") << "_dhoisted" << k << "(d_idx"
+         << hoistArguments(sites[k], b.facts, false, eqStruct(*eq)) << ");  // " << eq->name
+         << ": " << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
+         << "\n";
+  }
+}
+
+void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass,
+                                     const std::string& count, const std::string& pragma) const {
+  std::vector<std::string> calls;
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    const auto sites = hoistedSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const SourceOnlySite& s = sites[k];
+      if (calls.empty())
+        os << "        // Values of the loop bodies that depend on the source particle only, once "
+              "per\n        // particle (codegen/Hoist.cpp; sphc --no-hoist: per pair).\n"
+           << "        const int n_src = static_cast<int>(" << count << ");\n";
+      const std::string K = std::to_string(k);
+      const std::string ptr = hoistArgument(eqStruct(*eq), K);
+      const std::string member = "hoist_" + eqStruct(*eq) + "_" + K;
+      os << "        " << member << ".resize(n_src);  // " << eq->name << ": "
+         << oneLine(b.source.text.substr(s.begin, s.end - s.begin)) << "\n";
+      os << "        double* const " << ptr << " = " << member << ".data();\n";
+      calls.push_back(ptr + "[s_idx] = " + bodyFunctionName(eq->name, "loop") + "_hoisted" + K +
+                      "(s_idx" + hoistArguments(s, b.facts, true, eqStruct(*eq)) + ");");
+    }
+  }
+  if (calls.empty()) return;
+  os << pragma;
+  os << "        for (int s_idx = 0; s_idx < n_src; ++s_idx) {\n";
+  for (const auto& c : calls) os << "          " << c << "\n";
+  os << "        }\n";
+}
+
+void ScenePrinter::emitHoistMembers(std::ostream& os) const {
+  for (const PlanEquation& eq : plan_.equations) {
+    if (!eq.live) continue;
+    const auto& methods = plan_.equationDecls[eq.declIndex].methods;
+    if (!methods.count(ast::Method::Loop)) continue;
+    const PlanBody& b = methodBody(eq, ast::Method::Loop);
+    const auto sites = hoistedSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k)
+      os << "  std::vector<double> hoist_" << eqStruct(eq) << "_" << k << ";  // " << eq.name
+         << ": " << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
+         << " per source particle\n";
+  }
+}
+
+}  // namespace sphc
