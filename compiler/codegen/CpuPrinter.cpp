@@ -48,9 +48,13 @@ class CpuPrinter : public ScenePrinter {
   // --verlet-skin: the lists are kept across evaluations (sphc/verlet.h).
   bool verlet() const { return verletSkin_ > 0; }
   void verletMembers();
-  // The member holding the lists of the pass of destination d over source s in a phase.
-  std::string verletLists(const std::string& phase, int d, int s) const {
-    return "verlet_" + phase + "_" + arr(d).name + "_" + arr(s).name;
+  // The member holding the kept lists of the pass of destination work w over source s in a
+  // phase. The pair loops of every phase with the same destination and source share one set
+  // of lists (the support radius is the scene's), rebuilt by whichever loop finds them stale;
+  // a group with start_idx or stop_idx keeps lists of its own (its range, its phase).
+  std::string verletLists(const std::string& phase, const DestinationWork& w, int s) const {
+    return "verlet_" + (w.ranged() ? phase + "_" : std::string()) + arr(w.array).name + "_" +
+           arr(s).name;
   }
   bool timesNeighbourSearch() const override { return true; }
   void dataMovement() override;
@@ -153,14 +157,18 @@ void CpuPrinter::verletMembers() {
   out_ << "  static constexpr double VERLET_SKIN = " << skin << ";\n";
   out_ << "  static constexpr double VERLET_RADIUS2 = RADIUS2 * (1.0 + VERLET_SKIN) * "
           "(1.0 + VERLET_SKIN);\n";
+  std::set<std::string> declared;  // one member per set of lists (verletLists)
   std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
     for (const Phase& ph : g.phases)
       for (const DestinationWork& w : ph.destinations)
-        for (const NeighbourPass& pass : w.passes)
-          if (pass.searches())
-            out_ << "  sphc::VerletLists " << verletLists(ph.name, w.array, pass.source)
-                 << "{VERLET_SKIN};  // " << arr(w.array).name << " <- "
-                 << arr(pass.source).name << "\n";
+        for (const NeighbourPass& pass : w.passes) {
+          const std::string lists = verletLists(ph.name, w, pass.source);
+          if (pass.searches() && declared.insert(lists).second)
+            out_ << "  sphc::VerletLists " << lists << "{VERLET_SKIN};  // "
+                 << arr(w.array).name << " <- " << arr(pass.source).name
+                 << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase"))
+                 << "\n";
+        }
     for (const auto& sub : g.subgroups) walk(*sub);
   };
   walk(sched_.equations);
@@ -239,9 +247,10 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       continue;
     }
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
-    const std::string lists = verlet() ? verletLists(phase, d, s) : "";
+    const std::string lists = verlet() ? verletLists(phase, w, s) : "";
     if (verlet()) {
-      // Rebuilt when particles of either array moved too far since this loop's last build.
+      // Rebuilt when particles of either array moved too far since the lists' last build
+      // (by this loop or another one sharing them).
       const std::string arrays = d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}";
       const std::string range = rangeBegin(w) + ", " + rangeEnd(w);
       scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ") || "

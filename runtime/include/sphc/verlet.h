@@ -14,9 +14,11 @@
 // radius_scale * g, g the largest growth of any h; its skin at the build was at least
 // F * radius_scale * h_min (h_min the smallest h at the build). So the lists are rebuilt
 // when 2 d + radius_scale * g > F * radius_scale * h_min, when an array's particle count
-// changed, and at the first evaluation (VerletSkin::must_rebuild). Each pair loop keeps its
-// own lists and positions (VerletLists), so a loop that does not run at every evaluation
-// (a group with `every` or a condition, post_step) measures from its own build.
+// changed, and at the first evaluation (VerletSkin::must_rebuild). The pair loops of one
+// destination and source array share their lists and positions (VerletLists; a group with
+// start_idx or stop_idx keeps its own): every loop checks them at each of its evaluations,
+// so a loop that does not run at every evaluation (a group with `every` or a condition,
+// post_step) measures from the last build, whichever loop made it.
 #pragma once
 
 #include <cmath>
@@ -100,10 +102,11 @@ class VerletSkin {
   std::vector<Saved> saved_;
 };
 
-// The kept lists of one pair loop: per destination particle its candidates, and the
-// positions they were built from. The loop checks them at every evaluation (skin.must_rebuild
-// over its destination and source arrays) and rebuilds them from the cell lists when due; a
-// permutation of the particles into cell order moves them far and so rebuilds them too.
+// The kept lists of the pair loops of one destination and source array: per destination
+// particle its candidates, and the positions they were built from. Each loop checks them at
+// every evaluation (skin.must_rebuild over its destination and source arrays) and rebuilds
+// them from the cell lists when due; a permutation of the particles into cell order moves
+// them far and so rebuilds them too.
 struct VerletLists {
   explicit VerletLists(double skin_fraction) : skin(skin_fraction) {}
   VerletSkin skin;
