@@ -290,8 +290,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
            << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
     if (mpi_) scene_ << "          long candidates = 0;\n";
     if (verlet()) {
-      // The kept list of d_idx (built first if due, in the thread's scratch list, kept at its
-      // exact size), filtered with the support's test.
+      // The kept list of d_idx (built first if due, in the thread's scratch list, kept in
+      // increasing index at its exact size), filtered with the support's test.
       scene_ << "          std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
       scene_ << "          if (verlet_build) {\n";
       scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
@@ -299,7 +299,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "              const int s_idx = static_cast<int>(j);\n";
       emitNeighbourTest(scene_, host_, "return false;", "              ", "VERLET_RADIUS2");
       scene_ << "              return true;\n            });\n";
-      scene_ << "            kept.assign(nbrs_list.data(), nbrs_list.data() + n_kept);\n";
+      scene_ << "            sphc::keep_in_index_order(kept, nbrs_list.data(), n_kept);\n";
       scene_ << "          }\n";
       scene_ << "          const int n_nbrs = static_cast<int>(sphc::filter_neighbours(kept.data(), "
                 "kept.size(), nbrs_list, [&](std::uint32_t j) {\n";
