@@ -176,6 +176,9 @@ void CpuPrinter::verletMembers() {
 
 void CpuPrinter::searchMembers() {
   out_ << "  sphc::SearchDomain domain;\n";
+  if (verlet())
+    out_ << "  sphc::SearchDomain order_domain;  // the support's grid: the cell order of "
+            "permutations (--verlet-skin)\n";
   for (const auto& S : sourceArrays_)
     if (isStatic(S))
       out_ << "  sphc::SearchDomain domain_" << S << ";  // its own grid (build_static_cells)\n";
@@ -570,8 +573,19 @@ void CpuPrinter::emitStaticCells() {
   for (const auto& S : sourceArrays_) {
     if (!isStatic(S)) continue;
     searchDomain(S, "domain_" + S);
-    scene_ << "    domain_" << S << ".cell_size = domain.cell_size;  // every neighbour one cell away\n";
     const std::string build = cellListBuild(S, S + ".n", "domain_" + S);
+    if (verlet() && reorders(S)) {
+      // --verlet-skin: sorted into the cell order of the support's grid, as without lists
+      // (the same particle order), then the lists' cells.
+      scene_ << "    domain_" << S << ".cell_size = order_domain.cell_size;  // the cell order "
+             << "as without lists\n";
+      scene_ << "    " << build << "\n    " << permuteInCellOrder(S) << "\n";
+      scene_ << "    domain_" << S << ".cell_size = domain.cell_size;  // every candidate of the "
+             << "lists one cell away\n";
+      scene_ << "    " << build << "\n";
+      continue;
+    }
+    scene_ << "    domain_" << S << ".cell_size = domain.cell_size;  // every neighbour one cell away\n";
     scene_ << "    " << build << "\n";
     if (reorders(S)) scene_ << "    " << permuteInCellOrder(S) << "\n    " << build << "\n";
   }
@@ -581,8 +595,18 @@ void CpuPrinter::emitStaticCells() {
 // update_neighbours of a scene without periodic or mirror domain.
 void CpuPrinter::updateNeighbours() {
   if (!loopArrays_.empty()) searchDomain();
-  if (anyStatic())
-    scene_ << "    if (!static_cells_built) build_static_cells();  // once: they never move\n";
+  // --verlet-skin: permutations sort into the cell order of the support's grid (order_domain,
+  // made as `domain` is without lists), so that the particles are in the order they have
+  // without lists; the cell lists are then built on the lists' grid (`domain`).
+  const std::string orderDomain =
+      "order_domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);";
+  if (anyStatic()) {
+    if (verlet())
+      scene_ << "    if (!static_cells_built) {  // once: they never move\n      " << orderDomain
+             << "\n      build_static_cells();\n    }\n";
+    else
+      scene_ << "    if (!static_cells_built) build_static_cells();  // once: they never move\n";
+  }
   bool reordersMoving = false;
   for (const auto& S : sourceArrays_) reordersMoving |= !isStatic(S) && reorders(S);
   if (reordersMoving) {
@@ -591,12 +615,19 @@ void CpuPrinter::updateNeighbours() {
     // (--verlet-skin: a permutation moves the particles under the kept lists, which are
     // then rebuilt.)
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+    if (verlet()) scene_ << "    if (reorder) " << orderDomain << "\n";
   } else if (anyReorders()) {
     scene_ << "    ++builds;  // counted as with moving arrays (restart state)\n";
   }
   for (const auto& S : sourceArrays_) {
     if (isStatic(S)) continue;  // build_static_cells
     const std::string build = cellListBuild(S, S + ".n");
+    if (verlet() && reorders(S)) {
+      scene_ << "    if (reorder) {\n      " << cellListBuild(S, S + ".n", "order_domain")
+             << "\n      " << permuteInCellOrder(S) << "\n    }\n";
+      scene_ << "    " << build << "\n";
+      continue;
+    }
     scene_ << "    " << build << "\n";
     if (!reorders(S)) continue;  // a ranged group names its particles by index
     scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build
