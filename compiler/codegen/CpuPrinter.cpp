@@ -49,9 +49,13 @@ class CpuPrinter : public ScenePrinter {
   // --verlet-skin: the lists are kept across evaluations (sphc/verlet.h).
   bool verlet() const { return verletSkin_ > 0; }
   void verletMembers();
-  // The member holding the lists of the pass of destination d over source s in a phase.
-  std::string verletLists(const std::string& phase, int d, int s) const {
-    return "verlet_" + phase + "_" + arr(d).name + "_" + arr(s).name;
+  // The member holding the kept lists of the pass of destination work w over source s in a
+  // phase. The pair loops of every phase with the same destination and source share one set
+  // of lists (the support radius is the scene's), rebuilt by whichever loop finds them stale;
+  // a group with start_idx or stop_idx keeps lists of its own (its range, its phase).
+  std::string verletLists(const std::string& phase, const DestinationWork& w, int s) const {
+    return "verlet_" + (w.ranged() ? phase + "_" : std::string()) + arr(w.array).name + "_" +
+           arr(s).name;
   }
   bool timesNeighbourSearch() const override { return true; }
   void dataMovement() override;
@@ -154,14 +158,18 @@ void CpuPrinter::verletMembers() {
   out_ << "  static constexpr double VERLET_SKIN = " << skin << ";\n";
   out_ << "  static constexpr double VERLET_RADIUS2 = RADIUS2 * (1.0 + VERLET_SKIN) * "
           "(1.0 + VERLET_SKIN);\n";
+  std::set<std::string> declared;  // one member per set of lists (verletLists)
   std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
     for (const Phase& ph : g.phases)
       for (const DestinationWork& w : ph.destinations)
-        for (const NeighbourPass& pass : w.passes)
-          if (pass.searches())
-            out_ << "  sphc::VerletLists " << verletLists(ph.name, w.array, pass.source)
-                 << "{VERLET_SKIN};  // " << arr(w.array).name << " <- "
-                 << arr(pass.source).name << "\n";
+        for (const NeighbourPass& pass : w.passes) {
+          const std::string lists = verletLists(ph.name, w, pass.source);
+          if (pass.searches() && declared.insert(lists).second)
+            out_ << "  sphc::VerletLists " << lists << "{VERLET_SKIN};  // "
+                 << arr(w.array).name << " <- " << arr(pass.source).name
+                 << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase"))
+                 << "\n";
+        }
     for (const auto& sub : g.subgroups) walk(*sub);
   };
   walk(sched_.equations);
@@ -169,6 +177,9 @@ void CpuPrinter::verletMembers() {
 
 void CpuPrinter::searchMembers() {
   out_ << "  sphc::SearchDomain domain;\n";
+  if (verlet())
+    out_ << "  sphc::SearchDomain order_domain;  // the support's grid: the cell order of "
+            "permutations (--verlet-skin)\n";
   for (const auto& S : sourceArrays_)
     if (isStatic(S))
       out_ << "  sphc::SearchDomain domain_" << S << ";  // its own grid (build_static_cells)\n";
@@ -243,9 +254,10 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     emitHoistedValues(scene_, pass, hasDomain() ? S + ".n + ghosts_" + S + ".size()" : S + ".n",
                       parallelFor("        ", pass.order));
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
-    const std::string lists = verlet() ? verletLists(phase, d, s) : "";
+    const std::string lists = verlet() ? verletLists(phase, w, s) : "";
     if (verlet()) {
-      // Rebuilt when particles of either array moved too far since this loop's last build.
+      // Rebuilt when particles of either array moved too far since the lists' last build
+      // (by this loop or another one sharing them).
       const std::string arrays = d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}";
       const std::string range = rangeBegin(w) + ", " + rangeEnd(w);
       scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ") || "
@@ -286,8 +298,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
            << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
     if (mpi_) scene_ << "          long candidates = 0;\n";
     if (verlet()) {
-      // The kept list of d_idx (built first if due, in the thread's scratch list, kept at its
-      // exact size), filtered with the support's test.
+      // The kept list of d_idx (built first if due, in the thread's scratch list, kept in
+      // increasing index at its exact size), filtered with the support's test.
       scene_ << "          std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
       scene_ << "          if (verlet_build) {\n";
       scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
@@ -295,7 +307,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "              const int s_idx = static_cast<int>(j);\n";
       emitNeighbourTest(scene_, host_, "return false;", "              ", "VERLET_RADIUS2");
       scene_ << "              return true;\n            });\n";
-      scene_ << "            kept.assign(nbrs_list.data(), nbrs_list.data() + n_kept);\n";
+      scene_ << "            sphc::keep_in_index_order(kept, nbrs_list.data(), n_kept);\n";
       scene_ << "          }\n";
       scene_ << "          const int n_nbrs = static_cast<int>(sphc::filter_neighbours(kept.data(), "
                 "kept.size(), nbrs_list, [&](std::uint32_t j) {\n";
@@ -566,8 +578,19 @@ void CpuPrinter::emitStaticCells() {
   for (const auto& S : sourceArrays_) {
     if (!isStatic(S)) continue;
     searchDomain(S, "domain_" + S);
-    scene_ << "    domain_" << S << ".cell_size = domain.cell_size;  // every neighbour one cell away\n";
     const std::string build = cellListBuild(S, S + ".n", "domain_" + S);
+    if (verlet() && reorders(S)) {
+      // --verlet-skin: sorted into the cell order of the support's grid, as without lists
+      // (the same particle order), then the lists' cells.
+      scene_ << "    domain_" << S << ".cell_size = order_domain.cell_size;  // the cell order "
+             << "as without lists\n";
+      scene_ << "    " << build << "\n    " << permuteInCellOrder(S) << "\n";
+      scene_ << "    domain_" << S << ".cell_size = domain.cell_size;  // every candidate of the "
+             << "lists one cell away\n";
+      scene_ << "    " << build << "\n";
+      continue;
+    }
+    scene_ << "    domain_" << S << ".cell_size = domain.cell_size;  // every neighbour one cell away\n";
     scene_ << "    " << build << "\n";
     if (reorders(S)) scene_ << "    " << permuteInCellOrder(S) << "\n    " << build << "\n";
   }
@@ -577,8 +600,18 @@ void CpuPrinter::emitStaticCells() {
 // update_neighbours of a scene without periodic or mirror domain.
 void CpuPrinter::updateNeighbours() {
   if (!loopArrays_.empty()) searchDomain();
-  if (anyStatic())
-    scene_ << "    if (!static_cells_built) build_static_cells();  // once: they never move\n";
+  // --verlet-skin: permutations sort into the cell order of the support's grid (order_domain,
+  // made as `domain` is without lists), so that the particles are in the order they have
+  // without lists; the cell lists are then built on the lists' grid (`domain`).
+  const std::string orderDomain =
+      "order_domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);";
+  if (anyStatic()) {
+    if (verlet())
+      scene_ << "    if (!static_cells_built) {  // once: they never move\n      " << orderDomain
+             << "\n      build_static_cells();\n    }\n";
+    else
+      scene_ << "    if (!static_cells_built) build_static_cells();  // once: they never move\n";
+  }
   bool reordersMoving = false;
   for (const auto& S : sourceArrays_) reordersMoving |= !isStatic(S) && reorders(S);
   if (reordersMoving) {
@@ -587,12 +620,19 @@ void CpuPrinter::updateNeighbours() {
     // (--verlet-skin: a permutation moves the particles under the kept lists, which are
     // then rebuilt.)
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+    if (verlet()) scene_ << "    if (reorder) " << orderDomain << "\n";
   } else if (anyReorders()) {
     scene_ << "    ++builds;  // counted as with moving arrays (restart state)\n";
   }
   for (const auto& S : sourceArrays_) {
     if (isStatic(S)) continue;  // build_static_cells
     const std::string build = cellListBuild(S, S + ".n");
+    if (verlet() && reorders(S)) {
+      scene_ << "    if (reorder) {\n      " << cellListBuild(S, S + ".n", "order_domain")
+             << "\n      " << permuteInCellOrder(S) << "\n    }\n";
+      scene_ << "    " << build << "\n";
+      continue;
+    }
     scene_ << "    " << build << "\n";
     if (!reorders(S)) continue;  // a ranged group names its particles by index
     scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build

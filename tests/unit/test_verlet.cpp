@@ -120,4 +120,18 @@ TEST(VerletSkin, FilterKeepsTheCandidatesThatPassInOrder) {
             0u);
 }
 
+// The kept list is in increasing index whatever the candidates' order (two builds from
+// other cells, other candidate orders, give the same list), and its size is the count.
+TEST(VerletSkin, KeptListsAreInIncreasingIndex) {
+  const std::vector<std::uint32_t> a = {9, 4, 7, 1, 8, 2, 6, 99, 3};
+  const std::vector<std::uint32_t> b = {3, 99, 1, 2, 4, 6, 7, 8, 9};
+  std::vector<std::uint32_t> ka = {5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5}, kb;
+  sphc::keep_in_index_order(ka, a.data(), a.size());
+  sphc::keep_in_index_order(kb, b.data(), b.size());
+  EXPECT_EQ(ka, (std::vector<std::uint32_t>{1, 2, 3, 4, 6, 7, 8, 9, 99}));
+  EXPECT_EQ(ka, kb);
+  sphc::keep_in_index_order(ka, a.data(), 0);
+  EXPECT_TRUE(ka.empty());
+}
+
 }  // namespace

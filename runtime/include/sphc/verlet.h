@@ -5,8 +5,11 @@
 // with the cell lists when the lists are built, in the cell lists' candidate order. Every
 // evaluation then filters that list with the loop's usual cut-off test (the same
 // R2IJ >= RADIUS2 * hmax * hmax as without lists), so the set of interacting pairs is the
-// same; their order is the candidate order of the build, not of the current step (sums over
-// neighbours may round differently from a run without lists).
+// same. Each kept list is in increasing particle index (keep_in_index_order), so the
+// neighbours come in that order whenever the lists were built: the sums over neighbours are
+// a function of the particles now, not of the build (a run continued with --restart, which
+// builds its lists anew, and runs with another skin give the same bits). Without lists the
+// neighbours come in the cell lists' candidate order, so the sums may round differently.
 //
 // The lists stay complete while no pair can have come from beyond (1 + F) times its radius
 // at the build to within its radius now. A pair's distance shrank by at most 2 d, d the
@@ -14,11 +17,14 @@
 // radius_scale * g, g the largest growth of any h; its skin at the build was at least
 // F * radius_scale * h_min (h_min the smallest h at the build). So the lists are rebuilt
 // when 2 d + radius_scale * g > F * radius_scale * h_min, when an array's particle count
-// changed, and at the first evaluation (VerletSkin::must_rebuild). Each pair loop keeps its
-// own lists and positions (VerletLists), so a loop that does not run at every evaluation
-// (a group with `every` or a condition, post_step) measures from its own build.
+// changed, and at the first evaluation (VerletSkin::must_rebuild). The pair loops of one
+// destination and source array share their lists and positions (VerletLists; a group with
+// start_idx or stop_idx keeps its own): every loop checks them at each of its evaluations,
+// so a loop that does not run at every evaluation (a group with `every` or a condition,
+// post_step) measures from the last build, whichever loop made it.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -100,10 +106,11 @@ class VerletSkin {
   std::vector<Saved> saved_;
 };
 
-// The kept lists of one pair loop: per destination particle its candidates, and the
-// positions they were built from. The loop checks them at every evaluation (skin.must_rebuild
-// over its destination and source arrays) and rebuilds them from the cell lists when due; a
-// permutation of the particles into cell order moves them far and so rebuilds them too.
+// The kept lists of the pair loops of one destination and source array: per destination
+// particle its candidates, and the positions they were built from. Each loop checks them at
+// every evaluation (skin.must_rebuild over its destination and source arrays) and rebuilds
+// them from the cell lists when due; a permutation of the particles into cell order moves
+// them far and so rebuilds them too.
 struct VerletLists {
   explicit VerletLists(double skin_fraction) : skin(skin_fraction) {}
   VerletSkin skin;
@@ -113,6 +120,16 @@ struct VerletLists {
   long begin = 0, end = -1;
   bool built_for(long b, long e) const { return b == begin && e == end; }
 };
+
+// kept = the candidates cand[0, n) (one destination particle's, within the lists' radius)
+// in increasing particle index: the order in which the filtered neighbours are summed does
+// not depend on when, or from which cells, the lists were built.
+inline void keep_in_index_order(std::vector<std::uint32_t>& kept, const std::uint32_t* cand,
+                                std::size_t n) {
+  kept.assign(cand, cand + n);
+  // In particles sorted into the cells' order the candidates often come sorted already.
+  if (!std::is_sorted(kept.begin(), kept.end())) std::sort(kept.begin(), kept.end());
+}
 
 // out[0, count) = the candidates j of cand[0, n) with keep(j), in their order; returns count.
 // Branch-free like CellList::gather_neighbours: every candidate is written, the count
