@@ -72,13 +72,13 @@ static cl::opt<OnOff, false, NamedValues<OnOff>> FmaOpt(
 static cl::opt<std::string> VerletSkin(
     "verlet-skin",
     cl::desc("Neighbour lists kept across time steps: each destination particle's candidates "
-             "within (1 + F) times the support, rebuilt when particles moved too far. auto: "
-             "F = 0.1 where the lists are written for (serial and openmp, double precision, "
+             "within (1 + F) times the support, rebuilt when particles moved too far. auto "
+             "(default): F = 0.1 where the lists are written for (serial and openmp, double precision, "
              "no periodic/mirror domain, inlets, outlets or --mpi), off elsewhere (--report "
-             "says which); F in (0, 1]: that skin, an error elsewhere; off or 0 (default): "
+             "says which); F in (0, 1]: that skin, an error elsewhere; off or 0: "
              "the cell lists' neighbours at every evaluation. Sums over neighbours round "
              "differently with and without lists"),
-    cl::value_desc("auto|F|off"), cl::init("off"), cl::cat(SphcCat));
+    cl::value_desc("auto|F|off"), cl::init("auto"), cl::cat(SphcCat));
 static cl::opt<bool> NoHoist(
     "no-hoist",
     cl::desc("Compute every subexpression of a pair-loop body per pair, as written (default: "
@@ -86,8 +86,7 @@ static cl::opt<bool> NoHoist(
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double precision; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
-// --verlet-skin=auto: the skin, as a fraction of the support radius. (Not yet the default:
-// docs/performance.md, "Neighbour lists ... (`--verlet-skin=auto`)", says what is left.) Measured (callgrind
+// --verlet-skin=auto (the default): the skin, as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
 // than 0.2 on the cube and the dam break (0.2 keeps ~1.33x (3D) the candidates of 0.1 in
 // every list for fewer rebuilds).
