@@ -40,6 +40,12 @@ class ScheduleBuilder {
     return (plan_.domain.any() || plan_.distributed) && !plan_.arrays[a].ghostProps.empty();
   }
   using PairQuantityMap = std::map<std::pair<int, int>, std::set<std::string>>;
+  // A phase is named after its first live equation (its first one if none is live).
+  const PlanEquation& firstLive(const std::vector<int>& eqIds) const {
+    for (int e : eqIds)
+      if (plan_.equations[e].live) return plan_.equations[e];
+    return plan_.equations[eqIds.front()];
+  }
   void group(const PlanGroup& g, const std::string& name, ScheduleGroup& out);
   void fusedGroup(const std::vector<const PlanGroup*>& run, const std::string& name,
                   ScheduleGroup& out);
@@ -158,13 +164,7 @@ void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, Schedul
   std::vector<int> run;
   auto flush = [&] {
     if (run.empty()) return;
-    const PlanEquation* first = &plan_.equations[run.front()];
-    for (int e : run)
-      if (plan_.equations[e].live) {
-        first = &plan_.equations[e];
-        break;
-      }
-    std::string fn = unique(name + "_" + first->name);
+    std::string fn = unique(name + "_" + firstLive(run).name);
     out.members.push_back({true, static_cast<int>(out.phases.size())});
     out.phases.push_back(phase(g, run, fn, g.pairQuantities));
     out.calls.push_back(fn);
@@ -233,13 +233,7 @@ void ScheduleBuilder::fusedGroup(const std::vector<const PlanGroup*>& run,
     eqIds.insert(eqIds.end(), g->equations.begin(), g->equations.end());
     for (const auto& [key, q] : g->pairQuantities) pq[key].insert(q.begin(), q.end());
   }
-  const PlanEquation* firstEq = &plan_.equations[eqIds.front()];
-  for (int e : eqIds)
-    if (plan_.equations[e].live) {
-      firstEq = &plan_.equations[e];
-      break;
-    }
-  std::string fn = unique(name + "_" + firstEq->name);
+  std::string fn = unique(name + "_" + firstLive(eqIds).name);
   out.members.push_back({true, 0});
   out.phases.push_back(phase(first, eqIds, fn, pq));
   out.calls.push_back(fn);
