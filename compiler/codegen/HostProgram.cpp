@@ -256,7 +256,10 @@ void ScenePrinter::emitGroup(const ScheduleGroup& sg) {
     else
       emitGroup(*sg.subgroups[m.index]);
   }
-  scene_ << "  // group, from " << loc(g.loc) << "\n";
+  scene_ << "  // group, from " << loc(g.loc);
+  for (std::size_t k = 0; k < sg.fused.size(); ++k)  // group fusion (ScheduleGroupFusion.cpp)
+    scene_ << (k ? ", " : "; fused with the groups from ") << loc(sg.fused[k]->loc);
+  scene_ << "\n";
   if (g.every) {
     // `every = N`: only when the number of completed steps is a multiple of N (N < 1: never).
     auto pn = [&](const std::string& n) { return paramRef(n); };

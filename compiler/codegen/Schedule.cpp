@@ -17,8 +17,8 @@ namespace {
 
 class ScheduleBuilder {
  public:
-  ScheduleBuilder(const Plan& plan, const DiagnosticEngine& diags)
-      : plan_(plan), diags_(diags) {}
+  ScheduleBuilder(const Plan& plan, const DiagnosticEngine& diags, bool fuseGroups)
+      : plan_(plan), diags_(diags), fuseGroups_(fuseGroups) {}
   std::unique_ptr<Schedule> run();
   void postStepNeighbours();
 
@@ -39,11 +39,22 @@ class ScheduleBuilder {
   bool hasGhosts(int a) const {
     return (plan_.domain.any() || plan_.distributed) && !plan_.arrays[a].ghostProps.empty();
   }
+  using PairQuantityMap = std::map<std::pair<int, int>, std::set<std::string>>;
+  // A phase is named after its first live equation (its first one if none is live).
+  const PlanEquation& firstLive(const std::vector<int>& eqIds) const {
+    for (int e : eqIds)
+      if (plan_.equations[e].live) return plan_.equations[e];
+    return plan_.equations[eqIds.front()];
+  }
   void group(const PlanGroup& g, const std::string& name, ScheduleGroup& out);
-  Phase phase(const PlanGroup& g, const std::vector<int>& eqIds, const std::string& name);
-  DestinationWork destination(const PlanGroup& g, const std::vector<int>& eqIds, int d);
+  void fusedGroup(const std::vector<const PlanGroup*>& run, const std::string& name,
+                  ScheduleGroup& out);
+  Phase phase(const PlanGroup& g, const std::vector<int>& eqIds, const std::string& name,
+              const PairQuantityMap& pq);
+  DestinationWork destination(const PlanGroup& g, const std::vector<int>& eqIds, int d,
+                              const PairQuantityMap& pq);
   std::vector<NeighbourPass> neighbourPasses(const std::vector<const PlanEquation*>& eqs, int d,
-                                             const PlanGroup& g);
+                                             const PairQuantityMap& pq);
   std::vector<std::string> ghostRefresh(int d, const std::vector<const PlanEquation*>& eqs) const;
   std::vector<const PlanEquation*> convergers(const PlanGroup& g) const;
   void step();
@@ -63,6 +74,7 @@ class ScheduleBuilder {
 
   const Plan& plan_;
   const DiagnosticEngine& diags_;
+  bool fuseGroups_ = true;
   std::set<std::string> used_;
   std::unique_ptr<Schedule> s_;
   std::set<std::string> sourceNames_, loopNames_;
@@ -152,19 +164,31 @@ void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, Schedul
   std::vector<int> run;
   auto flush = [&] {
     if (run.empty()) return;
-    const PlanEquation* first = &plan_.equations[run.front()];
-    for (int e : run)
-      if (plan_.equations[e].live) {
-        first = &plan_.equations[e];
-        break;
-      }
-    std::string fn = unique(name + "_" + first->name);
+    std::string fn = unique(name + "_" + firstLive(run).name);
     out.members.push_back({true, static_cast<int>(out.phases.size())});
-    out.phases.push_back(phase(g, run, fn));
+    out.phases.push_back(phase(g, run, fn, g.pairQuantities));
     out.calls.push_back(fn);
     run.clear();
   };
-  for (int entry : g.order) {
+  std::vector<std::vector<int>> runs;
+  if (fuseGroups_) {
+    runs = groupFusionRuns(plan_, g);
+  } else {
+    for (size_t i = 0; i < g.order.size(); ++i) runs.push_back({static_cast<int>(i)});
+  }
+  for (const auto& groupRun : runs) {
+    const int entry = g.order[groupRun.front()];
+    if (groupRun.size() > 1) {  // consecutive subgroups run as one (ScheduleGroupFusion.cpp)
+      flush();
+      std::vector<const PlanGroup*> fused;
+      for (int k : groupRun) fused.push_back(g.subgroups[-g.order[k] - 1].get());
+      std::string fn = unique("group_" + lineOf(fused.front()->loc));
+      out.members.push_back({false, static_cast<int>(out.subgroups.size())});
+      out.subgroups.push_back(std::make_unique<ScheduleGroup>());
+      fusedGroup(fused, fn, *out.subgroups.back());
+      out.calls.push_back(fn);
+      continue;
+    }
     if (entry >= 0) {
       // A group's pre/post body is a phase of its own: it runs before (after) the whole
       // per-particle work of the group's other members.
@@ -195,6 +219,26 @@ void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, Schedul
   }
 }
 
+// A run of fused groups (ScheduleGroupFusion.cpp): the first group's function with one phase
+// of every group's equations, in order, and their pair quantities joined.
+void ScheduleBuilder::fusedGroup(const std::vector<const PlanGroup*>& run,
+                                 const std::string& name, ScheduleGroup& out) {
+  const PlanGroup& first = *run.front();
+  out.name = name;
+  out.group = &first;
+  out.fused.assign(run.begin() + 1, run.end());
+  std::vector<int> eqIds;
+  PairQuantityMap pq;
+  for (const PlanGroup* g : run) {
+    eqIds.insert(eqIds.end(), g->equations.begin(), g->equations.end());
+    for (const auto& [key, q] : g->pairQuantities) pq[key].insert(q.begin(), q.end());
+  }
+  std::string fn = unique(name + "_" + firstLive(eqIds).name);
+  out.members.push_back({true, 0});
+  out.phases.push_back(phase(first, eqIds, fn, pq));
+  out.calls.push_back(fn);
+}
+
 // The `converged` tests of an iterated group: those of its equations and of the equations in
 // its subgroups, at any depth (as PySPH's Group), except inside a nested iterated group.
 std::vector<const PlanEquation*> ScheduleBuilder::convergers(const PlanGroup& g) const {
@@ -215,7 +259,7 @@ std::vector<const PlanEquation*> ScheduleBuilder::convergers(const PlanGroup& g)
 }
 
 Phase ScheduleBuilder::phase(const PlanGroup& g, const std::vector<int>& eqIds,
-                             const std::string& name) {
+                             const std::string& name, const PairQuantityMap& pq) {
   Phase ph;
   ph.name = name;
   ph.group = &g;
@@ -226,12 +270,12 @@ Phase ScheduleBuilder::phase(const PlanGroup& g, const std::vector<int>& eqIds,
     if (eq.live && std::find(dests.begin(), dests.end(), eq.dest) == dests.end())
       dests.push_back(eq.dest);
   }
-  for (int d : dests) ph.destinations.push_back(destination(g, eqIds, d));
+  for (int d : dests) ph.destinations.push_back(destination(g, eqIds, d, pq));
   return ph;
 }
 
 DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vector<int>& eqIds,
-                                             int d) {
+                                             int d, const PairQuantityMap& pq) {
   DestinationWork w;
   w.array = d;
   for (int e : eqIds)
@@ -246,7 +290,7 @@ DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vect
       for (const auto& wr : plan_.bodies[b].facts.dWrites) w.destProps.insert(wr.prop);
     }
   w.initialize = withMethod(w.equations, ast::Method::Initialize);
-  w.passes = neighbourPasses(w.equations, d, g);
+  w.passes = neighbourPasses(w.equations, d, pq);
   w.postLoop = withMethod(w.equations, ast::Method::PostLoop);
   for (const auto* eq : withMethod(w.equations, ast::Method::Reduce)) {
     const auto& pd = plan_.equationDecls[eq->declIndex];
@@ -269,7 +313,7 @@ DestinationWork ScheduleBuilder::destination(const PlanGroup& g, const std::vect
 // One pass per source, in order of first use: every equation looping over that source shares
 // its candidates and pair quantities.
 std::vector<NeighbourPass> ScheduleBuilder::neighbourPasses(
-    const std::vector<const PlanEquation*>& eqs, int d, const PlanGroup& g) {
+    const std::vector<const PlanEquation*>& eqs, int d, const PairQuantityMap& pq) {
   std::vector<int> sources;
   for (const auto* eq : eqs)
     for (auto kind : {ast::Method::InitializePair, ast::Method::LoopAll, ast::Method::Loop})
@@ -281,8 +325,8 @@ std::vector<NeighbourPass> ScheduleBuilder::neighbourPasses(
   for (int s : sources) {
     NeighbourPass pass;
     pass.source = s;
-    auto it = g.pairQuantities.find({d, s});
-    if (it != g.pairQuantities.end()) pass.pairQuantities = it->second;
+    auto it = pq.find({d, s});
+    if (it != pq.end()) pass.pairQuantities = it->second;
     pass.pairQuantities = pairQuantityClosure(pass.pairQuantities);
     for (auto kind : {ast::Method::InitializePair, ast::Method::LoopAll, ast::Method::Loop})
       for (const auto* eq : withMethod(eqs, kind)) {
@@ -395,8 +439,9 @@ void ScheduleBuilder::adaptiveDt() {
 
 }  // namespace
 
-std::unique_ptr<Schedule> buildSchedule(const Plan& plan, const DiagnosticEngine& diags) {
-  return ScheduleBuilder(plan, diags).run();
+std::unique_ptr<Schedule> buildSchedule(const Plan& plan, const DiagnosticEngine& diags,
+                                        bool fuseGroups) {
+  return ScheduleBuilder(plan, diags, fuseGroups).run();
 }
 
 // ---- --dump-after=schedule ------------------------------------------------------------------
@@ -538,6 +583,12 @@ void SchedulePrinter::group(const ScheduleGroup& g, int indent) {
   if (pg.condition) os_ << ", condition";
   if (pg.postStep) os_ << ", post_step";
   os_ << "\n";
+  if (!g.fused.empty()) {
+    os_ << pad << "  fused with the groups from";
+    for (const PlanGroup* f : g.fused) os_ << " " << diags_.lineInfo(f->loc);
+    os_ << " (one phase: none reads or writes what an earlier one writes, nor writes what it "
+           "reads)\n";
+  }
   if (pg.iterate) {
     os_ << pad << "  iterated " << pg.minIterations << ".." << pg.maxIterations
         << " times (statistics " << g.statsIndex << "), converged when: "

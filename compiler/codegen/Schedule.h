@@ -134,6 +134,9 @@ struct ScheduleGroup {
   // neighbour search is rebuilt from the current positions (wrapping into a periodic box,
   // search domain, cell lists, ghosts), as at the start of an evaluation.
   bool rebuildNeighbours = false;
+  // Group fusion (ScheduleGroupFusion.cpp): the later consecutive groups of the parent whose
+  // equations run in this group's one phase (this group is the first of the run).
+  std::vector<const PlanGroup*> fused;
 };
 
 // Consecutive stepper statements (initialize, stageN) of the integrator's step, fused: one
@@ -242,9 +245,19 @@ struct Schedule {
 // DestinationWork::initializeFirst), and reductions' values computed in the post_loop loop.
 void fusePerParticleWork(Schedule& s);
 
+// Group fusion (ScheduleGroupFusion.cpp): whether a group may be joined with its neighbours
+// (plain: direct equations only, nothing that tests, repeats, skips, ranges or reduces), and
+// the parent's order split into runs (positions in PlanGroup::order): a run of two or more
+// consecutive subgroups runs as one phase, each one proved not to read or write what the
+// earlier ones of its run write, nor to write what they read.
+bool fusibleGroup(const Plan& plan, const PlanGroup& g);
+std::vector<std::vector<int>> groupFusionRuns(const Plan& plan, const PlanGroup& parent);
+
 // The schedule of an analysed plan (after the ghost pass). Pure: reads the plan only (and
-// the source lines of its groups, which name their functions).
-std::unique_ptr<Schedule> buildSchedule(const Plan& plan, const DiagnosticEngine& diags);
+// the source lines of its groups, which name their functions). fuseGroups = false
+// (--no-group-fusion): every group on its own.
+std::unique_ptr<Schedule> buildSchedule(const Plan& plan, const DiagnosticEngine& diags,
+                                        bool fuseGroups = true);
 
 // --dump-after=schedule.
 void printSchedule(const Schedule& s, const DiagnosticEngine& diags, llvm::raw_ostream& os);

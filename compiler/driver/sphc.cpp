@@ -79,6 +79,12 @@ static cl::opt<std::string> VerletSkin(
              "the cell lists' neighbours at every evaluation. Sums over neighbours round "
              "differently with and without lists"),
     cl::value_desc("auto|F|off"), cl::init("auto"), cl::cat(SphcCat));
+static cl::opt<bool> NoGroupFusion(
+    "no-group-fusion",
+    cl::desc("Run every group on its own (default: consecutive plain groups of which none "
+             "reads or writes what an earlier one writes, nor writes what it reads, run as one "
+             "phase, sharing their neighbour passes; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoHoist(
     "no-hoist",
     cl::desc("Compute every subexpression of a pair-loop body per pair, as written (default: "
@@ -322,7 +328,7 @@ int main(int argc, char** argv) {
   }
 
   // --- the back half: schedule, code generation and build ----------------------------
-  auto schedule = buildSchedule(*plan, diags);
+  auto schedule = buildSchedule(*plan, diags, !NoGroupFusion);
   log("schedule");
   if (DumpAfter == Pass::Schedule) {
     printSchedule(*schedule, diags, llvm::outs());
