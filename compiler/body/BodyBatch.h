@@ -10,6 +10,7 @@
 #include "llvm/ADT/StringRef.h"
 #include "llvm/Support/SourceMgr.h"
 
+#include <algorithm>
 #include <functional>
 #include <set>
 #include <string>
@@ -27,6 +28,35 @@ inline bool isPairQuantity(const std::string& name) { return findPairQuantity(na
 inline bool isPropertyName(llvm::StringRef name) {
   return (name.startswith("d_") || name.startswith("s_")) && name.size() > 2 &&
          name != "d_idx" && name != "s_idx";
+}
+
+// What a parameter of a body function stands for, by its name, in the order the body checker
+// (BodyChecker.cpp) and the source-only finder (SourceOnly.cpp) both classify names: a property
+// (d_NAME / s_NAME), the neighbour list (NBRS, N_NBRS), a pair quantity, the indices, t, dt, one
+// of the scalars the body is given, or none of these.
+enum class NameRole {
+  Property, Neighbours, PairQuantity, SourceIndex, DestinationIndex, Time, TimeStep, Scalar, Other
+};
+
+inline NameRole nameRole(const BodySource& body, llvm::StringRef name) {
+  if (isPropertyName(name)) return NameRole::Property;
+  if (name == "NBRS" || name == "N_NBRS") return NameRole::Neighbours;
+  if (isPairQuantity(name.str())) return NameRole::PairQuantity;
+  if (name == "s_idx") return NameRole::SourceIndex;
+  if (name == "d_idx") return NameRole::DestinationIndex;
+  if (name == "t") return NameRole::Time;
+  if (name == "dt") return NameRole::TimeStep;
+  if (std::find(body.scalars.begin(), body.scalars.end(), name) != body.scalars.end())
+    return NameRole::Scalar;
+  return NameRole::Other;
+}
+
+// One of the math functions a body may call (allowedMathFunctions) or a kernel function.
+inline bool isMathOrKernelFunction(const std::string& name) {
+  const auto& math = allowedMathFunctions();
+  const auto& kernel = kernelFunctions();
+  return std::find(math.begin(), math.end(), name) != math.end() ||
+         std::find(kernel.begin(), kernel.end(), name) != kernel.end();
 }
 
 inline const char* kindName(BodyKind kind) {

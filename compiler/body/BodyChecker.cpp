@@ -99,21 +99,24 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
       if (!indexed_.count(e) && recovering_ == 0)
         error(e->getLocation(), "property '" + name + "' must be indexed, e.g. " + name + "[" +
                                     name.substr(0, 2) + "idx]; there are no pointers in bodies");
-    } else if (name == "NBRS" || name == "N_NBRS") {
-      if (body_.kind != BodyKind::LoopAll)
-        batch_.reportOutsideLoop(i_, sph(e->getLocation()), name);
-    } else if (isPairQuantity(name) || name == "s_idx") {
-      if (body_.kind != BodyKind::Loop)
-        batch_.reportOutsideLoop(i_, sph(e->getLocation()), name);
-      else if (name != "s_idx")
-        facts_.pairQuantities.insert(name);
-    } else if (name == "t") {
-      facts_.usesT = true;
-    } else if (name == "dt") {
-      facts_.usesDt = true;
-    } else if (std::find(body_.scalars.begin(), body_.scalars.end(), name) !=
-               body_.scalars.end()) {
-      facts_.scalarsUsed.insert(name);
+      return true;
+    }
+    switch (nameRole(body_, name)) {
+      case NameRole::Neighbours:
+        if (body_.kind != BodyKind::LoopAll)
+          batch_.reportOutsideLoop(i_, sph(e->getLocation()), name);
+        break;
+      case NameRole::PairQuantity:
+      case NameRole::SourceIndex:
+        if (body_.kind != BodyKind::Loop)
+          batch_.reportOutsideLoop(i_, sph(e->getLocation()), name);
+        else if (name != "s_idx")
+          facts_.pairQuantities.insert(name);
+        break;
+      case NameRole::Time: facts_.usesT = true; break;
+      case NameRole::TimeStep: facts_.usesDt = true; break;
+      case NameRole::Scalar: facts_.scalarsUsed.insert(name); break;
+      default: break;
     }
     return true;
   }
@@ -345,12 +348,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   // A math function declared by the prelude (not only implicitly or by a body itself). The
   // prelude's declaration of a library builtin such as sqrt redeclares Clang's implicit one.
   bool isAllowedMath(const clang::FunctionDecl* fn) const {
-    const auto& allowed = allowedMathFunctions();
-    const auto& kernel = kernelFunctions();
-    const std::string name = fn->getName().str();
-    if (std::find(allowed.begin(), allowed.end(), name) == allowed.end() &&
-        std::find(kernel.begin(), kernel.end(), name) == kernel.end())
-      return false;
+    if (!isMathOrKernelFunction(fn->getName().str())) return false;
     for (const clang::FunctionDecl* d : fn->redecls())
       if (!d->isImplicit() && batch_.bodyAt(sm_, d->getLocation()) < 0) return true;
     return false;

@@ -109,10 +109,8 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
       if (auto* v = llvm::dyn_cast<clang::VarDecl>(d); v && !llvm::isa<clang::ParmVarDecl>(v))
         return sourceOnlyLocal(v);
       if (!llvm::isa<clang::ParmVarDecl>(d)) return false;
-      if (name == "t" || name == "dt") return true;
-      return std::find(body_.scalars.begin(), body_.scalars.end(), name) != body_.scalars.end() &&
-             !isPropertyName(name) && !isPairQuantity(name) && name != "d_idx" &&
-             name != "s_idx";
+      const NameRole role = nameRole(body_, name);
+      return role == NameRole::Time || role == NameRole::TimeStep || role == NameRole::Scalar;
     }
     if (auto* a = llvm::dyn_cast<clang::ArraySubscriptExpr>(e)) {
       auto* base = llvm::dyn_cast<clang::DeclRefExpr>(a->getBase()->IgnoreParenImpCasts());
@@ -136,12 +134,7 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
     if (auto* call = llvm::dyn_cast<clang::CallExpr>(e)) {
       const clang::FunctionDecl* fn = call->getDirectCallee();
       if (!fn) return false;
-      const std::string name = fn->getName().str();
-      const auto& math = allowedMathFunctions();
-      const auto& kernel = kernelFunctions();
-      if (std::find(math.begin(), math.end(), name) == math.end() &&
-          std::find(kernel.begin(), kernel.end(), name) == kernel.end())
-        return false;
+      if (!isMathOrKernelFunction(fn->getName().str())) return false;
       for (const clang::Expr* arg : call->arguments())
         if (!sourceOnly(arg)) return false;
       return true;
@@ -208,13 +201,13 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
       const std::string name = d->getName().str();
       if (auto* v = llvm::dyn_cast<clang::VarDecl>(d); v && !llvm::isa<clang::ParmVarDecl>(v)) {
         if (locals.insert(v).second) todo.push_back(v->getInit());
-      } else if (name == "t") {
-        site.usesT = true;
-      } else if (name == "dt") {
-        site.usesDt = true;
-      } else if (std::find(body_.scalars.begin(), body_.scalars.end(), name) !=
-                 body_.scalars.end()) {
-        site.scalars.insert(name);
+      } else {
+        switch (nameRole(body_, name)) {
+          case NameRole::Time: site.usesT = true; break;
+          case NameRole::TimeStep: site.usesDt = true; break;
+          case NameRole::Scalar: site.scalars.insert(name); break;
+          default: break;
+        }
       }
     }
     for (const clang::Stmt* c : s->children())
