@@ -5,6 +5,7 @@ how PySPH's dam_break_2d is made consistent at a dx other than its own)."""
 
 import argparse
 import os
+import re
 import resource
 import shutil
 import subprocess
@@ -87,3 +88,40 @@ def remove_tmp(tmp, keep):
         print("kept %s" % tmp)
     else:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+# The scenes of the callgrind benchmarks (fma_instructions.py, hoist_instructions.py).
+SCENE_FILES = {
+    "dambreak": os.path.join(ROOT, "examples", "dambreak.sph"),
+    "cube": os.path.join(ROOT, "bench", "cube.sph"),
+    "taylor_green": os.path.join(ROOT, "examples", "taylor_green.sph"),
+}
+
+
+def instruction_parser(doc):
+    """The options every callgrind benchmark takes: the scenes, sphc, --keep."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--scenes", default="dambreak,cube")
+    ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
+    ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
+    return ap
+
+
+def instructions(callgrind_file):
+    """The total instruction count (Ir) of a callgrind output file."""
+    with open(callgrind_file) as f:
+        for line in f:
+            m = re.match(r"(?:summary|totals):\s+(\d+)", line)
+            if m:
+                return int(m.group(1))
+    raise SystemExit("no instruction total in " + callgrind_file)
+
+
+def callgrind_build_run(sphc, path, exe, sphc_flags, options):
+    """Builds the scene path into exe (sphc path -o exe sphc_flags), runs it with the run-time
+    options and without output under valgrind --tool=callgrind; returns the callgrind file."""
+    run([sphc, path, "-o", exe] + sphc_flags)
+    cg = exe + ".callgrind"
+    run(["valgrind", "--tool=callgrind", "--callgrind-out-file=" + cg, exe] + options +
+        ["--no-output", "-d", exe + "_out", "--quiet"])
+    return cg

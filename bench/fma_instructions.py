@@ -21,42 +21,27 @@ Usage: python3 bench/fma_instructions.py [--scenes dambreak,cube] [--sphc build/
 Needs valgrind.
 """
 
-import argparse
 import os
-import re
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from common import remove_tmp, run  # noqa: E402
+from common import (SCENE_FILES, callgrind_build_run, instruction_parser, instructions,  # noqa: E402
+                    remove_tmp)
 
 FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -g"
 # scene: (file, run-time options)
 SCENES = {
-    "dambreak": (os.path.join(ROOT, "examples", "dambreak.sph"),
-                 ["--set", "dx=0.03", "--max-steps", "100"]),
-    "cube": (os.path.join(ROOT, "bench", "cube.sph"), ["--set", "nx=20", "--max-steps", "5"]),
+    "dambreak": (SCENE_FILES["dambreak"], ["--set", "dx=0.03", "--max-steps", "100"]),
+    "cube": (SCENE_FILES["cube"], ["--set", "nx=20", "--max-steps", "5"]),
 }
 VARIANTS = [("off", "off", "off"), ("on", "on", "off"), ("fast", "off", "fast")]
 
 
-def instructions(callgrind_file):
-    with open(callgrind_file) as f:
-        for line in f:
-            m = re.match(r"(?:summary|totals):\s+(\d+)", line)
-            if m:
-                return int(m.group(1))
-    raise SystemExit("no instruction total in " + callgrind_file)
-
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenes", default="dambreak,cube")
-    ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
-    ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
-    args = ap.parse_args()
+    args = instruction_parser(__doc__).parse_args()
     tmp = tempfile.mkdtemp(prefix="sphc_fma_")
     print("built with --cxxflags \"%s -ffp-contract=...\"; instructions under callgrind" % FLAGS)
     print("%-10s %-6s %-8s %-14s %15s %9s" % ("scene", "--fma", "contract", "run", "instructions",
@@ -66,11 +51,9 @@ def main():
         base = None
         for name, fma, contract in VARIANTS:
             exe = os.path.join(tmp, "%s_%s" % (scene, name))
-            run([args.sphc, path, "-o", exe, "--fma=" + fma,
-                 "--cxxflags", FLAGS + " -ffp-contract=" + contract])
-            cg = exe + ".callgrind"
-            run(["valgrind", "--tool=callgrind", "--callgrind-out-file=" + cg, exe] + options +
-                ["--no-output", "-d", exe + "_out", "--quiet"])
+            cg = callgrind_build_run(args.sphc, path, exe, ["--fma=" + fma, "--cxxflags",
+                                                            FLAGS + " -ffp-contract=" + contract],
+                                     options)
             n = instructions(cg)
             base = base or n
             print("%-10s %-6s %-8s %-14s %15.4g %9.3f" % (scene, fma, contract,

@@ -23,7 +23,6 @@ Usage: python3 bench/hoist_instructions.py [--scenes dambreak,cube] [--sphc buil
 Needs valgrind and callgrind_annotate (not with --cpu).
 """
 
-import argparse
 import os
 import re
 import subprocess
@@ -31,26 +30,22 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from common import load_average, remove_tmp, run  # noqa: E402
-from fma_instructions import instructions  # noqa: E402
+from common import (SCENE_FILES, callgrind_build_run, instruction_parser, instructions,  # noqa: E402
+                    load_average, remove_tmp, run)
 
 FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
 # scene: (file, run-time options)
 SCENES = {
-    "dambreak": (os.path.join(ROOT, "examples", "dambreak.sph"),
-                 ["--set", "dx=0.03", "--max-steps", "100"]),
-    "cube": (os.path.join(ROOT, "bench", "cube.sph"), ["--set", "nx=20", "--max-steps", "20"]),
-    "taylor_green": (os.path.join(ROOT, "examples", "taylor_green.sph"),
-                     ["--set", "nx=50", "--max-steps", "20"]),
+    "dambreak": (SCENE_FILES["dambreak"], ["--set", "dx=0.03", "--max-steps", "100"]),
+    "cube": (SCENE_FILES["cube"], ["--set", "nx=20", "--max-steps", "20"]),
+    "taylor_green": (SCENE_FILES["taylor_green"], ["--set", "nx=50", "--max-steps", "20"]),
 }
 VARIANTS = [("no-hoist", ["--no-hoist"]), ("hoist", [])]
 # --cpu: scene -> (file, options, particles, short steps, long steps)
 CPU_SCENES = {
-    "cube": (os.path.join(ROOT, "bench", "cube.sph"), ["--set", "nx=47"], 103823, 1, 11),
-    "dambreak": (os.path.join(ROOT, "examples", "dambreak.sph"), ["--set", "dx=0.0046"], 102243,
-                 1, 41),
+    "cube": (SCENE_FILES["cube"], ["--set", "nx=47"], 103823, 1, 11),
+    "dambreak": (SCENE_FILES["dambreak"], ["--set", "dx=0.0046"], 102243, 1, 41),
 }
 
 
@@ -95,10 +90,7 @@ def group_instructions(callgrind_file):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenes", default="dambreak,cube")
-    ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
-    ap.add_argument("--keep", action="store_true", help="keep the temporary directory")
+    ap = instruction_parser(__doc__)
     ap.add_argument("--cpu", action="store_true", help="CPU time per step at ~100k particles")
     ap.add_argument("--rounds", type=int, default=3)
     args = ap.parse_args()
@@ -117,10 +109,7 @@ def main():
         base = gbase = None
         for name, flags in VARIANTS:
             exe = os.path.join(tmp, "%s_%s" % (scene, name))
-            run([args.sphc, path, "-o", exe, "--cxxflags", FLAGS] + flags)
-            cg = exe + ".callgrind"
-            run(["valgrind", "--tool=callgrind", "--callgrind-out-file=" + cg, exe] + options +
-                ["--no-output", "-d", exe + "_out", "--quiet"])
+            cg = callgrind_build_run(args.sphc, path, exe, ["--cxxflags", FLAGS] + flags, options)
             n = instructions(cg)
             g = group_instructions(cg)
             base = base or n
