@@ -15,30 +15,16 @@
 #include "sphc/nnps.h"
 #include "sphc/particle_array.h"
 
+#include "random_particles.h"
+
 namespace {
 
 using sphc::CellList;
 using sphc::ParticleArray;
 using sphc::SearchDomain;
+using sphc_test::random_array;
 
 constexpr double kRadiusScale = 2.0;
-
-// n particles uniform in [0, L]^dim (other coordinates 0) with h in [0.5, 1.5] * h0.
-ParticleArray random_array(std::size_t n, int dim, double L, double h0, unsigned seed) {
-  ParticleArray pa;
-  pa.name = "fluid";
-  pa.resize(n);
-  for (const char* p : {"x", "y", "z", "h"}) pa.add_property(p);
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> pos(0.0, L), hs(0.5 * h0, 1.5 * h0);
-  for (std::size_t i = 0; i < n; ++i) {
-    pa.f64("x")[i] = pos(rng);
-    pa.f64("y")[i] = dim >= 2 ? pos(rng) : 0.0;
-    pa.f64("z")[i] = dim == 3 ? pos(rng) : 0.0;
-    pa.f64("h")[i] = hs(rng);
-  }
-  return pa;
-}
 
 std::vector<std::uint32_t> brute_force(double xi, double yi, double zi, double hi,
                                        const ParticleArray& pa) {

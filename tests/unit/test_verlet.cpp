@@ -13,28 +13,15 @@
 #include "sphc/particle_array.h"
 #include "sphc/verlet.h"
 
+#include "random_particles.h"
+
 namespace {
 
 using sphc::ParticleArray;
 using sphc::VerletSkin;
+using sphc_test::random_array;
 
 constexpr double kRadiusScale = 2.0;
-
-ParticleArray random_array(std::size_t n, double L, double h0, unsigned seed) {
-  ParticleArray pa;
-  pa.name = "fluid";
-  pa.resize(n);
-  for (const char* p : {"x", "y", "z", "h"}) pa.add_property(p);
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> pos(0.0, L), hs(0.8 * h0, 1.2 * h0);
-  for (std::size_t i = 0; i < n; ++i) {
-    pa.f64("x")[i] = pos(rng);
-    pa.f64("y")[i] = pos(rng);
-    pa.f64("z")[i] = pos(rng);
-    pa.f64("h")[i] = hs(rng);
-  }
-  return pa;
-}
 
 // The pairs (i, j) with |x_i - x_j| < scale * radius_scale * max(h_i, h_j), per i.
 std::vector<std::vector<std::uint32_t>> lists(const ParticleArray& pa, double scale) {
@@ -51,7 +38,7 @@ std::vector<std::vector<std::uint32_t>> lists(const ParticleArray& pa, double sc
 
 TEST(VerletSkin, ListsStayCompleteUntilARebuildIsDue) {
   const double skin = 0.15, h0 = 0.1;
-  ParticleArray pa = random_array(300, 1.0, h0, 7);
+  ParticleArray pa = random_array(300, 3, 1.0, h0, 7, 0.8, 1.2);
   std::vector<const ParticleArray*> all = {&pa};
   VerletSkin verlet(skin);
   EXPECT_TRUE(verlet.must_rebuild(all, kRadiusScale));  // never built
@@ -88,7 +75,7 @@ TEST(VerletSkin, ListsStayCompleteUntilARebuildIsDue) {
 }
 
 TEST(VerletSkin, CountChangeAndNaNForceARebuild) {
-  ParticleArray pa = random_array(50, 1.0, 0.1, 3);
+  ParticleArray pa = random_array(50, 3, 1.0, 0.1, 3, 0.8, 1.2);
   std::vector<const ParticleArray*> all = {&pa};
   VerletSkin verlet(0.1);
   verlet.mark(all);
@@ -102,7 +89,7 @@ TEST(VerletSkin, CountChangeAndNaNForceARebuild) {
   EXPECT_FALSE(verlet.must_rebuild(all, kRadiusScale));
   pa.resize(49);
   EXPECT_TRUE(verlet.must_rebuild(all, kRadiusScale));
-  ParticleArray other = random_array(10, 1.0, 0.1, 4);
+  ParticleArray other = random_array(10, 3, 1.0, 0.1, 4, 0.8, 1.2);
   verlet.mark(all);
   std::vector<const ParticleArray*> two = {&pa, &other};
   EXPECT_TRUE(verlet.must_rebuild(two, kRadiusScale));  // another set of arrays
