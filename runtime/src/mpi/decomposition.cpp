@@ -19,6 +19,8 @@ namespace sphc::mpi {
 namespace {
 
 std::vector<double> measured_weights(const Decomposition& d, std::size_t arrays);
+std::vector<double> pass_scales(const Decomposition& d,
+                                const std::vector<ParticleArray*>& arrays);
 void rebalance_with(Decomposition& d, const std::vector<ParticleArray*>& arrays,
                     bool per_particle);
 
@@ -29,6 +31,9 @@ struct Objects {
   // Measured: each particle's own counted work where its array's counts are of its
   // particles (the passes' order, nothing created or removed since), else weights.
   const Decomposition* counts = nullptr;
+  // With counts, per array: the factor on each particle's pass work that makes the array's
+  // mean the mean since the last re-balance (pass_scales); < 0: its weight instead.
+  std::vector<double> pass_scale;
   int dim = 2;
   unsigned long first = 0;  // global number of this rank's first object
 };
@@ -57,10 +62,13 @@ void obj_list(void* data, int, int, ZOLTAN_ID_PTR gids, ZOLTAN_ID_PTR lids, int 
     for (std::size_t k = 0; k < o.arrays->size(); ++k) {
       const std::size_t n = (*o.arrays)[k]->n;
       const Decomposition* c = o.counts;
+      const double scale = k < o.pass_scale.size() ? o.pass_scale[k] : 1.0;
       if (c && k < c->particle_work.size() && c->pass_n[k] == n &&
-          c->particle_work[k].size() >= n) {
+          c->particle_work[k].size() >= n && scale >= 0) {
         for (std::size_t j = 0; j < n; ++j)
-          wgts[i++] = static_cast<float>(c->particle_cost + c->particle_work[k][j]);
+          wgts[i++] = scale == 1.0
+                          ? static_cast<float>(c->particle_cost + c->particle_work[k][j])
+                          : static_cast<float>(c->particle_cost + scale * c->particle_work[k][j]);
         continue;
       }
       const float w = static_cast<float>(k < o.weights->size() ? (*o.weights)[k] : 1.0);
@@ -286,9 +294,13 @@ namespace {
 void rebalance_with(Decomposition& d, const std::vector<ParticleArray*>& arrays,
                     bool per_particle) {
   // Measured weights: what the particles of each array cost since the last re-balance (none
-  // counted yet: the estimate, set_weights); the count starts again.
-  if (d.mode == Weights::Measured && d.evaluations_counted > 0)
+  // counted yet: the estimate, set_weights); the count starts again. Each particle's own
+  // count is of the last evaluation: scaled to the mean since the last re-balance.
+  std::vector<double> scale;
+  if (d.mode == Weights::Measured && d.evaluations_counted > 0) {
     d.weights = measured_weights(d, arrays.size());
+    if (per_particle) scale = pass_scales(d, arrays);
+  }
   std::fill(d.work_since.begin(), d.work_since.end(), 0);
   std::fill(d.particles_since.begin(), d.particles_since.end(), 0);
   d.evaluations_counted = 0;
@@ -297,6 +309,7 @@ void rebalance_with(Decomposition& d, const std::vector<ParticleArray*>& arrays,
   o.arrays = &arrays;
   o.weights = &d.weights;
   if (per_particle && d.mode == Weights::Measured) o.counts = &d;
+  o.pass_scale = std::move(scale);
   o.dim = d.dim;
   const unsigned long n = local_count(arrays);
   MPI_Exscan(&n, &o.first, 1, MPI_UNSIGNED_LONG, MPI_SUM, MPI_COMM_WORLD);
@@ -407,6 +420,42 @@ std::vector<double> measured_weights(const Decomposition& d, std::size_t arrays)
     w[k] = v[arrays + k] > 0 ? static_cast<double>(v[k]) / static_cast<double>(v[arrays + k])
                              : (k < d.estimate.size() ? d.estimate[k] * d.particle_cost : 1.0);
   return w;
+}
+
+// Per array, the factor on each particle's pass work of the last evaluation (particle_work)
+// that gives the array's particles the mean pass work per particle since the last re-balance
+// (work_since): a group that runs only in some evaluations (every, condition, iterate) then
+// weighs as much as it costs on average, not all or nothing as in the last evaluation. 1 when
+// the two means agree; -1 where the last evaluation counted no pass work for the array (its
+// measured weight, the mean, for every particle). Collective.
+std::vector<double> pass_scales(const Decomposition& d,
+                                const std::vector<ParticleArray*>& arrays) {
+  const std::size_t K = arrays.size();
+  std::vector<long> v(4 * K, 0);  // since: pass work, particles; last: pass work, particles
+  for (std::size_t k = 0; k < K; ++k) {
+    const long since = k < d.work_since.size() ? d.work_since[k] : 0;
+    const long n_since = k < d.particles_since.size() ? d.particles_since[k] : 0;
+    v[k] = since - d.particle_cost * n_since;
+    v[K + k] = n_since;
+    const std::size_t n = arrays[k]->n;
+    if (k < d.particle_work.size() && d.pass_n[k] == n && d.particle_work[k].size() >= n) {
+      for (std::size_t j = 0; j < n; ++j) v[2 * K + k] += d.particle_work[k][j];
+      v[3 * K + k] = static_cast<long>(n);
+    }
+  }
+  all_reduce(v, MPI_SUM);
+  std::vector<double> scale(K, 1.0);
+  for (std::size_t k = 0; k < K; ++k) {
+    if (v[3 * K + k] == 0 || v[K + k] == 0) continue;  // no counts: unchanged
+    if (v[2 * K + k] == 0) {
+      scale[k] = v[k] > 0 ? -1.0 : 1.0;
+      continue;
+    }
+    if (v[k] * v[3 * K + k] == v[2 * K + k] * v[K + k]) continue;  // the same mean: exactly 1
+    scale[k] = (static_cast<double>(v[k]) / static_cast<double>(v[K + k])) /
+               (static_cast<double>(v[2 * K + k]) / static_cast<double>(v[3 * K + k]));
+  }
+  return scale;
 }
 
 }  // namespace

@@ -168,6 +168,57 @@ TEST(MpiDecomposition, MeasuredWeightsBalanceCountedWork) {
     std::printf("counted work max/mean: measured %.4f, estimated %.4f\n", measured, estimated);
 }
 
+// Measured weights with a group that runs in some evaluations only (decomposition.cpp,
+// pass_scales): two arrays, "fluid" the half x < 0.5 of an 80 x 80 lattice and "wall" the
+// other half. Every evaluation a pass tests 1 candidate per particle of each (30 units); in the
+// 1st and 3rd of the four evaluations before the scheduled re-balance a second group tests 200
+// more per fluid particle (6,000 units), in the 4th not. On average since the last re-balance a
+// fluid particle costs 1,300 + 30 + 3,000 units and a wall particle 1,330: the re-cut must
+// balance that mean work (within 15%, as above). Weighing each particle by its count of the
+// last evaluation alone (1,330 for both: the split by particle count) leaves the fluid's ranks
+// 1.53 times the mean (2 and 4 ranks).
+sphc::ParticleArray half(bool left) {
+  sphc::ParticleArray a = lattice(80);
+  a.name = left ? "fluid" : "wall";
+  std::vector<std::uint32_t> order, rest;
+  for (std::size_t i = 0; i < a.n; ++i)
+    ((a.f64("x")[i] < 0.5) == left ? order : rest).push_back(static_cast<std::uint32_t>(i));
+  const std::size_t n = order.size();
+  order.insert(order.end(), rest.begin(), rest.end());
+  a.permute(order);
+  a.resize(n);
+  return a;
+}
+
+TEST(MpiDecomposition, MeasuredWeightsAreTheMeanSinceTheLastRebalance) {
+  sphc::ParticleArray f = half(true), w = half(false);
+  sphc::mpi::Decomposition d;
+  sphc::mpi::init_decomposition(d, 2);
+  sphc::mpi::set_weights(d, {1.0, 1.0});
+  d.rebalance_every = 5;             // the 5th update re-cuts, after 4 counted evaluations
+  d.min_rebalance_gap = 1L << 50;    // no re-balance on imbalance
+  const std::vector<sphc::ParticleArray*> arrays = {&f, &w};
+  sphc::mpi::distribute(d, arrays);
+  sphc::mpi::update(d, arrays);  // the first evaluation: nothing counted yet
+  for (int e = 1; e <= 4; ++e) {
+    for (std::size_t k = 0; k < 2; ++k) {
+      const std::size_t n = arrays[k]->n;
+      const long per = 1 + (k == 0 && e % 2 == 1 ? 200 : 0);
+      long* pw = sphc::mpi::pass_work(d, k, n, n);
+      for (std::size_t i = 0; i < n; ++i) pw[i] += d.candidate_cost * per;
+      sphc::mpi::count_work(d, k, 0, per * static_cast<long>(n));
+    }
+    sphc::mpi::update(d, arrays);
+  }
+  EXPECT_EQ(d.rebalances, 2);  // distribute's and the scheduled one
+  const double mine = static_cast<double>(f.n) * (d.particle_cost + 30 + 3000) +
+                      static_cast<double>(w.n) * (d.particle_cost + 30);
+  const double ratio = sphc::mpi::max(mine) / (sphc::mpi::sum(mine) / sphc::mpi::size());
+  EXPECT_EQ(all_gids(f).size() + all_gids(w).size(), 6400u);
+  EXPECT_LT(ratio, 1.15);
+  if (sphc::mpi::rank() == 0) std::printf("mean work max/mean after the re-cut: %.4f\n", ratio);
+}
+
 // The neighbours of every real particle among real + halo particles are exactly those of a
 // serial brute force over all particles and their periodic images (or mirror images), with
 // the carried properties transformed.

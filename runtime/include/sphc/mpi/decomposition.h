@@ -32,7 +32,9 @@
 //     exact integer MPI_Allreduce, above the limit), at least min_rebalance_gap evaluations
 //     after the last one; it happens before that evaluation's particles migrate, and RCB
 //     weighs each particle by its own count (a wall next to the water tests many candidates,
-//     one far from it none). Where an array changed since the passes (inlets, outlets), its
+//     one far from it none), scaled per array so that its particles' mean is the mean since the
+//     last re-balance (a group that runs in some evaluations only weighs its average, not all
+//     or nothing as in the last evaluation). Where an array changed since the passes (inlets, outlets), its
 //     particles weigh the measured mean of its particles since the last re-balance instead,
 //     as in the scheduled re-balances after a migration. The first cut (distribute, restart:
 //     nothing counted yet) uses the compiler's estimate.
