@@ -314,8 +314,10 @@ int main(int argc, char** argv) {
     std::snprintf(skin, sizeof skin, "%g", kAutoVerletSkin);
     if (why.empty())
       plan->notes.push_back(std::string("neighbour lists kept across steps (--verlet-skin=auto): "
-                                        "candidates within (1 + ") +
-                            skin + ") times the support, rebuilt when particles moved too far");
+                                        "candidates within (1 + F) times the support, rebuilt "
+                                        "when particles moved too far; F chosen at run time "
+                                        "from how far they move between rebuilds (from ") +
+                            skin + "), the cell-order sort when they left that order");
     else
       plan->notes.push_back("neighbour lists gathered at every evaluation (--verlet-skin=auto): "
                             "lists kept across steps are not written for " + why);
@@ -343,6 +345,7 @@ int main(int argc, char** argv) {
   }
   EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
                        verletSkin, !NoHoist};
+  emitOpts.verletAuto = verletAuto;  // the skin and re-sort chosen at run time
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;
