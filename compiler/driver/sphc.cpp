@@ -73,7 +73,8 @@ static cl::opt<std::string> VerletSkin(
     "verlet-skin",
     cl::desc("Neighbour lists kept across time steps: each destination particle's candidates "
              "within (1 + F) times the support, rebuilt when particles moved too far. auto "
-             "(default): F = 0.1 where the lists are written for (serial and openmp, double precision, "
+             "(default): F chosen at run time (from 0.1) from how far particles move between "
+             "rebuilds, and the cell-order sort when they left that order, where the lists are written for (serial and openmp, double precision, "
              "no periodic/mirror domain, inlets, outlets or --mpi), off elsewhere (--report "
              "says which); F in (0, 1]: that skin, an error elsewhere; off or 0: "
              "the cell lists' neighbours at every evaluation. Sums over neighbours round "
@@ -92,7 +93,8 @@ static cl::opt<bool> NoHoist(
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double precision; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
-// --verlet-skin=auto (the default): the skin, as a fraction of the support radius. Measured (callgrind
+// --verlet-skin=auto (the default): the starting skin (the solver then chooses it,
+// sphc/verlet_tune.h, where SkinTuner::kStart is the same 0.1), as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
 // than 0.2 on the cube and the dam break (0.2 keeps ~1.33x (3D) the candidates of 0.1 in
 // every list for fewer rebuilds).
