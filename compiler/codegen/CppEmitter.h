@@ -38,6 +38,9 @@ struct EmitOptions {
   // backends, double precision, not --mpi); false (--no-hoist): computed per pair as written.
   // The values are the same bit for bit.
   bool hoist = true;
+  // --verlet-skin=auto: the skin and the cell-order re-sort chosen at run time
+  // (sphc/verlet_tune.h); false: the fixed skin verletSkin, re-sorted every REORDER_EVERY.
+  bool verletAuto = false;
 };
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.

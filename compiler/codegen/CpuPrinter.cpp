@@ -21,7 +21,8 @@ class CpuPrinter : public ScenePrinter {
         openmp_(opts.backend == Backend::OpenMP),
         verletSkin_(opts.verletSkin > 0 && !cpuSingle_ && !mpi_ && !hasDomain() && !hasZones()
                         ? opts.verletSkin
-                        : 0.0) {}
+                        : 0.0),
+        tuned_(verletSkin_ > 0 && opts.verletAuto) {}
 
  private:
   std::string backendComment() const override {
@@ -31,6 +32,7 @@ class CpuPrinter : public ScenePrinter {
   void runtimeIncludes() override {
     if (cpuSingle_) out_ << "#include \"sphc/float_arrays.h\"\n";
     if (verlet()) out_ << "#include \"sphc/verlet.h\"\n";
+    if (tuned_) out_ << "#include \"sphc/verlet_tune.h\"\n";
   }
   void systemIncludes() override {
     if (openmp_) out_ << "\n#include <omp.h>\n";
@@ -49,6 +51,18 @@ class CpuPrinter : public ScenePrinter {
   // --verlet-skin: the lists are kept across evaluations (sphc/verlet.h).
   bool verlet() const { return verletSkin_ > 0; }
   void verletMembers();
+  // --verlet-skin=auto: the skin and the re-sort chosen at run time (sphc/verlet_tune.h;
+  // CpuVerletTune.inc); --verlet-skin=F keeps the code of a fixed skin.
+  bool tuned() const { return tuned_; }
+  void tunedMembers();
+  // The arrays of a pair loop whose positions or h something may change (the others are
+  // static: the lists' rebuild check skips them).
+  std::vector<int> movingArrays(int d, int s) const;
+  std::string arrayList(const std::vector<int>& arrays) const;
+  void tunedRebuildCheck(const std::string& lists, const DestinationWork& w, int d, int s);
+  // The kept lists whose destination or source is array S (forgotten after S is sorted).
+  std::vector<std::string> listsOf(const std::string& S) const;
+  void tunedUpdateNeighbours();
   // The member holding the kept lists of the pass of destination work w over source s in a
   // phase. The pair loops of every phase with the same destination and source share one set
   // of lists (the support radius is the scene's), rebuilt by whichever loop finds them stale;
@@ -146,6 +160,7 @@ class CpuPrinter : public ScenePrinter {
 
   bool openmp_ = false;
   double verletSkin_ = 0.0;  // --verlet-skin (0: lists gathered at every evaluation)
+  bool tuned_ = false;       // --verlet-skin=auto: skin and re-sort chosen at run time
 };
 
 // --verlet-skin: the skin and, per pair loop (phase, destination, source), each destination
@@ -155,9 +170,13 @@ void CpuPrinter::verletMembers() {
   std::snprintf(skin, sizeof skin, "%.17g", verletSkin_);
   out_ << "  // --verlet-skin: candidates within (1 + VERLET_SKIN) times the support, kept across\n"
           "  // evaluations and rebuilt when particles moved too far (sphc/verlet.h).\n";
-  out_ << "  static constexpr double VERLET_SKIN = " << skin << ";\n";
-  out_ << "  static constexpr double VERLET_RADIUS2 = RADIUS2 * (1.0 + VERLET_SKIN) * "
-          "(1.0 + VERLET_SKIN);\n";
+  if (tuned()) {
+    tunedMembers();
+  } else {
+    out_ << "  static constexpr double VERLET_SKIN = " << skin << ";\n";
+    out_ << "  static constexpr double VERLET_RADIUS2 = RADIUS2 * (1.0 + VERLET_SKIN) * "
+            "(1.0 + VERLET_SKIN);\n";
+  }
   std::set<std::string> declared;  // one member per set of lists (verletLists)
   std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
     for (const Phase& ph : g.phases)
@@ -165,7 +184,7 @@ void CpuPrinter::verletMembers() {
         for (const NeighbourPass& pass : w.passes) {
           const std::string lists = verletLists(ph.name, w, pass.source);
           if (pass.searches() && declared.insert(lists).second)
-            out_ << "  sphc::VerletLists " << lists << "{VERLET_SKIN};  // "
+            out_ << "  sphc::VerletLists " << lists << (tuned() ? "{verlet_skin};  // " : "{VERLET_SKIN};  // ")
                  << arr(w.array).name << " <- " << arr(pass.source).name
                  << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase"))
                  << "\n";
@@ -255,7 +274,9 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
                       parallelFor("        ", pass.order));
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, w, s) : "";
-    if (verlet()) {
+    if (tuned()) {
+      tunedRebuildCheck(lists, w, d, s);
+    } else if (verlet()) {
       // Rebuilt when particles of either array moved too far since the lists' last build
       // (by this loop or another one sharing them).
       const std::string arrays = d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}";
@@ -305,7 +326,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
                 "nbrs_list, [&](std::uint32_t j) {\n";
       scene_ << "              const int s_idx = static_cast<int>(j);\n";
-      emitNeighbourTest(scene_, host_, "return false;", "              ", "VERLET_RADIUS2");
+      emitNeighbourTest(scene_, host_, "return false;", "              ",
+                        tuned() ? "verlet_radius2" : "VERLET_RADIUS2");
       scene_ << "              return true;\n            });\n";
       scene_ << "            sphc::keep_in_index_order(kept, nbrs_list.data(), n_kept);\n";
       scene_ << "          }\n";
@@ -500,7 +522,7 @@ void CpuPrinter::searchDomain(const std::string& only, const std::string& dom) {
   if (verlet()) {
     // Cells as large as the lists' radius (each pair loop rebuilds its lists when due).
     scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale * (1.0 + "
-              "VERLET_SKIN));\n";
+           << (tuned() ? "verlet_skin" : "VERLET_SKIN") << "));\n";
     return;
   }
   scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
@@ -585,8 +607,13 @@ void CpuPrinter::emitStaticCells() {
       scene_ << "    domain_" << S << ".cell_size = order_domain.cell_size;  // the cell order "
              << "as without lists\n";
       scene_ << "    " << build << "\n    " << permuteInCellOrder(S) << "\n";
-      scene_ << "    domain_" << S << ".cell_size = domain.cell_size;  // every candidate of the "
-             << "lists one cell away\n";
+      if (tuned())
+        scene_ << "    domain_" << S << ".cell_size = order_domain.cell_size * (1.0 + "
+               << "sphc::SkinTuner::kMax);  // every candidate of the lists one cell away, "
+               << "whatever skin is chosen\n";
+      else
+        scene_ << "    domain_" << S << ".cell_size = domain.cell_size;  // every candidate of the "
+               << "lists one cell away\n";
       scene_ << "    " << build << "\n";
       continue;
     }
@@ -599,6 +626,7 @@ void CpuPrinter::emitStaticCells() {
 
 // update_neighbours of a scene without periodic or mirror domain.
 void CpuPrinter::updateNeighbours() {
+  if (tuned()) return tunedUpdateNeighbours();  // CpuVerletTune.inc
   if (!loopArrays_.empty()) searchDomain();
   // --verlet-skin: permutations sort into the cell order of the support's grid (order_domain,
   // made as `domain` is without lists), so that the particles are in the order they have
@@ -690,6 +718,8 @@ void CpuPrinter::adaptiveDtArray(int a) {
   }
   scene_ << "      }\n    }\n";
 }
+
+#include "codegen/CpuVerletTune.inc"
 
 }  // namespace
 

@@ -73,7 +73,8 @@ static cl::opt<std::string> VerletSkin(
     "verlet-skin",
     cl::desc("Neighbour lists kept across time steps: each destination particle's candidates "
              "within (1 + F) times the support, rebuilt when particles moved too far. auto "
-             "(default): F = 0.1 where the lists are written for (serial and openmp, double precision, "
+             "(default): F chosen at run time (from 0.1) from how far particles move between "
+             "rebuilds, and the cell-order sort when they left that order, where the lists are written for (serial and openmp, double precision, "
              "no periodic/mirror domain, inlets, outlets or --mpi), off elsewhere (--report "
              "says which); F in (0, 1]: that skin, an error elsewhere; off or 0: "
              "the cell lists' neighbours at every evaluation. Sums over neighbours round "
@@ -92,7 +93,8 @@ static cl::opt<bool> NoHoist(
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double precision; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
-// --verlet-skin=auto (the default): the skin, as a fraction of the support radius. Measured (callgrind
+// --verlet-skin=auto (the default): the starting skin (the solver then chooses it,
+// sphc/verlet_tune.h, where SkinTuner::kStart is the same 0.1), as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
 // than 0.2 on the cube and the dam break (0.2 keeps ~1.33x (3D) the candidates of 0.1 in
 // every list for fewer rebuilds).
@@ -314,8 +316,10 @@ int main(int argc, char** argv) {
     std::snprintf(skin, sizeof skin, "%g", kAutoVerletSkin);
     if (why.empty())
       plan->notes.push_back(std::string("neighbour lists kept across steps (--verlet-skin=auto): "
-                                        "candidates within (1 + ") +
-                            skin + ") times the support, rebuilt when particles moved too far");
+                                        "candidates within (1 + F) times the support, rebuilt "
+                                        "when particles moved too far; F chosen at run time "
+                                        "from how far they move between rebuilds (from ") +
+                            skin + "), the cell-order sort when they left that order");
     else
       plan->notes.push_back("neighbour lists gathered at every evaluation (--verlet-skin=auto): "
                             "lists kept across steps are not written for " + why);
@@ -343,6 +347,7 @@ int main(int argc, char** argv) {
   }
   EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
                        verletSkin, !NoHoist};
+  emitOpts.verletAuto = verletAuto;  // the skin and re-sort chosen at run time
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;

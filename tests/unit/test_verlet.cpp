@@ -12,6 +12,7 @@
 
 #include "sphc/particle_array.h"
 #include "sphc/verlet.h"
+#include "sphc/verlet_tune.h"
 
 #include "random_particles.h"
 
@@ -119,6 +120,131 @@ TEST(VerletSkin, KeptListsAreInIncreasingIndex) {
   EXPECT_EQ(ka, kb);
   sphc::keep_in_index_order(ka, a.data(), 0);
   EXPECT_TRUE(ka.empty());
+}
+
+// --verlet-skin=auto (sphc/verlet_tune.h): the skin minimises the modelled cost per
+// evaluation, (1 + F)^dim (1 + k / F): no F of a fine scan around it costs less.
+TEST(SkinTuner, OptimalSkinMinimisesTheModelledCost) {
+  for (int dim : {1, 2, 3})
+    for (double k : {1e-4, 1e-3, 0.01, 0.05, 0.2, 1.0}) {
+      const double f = sphc::SkinTuner::optimal_skin(dim, k);
+      auto cost = [&](double F) { return std::pow(1.0 + F, dim) * (1.0 + k / F); };
+      ASSERT_GT(f, 0.0);
+      for (double F = 1e-3; F < 3.0; F *= 1.01)
+        EXPECT_GE(cost(F), cost(f) * (1.0 - 1e-12)) << "dim " << dim << " k " << k << " F " << F;
+    }
+  EXPECT_EQ(sphc::SkinTuner::optimal_skin(2, 0.0), 0.0);
+  // Rebuild / filter cost per candidate: 9 / pi + 1 in 2D, 27 / (4 pi / 3) + 1 in 3D.
+  EXPECT_NEAR(sphc::SkinTuner::cost_ratio(2), 3.8648, 1e-4);
+  EXPECT_NEAR(sphc::SkinTuner::cost_ratio(3), 7.4458, 1e-4);
+}
+
+// Particles of a 3D array that move at a constant speed, with the lists rebuilt when due
+// and their skin the tuner's: the skin starts at kStart, then is the model's optimum for the
+// measured movement per evaluation (clamped to [kMin, kMax]), larger for faster particles;
+// a rebuild after forget() (a sort) measures nothing. Returns the last skin.
+double tuned_skin(double speed, int evaluations, int* rebuilds) {
+  const double h0 = 0.1;
+  ParticleArray pa = random_array(200, 1.0, h0, 5);
+  for (std::size_t i = 0; i < pa.n; ++i) pa.f64("h")[i] = h0;  // one h: h_min = h0
+  std::vector<const ParticleArray*> all = {&pa};
+  sphc::VerletLists lists(sphc::SkinTuner::kStart);
+  sphc::SkinTuner tuner(3);
+  EXPECT_EQ(tuner.skin(), sphc::SkinTuner::kStart);
+  *rebuilds = 0;
+  for (int e = 0; e < evaluations; ++e) {
+    if (lists.skin.must_rebuild(all, kRadiusScale)) {
+      tuner.rebuilt(lists.skin, kRadiusScale);
+      lists.skin.set_skin(tuner.skin());
+      lists.skin.mark(all);
+      ++*rebuilds;
+    }
+    for (std::size_t i = 0; i < pa.n; ++i) pa.f64("x")[i] += speed * h0;  // moved 2 speed h0
+  }
+  // Each measured rebuild saw moved = 2 speed h0 per evaluation over radius_scale h_min =
+  // 2 h0: u = speed.
+  const double u = speed;
+  const double expect = std::min(
+      sphc::SkinTuner::kMax,
+      std::max(sphc::SkinTuner::kMin,
+               sphc::SkinTuner::optimal_skin(3, sphc::SkinTuner::cost_ratio(3) * u)));
+  EXPECT_NEAR(tuner.skin(), expect, 1e-6 * expect) << "speed " << speed;
+  // A sort (forget) then a rebuild: nothing measured, the skin stays.
+  lists.skin.forget();
+  EXPECT_TRUE(lists.skin.must_rebuild(all, kRadiusScale));
+  const double before = tuner.skin();
+  tuner.rebuilt(lists.skin, kRadiusScale);
+  EXPECT_EQ(tuner.skin(), before);
+  return tuner.skin();
+}
+
+TEST(SkinTuner, SkinFollowsTheMeasuredMovement) {
+  int slow_rebuilds = 0, fast_rebuilds = 0;
+  const double slow = tuned_skin(1e-3, 400, &slow_rebuilds);
+  const double fast = tuned_skin(1e-2, 400, &fast_rebuilds);
+  EXPECT_LT(slow, sphc::SkinTuner::kStart);  // slow particles: shorter lists
+  EXPECT_GT(fast, slow);
+  EXPECT_GT(slow_rebuilds, 2);
+  EXPECT_GT(fast_rebuilds, slow_rebuilds);
+  // Very fast particles hit kMax.
+  int n = 0;
+  EXPECT_EQ(tuned_skin(0.2, 50, &n), sphc::SkinTuner::kMax);
+}
+
+// The lists stay complete when the skin changes from build to build (each set is checked
+// against the skin it was built with): random motion with growing h, the skin chosen by the
+// tuner at each rebuild, every pair within the support in the kept lists.
+TEST(SkinTuner, ListsStayCompleteWhileTheSkinChanges) {
+  const double h0 = 0.1;
+  ParticleArray pa = random_array(300, 1.0, h0, 9);
+  std::vector<const ParticleArray*> all = {&pa};
+  VerletSkin verlet(sphc::SkinTuner::kStart);
+  sphc::SkinTuner tuner(3);
+  std::mt19937_64 rng(13);
+  std::normal_distribution<double> step(0.0, 0.004 * h0);
+  std::uniform_real_distribution<double> grow(0.0, 0.001 * h0);
+  std::vector<std::vector<std::uint32_t>> kept;
+  std::vector<double> skins;
+  for (int s = 0; s < 200; ++s) {
+    if (verlet.must_rebuild(all, kRadiusScale)) {
+      tuner.rebuilt(verlet, kRadiusScale);
+      verlet.set_skin(tuner.skin());
+      kept = lists(pa, 1.0 + verlet.skin());
+      verlet.mark(all);
+      skins.push_back(verlet.skin());
+    }
+    const auto now = lists(pa, 1.0);
+    for (std::size_t i = 0; i < pa.n; ++i)
+      for (std::uint32_t j : now[i])
+        ASSERT_TRUE(std::find(kept[i].begin(), kept[i].end(), j) != kept[i].end())
+            << "step " << s << ": pair " << i << ", " << j << " missing";
+    for (std::size_t i = 0; i < pa.n; ++i) {
+      pa.f64("x")[i] += step(rng);
+      pa.f64("y")[i] += step(rng);
+      pa.f64("z")[i] += step(rng);
+      pa.f64("h")[i] += grow(rng);
+    }
+  }
+  ASSERT_GT(skins.size(), 3u);
+  EXPECT_NE(skins.front(), skins.back());  // the skin did change
+}
+
+// The sort criterion: the share of places where the cell order breaks the present order.
+TEST(SkinTuner, SortWhenTheParticlesLeftCellOrder) {
+  std::vector<std::uint32_t> order(101);
+  for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+  EXPECT_EQ(sphc::out_of_order(order), 0.0);  // sorted already
+  sphc::SkinTuner tuner(2);
+  EXPECT_FALSE(tuner.sort_due(order));
+  std::swap(order[10], order[11]);  // two particles swapped: 3 breaks in 100 places
+  EXPECT_DOUBLE_EQ(sphc::out_of_order(order), 0.03);
+  EXPECT_FALSE(tuner.sort_due(order));
+  // Every other pair swapped: 3 of every 4 places break.
+  for (std::size_t k = 0; k + 1 < order.size(); k += 4) std::swap(order[k], order[k + 1]);
+  EXPECT_GT(sphc::out_of_order(order), sphc::SkinTuner::kSortDisorder);
+  EXPECT_TRUE(tuner.sort_due(order));
+  EXPECT_EQ(tuner.sorts(), 1);
+  EXPECT_EQ(sphc::out_of_order({}), 0.0);
 }
 
 }  // namespace

@@ -39,11 +39,23 @@ class VerletSkin {
   explicit VerletSkin(double skin) : skin_(skin) {}
 
   double skin() const { return skin_; }
+  // --verlet-skin=auto (sphc/verlet_tune.h): the skin of the next mark().
+  void set_skin(double skin) { skin_ = skin; }
+  // Forgets the last mark(): the next must_rebuild says yes (after a sort, whose permutation
+  // is no movement to measure).
+  void forget() { saved_.clear(); }
+  // What the last must_rebuild measured (2 d + radius_scale g; -1 where it answered without
+  // measuring), the must_rebuild calls since the last mark(), and h_min at the last mark().
+  double last_moved() const { return last_moved_; }
+  long checks() const { return checks_; }
+  double hmin() const { return hmin_; }
 
   // Whether the lists built at the last mark() may miss a pair now (see above): true before
   // the first mark(), when the arrays or their counts differ, or when the particles moved
   // (or h grew) too far. NaN positions also give true.
   bool must_rebuild(const std::vector<const ParticleArray*>& arrays, double radius_scale) const {
+    ++checks_;
+    last_moved_ = -1.0;
     if (saved_.size() != arrays.size()) return true;
     double d2max = 0.0, growth = 0.0;
     for (std::size_t a = 0; a < arrays.size(); ++a) {
@@ -66,11 +78,13 @@ class VerletSkin {
       }
     }
     const double moved = 2.0 * std::sqrt(d2max) + radius_scale * growth;
+    last_moved_ = moved;
     return !(moved <= skin_ * radius_scale * hmin_);
   }
 
   // Records the positions and h of the arrays the lists are built from now.
   void mark(const std::vector<const ParticleArray*>& arrays) {
+    checks_ = 0;
     saved_.resize(arrays.size());
     hmin_ = HUGE_VAL;
     for (std::size_t a = 0; a < arrays.size(); ++a) {
@@ -104,6 +118,8 @@ class VerletSkin {
   double skin_;
   double hmin_ = 0.0;
   std::vector<Saved> saved_;
+  mutable double last_moved_ = -1.0;  // measurements for sphc/verlet_tune.h
+  mutable long checks_ = 0;
 };
 
 // The kept lists of the pair loops of one destination and source array: per destination
