@@ -438,12 +438,6 @@ void CpuPrinter::ghostRefresh(const DestinationWork& w) {
            << propIndexList(d, refresh) << ");\n";
 }
 
-// Steppers are per particle (a body reads and writes its own particle d_idx only, as the
-// parallel loops of the OpenMP backend already require), so running the methods of a run
-// one after the other on each particle, in one pass, gives what running each method on all
-// particles in turn gives, bit for bit, with less memory traffic (PECIntegrator's
-// initialize and stage1 both read and write x, u, rho, ...). The arrays' passes share one
-// parallel region (`omp for nowait`: each array's particles are its own).
 // --omp-min-particles: the `if` clause of a stepper run's parallel region, on the particles
 // of all its arrays (" if (...)", or "").
 std::string CpuPrinter::stepperIf(const StepperRun& run) const {
@@ -454,6 +448,12 @@ std::string CpuPrinter::stepperIf(const StepperRun& run) const {
   return cond.empty() ? "" : " " + cond;
 }
 
+// Steppers are per particle (a body reads and writes its own particle d_idx only, as the
+// parallel loops of the OpenMP backend already require), so running the methods of a run
+// one after the other on each particle, in one pass, gives what running each method on all
+// particles in turn gives, bit for bit, with less memory traffic (PECIntegrator's
+// initialize and stage1 both read and write x, u, rho, ...). The arrays' passes share one
+// parallel region (`omp for nowait`: each array's particles are its own).
 void CpuPrinter::steppers() {
   for (const StepperRun& run : sched_.stepperRuns) {
     if (run.parts.empty()) continue;
