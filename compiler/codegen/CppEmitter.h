@@ -38,6 +38,11 @@ struct EmitOptions {
   // backends, double precision, not --mpi); false (--no-hoist): computed per pair as written.
   // The values are the same bit for bit.
   bool hoist = true;
+  // --omp-min-particles=N (OpenMP backend): a loop without neighbours (initialize, post_loop,
+  // initialize_pair, hoisted values, reductions, steppers, the adaptive step's limits) over
+  // fewer than N particles runs on the calling thread (an `if` clause): its few ns per
+  // particle cost less than waking the team. 0: every such loop parallel, as before.
+  long ompMinParticles = 0;
   // --verlet-skin=auto: the skin and the cell-order re-sort chosen at run time
   // (sphc/verlet_tune.h); false: the fixed skin verletSkin, re-sorted every REORDER_EVERY.
   bool verletAuto = false;

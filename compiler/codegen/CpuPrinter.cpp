@@ -19,6 +19,7 @@ class CpuPrinter : public ScenePrinter {
   CpuPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
       : ScenePrinter(sched, diags, opts),
         openmp_(opts.backend == Backend::OpenMP),
+        ompMinParticles_(opts.ompMinParticles),
         verletSkin_(opts.verletSkin > 0 && !cpuSingle_ && !mpi_ && !hasDomain() && !hasZones()
                         ? opts.verletSkin
                         : 0.0),
@@ -42,6 +43,11 @@ class CpuPrinter : public ScenePrinter {
   void extraMembers() override {
     if (openmp_)
       out_ << "  std::vector<" << real_ << "> reduce_scratch;  // reduce sum/mean, OpenMP\n";
+    if (openmp_ && ompMinParticles_ > 0)
+      out_ << "  // --omp-min-particles: loops without neighbours over fewer particles run on the\n"
+              "  // calling thread (waking the team costs more than their few ns per particle).\n"
+              "  static constexpr long OMP_MIN_PARTICLES = "
+           << ompMinParticles_ << ";\n";
     // The neighbour list of the destination particle in hand (pair loops, loop_all), one per
     // thread, reused from particle to particle (CellList::gather_neighbours).
     out_ << "  std::vector<std::vector<std::uint32_t>> nbrs_lists;\n";
@@ -77,6 +83,7 @@ class CpuPrinter : public ScenePrinter {
   void reduction(const DestinationWork& w, const Reduction& r);
   void ghostRefresh(const DestinationWork& w);
   void steppers() override;
+  std::string stepperIf(const StepperRun& run) const;
   void stepperCall(const StepStatement& st,
                    const std::function<std::string(int)>& timeAfter) override;
   void wrapPeriodic(int a) override {
@@ -130,6 +137,19 @@ class CpuPrinter : public ScenePrinter {
     return indent + "#pragma omp parallel for schedule(static)" +
            (clauses.empty() ? "" : " " + clauses) + "\n";
   }
+  // --omp-min-particles: the `if` clause of a loop without neighbours over `count`
+  // particles ("" when the option is 0). Each particle's result is the same on one thread.
+  std::string ompIf(const std::string& count) const {
+    return ompMinParticles_ > 0 ? "if (" + count + " >= OMP_MIN_PARTICLES)" : "";
+  }
+  // ompIf after `clauses`.
+  static std::string withIf(const std::string& clauses, const std::string& cond) {
+    return clauses.empty() ? cond : cond.empty() ? clauses : clauses + " " + cond;
+  }
+  // The number of particles of a destination's loops: its range or n.
+  static std::string rangeCount(const DestinationWork& w) {
+    return w.ranged() ? rangeEnd(w) + " - " + rangeBegin(w) : rangeEnd(w);
+  }
   // The data the CPU domain functions work on: "a" (the host array) or, with
   // --precision=single, "f32_a, a" (its float copy, and the host array for the integers).
   std::string hostData(int a) const {
@@ -159,6 +179,7 @@ class CpuPrinter : public ScenePrinter {
                             const std::string& dom = "domain") const;
 
   bool openmp_ = false;
+  long ompMinParticles_ = 0;  // --omp-min-particles (0: every loop parallel)
   double verletSkin_ = 0.0;  // --verlet-skin (0: lists gathered at every evaluation)
   bool tuned_ = false;       // --verlet-skin=auto: skin and re-sort chosen at run time
 };
@@ -234,7 +255,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     const std::vector<const PlanEquation*>& with =
         kind == ast::Method::Initialize ? w.initialize : w.postLoop;
     if (with.empty()) return;
-    scene_ << parallelFor("      ", w.perParticle);
+    scene_ << parallelFor("      ", w.perParticle, ompIf(rangeCount(w)));
     scene_ << "      for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
            << "; ++d_idx) {  // " << what << "\n";
     for (const auto* eq : with) scene_ << "        " << equationCall(*eq, kind, d);
@@ -258,7 +279,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
              << ";\n";
     // PySPH's initialize_pair: per destination particle, before this source's neighbours.
     if (!pass.initializePair.empty()) {
-      scene_ << parallelFor("        ", w.perParticle);
+      scene_ << parallelFor("        ", w.perParticle, ompIf(rangeCount(w)));
       scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
              << "; ++d_idx) {  // initialize_pair\n";
       for (const auto* eq : pass.initializePair)
@@ -271,7 +292,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     }
     // Source-only values of the loop bodies, once per source particle (codegen/Hoist.cpp).
     emitHoistedValues(scene_, pass, hasDomain() ? S + ".n + ghosts_" + S + ".size()" : S + ".n",
-                      parallelFor("        ", pass.order));
+                      parallelFor("        ", pass.order, ompIf("n_src")));
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, w, s) : "";
     if (tuned()) {
@@ -405,7 +426,7 @@ void CpuPrinter::reduction(const DestinationWork& w, const Reduction& r) {
                                  (onGhosts ? "  // real particles only" : "") + "\n";
     scene_ << "        std::vector<" << real_ << ">& values = reduce_scratch;\n";
     scene_ << "        values.resize(" << nReal << ");\n";
-    scene_ << parallelFor("        ", LoopOrder::Parallel);
+    scene_ << parallelFor("        ", LoopOrder::Parallel, ompIf(nReal));
     scene_ << loopHead;
     scene_ << "          values[d_idx] = " << value << ";\n";
     scene_ << loopHead << "          acc += values[d_idx];\n";
@@ -413,7 +434,8 @@ void CpuPrinter::reduction(const DestinationWork& w, const Reduction& r) {
       scene_ << "        acc = " << nReal << " > 0 ? acc / " << nReal << " : 0.0;\n";
   } else {
     scene_ << parallelFor("        ", LoopOrder::Parallel,
-                          std::string("reduction(") + (sum ? "+" : pd.reduceOp) + " : acc)");
+                          withIf(std::string("reduction(") + (sum ? "+" : pd.reduceOp) + " : acc)",
+                                 ompIf(nReal)));
     scene_ << "        for (int d_idx = 0; d_idx < " << nReal << "; ++d_idx) {"
            << (onGhosts ? "  // real particles only" : "") << "\n";
     scene_ << "          const " << real_ << " v = " << value << ";\n          " << combine
@@ -438,6 +460,16 @@ void CpuPrinter::ghostRefresh(const DestinationWork& w) {
            << propIndexList(d, refresh) << ");\n";
 }
 
+// --omp-min-particles: the `if` clause of a stepper run's parallel region, on the particles
+// of all its arrays (" if (...)", or "").
+std::string CpuPrinter::stepperIf(const StepperRun& run) const {
+  std::string count;
+  for (const StepperRun::Part& part : run.parts)
+    count += (count.empty() ? "" : " + ") + arr(part.array).name + ".n";
+  const std::string cond = ompIf("static_cast<long>(" + count + ")");
+  return cond.empty() ? "" : " " + cond;
+}
+
 // Steppers are per particle (a body reads and writes its own particle d_idx only, as the
 // parallel loops of the OpenMP backend already require), so running the methods of a run
 // one after the other on each particle, in one pass, gives what running each method on all
@@ -460,7 +492,7 @@ void CpuPrinter::steppers() {
       if (!used) unused += " (void)t_" + std::to_string(k) + ";";
     }
     if (!unused.empty()) scene_ << "   " << unused << "\n";
-    if (parallel) scene_ << "    #pragma omp parallel\n";
+    if (parallel) scene_ << "    #pragma omp parallel" << stepperIf(run) << "\n";
     scene_ << "    {\n";
     for (const StepperRun::Part& part : run.parts) {
       const PlanArray& A = arr(part.array);
@@ -699,7 +731,8 @@ void CpuPrinter::adaptiveDtArray(int a) {
   if (ad.force)
     for (int k = 0; k < plan_.dim; ++k)
       scene_ << "      const " << real_ << "* " << acc[k] << " = " << propPtr(a, acc[k]) << ";\n";
-  scene_ << parallelFor("      ", ad.order, "reduction(min : dt_cfl, dt_force, h2min)");
+  scene_ << parallelFor("      ", ad.order,
+                        withIf("reduction(min : dt_cfl, dt_force, h2min)", ompIf("static_cast<long>(" + arr(a).name + ".n)")));
   scene_ << "      for (std::size_t i = 0; i < " << arr(a).name << ".n; ++i) {\n";
   // |v| or |a| of particle i: "std::sqrt(u[i] * u[i] + v[i] * v[i])".
   auto magnitude = [&](const std::vector<std::string>& c) {

@@ -93,6 +93,16 @@ static cl::opt<bool> NoHoist(
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double precision; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+// --omp-min-particles (default): measured in docs/performance.md, "OpenMP on small scenes".
+static constexpr unsigned kDefaultOmpMinParticles = 10000;
+static cl::opt<unsigned> OmpMinParticles(
+    "omp-min-particles",
+    cl::desc("--backend=openmp: loops without neighbours (initialize, post_loop, steppers, "
+             "reductions, hoisted values, the adaptive step's limits) over fewer particles "
+             "than this run on one thread (an `if` clause; a parallel region costs more than "
+             "their work); pair loops stay parallel. 0: all parallel, as before this option. "
+             "The results are the same bit for bit"),
+    cl::value_desc("N"), cl::init(kDefaultOmpMinParticles), cl::cat(SphcCat));
 // --verlet-skin=auto (the default): the starting skin (the solver then chooses it,
 // sphc/verlet_tune.h, where SkinTuner::kStart is the same 0.1), as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
@@ -346,7 +356,7 @@ int main(int argc, char** argv) {
     return fail();
   }
   EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
-                       verletSkin, !NoHoist};
+                       verletSkin, !NoHoist, OmpMinParticles};
   emitOpts.verletAuto = verletAuto;  // the skin and re-sort chosen at run time
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);

@@ -51,9 +51,11 @@ struct Extent {
       return;
     }
     double l = lo[a], u = hi[a];
-    // The OpenMP build of the runtime (libsphc_runtime_omp) runs these loops in parallel;
-    // min and max do not depend on the order, so the result is the serial one.
-#pragma omp parallel for reduction(min : l) reduction(max : u) schedule(static)
+    // The OpenMP build of the runtime (libsphc_runtime_omp) runs these loops in parallel
+    // (from 16384 values: below, waking the team costs more than the loop; 12 regions a
+    // step in the 2D dam break); min and max do not depend on the order, so the result is
+    // the serial one.
+#pragma omp parallel for reduction(min : l) reduction(max : u) schedule(static) if (n > 16384)
     for (std::size_t i = 0; i < n; ++i) {
       const double w = v[i * stride];
       if (!std::isfinite(w)) continue;
@@ -67,7 +69,7 @@ struct Extent {
   template <class T>
   void add_h(const T* v, std::size_t n, std::size_t stride) {
     double m = hmax;
-#pragma omp parallel for reduction(max : m) schedule(static)
+#pragma omp parallel for reduction(max : m) schedule(static) if (n > 16384)
     for (std::size_t i = 0; i < n; ++i) {
       const double w = v[i * stride];
       if (std::isfinite(w) && w > m) m = w;
