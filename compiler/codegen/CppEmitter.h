@@ -38,6 +38,10 @@ struct EmitOptions {
   // backends, double precision, not --mpi); false (--no-hoist): computed per pair as written.
   // The values are the same bit for bit.
   bool hoist = true;
+  // --backend=opencl: the cell tables of all sources of a neighbour update built in one set
+  // of launches (sphc::ocl::build_tables); false (--no-batched-tables): CellTable::build per
+  // source. The same tables, the same results bit for bit.
+  bool batchedTables = true;
 };
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.

@@ -92,6 +92,12 @@ static cl::opt<bool> NoHoist(
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double precision; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoBatchedTables(
+    "no-batched-tables",
+    cl::desc("--backend=opencl: build each source's cell table in its own five launches "
+             "(default: the tables of all sources of an update in four launches per two "
+             "sources; the same tables, the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 // --verlet-skin=auto (the default): the skin, as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
 // than 0.2 on the cube and the dam break (0.2 keeps ~1.33x (3D) the candidates of 0.1 in
@@ -342,7 +348,7 @@ int main(int argc, char** argv) {
     return fail();
   }
   EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
-                       verletSkin, !NoHoist};
+                       verletSkin, !NoHoist, !NoBatchedTables};
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;

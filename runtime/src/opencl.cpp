@@ -31,11 +31,10 @@ inline int sphc_axis_cell(real v, int ncell) {
   return (int)v;
 }
 
-__kernel void sphc_cell_keys(const uint n, __global const real* x, __global const real* y,
+// The cell key of particle i, and its cell's count up by one.
+inline void sphc_cell_key_of(const uint i, __global const real* x, __global const real* y,
                              __global const real* z, const int has_y, const int has_z,
                              SPHC_GRID_ARGS, __global uint* keys, __global uint* count) {
-  const uint i = get_global_id(0);
-  if (i >= n) return;
   const int cx = sphc_axis_cell((x[i] - grid_lox) * grid_inv, grid_nx);
   const int cy = has_y ? sphc_axis_cell((y[i] - grid_loy) * grid_inv, grid_ny) : 0;
   const int cz = has_z ? sphc_axis_cell((z[i] - grid_loz) * grid_inv, grid_nz) : 0;
@@ -43,7 +42,26 @@ __kernel void sphc_cell_keys(const uint n, __global const real* x, __global cons
   keys[i] = key;
   atomic_inc(&count[key]);
 }
+#define SPHC_GRID_VALUES grid_lox, grid_loy, grid_loz, grid_inv, grid_nx, grid_ny, grid_nz
 
+__kernel void sphc_cell_keys(const uint n, __global const real* x, __global const real* y,
+                             __global const real* z, const int has_y, const int has_z,
+                             SPHC_GRID_ARGS, __global uint* keys, __global uint* count) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  sphc_cell_key_of(i, x, y, z, has_y, has_z, SPHC_GRID_VALUES, keys, count);
+}
+
+// One chunk [lo, hi) of a table: start/end from acc, and the count zeroed (the scatter's cursor).
+inline void sphc_scan_chunk(const uint lo, const uint hi, uint acc, __global uint* count,
+                            __global uint* start, __global uint* end) {
+  for (uint c = lo; c < hi; ++c) {
+    start[c] = acc;
+    acc += count[c];
+    end[c] = acc;
+    count[c] = 0;
+  }
+}
 // Exclusive scan of count[0..cells) into start (and end = start + count), in two kernels:
 // G work items sum chunks; then each of G work items adds up the sums of the chunks before its
 // own (G^2 / 2 reads in all, G = 256: cheaper than a launch) and writes its chunk.
@@ -62,12 +80,7 @@ __kernel void sphc_scan_apply(__global uint* count, const uint cells,
   const uint chunk = (cells + G - 1) / G;
   uint acc = 0;
   for (uint k = 0; k < g; ++k) acc += partial[k];
-  for (uint c = g * chunk; c < min(cells, (g + 1) * chunk); ++c) {
-    start[c] = acc;
-    acc += count[c];
-    end[c] = acc;
-    count[c] = 0;  // the cursor of sphc_scatter
-  }
+  sphc_scan_chunk(g * chunk, min(cells, (g + 1) * chunk), acc, count, start, end);
 }
 __kernel void sphc_scatter(const uint n, __global const uint* keys, __global const uint* start,
                            __global uint* cursor, __global uint* order) {
@@ -76,15 +89,9 @@ __kernel void sphc_scatter(const uint n, __global const uint* keys, __global con
   const uint key = keys[i];
   order[start[key] + atomic_inc(&cursor[key])] = i;
 }
-// The scatter's order within a cell depends on timing: sort each cell by index (cells hold a
-// few particles), so the order is deterministic and the CPU's (ascending index).
-// It also zeroes the cell's count (the scatter's cursor): the counts are all zero again for
-// the next build, which then needs no fill.
-__kernel void sphc_sort_cells(const uint cells, __global const uint* start,
-                              __global const uint* end, __global uint* order,
-                              __global uint* count) {
-  const uint c = get_global_id(0);
-  if (c >= cells) return;
+// Cell c's indices in ascending order, its count zeroed (sphc_sort_cells' body).
+inline void sphc_sort_cell(const uint c, __global const uint* start, __global const uint* end,
+                           __global uint* order, __global uint* count) {
   count[c] = 0;
   const uint b = start[c], e = end[c];
   for (uint k = b + 1; k < e; ++k) {
@@ -96,6 +103,83 @@ __kernel void sphc_sort_cells(const uint cells, __global const uint* start,
     }
     order[m] = v;
   }
+}
+// The scatter's order within a cell depends on timing: sort each cell by index (cells hold a
+// few particles), so the order is deterministic and the CPU's (ascending index).
+// It also zeroes the cell's count (the scatter's cursor): the counts are all zero again for
+// the next build, which then needs no fill.
+__kernel void sphc_sort_cells(const uint cells, __global const uint* start,
+                              __global const uint* end, __global uint* order,
+                              __global uint* count) {
+  const uint c = get_global_id(0);
+  if (c >= cells) return;
+  sphc_sort_cell(c, start, end, order, count);
+}
+
+// The cell tables of two sources (a, b) on one grid in four launches (build_tables), the
+// same tables as the five launches of sphc_cell_keys .. sphc_sort_cells for each: keys of a's
+// na particles then b's nb; the scan of both count tables in one work group (chunk sums in
+// local memory); the scatter; the per-cell sort of both tables. tables = 1: b is unused.
+__kernel void sphc_cell_keys2(const uint na, __global const real* xa, __global const real* ya,
+                              __global const real* za, const uint nb, __global const real* xb,
+                              __global const real* yb, __global const real* zb,
+                              const int has_y, const int has_z, SPHC_GRID_ARGS,
+                              __global uint* keys_a, __global uint* count_a,
+                              __global uint* keys_b, __global uint* count_b) {
+  const uint i = get_global_id(0);
+  if (i < na)
+    sphc_cell_key_of(i, xa, ya, za, has_y, has_z, SPHC_GRID_VALUES, keys_a, count_a);
+  else if (i - na < nb)
+    sphc_cell_key_of(i - na, xb, yb, zb, has_y, has_z, SPHC_GRID_VALUES, keys_b, count_b);
+}
+#define SPHC_SCAN_GROUP_MAX 256
+__kernel void sphc_scan_group2(const uint cells, const int tables, __global uint* count_a,
+                               __global uint* start_a, __global uint* end_a,
+                               __global uint* count_b, __global uint* start_b,
+                               __global uint* end_b) {
+  __local uint sums[2 * SPHC_SCAN_GROUP_MAX];
+  const uint g = get_local_id(0), G = get_local_size(0);
+  const uint chunk = (cells + G - 1) / G;
+  const uint lo = min(cells, g * chunk), hi = min(cells, lo + chunk);
+  uint sa = 0, sb = 0;
+  for (uint c = lo; c < hi; ++c) sa += count_a[c];
+  if (tables > 1)
+    for (uint c = lo; c < hi; ++c) sb += count_b[c];
+  sums[g] = sa;
+  sums[G + g] = sb;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  uint acc_a = 0, acc_b = 0;
+  for (uint k = 0; k < g; ++k) {
+    acc_a += sums[k];
+    acc_b += sums[G + k];
+  }
+  sphc_scan_chunk(lo, hi, acc_a, count_a, start_a, end_a);
+  if (tables > 1) sphc_scan_chunk(lo, hi, acc_b, count_b, start_b, end_b);
+}
+__kernel void sphc_scatter2(const uint na, __global const uint* keys_a,
+                            __global const uint* start_a, __global uint* cursor_a,
+                            __global uint* order_a, const uint nb, __global const uint* keys_b,
+                            __global const uint* start_b, __global uint* cursor_b,
+                            __global uint* order_b) {
+  const uint i = get_global_id(0);
+  if (i < na) {
+    const uint key = keys_a[i];
+    order_a[start_a[key] + atomic_inc(&cursor_a[key])] = i;
+  } else if (i - na < nb) {
+    const uint key = keys_b[i - na];
+    order_b[start_b[key] + atomic_inc(&cursor_b[key])] = i - na;
+  }
+}
+__kernel void sphc_sort_cells2(const uint cells, const int tables, __global const uint* start_a,
+                               __global const uint* end_a, __global uint* order_a,
+                               __global uint* count_a, __global const uint* start_b,
+                               __global const uint* end_b, __global uint* order_b,
+                               __global uint* count_b) {
+  const uint c = get_global_id(0);
+  if (c < cells)
+    sphc_sort_cell(c, start_a, end_a, order_a, count_a);
+  else if (tables > 1 && c - cells < cells)
+    sphc_sort_cell(c - cells, start_b, end_b, order_b, count_b);
 }
 
 __kernel void sphc_fill_uint(__global uint* v, const uint value, const uint count) {
@@ -395,6 +479,7 @@ void Context::init(const Selection& sel, bool double_precision, const std::strin
                                    reinterpret_cast<cl_context_properties>(pick->pid), 0};
   context_ = clCreateContext(props, 1, &pick->did, nullptr, nullptr, &err);
   check(err, "clCreateContext");
+  device_ = pick->did;
   queue_ = clCreateCommandQueue(context_, pick->did, 0, &err);
   check(err, "clCreateCommandQueue");
 
@@ -496,11 +581,15 @@ void Context::set_arg(cl_kernel k, cl_uint& i, const CellTable& c) {
 
 void Context::launch(cl_kernel k, std::size_t n, const std::string& name) {
   const std::size_t local = 64;
-  std::size_t global = (n + local - 1) / local * local;
+  enqueue(k, (n + local - 1) / local * local, nullptr, name);
+}
+
+void Context::enqueue(cl_kernel k, std::size_t global, const std::size_t* local,
+                      const std::string& name) {
   ++launches_;
   const auto start =
       profile_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
-  check(clEnqueueNDRangeKernel(queue_, k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(queue_, k, 1, nullptr, &global, local, 0, nullptr, nullptr),
         name.empty() ? "clEnqueueNDRangeKernel" : ("clEnqueueNDRangeKernel(" + name + ")").c_str());
   if (profile_) {
     finish();
@@ -508,6 +597,15 @@ void Context::launch(cl_kernel k, std::size_t n, const std::string& name) {
     slot.first += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     ++slot.second;
   }
+}
+
+void Context::launch_group(cl_kernel k, std::size_t local, const std::string& name) {
+  std::size_t most = 0;
+  check(clGetKernelWorkGroupInfo(k, device_, CL_KERNEL_WORK_GROUP_SIZE, sizeof most, &most,
+                                 nullptr),
+        "clGetKernelWorkGroupInfo");
+  local = std::max<std::size_t>(1, std::min(local, most));
+  enqueue(k, local, &local, name);
 }
 
 void Context::finish() { check(clFinish(queue_), "clFinish"); }
@@ -645,11 +743,7 @@ Grid Context::grid_of(const SearchDomain& dom) const {
   return g;
 }
 
-void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem z, std::size_t n) {
-  // A counting sort by cell: keys and counts, a scan into start/end, a scatter, and a sort of
-  // each cell's few indices (deterministic order). Five launches, O(n + cells) work. The
-  // counts are zero between builds (sphc_sort_cells zeroes them): filled once, when
-  // allocated.
+void CellTable::reserve(Context& ctx, const Grid& grid, std::size_t n) {
   if (n > padded || !keys) {
     if (keys) clReleaseMemObject(keys);
     if (order) clReleaseMemObject(order);
@@ -667,6 +761,14 @@ void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem
     const unsigned all = static_cast<unsigned>(cells);
     ctx.run("sphc_fill_uint", all, count, 0u, all);
   }
+}
+
+void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem z, std::size_t n) {
+  // A counting sort by cell: keys and counts, a scan into start/end, a scatter, and a sort of
+  // each cell's few indices (deterministic order). Five launches, O(n + cells) work. The
+  // counts are zero between builds (sphc_sort_cells zeroes them): filled once, when
+  // allocated.
+  reserve(ctx, grid, n);
   if (!partial) partial = ctx.alloc(kScanItems * sizeof(cl_uint));
   const unsigned nc = static_cast<unsigned>(grid.cells());
   const unsigned un = static_cast<unsigned>(n);
@@ -676,6 +778,34 @@ void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem
   ctx.run("sphc_scan_apply", kScanItems, count, nc, partial, start, end);
   ctx.run("sphc_scatter", n, un, keys, start, count, order);
   ctx.run("sphc_sort_cells", nc, nc, start, end, order, count);
+}
+
+void build_tables(Context& ctx, const Grid& grid, const std::vector<TableBuild>& tables) {
+  // Two tables per launch (a lone last one with an empty second), four launches per pair:
+  // cell keys, the scan in one work group, the scatter, the per-cell sorts. The tables are
+  // those of CellTable::build (the same counting sort, the same per-cell order).
+  const unsigned nc = static_cast<unsigned>(grid.cells());
+  for (const TableBuild& b : tables) b.table->reserve(ctx, grid, b.n);
+  for (std::size_t k = 0; k < tables.size(); k += 2) {
+    const TableBuild& a = tables[k];
+    const bool pair = k + 1 < tables.size();
+    const TableBuild& b = tables[pair ? k + 1 : k];
+    const unsigned na = static_cast<unsigned>(a.n), nb = pair ? static_cast<unsigned>(b.n) : 0u;
+    const CellTable &ta = *a.table, &tb = *b.table;
+    ctx.run("sphc_cell_keys2", std::size_t{na} + nb, na, a.x, a.y ? a.y : a.x, a.z ? a.z : a.x,
+            nb, b.x, b.y ? b.y : b.x, b.z ? b.z : b.x, a.y ? 1 : 0, a.z ? 1 : 0, grid, ta.keys,
+            ta.count, tb.keys, tb.count);
+    cl_kernel scan = ctx.kernel("sphc_scan_group2");
+    cl_uint i = 0;
+    ctx.set_arg(scan, i, nc);
+    ctx.set_arg(scan, i, pair ? 2 : 1);
+    for (cl_mem m : {ta.count, ta.start, ta.end, tb.count, tb.start, tb.end}) ctx.set_arg(scan, i, m);
+    ctx.launch_group(scan, kScanGroup, "sphc_scan_group2");
+    ctx.run("sphc_scatter2", std::size_t{na} + nb, na, ta.keys, ta.start, ta.count, ta.order, nb,
+            tb.keys, tb.start, tb.count, tb.order);
+    ctx.run("sphc_sort_cells2", std::size_t{nc} * (pair ? 2 : 1), nc, pair ? 2 : 1, ta.start,
+            ta.end, ta.order, ta.count, tb.start, tb.end, tb.order, tb.count);
+  }
 }
 
 void CellTable::release() {
