@@ -52,16 +52,6 @@ __kernel void sphc_cell_keys(const uint n, __global const real* x, __global cons
   sphc_cell_key_of(i, x, y, z, has_y, has_z, SPHC_GRID_VALUES, keys, count);
 }
 
-// One chunk [lo, hi) of a table: start/end from acc, and the count zeroed (the scatter's cursor).
-inline void sphc_scan_chunk(const uint lo, const uint hi, uint acc, __global uint* count,
-                            __global uint* start, __global uint* end) {
-  for (uint c = lo; c < hi; ++c) {
-    start[c] = acc;
-    acc += count[c];
-    end[c] = acc;
-    count[c] = 0;
-  }
-}
 // Exclusive scan of count[0..cells) into start (and end = start + count), in two kernels:
 // G work items sum chunks; then each of G work items adds up the sums of the chunks before its
 // own (G^2 / 2 reads in all, G = 256: cheaper than a launch) and writes its chunk.
@@ -80,7 +70,12 @@ __kernel void sphc_scan_apply(__global uint* count, const uint cells,
   const uint chunk = (cells + G - 1) / G;
   uint acc = 0;
   for (uint k = 0; k < g; ++k) acc += partial[k];
-  sphc_scan_chunk(g * chunk, min(cells, (g + 1) * chunk), acc, count, start, end);
+  for (uint c = g * chunk; c < min(cells, (g + 1) * chunk); ++c) {
+    start[c] = acc;
+    acc += count[c];
+    end[c] = acc;
+    count[c] = 0;  // the cursor of sphc_scatter
+  }
 }
 __kernel void sphc_scatter(const uint n, __global const uint* keys, __global const uint* start,
                            __global uint* cursor, __global uint* order) {
@@ -116,37 +111,60 @@ __kernel void sphc_sort_cells(const uint cells, __global const uint* start,
   sphc_sort_cell(c, start, end, order, count);
 }
 
-// The cell tables of two sources (a, b) on one grid in four launches (build_tables), the
-// same tables as the five launches of sphc_cell_keys .. sphc_sort_cells for each: keys of a's
-// na particles then b's nb; the scan of both count tables in one work group (chunk sums in
-// local memory); the scatter; the per-cell sort of both tables. tables = 1: b is unused.
-__kernel void sphc_cell_keys2(const uint na, __global const real* xa, __global const real* ya,
-                              __global const real* za, const uint nb, __global const real* xb,
-                              __global const real* yb, __global const real* zb,
-                              const int has_y, const int has_z, SPHC_GRID_ARGS,
-                              __global uint* keys_a, __global uint* count_a,
-                              __global uint* keys_b, __global uint* count_b) {
+// The cell tables of two sources (a, b) on one grid in three launches (build_tables), the
+// same tables as the five launches of sphc_cell_keys .. sphc_sort_cells for each:
+// sphc_cell_keys_scan2 (the keys and counts of a's na particles then b's nb, and the scan of
+// both count tables by the work group that finishes last), sphc_scatter2, sphc_sort_cells2.
+// tables = 1: b is unused.
+#define SPHC_SCAN_GROUP_MAX 64
+// One chunk [lo, hi) of a table: start/end from acc, and the count zeroed (the scatter's
+// cursor). The counts are read volatile: other work groups' atomics wrote them.
+inline void sphc_scan_chunk(const uint lo, const uint hi, uint acc,
+                            volatile __global uint* count, __global uint* start,
+                            __global uint* end) {
+  for (uint c = lo; c < hi; ++c) {
+    const uint k = count[c];
+    start[c] = acc;
+    acc += k;
+    end[c] = acc;
+    count[c] = 0;
+  }
+}
+inline uint sphc_chunk_sum(const uint lo, const uint hi, volatile __global uint* count) {
+  uint sum = 0;
+  for (uint c = lo; c < hi; ++c) sum += count[c];
+  return sum;
+}
+__kernel void sphc_cell_keys_scan2(const uint na, __global const real* xa,
+                                   __global const real* ya, __global const real* za,
+                                   const uint nb, __global const real* xb,
+                                   __global const real* yb, __global const real* zb,
+                                   const int has_y, const int has_z, SPHC_GRID_ARGS,
+                                   __global uint* keys_a, __global uint* count_a,
+                                   __global uint* keys_b, __global uint* count_b,
+                                   const uint cells, const int tables, __global uint* start_a,
+                                   __global uint* end_a, __global uint* start_b,
+                                   __global uint* end_b, __global uint* done) {
+  __local uint sums[2 * SPHC_SCAN_GROUP_MAX];
+  __local int last;
   const uint i = get_global_id(0);
   if (i < na)
     sphc_cell_key_of(i, xa, ya, za, has_y, has_z, SPHC_GRID_VALUES, keys_a, count_a);
   else if (i - na < nb)
     sphc_cell_key_of(i - na, xb, yb, zb, has_y, has_z, SPHC_GRID_VALUES, keys_b, count_b);
-}
-#define SPHC_SCAN_GROUP_MAX 256
-__kernel void sphc_scan_group2(const uint cells, const int tables, __global uint* count_a,
-                               __global uint* start_a, __global uint* end_a,
-                               __global uint* count_b, __global uint* start_b,
-                               __global uint* end_b) {
-  __local uint sums[2 * SPHC_SCAN_GROUP_MAX];
+  // The group's counts are done; the group that counts itself last scans (the others' counts
+  // are complete then).
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+  barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
+  if (get_local_id(0) == 0) last = atomic_inc(done) == get_num_groups(0) - 1;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (!last) return;
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
   const uint g = get_local_id(0), G = get_local_size(0);
   const uint chunk = (cells + G - 1) / G;
   const uint lo = min(cells, g * chunk), hi = min(cells, lo + chunk);
-  uint sa = 0, sb = 0;
-  for (uint c = lo; c < hi; ++c) sa += count_a[c];
-  if (tables > 1)
-    for (uint c = lo; c < hi; ++c) sb += count_b[c];
-  sums[g] = sa;
-  sums[G + g] = sb;
+  sums[g] = sphc_chunk_sum(lo, hi, count_a);
+  sums[G + g] = tables > 1 ? sphc_chunk_sum(lo, hi, count_b) : 0u;
   barrier(CLK_LOCAL_MEM_FENCE);
   uint acc_a = 0, acc_b = 0;
   for (uint k = 0; k < g; ++k) {
@@ -155,6 +173,7 @@ __kernel void sphc_scan_group2(const uint cells, const int tables, __global uint
   }
   sphc_scan_chunk(lo, hi, acc_a, count_a, start_a, end_a);
   if (tables > 1) sphc_scan_chunk(lo, hi, acc_b, count_b, start_b, end_b);
+  if (g == 0) *done = 0;  // for the next build
 }
 __kernel void sphc_scatter2(const uint na, __global const uint* keys_a,
                             __global const uint* start_a, __global uint* cursor_a,
@@ -599,13 +618,14 @@ void Context::enqueue(cl_kernel k, std::size_t global, const std::size_t* local,
   }
 }
 
-void Context::launch_group(cl_kernel k, std::size_t local, const std::string& name) {
+void Context::launch_local(cl_kernel k, std::size_t n, std::size_t local,
+                           const std::string& name) {
   std::size_t most = 0;
   check(clGetKernelWorkGroupInfo(k, device_, CL_KERNEL_WORK_GROUP_SIZE, sizeof most, &most,
                                  nullptr),
         "clGetKernelWorkGroupInfo");
   local = std::max<std::size_t>(1, std::min(local, most));
-  enqueue(k, local, &local, name);
+  enqueue(k, (n + local - 1) / local * local, &local, name);
 }
 
 void Context::finish() { check(clFinish(queue_), "clFinish"); }
@@ -781,9 +801,9 @@ void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem
 }
 
 void build_tables(Context& ctx, const Grid& grid, const std::vector<TableBuild>& tables) {
-  // Two tables per launch (a lone last one with an empty second), four launches per pair:
-  // cell keys, the scan in one work group, the scatter, the per-cell sorts. The tables are
-  // those of CellTable::build (the same counting sort, the same per-cell order).
+  // Two tables per launch (a lone last one with an empty second), three launches per pair:
+  // cell keys with the scan by the last work group, the scatter, the per-cell sorts. The
+  // tables are those of CellTable::build (the same counting sort, the same per-cell order).
   const unsigned nc = static_cast<unsigned>(grid.cells());
   for (const TableBuild& b : tables) b.table->reserve(ctx, grid, b.n);
   for (std::size_t k = 0; k < tables.size(); k += 2) {
@@ -791,16 +811,27 @@ void build_tables(Context& ctx, const Grid& grid, const std::vector<TableBuild>&
     const bool pair = k + 1 < tables.size();
     const TableBuild& b = tables[pair ? k + 1 : k];
     const unsigned na = static_cast<unsigned>(a.n), nb = pair ? static_cast<unsigned>(b.n) : 0u;
-    const CellTable &ta = *a.table, &tb = *b.table;
-    ctx.run("sphc_cell_keys2", std::size_t{na} + nb, na, a.x, a.y ? a.y : a.x, a.z ? a.z : a.x,
-            nb, b.x, b.y ? b.y : b.x, b.z ? b.z : b.x, a.y ? 1 : 0, a.z ? 1 : 0, grid, ta.keys,
-            ta.count, tb.keys, tb.count);
-    cl_kernel scan = ctx.kernel("sphc_scan_group2");
+    CellTable &ta = *a.table, &tb = *b.table;
+    if (!ta.done) {
+      ta.done = ctx.alloc(sizeof(cl_uint));
+      ctx.run("sphc_fill_uint", 1, ta.done, 0u, 1u);
+    }
+    cl_kernel keys = ctx.kernel("sphc_cell_keys_scan2");
     cl_uint i = 0;
-    ctx.set_arg(scan, i, nc);
-    ctx.set_arg(scan, i, pair ? 2 : 1);
-    for (cl_mem m : {ta.count, ta.start, ta.end, tb.count, tb.start, tb.end}) ctx.set_arg(scan, i, m);
-    ctx.launch_group(scan, kScanGroup, "sphc_scan_group2");
+    ctx.set_arg(keys, i, na);
+    for (cl_mem m : {a.x, a.y ? a.y : a.x, a.z ? a.z : a.x}) ctx.set_arg(keys, i, m);
+    ctx.set_arg(keys, i, nb);
+    for (cl_mem m : {b.x, b.y ? b.y : b.x, b.z ? b.z : b.x}) ctx.set_arg(keys, i, m);
+    ctx.set_arg(keys, i, a.y ? 1 : 0);
+    ctx.set_arg(keys, i, a.z ? 1 : 0);
+    ctx.set_arg(keys, i, grid);
+    for (cl_mem m : {ta.keys, ta.count, tb.keys, tb.count}) ctx.set_arg(keys, i, m);
+    ctx.set_arg(keys, i, nc);
+    ctx.set_arg(keys, i, pair ? 2 : 1);
+    for (cl_mem m : {ta.start, ta.end, tb.start, tb.end, ta.done}) ctx.set_arg(keys, i, m);
+    // At least one work group, which then scans.
+    ctx.launch_local(keys, std::max<std::size_t>(1, std::size_t{na} + nb), kScanGroup,
+                     "sphc_cell_keys_scan2");
     ctx.run("sphc_scatter2", std::size_t{na} + nb, na, ta.keys, ta.start, ta.count, ta.order, nb,
             tb.keys, tb.start, tb.count, tb.order);
     ctx.run("sphc_sort_cells2", std::size_t{nc} * (pair ? 2 : 1), nc, pair ? 2 : 1, ta.start,
@@ -809,7 +840,7 @@ void build_tables(Context& ctx, const Grid& grid, const std::vector<TableBuild>&
 }
 
 void CellTable::release() {
-  for (cl_mem* m : {&keys, &order, &start, &end, &count, &partial})
+  for (cl_mem* m : {&keys, &order, &start, &end, &count, &partial, &done})
     if (*m) {
       clReleaseMemObject(*m);
       *m = nullptr;

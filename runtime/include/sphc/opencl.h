@@ -63,6 +63,7 @@ class Context;
 struct CellTable {
   cl_mem keys = nullptr, order = nullptr, start = nullptr, end = nullptr;
   cl_mem count = nullptr, partial = nullptr;  // scratch of the counting sort
+  cl_mem done = nullptr;  // build_tables: work groups done counting (0 between builds)
   std::size_t padded = 0, cells = 0;          // capacity of keys/order, of the cell tables
   static constexpr std::size_t kScanItems = 256;
   // Room for n particles and the grid's cells (the counts zero when allocated).
@@ -72,16 +73,18 @@ struct CellTable {
   ~CellTable() { release(); }
 };
 
-// The cell tables of several sources on one grid in one set of launches: four per two
-// tables (cell keys, a one-work-group scan, scatter, per-cell sort) where CellTable::build
-// takes five per table; the same tables. y, z: nullptr beyond the dimension.
+// The cell tables of several sources on one grid in one set of launches: three per two
+// tables (cell keys with the scan by the work group that finishes last, scatter, per-cell
+// sort) where CellTable::build takes five per table; the same tables. y, z: nullptr beyond
+// the dimension.
 struct TableBuild {
   CellTable* table;
   cl_mem x, y, z;
   std::size_t n;
 };
-// Work items of the scan's work group (at most the kernel's work-group size on the device).
-constexpr std::size_t kScanGroup = 256;
+// Work items per work group of the keys kernel, hence of the scan (at most the kernel's
+// work-group size on the device; SPHC_SCAN_GROUP_MAX in the kernel source).
+constexpr std::size_t kScanGroup = 64;
 void build_tables(Context& ctx, const Grid& grid, const std::vector<TableBuild>& tables);
 
 // Device copies of the properties and constants of one ParticleArray. Each property buffer
@@ -189,8 +192,9 @@ class Context {
   // SPHC_OPENCL_PROFILE=1 in the environment: every launch waits for its kernel, and the
   // time per kernel name is printed to stderr at exit.
   void launch(cl_kernel k, std::size_t n, const std::string& name = "");
-  // One work group of `local` work items (fewer where the device allows fewer for k).
-  void launch_group(cl_kernel k, std::size_t local, const std::string& name);
+  // As launch, in work groups of `local` work items (fewer where the device allows fewer
+  // for k).
+  void launch_local(cl_kernel k, std::size_t n, std::size_t local, const std::string& name);
   bool profiling() const { return profile_; }
   // Kernel launches so far (every launch through `launch`: the scene's kernels, the neighbour
   // search's, reductions), for --timing's launches_per_step.
