@@ -46,6 +46,10 @@ struct EmitOptions {
   // --verlet-skin=auto: the skin and the cell-order re-sort chosen at run time
   // (sphc/verlet_tune.h); false: the fixed skin verletSkin, re-sorted every REORDER_EVERY.
   bool verletAuto = false;
+  // --backend=opencl: the cell tables of all sources of a neighbour update built in one set
+  // of launches (sphc::ocl::build_tables); false (--no-batched-tables): CellTable::build per
+  // source. The same tables, the same results bit for bit.
+  bool batchedTables = true;
 };
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.

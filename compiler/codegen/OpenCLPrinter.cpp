@@ -12,7 +12,7 @@ namespace {
 class OpenCLPrinter : public ScenePrinter {
  public:
   OpenCLPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
-      : ScenePrinter(sched, diags, opts) {
+      : ScenePrinter(sched, diags, opts), batchedTables_(opts.batchedTables) {
     // Line 1 of the kernel source is this directive, so lines are the source's own.
     cl_ << "#line 2 \"" << plan_.sceneName << ".cl\"\n";
   }
@@ -140,6 +140,11 @@ class OpenCLPrinter : public ScenePrinter {
                      const std::string& time = "t") const;
   // The statement that builds the cell table of source S over its first `count` particles.
   std::string cellListBuild(const std::string& S, const std::string& count) const;
+  // The statements that build the cell tables of the sources (name, particle count): one
+  // build_tables call (batchedTables_), else a cellListBuild each; `indent` before each line.
+  std::string cellTablesBuild(const std::vector<std::pair<std::string, std::string>>& sources,
+                              const std::string& indent) const;
+  bool batchedTables_ = true;
   // The extents of the arrays in neighbour loops, for ocl.search_domain / ocl.make_grid.
   std::string deviceExtents(const std::string& indent) const;
 };
@@ -193,6 +198,28 @@ std::string OpenCLPrinter::cellListBuild(const std::string& S, const std::string
                            [&](int a, const std::string& axis) { return devBuffer(a, axis); });
 }
 
+std::string OpenCLPrinter::cellTablesBuild(
+    const std::vector<std::pair<std::string, std::string>>& sources,
+    const std::string& indent) const {
+  std::string r;
+  if (!batchedTables_ || sources.empty()) {
+    for (const auto& [S, count] : sources) r += indent + cellListBuild(S, count) + "\n";
+    return r;
+  }
+  r = indent + "sphc::ocl::build_tables(ocl, grid, {";
+  const char* axes[3] = {"x", "y", "z"};
+  for (std::size_t k = 0; k < sources.size(); ++k) {
+    const auto& [S, count] = sources[k];
+    const int s = plan_.arrayIndex(S);
+    r += (k ? ",\n" + indent + "                                    " : std::string()) +
+         "{&cells_" + S;
+    for (int a = 0; a < 3; ++a)
+      r += ", " + (a >= plan_.dim ? std::string("nullptr") : devBuffer(s, axes[a]));
+    r += ", " + count + "}";
+  }
+  return r + "});  // every source's cell table in one set of launches\n";
+}
+
 // update_neighbours of a scene without periodic or mirror domain, on the device: the search
 // domain from min/max reductions, then a cell table per source (cell keys, bitonic sort, cell
 // start/end). Positions never leave the device.
@@ -204,6 +231,20 @@ void OpenCLPrinter::updateNeighbours() {
   // on the CPU (same grid, same order), so outputs list particles in the same order.
   if (anyReorders())
     scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+  if (batchedTables_ && !sourceArrays_.empty()) {
+    std::vector<std::pair<std::string, std::string>> all, reordered;
+    for (const auto& S : sourceArrays_) {
+      all.push_back({S, S + ".n"});
+      if (reorders(S)) reordered.push_back({S, S + ".n"});  // not a ranged group's source
+    }
+    scene_ << cellTablesBuild(all, "    ");
+    if (reordered.empty()) return;
+    scene_ << "    if (reorder) {\n";
+    for (const auto& [S, count] : reordered)
+      scene_ << "      dev_" << S << ".permute(ocl, cells_" << S << ", " << S << ");\n";
+    scene_ << cellTablesBuild(reordered, "      ") << "    }\n";
+    return;
+  }
   for (const auto& S : sourceArrays_) {
     const std::string build = cellListBuild(S, S + ".n");
     scene_ << "    " << build << "\n";
@@ -537,8 +578,9 @@ void OpenCLPrinter::updateNeighboursWithGhosts() {
   }
   scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
   scene_ << "    grid = ocl.grid_of(domain);\n";
-  for (const auto& S : sourceArrays_)
-    scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
+  std::vector<std::pair<std::string, std::string>> withGhosts;
+  for (const auto& S : sourceArrays_) withGhosts.push_back({S, S + ".n + ghosts_" + S + ".size()"});
+  scene_ << cellTablesBuild(withGhosts, "    ");
 }
 
 // Ghosts copy the values a phase computed on the real particles, where they carry them.

@@ -103,6 +103,12 @@ static cl::opt<unsigned> OmpMinParticles(
              "their work); pair loops stay parallel. 0: all parallel, as before this option. "
              "The results are the same bit for bit"),
     cl::value_desc("N"), cl::init(kDefaultOmpMinParticles), cl::cat(SphcCat));
+static cl::opt<bool> NoBatchedTables(
+    "no-batched-tables",
+    cl::desc("--backend=opencl: build each source's cell table in its own five launches "
+             "(default: the tables of all sources of an update in four launches per two "
+             "sources; the same tables, the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 // --verlet-skin=auto (the default): the starting skin (the solver then chooses it,
 // sphc/verlet_tune.h, where SkinTuner::kStart is the same 0.1), as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
@@ -356,8 +362,10 @@ int main(int argc, char** argv) {
     return fail();
   }
   EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
-                       verletSkin, !NoHoist, OmpMinParticles};
+                       verletSkin, !NoHoist};
+  emitOpts.ompMinParticles = OmpMinParticles;
   emitOpts.verletAuto = verletAuto;  // the skin and re-sort chosen at run time
+  emitOpts.batchedTables = !NoBatchedTables;
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;

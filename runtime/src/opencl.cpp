@@ -31,17 +31,25 @@ inline int sphc_axis_cell(real v, int ncell) {
   return (int)v;
 }
 
-__kernel void sphc_cell_keys(const uint n, __global const real* x, __global const real* y,
+// The cell key of particle i, and its cell's count up by one.
+inline void sphc_cell_key_of(const uint i, __global const real* x, __global const real* y,
                              __global const real* z, const int has_y, const int has_z,
                              SPHC_GRID_ARGS, __global uint* keys, __global uint* count) {
-  const uint i = get_global_id(0);
-  if (i >= n) return;
   const int cx = sphc_axis_cell((x[i] - grid_lox) * grid_inv, grid_nx);
   const int cy = has_y ? sphc_axis_cell((y[i] - grid_loy) * grid_inv, grid_ny) : 0;
   const int cz = has_z ? sphc_axis_cell((z[i] - grid_loz) * grid_inv, grid_nz) : 0;
   const uint key = (uint)((cz * grid_ny + cy) * grid_nx + cx);
   keys[i] = key;
   atomic_inc(&count[key]);
+}
+#define SPHC_GRID_VALUES grid_lox, grid_loy, grid_loz, grid_inv, grid_nx, grid_ny, grid_nz
+
+__kernel void sphc_cell_keys(const uint n, __global const real* x, __global const real* y,
+                             __global const real* z, const int has_y, const int has_z,
+                             SPHC_GRID_ARGS, __global uint* keys, __global uint* count) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  sphc_cell_key_of(i, x, y, z, has_y, has_z, SPHC_GRID_VALUES, keys, count);
 }
 
 // Exclusive scan of count[0..cells) into start (and end = start + count), in two kernels:
@@ -76,15 +84,9 @@ __kernel void sphc_scatter(const uint n, __global const uint* keys, __global con
   const uint key = keys[i];
   order[start[key] + atomic_inc(&cursor[key])] = i;
 }
-// The scatter's order within a cell depends on timing: sort each cell by index (cells hold a
-// few particles), so the order is deterministic and the CPU's (ascending index).
-// It also zeroes the cell's count (the scatter's cursor): the counts are all zero again for
-// the next build, which then needs no fill.
-__kernel void sphc_sort_cells(const uint cells, __global const uint* start,
-                              __global const uint* end, __global uint* order,
-                              __global uint* count) {
-  const uint c = get_global_id(0);
-  if (c >= cells) return;
+// Cell c's indices in ascending order, its count zeroed (sphc_sort_cells' body).
+inline void sphc_sort_cell(const uint c, __global const uint* start, __global const uint* end,
+                           __global uint* order, __global uint* count) {
   count[c] = 0;
   const uint b = start[c], e = end[c];
   for (uint k = b + 1; k < e; ++k) {
@@ -96,6 +98,107 @@ __kernel void sphc_sort_cells(const uint cells, __global const uint* start,
     }
     order[m] = v;
   }
+}
+// The scatter's order within a cell depends on timing: sort each cell by index (cells hold a
+// few particles), so the order is deterministic and the CPU's (ascending index).
+// It also zeroes the cell's count (the scatter's cursor): the counts are all zero again for
+// the next build, which then needs no fill.
+__kernel void sphc_sort_cells(const uint cells, __global const uint* start,
+                              __global const uint* end, __global uint* order,
+                              __global uint* count) {
+  const uint c = get_global_id(0);
+  if (c >= cells) return;
+  sphc_sort_cell(c, start, end, order, count);
+}
+
+// The cell tables of two sources (a, b) on one grid in three launches (build_tables), the
+// same tables as the five launches of sphc_cell_keys .. sphc_sort_cells for each:
+// sphc_cell_keys_scan2 (the keys and counts of a's na particles then b's nb, and the scan of
+// both count tables by the work group that finishes last), sphc_scatter2, sphc_sort_cells2.
+// tables = 1: b is unused.
+#define SPHC_SCAN_GROUP_MAX 64
+// One chunk [lo, hi) of a table: start/end from acc, and the count zeroed (the scatter's
+// cursor). The counts are read volatile: other work groups' atomics wrote them.
+inline void sphc_scan_chunk(const uint lo, const uint hi, uint acc,
+                            volatile __global uint* count, __global uint* start,
+                            __global uint* end) {
+  for (uint c = lo; c < hi; ++c) {
+    const uint k = count[c];
+    start[c] = acc;
+    acc += k;
+    end[c] = acc;
+    count[c] = 0;
+  }
+}
+inline uint sphc_chunk_sum(const uint lo, const uint hi, volatile __global uint* count) {
+  uint sum = 0;
+  for (uint c = lo; c < hi; ++c) sum += count[c];
+  return sum;
+}
+__kernel void sphc_cell_keys_scan2(const uint na, __global const real* xa,
+                                   __global const real* ya, __global const real* za,
+                                   const uint nb, __global const real* xb,
+                                   __global const real* yb, __global const real* zb,
+                                   const int has_y, const int has_z, SPHC_GRID_ARGS,
+                                   __global uint* keys_a, __global uint* count_a,
+                                   __global uint* keys_b, __global uint* count_b,
+                                   const uint cells, const int tables, __global uint* start_a,
+                                   __global uint* end_a, __global uint* start_b,
+                                   __global uint* end_b, __global uint* done) {
+  __local uint sums[2 * SPHC_SCAN_GROUP_MAX];
+  __local int last;
+  const uint i = get_global_id(0);
+  if (i < na)
+    sphc_cell_key_of(i, xa, ya, za, has_y, has_z, SPHC_GRID_VALUES, keys_a, count_a);
+  else if (i - na < nb)
+    sphc_cell_key_of(i - na, xb, yb, zb, has_y, has_z, SPHC_GRID_VALUES, keys_b, count_b);
+  // The group's counts are done; the group that counts itself last scans (the others' counts
+  // are complete then).
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+  barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
+  if (get_local_id(0) == 0) last = atomic_inc(done) == get_num_groups(0) - 1;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (!last) return;
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+  const uint g = get_local_id(0), G = get_local_size(0);
+  const uint chunk = (cells + G - 1) / G;
+  const uint lo = min(cells, g * chunk), hi = min(cells, lo + chunk);
+  sums[g] = sphc_chunk_sum(lo, hi, count_a);
+  sums[G + g] = tables > 1 ? sphc_chunk_sum(lo, hi, count_b) : 0u;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  uint acc_a = 0, acc_b = 0;
+  for (uint k = 0; k < g; ++k) {
+    acc_a += sums[k];
+    acc_b += sums[G + k];
+  }
+  sphc_scan_chunk(lo, hi, acc_a, count_a, start_a, end_a);
+  if (tables > 1) sphc_scan_chunk(lo, hi, acc_b, count_b, start_b, end_b);
+  if (g == 0) *done = 0;  // for the next build
+}
+__kernel void sphc_scatter2(const uint na, __global const uint* keys_a,
+                            __global const uint* start_a, __global uint* cursor_a,
+                            __global uint* order_a, const uint nb, __global const uint* keys_b,
+                            __global const uint* start_b, __global uint* cursor_b,
+                            __global uint* order_b) {
+  const uint i = get_global_id(0);
+  if (i < na) {
+    const uint key = keys_a[i];
+    order_a[start_a[key] + atomic_inc(&cursor_a[key])] = i;
+  } else if (i - na < nb) {
+    const uint key = keys_b[i - na];
+    order_b[start_b[key] + atomic_inc(&cursor_b[key])] = i - na;
+  }
+}
+__kernel void sphc_sort_cells2(const uint cells, const int tables, __global const uint* start_a,
+                               __global const uint* end_a, __global uint* order_a,
+                               __global uint* count_a, __global const uint* start_b,
+                               __global const uint* end_b, __global uint* order_b,
+                               __global uint* count_b) {
+  const uint c = get_global_id(0);
+  if (c < cells)
+    sphc_sort_cell(c, start_a, end_a, order_a, count_a);
+  else if (tables > 1 && c - cells < cells)
+    sphc_sort_cell(c - cells, start_b, end_b, order_b, count_b);
 }
 
 __kernel void sphc_fill_uint(__global uint* v, const uint value, const uint count) {
@@ -395,6 +498,7 @@ void Context::init(const Selection& sel, bool double_precision, const std::strin
                                    reinterpret_cast<cl_context_properties>(pick->pid), 0};
   context_ = clCreateContext(props, 1, &pick->did, nullptr, nullptr, &err);
   check(err, "clCreateContext");
+  device_ = pick->did;
   queue_ = clCreateCommandQueue(context_, pick->did, 0, &err);
   check(err, "clCreateCommandQueue");
 
@@ -496,11 +600,15 @@ void Context::set_arg(cl_kernel k, cl_uint& i, const CellTable& c) {
 
 void Context::launch(cl_kernel k, std::size_t n, const std::string& name) {
   const std::size_t local = 64;
-  std::size_t global = (n + local - 1) / local * local;
+  enqueue(k, (n + local - 1) / local * local, nullptr, name);
+}
+
+void Context::enqueue(cl_kernel k, std::size_t global, const std::size_t* local,
+                      const std::string& name) {
   ++launches_;
   const auto start =
       profile_ ? std::chrono::steady_clock::now() : std::chrono::steady_clock::time_point{};
-  check(clEnqueueNDRangeKernel(queue_, k, 1, nullptr, &global, nullptr, 0, nullptr, nullptr),
+  check(clEnqueueNDRangeKernel(queue_, k, 1, nullptr, &global, local, 0, nullptr, nullptr),
         name.empty() ? "clEnqueueNDRangeKernel" : ("clEnqueueNDRangeKernel(" + name + ")").c_str());
   if (profile_) {
     finish();
@@ -508,6 +616,16 @@ void Context::launch(cl_kernel k, std::size_t n, const std::string& name) {
     slot.first += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     ++slot.second;
   }
+}
+
+void Context::launch_local(cl_kernel k, std::size_t n, std::size_t local,
+                           const std::string& name) {
+  std::size_t most = 0;
+  check(clGetKernelWorkGroupInfo(k, device_, CL_KERNEL_WORK_GROUP_SIZE, sizeof most, &most,
+                                 nullptr),
+        "clGetKernelWorkGroupInfo");
+  local = std::max<std::size_t>(1, std::min(local, most));
+  enqueue(k, (n + local - 1) / local * local, &local, name);
 }
 
 void Context::finish() { check(clFinish(queue_), "clFinish"); }
@@ -645,11 +763,7 @@ Grid Context::grid_of(const SearchDomain& dom) const {
   return g;
 }
 
-void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem z, std::size_t n) {
-  // A counting sort by cell: keys and counts, a scan into start/end, a scatter, and a sort of
-  // each cell's few indices (deterministic order). Five launches, O(n + cells) work. The
-  // counts are zero between builds (sphc_sort_cells zeroes them): filled once, when
-  // allocated.
+void CellTable::reserve(Context& ctx, const Grid& grid, std::size_t n) {
   if (n > padded || !keys) {
     if (keys) clReleaseMemObject(keys);
     if (order) clReleaseMemObject(order);
@@ -667,6 +781,14 @@ void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem
     const unsigned all = static_cast<unsigned>(cells);
     ctx.run("sphc_fill_uint", all, count, 0u, all);
   }
+}
+
+void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem z, std::size_t n) {
+  // A counting sort by cell: keys and counts, a scan into start/end, a scatter, and a sort of
+  // each cell's few indices (deterministic order). Five launches, O(n + cells) work. The
+  // counts are zero between builds (sphc_sort_cells zeroes them): filled once, when
+  // allocated.
+  reserve(ctx, grid, n);
   if (!partial) partial = ctx.alloc(kScanItems * sizeof(cl_uint));
   const unsigned nc = static_cast<unsigned>(grid.cells());
   const unsigned un = static_cast<unsigned>(n);
@@ -678,8 +800,47 @@ void CellTable::build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem
   ctx.run("sphc_sort_cells", nc, nc, start, end, order, count);
 }
 
+void build_tables(Context& ctx, const Grid& grid, const std::vector<TableBuild>& tables) {
+  // Two tables per launch (a lone last one with an empty second), three launches per pair:
+  // cell keys with the scan by the last work group, the scatter, the per-cell sorts. The
+  // tables are those of CellTable::build (the same counting sort, the same per-cell order).
+  const unsigned nc = static_cast<unsigned>(grid.cells());
+  for (const TableBuild& b : tables) b.table->reserve(ctx, grid, b.n);
+  for (std::size_t k = 0; k < tables.size(); k += 2) {
+    const TableBuild& a = tables[k];
+    const bool pair = k + 1 < tables.size();
+    const TableBuild& b = tables[pair ? k + 1 : k];
+    const unsigned na = static_cast<unsigned>(a.n), nb = pair ? static_cast<unsigned>(b.n) : 0u;
+    CellTable &ta = *a.table, &tb = *b.table;
+    if (!ta.done) {
+      ta.done = ctx.alloc(sizeof(cl_uint));
+      ctx.run("sphc_fill_uint", 1, ta.done, 0u, 1u);
+    }
+    cl_kernel keys = ctx.kernel("sphc_cell_keys_scan2");
+    cl_uint i = 0;
+    ctx.set_arg(keys, i, na);
+    for (cl_mem m : {a.x, a.y ? a.y : a.x, a.z ? a.z : a.x}) ctx.set_arg(keys, i, m);
+    ctx.set_arg(keys, i, nb);
+    for (cl_mem m : {b.x, b.y ? b.y : b.x, b.z ? b.z : b.x}) ctx.set_arg(keys, i, m);
+    ctx.set_arg(keys, i, a.y ? 1 : 0);
+    ctx.set_arg(keys, i, a.z ? 1 : 0);
+    ctx.set_arg(keys, i, grid);
+    for (cl_mem m : {ta.keys, ta.count, tb.keys, tb.count}) ctx.set_arg(keys, i, m);
+    ctx.set_arg(keys, i, nc);
+    ctx.set_arg(keys, i, pair ? 2 : 1);
+    for (cl_mem m : {ta.start, ta.end, tb.start, tb.end, ta.done}) ctx.set_arg(keys, i, m);
+    // At least one work group, which then scans.
+    ctx.launch_local(keys, std::max<std::size_t>(1, std::size_t{na} + nb), kScanGroup,
+                     "sphc_cell_keys_scan2");
+    ctx.run("sphc_scatter2", std::size_t{na} + nb, na, ta.keys, ta.start, ta.count, ta.order, nb,
+            tb.keys, tb.start, tb.count, tb.order);
+    ctx.run("sphc_sort_cells2", std::size_t{nc} * (pair ? 2 : 1), nc, pair ? 2 : 1, ta.start,
+            ta.end, ta.order, ta.count, tb.start, tb.end, tb.order, tb.count);
+  }
+}
+
 void CellTable::release() {
-  for (cl_mem* m : {&keys, &order, &start, &end, &count, &partial})
+  for (cl_mem* m : {&keys, &order, &start, &end, &count, &partial, &done})
     if (*m) {
       clReleaseMemObject(*m);
       *m = nullptr;

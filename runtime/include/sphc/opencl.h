@@ -63,12 +63,29 @@ class Context;
 struct CellTable {
   cl_mem keys = nullptr, order = nullptr, start = nullptr, end = nullptr;
   cl_mem count = nullptr, partial = nullptr;  // scratch of the counting sort
+  cl_mem done = nullptr;  // build_tables: work groups done counting (0 between builds)
   std::size_t padded = 0, cells = 0;          // capacity of keys/order, of the cell tables
   static constexpr std::size_t kScanItems = 256;
+  // Room for n particles and the grid's cells (the counts zero when allocated).
+  void reserve(Context& ctx, const Grid& grid, std::size_t n);
   void build(Context& ctx, const Grid& grid, cl_mem x, cl_mem y, cl_mem z, std::size_t n);
   void release();
   ~CellTable() { release(); }
 };
+
+// The cell tables of several sources on one grid in one set of launches: three per two
+// tables (cell keys with the scan by the work group that finishes last, scatter, per-cell
+// sort) where CellTable::build takes five per table; the same tables. y, z: nullptr beyond
+// the dimension.
+struct TableBuild {
+  CellTable* table;
+  cl_mem x, y, z;
+  std::size_t n;
+};
+// Work items per work group of the keys kernel, hence of the scan (at most the kernel's
+// work-group size on the device; SPHC_SCAN_GROUP_MAX in the kernel source).
+constexpr std::size_t kScanGroup = 64;
+void build_tables(Context& ctx, const Grid& grid, const std::vector<TableBuild>& tables);
 
 // Device copies of the properties and constants of one ParticleArray. Each property buffer
 // holds `capacity` particles (>= n): room for ghosts after the n real particles.
@@ -175,6 +192,9 @@ class Context {
   // SPHC_OPENCL_PROFILE=1 in the environment: every launch waits for its kernel, and the
   // time per kernel name is printed to stderr at exit.
   void launch(cl_kernel k, std::size_t n, const std::string& name = "");
+  // As launch, in work groups of `local` work items (fewer where the device allows fewer
+  // for k).
+  void launch_local(cl_kernel k, std::size_t n, std::size_t local, const std::string& name);
   bool profiling() const { return profile_; }
   // Kernel launches so far (every launch through `launch`: the scene's kernels, the neighbour
   // search's, reductions), for --timing's launches_per_step.
@@ -183,9 +203,12 @@ class Context {
   void add_profile(const std::string& name, double seconds);
 
  private:
+  void enqueue(cl_kernel k, std::size_t global, const std::size_t* local,
+               const std::string& name);
   bool dp_ = true;
   std::string device_name_;
   cl_context context_ = nullptr;
+  cl_device_id device_ = nullptr;
   cl_command_queue queue_ = nullptr;
   cl_program program_ = nullptr;
   std::map<std::string, cl_kernel> kernels_;
