@@ -145,7 +145,7 @@ TEST(SkinTuner, OptimalSkinMinimisesTheModelledCost) {
 // a rebuild after forget() (a sort) measures nothing. Returns the last skin.
 double tuned_skin(double speed, int evaluations, int* rebuilds) {
   const double h0 = 0.1;
-  ParticleArray pa = random_array(200, 1.0, h0, 5);
+  ParticleArray pa = random_array(200, 3, 1.0, h0, 5, 0.8, 1.2);
   for (std::size_t i = 0; i < pa.n; ++i) pa.f64("h")[i] = h0;  // one h: h_min = h0
   std::vector<const ParticleArray*> all = {&pa};
   sphc::VerletLists lists(sphc::SkinTuner::kStart);
@@ -196,7 +196,7 @@ TEST(SkinTuner, SkinFollowsTheMeasuredMovement) {
 // tuner at each rebuild, every pair within the support in the kept lists.
 TEST(SkinTuner, ListsStayCompleteWhileTheSkinChanges) {
   const double h0 = 0.1;
-  ParticleArray pa = random_array(300, 1.0, h0, 9);
+  ParticleArray pa = random_array(300, 3, 1.0, h0, 9, 0.8, 1.2);
   std::vector<const ParticleArray*> all = {&pa};
   VerletSkin verlet(sphc::SkinTuner::kStart);
   sphc::SkinTuner tuner(3);
