@@ -5,6 +5,7 @@
 #include "analysis/Passes.h"
 #include "body/BodyAnalysis.h"
 #include "codegen/CppEmitter.h"
+#include "codegen/SymmetricPairs.h"
 #include "driver/Build.h"
 #include "driver/Study.h"
 #include "frontend/ASTPrinter.h"
@@ -91,6 +92,13 @@ static cl::opt<bool> NoHoist(
              "those that depend on the source particle only and divide or call sqrt, pow, ... "
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double precision; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoSymmetricPairs(
+    "no-symmetric-pairs",
+    cl::desc("Evaluate every pair of a pair loop for each of its two particles (default: where "
+             "the destination array is the source and the bodies allow it, each pair once for "
+             "both particles, on the CPU backends with kept neighbour lists; --report says "
+             "which loops; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
 // --verlet-skin=auto (the default): the skin, as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
@@ -343,6 +351,10 @@ int main(int argc, char** argv) {
   }
   EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
                        verletSkin, !NoHoist};
+  emitOpts.symmetricPairs = !NoSymmetricPairs;
+  if (Report && Emit != EmitKind::OpenCL)
+    for (const std::string& note : sphc::symmetricPairsNotes(*schedule, emitOpts))
+      llvm::outs() << "note: " << note << "\n";
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;
