@@ -242,7 +242,16 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     std::ostringstream locals;
     emitDestLocals(locals, in, q, host_);
     scene_ << locals.str();
-    emitDestinationHoisted(scene_, pass, in);
+    // The destination-only values as they were before the pass (a body may write what they
+    // read: at i's turn, i has already had the contributions of the particles before it).
+    for (const PlanEquation* eq : pass.equations) {
+      const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
+      for (size_t k = 0; k < sites.size(); ++k) {
+        const std::string K = std::to_string(k);
+        scene_ << in << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
+               << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+      }
+    }
     scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
     scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
     scene_ << in << "for (const std::uint32_t* k = " << from << "; k != k_end" << to
