@@ -76,7 +76,7 @@ void walkPasses(const ScheduleGroup& g,
 std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
                                   const NeighbourPass& pass, bool listsKept) {
   if (pass.source != w.array) return "the source is another array";
-  if (!listsKept) return "no neighbour lists kept in index order (--verlet-skin off here)";
+  if (!listsKept) return "no lists kept in index order here (--verlet-skin off)";
   if (w.ranged()) return "the group has start_idx or stop_idx";
   if (w.onGhosts) return "the group runs on the ghosts";
   if (!pass.loopAll.empty()) return pass.loopAll[0]->name + " has a loop_all (NBRS)";
