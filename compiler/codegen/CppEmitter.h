@@ -50,6 +50,11 @@ struct EmitOptions {
   // of launches (sphc::ocl::build_tables); false (--no-batched-tables): CellTable::build per
   // source. The same tables, the same results bit for bit.
   bool batchedTables = true;
+  // Pair loops whose destination array is their source evaluate each pair once for both
+  // particles where the bodies allow it (codegen/SymmetricPairs.cpp; CPU backends with kept
+  // neighbour lists); false (--no-symmetric-pairs): each destination gathers from all its
+  // neighbours. The values are the same bit for bit.
+  bool symmetricPairs = true;
 };
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.

@@ -5,6 +5,7 @@
 // destination particles only write their own particle (gather), so they need no atomics and
 // give the serial result bit for bit.
 #include "codegen/Printer.h"
+#include "codegen/SymmetricPairs.h"
 
 #include <cstdio>
 #include <functional>
@@ -23,7 +24,8 @@ class CpuPrinter : public ScenePrinter {
         verletSkin_(opts.verletSkin > 0 && !cpuSingle_ && !mpi_ && !hasDomain() && !hasZones()
                         ? opts.verletSkin
                         : 0.0),
-        tuned_(verletSkin_ > 0 && opts.verletAuto) {}
+        tuned_(verletSkin_ > 0 && opts.verletAuto),
+        symmetric_(opts.symmetricPairs) {}
 
  private:
   std::string backendComment() const override {
@@ -53,6 +55,7 @@ class CpuPrinter : public ScenePrinter {
     out_ << "  std::vector<std::vector<std::uint32_t>> nbrs_lists;\n";
     if (verlet()) verletMembers();
     emitHoistMembers(out_);
+    if (verlet() && symmetric_) emitSymmetricMembers(out_);
   }
   // --verlet-skin: the lists are kept across evaluations (sphc/verlet.h).
   bool verlet() const { return verletSkin_ > 0; }
@@ -182,6 +185,7 @@ class CpuPrinter : public ScenePrinter {
   long ompMinParticles_ = 0;  // --omp-min-particles (0: every loop parallel)
   double verletSkin_ = 0.0;  // --verlet-skin (0: lists gathered at every evaluation)
   bool tuned_ = false;       // --verlet-skin=auto: skin and re-sort chosen at run time
+  bool symmetric_ = true;    // each pair once where it may (--no-symmetric-pairs: false)
 };
 
 // --verlet-skin: the skin and, per pair loop (phase, destination, source), each destination
@@ -310,6 +314,11 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
       scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
       scene_ << "        }\n";
+    }
+    if (symmetric_ && symmetricPairsRefusal(plan_, w, pass, verlet()).empty()) {
+      emitSymmetricPass(w, pass, lists, openmp_);  // codegen/SymmetricPairs.cpp
+      scene_ << "      }\n";
+      continue;
     }
     scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
            << (openmp_ ? "omp_get_max_threads()" : "1") << "));\n";

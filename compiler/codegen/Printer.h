@@ -184,6 +184,21 @@ class ScenePrinter {
     return "dhoisted_" + eqValues + "_" + k;
   }
 
+  // ---- Each pair once for both particles (SymmetricPairs.cpp) ----
+  // A same-array pair loop that symmetricPairsRefusal() allows, on the CPU with kept lists
+  // (member `lists`): the lists built for all particles when due, the destination-only values
+  // of every particle, then each pair once (OpenMP: per block of particles).
+  void emitSymmetricPass(const DestinationWork& w, const NeighbourPass& pass,
+                         const std::string& lists, bool openmp);
+  // The call of eq's loop for destination s_idx and source d_idx, with the mirrored pair
+  // quantities (XIJ_ji, ...).
+  std::string callBodyMirrored(const PlanEquation& eq, int dest) const;
+  // The members holding the destination-only values of every particle (dhoist_eqN_K).
+  void emitSymmetricMembers(std::ostream& os) const;
+  std::string symmetricDestinationHoisted(const std::string& eqValues, const std::string& k) const {
+    return "dhoisted_all_" + eqValues + "_" + k;
+  }
+
   // ---- The host program (HostProgram.cpp) ----
   void emitBodies();
   void emitSceneFunctions();

@@ -5,6 +5,7 @@
 #include "analysis/Passes.h"
 #include "body/BodyAnalysis.h"
 #include "codegen/CppEmitter.h"
+#include "codegen/SymmetricPairs.h"
 #include "driver/Build.h"
 #include "driver/Study.h"
 #include "frontend/ASTPrinter.h"
@@ -108,6 +109,13 @@ static cl::opt<bool> NoBatchedTables(
     cl::desc("--backend=opencl: build each source's cell table in its own five launches "
              "(default: the tables of all sources of an update in four launches per two "
              "sources; the same tables, the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoSymmetricPairs(
+    "no-symmetric-pairs",
+    cl::desc("Evaluate every pair of a pair loop for each of its two particles (default: where "
+             "the destination array is the source and the bodies allow it, each pair once for "
+             "both particles, on the CPU backends with kept neighbour lists; --report says "
+             "which loops; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
 // --verlet-skin=auto (the default): the starting skin (the solver then chooses it,
 // sphc/verlet_tune.h, where SkinTuner::kStart is the same 0.1), as a fraction of the support radius. Measured (callgrind
@@ -366,6 +374,10 @@ int main(int argc, char** argv) {
   emitOpts.ompMinParticles = OmpMinParticles;
   emitOpts.verletAuto = verletAuto;  // the skin and re-sort chosen at run time
   emitOpts.batchedTables = !NoBatchedTables;
+  emitOpts.symmetricPairs = !NoSymmetricPairs;
+  if (Report && Emit != EmitKind::OpenCL)
+    for (const std::string& note : sphc::symmetricPairsNotes(*schedule, emitOpts))
+      llvm::outs() << "note: " << note << "\n";
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;

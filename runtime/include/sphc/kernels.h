@@ -124,6 +124,20 @@ struct RadialKernel {
     grad[1] = s * xij[1];
     grad[2] = s * xij[2];
   }
+  // The gradients of one pair for both particles (sphc's pair loops that evaluate each pair
+  // once): grad_ij = gradient(xij, rij, h) and grad_ji = gradient(xji, rij, h), xji = x_j -
+  // x_i, with the factor s computed once; each is gradient()'s value bit for bit.
+  template <class T>
+  static inline void gradient_pair(const T xij[3], const T xji[3], T rij, T h, T grad_ij[3],
+                                   T grad_ji[3]) {
+    const T s = rij > T(1e-12) ? dwdq(rij, h) / (h * rij) : T(0);
+    grad_ij[0] = s * xij[0];
+    grad_ij[1] = s * xij[1];
+    grad_ij[2] = s * xij[2];
+    grad_ji[0] = s * xji[0];
+    grad_ji[1] = s * xji[1];
+    grad_ji[2] = s * xji[2];
+  }
 };
 
 // The members f(q) and df(q) of a shape: the functions NAME_f and NAME_df of kernel_shapes.h.

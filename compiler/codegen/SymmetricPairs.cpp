@@ -1,0 +1,336 @@
+// Each pair once for both particles (codegen/SymmetricPairs.h): when a pair loop may, and
+// how the CPU printer writes it.
+//
+// Why it is the same bit for bit. Today destination i gathers over its kept list (increasing
+// source index): its sums receive the bodies' contributions in increasing source order. Here
+// the outer loop takes i in increasing order and, for each neighbour j >= i of i's list,
+// computes the pair quantities once and calls the bodies for (d = i, s = j), then, unless
+// j == i, for (d = j, s = i). Particle j thus receives the contributions of every i < j in
+// increasing i (at their turns), then its own and those of every k > j in increasing k (at
+// its turn): today's order. The mirrored quantities are today's values of (d = j, s = i):
+// XJI = x_j - x_i and VJI are computed as differences (so that a zero keeps today's sign);
+// R2IJ, RIJ, HIJ = 0.5 (h_i + h_j), WIJ, RHOIJ, RHOIJ1 and EPS are symmetric expressions
+// (IEEE addition and multiplication commute); WI and WJ swap; the gradients are s * XIJ with a
+// factor s of (RIJ, h) only, computed once for both (Kernel::gradient_pair). The conditions
+// (symmetricPairsRefusal): the bodies write only d_ properties at d_idx, read no s_ property
+// and the pair quantities no property the pass writes (so that what they read of the other
+// particle is what it was before the pass), index nothing but d_idx and s_idx, and no
+// loop_all needs the neighbour list; every initialize ran for all particles before the pass
+// (the CPU printer's destination loops: initialize, then the passes).
+#include "codegen/SymmetricPairs.h"
+
+#include "analysis/PairQuantityTable.h"
+#include "codegen/CppText.h"
+#include "codegen/Printer.h"
+
+#include <algorithm>
+
+namespace sphc {
+
+namespace {
+
+const PlanBody& loopBody(const Plan& plan, const PlanEquation& eq) {
+  return plan.bodies[plan.equationDecls[eq.declIndex].methods.at(ast::Method::Loop)];
+}
+
+// The index text of a property site `d_NAME[ index ]`, trimmed.
+std::string siteIndex(const BodySource& src, const PropSite& site) {
+  std::string t = src.text.substr(site.begin, site.end - site.begin);
+  size_t open = t.find('['), close = t.rfind(']');
+  if (open == std::string::npos || close == std::string::npos || close < open) return "";
+  std::string idx = t.substr(open + 1, close - open - 1);
+  idx.erase(0, idx.find_first_not_of(" \t\n"));
+  idx.erase(idx.find_last_not_of(" \t\n") + 1);
+  return idx;
+}
+
+// The name of a pair quantity for the mirrored call (destination j, source i).
+std::string mirrored(const std::string& q) {
+  if (q == "WI") return "WJ";
+  if (q == "WJ") return "WI";
+  const PairQuantity* pq = findPairQuantity(q);
+  if (pq && (pq->form == PairForm::Difference || pq->form == PairForm::Gradient))
+    return q + "_ji";
+  return q;  // symmetric in i and j
+}
+
+// The pair quantities the pass computes: q, with WI and WJ, DWI and DWJ together (each is the
+// other's mirror).
+std::set<std::string> withMirrors(std::set<std::string> q) {
+  if (q.count("WI") || q.count("WJ")) q.insert({"WI", "WJ"});
+  if (q.count("DWI") || q.count("DWJ")) q.insert({"DWI", "DWJ"});
+  return q;
+}
+
+void walkPasses(const ScheduleGroup& g,
+                const std::function<void(const Phase&, const DestinationWork&,
+                                         const NeighbourPass&)>& fn) {
+  for (const Phase& ph : g.phases)
+    for (const DestinationWork& w : ph.destinations)
+      for (const NeighbourPass& pass : w.passes) fn(ph, w, pass);
+  for (const auto& sub : g.subgroups) walkPasses(*sub, fn);
+}
+
+}  // namespace
+
+std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
+                                  const NeighbourPass& pass, bool listsKept) {
+  if (pass.source != w.array) return "the source is another array";
+  if (!listsKept) return "no lists kept in index order here (--verlet-skin off)";
+  if (w.ranged()) return "the group has start_idx or stop_idx";
+  if (w.onGhosts) return "the group runs on the ghosts";
+  if (!pass.loopAll.empty()) return pass.loopAll[0]->name + " has a loop_all (NBRS)";
+  if (pass.equations.empty()) return "no loop body";
+  if (pass.order != LoopOrder::Parallel) return "the schedule runs the pass in particle order";
+  const PlanArray& A = plan.arrays[w.array];
+  auto isConstant = [&](const std::string& p) {
+    return std::find(A.constants.begin(), A.constants.end(), p) != A.constants.end();
+  };
+  std::map<std::string, std::string> writer;  // property -> the first equation writing it
+  for (const PlanEquation* eq : pass.equations)
+    for (const PropAccess& a : loopBody(plan, *eq).facts.dWrites) writer.emplace(a.prop, eq->name);
+  for (const std::string& p : pass.shared)
+    if (writer.count(p))
+      return writer[p] + " writes d_" + p + ", which the pair quantities read";
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = loopBody(plan, *eq);
+    if (!b.facts.statesWritten.empty())
+      return eq->name + " writes its state " + *b.facts.statesWritten.begin();
+    for (const std::string& q : b.facts.pairQuantities)
+      if (!findPairQuantity(q)) return eq->name + " uses " + q + ", which has no mirror";
+    for (const PropSite& site : b.facts.sites) {
+      const std::string name = (site.source ? "s_" : "d_") + site.prop;
+      if (site.write && site.source) return eq->name + " writes " + name;
+      if (!site.source && isConstant(site.prop)) {
+        if (site.write) return eq->name + " writes the constant " + name;
+        continue;  // read: the same for every particle
+      }
+      const std::string idx = siteIndex(b.source, site);
+      if (idx != (site.source ? "s_idx" : "d_idx"))
+        return eq->name + " indexes " + name + " with `" + idx + "`";
+      if (site.source && writer.count(site.prop))
+        return eq->name + " reads " + name + ", which " + writer[site.prop] +
+               " writes in the pass";
+    }
+  }
+  return "";
+}
+
+std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOptions& opts) {
+  std::vector<std::string> notes;
+  const Plan& plan = *sched.plan;
+  // The CPU printer keeps lists where --verlet-skin is on for it (CpuPrinter's verlet()).
+  const bool listsKept = opts.verletSkin > 0 && opts.backend != Backend::OpenCL &&
+                         opts.precision == Precision::Double && !sched.distribution.enabled &&
+                         !sched.domain && plan.zones.empty();
+  walkPasses(sched.equations, [&](const Phase& ph, const DestinationWork& w,
+                                  const NeighbourPass& pass) {
+    if (pass.source != w.array || !pass.searches()) return;
+    const std::string loop = plan.arrays[w.array].name + " <- " + plan.arrays[pass.source].name +
+                             " in " + ph.name;
+    std::string why = opts.symmetricPairs ? symmetricPairsRefusal(plan, w, pass, listsKept)
+                                          : "--no-symmetric-pairs";
+    if (opts.backend == Backend::OpenCL) why = "the OpenCL backend gathers per destination";
+    notes.push_back(why.empty() ? "each pair once for both particles: " + loop
+                                : "pairs per destination particle: " + loop + ": " + why);
+  });
+  return notes;
+}
+
+// ---- The printer ----
+
+std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest) const {
+  const PlanBody& b = methodBody(eq, ast::Method::Loop);
+  const std::string eqValues = eqStruct(eq);
+  std::string s = bodyFunctionName(eq.name, "loop") + "(";
+  bool first = true;
+  for (const auto& p : bodyParams(b, dest, host_)) {
+    s += first ? "" : ", ";
+    first = false;
+    switch (p.kind) {
+      case BodyParam::Idx: s += "s_idx"; break;
+      case BodyParam::SIdx: s += "d_idx"; break;
+      case BodyParam::T: s += "t"; break;
+      case BodyParam::Dt: s += "dt"; break;
+      case BodyParam::Pair: s += mirrored(p.name); break;
+      case BodyParam::Scalar: s += eqValues + "." + p.name; break;
+      case BodyParam::DProp: s += "d_" + p.name; break;
+      case BodyParam::SProp: s += "s_" + p.name; break;
+      case BodyParam::Hoisted: s += hoistArgument(eqValues, p.name); break;
+      case BodyParam::DHoisted: s += symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]"; break;
+      default: SPHC_INTERNAL("a pair loop body with NBRS or N");
+    }
+  }
+  return s + ");  // " + eq.name + ", from " + loc(eq.loc) + ": destination s_idx, source d_idx\n";
+}
+
+void ScenePrinter::emitSymmetricMembers(std::ostream& os) const {
+  for (const PlanEquation& eq : plan_.equations) {
+    if (!eq.live) continue;
+    const auto& methods = plan_.equationDecls[eq.declIndex].methods;
+    if (!methods.count(ast::Method::Loop)) continue;
+    const PlanBody& b = methodBody(eq, ast::Method::Loop);
+    const auto sites = hoistedDestinationSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k)
+      os << "  std::vector<double> dhoist_" << eqStruct(eq) << "_" << k << ";  // " << eq.name
+         << ": its loop's destination-only value " << k
+         << " per particle (each pair once for both particles)\n";
+  }
+}
+
+void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPass& pass,
+                                     const std::string& lists, bool openmp) {
+  const int d = w.array;
+  const std::set<std::string> q = withMirrors(pass.pairQuantities);
+  const std::string thread = openmp ? "omp_get_thread_num()" : "0";
+  const std::string pragma = openmp ? "        #pragma omp parallel for schedule(static) "
+                                      "default(firstprivate) shared(cells)\n"
+                                    : "";
+  scene_ << "        // Each pair once for both particles (codegen/SymmetricPairs.cpp; sphc\n"
+            "        // --no-symmetric-pairs: per destination particle): the same sums bit for bit.\n";
+  // The kept lists first, all of them: a pair is visited from its lower particle's list.
+  scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
+         << (openmp ? "omp_get_max_threads()" : "1") << "));\n";
+  scene_ << "        if (verlet_build) {\n";
+  scene_ << (openmp ? "  " + pragma : "");
+  scene_ << "          for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+  emitDestLocals(scene_, "            ", {}, host_);
+  scene_ << "            std::vector<std::uint32_t>& nbrs_list = nbrs_lists[" << thread << "];\n";
+  scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
+            "nbrs_list, [&](std::uint32_t j) {\n";
+  scene_ << "              const int s_idx = static_cast<int>(j);\n";
+  emitNeighbourTest(scene_, host_, "return false;", "              ", "VERLET_RADIUS2");
+  scene_ << "              return true;\n            });\n";
+  scene_ << "            sphc::keep_in_index_order(" << lists
+         << ".lists[d_idx], nbrs_list.data(), n_kept);\n";
+  scene_ << "          }\n        }\n";
+  // The destination-only values of every particle, for the mirrored calls.
+  std::vector<std::string> fills;
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    const auto sites = hoistedDestinationSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const std::string K = std::to_string(k), E = eqStruct(*eq);
+      const std::string ptr = symmetricDestinationHoisted(E, K);
+      scene_ << "        dhoist_" << E << "_" << K << ".resize(n);\n";
+      scene_ << "        double* const " << ptr << " = dhoist_" << E << "_" << K << ".data();\n";
+      fills.push_back(E + "_" + K);
+    }
+  }
+  if (!fills.empty()) {
+    scene_ << pragma;
+    scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+    emitDestinationHoisted(scene_, pass, "          ");
+    for (const PlanEquation* eq : pass.equations) {
+      const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
+      for (size_t k = 0; k < sites.size(); ++k) {
+        const std::string K = std::to_string(k);
+        scene_ << "          " << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx] = "
+               << hoistDestinationArgument(eqStruct(*eq), K) << ";\n";
+      }
+    }
+    scene_ << "        }\n";
+  }
+  // One destination's neighbours in [from, to) of its kept list (sorted): the pair
+  // quantities, the bodies for d_idx and, with `both`, for s_idx (unless the self pair).
+  auto segment = [&](const std::string& indent, const std::string& begin, const std::string& end,
+                     const std::string& from, const std::string& to, bool both,
+                     const std::string& comment) {
+    scene_ << indent << "for (int d_idx = " << begin << "; d_idx < " << end << "; ++d_idx) {"
+           << comment << "\n";
+    const std::string in = indent + "  ";
+    std::ostringstream locals;
+    emitDestLocals(locals, in, q, host_);
+    scene_ << locals.str();
+    // The destination-only values as they were before the pass (a body may write what they
+    // read: at i's turn, i has already had the contributions of the particles before it).
+    for (const PlanEquation* eq : pass.equations) {
+      const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
+      for (size_t k = 0; k < sites.size(); ++k) {
+        const std::string K = std::to_string(k);
+        scene_ << in << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
+               << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+      }
+    }
+    scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+    scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
+    scene_ << in << "for (const std::uint32_t* k = " << from << "; k != k_end" << to
+           << "; ++k) {\n";
+    const std::string body = in + "  ";
+    scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
+    emitNeighbourTest(scene_, host_, "continue;", body);
+    const PairDialect dialect = [&] {
+      PairDialect pd;
+      pd.real = host_.real;
+      pd.sqrt = host_.sqrt;
+      pd.kernelW = host_.kernelW;
+      pd.kernelGradient = host_.kernelGradient;
+      pd.literalSuffix = host_.lit("");
+      return pd;
+    }();
+    auto difference = [&](const PairQuantity& pq, bool mirror) {
+      scene_ << body << "const double " << pq.name << (mirror ? "_ji" : "") << "[3] = {";
+      for (int c = 0; c < 3; ++c) {
+        scene_ << (c ? ", " : "");
+        if (c >= plan_.dim)
+          scene_ << "0.0";
+        else if (mirror)
+          scene_ << "sj_" << pq.components[c] << "[s_idx] - " << pq.components[c] << "i";
+        else
+          scene_ << pq.components[c] << "i - sj_" << pq.components[c] << "[s_idx]";
+      }
+      scene_ << "};\n";
+    };
+    if (both) difference(*findPairQuantity("XIJ"), true);
+    for (const PairQuantity& pq : pairQuantityTable()) {
+      if (!(pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name))))
+        continue;
+      if (both && pq.form == PairForm::Difference) {
+        difference(pq, false);
+        difference(pq, true);
+      } else if (both && pq.form == PairForm::Gradient) {
+        // grad_j of the mirrored call: DWIJ -> DWIJ_ji (same h), DWI (h_i) -> DWJ_ji, DWJ
+        // (h_j) -> DWI_ji.
+        const std::string partner =
+            pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
+        scene_ << body << "double " << pq.name << "[3], " << partner << "[3];\n";
+        scene_ << body << "Kernel::gradient_pair(XIJ, XIJ_ji, RIJ, " << pq.h << ", " << pq.name
+               << ", " << partner << ");\n";
+      } else {
+        scene_ << pairQuantityStatement(pq, plan_.dim, dialect, body);
+      }
+    }
+    for (const PlanEquation* eq : pass.equations)
+      scene_ << body << equationCall(*eq, ast::Method::Loop, d);
+    if (both) {
+      scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
+      for (const PlanEquation* eq : pass.equations)
+        scene_ << body << "  " << callBodyMirrored(*eq, d);
+      scene_ << body << "}\n";
+    }
+    scene_ << in << "}\n" << indent << "}\n";
+  };
+  const std::string lower = "std::lower_bound(kept.data(), k_end, static_cast<std::uint32_t>(";
+  if (!openmp) {
+    segment("        ", "0", "n", lower + "d_idx))", "", true, "  // pairs (d_idx, s_idx >= d_idx)");
+    return;
+  }
+  // OpenMP: contiguous blocks, one per thread; each particle's contributions in the serial
+  // order whatever the blocks.
+  scene_ << "        const int n_blocks = std::max(1, std::min(n, omp_get_max_threads()));\n";
+  scene_ << pragma;
+  scene_ << "        for (int blk = 0; blk < n_blocks; ++blk) {\n";
+  scene_ << "          const int b_begin = static_cast<int>(static_cast<long>(n) * blk / n_blocks);\n";
+  scene_ << "          const int b_end = static_cast<int>(static_cast<long>(n) * (blk + 1) / n_blocks);\n";
+  scene_ << "          // (1) from the neighbours in earlier blocks, per destination\n";
+  segment("          ", "b_begin", "b_end", "kept.data()",
+          " && *k < static_cast<std::uint32_t>(b_begin)", false, "");
+  scene_ << "          // (2) the pairs within the block, once for both particles\n";
+  segment("          ", "b_begin", "b_end", lower + "d_idx))",
+          " && *k < static_cast<std::uint32_t>(b_end)", true, "");
+  scene_ << "          // (3) from the neighbours in later blocks, per destination\n";
+  segment("          ", "b_begin", "b_end", lower + "b_end))", "", false, "");
+  scene_ << "        }\n";
+}
+
+}  // namespace sphc
