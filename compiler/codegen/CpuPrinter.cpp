@@ -21,10 +21,10 @@ class CpuPrinter : public ScenePrinter {
       : ScenePrinter(sched, diags, opts),
         openmp_(opts.backend == Backend::OpenMP),
         ompMinParticles_(opts.ompMinParticles),
-        verletSkin_(opts.verletSkin > 0 && !cpuSingle_ && !mpi_ && !hasDomain() && !hasZones()
+        verletSkin_(opts.verletSkin > 0 && !cpuSingle_ && !mpi_ && !ghostPairLoops() && !hasZones()
                         ? opts.verletSkin
                         : 0.0),
-        tuned_(verletSkin_ > 0 && opts.verletAuto),
+        tuned_(verletSkin_ > 0 && opts.verletAuto && !hasDomain()),
         symmetric_(opts.symmetricPairs) {}
 
  private:
@@ -72,6 +72,25 @@ class CpuPrinter : public ScenePrinter {
   // The kept lists whose destination or source is array S (forgotten after S is sorted).
   std::vector<std::string> listsOf(const std::string& S) const;
   void tunedUpdateNeighbours();
+  // Calls f(lists, phase, w, pass) for every pair loop that keeps lists (verletLists).
+  void forEachVerletLists(
+      const std::function<void(const std::string&, const Phase&, const DestinationWork&,
+                               const NeighbourPass&)>& f) const;
+  // Whether a neighbour pass runs on ghosts too (a `real = false` group with a domain): no
+  // kept lists there (the driver's ghostPairLoops on the plan).
+  bool ghostPairLoops() const {
+    bool any = false;
+    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+      for (const Phase& ph : g.phases)
+        for (const DestinationWork& w : ph.destinations)
+          for (const NeighbourPass& pass : w.passes) any |= w.onGhosts && pass.searches();
+      for (const auto& sub : g.subgroups) walk(*sub);
+    };
+    walk(sched_.equations);
+    return any;
+  }
+  // --verlet-skin with a periodic or mirror domain (the lists and ghosts kept together).
+  void updateNeighboursKeptGhosts();
   // The member holding the kept lists of the pass of destination work w over source s in a
   // phase. The pair loops of every phase with the same destination and source share one set
   // of lists (the support radius is the scene's), rebuilt by whichever loop finds them stale;
@@ -90,6 +109,11 @@ class CpuPrinter : public ScenePrinter {
   void stepperCall(const StepStatement& st,
                    const std::function<std::string(int)>& timeAfter) override;
   void wrapPeriodic(int a) override {
+    if (verlet()) {  // the particles near the box keep their ghosts (updateNeighboursKeptGhosts)
+      scene_ << "    sphc::wrap_periodic_far(box, " << hostData(a)
+             << ", WRAP_MARGIN * Kernel::radius_scale);\n";
+      return;
+    }
     scene_ << "    sphc::wrap_periodic(box, " << hostData(a) << ");\n";
   }
   void updateNeighbours() override;
@@ -106,6 +130,7 @@ class CpuPrinter : public ScenePrinter {
               "(sphc/solver.h)\n";
   }
   void mainBackendOptions() override {
+    if (verlet() && hasDomain()) out_ << "  prog.before_output = [] { scene.wrap_into_box(); };\n";
     if (openmp_)
       out_ << "  prog.set_threads = [](int n) {\n"
               "    if (n > 0) omp_set_num_threads(n);\n"
@@ -202,17 +227,33 @@ void CpuPrinter::verletMembers() {
     out_ << "  static constexpr double VERLET_RADIUS2 = RADIUS2 * (1.0 + VERLET_SKIN) * "
             "(1.0 + VERLET_SKIN);\n";
   }
+  forEachVerletLists([&](const std::string& lists, const Phase& ph, const DestinationWork& w,
+                         const NeighbourPass& pass) {
+    out_ << "  sphc::VerletLists " << lists << (tuned() ? "{verlet_skin};  // " : "{VERLET_SKIN};  // ")
+         << arr(w.array).name
+         << " <- " << arr(pass.source).name
+         << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase")) << "\n";
+  });
+  if (hasDomain())
+    out_ << "  // The ghosts are kept with the lists: found again when the particles moved too far\n"
+            "  // (ghost_skin, over every array of a pair loop) or at a permutation, else made\n"
+            "  // again in the same order from their originals (update_neighbours). Between\n"
+            "  // permutations a periodic axis wraps only the particles further than\n"
+            "  // WRAP_MARGIN supports outside the box (update_domain).\n"
+            "  sphc::VerletSkin ghost_skin{VERLET_SKIN};\n"
+            "  static constexpr double WRAP_MARGIN = 0.5;\n";
+}
+
+void CpuPrinter::forEachVerletLists(
+    const std::function<void(const std::string&, const Phase&, const DestinationWork&,
+                             const NeighbourPass&)>& f) const {
   std::set<std::string> declared;  // one member per set of lists (verletLists)
   std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
     for (const Phase& ph : g.phases)
       for (const DestinationWork& w : ph.destinations)
         for (const NeighbourPass& pass : w.passes) {
           const std::string lists = verletLists(ph.name, w, pass.source);
-          if (pass.searches() && declared.insert(lists).second)
-            out_ << "  sphc::VerletLists " << lists << (tuned() ? "{verlet_skin};  // " : "{VERLET_SKIN};  // ")
-                 << arr(w.array).name << " <- " << arr(pass.source).name
-                 << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase"))
-                 << "\n";
+          if (pass.searches() && declared.insert(lists).second) f(lists, ph, w, pass);
         }
     for (const auto& sub : g.subgroups) walk(*sub);
   };
@@ -235,6 +276,17 @@ void CpuPrinter::searchMembers() {
 }
 
 void CpuPrinter::dataMovement() {
+  if (verlet() && hasDomain()) {
+    // Kept lists: between rebuilds particles may be up to WRAP_MARGIN supports outside a
+    // periodic box (update_domain); an output holds them wrapped into it (the lists and
+    // ghosts are then rebuilt: the particles moved by a period).
+    scene_ << "  // Every particle into the periodic box: at a permutation (update_neighbours) and\n"
+              "  // before each output (prog.before_output).\n";
+    scene_ << "  void wrap_into_box() {\n";
+    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
+      scene_ << "    sphc::wrap_periodic(box, " << hostData(a) << ");\n";
+    scene_ << "  }\n\n";
+  }
   if (!cpuSingle_) return;
   // The float copies: made after set-up; the host doubles updated for output and checks.
   scene_ << "  void to_single() {\n";
@@ -579,6 +631,7 @@ std::string CpuPrinter::cellListBuild(const std::string& S, const std::string& c
 // real particles, the cell-order permutation (of real particles), then the ghosts of every
 // source array, and the cell lists over real particles and ghosts.
 void CpuPrinter::updateNeighboursWithGhosts() {
+  if (verlet()) return updateNeighboursKeptGhosts();
   if (mpi_) emitMigration();  // --mpi: particles that left this rank's region go first
   searchDomain();
   if (sourceArrays_.empty()) return;
@@ -609,9 +662,67 @@ void CpuPrinter::updateNeighboursWithGhosts() {
 
 std::string CpuPrinter::removeGhosts() const {
   std::string r;
+  if (verlet()) {  // the ghosts are kept for the next evaluation (updateNeighboursKeptGhosts)
+    for (const auto& S : sourceArrays_) r += "    sphc::hide_ghosts(" + S + ");\n";
+    return r;
+  }
   for (const auto& S : sourceArrays_)
     r += std::string(mpi_ ? "    sphc::mpi::remove_halo(" : "    sphc::remove_ghosts(") + hostData(plan_.arrayIndex(S)) + ", ghosts_" + S + ");\n";
   return r;
+}
+
+// update_neighbours of a scene with a periodic or mirror domain and kept lists
+// (docs/performance.md, "Neighbour lists with periodic and mirror sides"). The ghosts are found
+// (within the lists' radius and the wrap margin of a side) only when the lists must be built
+// again: when ghost_skin finds that some particle moved too far since (the kept lists' own
+// test, over every array of a pair loop), and at a permutation, before which the particles are
+// wrapped into the box. Otherwise the same ghosts, in the same order, are made again from
+// their originals, so the kept lists' indices still name the same particles and images.
+// Between two finds a real particle is at most WRAP_MARGIN supports outside a periodic box
+// (update_domain) and has moved less than the skin allows: every image within the support of
+// a particle now was within the lists' radius plus the margin of a side at the find.
+void CpuPrinter::updateNeighboursKeptGhosts() {
+  searchDomain();
+  if (sourceArrays_.empty()) return;
+  scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
+  scene_ << "    const bool new_ghosts = reorder || ghost_skin.must_rebuild(all, "
+            "Kernel::radius_scale);\n";
+  scene_ << "    if (reorder) {\n";
+  scene_ << "      // Every REORDER_EVERY builds the real particles are wrapped into the box and sorted\n"
+            "      // in the cell order of the support's grid (as without lists).\n";
+  scene_ << "      wrap_into_box();\n";
+  scene_ << "      order_domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
+  for (const auto& S : sourceArrays_)
+    if (reorders(S))
+      scene_ << "      " << cellListBuild(S, S + ".n", "order_domain") << "\n      "
+             << permuteInCellOrder(S) << "\n";
+  scene_ << "    }\n";
+  scene_ << "    // Ghosts within the lists' radius plus WRAP_MARGIN supports of a periodic or mirror side.\n";
+  scene_ << "    const double cutoff = domain.cell_size * (1.0 + VERLET_SKIN + WRAP_MARGIN) / "
+            "(1.0 + VERLET_SKIN);\n";
+  scene_ << "    if (new_ghosts) {\n";
+  for (const auto& S : sourceArrays_) {
+    int s = plan_.arrayIndex(S);
+    scene_ << "      sphc::add_ghosts(box, " << S << ", cutoff, ghosts_" << S << ", "
+           << propIndexList(s, arr(s).ghostProps) << ");  //";
+    for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
+    scene_ << "\n";
+  }
+  scene_ << "      ghost_skin.mark(all);\n";
+  forEachVerletLists([&](const std::string& lists, const Phase&, const DestinationWork&,
+                         const NeighbourPass&) {
+    scene_ << "      " << lists << ".end = -1;  // not built: the ghosts were renumbered\n";
+  });
+  scene_ << "    } else {  // the same ghosts, from their originals now\n";
+  for (const auto& S : sourceArrays_) {
+    int s = plan_.arrayIndex(S);
+    scene_ << "      sphc::restore_ghosts(box, " << S << ", ghosts_" << S << ", "
+           << propIndexList(s, arr(s).ghostProps) << ");\n";
+  }
+  scene_ << "    }\n";
+  scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
+  for (const auto& S : sourceArrays_)
+    scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
 }
 
 bool CpuPrinter::isStatic(const std::string& S) const {

@@ -94,14 +94,17 @@ void copy_property(const Domain& d, Reals reals, ParticleArray& a, const Ghosts&
   }
 }
 
-// wrap_periodic of n coordinates x along axis ax, in the arithmetic of T.
+// wrap_periodic of n coordinates x along axis ax, in the arithmetic of T. With h: only the
+// particles further than margin * h[i] outside [lo, hi) (wrap_periodic_far).
 template <class T>
-void wrap_axis(const Domain& d, int ax, T* x, std::size_t n) {
+void wrap_axis(const Domain& d, int ax, T* x, std::size_t n, const double* h = nullptr,
+               double margin = 0.0) {
   const T lo = static_cast<T>(d.lo[ax]), hi = static_cast<T>(d.hi[ax]), period = hi - lo;
 #pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
     T v = x[i];
     if (!std::isfinite(v) || (v >= lo && v < hi)) continue;
+    if (h && v >= lo - margin * h[i] && v < hi + margin * h[i]) continue;
     // Whole periods; the checks after it catch rounding at the ends.
     v -= std::floor((v - lo) / period) * period;
     if (v >= hi) v -= period;
@@ -254,6 +257,26 @@ void wrap_periodic(const Domain& d, ParticleArray& a) { wrap_all(d, HostReals{a}
 void wrap_periodic(const Domain& d, FloatArray& f, const ParticleArray& a) {
   wrap_all(d, FloatReals{f}, a);
 }
+
+void wrap_periodic_far(const Domain& d, ParticleArray& a, double margin) {
+  const int h = a.find("h");
+  if (h < 0 || a.props[h].type != PropType::F64) return wrap_periodic(d, a);
+  for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
+    if (!d.periodic(ax)) continue;
+    const int idx = a.find(kAxis[ax]);
+    if (idx < 0 || a.props[idx].type != PropType::F64) continue;
+    wrap_axis(d, ax, a.props[idx].f64.data(), a.n, a.props[h].f64.data(), margin);
+  }
+}
+
+std::size_t restore_ghosts(const Domain& d, ParticleArray& a, const Ghosts& g,
+                           const std::vector<int>& carried) {
+  resize_storage(HostReals{a}, a, a.n + g.size());
+  for (int idx : carried) copy_property(d, HostReals{a}, a, g, idx);
+  return g.size();
+}
+
+void hide_ghosts(ParticleArray& a) { resize_storage(HostReals{a}, a, a.n); }
 
 std::size_t find_ghosts(const Domain& d, const double* const pos[3], std::size_t n,
                         double cutoff, Ghosts& g, const std::string& array) {

@@ -851,6 +851,7 @@ class Simulation {
   }
 
   void write_output() {
+    if (prog_.before_output) prog_.before_output();
     writer_->write(prog_.output_arrays ? prog_.output_arrays() : arrays_, meta());
     last_output_step_ = step_;
     record_metrics();

@@ -134,6 +134,21 @@ void refresh_ghosts(const Domain& d, ParticleArray& a, const Ghosts& g,
 // Removes the ghosts: the storage of every property back to a.n particles; g emptied.
 void remove_ghosts(ParticleArray& a, Ghosts& g);
 
+// Kept ghosts (neighbour lists kept across steps, sphc --verlet-skin; docs/performance.md,
+// "Neighbour lists with periodic and mirror sides"). Between two rebuilds of the lists the
+// ghosts stay the same particles, in the same order, so the kept lists' indices stay valid:
+//   - wrap_periodic_far moves back into the box only the real particles further than
+//     margin * h outside it along a periodic axis (wrap_periodic wraps them all; a particle
+//     closer to the box keeps its place and its ghosts, and interacts through them);
+//   - hide_ghosts ends an evaluation: the storage back to a.n particles, `g` kept;
+//   - restore_ghosts starts the next one with the same ghosts: the storage grown to
+//     a.n + g.size() and the properties `carried` copied from their real particles through
+//     their images, as add_ghosts does (the positions follow their originals). Returns g.size().
+void wrap_periodic_far(const Domain& d, ParticleArray& a, double margin);
+void hide_ghosts(ParticleArray& a);
+std::size_t restore_ghosts(const Domain& d, ParticleArray& a, const Ghosts& g,
+                           const std::vector<int>& carried);
+
 // The same on the float copy `f` of `a` (--precision=single; see above).
 void wrap_periodic(const Domain& d, FloatArray& f, const ParticleArray& a);
 std::size_t add_ghosts(const Domain& d, FloatArray& f, ParticleArray& a, double cutoff, Ghosts& g,

@@ -138,6 +138,10 @@ struct SceneProgram {
   // Device backends: copies the device's particle data into the host arrays. The run loop
   // calls it only before it reads them (output, blow-up checks); empty = data lives on the host.
   std::function<void()> to_host;
+  // Called before each output is written (and its metrics evaluated); empty = nothing. A scene
+  // whose kept neighbour lists let particles stay slightly outside a periodic box between
+  // rebuilds wraps them into it here, so that every output holds positions in the box.
+  std::function<void()> before_output;
   // Multi-threaded backends: sets the number of threads (--threads N) and returns the number
   // in use; empty for a serial solver, which then refuses --threads.
   std::function<int(int threads)> set_threads;
