@@ -92,6 +92,13 @@ static cl::opt<bool> NoHoist(
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double precision; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> SingleUnit(
+    "single-unit",
+    cl::desc("Generate the solver as one translation unit (default, serial and openmp without "
+             "--mpi: the phases, the pair loops, are defined after struct Scene and built as "
+             "a unit of their own, in parallel with the rest, which shortens a cold build; "
+             "the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 // --verlet-skin=auto (the default): the skin, as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
 // than 0.2 on the cube and the dam break (0.2 keeps ~1.33x (3D) the candidates of 0.1 in
@@ -342,7 +349,7 @@ int main(int argc, char** argv) {
     return fail();
   }
   EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
-                       verletSkin, !NoHoist};
+                       verletSkin, !NoHoist, !SingleUnit};
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;
