@@ -795,10 +795,12 @@ std::string ScenePrinter::run() {
   emitSceneMembers();
   dataMovement();
   out_ << "\n" << scene_.str() << "};\n\n";
-  if (splitPhases_)
+  if (splitPhases_ && phases_.tellp() > 0)
     out_ << "}  // namespace sphc_scene\n\nusing namespace sphc_scene;\n\n"
          << kPhasesBeginMarker << " (sphc --single-unit: members of Scene) ----\n\n"
          << phases_.str() << kPhasesEndMarker << " ----\n\n";
+  else if (splitPhases_)
+    out_ << "}  // namespace sphc_scene\n\nusing namespace sphc_scene;\n\n";
   else
     out_ << "}  // namespace\n\n";
   emitMain();
