@@ -97,7 +97,8 @@ static cl::opt<bool> SingleUnit(
     cl::desc("Generate the solver as one translation unit (default, serial and openmp without "
              "--mpi: the phases, the pair loops, are defined after struct Scene and built as "
              "a unit of their own, in parallel with the rest, which shortens a cold build; "
-             "the results are the same bit for bit)"),
+             "the results are the same bit for bit). --emit=cpp prints the one-unit form; "
+             "the split file a build compiled is scene.cpp in its cache directory (sphc -v)"),
     cl::init(false), cl::cat(SphcCat));
 // --verlet-skin=auto (the default): the skin, as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
@@ -349,7 +350,7 @@ int main(int argc, char** argv) {
     return fail();
   }
   EmitOptions emitOpts{Backend, PrecisionOpt, GlobalIds || Mpi, FmaOpt == OnOff::On,
-                       verletSkin, !NoHoist, !SingleUnit};
+                       verletSkin, !NoHoist, !SingleUnit && Emit == EmitKind::Exe};
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
     return 0;
