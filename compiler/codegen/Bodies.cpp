@@ -36,6 +36,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   for (int a : sched.searchArrays) loopArrays_.insert(arr(a).name);
   mpi_ = sched.distribution.enabled;
   globalIds_ = opts.globalIds || mpi_;
+  splitPhases_ = opts.splitUnits && opts.backend != Backend::OpenCL && !mpi_;
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {

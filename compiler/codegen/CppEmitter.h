@@ -55,7 +55,18 @@ struct EmitOptions {
   // neighbour lists); false (--no-symmetric-pairs): each destination gathers from all its
   // neighbours. The values are the same bit for bit.
   bool symmetricPairs = true;
+  // The phases (the pair loops) are defined out of struct Scene, after it, between the
+  // marker lines below, and the scene's namespace is named (sphc_scene) so that the build
+  // can compile them as a translation unit of their own, in parallel with the rest
+  // (driver/Build.cpp); serial and openmp, not --mpi. false (--single-unit): the old single
+  // unit, byte for byte. The same object code either way, up to where functions are placed.
+  bool splitUnits = true;
 };
+
+// The lines around the out-of-class phases of a split solver (EmitOptions::splitUnits).
+inline constexpr const char* kPhasesBeginMarker =
+    "// ---- sphc: the phases, a translation unit of their own when sphc builds";
+inline constexpr const char* kPhasesEndMarker = "// ---- sphc: end of the phases";
 
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.
 std::string emitCpp(const Schedule& sched, const DiagnosticEngine& diags,

@@ -415,6 +415,34 @@ void ScenePrinter::emitHostReduces(const DestinationWork& w) {
 }
 
 void ScenePrinter::emitPhase(const Phase& ph) {
+  if (splitPhases_) {
+    // Printed on its own, then declared in struct Scene and defined after it (phases_).
+    std::ostringstream members;
+    scene_.swap(members);
+    emitPhaseMember(ph);
+    scene_.swap(members);
+    outOfClassPhase(ph, members.str());
+    return;
+  }
+  emitPhaseMember(ph);
+}
+
+// A phase printed as a member of struct Scene: `  // provenance`, `  void NAME(double t,
+// double dt) {`, the body, `  }`. Split (splitPhases_): the provenance and a declaration
+// stay in the class; the definition, qualified, goes after it with the same body.
+void ScenePrinter::outOfClassPhase(const Phase& ph, const std::string& member) {
+  const std::string head = "  void " + ph.name + "(double t, double dt) {\n";
+  const std::size_t at = member.find(head);
+  const std::size_t close = member.rfind("  }\n");
+  const std::string provenance = member.substr(0, at);
+  scene_ << provenance << "  void " << ph.name << "(double t, double dt);  // defined after "
+         << "the struct\n\n";
+  phases_ << provenance.substr(2) << "void sphc_scene::Scene::" << ph.name
+          << "(double t, double dt) {\n"
+          << member.substr(at + head.size(), close - at - head.size()) << "}\n\n";
+}
+
+void ScenePrinter::emitPhaseMember(const Phase& ph) {
   // Provenance: the group and the equations fused into this phase.
   scene_ << "  // phase of the group from " << loc(ph.group->loc) << ":";
   for (size_t k = 0; k < ph.equations.size(); ++k) {
@@ -751,7 +779,8 @@ std::string ScenePrinter::run() {
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   systemIncludes();
   out_ << "\n";
-  out_ << "namespace {\n\n";
+  // Split units (splitPhases_): a named namespace, whose Scene both units share.
+  out_ << (splitPhases_ ? "namespace sphc_scene {\n\n" : "namespace {\n\n");
   out_ << "constexpr int DIM = " << plan_.dim << ";\n";
   out_ << "using Kernel = sphc::" << plan_.kernel << "<DIM>;\n";
   out_ << "constexpr " << real_
@@ -765,7 +794,15 @@ std::string ScenePrinter::run() {
   beforeScene();
   emitSceneMembers();
   dataMovement();
-  out_ << "\n" << scene_.str() << "};\n\n}  // namespace\n\n";
+  out_ << "\n" << scene_.str() << "};\n\n";
+  if (splitPhases_ && phases_.tellp() > 0)
+    out_ << "}  // namespace sphc_scene\n\nusing namespace sphc_scene;\n\n"
+         << kPhasesBeginMarker << " (sphc --single-unit: members of Scene) ----\n\n"
+         << phases_.str() << kPhasesEndMarker << " ----\n\n";
+  else if (splitPhases_)
+    out_ << "}  // namespace sphc_scene\n\nusing namespace sphc_scene;\n\n";
+  else
+    out_ << "}  // namespace\n\n";
   emitMain();
   return out_.str();
 }

@@ -208,6 +208,8 @@ class ScenePrinter {
   void emitDomainSetup();
   void emitGroup(const ScheduleGroup& g);
   void emitPhase(const Phase& ph);
+  void emitPhaseMember(const Phase& ph);
+  void outOfClassPhase(const Phase& ph, const std::string& member);
   // A group option evaluated at run time (start_idx, stop_idx, condition) as C++: params,
   // array constants `arr.c` (their first value), t and dt.
   std::string groupOptionCpp(const ast::Expr& e) const;
@@ -331,6 +333,10 @@ class ScenePrinter {
   std::ostringstream out_;    // the file
   std::ostringstream scene_;  // members of struct Scene
   std::ostringstream cl_;     // OpenCL C of the kernels (--backend=opencl)
+  // EmitOptions::splitUnits on a CPU backend without --mpi: the phases' definitions, out of
+  // struct Scene (emitPhase), printed after it between the markers of CppEmitter.h.
+  bool splitPhases_ = false;
+  std::ostringstream phases_;
   std::vector<std::string> sourceArrays_;  // arrays that need a cell list, by name
   std::set<std::string> loopArrays_;       // arrays in a neighbour pass, as dest or source
 };

@@ -1,5 +1,7 @@
 #include "driver/Build.h"
 
+#include "codegen/CppEmitter.h"
+
 #include "llvm/ADT/SmallString.h"
 #include "llvm/ADT/StringExtras.h"
 #include "llvm/ADT/StringMap.h"
@@ -12,6 +14,7 @@
 #include "llvm/Support/SHA1.h"
 #include "llvm/Support/raw_ostream.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <map>
@@ -70,6 +73,48 @@ std::map<std::string, std::string> readBuildInfo(const std::string& file, std::s
 void addFileToHash(llvm::SHA1& h, const std::string& file) {
   if (auto buf = llvm::MemoryBuffer::getFile(file)) h.update((*buf)->getBuffer());
   h.update(file);
+}
+
+bool writeFile(const std::string& file, const std::string& text, std::string& message) {
+  std::error_code ec;
+  llvm::raw_fd_ostream os(file, ec);
+  if (ec) {
+    message = "cannot write '" + file + "': " + ec.message();
+    return false;
+  }
+  os << text;
+  return true;
+}
+
+// The generated code's translation units. A CPU solver's phases (the pair loops) are defined
+// out of struct Scene between two marker lines (codegen/HostProgram.cpp, unless
+// --single-unit): one unit is the code before the end marker (the declarations and the
+// phases), the other the code without the phases (the rest of the scene and main), each
+// compiled on its own, in parallel. The file as a whole is one valid unit too (--emit=cpp).
+std::vector<std::string> splitUnits(const std::string& cpp) {
+  const std::size_t begin = cpp.find(std::string("\n") + kPhasesBeginMarker);
+  const std::size_t end = cpp.find(std::string("\n") + kPhasesEndMarker);
+  if (begin == std::string::npos || end == std::string::npos || end < begin) return {cpp};
+  // Compiler messages about the code after the phases name the lines of the whole file
+  // (the build keeps it as scene.cpp).
+  const long line = 2 + std::count(cpp.begin(), cpp.begin() + end, '\n');
+  return {cpp.substr(0, end + 1),
+          cpp.substr(0, begin + 1) + "#line " + std::to_string(line) + " \"scene.cpp\"\n" +
+              cpp.substr(end + 1)};
+}
+
+// Whether the build can use the precompiled runtime headers: buildinfo's compiler and
+// default flags (plus the OpenMP flag), a serial or OpenMP solver, and the .gch in place.
+bool usesScenePch(const Install& install, std::map<std::string, std::string>& info,
+                  const std::string& cxx, const std::string& flags, const BuildRequest& req) {
+  if (cxx != info["cxx"] || req.mpi) return false;
+  std::string expected = info["cxxflags"];
+  if (req.backend == "openmp")
+    expected += " " + (info.count("openmp_flags") ? info["openmp_flags"] : "-fopenmp");
+  else if (req.backend != "serial")
+    return false;
+  if (flags != expected) return false;
+  return fs::exists(install.includeDir + "/sphc/scene_pch.h.gch/" + req.backend + ".gch");
 }
 
 }  // namespace
@@ -175,60 +220,119 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   // is atomic, so a reader sees either no cached build or a whole one.
   const std::string pid = std::to_string(llvm::sys::Process::getProcessId());
   std::string cppFile = std::string(dir) + "/scene." + pid + ".cpp";
-  std::string logFile = std::string(dir) + "/build." + pid + ".log";
-  {
-    llvm::raw_fd_ostream os(cppFile, ec);
-    if (ec) {
-      res.message = "cannot write '" + cppFile + "': " + ec.message();
-      return finish(false);
-    }
-    os << req.cpp;
-  }
+  if (!writeFile(cppFile, req.cpp, res.message)) return finish(false);
   std::string tmpExe = cachedExe + "." + pid + ".tmp";
-  std::vector<std::string> args;
   auto cxxPath = llvm::sys::findProgramByName(cxx);
   if (!cxxPath) {
     res.message = "cannot find the C++ compiler '" + cxx + "' (set it with --cxx)";
     return finish(false);
   }
-  args.push_back(*cxxPath);
+  std::vector<std::string> compile{*cxxPath};
   llvm::SmallVector<llvm::StringRef, 16> parts;
   llvm::StringRef(flags).split(parts, ' ', -1, false);
-  for (auto p : parts) args.push_back(p.str());
-  args.push_back("-I" + install.includeDir);
-  args.push_back(cppFile);
-  if (req.mpi) args.push_back(mpiLib);
-  args.push_back(runtimeLib);
+  for (auto p : parts) compile.push_back(p.str());
+  const std::vector<std::string> linkFlags = compile;  // the compiler and flags (-fopenmp)
+  compile.push_back("-I" + install.includeDir);
+  // The precompiled runtime headers (sphc/scene_pch.h.gch/<backend>.gch, built with the
+  // default flags by runtime/CMakeLists.txt): only for a build with buildinfo's compiler and
+  // flags. GCC checks the rest (CPU, macros) and parses the header where the .gch does not fit.
+  if (usesScenePch(install, info, cxx, flags, req)) {
+    compile.push_back("-include");
+    compile.push_back("sphc/scene_pch.h");
+  }
+  std::vector<std::string> link;
+  if (req.mpi) link.push_back(mpiLib);
+  link.push_back(runtimeLib);
   parts.clear();
   llvm::StringRef(libs).split(parts, ' ', -1, false);
-  for (auto p : parts) args.push_back(p.str());
-  args.push_back("-o");
-  args.push_back(tmpExe);
-  if (req.verbose) {
-    for (const auto& a : args) llvm::errs() << a << " ";
-    llvm::errs() << "\n";
+  for (auto p : parts) link.push_back(p.str());
+  link.push_back("-o");
+  link.push_back(tmpExe);
+
+  // One or two translation units (splitUnits): two are compiled at once, then linked.
+  const std::vector<std::string> units = splitUnits(req.cpp);
+  std::vector<std::string> logs, tmpFiles;
+  std::vector<std::vector<std::string>> commands;
+  if (units.size() == 1) {
+    std::vector<std::string> args = compile;
+    args.push_back(cppFile);
+    args.insert(args.end(), link.begin(), link.end());
+    commands.push_back(args);
+    logs.push_back(std::string(dir) + "/build." + pid + ".log");
+  } else {
+    std::vector<std::string> linkArgs = linkFlags;
+    for (std::size_t k = 0; k < units.size(); ++k) {
+      const std::string base = std::string(dir) + "/scene." + pid + ".unit" + std::to_string(k);
+      if (!writeFile(base + ".cpp", units[k], res.message)) return finish(false);
+      std::vector<std::string> args = compile;
+      args.insert(args.end(), {"-c", base + ".cpp", "-o", base + ".o"});
+      commands.push_back(args);
+      logs.push_back(base + ".log");
+      tmpFiles.insert(tmpFiles.end(), {base + ".cpp", base + ".o"});
+      linkArgs.push_back(base + ".o");
+    }
+    linkArgs.insert(linkArgs.end(), link.begin(), link.end());
+    commands.push_back(linkArgs);
+    logs.push_back(std::string(dir) + "/link." + pid + ".log");
   }
-  std::vector<llvm::StringRef> argRefs(args.begin(), args.end());
-  llvm::Optional<llvm::StringRef> redirects[] = {llvm::None, llvm::StringRef(logFile),
-                                                 llvm::StringRef(logFile)};
-  std::string execErr;
-  int rc = llvm::sys::ExecuteAndWait(args[0], argRefs, llvm::None, redirects, 0, 0, &execErr);
-  if (rc != 0) {
+  auto failed = [&](std::size_t k, const std::string& why) {
     std::string log;
-    if (auto buf = llvm::MemoryBuffer::getFile(logFile)) log = (*buf)->getBuffer().str();
+    if (auto buf = llvm::MemoryBuffer::getFile(logs[k])) log = (*buf)->getBuffer().str();
     if (log.size() > 4000) log = log.substr(0, 4000) + "\n...";
-    res.message = "the generated C++ did not compile (" +
-                  (execErr.empty() ? "exit code " + std::to_string(rc) : execErr) +
-                  "); generated code: " + cppFile + ", log: " + logFile + "\n" + log;
+    res.message = "the generated C++ did not compile (" + why + "); generated code: " + cppFile +
+                  ", log: " + logs[k] + "\n" + log;
     return finish(false);
+  };
+  if (req.verbose)
+    for (const auto& c : commands) {
+      for (const auto& a : c) llvm::errs() << a << " ";
+      llvm::errs() << "\n";
+    }
+  // The compiles (all but the link when there are units) run at once; the link after them.
+  const std::size_t nCompiles = units.size() == 1 ? 1 : units.size();
+  std::vector<std::vector<llvm::StringRef>> argRefs;
+  for (const auto& c : commands) argRefs.emplace_back(c.begin(), c.end());
+  std::vector<llvm::sys::ProcessInfo> running;
+  for (std::size_t k = 0; k < nCompiles; ++k) {
+    llvm::Optional<llvm::StringRef> redirects[] = {llvm::None, llvm::StringRef(logs[k]),
+                                                   llvm::StringRef(logs[k])};
+    std::string execErr;
+    running.push_back(llvm::sys::ExecuteNoWait(commands[k][0], argRefs[k], llvm::None,
+                                               redirects, 0, &execErr));
+    if (running.back().Pid == llvm::sys::ProcessInfo::InvalidPid) {
+      for (std::size_t j = 0; j + 1 < running.size(); ++j)
+        llvm::sys::Wait(running[j], 0, /*WaitUntilTerminates=*/true);
+      return failed(k, execErr);
+    }
   }
+  int firstFailure = -1;
+  std::string why;
+  for (std::size_t k = 0; k < running.size(); ++k) {
+    std::string execErr;
+    auto done = llvm::sys::Wait(running[k], 0, /*WaitUntilTerminates=*/true, &execErr);
+    if (done.ReturnCode != 0 && firstFailure < 0) {
+      firstFailure = static_cast<int>(k);
+      why = execErr.empty() ? "exit code " + std::to_string(done.ReturnCode) : execErr;
+    }
+  }
+  if (firstFailure >= 0) return failed(firstFailure, why);
+  if (commands.size() > nCompiles) {
+    const std::size_t k = commands.size() - 1;
+    llvm::Optional<llvm::StringRef> redirects[] = {llvm::None, llvm::StringRef(logs[k]),
+                                                   llvm::StringRef(logs[k])};
+    std::string execErr;
+    int rc = llvm::sys::ExecuteAndWait(commands[k][0], argRefs[k], llvm::None, redirects, 0, 0,
+                                       &execErr);
+    if (rc != 0) return failed(k, execErr.empty() ? "exit code " + std::to_string(rc) : execErr);
+  }
+  for (const auto& f : tmpFiles) fs::remove(f);
+  for (const auto& l : logs) fs::remove(l);
   if (auto e = fs::rename(tmpExe, cachedExe)) {
     res.message = "cannot move the built executable into the cache: " + e.message();
     return finish(false);
   }
   // Kept beside the executable for people who want to read what was built.
   fs::rename(cppFile, std::string(dir) + "/scene.cpp");
-  fs::remove(logFile);
   return deliver();
 }
 

@@ -118,6 +118,14 @@ static cl::opt<bool> NoSymmetricPairs(
              "both particles, on the CPU backends with kept neighbour lists; --report says "
              "which loops; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> SingleUnit(
+    "single-unit",
+    cl::desc("Generate the solver as one translation unit (default, serial and openmp without "
+             "--mpi: the phases, the pair loops, are defined after struct Scene and built as "
+             "a unit of their own, in parallel with the rest, which shortens a cold build; "
+             "the results are the same bit for bit). --emit=cpp prints the one-unit form; "
+             "the split file a build compiled is scene.cpp in its cache directory (sphc -v)"),
+    cl::init(false), cl::cat(SphcCat));
 // --verlet-skin=auto (the default): the starting skin (the solver then chooses it,
 // sphc/verlet_tune.h, where SkinTuner::kStart is the same 0.1), as a fraction of the support radius. Measured (callgrind
 // and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
@@ -394,6 +402,7 @@ int main(int argc, char** argv) {
   emitOpts.ompMinParticles = OmpMinParticles;
   emitOpts.verletAuto = verletAuto;  // the skin and re-sort chosen at run time
   emitOpts.batchedTables = !NoBatchedTables;
+  emitOpts.splitUnits = !SingleUnit && Emit == EmitKind::Exe;
   emitOpts.symmetricPairs = !NoSymmetricPairs;
   if (Report && Emit != EmitKind::OpenCL)
     for (const std::string& note : sphc::symmetricPairsNotes(*schedule, emitOpts))
