@@ -367,8 +367,9 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
       scene_ << "        }\n";
     }
-    if (symmetric_ && symmetricPairsRefusal(plan_, w, pass, verlet()).empty()) {
-      emitSymmetricPass(w, pass, lists, openmp_);  // codegen/SymmetricPairs.cpp
+    if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty()) {
+      emitSymmetricPass(w, pass, lists, openmp_,
+                        tuned() ? "verlet_radius2" : "VERLET_RADIUS2");  // codegen/SymmetricPairs.cpp
       scene_ << "      }\n";
       continue;
     }

@@ -189,7 +189,8 @@ class ScenePrinter {
   // (member `lists`): the lists built for all particles when due, the destination-only values
   // of every particle, then each pair once (OpenMP: per block of particles).
   void emitSymmetricPass(const DestinationWork& w, const NeighbourPass& pass,
-                         const std::string& lists, bool openmp);
+                         const std::string& lists, bool openmp,
+                         const std::string& listRadius2);
   // The call of eq's loop for destination s_idx and source d_idx, with the mirrored pair
   // quantities (XIJ_ji, ...).
   std::string callBodyMirrored(const PlanEquation& eq, int dest) const;

@@ -364,7 +364,12 @@ int main(int argc, char** argv) {
     const std::string why = verletUnsupported(*plan);
     char skin[32];
     std::snprintf(skin, sizeof skin, "%g", kAutoVerletSkin);
-    if (why.empty())
+    if (why.empty() && plan->domain.any())
+      plan->notes.push_back(std::string("neighbour lists kept across steps (--verlet-skin=auto): "
+                                        "candidates within (1 + F) times the support, F = ") +
+                            skin + " with periodic or mirror sides (the ghosts kept with the "
+                            "lists), rebuilt when particles moved too far");
+    else if (why.empty())
       plan->notes.push_back(std::string("neighbour lists kept across steps (--verlet-skin=auto): "
                                         "candidates within (1 + F) times the support, rebuilt "
                                         "when particles moved too far; F chosen at run time "
