@@ -257,12 +257,20 @@ void ScenePrinter::emitSlots() {
 
 std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int dest,
                                    const std::string& eqValues, const std::string& time,
-                                   const std::string& sep) const {
+                                   const std::string& sep,
+                                   const std::function<std::string(const BodyParam&)>& argument) const {
   std::string s = fn + "(";
   bool first = true;
   for (const auto& p : bodyParams(b, dest, host_)) {
     s += first ? "" : ", ";
     first = false;
+    if (argument) {
+      const std::string a = argument(p);
+      if (!a.empty()) {
+        s += a;
+        continue;
+      }
+    }
     switch (p.kind) {
       case BodyParam::Idx: s += "d_idx"; break;
       case BodyParam::SIdx: s += "s_idx"; break;

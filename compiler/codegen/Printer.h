@@ -128,9 +128,12 @@ class ScenePrinter {
   void emitHelperFunction(const PlanBody& f, const Dialect& d, std::ostringstream& os);
   // eqValues + sep + scalar: "eq3.rho0" on the host, "eq3_rho0" (a kernel argument) on the
   // device.
+  // argument(p), where given and not empty, replaces a parameter's usual argument (the
+  // mirrored calls of SymmetricPairs.cpp swap the indices and mirror the pair quantities).
   std::string callBody(const std::string& fn, const PlanBody& b, int dest,
                        const std::string& eqValues, const std::string& time,
-                       const std::string& sep = ".") const;
+                       const std::string& sep = ".",
+                       const std::function<std::string(const BodyParam&)>& argument = {}) const;
   // The destination particle's position, h (and velocity) as locals xi, yi, zi, hi (ui...).
   void emitDestLocals(std::ostream& os, const std::string& indent,
                       const std::set<std::string>& q, const Dialect& d) const;

@@ -145,26 +145,22 @@ std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOp
 std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest) const {
   const PlanBody& b = methodBody(eq, ast::Method::Loop);
   const std::string eqValues = eqStruct(eq);
-  std::string s = bodyFunctionName(eq.name, "loop") + "(";
-  bool first = true;
-  for (const auto& p : bodyParams(b, dest, host_)) {
-    s += first ? "" : ", ";
-    first = false;
+  // callBody's arguments but for the swapped indices, the mirrored pair quantities and the
+  // destination-only values of particle s_idx.
+  auto argument = [&](const BodyParam& p) -> std::string {
     switch (p.kind) {
-      case BodyParam::Idx: s += "s_idx"; break;
-      case BodyParam::SIdx: s += "d_idx"; break;
-      case BodyParam::T: s += "t"; break;
-      case BodyParam::Dt: s += "dt"; break;
-      case BodyParam::Pair: s += mirrored(p.name); break;
-      case BodyParam::Scalar: s += eqValues + "." + p.name; break;
-      case BodyParam::DProp: s += "d_" + p.name; break;
-      case BodyParam::SProp: s += "s_" + p.name; break;
-      case BodyParam::Hoisted: s += hoistArgument(eqValues, p.name); break;
-      case BodyParam::DHoisted: s += symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]"; break;
-      default: SPHC_INTERNAL("a pair loop body with NBRS or N");
+      case BodyParam::Idx: return "s_idx";
+      case BodyParam::SIdx: return "d_idx";
+      case BodyParam::Pair: return mirrored(p.name);
+      case BodyParam::DHoisted: return symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]";
+      case BodyParam::Nbrs:
+      case BodyParam::NNbrs:
+      case BodyParam::N: SPHC_INTERNAL("a pair loop body with NBRS or N");
+      default: return "";
     }
-  }
-  return s + ");  // " + eq.name + ", from " + loc(eq.loc) + ": destination s_idx, source d_idx\n";
+  };
+  return callBody(bodyFunctionName(eq.name, "loop"), b, dest, eqValues, "t", ".", argument) +
+         ";  // " + eq.name + ", from " + loc(eq.loc) + ": destination s_idx, source d_idx\n";
 }
 
 void ScenePrinter::emitSymmetricMembers(std::ostream& os) const {
