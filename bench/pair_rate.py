@@ -40,7 +40,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from common import children_cpu, remove_tmp  # noqa: E402
+from common import children_cpu, load_average, print_machine, remove_tmp  # noqa: E402
 TIMING_RE = re.compile(r"timing: steps=(\d+) particles=(\d+) wall_s=([0-9.eE+-]+)")
 
 # name: (source, defines, h at the scene's default parameters, kernel support in h,
@@ -198,7 +198,6 @@ def main():
                     help="at least this many particle-steps per pair-rate run (default 3e6)")
     ap.add_argument("--keep", action="store_true")
     args = ap.parse_args()
-    from time_to_solution import cpu_model, load_average
     tmp = tempfile.mkdtemp(prefix="sphc-pairs-")
     load0 = load_average()
     try:
@@ -210,9 +209,7 @@ def main():
                           "--backends", "serial", "--max-particles", str(args.max_particles)])
     finally:
         remove_tmp(tmp, args.keep)
-    print()
-    print("%s, %d cores; load average before: %s, after: %s" % (
-        cpu_model(), os.cpu_count() or 0, load0, load_average()))
+    print_machine(load0)
     return 0
 
 

@@ -45,7 +45,7 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from common import cpu_model, load_average, remove_tmp  # noqa: E402
+from common import load_average, print_machine, remove_tmp  # noqa: E402
 from pair_rate import SCENES, build, last_positions, pairs_per_step, solve  # noqa: E402
 
 # scene: (parameter, default values, values of --quick, h at a value)
@@ -200,9 +200,7 @@ def main(argv=None):
         table(cases, info, res, backends, {s: SIZES[s][0] for s in SIZES})
     finally:
         remove_tmp(tmp, args.keep)
-    print()
-    print("%s, %d cores; load average before: %s, after: %s" % (
-        cpu_model(), os.cpu_count() or 0, load0, load_average()))
+    print_machine(load0)
     return 0
 
 
