@@ -37,6 +37,14 @@ def load_average():
         return "unknown"
 
 
+def print_machine(load_before):
+    """The closing line of a benchmark: the CPU, its cores and the load average before (given)
+    and now."""
+    print()
+    print("%s, %d cores; load average before: %s, after: %s" % (
+        cpu_model(), os.cpu_count() or 0, load_before, load_average()))
+
+
 def children_cpu():
     r = resource.getrusage(resource.RUSAGE_CHILDREN)
     return r.ru_utime + r.ru_stime

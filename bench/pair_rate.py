@@ -20,14 +20,12 @@ Scenes: examples/dambreak.sph (2D, dx = 0.03, WendlandQuintic, h = 1.3 dx), benc
 (3D, 103,823 particles, cubic spline, h = 1.5 dx) and bench/dambreak3d_dualsphysics.sph
 (DualSPHysics' CaseDambreak parameters: 3D, dp = 0.0085, h = sqrt(3) dp, cubic spline).
 
---scaling: cost per particle-step of the serial solver of the 2D dam break and the 3D cube
-at about 10k, 30k, 100k, 300k and 1M particles; each size runs N steps and 1 step, and the
-difference (wall of the time loop; CPU time of the process) per step and particle is the
-figure, so set-up is excluded from both. --max-particles caps the sizes.
+--scaling: then bench/scaling.py (the cost per particle-step from 10k to 1M particles) with
+the serial backend; --max-particles caps its sizes. --scaling-only: that alone.
 
 Usage:
-  python3 bench/pair_rate.py [--steps 10] [--scaling] [--max-particles 1100000]
-                             [--sphc build/bin/sphc] [--threads 1] [--keep]
+  python3 bench/pair_rate.py [--steps 10] [--scenes dambreak2d,cube,...] [--scaling]
+                             [--max-particles 1100000] [--sphc build/bin/sphc] [--keep]
 """
 
 import argparse
@@ -42,7 +40,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from common import children_cpu, remove_tmp  # noqa: E402
+from common import children_cpu, load_average, print_machine, remove_tmp  # noqa: E402
 TIMING_RE = re.compile(r"timing: steps=(\d+) particles=(\d+) wall_s=([0-9.eE+-]+)")
 
 # name: (source, defines, h at the scene's default parameters, kernel support in h,
@@ -98,7 +96,7 @@ def solve(exe, steps, extra, outdir=None, threads=1):
     if not m:
         raise SystemExit("no timing line from %s:\n%s" % (cmd, out[-2000:]))
     return dict(steps=int(m.group(1)), particles=int(m.group(2)), loop=float(m.group(3)),
-                wall=wall, cpu=cpu)
+                wall=wall, cpu=cpu, out=out)
 
 
 def last_positions(outdir, scene):
@@ -119,9 +117,11 @@ def last_positions(outdir, scene):
     return pos
 
 
-def pairs_per_step(pos, h, groups, support):
+def pairs_per_step(pos, h, groups, support, sample=None):
     """Pairs (destination particle, source particle) within support * h, the particle itself
-    excluded, summed over groups [(dest, [sources])]; and the mean per destination array."""
+    excluded, summed over groups [(dest, [sources])]; and the mean per destination array.
+    With sample = K, destination arrays of more than K particles are counted on K of them
+    (every (n / K)-th) and the sum scaled to all."""
     import numpy as np
     from scipy.spatial import cKDTree
     trees = {}
@@ -129,12 +129,15 @@ def pairs_per_step(pos, h, groups, support):
     per_dest = {}
     for dest, sources in groups:
         n = 0
+        d = pos[dest]
+        stride = max(1, len(d) // sample) if sample else 1
         for src in sources:
             if src not in trees:
                 trees[src] = cKDTree(pos[src])
-            cnt = trees[src].query_ball_point(pos[dest], r=support * h, return_length=True)
-            n += int(np.sum(cnt)) - (len(pos[dest]) if src == dest else 0)
-        per_dest[dest] = n / len(pos[dest])
+            cnt = trees[src].query_ball_point(d[::stride], r=support * h, return_length=True)
+            n += (float(np.mean(cnt)) - (1 if src == dest else 0)) * len(d)
+        n = int(round(n))
+        per_dest[dest] = n / len(d)
         total += n
     return total, per_dest
 
@@ -182,51 +185,6 @@ def pair_rates(args, tmp):
     return rows
 
 
-SCALING = {
-    # scene: (parameter, [values], particles-per-value note)
-    "dambreak2d": ("dx", [0.0125, 0.0072, 0.0040, 0.0023, 0.0014]),
-    "cube": ("nx", [22, 32, 47, 68, 100]),
-}
-
-
-def scaling(args, tmp):
-    rows = []
-    for scene, (param, values) in SCALING.items():
-        if scene not in args.scaling_scenes.split(","):
-            continue
-        exe = build(args.sphc, scene, tmp)
-        for v in values:
-            extra = ["--set", "%s=%r" % (param, v), "--tf", "100"]  # steps decide, not tf
-            # steps: about 3 M particle-steps, at least 3
-            probe = solve(exe, 1, extra)
-            n = probe["particles"]
-            if n > args.max_particles:
-                continue
-            steps = max(3, int(round(args.particle_steps / n)))
-            print("%s %s=%r: %d particles, %d steps ..." % (scene, param, v, n, steps),
-                  flush=True)
-            r = solve(exe, steps + 1, extra)
-            steps = r["steps"] - probe["steps"]
-            loop = r["loop"] - probe["loop"]
-            cpu = r["cpu"] - probe["cpu"]
-            rows.append(dict(scene=scene, value=v, particles=n, steps=steps,
-                             us_wall=1e6 * loop / (steps * n), us_cpu=1e6 * cpu / (steps * n)))
-    print()
-    print("%-12s %8s %10s %6s %14s %14s %10s" % ("scene", "param", "particles", "steps",
-                                                  "us/p-step wall", "us/p-step CPU",
-                                                  "CPU / min"))
-    for scene in SCALING:
-        sel = [r for r in rows if r["scene"] == scene]
-        if not sel:
-            continue
-        lo = min(r["us_cpu"] for r in sel)
-        for r in sel:
-            print("%-12s %8s %10d %6d %14.3f %14.3f %10.2f" % (
-                scene, "%s=%g" % (SCALING[scene][0], r["value"]), r["particles"], r["steps"],
-                r["us_wall"], r["us_cpu"], r["us_cpu"] / lo))
-    return rows
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
@@ -237,22 +195,21 @@ def main():
     ap.add_argument("--scaling-scenes", default="dambreak2d,cube")
     ap.add_argument("--max-particles", type=int, default=1100000)
     ap.add_argument("--particle-steps", type=float, default=3e6,
-                    help="particle-steps per scaling run (default 3e6)")
+                    help="at least this many particle-steps per pair-rate run (default 3e6)")
     ap.add_argument("--keep", action="store_true")
     args = ap.parse_args()
-    from time_to_solution import cpu_model, load_average
     tmp = tempfile.mkdtemp(prefix="sphc-pairs-")
     load0 = load_average()
     try:
         if not args.scaling_only:
             pair_rates(args, tmp)
         if args.scaling or args.scaling_only:
-            scaling(args, tmp)
+            import scaling
+            scaling.main(["--sphc", args.sphc, "--scenes", args.scaling_scenes,
+                          "--backends", "serial", "--max-particles", str(args.max_particles)])
     finally:
         remove_tmp(tmp, args.keep)
-    print()
-    print("%s, %d cores; load average before: %s, after: %s" % (
-        cpu_model(), os.cpu_count() or 0, load0, load_average()))
+    print_machine(load0)
     return 0
 
 

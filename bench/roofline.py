@@ -14,10 +14,13 @@ For each scene (the 3D cube and the 2D dam break by default):
                    the difference of the two runs divided by S2 - S1 is the count per step, and
                    divided by the pairs within the support per step (KD-tree count of
                    bench/pair_rate.py) the count per pair (neighbour candidates rejected by the
-                   distance test included: their flops are part of the loop's work);
+                   distance test included: their flops are part of the loop's work). The pairs
+                   are ordered (i, j) and (j, i): where the loop evaluates each pair once for
+                   both particles (symmetric pairs) one evaluation covers two of them;
   time of the loop the default (-march=native) serial solver at the benchmark size, `perf
-                   record -e cpu-clock`: the share of the samples in that function, times the
-                   time loop's wall time;
+                   record -e cpu-clock` of two runs (2 and 2 + N steps): the difference of
+                   the function's samples / the sampling rate = its CPU seconds in N steps
+                   (set-up and the first neighbour-list build left out);
   achieved rate    flops per step x steps / time of the loop, against the core's FP64 peak:
                    clock (/proc/cpuinfo "cpu MHz", the nominal clock: a VM shows no boost) x
                    FMA units (2, assumed: Zen 2-5 and Intel since Haswell have two) x 2 flops x
@@ -25,7 +28,9 @@ For each scene (the 3D cube and the 2D dam break by default):
                    core has full-width units) -- printed for scalar, AVX2 and AVX-512 code;
   memory           bytes per step the loop must move at least (each property array it reads
                    once, each it writes twice: read and write back; 8 bytes per particle
-                   each, from the generated C++), against the STREAM-triad bandwidth measured
+                   each, from the generated C++; with kept neighbour lists also the entries
+                   it walks, s_idx >= d_idx: half the pairs within (1 + 0.1) 2h, 4 bytes
+                   each, and 24 bytes of vector per particle), against the STREAM-triad bandwidth measured
                    by bench/stream_triad.cpp: arithmetic intensity = flops / bytes, and the
                    time those bytes take at the measured bandwidth.
 
@@ -43,6 +48,8 @@ import sys
 import tempfile
 
 HZ = 1000   # perf's sampling rate (cpu-clock)
+PERF_SHORT = 2   # steps of the short perf run (its samples are subtracted)
+SKIN = 0.1   # the kept lists' skin of --verlet-skin=auto: lists hold the pairs within (1 + SKIN) 2h
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
@@ -152,7 +159,8 @@ def peak():
 
 def bytes_per_particle(sphc, scene, tmp):
     """Property arrays the interaction function touches, from the generated C++:
-    (read-only arrays, written arrays), counted per destination particle."""
+    (read-only arrays, written arrays, whether it keeps neighbour lists), counted per
+    destination particle."""
     src = os.path.join(ROOT, SCENES[scene][0])
     env = dict(os.environ)
     env.setdefault("SPHC_CACHE_DIR", os.path.join(tmp, "cache"))
@@ -161,9 +169,11 @@ def bytes_per_particle(sphc, scene, tmp):
     # The interaction group: the group_* function whose body has neighbour loops.
     bodies = re.split(r"\n  void ", cpp)
     best = None
+    def loops(b):   # neighbour loops of a function body: cell lists or kept lists
+        return b.count("for_each_candidate") + b.count("gather_neighbours")
     for b in bodies:
-        if b.startswith("group_") and "for_each_candidate" in b:
-            if best is None or b.count("for_each_candidate") > best.count("for_each_candidate"):
+        if b.startswith("group_") and loops(b):
+            if best is None or loops(b) > loops(best):
                 best = b
     if best is None:
         return None
@@ -172,7 +182,7 @@ def bytes_per_particle(sphc, scene, tmp):
         key = (m.group(3), m.group(5))
         (reads if m.group(1) else writes).add(key)
     reads -= writes
-    return reads, writes
+    return reads, writes, "gather_neighbours" in best
 
 
 def main():
@@ -227,36 +237,47 @@ def main():
             print("%s: timing %d steps (perf record) ..." % (scene, tsteps), flush=True)
             nexe = pair_rate.build(args.sphc, scene, tmp)
             tout = os.path.join(tmp, scene + "-timed")
-            pdata = os.path.join(tmp, scene + ".perf")
             e = dict(env, OMP_NUM_THREADS="1")
-            out, _, _ = run(["perf", "record", "-q", "-e", "cpu-clock", "-F", str(HZ), "-o",
-                             pdata, nexe,
-                             "--max-steps", str(tsteps), "--timing", "--quiet", "-d", tout,
-                             "--output-every", "1e9"] + timed, e)
-            m = pair_rate.TIMING_RE.search(out)
-            steps, npart, loop = int(m.group(1)), int(m.group(2)), float(m.group(3))
-            rep = subprocess.run(["perf", "report", "-i", pdata, "--stdio", "-n", "--sort",
-                                  "symbol"],
-                                 stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                                 universal_newlines=True).stdout
-            share, samples = 0.0, 0
             short = re.search(r"group_\w+", loop_fn).group(0)
-            for line in rep.splitlines():
-                mm = re.match(r"^\s+([0-9.]+)%\s+(\d+)\s.*\b" + re.escape(short) + r"\b", line)
-                if mm:
-                    share += float(mm.group(1)) / 100
-                    samples += int(mm.group(2))
-            # CPU seconds in the function: its cpu-clock samples / the sampling rate (on a
-            # shared machine the wall time counts the other jobs' time too).
-            t_cpu = samples / HZ
+            # Two runs, PERF_SHORT and PERF_SHORT + tsteps steps: the difference of the
+            # function's samples leaves out its evaluations outside the time loop (set-up)
+            # and the first neighbour-list build.
+            samples, share = {}, 0.0
+            for n_steps in (PERF_SHORT, PERF_SHORT + tsteps):
+                pdata = os.path.join(tmp, "%s-%d.perf" % (scene, n_steps))
+                out, _, _ = run(["perf", "record", "-q", "-e", "cpu-clock", "-F", str(HZ),
+                                 "-o", pdata, nexe, "--max-steps", str(n_steps), "--timing",
+                                 "--quiet", "-d", tout, "--output-every", "1e9"] + timed, e)
+                rep = subprocess.run(["perf", "report", "-i", pdata, "--stdio", "-n",
+                                      "--sort", "symbol"],
+                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                     universal_newlines=True).stdout
+                share, samples[n_steps] = 0.0, 0
+                for line in rep.splitlines():
+                    mm = re.match(r"^\s+([0-9.]+)%\s+(\d+)\s.*\b" + re.escape(short) + r"\b",
+                                  line)
+                    if mm:
+                        share += float(mm.group(1)) / 100
+                        samples[n_steps] += int(mm.group(2))
+            m = pair_rate.TIMING_RE.search(out)
+            steps, npart, loop = tsteps, int(m.group(2)), float(m.group(3))
+            # CPU seconds in the function over the tsteps steps: its cpu-clock samples / the
+            # sampling rate (on a shared machine the wall time counts the other jobs' time too).
+            t_cpu = (samples[PERF_SHORT + tsteps] - samples[PERF_SHORT]) / HZ
             tpos = last_positions(tout, scene)
             pairs, nb = pairs_per_step(tpos, h_timed, SCENES[scene][4], SCENES[scene][3])
             t_loop = t_cpu
             gflops = fpp * pairs * steps / t_loop / 1e9 if t_loop > 0 else float("nan")
             rw = bytes_per_particle(args.sphc, scene, tmp)
+            # The kept lists the loop reads per step: the entries s_idx >= d_idx (half of the
+            # pairs within the lists' radius), 4 bytes each, and a vector header (24 bytes) per
+            # destination particle; only when the function keeps lists.
+            list_pairs, _ = pairs_per_step(tpos, h_timed, SCENES[scene][4],
+                                           SCENES[scene][3] * (1 + SKIN))
+            list_bytes = (4 * list_pairs / 2 + 24 * npart) if rw and rw[2] else 0
             nbytes = None
             if rw:
-                nbytes = 8 * (len(rw[0]) + 2 * len(rw[1])) * npart * steps
+                nbytes = (8 * (len(rw[0]) + 2 * len(rw[1])) * npart + list_bytes) * steps
             rows.append(dict(scene=scene, fn=short, fpp=fpp, ipp=ipp, particles=npart,
                              pairs=pairs, nb=nb, steps=steps, loop=loop, share=share,
                              t_loop=t_loop, gflops=gflops, nbytes=nbytes, rw=rw))
@@ -286,7 +307,7 @@ def main():
             bwmax = max(bw.values())
             need = r["nbytes"] / (bwmax * 1e9)
             print("  memory: %d arrays read-only, %d read/write (const / non-const in the"
-                  " function; each once per particle): %.1f MB per step;"
+                  " function; each once per particle) and the kept lists: %.1f MB per step;"
                   " intensity %.1f flop/byte; at %.2f GB/s those bytes take %.3f s of the"
                   " %.3f s (%.0f%%)" % (len(r["rw"][0]), len(r["rw"][1]),
                                          r["nbytes"] / r["steps"] / 1e6, ai, bwmax, need,
