@@ -55,7 +55,8 @@ struct EmitOptions {
   // neighbour lists); false (--no-symmetric-pairs): each destination gathers from all its
   // neighbours. The values are the same bit for bit.
   bool symmetricPairs = true;
-  // The phases (the pair loops) are defined out of struct Scene, after it, between the
+  // The phases (the pair loops), and compute_accelerations, step and adaptive_dt (the
+  // per-step code inlined into them), are defined out of struct Scene, after it, between the
   // marker lines below, and the scene's namespace is named (sphc_scene) so that the build
   // can compile them as a translation unit of their own, in parallel with the rest
   // (driver/Build.cpp); serial and openmp, not --mpi. false (--single-unit): the old single

@@ -421,25 +421,38 @@ void ScenePrinter::emitPhase(const Phase& ph) {
     scene_.swap(members);
     emitPhaseMember(ph);
     scene_.swap(members);
-    outOfClassPhase(ph, members.str());
+    outOfClassMembers(members.str(), {ph.name});
     return;
   }
   emitPhaseMember(ph);
 }
 
-// A phase printed as a member of struct Scene: `  // provenance`, `  void NAME(double t,
-// double dt) {`, the body, `  }`. Split (splitPhases_): the provenance and a declaration
-// stay in the class; the definition, qualified, goes after it with the same body.
-void ScenePrinter::outOfClassPhase(const Phase& ph, const std::string& member) {
-  const std::string head = "  void " + ph.name + "(double t, double dt) {\n";
-  const std::size_t at = member.find(head);
-  const std::size_t close = member.rfind("  }\n");
-  const std::string provenance = member.substr(0, at);
-  scene_ << provenance << "  void " << ph.name << "(double t, double dt);  // defined after "
-         << "the struct\n\n";
-  phases_ << provenance.substr(2) << "void sphc_scene::Scene::" << ph.name
-          << "(double t, double dt) {\n"
-          << member.substr(at + head.size(), close - at - head.size()) << "}\n\n";
+// Members printed as in struct Scene: comment lines, `  TYPE NAME(ARGS) {`, the body, `  }`.
+// Split (splitPhases_): those named in `names` leave only their comments and a declaration
+// in the class (scene_); their definitions, qualified, go after it with the same comments and
+// body (phases_). The others stay in the class as printed.
+void ScenePrinter::outOfClassMembers(const std::string& members,
+                                     const std::set<std::string>& names) {
+  std::istringstream in(members);
+  std::string line, comments;
+  while (std::getline(in, line)) {
+    const std::size_t paren = line.find('(');
+    const std::size_t space = line.rfind(' ', paren);
+    const bool head = line.size() > 5 && line.compare(0, 2, "  ") == 0 && line[2] != ' ' &&
+                      line[2] != '/' && paren != std::string::npos && space > 2 &&
+                      line.compare(line.size() - 3, 3, ") {") == 0;
+    if (!head || !names.count(line.substr(space + 1, paren - space - 1))) {
+      scene_ << line << "\n";
+      comments = line.compare(0, 4, "  //") == 0 ? comments + line.substr(2) + "\n" : "";
+      continue;
+    }
+    scene_ << line.substr(0, line.size() - 2) << ";  // defined after the struct\n";
+    phases_ << comments << line.substr(2, space - 1) << "sphc_scene::Scene::"
+            << line.substr(space + 1) << "\n";
+    while (std::getline(in, line) && line != "  }") phases_ << line << "\n";
+    phases_ << "}\n\n";
+    comments.clear();
+  }
 }
 
 void ScenePrinter::emitPhaseMember(const Phase& ph) {
@@ -856,9 +869,22 @@ void ScenePrinter::emitBodies() {
 void ScenePrinter::emitSceneFunctions() {
   emitGroup(sched_.equations);
   steppers();
-  emitStep();
-  if (hasZones()) emitInletOutlet();
-  emitAdaptiveDt();
+  if (splitPhases_) {
+    // Split: what the run loop calls at every step is defined with the phases, so that
+    // the time step's code (steppers, neighbour updates, inlined there) is compiled in
+    // their unit (-O3) and the other unit holds only set-up, output and main.
+    std::ostringstream members;
+    scene_.swap(members);
+    emitStep();
+    if (hasZones()) emitInletOutlet();
+    emitAdaptiveDt();
+    scene_.swap(members);
+    outOfClassMembers(members.str(), {"compute_accelerations", "step", "adaptive_dt"});
+  } else {
+    emitStep();
+    if (hasZones()) emitInletOutlet();
+    emitAdaptiveDt();
+  }
   emitMetrics();
   distributedFunctions();
 }

@@ -213,7 +213,7 @@ class ScenePrinter {
   void emitGroup(const ScheduleGroup& g);
   void emitPhase(const Phase& ph);
   void emitPhaseMember(const Phase& ph);
-  void outOfClassPhase(const Phase& ph, const std::string& member);
+  void outOfClassMembers(const std::string& members, const std::set<std::string>& names);
   // A group option evaluated at run time (start_idx, stop_idx, condition) as C++: params,
   // array constants `arr.c` (their first value), t and dt.
   std::string groupOptionCpp(const ast::Expr& e) const;

@@ -6,6 +6,7 @@
 #include "llvm/ADT/StringExtras.h"
 #include "llvm/ADT/StringMap.h"
 #include "llvm/Support/FileSystem.h"
+#include "llvm/Support/Format.h"
 #include "llvm/Support/MemoryBuffer.h"
 #include "llvm/Support/Path.h"
 #include "llvm/Support/Process.h"
@@ -18,6 +19,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <map>
+#include <thread>
 
 namespace sphc {
 
@@ -105,16 +107,20 @@ std::vector<std::string> splitUnits(const std::string& cpp) {
 
 // Whether the build can use the precompiled runtime headers: buildinfo's compiler and
 // default flags (plus the OpenMP flag), a serial or OpenMP solver, and the .gch in place.
-bool usesScenePch(const Install& install, std::map<std::string, std::string>& info,
-                  const std::string& cxx, const std::string& flags, const BuildRequest& req) {
+bool usesDefaultFlags(std::map<std::string, std::string>& info, const std::string& cxx,
+                      const std::string& flags, const BuildRequest& req) {
   if (cxx != info["cxx"] || req.mpi) return false;
   std::string expected = info["cxxflags"];
   if (req.backend == "openmp")
     expected += " " + (info.count("openmp_flags") ? info["openmp_flags"] : "-fopenmp");
   else if (req.backend != "serial")
     return false;
-  if (flags != expected) return false;
-  return fs::exists(install.includeDir + "/sphc/scene_pch.h.gch/" + req.backend + ".gch");
+  return flags == expected;
+}
+bool usesScenePch(const Install& install, std::map<std::string, std::string>& info,
+                  const std::string& cxx, const std::string& flags, const BuildRequest& req) {
+  return usesDefaultFlags(info, cxx, flags, req) &&
+         fs::exists(install.includeDir + "/sphc/scene_pch.h.gch/" + req.backend + ".gch");
 }
 
 }  // namespace
@@ -159,7 +165,17 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   // The key: generated code, compiler, flags, libraries, the runtime library and headers.
   llvm::SHA1 sha;
   sha.update(req.cpp);
+  // The linker option of buildinfo (link_flags: -fuse-ld=gold where CMake found it), with its
+  // compiler only.
+  const std::string linkerFlags = cxx == info["cxx"] ? info["link_flags"] : "";
+  // Split units with the default flags: the unit without the phases and the time step (set-up,
+  // output, main: code that runs once or at outputs) is compiled at -O1 (cold_flags, which
+  // GCC's precompiled header accepts); the phases' unit keeps the default flags.
+  const std::string coldFlags =
+      usesDefaultFlags(info, cxx, flags, req) ? info["cold_flags"] : "";
   sha.update(cxx + "\n" + flags + "\n" + libs);
+  if (!linkerFlags.empty() || !coldFlags.empty())
+    sha.update("\n" + linkerFlags + "\n" + coldFlags);
   addFileToHash(sha, runtimeLib);
   std::error_code ec;
   std::vector<std::string> headers;
@@ -231,7 +247,12 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   llvm::SmallVector<llvm::StringRef, 16> parts;
   llvm::StringRef(flags).split(parts, ' ', -1, false);
   for (auto p : parts) compile.push_back(p.str());
-  const std::vector<std::string> linkFlags = compile;  // the compiler and flags (-fopenmp)
+  std::vector<std::string> linkFlags = compile;  // the compiler and flags (-fopenmp)
+  std::vector<std::string> linker;                 // -fuse-ld=gold
+  parts.clear();
+  llvm::StringRef(linkerFlags).split(parts, ' ', -1, false);
+  for (auto p : parts) linker.push_back(p.str());
+  linkFlags.insert(linkFlags.end(), linker.begin(), linker.end());
   compile.push_back("-I" + install.includeDir);
   // The precompiled runtime headers (sphc/scene_pch.h.gch/<backend>.gch, built with the
   // default flags by runtime/CMakeLists.txt): only for a build with buildinfo's compiler and
@@ -255,6 +276,7 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   std::vector<std::vector<std::string>> commands;
   if (units.size() == 1) {
     std::vector<std::string> args = compile;
+    args.insert(args.end(), linker.begin(), linker.end());
     args.push_back(cppFile);
     args.insert(args.end(), link.begin(), link.end());
     commands.push_back(args);
@@ -265,6 +287,11 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
       const std::string base = std::string(dir) + "/scene." + pid + ".unit" + std::to_string(k);
       if (!writeFile(base + ".cpp", units[k], res.message)) return finish(false);
       std::vector<std::string> args = compile;
+      if (k == 1 && !coldFlags.empty()) {
+        llvm::SmallVector<llvm::StringRef, 4> cold;
+        llvm::StringRef(coldFlags).split(cold, ' ', -1, false);
+        for (auto c : cold) args.push_back(c.str());
+      }
       args.insert(args.end(), {"-c", base + ".cpp", "-o", base + ".o"});
       commands.push_back(args);
       logs.push_back(base + ".log");
@@ -305,15 +332,40 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
       return failed(k, execErr);
     }
   }
+  // -v: each process's CPU time (the compiler's own processes included), when it ended.
+  auto report = [&](std::size_t k, const llvm::Optional<llvm::sys::ProcessStatistics>& stat) {
+    if (!req.verbose || !stat) return;
+    const std::string what = commands.size() == 1 ? "compile and link"
+                             : k + 1 == commands.size() ? "link"
+                                                        : "unit" + std::to_string(k);
+    auto secs = [](std::chrono::microseconds us) { return us.count() / 1e6; };
+    llvm::errs() << "sphc: " << what << " done at "
+                 << llvm::format("%.3f", std::chrono::duration<double>(
+                                             std::chrono::steady_clock::now() - start)
+                                             .count())
+                 << " s (CPU " << llvm::format("%.2f", secs(stat->TotalTime)) << " s, user "
+                 << llvm::format("%.2f", secs(stat->UserTime)) << " s)\n";
+  };
   int firstFailure = -1;
   std::string why;
-  for (std::size_t k = 0; k < running.size(); ++k) {
-    std::string execErr;
-    auto done = llvm::sys::Wait(running[k], 0, /*WaitUntilTerminates=*/true, &execErr);
-    if (done.ReturnCode != 0 && firstFailure < 0) {
-      firstFailure = static_cast<int>(k);
-      why = execErr.empty() ? "exit code " + std::to_string(done.ReturnCode) : execErr;
+  // Polled (not waited for in order) so that -v tells when each one ended.
+  std::vector<bool> ended(running.size(), false);
+  for (std::size_t left = running.size(); left > 0;) {
+    for (std::size_t k = 0; k < running.size(); ++k) {
+      if (ended[k]) continue;
+      std::string execErr;
+      llvm::Optional<llvm::sys::ProcessStatistics> stat;
+      auto done = llvm::sys::Wait(running[k], 0, /*WaitUntilTerminates=*/false, &execErr, &stat);
+      if (done.Pid == 0) continue;  // still running
+      ended[k] = true;
+      --left;
+      report(k, stat);
+      if (done.ReturnCode != 0 && firstFailure < 0) {
+        firstFailure = static_cast<int>(k);
+        why = execErr.empty() ? "exit code " + std::to_string(done.ReturnCode) : execErr;
+      }
     }
+    if (left > 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   if (firstFailure >= 0) return failed(firstFailure, why);
   if (commands.size() > nCompiles) {
@@ -321,8 +373,10 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
     llvm::Optional<llvm::StringRef> redirects[] = {llvm::None, llvm::StringRef(logs[k]),
                                                    llvm::StringRef(logs[k])};
     std::string execErr;
+    llvm::Optional<llvm::sys::ProcessStatistics> stat;
     int rc = llvm::sys::ExecuteAndWait(commands[k][0], argRefs[k], llvm::None, redirects, 0, 0,
-                                       &execErr);
+                                       &execErr, nullptr, &stat);
+    report(k, stat);
     if (rc != 0) return failed(k, execErr.empty() ? "exit code " + std::to_string(rc) : execErr);
   }
   for (const auto& f : tmpFiles) fs::remove(f);
