@@ -8,6 +8,7 @@
 #include "codegen/Printer.h"
 
 #include <algorithm>
+#include <cctype>
 
 namespace sphc {
 
@@ -37,6 +38,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   mpi_ = sched.distribution.enabled;
   globalIds_ = opts.globalIds || mpi_;
   splitPhases_ = opts.splitUnits && opts.backend != Backend::OpenCL && !mpi_;
+  intPow_ = opts.intPow && opts.backend != Backend::OpenCL && !singlePrecision_;
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {
@@ -184,6 +186,37 @@ void ScenePrinter::emitKernelFunctions() {
           "  return r > 0.0 ? g[0] : 0.0;\n"
           "}\n\n";
   deviceKernelFunctions();
+}
+
+// pow(x, y) in the bodies and helper functions (found by a lexical scan for the identifier).
+bool ScenePrinter::intPowUsed() const {
+  if (!intPow_) return false;
+  auto ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  auto calls = [&](const std::string& text) {
+    for (size_t at = text.find("pow"); at != std::string::npos; at = text.find("pow", at + 1)) {
+      bool before = at > 0 && ident(text[at - 1]);
+      bool after = at + 3 < text.size() && ident(text[at + 3]);
+      if (!before && !after) return true;
+    }
+    return false;
+  };
+  for (const auto& b : plan_.bodies)
+    if (calls(b.source.text)) return true;
+  for (const auto& f : plan_.functions)
+    if (calls(f.source.text)) return true;
+  return false;
+}
+
+// A `pow` of the scene's namespace, which the bodies' unqualified calls find before the C
+// library's: sphc::pow_int multiplies where the exponent is a small integer (docs/
+// performance.md, "Cheaper arithmetic"). Not on the OpenCL device (its pow, within the
+// backends' agreement) nor in single precision.
+void ScenePrinter::emitPowFunction() {
+  if (!intPowUsed()) return;
+  out_ << "// pow(x, y) of the bodies: x^y by multiplications where y is an integer with |y| <= 8\n"
+          "// (within 8 ulp of the C library's pow), pow itself otherwise (sphc/pow.h; sphc\n"
+          "// --int-pow=off: the C library's pow).\n"
+          "static inline double pow(double x, double y) { return sphc::pow_int(x, y); }\n\n";
 }
 
 void ScenePrinter::emitLineDirective(std::ostringstream& os, llvm::SMLoc l) const {

@@ -55,6 +55,10 @@ struct EmitOptions {
   // neighbour lists); false (--no-symmetric-pairs): each destination gathers from all its
   // neighbours. The values are the same bit for bit.
   bool symmetricPairs = true;
+  // `pow` in the bodies of the CPU backends (double precision) is sphc::pow_int (sphc/pow.h):
+  // by multiplications where the exponent is an integer of magnitude <= 8, the C library's
+  // pow otherwise; false (--int-pow=off): the C library's pow everywhere.
+  bool intPow = true;
   // The phases (the pair loops), and compute_accelerations, step and adaptive_dt (the
   // per-step code inlined into them), are defined out of struct Scene, after it, between the
   // marker lines below, and the scene's namespace is named (sphc_scene) so that the build

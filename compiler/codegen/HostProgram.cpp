@@ -789,6 +789,7 @@ std::string ScenePrinter::run() {
             "#include \"sphc/mpi/gather.h\"\n#include \"sphc/mpi/halo.h\"\n"
             "#include \"sphc/mpi/output.h\"\n";
   runtimeIncludes();
+  if (intPowUsed()) out_ << "#include \"sphc/pow.h\"\n";
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   systemIncludes();
   out_ << "\n";
@@ -829,6 +830,7 @@ std::string ScenePrinter::kernelSource() {
 // The functions of equation and stepper bodies (each declaration once), where they run.
 void ScenePrinter::emitBodies() {
   emitKernelFunctions();
+  emitPowFunction();
   // The .sph file's helper functions, before the bodies that call them: on the host (the C++
   // of the CPU backends, and the host-run converged tests of OpenCL) and in the kernels.
   for (const auto& f : plan_.functions) {

@@ -125,6 +125,10 @@ class ScenePrinter {
                         int destArray, const Dialect& d, std::ostringstream& os);
   std::string bodyText(const PlanBody& b, const Dialect& d) const;
   void emitKernelFunctions();
+  // pow(x, y) of the bodies as sphc::pow_int (--int-pow, CPU double precision): whether it is
+  // emitted (some body calls pow), and its definition, with the kernel functions.
+  bool intPowUsed() const;
+  void emitPowFunction();
   void emitHelperFunction(const PlanBody& f, const Dialect& d, std::ostringstream& os);
   // eqValues + sep + scalar: "eq3.rho0" on the host, "eq3_rho0" (a kernel argument) on the
   // device.
@@ -340,6 +344,7 @@ class ScenePrinter {
   // EmitOptions::splitUnits on a CPU backend without --mpi: the phases' definitions, out of
   // struct Scene (emitPhase), printed after it between the markers of CppEmitter.h.
   bool splitPhases_ = false;
+  bool intPow_ = false;  // EmitOptions::intPow, CPU double precision
   std::ostringstream phases_;
   std::vector<std::string> sourceArrays_;  // arrays that need a cell list, by name
   std::set<std::string> loopArrays_;       // arrays in a neighbour pass, as dest or source

@@ -71,6 +71,14 @@ static cl::opt<OnOff, false, NamedValues<OnOff>> FmaOpt(
                           "backend (default)"),
                clEnumValN(OnOff::Off, "off", "a multiply and an add, each rounded")),
     cl::cat(SphcCat));
+static cl::opt<OnOff, false, NamedValues<OnOff>> IntPowOpt(
+    "int-pow", cl::desc("pow(x, y) in the bodies (serial and openmp, double precision):"),
+    cl::init(OnOff::On),
+    cl::values(clEnumValN(OnOff::On, "on",
+                          "by multiplications where y is an integer with |y| <= 8 (within 8 "
+                          "ulp of the C library's pow), pow otherwise (default)"),
+               clEnumValN(OnOff::Off, "off", "the C library's pow")),
+    cl::cat(SphcCat));
 static cl::opt<std::string> VerletSkin(
     "verlet-skin",
     cl::desc("Neighbour lists kept across time steps: each destination particle's candidates "
@@ -427,6 +435,7 @@ int main(int argc, char** argv) {
   emitOpts.batchedTables = !NoBatchedTables;
   emitOpts.splitUnits = !SingleUnit && Emit == EmitKind::Exe;
   emitOpts.symmetricPairs = !NoSymmetricPairs;
+  emitOpts.intPow = IntPowOpt == OnOff::On;
   if (Report && Emit != EmitKind::OpenCL)
     for (const std::string& note : sphc::symmetricPairsNotes(*schedule, emitOpts))
       llvm::outs() << "note: " << note << "\n";

@@ -21,6 +21,7 @@
 #include "sphc/metrics.h"
 #include "sphc/nnps.h"
 #include "sphc/particle_array.h"
+#include "sphc/pow.h"
 #include "sphc/restart.h"
 #include "sphc/solver.h"
 #include "sphc/verlet.h"
