@@ -55,6 +55,10 @@ struct EmitOptions {
   // neighbour lists); false (--no-symmetric-pairs): each destination gathers from all its
   // neighbours. The values are the same bit for bit.
   bool symmetricPairs = true;
+  // With kept lists (CPU, no periodic or mirror domain) the search domain and the moving
+  // sources' cell lists are built only at the updates where a pair loop rebuilds its lists
+  // (codegen/CpuLazyCells.inc); false (--no-lazy-cells): at every update. Bitwise the same.
+  bool lazyCells = true;
   // The phases (the pair loops) are defined out of struct Scene, after it, between the
   // marker lines below, and the scene's namespace is named (sphc_scene) so that the build
   // can compile them as a translation unit of their own, in parallel with the rest

@@ -25,7 +25,8 @@ class CpuPrinter : public ScenePrinter {
                         ? opts.verletSkin
                         : 0.0),
         tuned_(verletSkin_ > 0 && opts.verletAuto && !hasDomain()),
-        symmetric_(opts.symmetricPairs) {}
+        symmetric_(opts.symmetricPairs),
+        lazyCells_(opts.lazyCells) {}
 
  private:
   std::string backendComment() const override {
@@ -75,7 +76,7 @@ class CpuPrinter : public ScenePrinter {
   // --verlet-skin without a periodic or mirror domain: the search domain and the moving
   // sources' cell lists are built only where a pair loop rebuilds its kept lists
   // (CpuLazyCells.inc; docs/performance.md, "Cell lists only when a kept list is rebuilt").
-  bool lazyCells() const { return verlet() && !hasDomain(); }
+  bool lazyCells() const { return lazyCells_ && verlet() && !hasDomain(); }
   void emitLazyCells();
   void lazyCellsMembers();
   void lazyCellsDue();  // end of update_neighbours: the domain and cells out of date
@@ -222,6 +223,7 @@ class CpuPrinter : public ScenePrinter {
   double verletSkin_ = 0.0;  // --verlet-skin (0: lists gathered at every evaluation)
   bool tuned_ = false;       // --verlet-skin=auto: skin and re-sort chosen at run time
   bool symmetric_ = true;    // each pair once where it may (--no-symmetric-pairs: false)
+  bool lazyCells_ = true;    // cells only where kept lists are rebuilt (--no-lazy-cells: false)
 };
 
 // --verlet-skin: the skin and, per pair loop (phase, destination, source), each destination
@@ -377,7 +379,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          " << lists << ".begin = " << rangeBegin(w) << ";\n";
       scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
       scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
-      if (d == s && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
+      if (d == s && symmetric_ && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
       scene_ << "        }\n";
     }
     if (lazyCells() && !isStatic(S))  // CpuLazyCells.inc
