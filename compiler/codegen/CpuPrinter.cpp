@@ -790,8 +790,10 @@ void CpuPrinter::emitStaticCells() {
 // update_neighbours of a scene without periodic or mirror domain.
 void CpuPrinter::updateNeighbours() {
   if (tuned()) return tunedUpdateNeighbours();  // CpuVerletTune.inc
-  if (lazyCells()) {
-    if (!loopArrays_.empty()) scene_ << loopArraysDecl();
+  bool reordersMoving = false;
+  for (const auto& S : sourceArrays_) reordersMoving |= !isStatic(S) && reorders(S);
+  if (lazyCells()) {  // `all` for order_domain; the domain: make_domain (CpuLazyCells.inc)
+    if (!loopArrays_.empty() && (reordersMoving || anyStatic())) scene_ << loopArraysDecl();
   } else if (!loopArrays_.empty()) {
     searchDomain();
   }
@@ -810,8 +812,6 @@ void CpuPrinter::updateNeighbours() {
     else
       scene_ << "    if (!static_cells_built) build_static_cells();  // once: they never move\n";
   }
-  bool reordersMoving = false;
-  for (const auto& S : sourceArrays_) reordersMoving |= !isStatic(S) && reorders(S);
   if (reordersMoving) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
