@@ -59,6 +59,10 @@ struct EmitOptions {
   // by multiplications where the exponent is an integer of magnitude <= 8, the C library's
   // pow otherwise; false (--int-pow=off): the C library's pow everywhere.
   bool intPow = true;
+  // With kept lists (CPU, no periodic or mirror domain) the search domain and the moving
+  // sources' cell lists are built only at the updates where a pair loop rebuilds its lists
+  // (codegen/CpuLazyCells.inc); false (--no-lazy-cells): at every update. Bitwise the same.
+  bool lazyCells = true;
   // The phases (the pair loops), and compute_accelerations, step and adaptive_dt (the
   // per-step code inlined into them), are defined out of struct Scene, after it, between the
   // marker lines below, and the scene's namespace is named (sphc_scene) so that the build

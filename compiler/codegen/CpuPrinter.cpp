@@ -25,7 +25,8 @@ class CpuPrinter : public ScenePrinter {
                         ? opts.verletSkin
                         : 0.0),
         tuned_(verletSkin_ > 0 && opts.verletAuto && !hasDomain()),
-        symmetric_(opts.symmetricPairs) {}
+        symmetric_(opts.symmetricPairs),
+        lazyCells_(opts.lazyCells) {}
 
  private:
   std::string backendComment() const override {
@@ -72,6 +73,16 @@ class CpuPrinter : public ScenePrinter {
   // The kept lists whose destination or source is array S (forgotten after S is sorted).
   std::vector<std::string> listsOf(const std::string& S) const;
   void tunedUpdateNeighbours();
+  // --verlet-skin without a periodic or mirror domain: the search domain and the moving
+  // sources' cell lists are built only where a pair loop rebuilds its kept lists
+  // (CpuLazyCells.inc; docs/performance.md, "Cell lists only when a kept list is rebuilt").
+  bool lazyCells() const { return lazyCells_ && verlet() && !hasDomain(); }
+  void emitLazyCells();
+  void lazyCellsMembers();
+  void lazyCellsDue();  // end of update_neighbours: the domain and cells out of date
+  // `const std::vector<const sphc::ParticleArray*> all = {...};`: the arrays of the
+  // neighbour loops (the search domain's).
+  std::string loopArraysDecl() const;
   // Calls f(lists, phase, w, pass) for every pair loop that keeps lists (verletLists).
   void forEachVerletLists(
       const std::function<void(const std::string&, const Phase&, const DestinationWork&,
@@ -119,6 +130,7 @@ class CpuPrinter : public ScenePrinter {
   void updateNeighbours() override;
   void staticCellLists() override {
     if (anyStatic()) emitStaticCells();
+    if (lazyCells()) emitLazyCells();  // CpuLazyCells.inc
   }
   void updateNeighboursWithGhosts() override;
   std::string removeGhosts() const override;
@@ -211,6 +223,7 @@ class CpuPrinter : public ScenePrinter {
   double verletSkin_ = 0.0;  // --verlet-skin (0: lists gathered at every evaluation)
   bool tuned_ = false;       // --verlet-skin=auto: skin and re-sort chosen at run time
   bool symmetric_ = true;    // each pair once where it may (--no-symmetric-pairs: false)
+  bool lazyCells_ = true;    // cells only where kept lists are rebuilt (--no-lazy-cells: false)
 };
 
 // --verlet-skin: the skin and, per pair loop (phase, destination, source), each destination
@@ -273,6 +286,7 @@ void CpuPrinter::searchMembers() {
     for (const auto& a : plan_.arrays)
       out_ << "  sphc::FloatArray f32_" << a.name << ";  // what the scene computes on\n";
   for (const auto& S : sourceArrays_) out_ << "  sphc::CellList cells_" << S << ";\n";
+  if (lazyCells()) lazyCellsMembers();
 }
 
 void CpuPrinter::dataMovement() {
@@ -365,8 +379,11 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          " << lists << ".begin = " << rangeBegin(w) << ";\n";
       scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
       scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
+      if (d == s && symmetric_ && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
       scene_ << "        }\n";
     }
+    if (lazyCells() && !isStatic(S))  // CpuLazyCells.inc
+      scene_ << "        if (verlet_build) build_cells_" << S << "();  // the cells of this update, once\n";
     if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty()) {
       emitSymmetricPass(w, pass, lists, openmp_,
                         tuned() ? "verlet_radius2" : "VERLET_RADIUS2");  // codegen/SymmetricPairs.cpp
@@ -605,14 +622,7 @@ void CpuPrinter::searchDomain(const std::string& only, const std::string& dom) {
            << "}, DIM, Kernel::radius_scale);\n";
     return;
   }
-  scene_ << "    const std::vector<const sphc::ParticleArray*> all = {";
-  bool first = true;
-  for (const auto& a : plan_.arrays) {
-    if (!loopArrays_.count(a.name)) continue;
-    scene_ << (first ? "" : ", ") << "&" << a.name;
-    first = false;
-  }
-  scene_ << "};\n";
+  scene_ << loopArraysDecl();
   if (verlet()) {
     // Cells as large as the lists' radius (each pair loop rebuilds its lists when due).
     scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale * (1.0 + "
@@ -780,21 +790,28 @@ void CpuPrinter::emitStaticCells() {
 // update_neighbours of a scene without periodic or mirror domain.
 void CpuPrinter::updateNeighbours() {
   if (tuned()) return tunedUpdateNeighbours();  // CpuVerletTune.inc
-  if (!loopArrays_.empty()) searchDomain();
+  bool reordersMoving = false;
+  for (const auto& S : sourceArrays_) reordersMoving |= !isStatic(S) && reorders(S);
+  if (lazyCells()) {  // `all` for order_domain; the domain: make_domain (CpuLazyCells.inc)
+    if (!loopArrays_.empty() && (reordersMoving || anyStatic())) scene_ << loopArraysDecl();
+  } else if (!loopArrays_.empty()) {
+    searchDomain();
+  }
   // --verlet-skin: permutations sort into the cell order of the support's grid (order_domain,
   // made as `domain` is without lists), so that the particles are in the order they have
   // without lists; the cell lists are then built on the lists' grid (`domain`).
   const std::string orderDomain =
       "order_domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);";
   if (anyStatic()) {
-    if (verlet())
+    if (lazyCells())  // build_static_cells reads the lists' cell size
+      scene_ << "    if (!static_cells_built) {  // once: they never move\n      make_domain();\n      "
+             << orderDomain << "\n      build_static_cells();\n    }\n";
+    else if (verlet())
       scene_ << "    if (!static_cells_built) {  // once: they never move\n      " << orderDomain
              << "\n      build_static_cells();\n    }\n";
     else
       scene_ << "    if (!static_cells_built) build_static_cells();  // once: they never move\n";
   }
-  bool reordersMoving = false;
-  for (const auto& S : sourceArrays_) reordersMoving |= !isStatic(S) && reorders(S);
   if (reordersMoving) {
     // Every REORDER_EVERY builds the particles are sorted in cell order, so that neighbours
     // are close in memory; all per-particle state moves with them.
@@ -808,6 +825,12 @@ void CpuPrinter::updateNeighbours() {
   for (const auto& S : sourceArrays_) {
     if (isStatic(S)) continue;  // build_static_cells
     const std::string build = cellListBuild(S, S + ".n");
+    if (lazyCells()) {
+      if (reorders(S))
+        scene_ << "    if (reorder) {\n      " << cellListBuild(S, S + ".n", "order_domain")
+               << "\n      " << permuteInCellOrder(S) << "\n    }\n";
+      continue;
+    }
     if (verlet() && reorders(S)) {
       scene_ << "    if (reorder) {\n      " << cellListBuild(S, S + ".n", "order_domain")
              << "\n      " << permuteInCellOrder(S) << "\n    }\n";
@@ -819,6 +842,7 @@ void CpuPrinter::updateNeighbours() {
     scene_ << "    if (reorder) {\n      " << permuteInCellOrder(S) << "\n      " << build
            << "\n    }\n";
   }
+  if (lazyCells()) lazyCellsDue();
 }
 
 // The call of update_neighbours() in compute_accelerations, timed for --timing.
@@ -874,6 +898,7 @@ void CpuPrinter::adaptiveDtArray(int a) {
 }
 
 #include "codegen/CpuVerletTune.inc"
+#include "codegen/CpuLazyCells.inc"
 
 }  // namespace
 

@@ -204,6 +204,13 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   scene_ << "            sphc::keep_in_index_order(" << lists
          << ".lists[d_idx], nbrs_list.data(), n_kept);\n";
   scene_ << "          }\n        }\n";
+  // Where s_idx >= d_idx starts in each kept list: once per build (whichever loop built).
+  scene_ << "        if (" << lists << ".upper.empty()) {  // after a build: where s_idx >= d_idx "
+            "starts in each kept list\n";
+  scene_ << "          " << lists << ".upper.resize(n);\n" << (openmp ? "  " + pragma : "");
+  scene_ << "          for (int d_idx = 0; d_idx < n; ++d_idx) " << lists
+         << ".upper[d_idx] = sphc::upper_start(" << lists << ".lists[d_idx], d_idx);\n";
+  scene_ << "        }\n";
   // The destination-only values of every particle, for the mirrored calls.
   std::vector<std::string> fills;
   for (const PlanEquation* eq : pass.equations) {
@@ -311,8 +318,9 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     scene_ << in << "}\n" << indent << "}\n";
   };
   const std::string lower = "std::lower_bound(kept.data(), k_end, static_cast<std::uint32_t>(";
+  const std::string upper = "kept.data() + " + lists + ".upper[d_idx]";  // s_idx >= d_idx
   if (!openmp) {
-    segment("        ", "0", "n", lower + "d_idx))", "", true, "  // pairs (d_idx, s_idx >= d_idx)");
+    segment("        ", "0", "n", upper, "", true, "  // pairs (d_idx, s_idx >= d_idx)");
     return;
   }
   // OpenMP: contiguous blocks, one per thread; each particle's contributions in the serial
@@ -326,7 +334,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   segment("          ", "b_begin", "b_end", "kept.data()",
           " && *k < static_cast<std::uint32_t>(b_begin)", false, "");
   scene_ << "          // (2) the pairs within the block, once for both particles\n";
-  segment("          ", "b_begin", "b_end", lower + "d_idx))",
+  segment("          ", "b_begin", "b_end", upper,
           " && *k < static_cast<std::uint32_t>(b_end)", true, "");
   scene_ << "          // (3) from the neighbours in later blocks, per destination\n";
   segment("          ", "b_begin", "b_end", lower + "b_end))", "", false, "");

@@ -128,6 +128,12 @@ static cl::opt<bool> NoSymmetricPairs(
              "both particles, on the CPU backends with kept neighbour lists; --report says "
              "which loops; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoLazyCells(
+    "no-lazy-cells",
+    cl::desc("With kept neighbour lists, build the search domain and cell lists at every "
+             "neighbour update (default: only at the updates where a pair loop rebuilds its "
+             "kept lists, the only ones that read them; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> SingleUnit(
     "single-unit",
     cl::desc("Generate the solver as one translation unit (default, serial and openmp without "
@@ -436,6 +442,7 @@ int main(int argc, char** argv) {
   emitOpts.splitUnits = !SingleUnit && Emit == EmitKind::Exe;
   emitOpts.symmetricPairs = !NoSymmetricPairs;
   emitOpts.intPow = IntPowOpt == OnOff::On;
+  emitOpts.lazyCells = !NoLazyCells;
   if (Report && Emit != EmitKind::OpenCL)
     for (const std::string& note : sphc::symmetricPairsNotes(*schedule, emitOpts))
       llvm::outs() << "note: " << note << "\n";

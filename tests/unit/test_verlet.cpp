@@ -229,6 +229,16 @@ TEST(SkinTuner, ListsStayCompleteWhileTheSkinChanges) {
   EXPECT_NE(skins.front(), skins.back());  // the skin did change
 }
 
+// The symmetric loops' start in a kept list: the first j >= i (the self pair included).
+TEST(VerletSkin, UpperStartIsTheFirstIndexNotBelowTheParticle) {
+  const std::vector<std::uint32_t> kept = {1, 4, 5, 9};
+  EXPECT_EQ(sphc::upper_start(kept, 0), 0u);
+  EXPECT_EQ(sphc::upper_start(kept, 4), 1u);  // i itself
+  EXPECT_EQ(sphc::upper_start(kept, 6), 3u);
+  EXPECT_EQ(sphc::upper_start(kept, 10), 4u);  // none: the end
+  EXPECT_EQ(sphc::upper_start({}, 3), 0u);
+}
+
 // The sort criterion: the share of places where the cell order breaks the present order.
 TEST(SkinTuner, SortWhenTheParticlesLeftCellOrder) {
   std::vector<std::uint32_t> order(101);

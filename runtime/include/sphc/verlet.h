@@ -135,7 +135,15 @@ struct VerletLists {
   // or stop_idx builds its range only; another range rebuilds them).
   long begin = 0, end = -1;
   bool built_for(long b, long e) const { return b == begin && e == end; }
+  // The loops over each pair once (destination = source): per particle i, where j >= i
+  // starts in its kept list (upper_start), found once per build; cleared at every build.
+  std::vector<std::uint32_t> upper;
 };
+
+// The position of the first j >= i in the kept list of particle i (in increasing index).
+inline std::uint32_t upper_start(const std::vector<std::uint32_t>& kept, std::uint32_t i) {
+  return static_cast<std::uint32_t>(std::lower_bound(kept.begin(), kept.end(), i) - kept.begin());
+}
 
 // kept = the candidates cand[0, n) (one destination particle's, within the lists' radius)
 // in increasing particle index: the order in which the filtered neighbours are summed does
