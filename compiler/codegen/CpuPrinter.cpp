@@ -61,6 +61,12 @@ class CpuPrinter : public ScenePrinter {
   // --verlet-skin: the lists are kept across evaluations (sphc/verlet.h).
   bool verlet() const { return verletSkin_ > 0; }
   void verletMembers();
+  // The rebuild check of the kept lists `lists` of w's pass over source s (verlet_build).
+  void listsRebuildCheck(const std::string& lists, const DestinationWork& w, int s);
+  // The destinations {A, B} of w's phase whose pair loops A <- B and B <- A run as one pass
+  // (crossPairsRefusal; serial with kept lists), where w is A or B; {} elsewhere.
+  std::pair<const DestinationWork*, const DestinationWork*> crossPair(
+      const DestinationWork& w) const;
   // --verlet-skin=auto: the skin and the re-sort chosen at run time (sphc/verlet_tune.h;
   // CpuVerletTune.inc); --verlet-skin=F keeps the code of a fixed skin.
   bool tuned() const { return tuned_; }
@@ -332,8 +338,20 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "      }\n";
   };
   perParticle(ast::Method::Initialize, "initialize");
+  // Pair loops A <- B and B <- A as one pass (codegen/SymmetricPairs.cpp, crossPairsRefusal):
+  // A's last pass runs in B's first's place.
+  const auto cross = crossPair(w);
   // One neighbour pass per source.
   for (const NeighbourPass& pass : w.passes) {
+    if (cross.first == &w && &pass == &w.passes.back()) continue;  // in cross.second's
+    if (cross.second == &w && &pass == &w.passes.front()) {
+      const DestinationWork& A = *cross.first;
+      const std::string lists = verletLists(phase, A, w.array);
+      emitCrossPass(A, A.passes.back(), w, pass, lists,
+                    tuned() ? "verlet_radius2" : "VERLET_RADIUS2",
+                    [&] { listsRebuildCheck(lists, A, w.array); });
+      continue;
+    }
     const int s = pass.source;
     const std::string& S = arr(s).name;
     const std::set<std::string>& q = pass.pairQuantities;
@@ -365,25 +383,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
                       parallelFor("        ", pass.order, ompIf("n_src")));
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, w, s) : "";
-    if (tuned()) {
-      tunedRebuildCheck(lists, w, d, s);
-    } else if (verlet()) {
-      // Rebuilt when particles of either array moved too far since the lists' last build
-      // (by this loop or another one sharing them).
-      const std::string arrays = d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}";
-      const std::string range = rangeBegin(w) + ", " + rangeEnd(w);
-      scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ") || "
-             << lists << ".skin.must_rebuild(" << arrays << ", Kernel::radius_scale);\n";
-      scene_ << "        if (verlet_build) {\n";
-      scene_ << "          " << lists << ".skin.mark(" << arrays << ");\n";
-      scene_ << "          " << lists << ".begin = " << rangeBegin(w) << ";\n";
-      scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
-      scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
-      if (d == s && symmetric_ && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
-      scene_ << "        }\n";
-    }
-    if (lazyCells() && !isStatic(S))  // CpuLazyCells.inc
-      scene_ << "        if (verlet_build) build_cells_" << S << "();  // the cells of this update, once\n";
+    listsRebuildCheck(lists, w, s);
     if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty()) {
       emitSymmetricPass(w, pass, lists, openmp_,
                         tuned() ? "verlet_radius2" : "VERLET_RADIUS2");  // codegen/SymmetricPairs.cpp
@@ -470,6 +470,52 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
   for (const Reduction& r : w.reductions) reduction(w, r);
   emitHostReduces(w);
   ghostRefresh(w);
+}
+
+void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWork& w, int s) {
+  const int d = w.array;
+  const std::string& D = arr(d).name;
+  const std::string& S = arr(s).name;
+  if (tuned()) {
+    tunedRebuildCheck(lists, w, d, s);
+  } else if (verlet()) {
+    // Rebuilt when particles of either array moved too far since the lists' last build
+    // (by this loop or another one sharing them).
+    const std::string arrays = d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}";
+    const std::string range = rangeBegin(w) + ", " + rangeEnd(w);
+    scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ") || "
+           << lists << ".skin.must_rebuild(" << arrays << ", Kernel::radius_scale);\n";
+    scene_ << "        if (verlet_build) {\n";
+    scene_ << "          " << lists << ".skin.mark(" << arrays << ");\n";
+    scene_ << "          " << lists << ".begin = " << rangeBegin(w) << ";\n";
+    scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
+    scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
+    if (d == s && symmetric_ && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
+    scene_ << "        }\n";
+  }
+  if (lazyCells() && !isStatic(S))  // CpuLazyCells.inc
+    scene_ << "        if (verlet_build) build_cells_" << S << "();  // the cells of this update, once\n";
+}
+
+std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
+    const DestinationWork& w) const {
+  if (!symmetric_ || !verlet() || openmp_ || hasDomain()) return {};
+  std::pair<const DestinationWork*, const DestinationWork*> found{};
+  std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+    for (const Phase& ph : g.phases)
+      for (size_t a = 0; a + 1 < ph.destinations.size(); ++a) {
+        const DestinationWork& A = ph.destinations[a];
+        const DestinationWork& B = ph.destinations[a + 1];
+        if ((&w == &A || &w == &B) && A.array != B.array && !A.passes.empty() &&
+            !B.passes.empty() && A.passes.back().source == B.array &&
+            B.passes.front().source == A.array && A.passes.back().searches() &&
+            B.passes.front().searches() && crossPairsRefusal(plan_, ph, a, a + 1, true).empty())
+          found = {&A, &B};
+      }
+    for (const auto& sub : g.subgroups) walk(*sub);
+  };
+  walk(sched_.equations);
+  return found;
 }
 
 // A reduction of the destination's real particles into one of its constants.

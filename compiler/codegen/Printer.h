@@ -199,8 +199,23 @@ class ScenePrinter {
                          const std::string& lists, bool openmp,
                          const std::string& listRadius2);
   // The call of eq's loop for destination s_idx and source d_idx, with the mirrored pair
-  // quantities (XIJ_ji, ...).
-  std::string callBodyMirrored(const PlanEquation& eq, int dest) const;
+  // quantities (XIJ_ji, ...); with `pointers`, its property arguments are pointers + d_NAME
+  // and pointers + s_NAME (emitCrossPass: mirror_d_, mirror_s_).
+  std::string callBodyMirrored(const PlanEquation& eq, int dest,
+                               const std::string& pointers = "") const;
+  // Pair loops A <- B (A's last) and B <- A (B's first) of one phase that crossPairsRefusal()
+  // allows (serial, kept lists): in B's destination after its initialize, one pass over A's
+  // kept lists of B, the bodies of both per pair; `listsCheck` writes the rebuild check
+  // (verlet_build) of those lists.
+  void emitCrossPass(const DestinationWork& A, const NeighbourPass& ab, const DestinationWork& B,
+                     const NeighbourPass& ba, const std::string& lists,
+                     const std::string& listRadius2, const std::function<void()>& listsCheck);
+  // Pieces of both: the kept lists of every destination particle when due (verlet_build);
+  // the destination-only values of every particle (dhoisted_all_*); the pair quantities of
+  // a neighbour s_idx, with `both` the mirrored ones too (XIJ_ji, DWIJ_ji, ...).
+  void emitKeptListsBuild(const std::string& lists, bool openmp, const std::string& listRadius2);
+  void emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma);
+  void emitPairQuantitiesOnce(const std::set<std::string>& q, bool both, const std::string& body);
   // The members holding the destination-only values of every particle (dhoist_eqN_K).
   void emitSymmetricMembers(std::ostream& os) const;
   std::string symmetricDestinationHoisted(const std::string& eqValues, const std::string& k) const {

@@ -71,11 +71,10 @@ void walkPasses(const ScheduleGroup& g,
   for (const auto& sub : g.subgroups) walkPasses(*sub, fn);
 }
 
-}  // namespace
-
-std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
-                                  const NeighbourPass& pass, bool listsKept) {
-  if (pass.source != w.array) return "the source is another array";
+// symmetricPairsRefusal without the same-array condition: what the bodies and the pass of
+// w must be for a pair's mirrored call (also for a pair loop of two arrays, crossPairsRefusal).
+std::string pairBodiesRefusal(const Plan& plan, const DestinationWork& w,
+                              const NeighbourPass& pass, bool listsKept) {
   if (!listsKept) return "no lists kept in index order here (--verlet-skin off)";
   if (w.ranged()) return "the group has start_idx or stop_idx";
   if (w.onGhosts) return "the group runs on the ghosts";
@@ -116,6 +115,68 @@ std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
   return "";
 }
 
+}  // namespace
+
+std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
+                                  const NeighbourPass& pass, bool listsKept) {
+  if (pass.source != w.array) return "the source is another array";
+  return pairBodiesRefusal(plan, w, pass, listsKept);
+}
+
+std::string crossPairsRefusal(const Plan& plan, const Phase& ph, size_t a, size_t b,
+                              bool listsKept) {
+  const DestinationWork& A = ph.destinations[a];
+  const DestinationWork& B = ph.destinations[b];
+  const std::string& nameA = plan.arrays[A.array].name;
+  const std::string& nameB = plan.arrays[B.array].name;
+  if (b != a + 1) return nameB + " is not the destination after " + nameA + " in the phase";
+  const NeighbourPass& ab = A.passes.back();
+  const NeighbourPass& ba = B.passes.front();
+  if (ab.source != B.array) return nameA + " <- " + nameB + " is not " + nameA + "'s last pair loop";
+  if (ba.source != A.array) return nameB + " <- " + nameA + " is not " + nameB + "'s first pair loop";
+  if (!A.postLoop.empty() || !A.reductions.empty() || !A.hostReduce.empty() ||
+      !A.ghostRefresh.empty())
+    return nameA + " has work after its pair loops (post_loop, a reduction, ghosts to refresh)";
+  if (!ab.initializePair.empty() || !ba.initializePair.empty()) return "an initialize_pair";
+  for (const auto& [w, pass] : {std::pair{&A, &ab}, std::pair{&B, &ba}}) {
+    const std::string why = pairBodiesRefusal(plan, *w, *pass, listsKept);
+    if (!why.empty())
+      return plan.arrays[w->array].name + " <- " + plan.arrays[pass->source].name + ": " + why;
+  }
+  // What each loop reads of the other's destination (its source properties, those of its
+  // pair quantities) must not change during the pass: today it is read before (A <- B) or
+  // after (B <- A) the other loop.
+  auto reads = [](const NeighbourPass& p) {
+    std::set<std::string> r = p.sourceProps;
+    r.insert(p.shared.begin(), p.shared.end());
+    return r;
+  };
+  auto writes = [&](const NeighbourPass& p, const PlanEquation*& who, const std::string& prop) {
+    for (const PlanEquation* eq : p.equations)
+      for (const PropAccess& w : loopBody(plan, *eq).facts.dWrites)
+        if (w.prop == prop) return who = eq, true;
+    return false;
+  };
+  const PlanEquation* who = nullptr;
+  for (const std::string& p : reads(ab))
+    if (writes(ba, who, p))
+      return who->name + " writes " + nameB + "." + p + ", which " + nameA + " <- " + nameB +
+             " reads";
+  for (const std::string& p : reads(ba))
+    if (writes(ab, who, p))
+      return who->name + " writes " + nameA + "." + p + ", which " + nameB + " <- " + nameA +
+             " reads";
+  // B's initialize runs before the pass, today after A <- B.
+  for (const PlanEquation* eq : B.initialize) {
+    const auto& methods = plan.equationDecls[eq->declIndex].methods;
+    for (const PropAccess& w : plan.bodies[methods.at(ast::Method::Initialize)].facts.dWrites)
+      if (reads(ab).count(w.prop))
+        return eq->name + "'s initialize writes " + nameB + "." + w.prop + ", which " + nameA +
+               " <- " + nameB + " reads before it";
+  }
+  return "";
+}
+
 std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOptions& opts) {
   std::vector<std::string> notes;
   const Plan& plan = *sched.plan;
@@ -137,12 +198,43 @@ std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOp
     notes.push_back(why.empty() ? "each pair once for both particles: " + loop
                                 : "pairs per destination particle: " + loop + ": " + why);
   });
+  // Pair loops of two arrays, A <- B and B <- A in one phase.
+  std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+    for (const Phase& ph : g.phases)
+      for (size_t a = 0; a < ph.destinations.size(); ++a)
+        for (size_t b = a + 1; b < ph.destinations.size(); ++b) {
+          auto loopOver = [](const DestinationWork& w, int s) {
+            for (const NeighbourPass& p : w.passes)
+              if (p.source == s && p.searches()) return true;
+            return false;
+          };
+          const DestinationWork& A = ph.destinations[a];
+          const DestinationWork& B = ph.destinations[b];
+          if (A.array == B.array || !loopOver(A, B.array) || !loopOver(B, A.array)) continue;
+          const std::string loop = plan.arrays[A.array].name + " <- " +
+                                   plan.arrays[B.array].name + " with " +
+                                   plan.arrays[B.array].name + " <- " +
+                                   plan.arrays[A.array].name + " in " + ph.name;
+          std::string why = opts.symmetricPairs ? crossPairsRefusal(plan, ph, a, b, listsKept)
+                                                : "--no-symmetric-pairs";
+          if (why.empty() && sched.domain) why = "the sources include periodic or mirror ghosts";
+          if (why.empty() && opts.backend == Backend::OpenMP)
+            why = "OpenMP keeps a pass per destination array (the second array's sums would be "
+                  "written by several threads)";
+          if (opts.backend == Backend::OpenCL) why = "the OpenCL backend gathers per destination";
+          notes.push_back(why.empty() ? "each pair once for both particles: " + loop
+                                      : "pairs per destination particle: " + loop + ": " + why);
+        }
+    for (const auto& sub : g.subgroups) walk(*sub);
+  };
+  walk(sched.equations);
   return notes;
 }
 
 // ---- The printer ----
 
-std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest) const {
+std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest,
+                                           const std::string& pointers) const {
   const PlanBody& b = methodBody(eq, ast::Method::Loop);
   const std::string eqValues = eqStruct(eq);
   // callBody's arguments but for the swapped indices, the mirrored pair quantities and the
@@ -153,6 +245,8 @@ std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest) con
       case BodyParam::SIdx: return "d_idx";
       case BodyParam::Pair: return mirrored(p.name);
       case BodyParam::DHoisted: return symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]";
+      case BodyParam::DProp: return pointers.empty() ? "" : pointers + "d_" + p.name;
+      case BodyParam::SProp: return pointers.empty() ? "" : pointers + "s_" + p.name;
       case BodyParam::Nbrs:
       case BodyParam::NNbrs:
       case BodyParam::N: SPHC_INTERNAL("a pair loop body with NBRS or N");
@@ -182,28 +276,13 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
                                      const std::string& listRadius2) {
   const int d = w.array;
   const std::set<std::string> q = withMirrors(pass.pairQuantities);
-  const std::string thread = openmp ? "omp_get_thread_num()" : "0";
   const std::string pragma = openmp ? "        #pragma omp parallel for schedule(static) "
                                       "default(firstprivate) shared(cells)\n"
                                     : "";
   scene_ << "        // Each pair once for both particles (codegen/SymmetricPairs.cpp; sphc\n"
             "        // --no-symmetric-pairs: per destination particle): the same sums bit for bit.\n";
   // The kept lists first, all of them: a pair is visited from its lower particle's list.
-  scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
-         << (openmp ? "omp_get_max_threads()" : "1") << "));\n";
-  scene_ << "        if (verlet_build) {\n";
-  scene_ << (openmp ? "  " + pragma : "");
-  scene_ << "          for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
-  emitDestLocals(scene_, "            ", {}, host_);
-  scene_ << "            std::vector<std::uint32_t>& nbrs_list = nbrs_lists[" << thread << "];\n";
-  scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
-            "nbrs_list, [&](std::uint32_t j) {\n";
-  scene_ << "              const int s_idx = static_cast<int>(j);\n";
-  emitNeighbourTest(scene_, host_, "return false;", "              ", listRadius2);
-  scene_ << "              return true;\n            });\n";
-  scene_ << "            sphc::keep_in_index_order(" << lists
-         << ".lists[d_idx], nbrs_list.data(), n_kept);\n";
-  scene_ << "          }\n        }\n";
+  emitKeptListsBuild(lists, openmp, listRadius2);
   // Where s_idx >= d_idx starts in each kept list: once per build (whichever loop built).
   scene_ << "        if (" << lists << ".upper.empty()) {  // after a build: where s_idx >= d_idx "
             "starts in each kept list\n";
@@ -212,32 +291,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
          << ".upper[d_idx] = sphc::upper_start(" << lists << ".lists[d_idx], d_idx);\n";
   scene_ << "        }\n";
   // The destination-only values of every particle, for the mirrored calls.
-  std::vector<std::string> fills;
-  for (const PlanEquation* eq : pass.equations) {
-    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
-    const auto sites = hoistedDestinationSites(b, host_);
-    for (size_t k = 0; k < sites.size(); ++k) {
-      const std::string K = std::to_string(k), E = eqStruct(*eq);
-      const std::string ptr = symmetricDestinationHoisted(E, K);
-      scene_ << "        dhoist_" << E << "_" << K << ".resize(n);\n";
-      scene_ << "        double* const " << ptr << " = dhoist_" << E << "_" << K << ".data();\n";
-      fills.push_back(E + "_" + K);
-    }
-  }
-  if (!fills.empty()) {
-    scene_ << pragma;
-    scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
-    emitDestinationHoisted(scene_, pass, "          ");
-    for (const PlanEquation* eq : pass.equations) {
-      const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
-      for (size_t k = 0; k < sites.size(); ++k) {
-        const std::string K = std::to_string(k);
-        scene_ << "          " << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx] = "
-               << hoistDestinationArgument(eqStruct(*eq), K) << ";\n";
-      }
-    }
-    scene_ << "        }\n";
-  }
+  emitDestinationHoistedAll(pass, pragma);
   // One destination's neighbours in [from, to) of its kept list (sorted): the pair
   // quantities, the bodies for d_idx and, with `both`, for s_idx (unless the self pair).
   auto segment = [&](const std::string& indent, const std::string& begin, const std::string& end,
@@ -266,47 +320,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     const std::string body = in + "  ";
     scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
     emitNeighbourTest(scene_, host_, "continue;", body);
-    const PairDialect dialect = [&] {
-      PairDialect pd;
-      pd.real = host_.real;
-      pd.sqrt = host_.sqrt;
-      pd.kernelW = host_.kernelW;
-      pd.kernelGradient = host_.kernelGradient;
-      pd.literalSuffix = host_.lit("");
-      return pd;
-    }();
-    auto difference = [&](const PairQuantity& pq, bool mirror) {
-      scene_ << body << "const double " << pq.name << (mirror ? "_ji" : "") << "[3] = {";
-      for (int c = 0; c < 3; ++c) {
-        scene_ << (c ? ", " : "");
-        if (c >= plan_.dim)
-          scene_ << "0.0";
-        else if (mirror)
-          scene_ << "sj_" << pq.components[c] << "[s_idx] - " << pq.components[c] << "i";
-        else
-          scene_ << pq.components[c] << "i - sj_" << pq.components[c] << "[s_idx]";
-      }
-      scene_ << "};\n";
-    };
-    if (both) difference(*findPairQuantity("XIJ"), true);
-    for (const PairQuantity& pq : pairQuantityTable()) {
-      if (!(pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name))))
-        continue;
-      if (both && pq.form == PairForm::Difference) {
-        difference(pq, false);
-        difference(pq, true);
-      } else if (both && pq.form == PairForm::Gradient) {
-        // grad_j of the mirrored call: DWIJ -> DWIJ_ji (same h), DWI (h_i) -> DWJ_ji, DWJ
-        // (h_j) -> DWI_ji.
-        const std::string partner =
-            pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
-        scene_ << body << "double " << pq.name << "[3], " << partner << "[3];\n";
-        scene_ << body << "Kernel::gradient_pair(XIJ, XIJ_ji, RIJ, " << pq.h << ", " << pq.name
-               << ", " << partner << ");\n";
-      } else {
-        scene_ << pairQuantityStatement(pq, plan_.dim, dialect, body);
-      }
-    }
+    emitPairQuantitiesOnce(q, both, body);
     for (const PlanEquation* eq : pass.equations)
       scene_ << body << equationCall(*eq, ast::Method::Loop, d);
     if (both) {
@@ -339,6 +353,168 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   scene_ << "          // (3) from the neighbours in later blocks, per destination\n";
   segment("          ", "b_begin", "b_end", lower + "b_end))", "", false, "");
   scene_ << "        }\n";
+}
+
+void ScenePrinter::emitKeptListsBuild(const std::string& lists, bool openmp,
+                                      const std::string& listRadius2) {
+  const std::string thread = openmp ? "omp_get_thread_num()" : "0";
+  const std::string pragma = openmp ? "        #pragma omp parallel for schedule(static) "
+                                      "default(firstprivate) shared(cells)\n"
+                                    : "";
+  scene_ << "        nbrs_lists.resize(std::max<std::size_t>(nbrs_lists.size(), "
+         << (openmp ? "omp_get_max_threads()" : "1") << "));\n";
+  scene_ << "        if (verlet_build) {\n";
+  scene_ << (openmp ? "  " + pragma : "");
+  scene_ << "          for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+  emitDestLocals(scene_, "            ", {}, host_);
+  scene_ << "            std::vector<std::uint32_t>& nbrs_list = nbrs_lists[" << thread << "];\n";
+  scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
+            "nbrs_list, [&](std::uint32_t j) {\n";
+  scene_ << "              const int s_idx = static_cast<int>(j);\n";
+  emitNeighbourTest(scene_, host_, "return false;", "              ", listRadius2);
+  scene_ << "              return true;\n            });\n";
+  scene_ << "            sphc::keep_in_index_order(" << lists
+         << ".lists[d_idx], nbrs_list.data(), n_kept);\n";
+  scene_ << "          }\n        }\n";
+}
+
+void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma) {
+  std::vector<std::string> fills;
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    const auto sites = hoistedDestinationSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const std::string K = std::to_string(k), E = eqStruct(*eq);
+      const std::string ptr = symmetricDestinationHoisted(E, K);
+      scene_ << "        dhoist_" << E << "_" << K << ".resize(n);\n";
+      scene_ << "        double* const " << ptr << " = dhoist_" << E << "_" << K << ".data();\n";
+      fills.push_back(E + "_" + K);
+    }
+  }
+  if (!fills.empty()) {
+    scene_ << pragma;
+    scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+    emitDestinationHoisted(scene_, pass, "          ");
+    for (const PlanEquation* eq : pass.equations) {
+      const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
+      for (size_t k = 0; k < sites.size(); ++k) {
+        const std::string K = std::to_string(k);
+        scene_ << "          " << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx] = "
+               << hoistDestinationArgument(eqStruct(*eq), K) << ";\n";
+      }
+    }
+    scene_ << "        }\n";
+  }
+}
+
+void ScenePrinter::emitPairQuantitiesOnce(const std::set<std::string>& q, bool both,
+                                          const std::string& body) {
+  const PairDialect dialect = [&] {
+    PairDialect pd;
+    pd.real = host_.real;
+    pd.sqrt = host_.sqrt;
+    pd.kernelW = host_.kernelW;
+    pd.kernelGradient = host_.kernelGradient;
+    pd.literalSuffix = host_.lit("");
+    return pd;
+  }();
+  auto difference = [&](const PairQuantity& pq, bool mirror) {
+    scene_ << body << "const double " << pq.name << (mirror ? "_ji" : "") << "[3] = {";
+    for (int c = 0; c < 3; ++c) {
+      scene_ << (c ? ", " : "");
+      if (c >= plan_.dim)
+        scene_ << "0.0";
+      else if (mirror)
+        scene_ << "sj_" << pq.components[c] << "[s_idx] - " << pq.components[c] << "i";
+      else
+        scene_ << pq.components[c] << "i - sj_" << pq.components[c] << "[s_idx]";
+    }
+    scene_ << "};\n";
+  };
+  if (both) difference(*findPairQuantity("XIJ"), true);
+  for (const PairQuantity& pq : pairQuantityTable()) {
+    if (!(pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name))))
+      continue;
+    if (both && pq.form == PairForm::Difference) {
+      difference(pq, false);
+      difference(pq, true);
+    } else if (both && pq.form == PairForm::Gradient) {
+      // grad_j of the mirrored call: DWIJ -> DWIJ_ji (same h), DWI (h_i) -> DWJ_ji, DWJ
+      // (h_j) -> DWI_ji.
+      const std::string partner =
+          pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
+      scene_ << body << "double " << pq.name << "[3], " << partner << "[3];\n";
+      scene_ << body << "Kernel::gradient_pair(XIJ, XIJ_ji, RIJ, " << pq.h << ", " << pq.name
+             << ", " << partner << ");\n";
+    } else {
+      scene_ << pairQuantityStatement(pq, plan_.dim, dialect, body);
+    }
+  }
+}
+
+void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& ab,
+                                 const DestinationWork& B, const NeighbourPass& ba,
+                                 const std::string& lists, const std::string& listRadius2,
+                                 const std::function<void()>& listsCheck) {
+  const std::string& nameA = arr(A.array).name;
+  const std::string& nameB = arr(B.array).name;
+  std::set<std::string> q = ab.pairQuantities;
+  q.insert(ba.pairQuantities.begin(), ba.pairQuantities.end());
+  q = withMirrors(q);
+  std::set<std::string> shared = ab.shared;
+  shared.insert(ba.shared.begin(), ba.shared.end());
+  scene_ << "      {  // neighbours: " << nameA << " <- " << nameB << " with " << nameB << " <- "
+         << nameA << ", each pair once for both particles\n";
+  scene_ << "        // (codegen/SymmetricPairs.cpp; sphc --no-symmetric-pairs: a pass per destination\n"
+            "        // array): the same sums bit for bit. First what the calls for " << nameB
+         << " <- " << nameA << " take:\n"
+            "        // " << nameA << "'s properties and source-only values, the destination-only "
+            "values of every\n        // " << nameB << " particle, its pointers (mirror_).\n";
+  for (const auto& p : ba.sourceProps)
+    scene_ << "        const " << hostType(A.array, p) << "* s_" << p << " = "
+           << propPtr(A.array, p) << ";\n";
+  emitHoistedValues(scene_, ba, nameA + ".n", "");
+  emitDestinationHoistedAll(ba, "");
+  std::set<std::string> dprops;  // of B, in the bodies of B <- A
+  for (const PlanEquation* eq : ba.equations)
+    for (const BodyParam& p : bodyParams(methodBody(*eq, ast::Method::Loop), B.array, host_))
+      if (p.kind == BodyParam::DProp) dprops.insert(p.name);
+  for (const auto& p : dprops) scene_ << "        auto* const mirror_d_" << p << " = d_" << p << ";\n";
+  for (const auto& p : ba.sourceProps)
+    scene_ << "        auto* const mirror_s_" << p << " = s_" << p << ";\n";
+  scene_ << "        {  // " << nameA << " <- " << nameB << ": d_idx a particle of " << nameA
+         << ", s_idx of " << nameB << "\n";
+  scene_ << "        const int n = static_cast<int>(" << nameA << ".n);\n";
+  for (const auto& p : A.destProps)
+    scene_ << "        " << hostType(A.array, p) << "* d_" << p << " = " << propPtr(A.array, p)
+           << ";\n";
+  for (const auto& p : shared) {
+    scene_ << "        const " << host_.real << "* di_" << p << " = " << propPtr(A.array, p) << ";\n";
+    scene_ << "        const " << host_.real << "* sj_" << p << " = " << propPtr(B.array, p) << ";\n";
+  }
+  for (const auto& p : ab.sourceProps)
+    scene_ << "        const " << hostType(B.array, p) << "* s_" << p << " = "
+           << propPtr(B.array, p) << ";\n";
+  emitHoistedValues(scene_, ab, nameB + ".n", "");
+  scene_ << "        const sphc::CellList& cells = cells_" << nameB << ";\n";
+  listsCheck();
+  emitKeptListsBuild(lists, false, listRadius2);
+  scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {  // pairs (d_idx of " << nameA
+         << ", s_idx of " << nameB << ")\n";
+  emitDestLocals(scene_, "          ", q, host_);
+  emitDestinationHoisted(scene_, ab, "          ");
+  scene_ << "          const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+  scene_ << "          const std::uint32_t* const k_end = kept.data() + kept.size();\n";
+  scene_ << "          for (const std::uint32_t* k = kept.data(); k != k_end; ++k) {\n";
+  const std::string body = "            ";
+  scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
+  emitNeighbourTest(scene_, host_, "continue;", body);
+  emitPairQuantitiesOnce(q, true, body);
+  for (const PlanEquation* eq : ab.equations)
+    scene_ << body << equationCall(*eq, ast::Method::Loop, A.array);
+  for (const PlanEquation* eq : ba.equations)
+    scene_ << body << callBodyMirrored(*eq, B.array, "mirror_");
+  scene_ << "          }\n        }\n        }\n      }\n";
 }
 
 }  // namespace sphc

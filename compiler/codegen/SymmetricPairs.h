@@ -27,8 +27,17 @@ namespace sphc {
 std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
                                   const NeighbourPass& pass, bool listsKept);
 
+// Pair loops of two arrays (A <- B and B <- A, e.g. fluid <- boundary with boundary <- fluid):
+// why destinations a and b of phase ph cannot evaluate each pair once for both ("" where
+// they can). The CPU printer then runs A <- B, A's last pair loop, in B's place, as B's
+// first: for each particle a of A, each b of a's kept list (index order), the pair
+// quantities once, A's bodies for (a, b), then B's for (b, a) with the mirrored quantities.
+// Each particle receives its contributions in the order it gathers them today.
+std::string crossPairsRefusal(const Plan& plan, const Phase& ph, size_t a, size_t b,
+                              bool listsKept);
+
 // --report: one note per same-array pair loop of the schedule, whether it evaluates each pair
-// once and, where not, why.
+// once and, where not, why; then one per pair of loops A <- B, B <- A of one phase.
 std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOptions& opts);
 
 }  // namespace sphc
