@@ -340,8 +340,7 @@ void ScenePrinter::emitDestLocals(std::ostream& os, const std::string& indent,
            << pq.components[k] << "[d_idx];\n";
 }
 
-// The spellings the pair-quantity statements take in a dialect.
-static PairDialect pairDialectOf(const Dialect& dl) {
+PairDialect pairDialectOf(const Dialect& dl) {
   PairDialect dialect;
   dialect.real = dl.real;
   dialect.sqrt = dl.sqrt;

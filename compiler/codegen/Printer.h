@@ -48,6 +48,10 @@ struct Dialect {
   std::string lit(const std::string& v) const { return floatLiterals ? v + "f" : v; }
 };
 
+struct PairDialect;  // analysis/PairQuantityTable.h
+// The spellings the pair-quantity statements take in a dialect (codegen/Bodies.cpp).
+PairDialect pairDialectOf(const Dialect& dl);
+
 class ScenePrinter {
  public:
   ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts);

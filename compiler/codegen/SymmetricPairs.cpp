@@ -409,15 +409,7 @@ void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const st
 
 void ScenePrinter::emitPairQuantitiesOnce(const std::set<std::string>& q, bool both,
                                           const std::string& body) {
-  const PairDialect dialect = [&] {
-    PairDialect pd;
-    pd.real = host_.real;
-    pd.sqrt = host_.sqrt;
-    pd.kernelW = host_.kernelW;
-    pd.kernelGradient = host_.kernelGradient;
-    pd.literalSuffix = host_.lit("");
-    return pd;
-  }();
+  const PairDialect dialect = pairDialectOf(host_);
   auto difference = [&](const PairQuantity& pq, bool mirror) {
     scene_ << body << "const double " << pq.name << (mirror ? "_ji" : "") << "[3] = {";
     for (int c = 0; c < 3; ++c) {
