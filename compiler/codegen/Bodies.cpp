@@ -38,7 +38,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   mpi_ = sched.distribution.enabled;
   globalIds_ = opts.globalIds || mpi_;
   splitPhases_ = opts.splitUnits && opts.backend != Backend::OpenCL && !mpi_;
-  intPow_ = opts.intPow && opts.backend != Backend::OpenCL && !singlePrecision_;
+  intPow_ = opts.intPow && !singlePrecision_;
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {
@@ -209,14 +209,15 @@ bool ScenePrinter::intPowUsed() const {
 
 // A `pow` of the scene's namespace, which the bodies' unqualified calls find before the C
 // library's: sphc::pow_int multiplies where the exponent is a small integer (docs/
-// performance.md, "Cheaper arithmetic"). Not on the OpenCL device (its pow, within the
-// backends' agreement) nor in single precision.
+// performance.md, "Cheaper arithmetic"); the OpenCL device the same (devicePowFunction).
+// Not in single precision.
 void ScenePrinter::emitPowFunction() {
   if (!intPowUsed()) return;
   out_ << "// pow(x, y) of the bodies: x^y by multiplications where y is an integer with |y| <= 8\n"
           "// (within 8 ulp of the C library's pow), pow itself otherwise (sphc/pow.h; sphc\n"
           "// --int-pow=off: the C library's pow).\n"
           "static inline double pow(double x, double y) { return sphc::pow_int(x, y); }\n\n";
+  devicePowFunction();
 }
 
 void ScenePrinter::emitLineDirective(std::ostringstream& os, llvm::SMLoc l) const {

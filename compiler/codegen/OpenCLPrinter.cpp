@@ -27,6 +27,7 @@ class OpenCLPrinter : public ScenePrinter {
   // copy of the constants.
   bool bodyOnDevice(bool converged) const override { return !converged; }
   void deviceKernelFunctions() override;
+  void devicePowFunction() override;
   void beforeScene() override;
   void searchMembers() override;
   std::string ghostsType() const override { return "sphc::ocl::DeviceGhosts"; }
@@ -157,6 +158,42 @@ void OpenCLPrinter::deviceKernelFunctions() {
          "  kernel_gradient(x, r, h, g);\n"
          "  return r > 0.0 ? g[0] : 0.0;\n"
          "}\n";
+  resetLineDirective(cl_, device_);
+}
+
+// sphc/pow.h's pow_int in OpenCL C (the same products in the same order, the same special
+// values to the built-in pow), so that the device computes the bodies' integer powers as the
+// CPU backends do. The built-in pow cannot be overloaded: the bodies' calls reach it through
+// a macro defined after it.
+void OpenCLPrinter::devicePowFunction() {
+  if (!bodyOnDevice(false)) return;
+  cl_ << "// pow(x, y) of the bodies: x^y by multiplications where y is an integer with |y| <= 8,\n"
+         "// the built-in pow otherwise (sphc/pow.h's pow_int; sphc --int-pow=off: pow).\n"
+         "inline real sphc_pow_uint_small(real x, int n) {\n"
+         "  switch (n) {\n"
+         "    case 0: return 1.0;\n"
+         "    case 1: return x;\n"
+         "    case 2: return x * x;\n"
+         "    case 3: return x * x * x;\n"
+         "    case 4: { const real x2 = x * x; return x2 * x2; }\n"
+         "    case 5: { const real x2 = x * x; return x2 * x2 * x; }\n"
+         "    case 6: { const real x2 = x * x; return x2 * x2 * x2; }\n"
+         "    case 7: { const real x2 = x * x; return x2 * x2 * x2 * x; }\n"
+         "    default: { const real x2 = x * x; const real x4 = x2 * x2; return x4 * x4; }\n"
+         "  }\n"
+         "}\n"
+         "inline real sphc_pow_int(real x, real y) {\n"
+         "  if (fabs(y) <= 8.0) {  // false for NaN\n"
+         "    const int n = (int)y;\n"
+         "    if ((real)n == y) {\n"
+         "      const real r = sphc_pow_uint_small(x, n < 0 ? -n : n);\n"
+         "      const real a = fabs(r);\n"
+         "      if (a >= DBL_MIN && a <= DBL_MAX) return n < 0 ? 1.0 / r : r;\n"
+         "    }\n"
+         "  }\n"
+         "  return pow(x, y);\n"
+         "}\n"
+         "#define pow(x, y) sphc_pow_int(x, y)\n";
   resetLineDirective(cl_, device_);
 }
 

@@ -70,6 +70,7 @@ class ScenePrinter {
   // Where the body of an equation method or stepper runs: its dialect and stream.
   virtual bool bodyOnDevice(bool converged) const { return false; }
   virtual void deviceKernelFunctions() {}
+  virtual void devicePowFunction() {}  // sphc::pow_int in the kernels' language
   virtual void beforeScene() {}                     // before "The scene" (OpenCL: SCENE_CL)
   virtual void searchMembers() = 0;                 // neighbour search state of struct Scene
   virtual std::string ghostsType() const = 0;
@@ -363,7 +364,7 @@ class ScenePrinter {
   // EmitOptions::splitUnits on a CPU backend without --mpi: the phases' definitions, out of
   // struct Scene (emitPhase), printed after it between the markers of CppEmitter.h.
   bool splitPhases_ = false;
-  bool intPow_ = false;  // EmitOptions::intPow, CPU double precision
+  bool intPow_ = false;  // EmitOptions::intPow, double precision (host and device)
   std::ostringstream phases_;
   std::vector<std::string> sourceArrays_;  // arrays that need a cell list, by name
   std::set<std::string> loopArrays_;       // arrays in a neighbour pass, as dest or source

@@ -72,7 +72,7 @@ static cl::opt<OnOff, false, NamedValues<OnOff>> FmaOpt(
                clEnumValN(OnOff::Off, "off", "a multiply and an add, each rounded")),
     cl::cat(SphcCat));
 static cl::opt<OnOff, false, NamedValues<OnOff>> IntPowOpt(
-    "int-pow", cl::desc("pow(x, y) in the bodies (serial and openmp, double precision):"),
+    "int-pow", cl::desc("pow(x, y) in the bodies (double precision, every backend):"),
     cl::init(OnOff::On),
     cl::values(clEnumValN(OnOff::On, "on",
                           "by multiplications where y is an integer with |y| <= 8 (within 8 "
