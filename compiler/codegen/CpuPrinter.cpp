@@ -4,6 +4,8 @@
 // marks parallel gets `#pragma omp parallel for` on OpenMP and nothing on serial. Loops over
 // destination particles only write their own particle (gather), so they need no atomics and
 // give the serial result bit for bit.
+#include "codegen/CpuLazyCells.h"
+#include "codegen/CpuVerletTune.h"
 #include "codegen/Printer.h"
 #include "codegen/SymmetricPairs.h"
 
@@ -68,24 +70,24 @@ class CpuPrinter : public ScenePrinter {
   std::pair<const DestinationWork*, const DestinationWork*> crossPair(
       const DestinationWork& w) const;
   // --verlet-skin=auto: the skin and the re-sort chosen at run time (sphc/verlet_tune.h;
-  // CpuVerletTune.inc); --verlet-skin=F keeps the code of a fixed skin.
+  // CpuVerletTune.cpp); --verlet-skin=F keeps the code of a fixed skin.
   bool tuned() const { return tuned_; }
   void tunedMembers();
   // The arrays of a pair loop whose positions or h something may change (the others are
   // static: the lists' rebuild check skips them).
   std::vector<int> movingArrays(int d, int s) const;
-  std::string arrayList(const std::vector<int>& arrays) const;
   void tunedRebuildCheck(const std::string& lists, const DestinationWork& w, int d, int s);
   // The kept lists whose destination or source is array S (forgotten after S is sorted).
   std::vector<std::string> listsOf(const std::string& S) const;
   void tunedUpdateNeighbours();
   // --verlet-skin without a periodic or mirror domain: the search domain and the moving
   // sources' cell lists are built only where a pair loop rebuilds its kept lists
-  // (CpuLazyCells.inc; docs/performance.md, "Cell lists only when a kept list is rebuilt").
+  // (CpuLazyCells.cpp; docs/performance.md, "Cell lists only when a kept list is rebuilt").
   bool lazyCells() const { return lazyCells_ && verlet() && !hasDomain(); }
   void emitLazyCells();
   void lazyCellsMembers();
   void lazyCellsDue();  // end of update_neighbours: the domain and cells out of date
+  std::vector<std::string> movingSources() const;  // the sources that are not static
   // `const std::vector<const sphc::ParticleArray*> all = {...};`: the arrays of the
   // neighbour loops (the search domain's).
   std::string loopArraysDecl() const;
@@ -136,7 +138,7 @@ class CpuPrinter : public ScenePrinter {
   void updateNeighbours() override;
   void staticCellLists() override {
     if (anyStatic()) emitStaticCells();
-    if (lazyCells()) emitLazyCells();  // CpuLazyCells.inc
+    if (lazyCells()) emitLazyCells();  // CpuLazyCells.cpp
   }
   void updateNeighboursWithGhosts() override;
   std::string removeGhosts() const override;
@@ -493,7 +495,7 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
     if (d == s && symmetric_ && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
     scene_ << "        }\n";
   }
-  if (lazyCells() && !isStatic(S))  // CpuLazyCells.inc
+  if (lazyCells() && !isStatic(S))  // CpuLazyCells.cpp
     scene_ << "        if (verlet_build) build_cells_" << S << "();  // the cells of this update, once\n";
 }
 
@@ -835,7 +837,7 @@ void CpuPrinter::emitStaticCells() {
 
 // update_neighbours of a scene without periodic or mirror domain.
 void CpuPrinter::updateNeighbours() {
-  if (tuned()) return tunedUpdateNeighbours();  // CpuVerletTune.inc
+  if (tuned()) return tunedUpdateNeighbours();  // CpuVerletTune.cpp
   bool reordersMoving = false;
   for (const auto& S : sourceArrays_) reordersMoving |= !isStatic(S) && reorders(S);
   if (lazyCells()) {  // `all` for order_domain; the domain: make_domain (CpuLazyCells.inc)
@@ -943,8 +945,84 @@ void CpuPrinter::adaptiveDtArray(int a) {
   scene_ << "      }\n    }\n";
 }
 
-#include "codegen/CpuVerletTune.inc"
-#include "codegen/CpuLazyCells.inc"
+// --verlet-skin=auto (CpuVerletTune.cpp) with this scene's arrays, lists and statements.
+void CpuPrinter::tunedMembers() { verlet_tune::members(out_); }
+
+std::vector<int> CpuPrinter::movingArrays(int d, int s) const {
+  std::vector<int> moving;
+  for (int a : {d, s})
+    if (!isStatic(arr(a).name) && (moving.empty() || moving.back() != a)) moving.push_back(a);
+  return moving;
+}
+
+void CpuPrinter::tunedRebuildCheck(const std::string& lists, const DestinationWork& w, int d,
+                                   int s) {
+  verlet_tune::KeptLoop loop;
+  loop.lists = lists;
+  loop.begin = rangeBegin(w);
+  loop.end = rangeEnd(w);
+  loop.dest = arr(d).name;
+  for (int a : movingArrays(d, s)) loop.moving.push_back(arr(a).name);
+  if (d != s && loop.moving.size() == 1)
+    loop.staticArray = loop.moving[0] == arr(d).name ? arr(s).name : arr(d).name;
+  loop.ranged = w.ranged();
+  loop.clearUpper = d == s && symmetric_;
+  verlet_tune::rebuildCheck(scene_, loop);
+}
+
+std::vector<std::string> CpuPrinter::listsOf(const std::string& S) const {
+  std::vector<std::string> out;
+  forEachVerletLists([&](const std::string& lists, const Phase&, const DestinationWork& w,
+                         const NeighbourPass& pass) {
+    if (arr(w.array).name == S || arr(pass.source).name == S) out.push_back(lists);
+  });
+  return out;
+}
+
+void CpuPrinter::tunedUpdateNeighbours() {
+  verlet_tune::Update u;
+  u.lazyCells = lazyCells();
+  u.loopArrays = !loopArrays_.empty();
+  u.anyStatic = anyStatic();
+  u.anyReorders = anyReorders();
+  u.loopArraysDecl = loopArraysDecl();
+  for (const auto& S : sourceArrays_) {
+    verlet_tune::Source src;
+    src.name = S;
+    src.isStatic = isStatic(S);
+    src.reorders = reorders(S);
+    src.orderCells = cellListBuild(S, S + ".n", "order_domain");
+    src.cells = cellListBuild(S, S + ".n");
+    src.permute = permuteInCellOrder(S);
+    src.lists = listsOf(S);
+    u.sources.push_back(src);
+  }
+  verlet_tune::updateNeighbours(scene_, u, [&] { searchDomain(); }, [&] { lazyCellsDue(); });
+}
+
+// Lazy cell lists (CpuLazyCells.cpp) with this scene's arrays and statements.
+std::vector<std::string> CpuPrinter::movingSources() const {
+  std::vector<std::string> moving;
+  for (const auto& S : sourceArrays_)
+    if (!isStatic(S)) moving.push_back(S);
+  return moving;
+}
+
+std::string CpuPrinter::loopArraysDecl() const {
+  std::vector<std::string> names;
+  for (const auto& a : plan_.arrays)
+    if (loopArrays_.count(a.name)) names.push_back(a.name);
+  return lazy_cells::loopArraysDecl(names);
+}
+
+void CpuPrinter::lazyCellsMembers() { lazy_cells::members(out_, movingSources()); }
+
+void CpuPrinter::lazyCellsDue() { lazy_cells::markDue(scene_, movingSources()); }
+
+void CpuPrinter::emitLazyCells() {
+  lazy_cells::functions(scene_, movingSources(), [&] { searchDomain(); },
+                        [&](const std::string& S) { return cellListBuild(S, S + ".n"); });
+}
 
 }  // namespace
 
