@@ -273,6 +273,8 @@ void CpuPrinter::forEachVerletLists(
     for (const Phase& ph : g.phases)
       for (const DestinationWork& w : ph.destinations)
         for (const NeighbourPass& pass : w.passes) {
+          // B <- A run in A <- B's pass (crossPair) reads A <- B's lists: none of its own.
+          if (crossPair(w).second == &w && &pass == &w.passes.front()) continue;
           const std::string lists = verletLists(ph.name, w, pass.source);
           if (pass.searches() && declared.insert(lists).second) f(lists, ph, w, pass);
         }
