@@ -207,7 +207,7 @@ def main():
     print("%-80s %7s %9s %9s %9s" % ("region (function:line of the --emit=cpp, label)", "calls",
                                       "CPU sum", "max", "imbal."))
     for name, calls, s, mx in sorted(regions, key=lambda x: -x[3])[:a.top]:
-        print("%-80s %7.0f %9.3f %9.3f %9.3f" % (name[:80], calls, s, mx, mx - s / threads))
+        print("%-80s %7.0f %9.3f %9.3f %9.3f" % (name, calls, s, mx, mx - s / threads))
     print("%-80s %7s %9.3f %9.3f %9.3f" % ("all %d regions" % len(regions), "", total_sum,
                                            total_max, total_max - total_sum / threads))
     print("calling thread outside the regions [s CPU]: %.3f (%.1f%% of the work)"
