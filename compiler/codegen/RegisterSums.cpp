@@ -6,12 +6,13 @@
 // loads and stores each sum: the C++ compiler cannot keep them in registers across the
 // neighbours, as the stores through d_ pointers may alias what the next pair reads (and in a
 // pass of each pair once, SymmetricPairs.cpp, the mirrored calls do write the same arrays at
-// s_idx). Here, for a pair loop that allows it, each accumulated property is a local array
-// `acc_NAME[k]` (k the component) of the destination loop: loaded before the neighbours,
-// stored after them; the bodies' calls for d_idx take a second printing of the body,
-// NAME_loop_sums, whose sites `d_NAME[S * d_idx + k]` read and write `acc_NAME[k]` (GCC's
-// scalar replacement then keeps them in registers). The mirrored calls (destination s_idx)
-// write memory as before.
+// s_idx). Here, for a pair loop that allows it, each component k of an accumulated property
+// is a local of the destination loop, `acc_NAME` (stride 1) or `acck_NAME` (`acc0_binv`):
+// loaded before the neighbours, stored after them. The bodies' calls for d_idx take a second
+// printing of the body, NAME_loop_sums, whose sites `d_NAME[S * d_idx + k]` are those locals,
+// passed by reference (once inlined, their addresses are not taken: GCC keeps them in
+// registers; local arrays passed by pointer stayed on the stack). The mirrored calls
+// (destination s_idx) write memory as before.
 //
 // Why it is the same bit for bit: the same operations in the same order, on the same values.
 // During the neighbour loop of d_idx no other code reads or writes d_NAME[S * d_idx + k]:
@@ -99,6 +100,24 @@ bool destinationSites(const std::string& text, const std::string& prop,
   return true;
 }
 
+// The local of component k of a sum of stride S: acc_NAME (S = 1), accK_NAME.
+std::string localName(const std::string& prop, int stride, int comp) {
+  return stride == 1 ? "acc_" + prop : "acc" + std::to_string(comp) + "_" + prop;
+}
+
+// The components of d_NAME a body's text updates (its stride: 1 where it indexes none).
+std::set<int> bodyComponents(const std::string& text, const std::string& prop, int& stride) {
+  std::vector<DestinationSite> sites;
+  std::set<int> comps;
+  stride = 1;
+  if (!destinationSites(text, prop, sites)) return comps;
+  for (const DestinationSite& s : sites) {
+    comps.insert(s.comp);
+    stride = s.stride;
+  }
+  return comps;
+}
+
 std::string indexText(int stride, int comp) {
   return stride == 1 ? std::string("d_idx")
                      : std::to_string(stride) + " * d_idx + " + std::to_string(comp);
@@ -174,23 +193,18 @@ void ScenePrinter::emitSumsLoad(std::ostream& os, const std::string& indent,
   for (const auto& [p, sc] : rs.props) names += (names.empty() ? "" : ", ") + p;
   os << indent << "// The destination's sums in locals across its neighbours (codegen/RegisterSums.cpp;\n"
      << indent << "// sphc --no-register-sums: in memory at every pair): " << names << ".\n";
-  for (const auto& [p, sc] : rs.props) {
-    const int size = *sc.second.rbegin() + 1;
-    os << indent << host_.real << " acc_" << p << "[" << size << "] = {";
-    for (int k = 0; k < size; ++k)
-      os << (k ? ", " : "")
-         << (sc.second.count(k) ? "d_" + p + "[" + indexText(sc.first, k) + "]"
-                                : std::string("0.0"));
-    os << "};\n";
-  }
+  for (const auto& [p, sc] : rs.props)
+    for (int k : sc.second)
+      os << indent << host_.real << " " << localName(p, sc.first, k) << " = d_" << p << "["
+         << indexText(sc.first, k) << "];\n";
 }
 
 void ScenePrinter::emitSumsStore(std::ostream& os, const std::string& indent,
                                  const RegisterSums& rs) const {
   for (const auto& [p, sc] : rs.props)
     for (int k : sc.second)
-      os << indent << "d_" << p << "[" << indexText(sc.first, k) << "] = acc_" << p << "[" << k
-         << "];\n";
+      os << indent << "d_" << p << "[" << indexText(sc.first, k) << "] = "
+         << localName(p, sc.first, k) << ";\n";
 }
 
 std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const RegisterSums& rs) const {
@@ -200,8 +214,12 @@ std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const Register
   for (const std::string& p : own) any = any || rs.props.count(p);
   if (!any) return equationCall(eq, ast::Method::Loop, d);
   auto argument = [&](const BodyParam& p) -> std::string {
-    if (p.kind == BodyParam::DProp && own.count(p.name)) return "acc_" + p.name;
-    return "";
+    if (p.kind != BodyParam::DProp || !own.count(p.name)) return "";
+    int stride = 1;
+    std::string args;
+    for (int k : bodyComponents(b.source.text, p.name, stride))
+      args += (args.empty() ? "" : ", ") + localName(p.name, stride, k);
+    return args;
   };
   return callBody(bodyFunctionName(eq.name, "loop") + "_sums", b, d, eqStruct(eq), "t", ".",
                   argument) +
@@ -236,18 +254,25 @@ void ScenePrinter::emitSumsFunction(const PlanEquation& eq, std::ostringstream& 
     std::vector<DestinationSite> sites;
     if (!destinationSites(b.source.text, p, sites)) return;  // refused (registerSums)
     for (const DestinationSite& site : sites)
-      edits.push_back({site.begin, site.end, "acc_" + p + "[" + std::to_string(site.comp) + "]"});
+      edits.push_back({site.begin, site.end, localName(p, site.stride, site.comp)});
   }
   const std::string name = bodyFunctionName(eq.name, "loop") + "_sums";
   os << "// " << b.source.label << ", from " << loc(b.source.start)
-     << ": the destination's sums in locals acc_NAME[component] (codegen/RegisterSums.cpp)\n";
+     << ": the destination's sums in locals (acc_NAME, accK_NAME: component K;\n"
+     << "// codegen/RegisterSums.cpp)\n";
   if (host_.lineDirectives) emitLineDirective(os, b.source.start);
   os << host_.functionPrefix << "void " << name << "(";
   bool first = true;
   for (const BodyParam& p : bodyParams(b, eq.dest, host_)) {
-    os << (first ? "" : ", ")
-       << (p.kind == BodyParam::DProp && own.count(p.name) ? host_.real + "* acc_" + p.name
-                                                          : p.decl);
+    if (p.kind == BodyParam::DProp && own.count(p.name)) {
+      int stride = 1;
+      for (int k : bodyComponents(b.source.text, p.name, stride)) {
+        os << (first ? "" : ", ") << host_.real << "& " << localName(p.name, stride, k);
+        first = false;
+      }
+      continue;
+    }
+    os << (first ? "" : ", ") << p.decl;
     first = false;
   }
   os << ") {";
