@@ -171,8 +171,19 @@ RegisterSums ScenePrinter::registerSums(const DestinationWork& w,
         entry.second.insert(site.comp);
       }
       if (entry.second.empty()) return refuse(eq->name + " writes d_" + p + " nowhere found");
+      // The array's layout: then the mirrored calls' d_NAME[S * s_idx + k'] (s_idx != d_idx,
+      // k' < S) never touch the destination's slots.
+      const PlanProperty* pp = A.find(p);
+      if (!pp || pp->stride != entry.first)
+        return refuse(eq->name + " indexes d_" + p + " with a stride other than its own");
     }
   }
+  // The locals' names are free in the bodies.
+  for (const PlanEquation* eq : pass.equations)
+    for (const auto& [p, sc] : rs.props)
+      for (int k : sc.second)
+        if (occurrences(methodBody(*eq, ast::Method::Loop).source.text, localName(p, sc.first, k)))
+          return refuse(eq->name + " names " + localName(p, sc.first, k));
   if (mirrored)
     for (const PlanEquation* eq : mirrored->equations)
       for (const std::string& p : sums)
