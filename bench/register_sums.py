@@ -25,15 +25,13 @@ Needs valgrind and callgrind_annotate (not with --cpu).
 """
 
 import os
-import re
-import subprocess
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (SCENE_FILES, instruction_parser, instructions, load_average,  # noqa: E402
-                    remove_tmp, run)
+from common import (SCENE_FILES, group_instructions, instruction_parser,  # noqa: E402
+                    instructions, load_average, remove_tmp, run)
 
 FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
 # The dam break with PySPH's effects (bench/time_to_solution.py): its sphc defines and options.
@@ -52,18 +50,6 @@ CPU_SCENES = {
     "cube": (SCENE_FILES["cube"], [], ["--set", "nx=47"], 1, 11),
 }
 VARIANTS = [("memory", ["--no-register-sums"]), ("locals", [])]
-
-
-def group_instructions(callgrind_file):
-    """Instructions of the functions named group_* (inclusive of what is inlined in them)."""
-    out = subprocess.run(["callgrind_annotate", "--inclusive=no", callgrind_file],
-                         capture_output=True, text=True, check=True).stdout
-    total = 0
-    for line in out.splitlines():
-        m = re.match(r"\s*([\d,]+)\s.*\bScene::(group_\w+)", line)
-        if m:
-            total += int(m.group(1).replace(",", ""))
-    return total
 
 
 def callgrind(exe, options, steps):
