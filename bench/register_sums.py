@@ -76,8 +76,9 @@ def instructions_per_step(args, tmp):
             g = (g1 - g0) / (long_ - short)
             base = base or n
             gbase = gbase or g
-            print("%-15s %-8s %-11s %15.4g %9.3f %15.4g %9.3f" % (
-                scene, name, "%d-%d" % (short, long_), n, n / base, g, g / gbase))
+            print("%-15s %-8s %-11s %15.4g %9.3f %15.4g %9s" % (
+                scene, name, "%d-%d" % (short, long_), n, n / base, g,
+                "%.3f" % (g / gbase) if gbase else "-"))
             sys.stdout.flush()
 
 
