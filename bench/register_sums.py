@@ -40,14 +40,14 @@ PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
 SCENES = {
     "dambreak": (SCENE_FILES["dambreak"], [], [], 50, 150),
     "dambreak_pysph": (SCENE_FILES["dambreak"], PYSPH_EFFECTS, ["--set", "cfl=0.3"], 50, 150),
-    "cube": (SCENE_FILES["cube"], [], ["--set", "nx=20"], 5, 15),
+    "cube": (SCENE_FILES["cube"], [], ["--set", "nx=20", "--tf", "1"], 5, 15),
 }
 # --cpu: the same at ~100k particles (dam break dx = 0.0046; cube nx = 47, PySPH's).
 CPU_SCENES = {
     "dambreak": (SCENE_FILES["dambreak"], [], ["--set", "dx=0.0046"], 1, 21),
     "dambreak_pysph": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
                        ["--set", "dx=0.0046", "--set", "cfl=0.3"], 1, 21),
-    "cube": (SCENE_FILES["cube"], [], ["--set", "nx=47"], 1, 11),
+    "cube": (SCENE_FILES["cube"], [], ["--set", "nx=47", "--tf", "1"], 1, 11),
 }
 VARIANTS = [("memory", ["--no-register-sums"]), ("locals", [])]
 
