@@ -125,6 +125,18 @@ def instructions(callgrind_file):
     raise SystemExit("no instruction total in " + callgrind_file)
 
 
+def group_instructions(callgrind_file):
+    """Instructions of the functions named group_* (inclusive of what is inlined in them)."""
+    out = subprocess.run(["callgrind_annotate", "--inclusive=no", callgrind_file],
+                         capture_output=True, text=True, check=True).stdout
+    total = 0
+    for line in out.splitlines():
+        m = re.match(r"\s*([\d,]+)\s.*\bScene::(group_\w+)", line)
+        if m:
+            total += int(m.group(1).replace(",", ""))
+    return total
+
+
 def callgrind_build_run(sphc, path, exe, sphc_flags, options):
     """Builds the scene path into exe (sphc path -o exe sphc_flags), runs it with the run-time
     options and without output under valgrind --tool=callgrind; returns the callgrind file."""

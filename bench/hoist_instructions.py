@@ -24,15 +24,13 @@ Needs valgrind and callgrind_annotate (not with --cpu).
 """
 
 import os
-import re
-import subprocess
 import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (SCENE_FILES, callgrind_build_run, instruction_parser, instructions,  # noqa: E402
-                    load_average, remove_tmp, run)
+from common import (SCENE_FILES, callgrind_build_run, group_instructions,  # noqa: E402
+                    instruction_parser, instructions, load_average, remove_tmp, run)
 
 FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
 # scene: (file, run-time options)
@@ -75,18 +73,6 @@ def cpu_per_step(args, tmp):
         med = {name: sorted(v)[len(v) // 2] for name, v in per.items()}
         print("%-10s median: no-hoist %.4f s, hoist %.4f s per step: hoist / no-hoist = %.3f"
               % (scene, med["no-hoist"], med["hoist"], med["hoist"] / med["no-hoist"]))
-
-
-def group_instructions(callgrind_file):
-    """Instructions of the functions named group_* (inclusive of what is inlined in them)."""
-    out = subprocess.run(["callgrind_annotate", "--inclusive=no", callgrind_file],
-                         capture_output=True, text=True, check=True).stdout
-    total = 0
-    for line in out.splitlines():
-        m = re.match(r"\s*([\d,]+)\s.*\bScene::(group_\w+)", line)
-        if m:
-            total += int(m.group(1).replace(",", ""))
-    return total
 
 
 def main():

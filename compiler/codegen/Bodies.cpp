@@ -39,6 +39,8 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   globalIds_ = opts.globalIds || mpi_;
   splitPhases_ = opts.splitUnits && opts.backend != Backend::OpenCL && !mpi_;
   intPow_ = opts.intPow && !singlePrecision_;
+  registerSums_ = opts.registerSums && opts.backend != Backend::OpenCL && !singlePrecision_ &&
+                  !mpi_;
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {
@@ -385,10 +387,11 @@ void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::stri
 
 void ScenePrinter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
                                  const std::vector<const PlanEquation*>& loopers, int d,
-                                 const Dialect& dl, bool test) {
+                                 const Dialect& dl, bool test, const RegisterSums* sums) {
   emitPairQuantities(os, q, dl, test);
   for (const auto* eq : loopers)
-    os << "            " << equationCall(*eq, ast::Method::Loop, d, dl.scalarSep);
+    os << "            "
+       << (sums ? pairCall(*eq, d, *sums) : equationCall(*eq, ast::Method::Loop, d, dl.scalarSep));
 }
 
 std::string ScenePrinter::equationCall(const PlanEquation& eq, ast::Method::Kind kind, int d,

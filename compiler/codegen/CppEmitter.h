@@ -70,6 +70,12 @@ struct EmitOptions {
   // (driver/Build.cpp); serial and openmp, not --mpi. false (--single-unit): the old single
   // unit, byte for byte. The same object code either way, up to where functions are placed.
   bool splitUnits = true;
+  // In the CPU pair loops the destination's sums (the d_ properties the loop bodies
+  // accumulate at d_idx, by literal components) are locals across its neighbours, loaded
+  // before them and stored after them (codegen/RegisterSums.cpp; serial and openmp, double
+  // precision, not --mpi); false (--no-register-sums): updated in memory at every pair, as
+  // before. The values are the same bit for bit.
+  bool registerSums = true;
 };
 
 // The lines around the out-of-class phases of a split solver (EmitOptions::splitUnits).

@@ -458,10 +458,13 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          }\n";
     }
     if (!pass.equations.empty()) {
+      const RegisterSums sums = registerSums(w, pass);  // codegen/RegisterSums.cpp
+      emitSumsLoad(scene_, "          ", sums);
       scene_ << "          for (int k_nbr = 0; k_nbr < n_nbrs; ++k_nbr) {\n";
       scene_ << "            const int s_idx = static_cast<int>(NBRS[k_nbr]);\n";
-      emitCandidate(scene_, q, pass.equations, d, host_, /*test=*/false);
+      emitCandidate(scene_, q, pass.equations, d, host_, /*test=*/false, &sums);
       scene_ << "          }\n";
+      emitSumsStore(scene_, "          ", sums);
     }
     scene_ << "        }\n";
     if (mpi_)

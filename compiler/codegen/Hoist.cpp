@@ -127,10 +127,11 @@ std::vector<SourceOnlySite> ScenePrinter::hoistedSites(const PlanBody& b, const 
   return kept;
 }
 
-std::string ScenePrinter::hoistedBodyText(const PlanBody& b, const Dialect& d) const {
+std::string ScenePrinter::hoistedBodyText(const PlanBody& b, const Dialect& d,
+                                          const std::vector<TextEdit>& extra) const {
   std::string text = b.source.text;
   BodyFacts facts = b.facts;
-  std::vector<TextEdit> edits;
+  std::vector<TextEdit> edits = extra;
   auto replace = [&](const std::vector<SourceOnlySite>& sites, const std::string& name,
                      const std::string& index) {
     for (size_t k = 0; k < sites.size(); ++k) {

@@ -853,6 +853,7 @@ void ScenePrinter::emitBodies() {
                        : kind == ast::Method::Converged ? "int"
                                                         : "void",
                        eq.dest, dev ? device_ : host_, dev ? cl_ : out_);
+      if (kind == ast::Method::Loop && !dev) emitSumsFunction(eq, out_);  // RegisterSums.cpp
     }
   }
   std::set<int> emittedSteppers;

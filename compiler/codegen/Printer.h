@@ -9,6 +9,7 @@
 // but spellings.
 #pragma once
 
+#include "body/TextEdits.h"
 #include "codegen/CppEmitter.h"
 #include "codegen/CppText.h"
 #include "codegen/Schedule.h"
@@ -46,6 +47,14 @@ struct Dialect {
   // Loop bodies read their source-only values from per-particle arrays (codegen/Hoist.cpp).
   bool hoist = false;
   std::string lit(const std::string& v) const { return floatLiterals ? v + "f" : v; }
+};
+
+// For one pair loop: its accumulated d_ properties, each with its stride and the components
+// the bodies update (empty: the sums stay in memory, `refusal` says why; RegisterSums.cpp).
+struct RegisterSums {
+  std::map<std::string, std::pair<int, std::set<int>>> props;  // name -> stride, components
+  std::string refusal;
+  bool active() const { return !props.empty(); }
 };
 
 struct PairDialect;  // analysis/PairQuantityTable.h
@@ -152,7 +161,7 @@ class ScenePrinter {
   // gathered neighbour list), the quantities without the cut-off test.
   void emitCandidate(std::ostream& os, const std::set<std::string>& q,
                      const std::vector<const PlanEquation*>& loopers, int d, const Dialect& dl,
-                     bool test = true);
+                     bool test = true, const RegisterSums* sums = nullptr);
   // loop_all: the neighbour test of one candidate s_idx (hj, XIJ, R2IJ and the cut-off,
   // leaving with `skip`), before it joins the neighbour list. `radius2`: the squared radius
   // in units of hmax (RADIUS2, the support; VERLET_RADIUS2 for the lists of --verlet-skin).
@@ -173,7 +182,9 @@ class ScenePrinter {
   std::vector<SourceOnlySite> hoistedDestinationSites(const PlanBody& b, const Dialect& d) const;
   // The body's text with each hoisted site replaced by `s_hoistedK[s_idx]` (and its facts
   // moved with it), its multiply-adds fused.
-  std::string hoistedBodyText(const PlanBody& b, const Dialect& d) const;
+  // `extra`: further edits of the text (RegisterSums.cpp), none overlapping a hoisted site.
+  std::string hoistedBodyText(const PlanBody& b, const Dialect& d,
+                              const std::vector<TextEdit>& extra = {}) const;
   // After a loop body's function `name`: one function per hoisted site, NAME_hoistedK(s_idx,
   // ...), returning the site's value for a source particle.
   void emitHoistFunctions(const PlanBody& b, const std::string& name, const Dialect& d,
@@ -226,6 +237,22 @@ class ScenePrinter {
   std::string symmetricDestinationHoisted(const std::string& eqValues, const std::string& k) const {
     return "dhoisted_all_" + eqValues + "_" + k;
   }
+
+  // ---- The destination's sums in locals across its neighbours (RegisterSums.cpp) ----
+  // The sums of pass (destination w) in locals, or why not; `mirrored`: the pass of the
+  // other array whose calls go with it (a cross pass, SymmetricPairs.cpp).
+  RegisterSums registerSums(const DestinationWork& w, const NeighbourPass& pass,
+                            const NeighbourPass* mirrored = nullptr) const;
+  // Before the neighbour loop: the locals acc_NAME loaded (or, refused, a comment why);
+  // after it: stored.
+  void emitSumsLoad(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
+  void emitSumsStore(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
+  // The call of eq's loop for destination d: with rs active, of its function on the locals.
+  std::string pairCall(const PlanEquation& eq, int d, const RegisterSums& rs) const;
+  // After eq's loop function: its form on the locals (NAME_loop_sums), where a loop uses it.
+  void emitSumsFunction(const PlanEquation& eq, std::ostringstream& os);
+  bool registerSums_ = false;                // EmitOptions::registerSums (CPU double, not mpi)
+  std::unique_ptr<std::set<int>> sumsDecls_;  // equation declarations whose _sums form is used
 
   // ---- The host program (HostProgram.cpp) ----
   void emitBodies();

@@ -292,6 +292,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   scene_ << "        }\n";
   // The destination-only values of every particle, for the mirrored calls.
   emitDestinationHoistedAll(pass, pragma);
+  const RegisterSums sums = registerSums(w, pass);
   // One destination's neighbours in [from, to) of its kept list (sorted): the pair
   // quantities, the bodies for d_idx and, with `both`, for s_idx (unless the self pair).
   auto segment = [&](const std::string& indent, const std::string& begin, const std::string& end,
@@ -315,21 +316,23 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     }
     scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
     scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
+    emitSumsLoad(scene_, in, sums);  // codegen/RegisterSums.cpp
     scene_ << in << "for (const std::uint32_t* k = " << from << "; k != k_end" << to
            << "; ++k) {\n";
     const std::string body = in + "  ";
     scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
     emitNeighbourTest(scene_, host_, "continue;", body);
     emitPairQuantitiesOnce(q, both, body);
-    for (const PlanEquation* eq : pass.equations)
-      scene_ << body << equationCall(*eq, ast::Method::Loop, d);
+    for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
     if (both) {
       scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
       for (const PlanEquation* eq : pass.equations)
         scene_ << body << "  " << callBodyMirrored(*eq, d);
       scene_ << body << "}\n";
     }
-    scene_ << in << "}\n" << indent << "}\n";
+    scene_ << in << "}\n";
+    emitSumsStore(scene_, in, sums);
+    scene_ << indent << "}\n";
   };
   const std::string lower = "std::lower_bound(kept.data(), k_end, static_cast<std::uint32_t>(";
   const std::string upper = "kept.data() + " + lists + ".upper[d_idx]";  // s_idx >= d_idx
@@ -497,16 +500,19 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   emitDestinationHoisted(scene_, ab, "          ");
   scene_ << "          const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
   scene_ << "          const std::uint32_t* const k_end = kept.data() + kept.size();\n";
+  const RegisterSums sums = registerSums(A, ab, &ba);  // codegen/RegisterSums.cpp
+  emitSumsLoad(scene_, "          ", sums);
   scene_ << "          for (const std::uint32_t* k = kept.data(); k != k_end; ++k) {\n";
   const std::string body = "            ";
   scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
   emitNeighbourTest(scene_, host_, "continue;", body);
   emitPairQuantitiesOnce(q, true, body);
-  for (const PlanEquation* eq : ab.equations)
-    scene_ << body << equationCall(*eq, ast::Method::Loop, A.array);
+  for (const PlanEquation* eq : ab.equations) scene_ << body << pairCall(*eq, A.array, sums);
   for (const PlanEquation* eq : ba.equations)
     scene_ << body << callBodyMirrored(*eq, B.array, "mirror_");
-  scene_ << "          }\n        }\n        }\n      }\n";
+  scene_ << "          }\n";
+  emitSumsStore(scene_, "          ", sums);
+  scene_ << "        }\n        }\n      }\n";
 }
 
 }  // namespace sphc

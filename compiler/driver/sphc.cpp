@@ -128,6 +128,14 @@ static cl::opt<bool> NoSymmetricPairs(
              "both particles, on the CPU backends with kept neighbour lists; --report says "
              "which loops; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoRegisterSums(
+    "no-register-sums",
+    cl::desc("In the CPU pair loops, update the destination's sums in memory at every pair "
+             "(default: the d_ properties the loop bodies accumulate at d_idx are locals "
+             "across the neighbours, loaded before them and stored after them, where the "
+             "bodies allow it; serial and openmp, double precision; the results are the same "
+             "bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoLazyCells(
     "no-lazy-cells",
     cl::desc("With kept neighbour lists, build the search domain and cell lists at every "
@@ -443,6 +451,7 @@ int main(int argc, char** argv) {
   emitOpts.symmetricPairs = !NoSymmetricPairs;
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
+  emitOpts.registerSums = !NoRegisterSums;
   if (Report && Emit != EmitKind::OpenCL)
     for (const std::string& note : sphc::symmetricPairsNotes(*schedule, emitOpts))
       llvm::outs() << "note: " << note << "\n";
