@@ -193,15 +193,7 @@ void ScenePrinter::emitKernelFunctions() {
 // pow(x, y) in the bodies and helper functions (found by a lexical scan for the identifier).
 bool ScenePrinter::intPowUsed() const {
   if (!intPow_) return false;
-  auto ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
-  auto calls = [&](const std::string& text) {
-    for (size_t at = text.find("pow"); at != std::string::npos; at = text.find("pow", at + 1)) {
-      bool before = at > 0 && ident(text[at - 1]);
-      bool after = at + 3 < text.size() && ident(text[at + 3]);
-      if (!before && !after) return true;
-    }
-    return false;
-  };
+  auto calls = [](const std::string& text) { return identifierOccurrences(text, "pow") > 0; };
   for (const auto& b : plan_.bodies)
     if (calls(b.source.text)) return true;
   for (const auto& f : plan_.functions)

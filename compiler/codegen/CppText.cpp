@@ -161,4 +161,15 @@ std::string singlePrecisionBody(const std::string& text) {
   return out;
 }
 
+bool isIdentifierChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+size_t identifierOccurrences(const std::string& text, const std::string& name) {
+  size_t n = 0;
+  for (size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1))
+    if ((at == 0 || !isIdentifierChar(text[at - 1])) &&
+        (at + name.size() >= text.size() || !isIdentifierChar(text[at + name.size()])))
+      ++n;
+  return n;
+}
+
 }  // namespace sphc

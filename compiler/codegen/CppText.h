@@ -32,6 +32,11 @@ std::string accessor(const std::string& t);
 // The function holding method `method` of an equation or stepper: Owner_method.
 std::string bodyFunctionName(const std::string& owner, const std::string& method);
 
+// A letter, digit or underscore: a character of a C identifier.
+bool isIdentifierChar(char c);
+// How many times the identifier `name` occurs in text as a whole word.
+size_t identifierOccurrences(const std::string& text, const std::string& name);
+
 // `name`, or `name_` where `name` is a C++ keyword (a property may be called `new`).
 std::string cppSafeName(const std::string& name);
 

@@ -26,6 +26,7 @@
 //     the pair quantities (the destination's are loaded before the loop in either form);
 //   - no loop_all runs in the pass (it would read the sums between the loads and the loop).
 // Where a loop is refused, a comment in the generated code says why.
+#include "codegen/CppText.h"
 #include "codegen/Printer.h"
 
 #include <regex>
@@ -52,17 +53,6 @@ struct DestinationSite {
   unsigned begin = 0, end = 0;
   int stride = 0, comp = 0;
 };
-// How many times the identifier `name` occurs in text.
-size_t occurrences(const std::string& text, const std::string& name) {
-  auto ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
-  size_t n = 0;
-  for (size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1))
-    if ((at == 0 || !ident(text[at - 1])) &&
-        (at + name.size() >= text.size() || !ident(text[at + name.size()])))
-      ++n;
-  return n;
-}
-
 // The d_ properties body b writes, constants of array a (if any) left out.
 std::set<std::string> written(const PlanBody& b, const PlanArray* a = nullptr) {
   std::set<std::string> w;
@@ -77,13 +67,10 @@ std::set<std::string> written(const PlanBody& b, const PlanArray* a = nullptr) {
 bool destinationSites(const std::string& text, const std::string& prop,
                       std::vector<DestinationSite>& out) {
   const std::string name = "d_" + prop;
-  static const auto ident = [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-  };
   out.clear();
   for (size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1)) {
-    if ((at > 0 && ident(text[at - 1])) ||
-        (at + name.size() < text.size() && ident(text[at + name.size()])))
+    if ((at > 0 && isIdentifierChar(text[at - 1])) ||
+        (at + name.size() < text.size() && isIdentifierChar(text[at + name.size()])))
       continue;
     size_t open = at + name.size();
     while (open < text.size() && (text[open] == ' ' || text[open] == '\t')) ++open;
@@ -152,10 +139,10 @@ RegisterSums ScenePrinter::registerSums(const DestinationWork& w,
     if (!b.facts.ok || b.source.kind != BodyKind::Loop) return refuse(eq->name + " is no plain loop");
     const std::set<std::string> own = written(b, &A);
     for (const std::string& p : sums) {
-      if (pass.source == w.array && occurrences(b.source.text, "s_" + p))
+      if (pass.source == w.array && identifierOccurrences(b.source.text, "s_" + p))
         return refuse(eq->name + " reads s_" + p + ", a sum of the pass");
       if (!own.count(p)) {
-        if (occurrences(b.source.text, "d_" + p))
+        if (identifierOccurrences(b.source.text, "d_" + p))
           return refuse(eq->name + " reads d_" + p + ", which another body accumulates");
         continue;
       }
@@ -182,12 +169,12 @@ RegisterSums ScenePrinter::registerSums(const DestinationWork& w,
   for (const PlanEquation* eq : pass.equations)
     for (const auto& [p, sc] : rs.props)
       for (int k : sc.second)
-        if (occurrences(methodBody(*eq, ast::Method::Loop).source.text, localName(p, sc.first, k)))
+        if (identifierOccurrences(methodBody(*eq, ast::Method::Loop).source.text, localName(p, sc.first, k)))
           return refuse(eq->name + " names " + localName(p, sc.first, k));
   if (mirrored)
     for (const PlanEquation* eq : mirrored->equations)
       for (const std::string& p : sums)
-        if (occurrences(methodBody(*eq, ast::Method::Loop).source.text, "s_" + p))
+        if (identifierOccurrences(methodBody(*eq, ast::Method::Loop).source.text, "s_" + p))
           return refuse(eq->name + " (the mirrored calls) reads s_" + p + ", a sum of the pass");
   return rs;
 }
