@@ -246,28 +246,6 @@ const Property& property_named(const ParticleArray& a, const std::string& name) 
   return a.props[static_cast<std::size_t>(idx)];
 }
 
-// The properties written for one output array: x, y, z, then the requested ones (or all),
-// each once, in order.
-std::vector<const Property*> selected_properties(const OutputArray& out) {
-  const ParticleArray& a = *out.array;
-  std::vector<std::string> names(std::begin(kPositions), std::end(kPositions));
-  if (out.props.empty()) {
-    for (const Property& p : a.props) names.push_back(p.name);
-  } else {
-    names.insert(names.end(), out.props.begin(), out.props.end());
-  }
-  std::vector<const Property*> selected;
-  for (const std::string& name : names) {
-    // A 1D or 2D scene has no y/z: write_array writes zeros for them instead.
-    if (is_position(name) && name != "x" && a.find(name) < 0) continue;
-    const Property& p = property_named(a, name);
-    bool seen = false;
-    for (const Property* q : selected) seen = seen || q == &p;
-    if (!seen) selected.push_back(&p);
-  }
-  return selected;
-}
-
 void write_property(const H5File& f, hid_t group, const std::string& group_path,
                     const Property& p, std::size_t n) {
   const std::string where = child_path(group_path, p.name);
@@ -315,7 +293,7 @@ void write_array(const H5File& f, hid_t file, const OutputArray& out) {
                     H5Gclose, where, "cannot create group");
   write_scalar_attribute(f, group.get(), where, "n", H5T_NATIVE_INT64,
                          static_cast<std::int64_t>(a.n));
-  for (const Property* p : selected_properties(out)) write_property(f, group.get(), where, *p, a.n);
+  for (const Property* p : output_properties(out)) write_property(f, group.get(), where, *p, a.n);
   // Positions a lower-dimensional scene does not have are written as zeros, so that every
   // file has x, y and z (ParaView's X_Y_Z geometry, and readers that expect all three).
   for (const char* pos : kPositions) {
@@ -541,6 +519,26 @@ bool parse_csv_number(const std::string& text, double& value) {
 
 }  // namespace
 
+std::vector<const Property*> output_properties(const OutputArray& out) {
+  const ParticleArray& a = *out.array;
+  std::vector<std::string> names(std::begin(kPositions), std::end(kPositions));
+  if (out.props.empty()) {
+    for (const Property& p : a.props) names.push_back(p.name);
+  } else {
+    names.insert(names.end(), out.props.begin(), out.props.end());
+  }
+  std::vector<const Property*> selected;
+  for (const std::string& name : names) {
+    // A 1D or 2D scene has no y/z: write_array writes zeros for them instead.
+    if (is_position(name) && name != "x" && a.find(name) < 0) continue;
+    const Property& p = property_named(a, name);
+    bool seen = false;
+    for (const Property* q : selected) seen = seen || q == &p;
+    if (!seen) selected.push_back(&p);
+  }
+  return selected;
+}
+
 // -------------------------------------------------------------------------------------------------
 
 void write_particles_hdf5(const std::string& path, const std::vector<OutputArray>& arrays,
@@ -654,7 +652,7 @@ XdmfEntry make_xdmf_entry(const std::string& h5_file, double t,
   for (const OutputArray& out : arrays) {
     e.arrays.emplace_back(out.array->name, out.array->n);
     auto& props = e.props.emplace_back();
-    for (const Property* p : selected_properties(out)) props.emplace_back(p->name, p->stride);
+    for (const Property* p : output_properties(out)) props.emplace_back(p->name, p->stride);
   }
   return e;
 }

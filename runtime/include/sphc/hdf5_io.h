@@ -33,6 +33,12 @@ struct OutputArray {
   std::vector<std::string> props;
 };
 
+// The properties write_particles_hdf5 writes for `out`, in its order: x, then y and z where
+// the array has them (it writes zeros for the others), then the requested properties (or
+// all), each once. Throws, naming the array and the property, where a requested one is
+// missing. Every writer of the format (the serial one, the MPI ranks' collective one) uses it.
+std::vector<const Property*> output_properties(const OutputArray& out);
+
 // Root attributes of an output file.
 struct OutputMeta {
   double t = 0.0;

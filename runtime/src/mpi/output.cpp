@@ -54,25 +54,9 @@ struct Column {
 // has), the selected properties (or all), each once; then zeros for the missing positions.
 std::vector<Column> columns_of(const OutputArray& out) {
   const ParticleArray& a = *out.array;
-  std::vector<std::string> names(std::begin(kPositions), std::end(kPositions));
-  if (out.props.empty()) {
-    for (const Property& p : a.props) names.push_back(p.name);
-  } else {
-    names.insert(names.end(), out.props.begin(), out.props.end());
-  }
   std::vector<Column> cols;
-  for (const std::string& name : names) {
-    const int k = a.find(name);
-    if (k < 0) {
-      if (name == "y" || name == "z") continue;
-      throw std::runtime_error(
-          fmt::format("array '{}' has no property '{}' to write", a.name, name));
-    }
-    const Property& p = a.props[static_cast<std::size_t>(k)];
-    bool seen = false;
-    for (const Column& c : cols) seen = seen || c.prop == &p;
-    if (!seen) cols.push_back(Column{p.name, p.type, std::max(p.stride, 1), &p});
-  }
+  for (const Property* p : output_properties(out))
+    cols.push_back(Column{p->name, p->type, std::max(p->stride, 1), p});
   for (const char* pos : kPositions)
     if (a.find(pos) < 0) cols.push_back(Column{pos, PropType::F64, 1, nullptr});
   return cols;
