@@ -1,5 +1,7 @@
 #include "analysis/PairQuantityTable.h"
 
+#include "body/Identifiers.h"
+
 #include <algorithm>
 #include <cctype>
 #include <map>
@@ -125,12 +127,11 @@ namespace {
 // `f` in the dialect: floating literals get the suffix, sqrt its spelling.
 std::string spell(const std::string& f, const PairDialect& d) {
   std::string out;
-  auto ident = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
   for (size_t i = 0; i < f.size();) {
     char c = f[i];
-    if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
+    if (isIdentifierStart(c)) {
       size_t j = i;
-      while (j < f.size() && ident(f[j])) ++j;
+      while (j < f.size() && isIdentifierChar(f[j])) ++j;
       std::string word = f.substr(i, j - i);
       out += word == "sqrt" ? d.sqrt : word;
       i = j;

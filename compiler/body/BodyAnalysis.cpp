@@ -22,6 +22,7 @@
 // own view of the positions (__LINE__, presumed locations) consistent with that.
 #include "body/BodyAnalysis.h"
 #include "body/BodyBatch.h"
+#include "body/Identifiers.h"
 
 #include "clang/AST/ASTConsumer.h"
 #include "clang/AST/ASTContext.h"
@@ -69,8 +70,6 @@ bool isTwoArgumentMathFunction(llvm::StringRef name) {
   return name == "pow" || name == "atan2" || name == "fmin" || name == "fmax" ||
          name == "fmod" || name == "hypot" || name == "copysign";
 }
-
-bool isIdentChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
 
 // What a quick lexical scan of a body finds: its identifiers (in order of first appearance,
 // outside comments and literals) and the offsets of preprocessor directives other than
@@ -131,9 +130,9 @@ BodyTokens scanBody(llvm::StringRef text) {
       else
         open.pop_back();
       ++i;
-    } else if (isIdentChar(c)) {
+    } else if (isIdentifierChar(c)) {
       size_t j = i;
-      while (j < text.size() && isIdentChar(text[j])) ++j;
+      while (j < text.size() && isIdentifierChar(text[j])) ++j;
       std::string ident = text.slice(i, j).str();
       if (!std::isdigit(static_cast<unsigned char>(c)) && !tokens.has(ident))
         tokens.identifiers.push_back(ident);
@@ -318,7 +317,7 @@ void Batch::synthesise() {
 llvm::StringRef identifierAt(const char* p) {
   while (*p == '(' || *p == ' ' || *p == '\t') ++p;
   const char* q = p;
-  while (isIdentChar(*q)) ++q;
+  while (isIdentifierChar(*q)) ++q;
   return llvm::StringRef(p, q - p);
 }
 

@@ -113,7 +113,6 @@ std::string bodyFunctionName(const std::string& owner, const std::string& method
 // comments and punctuation; comments are copied as they are.
 std::string singlePrecisionBody(const std::string& text) {
   std::string out;
-  auto isIdent = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
   size_t i = 0;
   while (i < text.size()) {
     char c = text[i];
@@ -122,9 +121,9 @@ std::string singlePrecisionBody(const std::string& text) {
       end = end == std::string::npos ? text.size() : end + (text[i + 1] == '/' ? 0 : 2);
       out += text.substr(i, end - i);
       i = end;
-    } else if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
+    } else if (isIdentifierStart(c)) {
       size_t end = i;
-      while (end < text.size() && isIdent(text[end])) ++end;
+      while (end < text.size() && isIdentifierChar(text[end])) ++end;
       std::string word = text.substr(i, end - i);
       out += word == "double" ? "float" : word;
       i = end;
@@ -135,7 +134,7 @@ std::string singlePrecisionBody(const std::string& text) {
       size_t end = i;
       while (end < text.size()) {
         char d = text[end];
-        if (isIdent(d) || d == '.') {
+        if (isIdentifierChar(d) || d == '.') {
           ++end;
         } else if ((d == '+' || d == '-') && (text[end - 1] == 'e' || text[end - 1] == 'E') &&
                    !(text[i] == '0' && i + 1 < text.size() &&
@@ -160,8 +159,6 @@ std::string singlePrecisionBody(const std::string& text) {
   }
   return out;
 }
-
-bool isIdentifierChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
 
 size_t identifierOccurrences(const std::string& text, const std::string& name) {
   size_t n = 0;

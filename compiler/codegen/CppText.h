@@ -3,6 +3,7 @@
 // body functions, and a body rewritten for --precision=single. Free functions of text only.
 #pragma once
 
+#include "body/Identifiers.h"
 #include "frontend/AST.h"
 
 #include <functional>
@@ -32,8 +33,6 @@ std::string accessor(const std::string& t);
 // The function holding method `method` of an equation or stepper: Owner_method.
 std::string bodyFunctionName(const std::string& owner, const std::string& method);
 
-// A letter, digit or underscore: a character of a C identifier.
-bool isIdentifierChar(char c);
 // How many times the identifier `name` occurs in text as a whole word.
 size_t identifierOccurrences(const std::string& text, const std::string& name);
 

@@ -1,5 +1,7 @@
 #include "codegen/FusedMultiplyAdd.h"
 
+#include "body/Identifiers.h"
+
 #include <algorithm>
 #include <cctype>
 
@@ -89,9 +91,6 @@ class Fuser {
   }
 
   static bool isBlank(char c) { return c == ' ' || c == '\t'; }
-  static bool isIdentifierChar(char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
-  }
 
   std::string render(const Site& s) const {
     std::string a = print(s.aBegin, s.aEnd), b = print(s.bBegin, s.bEnd);
