@@ -79,7 +79,7 @@ class VerletSkin {
       else if (x && !y && !z)
         moved_since_mark<false, false>(x, nullptr, nullptr, h, s, n, d2m, gm, nan);
       else
-        moved_since_mark_any(x, y, z, h, s, n, d2m, gm, nan);
+        moved_since_mark<true, true, true>(x, y, z, h, s, n, d2m, gm, nan);
       if (nan) return true;  // NaN
       d2max = d2m > d2max ? d2m : d2max;
       growth = gm > growth ? gm : growth;
@@ -124,8 +124,9 @@ class VerletSkin {
   };
   // The largest squared displacement and growth of h of one array since mark(), and whether
   // a NaN was met. OpenMP (from 16,384 particles, the runtime's threshold): a max reduction,
-  // whose value does not depend on the order.
-  template <bool HasY, bool HasZ>
+  // whose value does not depend on the order. Generic: any set of present axes, a missing
+  // one read as 0 (the loop of before).
+  template <bool HasY, bool HasZ, bool Generic = false>
   static void moved_since_mark(const double* x, const double* y, const double* z,
                                const double* h, const Saved& s, long n, double& d2max,
                                double& growth, bool& nan_met) {
@@ -137,45 +138,28 @@ class VerletSkin {
     bool nan = false;
 #pragma omp parallel for schedule(static) reduction(max : d2m, gm) reduction(| : nan) if (n > 16384)
     for (long i = 0; i < n; ++i) {
-      const double dx = x[i] - sx[i];
-      double d2 = dx * dx;
-      if (HasY) {
-        const double dy = y[i] - sy[i];
-        d2 = dx * dx + dy * dy;
-        if (HasZ) {
-          const double dz = z[i] - sz[i];
-          d2 = dx * dx + dy * dy + dz * dz;
+      double d2;
+      if (Generic) {
+        const double dx = (x ? x[i] : 0.0) - sx[i];
+        const double dy = (y ? y[i] : 0.0) - sy[i];
+        const double dz = (z ? z[i] : 0.0) - sz[i];
+        d2 = dx * dx + dy * dy + dz * dz;
+      } else {
+        const double dx = x[i] - sx[i];
+        d2 = dx * dx;
+        if (HasY) {
+          const double dy = y[i] - sy[i];
+          d2 = dx * dx + dy * dy;
+          if (HasZ) {
+            const double dz = z[i] - sz[i];
+            d2 = dx * dx + dy * dy + dz * dz;
+          }
         }
       }
       const double dh = h[i] - sh[i];
       d2m = d2 > d2m ? d2 : d2m;
       gm = dh > gm ? dh : gm;
       nan = nan | (d2 != d2) | (dh != dh);
-    }
-    d2max = d2m;
-    growth = gm;
-    nan_met = nan;
-  }
-  // The same for any set of present axes (a missing one reads as 0).
-  static void moved_since_mark_any(const double* x, const double* y, const double* z,
-                                   const double* h, const Saved& s, long n, double& d2max,
-                                   double& growth, bool& nan_met) {
-    const double* sx = s.x.data();
-    const double* sy = s.y.data();
-    const double* sz = s.z.data();
-    const double* sh = s.h.data();
-    double d2m = 0.0, gm = 0.0;
-    bool nan = false;
-#pragma omp parallel for schedule(static) reduction(max : d2m, gm) reduction(|| : nan) if (n > 16384)
-    for (long i = 0; i < n; ++i) {
-      const double dx = (x ? x[i] : 0.0) - sx[i];
-      const double dy = (y ? y[i] : 0.0) - sy[i];
-      const double dz = (z ? z[i] : 0.0) - sz[i];
-      const double d2 = dx * dx + dy * dy + dz * dz;
-      const double dh = h[i] - sh[i];
-      d2m = d2 > d2m ? d2 : d2m;
-      gm = dh > gm ? dh : gm;
-      nan = nan || d2 != d2 || dh != dh;
     }
     d2max = d2m;
     growth = gm;
