@@ -938,14 +938,24 @@ void CpuPrinter::adaptiveDtArray(int a) {
     for (int k = 0; k < plan_.dim; ++k) s += (k ? " + " : "") + c[k] + "[i] * " + c[k] + "[i]";
     return s + ")";
   };
+  // The minima by a compare, not std::fmin (a call into libm per particle: GCC does not
+  // inline it): the running minimum starts at HUGE_VAL and never becomes NaN, and for such a
+  // minimum m, `v < m ? v : m` is fmin(m, v) bit for bit (a NaN v leaves m, as fmin does).
   if (ad.cfl) {
     scene_ << "        const double vmag = " << magnitude(vel) << ";\n";
-    scene_ << "        dt_cfl = std::fmin(dt_cfl, h[i] / (cs[i] + vmag));\n";
+    scene_ << "        const double cfl_i = h[i] / (cs[i] + vmag);\n";
+    scene_ << "        dt_cfl = cfl_i < dt_cfl ? cfl_i : dt_cfl;\n";
   }
-  if (ad.viscous) scene_ << "        h2min = std::fmin(h2min, h[i] * h[i]);\n";
+  if (ad.viscous) {
+    scene_ << "        const double h2_i = h[i] * h[i];\n";
+    scene_ << "        h2min = h2_i < h2min ? h2_i : h2min;\n";
+  }
   if (ad.force) {
     scene_ << "        const double amag = " << magnitude(acc) << ";\n";
-    scene_ << "        if (amag > 0) dt_force = std::fmin(dt_force, std::sqrt(h[i] / amag));\n";
+    scene_ << "        if (amag > 0) {\n";
+    scene_ << "          const double force_i = std::sqrt(h[i] / amag);\n";
+    scene_ << "          dt_force = force_i < dt_force ? force_i : dt_force;\n";
+    scene_ << "        }\n";
   }
   scene_ << "      }\n    }\n";
 }

@@ -122,6 +122,100 @@ TEST(VerletSkin, KeptListsAreInIncreasingIndex) {
   EXPECT_TRUE(ka.empty());
 }
 
+// Lists up to kInsertionSortMax are sorted by insertion, longer ones by std::sort: both give
+// the increasing order of std::sort, for lists sorted, in ascending runs (as the cells give
+// them), reversed and shuffled, of every length around the switch.
+TEST(VerletSkin, KeptListsByInsertionAreThoseOfStdSort) {
+  std::mt19937_64 rng(5);
+  for (std::size_t n = 0; n <= 2 * sphc::kInsertionSortMax + 5; ++n) {
+    std::vector<std::uint32_t> ids(4 * n + 1);
+    for (std::size_t k = 0; k < ids.size(); ++k) ids[k] = static_cast<std::uint32_t>(3 * k + 1);
+    std::shuffle(ids.begin(), ids.end(), rng);
+    std::vector<std::uint32_t> cand(ids.begin(), ids.begin() + n), want = cand;
+    std::sort(want.begin(), want.end());
+    std::vector<std::vector<std::uint32_t>> forms = {cand, want, {want.rbegin(), want.rend()}};
+    std::vector<std::uint32_t> runs = want;  // three ascending runs, the last first
+    std::rotate(runs.begin(), runs.begin() + static_cast<long>(2 * n / 3), runs.end());
+    std::rotate(runs.begin(), runs.begin() + static_cast<long>(n / 3), runs.end());
+    forms.push_back(runs);
+    for (const auto& f : forms) {
+      std::vector<std::uint32_t> kept = {7, 7, 7};
+      sphc::keep_in_index_order(kept, f.data(), f.size());
+      EXPECT_EQ(kept, want) << "n = " << n;
+    }
+  }
+}
+
+// must_rebuild's loop per set of axes (1D x; 2D x, y; 3D x, y, z) answers as the loop over
+// x, y and z with a missing axis read as 0 did, and measures the same displacement bit for
+// bit (last_moved): arrays without z (2D) or without y and z (1D), displacements around the
+// threshold, h growing, NaN.
+TEST(VerletSkin, DisplacementCheckPerAxisSetIsTheGenericOne) {
+  const double skin = 0.1, h0 = 0.1;
+  for (int dim = 1; dim <= 3; ++dim) {
+    ParticleArray pa;
+    pa.name = "fluid";
+    pa.resize(400);
+    const char* axes[3] = {"x", "y", "z"};
+    for (int k = 0; k < dim; ++k) pa.add_property(axes[k]);
+    pa.add_property("h");
+    std::mt19937_64 rng(17 + dim);
+    std::uniform_real_distribution<double> pos(0.0, 1.0), hs(0.9 * h0, 1.1 * h0);
+    for (std::size_t i = 0; i < pa.n; ++i) {
+      for (int k = 0; k < dim; ++k) pa.f64(axes[k])[i] = pos(rng);
+      pa.f64("h")[i] = hs(rng);
+    }
+    std::vector<const ParticleArray*> all = {&pa};
+    VerletSkin verlet(skin);
+    verlet.mark(all);
+    std::vector<std::vector<double>> saved;
+    for (int k = 0; k < dim; ++k)
+      saved.emplace_back(pa.f64(axes[k]), pa.f64(axes[k]) + pa.n);
+    const std::vector<double> hsaved(pa.f64("h"), pa.f64("h") + pa.n);
+    int yes = 0, no = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+      // From the marked positions, a few particles moved by up to ~2x the threshold
+      // (a rebuild where 2 |d| > 0.1 * 2 * h_min, h_min >= 0.9 h0).
+      for (int k = 0; k < dim; ++k) std::copy(saved[k].begin(), saved[k].end(), pa.f64(axes[k]));
+      std::copy(hsaved.begin(), hsaved.end(), pa.f64("h"));
+      const double dmax = 0.1 * h0 / std::sqrt(static_cast<double>(dim));
+      std::uniform_real_distribution<double> d(-dmax, dmax);
+      std::uniform_int_distribution<std::size_t> who(0, pa.n - 1);
+      for (int m = 0; m < 3; ++m) {
+        const std::size_t i = who(rng);
+        for (int k = 0; k < dim; ++k) pa.f64(axes[k])[i] += d(rng);
+        if (trial % 7 == 0) pa.f64("h")[i] += 0.004 * h0;
+      }
+      // The generic loop (missing axes 0, as mark() saved them).
+      double d2m = 0.0, gm = 0.0;
+      for (std::size_t i = 0; i < pa.n; ++i) {
+        double c[3] = {0.0, 0.0, 0.0};
+        for (int k = 0; k < dim; ++k) c[k] = pa.f64(axes[k])[i] - saved[k][i];
+        const double d2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        const double dh = pa.f64("h")[i] - hsaved[i];
+        d2m = d2 > d2m ? d2 : d2m;
+        gm = dh > gm ? dh : gm;
+      }
+      const double moved = 2.0 * std::sqrt(d2m) + kRadiusScale * gm;
+      const bool want = !(moved <= skin * kRadiusScale * verlet.hmin());
+      EXPECT_EQ(verlet.must_rebuild(all, kRadiusScale), want) << "dim " << dim;
+      EXPECT_EQ(verlet.last_moved(), moved) << "dim " << dim;
+      (want ? yes : no) += 1;
+    }
+    EXPECT_GT(yes, 0) << "dim " << dim;  // both answers met
+    EXPECT_GT(no, 0) << "dim " << dim;
+    verlet.mark(all);  // NaN in the last axis, then in h, each alone forces a rebuild
+    EXPECT_FALSE(verlet.must_rebuild(all, kRadiusScale));
+    const double x3 = pa.f64(axes[dim - 1])[3];
+    pa.f64(axes[dim - 1])[3] = std::nan("");
+    EXPECT_TRUE(verlet.must_rebuild(all, kRadiusScale));
+    pa.f64(axes[dim - 1])[3] = x3;
+    EXPECT_FALSE(verlet.must_rebuild(all, kRadiusScale));
+    pa.f64("h")[5] = std::nan("");
+    EXPECT_TRUE(verlet.must_rebuild(all, kRadiusScale));
+  }
+}
+
 // --verlet-skin=auto (sphc/verlet_tune.h): the skin minimises the modelled cost per
 // evaluation, (1 + F)^dim (1 + k / F): no F of a fine scan around it costs less.
 TEST(SkinTuner, OptimalSkinMinimisesTheModelledCost) {

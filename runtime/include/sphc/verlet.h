@@ -66,26 +66,20 @@ class VerletSkin {
       const double* y = coordinate(pa, "y");
       const double* z = coordinate(pa, "z");
       const double* h = pa.f64("h");
-      // OpenMP (from 16,384 particles, the runtime's threshold): a max reduction, whose
-      // value does not depend on the order; NaN: true, as at the first one found.
       const long n = static_cast<long>(pa.n);
-      const double* sx = s.x.data();
-      const double* sy = s.y.data();
-      const double* sz = s.z.data();
-      const double* sh = s.h.data();
       double d2m = 0.0, gm = 0.0;
       bool nan = false;
-#pragma omp parallel for schedule(static) reduction(max : d2m, gm) reduction(|| : nan) if (n > 16384)
-      for (long i = 0; i < n; ++i) {
-        const double dx = (x ? x[i] : 0.0) - sx[i];
-        const double dy = (y ? y[i] : 0.0) - sy[i];
-        const double dz = (z ? z[i] : 0.0) - sz[i];
-        const double d2 = dx * dx + dy * dy + dz * dz;
-        const double dh = h[i] - sh[i];
-        d2m = d2 > d2m ? d2 : d2m;
-        gm = dh > gm ? dh : gm;
-        nan = nan || d2 != d2 || dh != dh;
-      }
+      // One loop per set of coordinates present (1D, 2D, 3D): no test of a missing axis per
+      // particle. A missing axis was saved as zeros by mark(), so its term was +0 and d2, hence
+      // the answer, is bit for bit the same without it.
+      if (x && y && z)
+        moved_since_mark<true, true>(x, y, z, h, s, n, d2m, gm, nan);
+      else if (x && y && !z)
+        moved_since_mark<true, false>(x, y, nullptr, h, s, n, d2m, gm, nan);
+      else if (x && !y && !z)
+        moved_since_mark<false, false>(x, nullptr, nullptr, h, s, n, d2m, gm, nan);
+      else
+        moved_since_mark<true, true, true>(x, y, z, h, s, n, d2m, gm, nan);
       if (nan) return true;  // NaN
       d2max = d2m > d2max ? d2m : d2max;
       growth = gm > growth ? gm : growth;
@@ -128,6 +122,49 @@ class VerletSkin {
     std::size_t n = 0;
     std::vector<double> x, y, z, h;
   };
+  // The largest squared displacement and growth of h of one array since mark(), and whether
+  // a NaN was met. OpenMP (from 16,384 particles, the runtime's threshold): a max reduction,
+  // whose value does not depend on the order. Generic: any set of present axes, a missing
+  // one read as 0 (the loop of before).
+  template <bool HasY, bool HasZ, bool Generic = false>
+  static void moved_since_mark(const double* x, const double* y, const double* z,
+                               const double* h, const Saved& s, long n, double& d2max,
+                               double& growth, bool& nan_met) {
+    const double* sx = s.x.data();
+    const double* sy = s.y.data();
+    const double* sz = s.z.data();
+    const double* sh = s.h.data();
+    double d2m = 0.0, gm = 0.0;
+    bool nan = false;
+#pragma omp parallel for schedule(static) reduction(max : d2m, gm) reduction(| : nan) if (n > 16384)
+    for (long i = 0; i < n; ++i) {
+      double d2;
+      if (Generic) {
+        const double dx = (x ? x[i] : 0.0) - sx[i];
+        const double dy = (y ? y[i] : 0.0) - sy[i];
+        const double dz = (z ? z[i] : 0.0) - sz[i];
+        d2 = dx * dx + dy * dy + dz * dz;
+      } else {
+        const double dx = x[i] - sx[i];
+        d2 = dx * dx;
+        if (HasY) {
+          const double dy = y[i] - sy[i];
+          d2 = dx * dx + dy * dy;
+          if (HasZ) {
+            const double dz = z[i] - sz[i];
+            d2 = dx * dx + dy * dy + dz * dz;
+          }
+        }
+      }
+      const double dh = h[i] - sh[i];
+      d2m = d2 > d2m ? d2 : d2m;
+      gm = dh > gm ? dh : gm;
+      nan = nan | (d2 != d2) | (dh != dh);
+    }
+    d2max = d2m;
+    growth = gm;
+    nan_met = nan;
+  }
   double skin_;
   double hmin_ = 0.0;
   std::vector<Saved> saved_;
@@ -158,14 +195,31 @@ inline std::uint32_t upper_start(const std::vector<std::uint32_t>& kept, std::ui
   return static_cast<std::uint32_t>(std::lower_bound(kept.begin(), kept.end(), i) - kept.begin());
 }
 
+// keep_in_index_order: lists up to this length are sorted by insertion.
+constexpr std::size_t kInsertionSortMax = 64;
+
 // kept = the candidates cand[0, n) (one destination particle's, within the lists' radius)
 // in increasing particle index: the order in which the filtered neighbours are summed does
 // not depend on when, or from which cells, the lists were built.
 inline void keep_in_index_order(std::vector<std::uint32_t>& kept, const std::uint32_t* cand,
                                 std::size_t n) {
   kept.assign(cand, cand + n);
-  // In particles sorted into the cells' order the candidates often come sorted already.
-  if (!std::is_sorted(kept.begin(), kept.end())) std::sort(kept.begin(), kept.end());
+  // In particles sorted into the cells' order the candidates often come sorted already, and
+  // otherwise as a few ascending runs (one per cell, or per row of cells). Short lists (2D,
+  // ~25 candidates; 3D with few neighbours) by insertion, which costs n compares on a sorted
+  // list and one move per inversion; long ones by std::sort. The indices are distinct, so both
+  // give the one increasing order: the lists, and every sum over them, are the same bit for bit.
+  if (n <= kInsertionSortMax) {
+    std::uint32_t* a = kept.data();
+    for (std::size_t i = 1; i < n; ++i) {
+      const std::uint32_t v = a[i];
+      std::size_t j = i;
+      for (; j > 0 && a[j - 1] > v; --j) a[j] = a[j - 1];
+      a[j] = v;
+    }
+  } else if (!std::is_sorted(kept.begin(), kept.end())) {
+    std::sort(kept.begin(), kept.end());
+  }
 }
 
 // out[0, count) = the candidates j of cand[0, n) with keep(j), in their order; returns count.
