@@ -295,9 +295,14 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   const RegisterSums sums = registerSums(w, pass);
   // One destination's neighbours in [from, to) of its kept list (sorted): the pair
   // quantities, the bodies for d_idx and, with `both`, for s_idx (unless the self pair).
+  // With `tail` (OpenMP blocks), the rest of the list after `to` follows for d_idx alone, in
+  // the same destination loop: d_idx's sums are complete but for these once its turn in the
+  // block has come (later turns write only s_idx > their d_idx), so they come in the same
+  // order as from a loop of their own after the block.
   auto segment = [&](const std::string& indent, const std::string& begin, const std::string& end,
                      const std::string& from, const std::string& to, bool both,
-                     const std::string& comment) {
+                     const std::string& comment, bool tail = false,
+                     const std::string& skip = "") {
     scene_ << indent << "for (int d_idx = " << begin << "; d_idx < " << end << "; ++d_idx) {"
            << comment << "\n";
     const std::string in = indent + "  ";
@@ -316,25 +321,42 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     }
     scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
     scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
+    if (!skip.empty()) scene_ << in << "if (" << skip << ") continue;  // no neighbour in [from, to)\n";
     emitSumsLoad(scene_, in, sums);  // codegen/RegisterSums.cpp
-    scene_ << in << "for (const std::uint32_t* k = " << from << "; k != k_end" << to
-           << "; ++k) {\n";
     const std::string body = in + "  ";
-    scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
-    emitNeighbourTest(scene_, host_, "continue;", body);
-    emitPairQuantitiesOnce(q, both, body);
-    for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
-    if (both) {
-      scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
-      for (const PlanEquation* eq : pass.equations)
-        scene_ << body << "  " << callBodyMirrored(*eq, d);
-      scene_ << body << "}\n";
+    auto pairs = [&](bool bothSides) {
+      scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
+      emitNeighbourTest(scene_, host_, "continue;", body);
+      emitPairQuantitiesOnce(q, bothSides, body);
+      for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
+      if (bothSides) {
+        scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
+        for (const PlanEquation* eq : pass.equations)
+          scene_ << body << "  " << callBodyMirrored(*eq, d);
+        scene_ << body << "}\n";
+      }
+      scene_ << in << "}\n";
+    };
+    if (!tail) {
+      scene_ << in << "for (const std::uint32_t* k = " << from << "; k != k_end" << to
+             << "; ++k) {\n";
+      pairs(both);
+    } else {
+      // `to` is the block's end: where the list passes it (found once; the last block's
+      // lists end there).
+      scene_ << in << "const std::uint32_t* k = " << from << ";\n";
+      scene_ << in << "const std::uint32_t* const k_mid = " << to << " == n || k == k_end || "
+             << "k_end[-1] < static_cast<std::uint32_t>(" << to << ")\n"
+             << in << "    ? k_end : std::lower_bound(k, k_end, static_cast<std::uint32_t>(" << to
+             << "));\n";
+      scene_ << in << "for (; k != k_mid; ++k) {\n";
+      pairs(both);
+      scene_ << in << "for (; k != k_end; ++k) {  // (3) the neighbours in later blocks: d_idx only\n";
+      pairs(false);
     }
-    scene_ << in << "}\n";
     emitSumsStore(scene_, in, sums);
     scene_ << indent << "}\n";
   };
-  const std::string lower = "std::lower_bound(kept.data(), k_end, static_cast<std::uint32_t>(";
   const std::string upper = "kept.data() + " + lists + ".upper[d_idx]";  // s_idx >= d_idx
   if (!openmp) {
     segment("        ", "0", "n", upper, "", true, "  // pairs (d_idx, s_idx >= d_idx)");
@@ -347,14 +369,15 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   scene_ << "        for (int blk = 0; blk < n_blocks; ++blk) {\n";
   scene_ << "          const int b_begin = static_cast<int>(static_cast<long>(n) * blk / n_blocks);\n";
   scene_ << "          const int b_end = static_cast<int>(static_cast<long>(n) * (blk + 1) / n_blocks);\n";
-  scene_ << "          // (1) from the neighbours in earlier blocks, per destination\n";
-  segment("          ", "b_begin", "b_end", "kept.data()",
-          " && *k < static_cast<std::uint32_t>(b_begin)", false, "");
-  scene_ << "          // (2) the pairs within the block, once for both particles\n";
-  segment("          ", "b_begin", "b_end", upper,
-          " && *k < static_cast<std::uint32_t>(b_end)", true, "");
-  scene_ << "          // (3) from the neighbours in later blocks, per destination\n";
-  segment("          ", "b_begin", "b_end", lower + "b_end))", "", false, "");
+  scene_ << "          // (1) from the neighbours in earlier blocks, per destination (none in the first)\n";
+  scene_ << "          if (b_begin > 0) {\n";
+  segment("            ", "b_begin", "b_end", "kept.data()",
+          " && *k < static_cast<std::uint32_t>(b_begin)", false, "", false,
+          "k_end == kept.data() || kept.front() >= static_cast<std::uint32_t>(b_begin)");
+  scene_ << "          }\n";
+  scene_ << "          // (2) the pairs within the block, once for both particles, then (3) from the\n"
+            "          // neighbours in later blocks, per destination, in the same loop\n";
+  segment("          ", "b_begin", "b_end", upper, "b_end", true, "", true);
   scene_ << "        }\n";
 }
 
