@@ -519,7 +519,9 @@ std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
         if ((&w == &A || &w == &B) && A.array != B.array && !A.passes.empty() &&
             !B.passes.empty() && A.passes.back().source == B.array &&
             B.passes.front().source == A.array && A.passes.back().searches() &&
-            B.passes.front().searches() && crossPairsRefusal(plan_, ph, a, a + 1, true).empty())
+            B.passes.front().searches() && crossPairsRefusal(plan_, ph, a, a + 1, true).empty() &&
+            !simdPairsRefusal(A, A.passes.back()).empty() &&  // --simd-pairs: per destination,
+            !simdPairsRefusal(B, B.passes.front()).empty())   // as the OpenMP backend's
           found = {&A, &B};
       }
     for (const auto& sub : g.subgroups) walk(*sub);

@@ -28,6 +28,7 @@
 #include "codegen/Printer.h"
 
 #include <algorithm>
+#include <set>
 
 namespace sphc {
 
@@ -71,6 +72,35 @@ bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std:
   return true;
 }
 
+// The first call in `text` (comments skipped) of a math function GCC does not vectorise
+// without -ffast-math (no SIMD clone in glibc then), "" if none. With one in a body the loop
+// may or may not vectorise depending on where GCC inlines it (the serial and the OpenMP
+// builds would differ in their bits): refused instead.
+static std::string scalarMathCall(const std::string& text) {
+  static const std::set<std::string> scalarOnly = {
+      "pow",  "exp",  "exp2", "expm1", "log",   "log2",  "log10", "log1p", "sin",    "cos",
+      "tan",  "asin", "acos", "atan",  "atan2", "sinh",  "cosh",  "tanh",  "cbrt",   "erf",
+      "erfc", "tgamma", "lgamma", "hypot", "fmod"};
+  for (size_t at = 0; at < text.size();) {
+    if (text.compare(at, 2, "//") == 0) {
+      at = text.find('\n', at);
+      continue;
+    }
+    if (!isIdentifierChar(text[at])) {
+      ++at;
+      continue;
+    }
+    size_t end = at;
+    while (end < text.size() && isIdentifierChar(text[end])) ++end;
+    size_t open = end;
+    while (open < text.size() && (text[open] == ' ' || text[open] == '\t')) ++open;
+    const std::string word = text.substr(at, end - at);
+    if (open < text.size() && text[open] == '(' && scalarOnly.count(word)) return word;
+    at = end;
+  }
+  return "";
+}
+
 std::string ScenePrinter::simdPairsRefusal(const DestinationWork& w,
                                            const NeighbourPass& pass) const {
   if (!simdPairs_) return "off";
@@ -90,6 +120,10 @@ std::string ScenePrinter::simdPairsRefusal(const DestinationWork& w,
     std::vector<TextEdit> edits;
     std::string why;
     if (!scalarPairEdits(b.source.text, edits, why)) return eq->name + ": " + why;
+    const std::string call = scalarMathCall(b.source.text);
+    if (!call.empty())
+      return eq->name + " calls " + call + ", which GCC does not vectorise (its loop would be "
+             "scalar or not depending on inlining)";
   }
   return "";
 }
