@@ -11,7 +11,7 @@ two variants interleaved, --rounds times; the minimum and the median over the ro
 printed (on a loaded machine only ratios of interleaved runs mean something). Also the
 zmm gathers (vgatherdpd) in each executable.
 
-Usage: python3 bench/simd_print.py [--scenes cube,dambreak,dambreak_pysph] [--rounds 5]
+Usage: python3 bench/simd_print.py [--scenes cube,dambreak,dambreak_pysph] [--rounds 5] [--with-ns]
 """
 
 import os
@@ -22,8 +22,8 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (SCENE_FILES, instruction_parser, load_average, remove_tmp,  # noqa: E402
-                    run)
+from common import (SCENE_FILES, cpu_per_step_rounds, instruction_parser,  # noqa: E402
+                    load_average, remove_tmp, run)
 
 PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
 # scene: (file, sphc flags, run-time options, short steps, long steps); ~100k particles
@@ -46,25 +46,19 @@ def main():
     ap = instruction_parser(__doc__)
     ap.set_defaults(scenes="cube,dambreak,dambreak_pysph")
     ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--with-ns", action="store_true",
+                    help="also the scalar per-destination loops (--no-symmetric-pairs)")
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="sphc_simdprint_")
     print("load average before: %s" % load_average())
-    env = dict(os.environ, OMP_NUM_THREADS="1")
     for scene in args.scenes.split(","):
         path, sflags, options, short, long_ = SCENES[scene]
         exes = {}
-        for name, flags in VARIANTS:
+        variants = VARIANTS + ([("ns", ["--no-symmetric-pairs"])] if args.with_ns else [])
+        for name, flags in variants:
             exes[name] = os.path.join(tmp, "%s_%s" % (scene, name))
             run([args.sphc, path, "-o", exes[name]] + sflags + flags)
-        per = {name: [] for name, _ in VARIANTS}
-        for _ in range(args.rounds):
-            for name, _ in VARIANTS:
-                cpu = []
-                for steps in (short, long_):
-                    run([exes[name]] + options + ["--max-steps", str(steps), "--no-output",
-                                                  "--quiet", "-d", exes[name] + "_out"], env=env)
-                    cpu.append(run.cpu)
-                per[name].append((cpu[1] - cpu[0]) / (long_ - short))
+        per = cpu_per_step_rounds(exes, options, short, long_, args.rounds)
         d, s = per["default"], per["simd"]
         print("%-15s steps %d-%d, min of %d: default %.4f s, simd %.4f s per step: simd / default "
               "= %.3f (medians %.3f); zmm gathers %d / %d  [all: default %s; simd %s]" % (
@@ -72,6 +66,11 @@ def main():
                   statistics.median(s) / statistics.median(d), gathers(exes["default"]),
                   gathers(exes["simd"]), " ".join("%.4f" % v for v in d),
                   " ".join("%.4f" % v for v in s)))
+        if args.with_ns:
+            print("%-15s scalar per destination (--no-symmetric-pairs): %.4f s (/ default %.3f); "
+                  "simd / ns = %.3f  [all: %s]" % (
+                      scene, min(per["ns"]), min(per["ns"]) / min(d), min(s) / min(per["ns"]),
+                      " ".join("%.4f" % v for v in per["ns"])))
         sys.stdout.flush()
     print("load average after: %s" % load_average())
     remove_tmp(tmp, args.keep)

@@ -28,17 +28,24 @@
 #include "codegen/Printer.h"
 
 #include <algorithm>
+#include <functional>
 #include <set>
 
 namespace sphc {
 
-bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std::string& why) {
-  auto blank = [&](size_t i) {
-    while (i < text.size() && (text[i] == ' ' || text[i] == '\t')) ++i;
-    return i;
-  };
+namespace {
+
+size_t skipBlanks(const std::string& text, size_t i) {
+  while (i < text.size() && (text[i] == ' ' || text[i] == '\t')) ++i;
+  return i;
+}
+
+// Calls visit(word, begin, end) for each identifier of text outside comments (which keep
+// their words: `// VIJ = v_a - v_b`); visit returns where the scan goes on (end, or past
+// what it read), or npos to stop.
+void scanIdentifiers(const std::string& text,
+                     const std::function<size_t(const std::string&, size_t, size_t)>& visit) {
   for (size_t at = 0; at < text.size();) {
-    // Comments keep their words (`// VIJ = v_a - v_b`).
     if (text.compare(at, 2, "//") == 0) {
       at = text.find('\n', at);
       continue;
@@ -54,51 +61,49 @@ bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std:
     }
     size_t end = at;
     while (end < text.size() && isIdentifierChar(text[end])) ++end;
-    const std::string word = text.substr(at, end - at);
-    const PairQuantity* pq = findPairQuantity(word);
-    if (pq && pq->vector) {
-      const size_t open = blank(end), digit = blank(open + 1), close = blank(digit + 1);
-      if (close >= text.size() || text[open] != '[' || text[digit] < '0' || text[digit] > '2' ||
-          text[close] != ']') {
-        why = word + " is used otherwise than by a literal component (" + word + "[0])";
-        return false;
-      }
-      edits.push_back({static_cast<unsigned>(at), static_cast<unsigned>(close + 1),
-                       word + "_" + text[digit]});
-      end = close + 1;
-    }
-    at = end;
+    at = visit(text.substr(at, end - at), at, end);
   }
-  return true;
 }
 
-// The first call in `text` (comments skipped) of a math function GCC does not vectorise
-// without -ffast-math (no SIMD clone in glibc then), "" if none. With one in a body the loop
-// may or may not vectorise depending on where GCC inlines it (the serial and the OpenMP
-// builds would differ in their bits): refused instead.
-static std::string scalarMathCall(const std::string& text) {
+// The first call in `text` of a math function GCC does not vectorise without -ffast-math
+// (no SIMD clone in glibc then), "" if none. With one in a body the loop may or may not
+// vectorise depending on where GCC inlines it (the serial and the OpenMP builds would differ
+// in their bits): refused instead.
+std::string scalarMathCall(const std::string& text) {
   static const std::set<std::string> scalarOnly = {
       "pow",  "exp",  "exp2", "expm1", "log",   "log2",  "log10", "log1p", "sin",    "cos",
       "tan",  "asin", "acos", "atan",  "atan2", "sinh",  "cosh",  "tanh",  "cbrt",   "erf",
       "erfc", "tgamma", "lgamma", "hypot", "fmod"};
-  for (size_t at = 0; at < text.size();) {
-    if (text.compare(at, 2, "//") == 0) {
-      at = text.find('\n', at);
-      continue;
+  std::string found;
+  scanIdentifiers(text, [&](const std::string& word, size_t, size_t end) {
+    const size_t open = skipBlanks(text, end);
+    if (open < text.size() && text[open] == '(' && scalarOnly.count(word)) {
+      found = word;
+      return std::string::npos;
     }
-    if (!isIdentifierChar(text[at])) {
-      ++at;
-      continue;
+    return end;
+  });
+  return found;
+}
+
+}  // namespace
+
+bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std::string& why) {
+  scanIdentifiers(text, [&](const std::string& word, size_t at, size_t end) {
+    const PairQuantity* pq = findPairQuantity(word);
+    if (!pq || !pq->vector) return end;
+    const size_t open = skipBlanks(text, end), digit = skipBlanks(text, open + 1),
+                 close = skipBlanks(text, digit + 1);
+    if (close >= text.size() || text[open] != '[' || text[digit] < '0' || text[digit] > '2' ||
+        text[close] != ']') {
+      why = word + " is used otherwise than by a literal component (" + word + "[0])";
+      return std::string::npos;
     }
-    size_t end = at;
-    while (end < text.size() && isIdentifierChar(text[end])) ++end;
-    size_t open = end;
-    while (open < text.size() && (text[open] == ' ' || text[open] == '\t')) ++open;
-    const std::string word = text.substr(at, end - at);
-    if (open < text.size() && text[open] == '(' && scalarOnly.count(word)) return word;
-    at = end;
-  }
-  return "";
+    edits.push_back({static_cast<unsigned>(at), static_cast<unsigned>(close + 1),
+                     word + "_" + text[digit]});
+    return close + 1;
+  });
+  return why.empty();
 }
 
 std::string ScenePrinter::simdPairsRefusal(const DestinationWork& w,
