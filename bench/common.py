@@ -106,6 +106,23 @@ SCENE_FILES = {
 }
 
 
+def cpu_per_step_rounds(exes, options, short, long_, rounds):
+    """CPU seconds (user + system) per step of each executable ({name: path}), (long - short
+    run) / steps, without output, on one OpenMP thread; the executables interleaved, `rounds`
+    times: {name: [per round]}."""
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    per = {name: [] for name in exes}
+    for _ in range(rounds):
+        for name, exe in exes.items():
+            cpu = []
+            for steps in (short, long_):
+                run([exe] + options + ["--max-steps", str(steps), "--no-output", "--quiet",
+                                       "-d", exe + "_out"], env=env)
+                cpu.append(run.cpu)
+            per[name].append((cpu[1] - cpu[0]) / (long_ - short))
+    return per
+
+
 def instruction_parser(doc):
     """The options every callgrind benchmark takes: the scenes, sphc, --keep."""
     ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])

@@ -30,8 +30,8 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (SCENE_FILES, group_instructions, instruction_parser,  # noqa: E402
-                    instructions, load_average, remove_tmp, run)
+from common import (SCENE_FILES, cpu_per_step_rounds, group_instructions,  # noqa: E402
+                    instruction_parser, instructions, load_average, remove_tmp, run)
 
 FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
 # The dam break with PySPH's effects (bench/time_to_solution.py): its sphc defines and options.
@@ -91,16 +91,7 @@ def cpu_per_step(args, tmp):
         for name, flags in VARIANTS:
             exes[name] = os.path.join(tmp, "%s_%s" % (scene, name))
             run([args.sphc, path, "-o", exes[name]] + sflags + flags)
-        per = {name: [] for name, _ in VARIANTS}
-        env = dict(os.environ, OMP_NUM_THREADS="1")
-        for _ in range(args.rounds):
-            for name, _ in VARIANTS:
-                cpu = []
-                for steps in (short, long_):
-                    run([exes[name]] + options + ["--max-steps", str(steps), "--no-output",
-                                                  "--quiet", "-d", exes[name] + "_out"], env=env)
-                    cpu.append(run.cpu)
-                per[name].append((cpu[1] - cpu[0]) / (long_ - short))
+        per = cpu_per_step_rounds(exes, options, short, long_, args.rounds)
         best = {name: min(v) for name, v in per.items()}
         print("%-15s memory %.4f s, locals %.4f s per step (min of %d): locals / memory = %.3f"
               "  [all: memory %s; locals %s]" % (

@@ -41,6 +41,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   intPow_ = opts.intPow && !singlePrecision_;
   registerSums_ = opts.registerSums && opts.backend != Backend::OpenCL && !singlePrecision_ &&
                   !mpi_;
+  simdPairs_ = opts.simdPairs && registerSums_;  // SimdPairs.cpp: on the sums in locals
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {

@@ -76,6 +76,13 @@ struct EmitOptions {
   // precision, not --mpi); false (--no-register-sums): updated in memory at every pair, as
   // before. The values are the same bit for bit.
   bool registerSums = true;
+  // --simd-pairs: the CPU pair loops that allow it (codegen/SimdPairs.cpp) are printed per
+  // destination with the neighbour loop under `#pragma omp simd reduction(+: sums)`, the pair
+  // quantities scalars (XIJ_0, ...), the bodies' calls of their NAME_loop_simd form; the
+  // build adds -fopenmp-simd. false (the default): today's loops, byte for byte. The sums are
+  // reassociated across the SIMD lanes: not bitwise the scalar loop's (serial and OpenMP with
+  // the switch are bitwise equal).
+  bool simdPairs = false;
 };
 
 // The lines around the out-of-class phases of a split solver (EmitOptions::splitUnits).

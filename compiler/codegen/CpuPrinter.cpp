@@ -388,7 +388,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, w, s) : "";
     listsRebuildCheck(lists, w, s);
-    if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty()) {
+    if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty() &&
+        !simdPairsRefusal(w, pass).empty()) {  // --simd-pairs: per destination in SIMD lanes
       emitSymmetricPass(w, pass, lists, openmp_,
                         tuned() ? "verlet_radius2" : "VERLET_RADIUS2");  // codegen/SymmetricPairs.cpp
       scene_ << "      }\n";
@@ -460,10 +461,12 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     if (!pass.equations.empty()) {
       const RegisterSums sums = registerSums(w, pass);  // codegen/RegisterSums.cpp
       emitSumsLoad(scene_, "          ", sums);
-      scene_ << "          for (int k_nbr = 0; k_nbr < n_nbrs; ++k_nbr) {\n";
-      scene_ << "            const int s_idx = static_cast<int>(NBRS[k_nbr]);\n";
-      emitCandidate(scene_, q, pass.equations, d, host_, /*test=*/false, &sums);
-      scene_ << "          }\n";
+      if (!emitSimdNeighbours(scene_, w, pass, sums)) {  // codegen/SimdPairs.cpp (--simd-pairs)
+        scene_ << "          for (int k_nbr = 0; k_nbr < n_nbrs; ++k_nbr) {\n";
+        scene_ << "            const int s_idx = static_cast<int>(NBRS[k_nbr]);\n";
+        emitCandidate(scene_, q, pass.equations, d, host_, /*test=*/false, &sums);
+        scene_ << "          }\n";
+      }
       emitSumsStore(scene_, "          ", sums);
     }
     scene_ << "        }\n";
@@ -516,7 +519,9 @@ std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
         if ((&w == &A || &w == &B) && A.array != B.array && !A.passes.empty() &&
             !B.passes.empty() && A.passes.back().source == B.array &&
             B.passes.front().source == A.array && A.passes.back().searches() &&
-            B.passes.front().searches() && crossPairsRefusal(plan_, ph, a, a + 1, true).empty())
+            B.passes.front().searches() && crossPairsRefusal(plan_, ph, a, a + 1, true).empty() &&
+            !simdPairsRefusal(A, A.passes.back()).empty() &&  // --simd-pairs: per destination,
+            !simdPairsRefusal(B, B.passes.front()).empty())   // as the OpenMP backend's
           found = {&A, &B};
       }
     for (const auto& sub : g.subgroups) walk(*sub);

@@ -854,6 +854,7 @@ void ScenePrinter::emitBodies() {
                                                         : "void",
                        eq.dest, dev ? device_ : host_, dev ? cl_ : out_);
       if (kind == ast::Method::Loop && !dev) emitSumsFunction(eq, out_);  // RegisterSums.cpp
+      if (kind == ast::Method::Loop && !dev) emitSimdFunction(eq, out_);  // SimdPairs.cpp
     }
   }
   std::set<int> emittedSteppers;

@@ -60,6 +60,10 @@ struct RegisterSums {
 struct PairDialect;  // analysis/PairQuantityTable.h
 // The spellings the pair-quantity statements take in a dialect (codegen/Bodies.cpp).
 PairDialect pairDialectOf(const Dialect& dl);
+// The vector pair quantities of a body's text as scalars (SimdPairs.cpp): an edit
+// `XIJ[k]` -> `XIJ_k` per indexing by a literal k < 3, appended to `edits`; false (and `why`)
+// where one is named otherwise (a pointer passed on, a computed index).
+bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std::string& why);
 
 class ScenePrinter {
  public:
@@ -248,11 +252,36 @@ class ScenePrinter {
   void emitSumsLoad(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
   void emitSumsStore(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
   // The call of eq's loop for destination d: with rs active, of its function on the locals.
-  std::string pairCall(const PlanEquation& eq, int d, const RegisterSums& rs) const;
+  std::string pairCall(const PlanEquation& eq, int d, const RegisterSums& rs,
+                       bool scalarPairs = false) const;
   // After eq's loop function: its form on the locals (NAME_loop_sums), where a loop uses it.
   void emitSumsFunction(const PlanEquation& eq, std::ostringstream& os);
   bool registerSums_ = false;                // EmitOptions::registerSums (CPU double, not mpi)
   std::unique_ptr<std::set<int>> sumsDecls_;  // equation declarations whose _sums form is used
+  // eq's loop on the locals, named NAME_loop_sums; `scalarPairs`: NAME_loop_simd, its vector
+  // pair quantities three scalars each (XIJ_0, XIJ_1, XIJ_2; SimdPairs.cpp).
+  void printSumsFunction(const PlanEquation& eq, bool scalarPairs, std::ostringstream& os) const;
+  // The destination properties a loop body reads and writes not, indexed `S * d_idx + k`
+  // only (floating): name -> stride, components; in its _simd form values (dval_NAME,
+  // dvalK_NAME) loaded before the loop.
+  std::map<std::string, std::pair<int, std::set<int>>> destinationValues(const PlanBody& b,
+                                                                         int d) const;
+  std::vector<SourceOnlySite> allHoistedSites(const PlanBody& b) const;  // source and destination
+  static std::string destinationValueName(const std::string& prop, int stride, int comp);
+  std::string destinationValueLoad(const std::string& prop, int stride, int comp) const;
+
+  // ---- SIMD pair loops (SimdPairs.cpp; sphc --simd-pairs) ----
+  // Why pass (destination w) cannot be printed in SIMD lanes, "" if it can (the switch off:
+  // "off").
+  std::string simdPairsRefusal(const DestinationWork& w, const NeighbourPass& pass) const;
+  // The neighbour loop of a per-destination pass in SIMD lanes (true), or a comment why not
+  // (false: the caller prints the scalar loop); nothing with the switch off.
+  bool emitSimdNeighbours(std::ostream& os, const DestinationWork& w, const NeighbourPass& pass,
+                          const RegisterSums& sums);
+  // After eq's loop function: its NAME_loop_simd form, where a SIMD loop calls it.
+  void emitSimdFunction(const PlanEquation& eq, std::ostringstream& os);
+  bool simdPairs_ = false;                    // EmitOptions::simdPairs (CPU double, not mpi)
+  std::unique_ptr<std::set<int>> simdDecls_;  // equation declarations whose _simd form is used
 
   // ---- The host program (HostProgram.cpp) ----
   void emitBodies();

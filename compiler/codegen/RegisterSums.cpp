@@ -26,6 +26,7 @@
 //     the pair quantities (the destination's are loaded before the loop in either form);
 //   - no loop_all runs in the pass (it would read the sums between the loads and the loop).
 // Where a loop is refused, a comment in the generated code says why.
+#include "analysis/PairQuantityTable.h"
 #include "codegen/CppText.h"
 #include "codegen/Printer.h"
 
@@ -205,13 +206,83 @@ void ScenePrinter::emitSumsStore(std::ostream& os, const std::string& indent,
          << localName(p, sc.first, k) << ";\n";
 }
 
-std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const RegisterSums& rs) const {
+// The sites of d_NAME outside the hoisted expressions (which the body's text loses).
+static bool valueSites(const std::string& text, const std::string& prop,
+                       const std::vector<SourceOnlySite>& hoisted,
+                       std::vector<DestinationSite>& sites) {
+  if (!destinationSites(text, prop, sites)) return false;
+  sites.erase(std::remove_if(sites.begin(), sites.end(),
+                             [&](const DestinationSite& s) {
+                               for (const SourceOnlySite& h : hoisted)
+                                 if (s.begin >= h.begin && s.end <= h.end) return true;
+                               return false;
+                             }),
+              sites.end());
+  return true;
+}
+
+std::vector<SourceOnlySite> ScenePrinter::allHoistedSites(const PlanBody& b) const {
+  std::vector<SourceOnlySite> hoisted = hoistedSites(b, host_);
+  for (const SourceOnlySite& h : hoistedDestinationSites(b, host_)) hoisted.push_back(h);
+  return hoisted;
+}
+
+std::map<std::string, std::pair<int, std::set<int>>> ScenePrinter::destinationValues(
+    const PlanBody& b, int d) const {
+  std::map<std::string, std::pair<int, std::set<int>>> values;
+  const std::set<std::string> own = written(b);
+  for (const PropAccess& r : b.facts.dReads) {
+    const std::string& p = r.prop;
+    if (own.count(p) || values.count(p) || !arr(d).find(p) || propType(d, p, host_) != host_.real)
+      continue;
+    std::vector<DestinationSite> sites;
+    if (!valueSites(b.source.text, p, allHoistedSites(b), sites) || sites.empty()) continue;
+    auto& entry = values[p];
+    for (const DestinationSite& site : sites) {
+      if (entry.first != 0 && entry.first != site.stride) {
+        values.erase(p);
+        break;
+      }
+      entry.first = site.stride;
+      entry.second.insert(site.comp);
+    }
+    if (values.count(p))
+      for (int k : entry.second)
+        if (identifierOccurrences(b.source.text, destinationValueName(p, entry.first, k))) {
+          values.erase(p);
+          break;
+        }
+  }
+  return values;
+}
+
+std::string ScenePrinter::destinationValueName(const std::string& prop, int stride, int comp) {
+  return stride == 1 ? "dval_" + prop : "dval" + std::to_string(comp) + "_" + prop;
+}
+
+std::string ScenePrinter::destinationValueLoad(const std::string& prop, int stride, int comp) const {
+  return "const " + host_.real + " " + destinationValueName(prop, stride, comp) + " = d_" + prop +
+         "[" + indexText(stride, comp) + "];";
+}
+
+std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const RegisterSums& rs,
+                                   bool scalarPairs) const {
   const PlanBody& b = methodBody(eq, ast::Method::Loop);
   const std::set<std::string> own = written(b, &arr(d));
   bool any = false;
   for (const std::string& p : own) any = any || rs.props.count(p);
-  if (!any) return equationCall(eq, ast::Method::Loop, d);
+  if (!any && !scalarPairs) return equationCall(eq, ast::Method::Loop, d);
+  const auto values = scalarPairs ? destinationValues(b, d) : decltype(destinationValues(b, d))();
   auto argument = [&](const BodyParam& p) -> std::string {
+    if (scalarPairs && p.kind == BodyParam::Pair && findPairQuantity(p.name)->vector)
+      return p.name + "_0, " + p.name + "_1, " + p.name + "_2";
+    if (p.kind == BodyParam::DProp && values.count(p.name)) {
+      std::string args;
+      const auto& sc = values.at(p.name);
+      for (int k : sc.second)
+        args += (args.empty() ? "" : ", ") + destinationValueName(p.name, sc.first, k);
+      return args;
+    }
     if (p.kind != BodyParam::DProp || !own.count(p.name)) return "";
     int stride = 1;
     std::string args;
@@ -219,8 +290,8 @@ std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const Register
       args += (args.empty() ? "" : ", ") + localName(p.name, stride, k);
     return args;
   };
-  return callBody(bodyFunctionName(eq.name, "loop") + "_sums", b, d, eqStruct(eq), "t", ".",
-                  argument) +
+  return callBody(bodyFunctionName(eq.name, "loop") + (scalarPairs ? "_simd" : "_sums"), b, d,
+                  eqStruct(eq), "t", ".", argument) +
          ";  // " + eq.name + ", from " + loc(eq.loc) + "\n";
 }
 
@@ -245,6 +316,11 @@ void ScenePrinter::emitSumsFunction(const PlanEquation& eq, std::ostringstream& 
     walk(sched_.equations);
   }
   if (!sumsDecls_->count(eq.declIndex)) return;
+  printSumsFunction(eq, false, os);
+}
+
+void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
+                                     std::ostringstream& os) const {
   const PlanBody& b = methodBody(eq, ast::Method::Loop);
   const std::set<std::string> own = written(b, &arr(eq.dest));
   std::vector<TextEdit> edits;
@@ -254,14 +330,42 @@ void ScenePrinter::emitSumsFunction(const PlanEquation& eq, std::ostringstream& 
     for (const DestinationSite& site : sites)
       edits.push_back({site.begin, site.end, localName(p, site.stride, site.comp)});
   }
-  const std::string name = bodyFunctionName(eq.name, "loop") + "_sums";
+  std::string why;
+  if (scalarPairs && !scalarPairEdits(b.source.text, edits, why)) return;  // refused
+  // The destination's other properties as values loaded before the SIMD loop (a load at
+  // d_idx under an `if` GCC does not vectorise).
+  const auto values = scalarPairs ? destinationValues(b, eq.dest)
+                                  : decltype(destinationValues(b, eq.dest))();
+  for (const auto& [p, sc] : values) {
+    std::vector<DestinationSite> sites;
+    valueSites(b.source.text, p, allHoistedSites(b), sites);
+    for (const DestinationSite& site : sites)
+      edits.push_back({site.begin, site.end, destinationValueName(p, site.stride, site.comp)});
+  }
+  const std::string name = bodyFunctionName(eq.name, "loop") + (scalarPairs ? "_simd" : "_sums");
   os << "// " << b.source.label << ", from " << loc(b.source.start)
      << ": the destination's sums in locals (acc_NAME, accK_NAME: component K;\n"
-     << "// codegen/RegisterSums.cpp)\n";
+     << (scalarPairs ? "// the pair quantities' components scalars, XIJ_0 for XIJ[0]: the SIMD "
+                       "pair loops,\n// codegen/SimdPairs.cpp)\n"
+                     : "// codegen/RegisterSums.cpp)\n");
   if (host_.lineDirectives) emitLineDirective(os, b.source.start);
   os << host_.functionPrefix << "void " << name << "(";
   bool first = true;
   for (const BodyParam& p : bodyParams(b, eq.dest, host_)) {
+    if (scalarPairs && p.kind == BodyParam::Pair && findPairQuantity(p.name)->vector) {
+      for (int k = 0; k < 3; ++k)
+        os << (first && k == 0 ? "" : ", ") << host_.real << " " << p.name << "_" << k;
+      first = false;
+      continue;
+    }
+    if (p.kind == BodyParam::DProp && values.count(p.name)) {
+      const auto& sc = values.at(p.name);
+      for (int k : sc.second) {
+        os << (first ? "" : ", ") << host_.real << " " << destinationValueName(p.name, sc.first, k);
+        first = false;
+      }
+      continue;
+    }
     if (p.kind == BodyParam::DProp && own.count(p.name)) {
       int stride = 1;
       for (int k : bodyComponents(b.source.text, p.name, stride)) {

@@ -115,6 +115,7 @@ bool usesDefaultFlags(std::map<std::string, std::string>& info, const std::strin
     expected += " " + (info.count("openmp_flags") ? info["openmp_flags"] : "-fopenmp");
   else if (req.backend != "serial")
     return false;
+  if (req.simd) expected += " -fopenmp-simd";  // --simd-pairs
   return flags == expected;
 }
 bool usesScenePch(const Install& install, std::map<std::string, std::string>& info,
@@ -151,6 +152,8 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
                                                 : std::string("-DCL_TARGET_OPENCL_VERSION=120"));
     libs += " " + info["opencl_libs"];
   }
+  // --simd-pairs: the pair loops' `#pragma omp simd` (codegen/SimdPairs.cpp).
+  if (req.simd) flags += " -fopenmp-simd";
   // --mpi: libsphc_mpi (before the runtime it uses), MPI and Zoltan.
   const std::string mpiLib = install.libDir + "/libsphc_mpi.a";
   if (req.mpi) {

@@ -23,6 +23,7 @@ struct BuildRequest {
   std::string cxxflags;     // override of the flags ("" = from buildinfo)
   std::string backend = "serial";  // serial, openmp or opencl: which runtime and flags
   bool mpi = false;         // --mpi: link libsphc_mpi, MPI and Zoltan
+  bool simd = false;        // --simd-pairs: -fopenmp-simd (the loops' `omp simd`)
   bool useCache = true;
   bool verbose = false;
 };

@@ -136,6 +136,15 @@ static cl::opt<bool> NoRegisterSums(
              "bodies allow it; serial and openmp, double precision; the results are the same "
              "bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> SimdPairs(
+    "simd-pairs",
+    cl::desc("In the CPU pair loops (serial and openmp, double precision) whose bodies allow "
+             "it, process the neighbours of a destination in SIMD lanes: `#pragma omp simd` "
+             "with the destination's sums as reductions, built with -fopenmp-simd; such a "
+             "loop is per destination even where each pair could be evaluated once (default: "
+             "off; the sums are reassociated, so the results differ from the scalar loop's "
+             "in the last bits)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoLazyCells(
     "no-lazy-cells",
     cl::desc("With kept neighbour lists, build the search domain and cell lists at every "
@@ -452,6 +461,7 @@ int main(int argc, char** argv) {
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;
+  emitOpts.simdPairs = SimdPairs;
   if (Report && Emit != EmitKind::OpenCL)
     for (const std::string& note : sphc::symmetricPairsNotes(*schedule, emitOpts))
       llvm::outs() << "note: " << note << "\n";
@@ -477,6 +487,7 @@ int main(int argc, char** argv) {
   req.backend = backendName(Backend);
   req.mpi = Mpi;
   req.useCache = !NoCache;
+  req.simd = SimdPairs && !Mpi && backendName(Backend) != std::string("opencl");
   req.verbose = Verbose;
   BuildResult res = buildExecutable(install, req);
   log("build");

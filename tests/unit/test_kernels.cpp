@@ -667,3 +667,33 @@ TEST(Kernels, FloatCallsComputeInFloatAndAgree) {
 }
 
 }  // namespace
+
+// sphc --simd-pairs (codegen/SimdPairs.cpp): the gradient as gradient_factor(r, h) * xij,
+// bit for bit gradient()'s, at r = 0 (factor 0), below the 1e-12 guard, inside and beyond
+// the support, for every kernel.
+template <class K>
+void expect_gradient_factor_exact() {
+  const double dirs[2][3] = {{0.6, -0.48, 0.64}, {1.0, 0.0, 0.0}};
+  const double rs[] = {0.0, 5e-13, 1e-12, 2e-12, 0.013, 0.37, 0.5, 0.99, 1.0, 1.41, 1.999,
+                       2.0, 2.7, 3.0, 3.5};
+  for (const auto& u : dirs)
+    for (double r : rs) {
+      const double xij[3] = {r * u[0], r * u[1], r * u[2]};
+      double g[3];
+      K::gradient(xij, r, 0.8, g);
+      const double s = K::gradient_factor(r, 0.8);
+      for (int d = 0; d < 3; ++d) EXPECT_EQ(s * xij[d], g[d]) << K::name << " r=" << r;
+    }
+}
+
+TEST(Kernels, GradientFactorIsGradientsFactor) {
+  expect_gradient_factor_exact<sphc::CubicSpline<3>>();
+  expect_gradient_factor_exact<sphc::CubicSpline<2>>();
+  expect_gradient_factor_exact<sphc::QuinticSpline<2>>();
+  expect_gradient_factor_exact<sphc::WendlandQuintic<2>>();
+  expect_gradient_factor_exact<sphc::WendlandQuintic<1>>();
+  expect_gradient_factor_exact<sphc::Gaussian<3>>();
+  expect_gradient_factor_exact<sphc::WendlandQuinticC4<2>>();
+  expect_gradient_factor_exact<sphc::WendlandQuinticC6<3>>();
+  expect_gradient_factor_exact<sphc::SuperGaussian<2>>();
+}

@@ -124,6 +124,14 @@ struct RadialKernel {
     grad[1] = s * xij[1];
     grad[2] = s * xij[2];
   }
+  // The factor s of gradient() (grad = s * xij), its value bit for bit, as a select on a
+  // safe divisor (no branch: the SIMD pair loops of sphc --simd-pairs, codegen/SimdPairs.cpp).
+  template <class T>
+  static inline T gradient_factor(T rij, T h) {
+    const bool apart = rij > T(1e-12);
+    const T s = dwdq(rij, h) / (h * (apart ? rij : T(1)));
+    return apart ? s : T(0);
+  }
   // The gradients of one pair for both particles (sphc's pair loops that evaluate each pair
   // once): grad_ij = gradient(xij, rij, h) and grad_ji = gradient(xji, rij, h), xji = x_j -
   // x_i, with the factor s computed once; each is gradient()'s value bit for bit.

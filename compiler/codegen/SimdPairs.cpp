@@ -1,0 +1,216 @@
+// SIMD pair loops (sphc --simd-pairs; CPU backends, double precision, not --mpi; off by
+// default): the neighbours of one destination in SIMD lanes.
+//
+// A per-destination pair loop whose destination's sums are locals (codegen/RegisterSums.cpp)
+// is printed with its neighbour loop under
+//   #pragma omp simd reduction(+: acc_arho, acc_au, ...)
+// over the list already filtered to the support (so no cut-off test in the loop), its pair
+// quantities scalars (XIJ_0, XIJ_1, XIJ_2 in place of XIJ[3]; a gradient as its factor
+// Kernel::gradient_factor times XIJ_k), and each body called in a third printing,
+// NAME_loop_simd: the _sums form with `XIJ[k]` written `XIJ_k`. GCC vectorises such a loop
+// (source properties gathered, the sums in vector registers, one horizontal sum per
+// destination); local arrays passed by pointer (XIJ[3]) it does not (docs/performance.md,
+// "SIMD pair loops: measured"). The bodies' `if`s are left to GCC's if-conversion: where it
+// cannot, the loop stays scalar, with the same results. The build adds -fopenmp-simd
+// (driver/Build.cpp).
+//
+// Results: each sum is reassociated (one partial sum per lane, added at the end), so they
+// differ from the scalar loop's in the last bits; the same loop in serial and OpenMP
+// (each destination in one thread) gives the same bits. A pass of each pair once
+// (SymmetricPairs.cpp) that could be a SIMD loop is printed per destination instead.
+//
+// Refused (the loop's comment says why, the scalar loop follows): the sums not in locals,
+// a body writing a destination property that is not one of those sums (every lane would
+// store it), a body writing a scalar state, a loop_all in the pass, a vector pair quantity
+// named otherwise than indexed by a literal component.
+#include "analysis/PairQuantityTable.h"
+#include "codegen/CppText.h"
+#include "codegen/Printer.h"
+
+#include <algorithm>
+#include <functional>
+#include <set>
+
+namespace sphc {
+
+namespace {
+
+size_t skipBlanks(const std::string& text, size_t i) {
+  while (i < text.size() && (text[i] == ' ' || text[i] == '\t')) ++i;
+  return i;
+}
+
+// Calls visit(word, begin, end) for each identifier of text outside comments (which keep
+// their words: `// VIJ = v_a - v_b`); visit returns where the scan goes on (end, or past
+// what it read), or npos to stop.
+void scanIdentifiers(const std::string& text,
+                     const std::function<size_t(const std::string&, size_t, size_t)>& visit) {
+  for (size_t at = 0; at < text.size();) {
+    if (text.compare(at, 2, "//") == 0) {
+      at = text.find('\n', at);
+      continue;
+    }
+    if (text.compare(at, 2, "/*") == 0) {
+      at = text.find("*/", at + 2);
+      at = at == std::string::npos ? at : at + 2;
+      continue;
+    }
+    if (!isIdentifierChar(text[at])) {
+      ++at;
+      continue;
+    }
+    size_t end = at;
+    while (end < text.size() && isIdentifierChar(text[end])) ++end;
+    at = visit(text.substr(at, end - at), at, end);
+  }
+}
+
+// The first call in `text` of a math function GCC does not vectorise without -ffast-math
+// (no SIMD clone in glibc then), "" if none. With one in a body the loop may or may not
+// vectorise depending on where GCC inlines it (the serial and the OpenMP builds would differ
+// in their bits): refused instead.
+std::string scalarMathCall(const std::string& text) {
+  static const std::set<std::string> scalarOnly = {
+      "pow",  "exp",  "exp2", "expm1", "log",   "log2",  "log10", "log1p", "sin",    "cos",
+      "tan",  "asin", "acos", "atan",  "atan2", "sinh",  "cosh",  "tanh",  "cbrt",   "erf",
+      "erfc", "tgamma", "lgamma", "hypot", "fmod"};
+  std::string found;
+  scanIdentifiers(text, [&](const std::string& word, size_t, size_t end) {
+    const size_t open = skipBlanks(text, end);
+    if (open < text.size() && text[open] == '(' && scalarOnly.count(word)) {
+      found = word;
+      return std::string::npos;
+    }
+    return end;
+  });
+  return found;
+}
+
+}  // namespace
+
+bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std::string& why) {
+  scanIdentifiers(text, [&](const std::string& word, size_t at, size_t end) {
+    const PairQuantity* pq = findPairQuantity(word);
+    if (!pq || !pq->vector) return end;
+    const size_t open = skipBlanks(text, end), digit = skipBlanks(text, open + 1),
+                 close = skipBlanks(text, digit + 1);
+    if (close >= text.size() || text[open] != '[' || text[digit] < '0' || text[digit] > '2' ||
+        text[close] != ']') {
+      why = word + " is used otherwise than by a literal component (" + word + "[0])";
+      return std::string::npos;
+    }
+    edits.push_back({static_cast<unsigned>(at), static_cast<unsigned>(close + 1),
+                     word + "_" + text[digit]});
+    return close + 1;
+  });
+  return why.empty();
+}
+
+std::string ScenePrinter::simdPairsRefusal(const DestinationWork& w,
+                                           const NeighbourPass& pass) const {
+  if (!simdPairs_) return "off";
+  if (pass.equations.empty()) return "no loop bodies";
+  if (!pass.loopAll.empty()) return pass.loopAll[0]->name + " has a loop_all";
+  const RegisterSums rs = registerSums(w, pass);
+  if (!rs.active())
+    return "the destination's sums are not in locals" +
+           (rs.refusal.empty() ? std::string() : " (" + rs.refusal + ")");
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    for (const PropAccess& x : b.facts.dWrites)
+      if (!rs.props.count(x.prop))
+        return eq->name + " writes d_" + x.prop + ", which is no sum in locals";
+    if (!b.facts.statesWritten.empty())
+      return eq->name + " writes the state " + *b.facts.statesWritten.begin();
+    std::vector<TextEdit> edits;
+    std::string why;
+    if (!scalarPairEdits(b.source.text, edits, why)) return eq->name + ": " + why;
+    const std::string call = scalarMathCall(b.source.text);
+    if (!call.empty())
+      return eq->name + " calls " + call + ", which GCC does not vectorise (its loop would be "
+             "scalar or not depending on inlining)";
+  }
+  return "";
+}
+
+bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w,
+                                      const NeighbourPass& pass, const RegisterSums& sums) {
+  if (!simdPairs_) return false;
+  const std::string why = simdPairsRefusal(w, pass);
+  const std::string in = "          ";
+  if (!why.empty()) {
+    os << in << "// Not in SIMD lanes (codegen/SimdPairs.cpp): " << why << ".\n";
+    return false;
+  }
+  std::string reduction;
+  for (const auto& [p, sc] : sums.props)
+    for (int k : sc.second)
+      reduction += (reduction.empty() ? "" : ", ") +
+                   (sc.first == 1 ? "acc_" + p : "acc" + std::to_string(k) + "_" + p);
+  os << in << "// The neighbours in SIMD lanes, the sums reduced across them (codegen/SimdPairs.cpp;\n"
+     << in << "// sphc --simd-pairs; the list holds neighbours only: no cut-off test).\n";
+  // The destination's other properties the bodies read, loaded once.
+  std::set<std::string> loads;
+  for (const PlanEquation* eq : pass.equations)
+    for (const auto& [p, sc] : destinationValues(methodBody(*eq, ast::Method::Loop), w.array))
+      for (int k : sc.second)
+        if (loads.insert(destinationValueName(p, sc.first, k)).second)
+          os << in << destinationValueLoad(p, sc.first, k) << "\n";
+  os << in << "#pragma omp simd reduction(+: " << reduction << ")\n";
+  os << in << "for (int k_nbr = 0; k_nbr < n_nbrs; ++k_nbr) {\n";
+  const std::string body = in + "  ";
+  os << body << "const int s_idx = static_cast<int>(NBRS[k_nbr]);\n";
+  os << body << "const " << host_.real << " hj = sj_h[s_idx];\n";
+  // The pair quantities as scalars: vectors by component, gradients as a factor times XIJ.
+  const PairDialect dialect = pairDialectOf(host_);
+  for (const PairQuantity& pq : pairQuantityTable()) {
+    if (!(pq.when == PairWhen::BeforeTest || pq.when == PairWhen::EveryNeighbour ||
+          pass.pairQuantities.count(pq.name)))
+      continue;
+    if (pq.form == PairForm::Difference) {
+      for (int k = 0; k < 3; ++k)
+        os << body << "const " << host_.real << " " << pq.name << "_" << k << " = "
+           << (k < plan_.dim ? pq.components[k] + "i - sj_" + pq.components[k] + "[s_idx]"
+                             : std::string("0.0"))
+           << ";\n";
+    } else if (pq.form == PairForm::Gradient) {
+      os << body << "const " << host_.real << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
+         << pq.h << ");\n";
+      for (int k = 0; k < 3; ++k)
+        os << body << "const " << host_.real << " " << pq.name << "_" << k << " = " << pq.name
+           << "_f * XIJ_" << k << ";\n";
+    } else {
+      std::string s = pairQuantityStatement(pq, plan_.dim, dialect, body);
+      std::vector<TextEdit> edits;
+      std::string unused;
+      scalarPairEdits(s, edits, unused);
+      std::sort(edits.begin(), edits.end(),
+                [](const TextEdit& a, const TextEdit& b) { return a.begin > b.begin; });
+      for (const TextEdit& e : edits) s.replace(e.begin, e.end - e.begin, e.replacement);
+      os << s;
+    }
+  }
+  for (const PlanEquation* eq : pass.equations)
+    os << body << pairCall(*eq, w.array, sums, /*scalarPairs=*/true);
+  os << in << "}\n";
+  return true;
+}
+
+void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& os) {
+  if (!simdPairs_) return;
+  if (!simdDecls_) {  // the declarations whose loop some SIMD pass calls
+    simdDecls_ = std::make_unique<std::set<int>>();
+    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+      for (const Phase& ph : g.phases)
+        for (const DestinationWork& w : ph.destinations)
+          for (const NeighbourPass& pass : w.passes)
+            if (simdPairsRefusal(w, pass).empty())
+              for (const PlanEquation* e : pass.equations) simdDecls_->insert(e->declIndex);
+      for (const auto& sub : g.subgroups) walk(*sub);
+    };
+    walk(sched_.equations);
+  }
+  if (simdDecls_->count(eq.declIndex)) printSumsFunction(eq, true, os);
+}
+
+}  // namespace sphc
