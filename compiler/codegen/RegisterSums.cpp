@@ -231,12 +231,13 @@ std::map<std::string, std::pair<int, std::set<int>>> ScenePrinter::destinationVa
     const PlanBody& b, int d) const {
   std::map<std::string, std::pair<int, std::set<int>>> values;
   const std::set<std::string> own = written(b);
+  const std::vector<SourceOnlySite> hoisted = allHoistedSites(b);
   for (const PropAccess& r : b.facts.dReads) {
     const std::string& p = r.prop;
     if (own.count(p) || values.count(p) || !arr(d).find(p) || propType(d, p, host_) != host_.real)
       continue;
     std::vector<DestinationSite> sites;
-    if (!valueSites(b.source.text, p, allHoistedSites(b), sites) || sites.empty()) continue;
+    if (!valueSites(b.source.text, p, hoisted, sites) || sites.empty()) continue;
     auto& entry = values[p];
     for (const DestinationSite& site : sites) {
       if (entry.first != 0 && entry.first != site.stride) {
@@ -299,21 +300,16 @@ void ScenePrinter::emitSumsFunction(const PlanEquation& eq, std::ostringstream& 
   if (!registerSums_) return;
   if (!sumsDecls_) {  // the declarations whose loop some pass calls on the locals
     sumsDecls_ = std::make_unique<std::set<int>>();
-    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-      for (const Phase& ph : g.phases)
-        for (const DestinationWork& w : ph.destinations)
-          for (const NeighbourPass& pass : w.passes) {
-            const RegisterSums rs = registerSums(w, pass);
-            for (const PlanEquation* e : pass.equations) {
-              bool any = false;
-              for (const PropAccess& a : methodBody(*e, ast::Method::Loop).facts.dWrites)
-                any = any || rs.props.count(a.prop);
-              if (any) sumsDecls_->insert(e->declIndex);
-            }
-          }
-      for (const auto& sub : g.subgroups) walk(*sub);
-    };
-    walk(sched_.equations);
+    walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
+                                     const NeighbourPass& pass) {
+      const RegisterSums rs = registerSums(w, pass);
+      for (const PlanEquation* e : pass.equations) {
+        bool any = false;
+        for (const PropAccess& a : methodBody(*e, ast::Method::Loop).facts.dWrites)
+          any = any || rs.props.count(a.prop);
+        if (any) sumsDecls_->insert(e->declIndex);
+      }
+    });
   }
   if (!sumsDecls_->count(eq.declIndex)) return;
   printSumsFunction(eq, false, os);
@@ -336,9 +332,11 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
   // d_idx under an `if` GCC does not vectorise).
   const auto values = scalarPairs ? destinationValues(b, eq.dest)
                                   : decltype(destinationValues(b, eq.dest))();
+  const std::vector<SourceOnlySite> hoisted =
+      values.empty() ? std::vector<SourceOnlySite>() : allHoistedSites(b);
   for (const auto& [p, sc] : values) {
     std::vector<DestinationSite> sites;
-    valueSites(b.source.text, p, allHoistedSites(b), sites);
+    valueSites(b.source.text, p, hoisted, sites);
     for (const DestinationSite& site : sites)
       edits.push_back({site.begin, site.end, destinationValueName(p, site.stride, site.comp)});
   }

@@ -663,4 +663,13 @@ void printSchedule(const Schedule& s, const DiagnosticEngine& diags, llvm::raw_o
   SchedulePrinter(s, diags, os).print();
 }
 
+void walkPasses(const ScheduleGroup& g,
+                const std::function<void(const Phase&, const DestinationWork&,
+                                         const NeighbourPass&)>& fn) {
+  for (const Phase& ph : g.phases)
+    for (const DestinationWork& w : ph.destinations)
+      for (const NeighbourPass& pass : w.passes) fn(ph, w, pass);
+  for (const auto& sub : g.subgroups) walkPasses(*sub, fn);
+}
+
 }  // namespace sphc

@@ -13,6 +13,7 @@
 
 #include "llvm/Support/raw_ostream.h"
 
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -138,6 +139,11 @@ struct ScheduleGroup {
   // equations run in this group's one phase (this group is the first of the run).
   std::vector<const PlanGroup*> fused;
 };
+
+// Calls fn for every neighbour pass of g's phases and of its subgroups at any depth, in order.
+void walkPasses(const ScheduleGroup& g,
+                const std::function<void(const Phase&, const DestinationWork&,
+                                         const NeighbourPass&)>& fn);
 
 // Consecutive stepper statements (initialize, stageN) of the integrator's step, fused: one
 // pass per array doing all the run's methods per particle. Steppers read and write their own

@@ -200,15 +200,11 @@ void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& 
   if (!simdPairs_) return;
   if (!simdDecls_) {  // the declarations whose loop some SIMD pass calls
     simdDecls_ = std::make_unique<std::set<int>>();
-    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-      for (const Phase& ph : g.phases)
-        for (const DestinationWork& w : ph.destinations)
-          for (const NeighbourPass& pass : w.passes)
-            if (simdPairsRefusal(w, pass).empty())
-              for (const PlanEquation* e : pass.equations) simdDecls_->insert(e->declIndex);
-      for (const auto& sub : g.subgroups) walk(*sub);
-    };
-    walk(sched_.equations);
+    walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
+                                     const NeighbourPass& pass) {
+      if (simdPairsRefusal(w, pass).empty())
+        for (const PlanEquation* e : pass.equations) simdDecls_->insert(e->declIndex);
+    });
   }
   if (simdDecls_->count(eq.declIndex)) printSumsFunction(eq, true, os);
 }

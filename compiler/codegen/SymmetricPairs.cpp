@@ -62,15 +62,6 @@ std::set<std::string> withMirrors(std::set<std::string> q) {
   return q;
 }
 
-void walkPasses(const ScheduleGroup& g,
-                const std::function<void(const Phase&, const DestinationWork&,
-                                         const NeighbourPass&)>& fn) {
-  for (const Phase& ph : g.phases)
-    for (const DestinationWork& w : ph.destinations)
-      for (const NeighbourPass& pass : w.passes) fn(ph, w, pass);
-  for (const auto& sub : g.subgroups) walkPasses(*sub, fn);
-}
-
 // symmetricPairsRefusal without the same-array condition: what the bodies and the pass of
 // w must be for a pair's mirrored call (also for a pair loop of two arrays, crossPairsRefusal).
 std::string pairBodiesRefusal(const Plan& plan, const DestinationWork& w,
