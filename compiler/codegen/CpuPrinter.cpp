@@ -65,6 +65,10 @@ class CpuPrinter : public ScenePrinter {
   void verletMembers();
   // The rebuild check of the kept lists `lists` of w's pass over source s (verlet_build).
   void listsRebuildCheck(const std::string& lists, const DestinationWork& w, int s);
+  // One displacement scan per array and phase (sphc::PhaseDisplacements): declared where the
+  // phase keeps lists and nothing in it writes positions or h; its checks then pass it.
+  void phasePrologue(const Phase& ph) override;
+  bool phaseDisplacements_ = false;
   // The destinations {A, B} of w's phase whose pair loops A <- B and B <- A run as one pass
   // (crossPairsRefusal; serial with kept lists), where w is A or B; {} elsewhere.
   std::pair<const DestinationWork*, const DestinationWork*> crossPair(
@@ -490,13 +494,28 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
     tunedRebuildCheck(lists, w, d, s);
   } else if (verlet()) {
     // Rebuilt when particles of either array moved too far since the lists' last build
-    // (by this loop or another one sharing them).
-    const std::string arrays = d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}";
+    // (by this loop or another one sharing them). A static array (isStatic: never moves, h
+    // constant) is left out of the check and of the positions kept, as with
+    // --verlet-skin=tuned (CpuVerletTune.cpp's rebuildCheck); with neither array moving the
+    // lists are built once.
+    std::string arrays;
+    for (int a : movingArrays(d, s)) arrays += (arrays.empty() ? "{&" : ", &") + arr(a).name;
     const std::string range = rangeBegin(w) + ", " + rangeEnd(w);
-    scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ") || "
-           << lists << ".skin.must_rebuild(" << arrays << ", Kernel::radius_scale);\n";
+    const std::string phase = phaseDisplacements_ ? ", &phase_moved" : "";
+    if (arrays.empty()) {
+      scene_ << "        // Neither array moves: the lists are built once.\n";
+      scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ");\n";
+    } else {
+      arrays += "}";
+      if (arrays != (d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}"))
+        scene_ << "        // Checked over the array that moves (the other is static).\n";
+      scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ") || "
+             << lists << ".skin.must_rebuild(" << arrays << ", Kernel::radius_scale" << phase
+             << ");\n";
+    }
     scene_ << "        if (verlet_build) {\n";
-    scene_ << "          " << lists << ".skin.mark(" << arrays << ");\n";
+    if (!arrays.empty())
+      scene_ << "          " << lists << ".skin.mark(" << arrays << phase << ");\n";
     scene_ << "          " << lists << ".begin = " << rangeBegin(w) << ";\n";
     scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
     scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
@@ -967,6 +986,28 @@ void CpuPrinter::adaptiveDtArray(int a) {
 
 // --verlet-skin=auto (CpuVerletTune.cpp) with this scene's arrays, lists and statements.
 void CpuPrinter::tunedMembers() { verlet_tune::members(out_); }
+
+void CpuPrinter::phasePrologue(const Phase& ph) {
+  phaseDisplacements_ = false;
+  if (!verlet() || tuned() || hasDomain()) return;
+  bool keeps = false;
+  for (const DestinationWork& w : ph.destinations)
+    for (const NeighbourPass& pass : w.passes) keeps |= pass.searches();
+  if (!keeps) return;
+  // Nothing of the phase may move a particle or change h between its checks.
+  for (int k : ph.equations) {
+    const PlanEquation& eq = plan_.equations[k];
+    if (!eq.live) continue;
+    if (eq.declIndex < 0) return;
+    for (const auto& [kind, body] : plan_.equationDecls[eq.declIndex].methods)
+      for (const PropAccess& wr : plan_.bodies[body].facts.dWrites)
+        if (wr.prop == "x" || wr.prop == "y" || wr.prop == "z" || wr.prop == "h") return;
+  }
+  phaseDisplacements_ = true;
+  scene_ << "    // Each array's displacement since its lists' build measured once in this phase\n"
+            "    // (nothing in it moves a particle or changes h; sphc/verlet.h).\n"
+            "    sphc::PhaseDisplacements phase_moved;\n";
+}
 
 std::vector<int> CpuPrinter::movingArrays(int d, int s) const {
   std::vector<int> moving;

@@ -466,6 +466,7 @@ void ScenePrinter::emitPhaseMember(const Phase& ph) {
   scene_ << "  void " << ph.name << "(double t, double dt) {\n";
   // Every body takes t and dt: only a phase whose equations were all pruned ignores them.
   if (ph.destinations.empty()) scene_ << "    (void)t; (void)dt;\n";
+  phasePrologue(ph);
   for (const DestinationWork& w : ph.destinations) {
     const std::string& D = arr(w.array).name;
     // Groups with `real = false` run on the ghosts too (they follow the real particles).

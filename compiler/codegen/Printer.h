@@ -95,6 +95,8 @@ class ScenePrinter {
   virtual void dataMovement() {}                    // to_device/to_single, to_host
   // One destination of a phase, after `const int n = ...;` (its ghost refresh included).
   virtual void destination(const DestinationWork& w, const std::string& phase) = 0;
+  // After the phase function's opening line, before its destinations.
+  virtual void phasePrologue(const Phase& ph) {}
   // Before a `converged` test reads properties on the host.
   virtual void beforeConverged(const PlanEquation& eq) {}
   // After a `converged` test wrote the array constant of index c on the host.

@@ -216,6 +216,103 @@ TEST(VerletSkin, DisplacementCheckPerAxisSetIsTheGenericOne) {
   }
 }
 
+// sphc::PhaseDisplacements: several skins over the same arrays checked and marked within one
+// phase (positions unchanged) give the answers and last_moved() of skins without it, bit for
+// bit; the skins that marked an array in the phase share one copy, and each array's
+// displacement is measured once (the second skin's answer follows a change the scan would
+// see only if it scanned: moving a particle between the two checks of one phase, which the
+// printer rules out, leaves the second answer at the first's).
+TEST(VerletSkin, OneDisplacementScanPerPhaseGivesTheAnswersOfAScanPerCheck) {
+  const double skin = 0.1, h0 = 0.1;
+  ParticleArray fluid, wall;
+  for (ParticleArray* pa : {&fluid, &wall}) {
+    pa->resize(pa == &fluid ? 300 : 120);
+    for (const char* p : {"x", "y", "h"}) pa->add_property(p);
+  }
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> pos(0.0, 1.0), hs(0.9 * h0, 1.1 * h0);
+  for (ParticleArray* pa : {&fluid, &wall})
+    for (std::size_t i = 0; i < pa->n; ++i) {
+      pa->f64("x")[i] = pos(rng);
+      pa->f64("y")[i] = pos(rng);
+      pa->f64("h")[i] = hs(rng);
+    }
+  const std::vector<const ParticleArray*> ff = {&fluid}, fw = {&fluid, &wall};
+  VerletSkin a(skin), b(skin), a_ref(skin), b_ref(skin);  // b, b_ref over fluid and wall
+  {
+    sphc::PhaseDisplacements phase;
+    a.mark(ff, &phase);
+    b.mark(fw, &phase);
+    ASSERT_NE(phase.marked(&fluid), nullptr);
+    ASSERT_NE(phase.marked(&wall), nullptr);
+  }
+  a_ref.mark(ff);
+  b_ref.mark(fw);
+  EXPECT_EQ(a.hmin(), a_ref.hmin());
+  EXPECT_EQ(b.hmin(), b_ref.hmin());
+  int yes = 0, no = 0;
+  std::uniform_int_distribution<std::size_t> who(0, fluid.n - 1);
+  std::uniform_real_distribution<double> d(-0.06 * h0, 0.06 * h0);
+  for (int phase_no = 0; phase_no < 300; ++phase_no) {
+    // Between phases a few particles move, and (now and then) the walls' h grows.
+    for (int m = 0; m < 2; ++m) {
+      const std::size_t i = who(rng);
+      fluid.f64("x")[i] += d(rng);
+      fluid.f64("y")[i] += d(rng);
+    }
+    if (phase_no % 37 == 5) wall.f64("h")[3] += 0.003 * h0;
+    sphc::PhaseDisplacements phase;
+    const bool ra = a.must_rebuild(ff, kRadiusScale, &phase);
+    const bool rb = b.must_rebuild(fw, kRadiusScale, &phase);
+    if (phase_no == 0) EXPECT_EQ(phase.scans(), 2u);  // one copy of the fluid: scanned once
+    const bool want_a = a_ref.must_rebuild(ff, kRadiusScale);
+    const bool want_b = b_ref.must_rebuild(fw, kRadiusScale);
+    EXPECT_EQ(ra, want_a) << phase_no;
+    EXPECT_EQ(rb, want_b) << phase_no;
+    EXPECT_EQ(a.last_moved(), a_ref.last_moved()) << phase_no;
+    EXPECT_EQ(b.last_moved(), b_ref.last_moved()) << phase_no;
+    if (phase_no % 50 == 17) {  // one array's scan in the phase, reused: a move now is not seen
+      const double x0 = fluid.f64("x")[7];
+      fluid.f64("x")[7] += 10.0;
+      EXPECT_EQ(b.must_rebuild(fw, kRadiusScale, &phase), want_b);
+      EXPECT_TRUE(b.must_rebuild(fw, kRadiusScale));  // without the phase: scanned, seen
+      fluid.f64("x")[7] = x0;
+    }
+    (want_a ? yes : no) += 1;
+    // Rebuilds as a printed phase does them: each due list marks, sharing the phase's copy.
+    if (ra) a.mark(ff, &phase);
+    if (rb) b.mark(fw, &phase);
+    if (want_a) a_ref.mark(ff);
+    if (want_b) b_ref.mark(fw);
+  }
+  EXPECT_GT(yes, 0);
+  EXPECT_GT(no, 0);
+}
+
+// A set of axes other than x; x, y; x, y, z (here y alone missing) is scanned by the 3D loop
+// with the saved zeros read for the missing axis: the displacement of the loop that read it
+// as 0, bit for bit.
+TEST(VerletSkin, DisplacementCheckWithAMissingMiddleAxis) {
+  ParticleArray pa;
+  pa.resize(50);
+  for (const char* p : {"x", "z", "h"}) pa.add_property(p);
+  for (std::size_t i = 0; i < pa.n; ++i) {
+    pa.f64("x")[i] = 0.01 * i;
+    pa.f64("z")[i] = 0.02 * i;
+    pa.f64("h")[i] = 0.1;
+  }
+  const std::vector<const ParticleArray*> all = {&pa};
+  VerletSkin verlet(0.1);
+  verlet.mark(all);
+  pa.f64("x")[4] += 0.003;
+  pa.f64("z")[4] += 0.004;
+  EXPECT_FALSE(verlet.must_rebuild(all, kRadiusScale));
+  const double dx = (0.01 * 4 + 0.003) - 0.01 * 4, dz = (0.02 * 4 + 0.004) - 0.02 * 4;
+  EXPECT_EQ(verlet.last_moved(), 2.0 * std::sqrt(dx * dx + 0.0 * 0.0 + dz * dz));
+  pa.f64("z")[9] += 0.02;  // 2 * 0.02 > 0.1 * 2 * 0.1
+  EXPECT_TRUE(verlet.must_rebuild(all, kRadiusScale));
+}
+
 // --verlet-skin=auto (sphc/verlet_tune.h): the skin minimises the modelled cost per
 // evaluation, (1 + F)^dim (1 + k / F): no F of a fine scan around it costs less.
 TEST(SkinTuner, OptimalSkinMinimisesTheModelledCost) {

@@ -28,11 +28,58 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "sphc/particle_array.h"
 
 namespace sphc {
+
+// The positions and h of one array when kept lists were built (VerletSkin::mark), shared by
+// the skins that marked it at the same positions within one phase (PhaseDisplacements).
+struct MarkedPositions {
+  std::size_t n = 0;
+  std::vector<double> x, y, z, h;
+  double hmin = HUGE_VAL;  // the smallest h (NaN skipped)
+};
+
+// One scan of each array's displacements per phase (docs/performance.md, "The dam break's
+// step: one displacement check per array set"). The generated phase declares one where
+// nothing in it writes positions, h or counts; each rebuild check of the phase's kept lists
+// passes it to must_rebuild and mark: an array whose positions several lists marked within
+// one phase is marked once (the skins share the saved copy), and its displacement from that
+// copy is measured once per phase, however many lists' checks read it. The answers and
+// last_moved() are those of a scan per check, bit for bit (the same doubles, max and min
+// being exact).
+class PhaseDisplacements {
+ public:
+  struct Moved {
+    // Held so that no copy marked later in the phase can take its address.
+    std::shared_ptr<const MarkedPositions> from;
+    double d2max, growth;
+    bool nan;
+  };
+  const Moved* find(const MarkedPositions* from) const {
+    for (const Moved& m : moved_)
+      if (m.from.get() == from) return &m;
+    return nullptr;
+  }
+  void add(const Moved& m) { moved_.push_back(m); }
+  std::size_t scans() const { return moved_.size(); }  // the arrays measured in this phase
+  // The copy marked for `pa` in this phase (nullptr if none): the same positions now.
+  std::shared_ptr<const MarkedPositions> marked(const ParticleArray* pa) const {
+    for (const auto& m : marked_)
+      if (m.first == pa && m.second->n == pa->n) return m.second;
+    return nullptr;
+  }
+  void add(const ParticleArray* pa, std::shared_ptr<const MarkedPositions> s) {
+    marked_.emplace_back(pa, std::move(s));
+  }
+
+ private:
+  std::vector<Moved> moved_;
+  std::vector<std::pair<const ParticleArray*, std::shared_ptr<const MarkedPositions>>> marked_;
+};
 
 class VerletSkin {
  public:
@@ -52,34 +99,29 @@ class VerletSkin {
 
   // Whether the lists built at the last mark() may miss a pair now (see above): true before
   // the first mark(), when the arrays or their counts differ, or when the particles moved
-  // (or h grew) too far. NaN positions also give true.
-  bool must_rebuild(const std::vector<const ParticleArray*>& arrays, double radius_scale) const {
+  // (or h grew) too far. NaN positions also give true. With `phase`, an array's displacement
+  // already measured in this phase from the same marked copy is not scanned again.
+  bool must_rebuild(const std::vector<const ParticleArray*>& arrays, double radius_scale,
+                    PhaseDisplacements* phase = nullptr) const {
     ++checks_;
     last_moved_ = -1.0;
     if (saved_.size() != arrays.size()) return true;
     double d2max = 0.0, growth = 0.0;
     for (std::size_t a = 0; a < arrays.size(); ++a) {
       const ParticleArray& pa = *arrays[a];
-      const Saved& s = saved_[a];
+      const MarkedPositions& s = *saved_[a];
       if (pa.n != s.n) return true;
-      const double* x = coordinate(pa, "x");
-      const double* y = coordinate(pa, "y");
-      const double* z = coordinate(pa, "z");
-      const double* h = pa.f64("h");
-      const long n = static_cast<long>(pa.n);
+      const PhaseDisplacements::Moved* known = phase ? phase->find(&s) : nullptr;
       double d2m = 0.0, gm = 0.0;
       bool nan = false;
-      // One loop per set of coordinates present (1D, 2D, 3D): no test of a missing axis per
-      // particle. A missing axis was saved as zeros by mark(), so its term was +0 and d2, hence
-      // the answer, is bit for bit the same without it.
-      if (x && y && z)
-        moved_since_mark<true, true>(x, y, z, h, s, n, d2m, gm, nan);
-      else if (x && y && !z)
-        moved_since_mark<true, false>(x, y, nullptr, h, s, n, d2m, gm, nan);
-      else if (x && !y && !z)
-        moved_since_mark<false, false>(x, nullptr, nullptr, h, s, n, d2m, gm, nan);
-      else
-        moved_since_mark<true, true, true>(x, y, z, h, s, n, d2m, gm, nan);
+      if (known) {
+        d2m = known->d2max;
+        gm = known->growth;
+        nan = known->nan;
+      } else {
+        moved_since(pa, s, d2m, gm, nan);
+        if (phase) phase->add({saved_[a], d2m, gm, nan});
+      }
       if (nan) return true;  // NaN
       d2max = d2m > d2max ? d2m : d2max;
       growth = gm > growth ? gm : growth;
@@ -89,26 +131,22 @@ class VerletSkin {
     return !(moved <= skin_ * radius_scale * hmin_);
   }
 
-  // Records the positions and h of the arrays the lists are built from now.
-  void mark(const std::vector<const ParticleArray*>& arrays) {
+  // Records the positions and h of the arrays the lists are built from now (with `phase`: the
+  // copy another skin marked in this phase, the same positions, where there is one).
+  void mark(const std::vector<const ParticleArray*>& arrays,
+            PhaseDisplacements* phase = nullptr) {
     checks_ = 0;
     saved_.resize(arrays.size());
     hmin_ = HUGE_VAL;
     for (std::size_t a = 0; a < arrays.size(); ++a) {
       const ParticleArray& pa = *arrays[a];
-      Saved& s = saved_[a];
-      s.n = pa.n;
-      const char* axes[3] = {"x", "y", "z"};
-      std::vector<double>* to[3] = {&s.x, &s.y, &s.z};
-      for (int k = 0; k < 3; ++k) {
-        const double* c = coordinate(pa, axes[k]);
-        if (c)
-          to[k]->assign(c, c + pa.n);
-        else
-          to[k]->assign(pa.n, 0.0);
+      std::shared_ptr<const MarkedPositions> s = phase ? phase->marked(&pa) : nullptr;
+      if (!s) {
+        s = copy_positions(pa);
+        if (phase) phase->add(&pa, s);
       }
-      s.h.assign(pa.f64("h"), pa.f64("h") + pa.n);
-      for (double h : s.h) hmin_ = h < hmin_ ? h : hmin_;
+      saved_[a] = s;
+      hmin_ = s->hmin < hmin_ ? s->hmin : hmin_;
     }
   }
 
@@ -118,18 +156,52 @@ class VerletSkin {
     const int k = pa.find(axis);
     return k < 0 ? nullptr : pa.f64(k);
   }
-  struct Saved {
-    std::size_t n = 0;
-    std::vector<double> x, y, z, h;
-  };
+  static std::shared_ptr<const MarkedPositions> copy_positions(const ParticleArray& pa) {
+    auto s = std::make_shared<MarkedPositions>();
+    s->n = pa.n;
+    const char* axes[3] = {"x", "y", "z"};
+    std::vector<double>* to[3] = {&s->x, &s->y, &s->z};
+    for (int k = 0; k < 3; ++k) {
+      const double* c = coordinate(pa, axes[k]);
+      if (c)
+        to[k]->assign(c, c + pa.n);
+      else
+        to[k]->assign(pa.n, 0.0);
+    }
+    s->h.assign(pa.f64("h"), pa.f64("h") + pa.n);
+    for (double h : s->h) s->hmin = h < s->hmin ? h : s->hmin;
+    return s;
+  }
+  // The largest squared displacement and growth of h of one array since its mark.
+  static void moved_since(const ParticleArray& pa, const MarkedPositions& s, double& d2m,
+                          double& gm, bool& nan) {
+    const double* x = coordinate(pa, "x");
+    const double* y = coordinate(pa, "y");
+    const double* z = coordinate(pa, "z");
+    const double* h = pa.f64("h");
+    const long n = static_cast<long>(pa.n);
+    // One loop per set of coordinates present (1D, 2D, 3D): no test of a missing axis per
+    // particle. A missing axis was saved as zeros by mark(), so its term was +0 and d2, hence
+    // the answer, is bit for bit the same without it. Any other set (an axis missing below a
+    // present one) is the 3D loop with the saved zeros read for a missing axis: 0 - 0 = +0,
+    // as a missing axis read as 0 gave.
+    if (x && y && z)
+      moved_since_mark<true, true>(x, y, z, h, s, n, d2m, gm, nan);
+    else if (x && y && !z)
+      moved_since_mark<true, false>(x, y, nullptr, h, s, n, d2m, gm, nan);
+    else if (x && !y && !z)
+      moved_since_mark<false, false>(x, nullptr, nullptr, h, s, n, d2m, gm, nan);
+    else
+      moved_since_mark<true, true>(x ? x : s.x.data(), y ? y : s.y.data(), z ? z : s.z.data(),
+                                   h, s, n, d2m, gm, nan);
+  }
   // The largest squared displacement and growth of h of one array since mark(), and whether
   // a NaN was met. OpenMP (from 16,384 particles, the runtime's threshold): a max reduction,
-  // whose value does not depend on the order. Generic: any set of present axes, a missing
-  // one read as 0 (the loop of before).
-  template <bool HasY, bool HasZ, bool Generic = false>
+  // whose value does not depend on the order.
+  template <bool HasY, bool HasZ>
   static void moved_since_mark(const double* x, const double* y, const double* z,
-                               const double* h, const Saved& s, long n, double& d2max,
-                               double& growth, bool& nan_met) {
+                               const double* h, const MarkedPositions& s, long n,
+                               double& d2max, double& growth, bool& nan_met) {
     const double* sx = s.x.data();
     const double* sy = s.y.data();
     const double* sz = s.z.data();
@@ -138,22 +210,14 @@ class VerletSkin {
     bool nan = false;
 #pragma omp parallel for schedule(static) reduction(max : d2m, gm) reduction(| : nan) if (n > 16384)
     for (long i = 0; i < n; ++i) {
-      double d2;
-      if (Generic) {
-        const double dx = (x ? x[i] : 0.0) - sx[i];
-        const double dy = (y ? y[i] : 0.0) - sy[i];
-        const double dz = (z ? z[i] : 0.0) - sz[i];
-        d2 = dx * dx + dy * dy + dz * dz;
-      } else {
-        const double dx = x[i] - sx[i];
-        d2 = dx * dx;
-        if (HasY) {
-          const double dy = y[i] - sy[i];
-          d2 = dx * dx + dy * dy;
-          if (HasZ) {
-            const double dz = z[i] - sz[i];
-            d2 = dx * dx + dy * dy + dz * dz;
-          }
+      const double dx = x[i] - sx[i];
+      double d2 = dx * dx;
+      if (HasY) {
+        const double dy = y[i] - sy[i];
+        d2 = dx * dx + dy * dy;
+        if (HasZ) {
+          const double dz = z[i] - sz[i];
+          d2 = dx * dx + dy * dy + dz * dz;
         }
       }
       const double dh = h[i] - sh[i];
@@ -167,7 +231,7 @@ class VerletSkin {
   }
   double skin_;
   double hmin_ = 0.0;
-  std::vector<Saved> saved_;
+  std::vector<std::shared_ptr<const MarkedPositions>> saved_;
   mutable double last_moved_ = -1.0;  // measurements for sphc/verlet_tune.h
   mutable long checks_ = 0;
 };
