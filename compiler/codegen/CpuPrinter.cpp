@@ -66,7 +66,8 @@ class CpuPrinter : public ScenePrinter {
   // The rebuild check of the kept lists `lists` of w's pass over source s (verlet_build).
   void listsRebuildCheck(const std::string& lists, const DestinationWork& w, int s);
   // One displacement scan per array and phase (sphc::PhaseDisplacements): declared where the
-  // phase keeps lists and nothing in it writes positions or h; its checks then pass it.
+  // phase checks two kept lists or more and nothing in it writes positions or h; its checks
+  // then pass it.
   void phasePrologue(const Phase& ph) override;
   bool phaseDisplacements_ = false;
   // The destinations {A, B} of w's phase whose pair loops A <- B and B <- A run as one pass
@@ -990,10 +991,11 @@ void CpuPrinter::tunedMembers() { verlet_tune::members(out_); }
 void CpuPrinter::phasePrologue(const Phase& ph) {
   phaseDisplacements_ = false;
   if (!verlet() || tuned() || hasDomain()) return;
-  bool keeps = false;
+  int checks = 0;  // of kept lists (a cross pass checks A <- B's lists only)
   for (const DestinationWork& w : ph.destinations)
-    for (const NeighbourPass& pass : w.passes) keeps |= pass.searches();
-  if (!keeps) return;
+    for (const NeighbourPass& pass : w.passes)
+      checks += pass.searches() && !(crossPair(w).first == &w && &pass == &w.passes.back());
+  if (checks < 2) return;
   // Nothing of the phase may move a particle or change h between its checks.
   for (int k : ph.equations) {
     const PlanEquation& eq = plan_.equations[k];
