@@ -90,6 +90,19 @@ bool overlaps(const SourceOnlySite& x, const SourceOnlySite& y) {
   return x.begin < y.end && y.begin < x.end;
 }
 
+// A destination-only site of the equation's parameters (and t, dt) alone: no property, no
+// local, no d_idx (e.g. the shifting normaliser 1 / KERNEL_W(1 / hdx, 1)). Its value is the
+// same for every particle of a pass: computed once per pass (passHoisted), before the
+// destination loop, and the loop's local takes it.
+bool particleFree(const std::string& text, const BodyFacts& f, const SourceOnlySite& s) {
+  return s.locals.empty() && sideReads(f, s, false).empty() &&
+         text.substr(s.begin, s.end - s.begin).find("d_idx") == std::string::npos;
+}
+
+std::string passHoisted(const std::string& eqStruct, size_t k) {
+  return "pass_dhoisted_" + eqStruct + "_" + std::to_string(k);
+}
+
 }  // namespace
 
 std::vector<SourceOnlySite> ScenePrinter::hoistedDestinationSites(const PlanBody& b,
@@ -204,17 +217,38 @@ void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass&
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     const auto sites = hoistedDestinationSites(b, host_);
-    for (size_t k = 0; k < sites.size(); ++k)
-      os << indent << "const double " << hoistDestinationArgument(eqStruct(*eq), std::to_string(k))
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const std::string local = hoistDestinationArgument(eqStruct(*eq), std::to_string(k));
+      if (particleFree(b.source.text, b.facts, sites[k])) {  // emitHoistedValues computed it
+        os << indent << "const double " << local << " = " << passHoisted(eqStruct(*eq), k)
+           << ";  // " << eq->name << ": once per pass\n";
+        continue;
+      }
+      os << indent << "const double " << local
          << " = " << bodyFunctionName(eq->name, "loop") << "_dhoisted" << k << "(d_idx"
          << hoistArguments(sites[k], b.facts, false, eqStruct(*eq)) << ");  // " << eq->name
          << ": " << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
          << "\n";
+    }
   }
 }
 
 void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass,
                                      const std::string& count, const std::string& pragma) const {
+  // The destination-only values of the parameters alone, once per pass (particleFree; read
+  // by emitDestinationHoisted's locals).
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    const auto sites = hoistedDestinationSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k)
+      if (particleFree(b.source.text, b.facts, sites[k]))
+        os << "        const double " << passHoisted(eqStruct(*eq), k) << " = "
+           << bodyFunctionName(eq->name, "loop") << "_dhoisted" << k << "(0"
+           << hoistArguments(sites[k], b.facts, false, eqStruct(*eq)) << ");  // " << eq->name
+           << ": "
+           << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
+           << ", of the parameters only: once per pass\n";
+  }
   std::vector<std::string> calls;
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
