@@ -39,6 +39,7 @@ class CpuPrinter : public ScenePrinter {
     if (cpuSingle_) out_ << "#include \"sphc/float_arrays.h\"\n";
     if (verlet()) out_ << "#include \"sphc/verlet.h\"\n";
     if (tuned_) out_ << "#include \"sphc/verlet_tune.h\"\n";
+    if (openmp_ && anyCrossPair()) out_ << "#include \"sphc/cross_pairs.h\"\n";
   }
   void systemIncludes() override {
     if (openmp_) out_ << "\n#include <omp.h>\n";
@@ -66,9 +67,19 @@ class CpuPrinter : public ScenePrinter {
   // The rebuild check of the kept lists `lists` of w's pass over source s (verlet_build).
   void listsRebuildCheck(const std::string& lists, const DestinationWork& w, int s);
   // The destinations {A, B} of w's phase whose pair loops A <- B and B <- A run as one pass
-  // (crossPairsRefusal; serial with kept lists), where w is A or B; {} elsewhere.
+  // (crossPairsRefusal; kept lists; OpenMP in blocks), where w is A or B; {} elsewhere.
   std::pair<const DestinationWork*, const DestinationWork*> crossPair(
       const DestinationWork& w) const;
+  bool anyCrossPair() const {
+    bool any = false;
+    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+      for (const Phase& ph : g.phases)
+        for (const DestinationWork& w : ph.destinations) any |= crossPair(w).first != nullptr;
+      for (const auto& sub : g.subgroups) walk(*sub);
+    };
+    walk(sched_.equations);
+    return any;
+  }
   // --verlet-skin=auto: the skin and the re-sort chosen at run time (sphc/verlet_tune.h;
   // CpuVerletTune.cpp); --verlet-skin=F keeps the code of a fixed skin.
   bool tuned() const { return tuned_; }
@@ -254,6 +265,9 @@ void CpuPrinter::verletMembers() {
          << arr(w.array).name
          << " <- " << arr(pass.source).name
          << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase")) << "\n";
+    if (openmp_ && crossPair(w).first == &w && &pass == &w.passes.back())
+      out_ << "  sphc::CrossSources " << lists << "_by_source;  // the same lists from "
+           << arr(pass.source).name << "'s side (sphc/cross_pairs.h)\n";
   });
   if (hasDomain())
     out_ << "  // The ghosts are kept with the lists: found again when the particles moved too far\n"
@@ -353,7 +367,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       const std::string lists = verletLists(phase, A, w.array);
       emitCrossPass(A, A.passes.back(), w, pass, lists,
                     tuned() ? "verlet_radius2" : "VERLET_RADIUS2",
-                    [&] { listsRebuildCheck(lists, A, w.array); });
+                    [&] { listsRebuildCheck(lists, A, w.array); },
+                    parallelFor("        ", pass.order, ompIf("n_src")));  // OpenMP: in blocks
       continue;
     }
     const int s = pass.source;
@@ -509,7 +524,7 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
 
 std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
     const DestinationWork& w) const {
-  if (!symmetric_ || !verlet() || openmp_ || hasDomain()) return {};
+  if (!symmetric_ || !verlet() || hasDomain()) return {};
   std::pair<const DestinationWork*, const DestinationWork*> found{};
   std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
     for (const Phase& ph : g.phases)
