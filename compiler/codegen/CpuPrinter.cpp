@@ -70,6 +70,21 @@ class CpuPrinter : public ScenePrinter {
   // (crossPairsRefusal; kept lists; OpenMP in blocks), where w is A or B; {} elsewhere.
   std::pair<const DestinationWork*, const DestinationWork*> crossPair(
       const DestinationWork& w) const;
+  // OpenMP: the kept lists of the A <- B loops run with B <- A as one pass, each with the
+  // name of B (their member LISTS_by_source, sphc/cross_pairs.h, found again after a build).
+  std::map<std::string, std::string> crossSourceLists() const {
+    std::map<std::string, std::string> out;
+    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+      for (const Phase& ph : g.phases)
+        for (const DestinationWork& w : ph.destinations)
+          if (openmp_ && crossPair(w).first == &w)
+            out.emplace(verletLists(ph.name, w, w.passes.back().source),
+                        arr(w.passes.back().source).name);
+      for (const auto& sub : g.subgroups) walk(*sub);
+    };
+    walk(sched_.equations);
+    return out;
+  }
   bool anyCrossPair() const {
     bool any = false;
     std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
@@ -265,10 +280,10 @@ void CpuPrinter::verletMembers() {
          << arr(w.array).name
          << " <- " << arr(pass.source).name
          << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase")) << "\n";
-    if (openmp_ && crossPair(w).first == &w && &pass == &w.passes.back())
-      out_ << "  sphc::CrossSources " << lists << "_by_source;  // the same lists from "
-           << arr(pass.source).name << "'s side (sphc/cross_pairs.h)\n";
   });
+  for (const auto& [lists, B] : crossSourceLists())
+    out_ << "  sphc::CrossSources " << lists << "_by_source;  // the same lists from " << B
+         << "'s side (sphc/cross_pairs.h)\n";
   if (hasDomain())
     out_ << "  // The ghosts are kept with the lists: found again when the particles moved too far\n"
             "  // (ghost_skin, over every array of a pair loop) or at a permutation, else made\n"
@@ -516,6 +531,8 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
     scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
     scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
     if (d == s && symmetric_ && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
+    if (crossSourceLists().count(lists))
+      scene_ << "          " << lists << "_by_source.clear();  // found again by the pass over pairs of two arrays once\n";
     scene_ << "        }\n";
   }
   if (lazyCells() && !isStatic(S))  // CpuLazyCells.cpp
@@ -1002,6 +1019,7 @@ void CpuPrinter::tunedRebuildCheck(const std::string& lists, const DestinationWo
     loop.staticArray = loop.moving[0] == arr(d).name ? arr(s).name : arr(d).name;
   loop.ranged = w.ranged();
   loop.clearUpper = d == s && symmetric_;
+  loop.clearCross = crossSourceLists().count(lists) > 0;
   verlet_tune::rebuildCheck(scene_, loop);
 }
 

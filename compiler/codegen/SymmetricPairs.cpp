@@ -545,9 +545,10 @@ void ScenePrinter::emitCrossBlocksHead(const std::string& lists, const std::stri
             "        // " << nameA << " index whatever the blocks (sphc/cross_pairs.h): in the "
             "block holding all its\n"
             "        // candidates, else after the blocks. The lists read from " << nameB
-         << "'s side, once per build:\n";
-  scene_ << "        if (verlet_build) " << lists << "_by_source.build(" << lists << ".lists, "
-         << nameB << ".n);\n";
+         << "'s side, again after a build\n"
+            "        // (by whichever loop builds the lists):\n";
+  scene_ << "        if (" << lists << "_by_source.empty()) " << lists << "_by_source.build("
+         << lists << ".lists, " << nameB << ".n);\n";
   scene_ << "        const std::uint32_t* const by_source_first = " << lists << "_by_source.first.data();\n";
   scene_ << "        const std::uint32_t* const by_source_last = " << lists << "_by_source.last.data();\n";
   scene_ << "        const int n_blocks = std::max(1, std::min(n, omp_get_max_threads()));\n";

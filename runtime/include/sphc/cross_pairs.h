@@ -32,6 +32,11 @@ struct CrossSources {
   std::vector<std::uint32_t> spanning;
   long spanning_for[2] = {-1, -1};
 
+  // Emptied at every build of the lists (by whichever loop builds them), built again by the
+  // pass that reads it.
+  void clear() { starts.clear(); }
+  bool empty() const { return starts.empty(); }
+
   // From the kept lists of A <- B (lists[a], increasing b), with nb particles in B.
   void build(const std::vector<std::vector<std::uint32_t>>& lists, std::size_t nb) {
     starts.assign(nb + 1, 0);
