@@ -224,7 +224,7 @@ class ScenePrinter {
   std::string callBodyMirrored(const PlanEquation& eq, int dest,
                                const std::string& pointers = "") const;
   // Pair loops A <- B (A's last) and B <- A (B's first) of one phase that crossPairsRefusal()
-  // allows (serial, kept lists): in B's destination after its initialize, one pass over A's
+  // allows (kept lists): in B's destination after its initialize, one pass over A's
   // kept lists of B, the bodies of both per pair; `listsCheck` writes the rebuild check
   // (verlet_build) of those lists. With `hoistPragma` (OpenMP: the pragma of the source-only
   // values' loops), A's particles in blocks per thread (emitCrossBlocksHead), then the B
