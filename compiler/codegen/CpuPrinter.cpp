@@ -39,6 +39,7 @@ class CpuPrinter : public ScenePrinter {
     if (cpuSingle_) out_ << "#include \"sphc/float_arrays.h\"\n";
     if (verlet()) out_ << "#include \"sphc/verlet.h\"\n";
     if (tuned_) out_ << "#include \"sphc/verlet_tune.h\"\n";
+    if (openmp_ && anyCrossPair()) out_ << "#include \"sphc/cross_pairs.h\"\n";
   }
   void systemIncludes() override {
     if (openmp_) out_ << "\n#include <omp.h>\n";
@@ -71,9 +72,34 @@ class CpuPrinter : public ScenePrinter {
   void phasePrologue(const Phase& ph) override;
   bool phaseDisplacements_ = false;
   // The destinations {A, B} of w's phase whose pair loops A <- B and B <- A run as one pass
-  // (crossPairsRefusal; serial with kept lists), where w is A or B; {} elsewhere.
+  // (crossPairsRefusal; kept lists; OpenMP in blocks), where w is A or B; {} elsewhere.
   std::pair<const DestinationWork*, const DestinationWork*> crossPair(
       const DestinationWork& w) const;
+  // OpenMP: the kept lists of the A <- B loops run with B <- A as one pass, each with the
+  // name of B (their member LISTS_by_source, sphc/cross_pairs.h, found again after a build).
+  std::map<std::string, std::string> crossSourceLists() const {
+    std::map<std::string, std::string> out;
+    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+      for (const Phase& ph : g.phases)
+        for (const DestinationWork& w : ph.destinations)
+          if (openmp_ && crossPair(w).first == &w)
+            out.emplace(verletLists(ph.name, w, w.passes.back().source),
+                        arr(w.passes.back().source).name);
+      for (const auto& sub : g.subgroups) walk(*sub);
+    };
+    walk(sched_.equations);
+    return out;
+  }
+  bool anyCrossPair() const {
+    bool any = false;
+    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+      for (const Phase& ph : g.phases)
+        for (const DestinationWork& w : ph.destinations) any |= crossPair(w).first != nullptr;
+      for (const auto& sub : g.subgroups) walk(*sub);
+    };
+    walk(sched_.equations);
+    return any;
+  }
   // --verlet-skin=auto: the skin and the re-sort chosen at run time (sphc/verlet_tune.h;
   // CpuVerletTune.cpp); --verlet-skin=F keeps the code of a fixed skin.
   bool tuned() const { return tuned_; }
@@ -260,6 +286,9 @@ void CpuPrinter::verletMembers() {
          << " <- " << arr(pass.source).name
          << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase")) << "\n";
   });
+  for (const auto& [lists, B] : crossSourceLists())
+    out_ << "  sphc::CrossSources " << lists << "_by_source;  // the same lists from " << B
+         << "'s side (sphc/cross_pairs.h)\n";
   if (hasDomain())
     out_ << "  // The ghosts are kept with the lists: found again when the particles moved too far\n"
             "  // (ghost_skin, over every array of a pair loop) or at a permutation, else made\n"
@@ -358,7 +387,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       const std::string lists = verletLists(phase, A, w.array);
       emitCrossPass(A, A.passes.back(), w, pass, lists,
                     tuned() ? "verlet_radius2" : "VERLET_RADIUS2",
-                    [&] { listsRebuildCheck(lists, A, w.array); });
+                    [&] { listsRebuildCheck(lists, A, w.array); },
+                    parallelFor("        ", pass.order, ompIf("n_src")));  // OpenMP: in blocks
       continue;
     }
     const int s = pass.source;
@@ -521,6 +551,8 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
     scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
     scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
     if (d == s && symmetric_ && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
+    if (crossSourceLists().count(lists))
+      scene_ << "          " << lists << "_by_source.clear();  // found again by the pass over pairs of two arrays once\n";
     scene_ << "        }\n";
   }
   if (lazyCells() && !isStatic(S))  // CpuLazyCells.cpp
@@ -529,7 +561,7 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
 
 std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
     const DestinationWork& w) const {
-  if (!symmetric_ || !verlet() || openmp_ || hasDomain()) return {};
+  if (!symmetric_ || !verlet() || hasDomain()) return {};
   std::pair<const DestinationWork*, const DestinationWork*> found{};
   std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
     for (const Phase& ph : g.phases)
@@ -1030,6 +1062,7 @@ void CpuPrinter::tunedRebuildCheck(const std::string& lists, const DestinationWo
     loop.staticArray = loop.moving[0] == arr(d).name ? arr(s).name : arr(d).name;
   loop.ranged = w.ranged();
   loop.clearUpper = d == s && symmetric_;
+  loop.clearCross = crossSourceLists().count(lists) > 0;
   verlet_tune::rebuildCheck(scene_, loop);
 }
 

@@ -24,6 +24,7 @@ struct KeptLoop {
   std::vector<std::string> moving;  // the arrays that may move (destination first)
   bool ranged = false;              // a range of its own (start_idx, stop_idx)
   bool clearUpper = false;          // a symmetric loop's `upper` found again after a build
+  bool clearCross = false;          // OpenMP pairs of two arrays once: LISTS_by_source too
 };
 // `verlet_build` and the rebuild: skin, positions, range.
 void rebuildCheck(std::ostream& scene, const KeptLoop& loop);

@@ -226,12 +226,20 @@ class ScenePrinter {
   std::string callBodyMirrored(const PlanEquation& eq, int dest,
                                const std::string& pointers = "") const;
   // Pair loops A <- B (A's last) and B <- A (B's first) of one phase that crossPairsRefusal()
-  // allows (serial, kept lists): in B's destination after its initialize, one pass over A's
+  // allows (kept lists): in B's destination after its initialize, one pass over A's
   // kept lists of B, the bodies of both per pair; `listsCheck` writes the rebuild check
-  // (verlet_build) of those lists.
+  // (verlet_build) of those lists. With `hoistPragma` (OpenMP: the pragma of the source-only
+  // values' loops), A's particles in blocks per thread (emitCrossBlocksHead), then the B
+  // particles whose candidates span blocks (emitCrossSpanning; sphc/cross_pairs.h).
   void emitCrossPass(const DestinationWork& A, const NeighbourPass& ab, const DestinationWork& B,
                      const NeighbourPass& ba, const std::string& lists,
-                     const std::string& listRadius2, const std::function<void()>& listsCheck);
+                     const std::string& listRadius2, const std::function<void()>& listsCheck,
+                     const std::string& hoistPragma = "");
+  void emitCrossBlocksHead(const std::string& lists, const std::string& nameA,
+                           const std::string& nameB);
+  void emitCrossSpanning(const NeighbourPass& ba, int b, const std::set<std::string>& q,
+                         const std::string& lists, const std::string& nameA,
+                         const std::string& nameB);
   // Pieces of both: the kept lists of every destination particle when due (verlet_build);
   // the destination-only values of every particle (dhoisted_all_*); the pair quantities of
   // a neighbour s_idx, with `both` the mirrored ones too (XIJ_ji, DWIJ_ji, ...).

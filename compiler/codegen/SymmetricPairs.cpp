@@ -209,9 +209,6 @@ std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOp
           std::string why = opts.symmetricPairs ? crossPairsRefusal(plan, ph, a, b, listsKept)
                                                 : "--no-symmetric-pairs";
           if (why.empty() && sched.domain) why = "the sources include periodic or mirror ghosts";
-          if (why.empty() && opts.backend == Backend::OpenMP)
-            why = "OpenMP keeps a pass per destination array (the second array's sums would be "
-                  "written by several threads)";
           if (opts.backend == Backend::OpenCL) why = "the OpenCL backend gathers per destination";
           notes.push_back(why.empty() ? "each pair once for both particles: " + loop
                                       : "pairs per destination particle: " + loop + ": " + why);
@@ -464,7 +461,9 @@ void ScenePrinter::emitPairQuantitiesOnce(const std::set<std::string>& q, bool b
 void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& ab,
                                  const DestinationWork& B, const NeighbourPass& ba,
                                  const std::string& lists, const std::string& listRadius2,
-                                 const std::function<void()>& listsCheck) {
+                                 const std::function<void()>& listsCheck,
+                                 const std::string& hoistPragma) {
+  const bool openmp = !hoistPragma.empty();
   const std::string& nameA = arr(A.array).name;
   const std::string& nameB = arr(B.array).name;
   std::set<std::string> q = ab.pairQuantities;
@@ -482,8 +481,8 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   for (const auto& p : ba.sourceProps)
     scene_ << "        const " << hostType(A.array, p) << "* s_" << p << " = "
            << propPtr(A.array, p) << ";\n";
-  emitHoistedValues(scene_, ba, nameA + ".n", "");
-  emitDestinationHoistedAll(ba, "");
+  emitHoistedValues(scene_, ba, nameA + ".n", hoistPragma);
+  emitDestinationHoistedAll(ba, openmp ? "        #pragma omp parallel for schedule(static)\n" : "");
   std::set<std::string> dprops;  // of B, in the bodies of B <- A
   for (const PlanEquation* eq : ba.equations)
     for (const BodyParam& p : bodyParams(methodBody(*eq, ast::Method::Loop), B.array, host_))
@@ -504,29 +503,91 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   for (const auto& p : ab.sourceProps)
     scene_ << "        const " << hostType(B.array, p) << "* s_" << p << " = "
            << propPtr(B.array, p) << ";\n";
-  emitHoistedValues(scene_, ab, nameB + ".n", "");
+  emitHoistedValues(scene_, ab, nameB + ".n", hoistPragma);
   scene_ << "        const sphc::CellList& cells = cells_" << nameB << ";\n";
   listsCheck();
-  emitKeptListsBuild(lists, false, listRadius2);
-  scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {  // pairs (d_idx of " << nameA
+  emitKeptListsBuild(lists, openmp, listRadius2);
+  if (openmp) emitCrossBlocksHead(lists, nameA, nameB);
+  // OpenMP: blocks of A's particles (emitCrossBlocksHead), two spaces further in.
+  const std::string in = openmp ? "  " : "";
+  scene_ << in << "        for (int d_idx = " << (openmp ? "b_begin" : "0") << "; d_idx < "
+         << (openmp ? "b_end" : "n") << "; ++d_idx) {  // pairs (d_idx of " << nameA
          << ", s_idx of " << nameB << ")\n";
-  emitDestLocals(scene_, "          ", q, host_);
-  emitDestinationHoisted(scene_, ab, "          ");
-  scene_ << "          const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
-  scene_ << "          const std::uint32_t* const k_end = kept.data() + kept.size();\n";
+  emitDestLocals(scene_, in + "          ", q, host_);
+  emitDestinationHoisted(scene_, ab, in + "          ");
+  scene_ << in << "          const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+  scene_ << in << "          const std::uint32_t* const k_end = kept.data() + kept.size();\n";
   const RegisterSums sums = registerSums(A, ab, &ba);  // codegen/RegisterSums.cpp
-  emitSumsLoad(scene_, "          ", sums);
-  scene_ << "          for (const std::uint32_t* k = kept.data(); k != k_end; ++k) {\n";
-  const std::string body = "            ";
+  emitSumsLoad(scene_, in + "          ", sums);
+  scene_ << in << "          for (const std::uint32_t* k = kept.data(); k != k_end; ++k) {\n";
+  const std::string body = in + "            ";
   scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
   emitNeighbourTest(scene_, host_, "continue;", body);
   emitPairQuantitiesOnce(q, true, body);
   for (const PlanEquation* eq : ab.equations) scene_ << body << pairCall(*eq, A.array, sums);
+  if (openmp)
+    scene_ << body << "if (by_source_first[s_idx] >= u_begin && by_source_last[s_idx] < u_end) {  "
+              "// all of " << nameB << " s_idx's candidates in this block\n";
   for (const PlanEquation* eq : ba.equations)
-    scene_ << body << callBodyMirrored(*eq, B.array, "mirror_");
-  scene_ << "          }\n";
-  emitSumsStore(scene_, "          ", sums);
-  scene_ << "        }\n        }\n      }\n";
+    scene_ << body << (openmp ? "  " : "") << callBodyMirrored(*eq, B.array, "mirror_");
+  if (openmp) scene_ << body << "}\n";
+  scene_ << in << "          }\n";
+  emitSumsStore(scene_, in + "          ", sums);
+  scene_ << in << "        }\n";
+  if (openmp) emitCrossSpanning(ba, B.array, q, lists, nameA, nameB);
+  scene_ << "        }\n      }\n";
+}
+
+void ScenePrinter::emitCrossBlocksHead(const std::string& lists, const std::string& nameA,
+                                       const std::string& nameB) {
+  scene_ << "        // " << nameA << " in contiguous blocks, one per thread; each " << nameB
+         << " particle's sums in increasing\n"
+            "        // " << nameA << " index whatever the blocks (sphc/cross_pairs.h): in the "
+            "block holding all its\n"
+            "        // candidates, else after the blocks. The lists read from " << nameB
+         << "'s side, again after a build\n"
+            "        // (by whichever loop builds the lists):\n";
+  scene_ << "        if (" << lists << "_by_source.empty()) " << lists << "_by_source.build("
+         << lists << ".lists, " << nameB << ".n);\n";
+  scene_ << "        const std::uint32_t* const by_source_first = " << lists << "_by_source.first.data();\n";
+  scene_ << "        const std::uint32_t* const by_source_last = " << lists << "_by_source.last.data();\n";
+  scene_ << "        const int n_blocks = std::max(1, std::min(n, omp_get_max_threads()));\n";
+  scene_ << "        #pragma omp parallel for schedule(static) default(firstprivate) shared(cells)\n";
+  scene_ << "        for (int blk = 0; blk < n_blocks; ++blk) {\n";
+  scene_ << "          const int b_begin = static_cast<int>(static_cast<long>(n) * blk / n_blocks);\n";
+  scene_ << "          const int b_end = static_cast<int>(static_cast<long>(n) * (blk + 1) / n_blocks);\n";
+  scene_ << "          const std::uint32_t u_begin = static_cast<std::uint32_t>(b_begin), "
+            "u_end = static_cast<std::uint32_t>(b_end);\n";
+}
+
+void ScenePrinter::emitCrossSpanning(const NeighbourPass& ba, int b, const std::set<std::string>& q,
+                                     const std::string& lists, const std::string& nameA,
+                                     const std::string& nameB) {
+  scene_ << "        }\n";
+  scene_ << "        // The " << nameB << " particles whose candidates lie in several blocks: "
+            "each over its\n"
+            "        // candidates in increasing " << nameA << " index, the pair as above (d_idx of "
+         << nameA << ", s_idx of " << nameB << ").\n";
+  scene_ << "        const std::vector<std::uint32_t>& spanning = " << lists
+         << "_by_source.spanning_blocks(n, n_blocks);\n";
+  scene_ << "        const int n_spanning = static_cast<int>(spanning.size());\n";
+  scene_ << "        const std::uint32_t* const by_source_starts = " << lists
+         << "_by_source.starts.data();\n";
+  scene_ << "        const std::uint32_t* const by_source_dests = " << lists
+         << "_by_source.dests.data();\n";
+  scene_ << "        #pragma omp parallel for schedule(static) default(firstprivate) shared(spanning)\n";
+  scene_ << "        for (int m = 0; m < n_spanning; ++m) {\n";
+  scene_ << "          const int s_idx = static_cast<int>(spanning[m]);\n";
+  scene_ << "          const std::uint32_t* const k_end = by_source_dests + by_source_starts[s_idx + 1];\n";
+  scene_ << "          for (const std::uint32_t* k = by_source_dests + by_source_starts[s_idx]; "
+            "k != k_end; ++k) {\n";
+  const std::string body = "            ";
+  scene_ << body << "const int d_idx = static_cast<int>(*k);\n";
+  emitDestLocals(scene_, body, q, host_);
+  emitNeighbourTest(scene_, host_, "continue;", body);
+  emitPairQuantitiesOnce(q, true, body);
+  for (const PlanEquation* eq : ba.equations) scene_ << body << callBodyMirrored(*eq, b, "mirror_");
+  scene_ << "          }\n        }\n";
 }
 
 }  // namespace sphc

@@ -11,6 +11,7 @@
 #ifndef SPHC_SCENE_PCH_H
 #define SPHC_SCENE_PCH_H
 
+#include "sphc/cross_pairs.h"
 #include "sphc/domain.h"
 #include "sphc/float_arrays.h"
 #include "sphc/geometry.h"
