@@ -251,16 +251,21 @@ class ScenePrinter {
   // after it: stored.
   void emitSumsLoad(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
   void emitSumsStore(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
-  // The call of eq's loop for destination d: with rs active, of its function on the locals.
+  // The call of eq's loop for destination d: with rs active, of its function on the locals
+  // (named sumsPrefix + acc_NAME); `first`, where it returns an argument, overrides the others
+  // (SimdPairs.cpp: the mirrored call in SIMD lanes).
   std::string pairCall(const PlanEquation& eq, int d, const RegisterSums& rs,
-                       bool scalarPairs = false) const;
+                       bool scalarPairs = false, const std::string& sumsPrefix = "",
+                       const std::function<std::string(const BodyParam&)>& first = nullptr) const;
   // After eq's loop function: its form on the locals (NAME_loop_sums), where a loop uses it.
   void emitSumsFunction(const PlanEquation& eq, std::ostringstream& os);
   bool registerSums_ = false;                // EmitOptions::registerSums (CPU double, not mpi)
   std::unique_ptr<std::set<int>> sumsDecls_;  // equation declarations whose _sums form is used
   // eq's loop on the locals, named NAME_loop_sums; `scalarPairs`: NAME_loop_simd, its vector
   // pair quantities three scalars each (XIJ_0, XIJ_1, XIJ_2; SimdPairs.cpp).
-  void printSumsFunction(const PlanEquation& eq, bool scalarPairs, std::ostringstream& os) const;
+  // `mirror`: NAME_loop_simd_mirror, also its source properties values (sval_NAME).
+  void printSumsFunction(const PlanEquation& eq, bool scalarPairs, std::ostringstream& os,
+                         bool mirror = false) const;
   // The destination properties a loop body reads and writes not, indexed `S * d_idx + k`
   // only (floating): name -> stride, components; in its _simd form values (dval_NAME,
   // dvalK_NAME) loaded before the loop.
@@ -268,6 +273,9 @@ class ScenePrinter {
                                                                          int d) const;
   std::vector<SourceOnlySite> allHoistedSites(const PlanBody& b) const;  // source and destination
   static std::string destinationValueName(const std::string& prop, int stride, int comp);
+  // The source properties a loop body reads, indexed `S * s_idx + k` only (sval_NAME).
+  std::map<std::string, std::pair<int, std::set<int>>> sourceValues(const PlanBody& b) const;
+  static std::string sourceValueName(const std::string& prop, int stride, int comp);
   std::string destinationValueLoad(const std::string& prop, int stride, int comp) const;
 
   // ---- SIMD pair loops (SimdPairs.cpp; sphc --simd-pairs) ----
@@ -278,6 +286,20 @@ class ScenePrinter {
   // (false: the caller prints the scalar loop); nothing with the switch off.
   bool emitSimdNeighbours(std::ostream& os, const DestinationWork& w, const NeighbourPass& pass,
                           const RegisterSums& sums);
+  // Each pair once in SIMD lanes (the rest of emitSymmetricPass where simdPairsRefusal()
+  // allows it): serial, or OpenMP blocks, bitwise equal; q the pair quantities with mirrors.
+  void emitSymmetricSimdLoops(const DestinationWork& w, const NeighbourPass& pass,
+                              const std::string& lists, bool openmp,
+                              const std::set<std::string>& q, const RegisterSums& sums);
+  // Pieces of it: the pair quantities as scalars (with `both` the mirrored ones, XIJ_ji_0,
+  // ...) and the cut-off as a mask (in_support); the destination's other values (dval_NAME);
+  // the mirrored call of eq in its _simd form, on the locals sumsPrefix + acc_NAME.
+  void emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q, bool both,
+                              const std::string& body) const;
+  void emitDestinationValueLoads(std::ostream& os, const DestinationWork& w,
+                                 const NeighbourPass& pass, const std::string& in) const;
+  std::string simdMirroredCall(const PlanEquation& eq, int d, const RegisterSums& sums,
+                               const std::string& sumsPrefix) const;
   // After eq's loop function: its NAME_loop_simd form, where a SIMD loop calls it.
   void emitSimdFunction(const PlanEquation& eq, std::ostringstream& os);
   bool simdPairs_ = false;                    // EmitOptions::simdPairs (CPU double, not mpi)

@@ -108,6 +108,8 @@ std::string pairBodiesRefusal(const Plan& plan, const DestinationWork& w,
 
 }  // namespace
 
+std::string mirroredPairQuantity(const std::string& q) { return mirrored(q); }
+
 std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
                                   const NeighbourPass& pass, bool listsKept) {
   if (pass.source != w.array) return "the source is another array";
@@ -270,8 +272,13 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   const std::string pragma = openmp ? "        #pragma omp parallel for schedule(static) "
                                       "default(firstprivate) shared(cells)\n"
                                     : "";
-  scene_ << "        // Each pair once for both particles (codegen/SymmetricPairs.cpp; sphc\n"
-            "        // --no-symmetric-pairs: per destination particle): the same sums bit for bit.\n";
+  const bool simd = simdPairsRefusal(w, pass).empty();  // --simd-pairs: SimdPairs.cpp
+  if (simd)
+    scene_ << "        // Each pair once for both particles in SIMD lanes (codegen/SimdPairs.cpp;\n"
+              "        // sphc --simd-pairs): the sums reassociated across the lanes.\n";
+  else
+    scene_ << "        // Each pair once for both particles (codegen/SymmetricPairs.cpp; sphc\n"
+              "        // --no-symmetric-pairs: per destination particle): the same sums bit for bit.\n";
   // The kept lists first, all of them: a pair is visited from its lower particle's list.
   emitKeptListsBuild(lists, openmp, listRadius2);
   // Where s_idx >= d_idx starts in each kept list: once per build (whichever loop built).
@@ -284,6 +291,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   // The destination-only values of every particle, for the mirrored calls.
   emitDestinationHoistedAll(pass, pragma);
   const RegisterSums sums = registerSums(w, pass);
+  if (simd) return emitSymmetricSimdLoops(w, pass, lists, openmp, q, sums);
   // One destination's neighbours in [from, to) of its kept list (sorted): the pair
   // quantities, the bodies for d_idx and, with `both`, for s_idx (unless the self pair).
   // With `tail` (OpenMP blocks), the rest of the list after `to` follows for d_idx alone, in

@@ -36,6 +36,10 @@ std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
 std::string crossPairsRefusal(const Plan& plan, const Phase& ph, size_t a, size_t b,
                               bool listsKept);
 
+// The name of pair quantity q in the mirrored call (destination j, source i): WI <-> WJ,
+// XIJ -> XIJ_ji (differences and gradients), q itself where symmetric.
+std::string mirroredPairQuantity(const std::string& q);
+
 // --report: one note per same-array pair loop of the schedule, whether it evaluates each pair
 // once and, where not, why; then one per pair of loops A <- B, B <- A of one phase.
 std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOptions& opts);
