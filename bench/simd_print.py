@@ -11,7 +11,13 @@ two variants interleaved, --rounds times; the minimum and the median over the ro
 printed (on a loaded machine only ratios of interleaved runs mean something). Also the
 zmm gathers (vgatherdpd) in each executable.
 
-Usage: python3 bench/simd_print.py [--scenes cube,dambreak,dambreak_pysph] [--rounds 5] [--with-ns]
+Since stop 32 a same-array loop of each pair once is printed in SIMD lanes too (masked
+scatters for the source side); --base-sphc PATH adds a third variant, --simd-pairs printed by
+another sphc (e.g. one built from an earlier commit: the per-destination form), and the
+scene dambreak_coarse is the dam break with its own effects at dx = 0.03.
+
+Usage: python3 bench/simd_print.py [--scenes cube,dambreak,dambreak_pysph,dambreak_coarse]
+       [--rounds 5] [--with-ns] [--base-sphc PATH]
 """
 
 import os
@@ -32,14 +38,15 @@ SCENES = {
     "dambreak": (SCENE_FILES["dambreak"], [], ["--set", "dx=0.0047"], 5, 45),
     "dambreak_pysph": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
                        ["--set", "dx=0.0047", "--set", "cfl=0.3"], 5, 105),
+    "dambreak_coarse": (SCENE_FILES["dambreak"], [], ["--set", "dx=0.03"], 50, 1050),
 }
 VARIANTS = [("default", []), ("simd", ["--simd-pairs"])]
 
 
-def gathers(exe):
+def gathers(exe, what="vgatherdpd"):
     dis = subprocess.run(["objdump", "-d", "--no-show-raw-insn", exe], stdout=subprocess.PIPE,
                          universal_newlines=True).stdout
-    return sum(1 for line in dis.splitlines() if "vgatherdpd" in line and "zmm" in line)
+    return sum(1 for line in dis.splitlines() if what in line and "zmm" in line)
 
 
 def main():
@@ -48,6 +55,8 @@ def main():
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--with-ns", action="store_true",
                     help="also the scalar per-destination loops (--no-symmetric-pairs)")
+    ap.add_argument("--base-sphc", default="",
+                    help="also --simd-pairs printed by this sphc (variant simd_base)")
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="sphc_simdprint_")
     print("load average before: %s" % load_average())
@@ -55,9 +64,12 @@ def main():
         path, sflags, options, short, long_ = SCENES[scene]
         exes = {}
         variants = VARIANTS + ([("ns", ["--no-symmetric-pairs"])] if args.with_ns else [])
+        if args.base_sphc:
+            variants.append(("simd_base", ["--simd-pairs"]))
         for name, flags in variants:
             exes[name] = os.path.join(tmp, "%s_%s" % (scene, name))
-            run([args.sphc, path, "-o", exes[name]] + sflags + flags)
+            sphc = args.base_sphc if name == "simd_base" else args.sphc
+            run([sphc, path, "-o", exes[name]] + sflags + flags)
         per = cpu_per_step_rounds(exes, options, short, long_, args.rounds)
         d, s = per["default"], per["simd"]
         print("%-15s steps %d-%d, min of %d: default %.4f s, simd %.4f s per step: simd / default "
@@ -66,6 +78,16 @@ def main():
                   statistics.median(s) / statistics.median(d), gathers(exes["default"]),
                   gathers(exes["simd"]), " ".join("%.4f" % v for v in d),
                   " ".join("%.4f" % v for v in s)))
+        print("%-15s zmm scatters (vscatterdpd): default %d, simd %d" % (
+            scene, gathers(exes["default"], "vscatterdpd"), gathers(exes["simd"], "vscatterdpd")))
+        if args.base_sphc:
+            b = per["simd_base"]
+            print("%-15s --simd-pairs of --base-sphc: %.4f s (/ default %.3f, medians %.3f); "
+                  "simd / simd_base = %.3f (medians %.3f); zmm gathers %d  [all: %s]" % (
+                      scene, min(b), min(b) / min(d),
+                      statistics.median(b) / statistics.median(d), min(s) / min(b),
+                      statistics.median(s) / statistics.median(b), gathers(exes["simd_base"]),
+                      " ".join("%.4f" % v for v in b)))
         if args.with_ns:
             print("%-15s scalar per destination (--no-symmetric-pairs): %.4f s (/ default %.3f); "
                   "simd / ns = %.3f  [all: %s]" % (
