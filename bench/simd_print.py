@@ -11,10 +11,10 @@ two variants interleaved, --rounds times; the minimum and the median over the ro
 printed (on a loaded machine only ratios of interleaved runs mean something). Also the
 zmm gathers (vgatherdpd) in each executable.
 
-Since stop 32 a same-array loop of each pair once is printed in SIMD lanes too (masked
-scatters for the source side); --base-sphc PATH adds a third variant, --simd-pairs printed by
-another sphc (e.g. one built from an earlier commit: the per-destination form), and the
-scene dambreak_coarse is the dam break with its own effects at dx = 0.03.
+Stop 32: the variant sym, `--simd-pairs --simd-symmetric`, prints a same-array loop of each
+pair once in SIMD lanes (masked scatters for the source side) instead of per destination;
+--base-sphc PATH adds a variant simd_base, --simd-pairs printed by another sphc (an earlier
+commit's); the scene dambreak_coarse is the dam break with its own effects at dx = 0.03.
 
 Usage: python3 bench/simd_print.py [--scenes cube,dambreak,dambreak_pysph,dambreak_coarse]
        [--rounds 5] [--with-ns] [--base-sphc PATH]
@@ -40,7 +40,8 @@ SCENES = {
                        ["--set", "dx=0.0047", "--set", "cfl=0.3"], 5, 105),
     "dambreak_coarse": (SCENE_FILES["dambreak"], [], ["--set", "dx=0.03"], 50, 1050),
 }
-VARIANTS = [("default", []), ("simd", ["--simd-pairs"])]
+VARIANTS = [("default", []), ("simd", ["--simd-pairs"]),
+            ("sym", ["--simd-pairs", "--simd-symmetric"])]
 
 
 def gathers(exe, what="vgatherdpd"):
@@ -78,8 +79,13 @@ def main():
                   statistics.median(s) / statistics.median(d), gathers(exes["default"]),
                   gathers(exes["simd"]), " ".join("%.4f" % v for v in d),
                   " ".join("%.4f" % v for v in s)))
-        print("%-15s zmm scatters (vscatterdpd): default %d, simd %d" % (
-            scene, gathers(exes["default"], "vscatterdpd"), gathers(exes["simd"], "vscatterdpd")))
+        y = per["sym"]
+        print("%-15s sym (--simd-symmetric): %.4f s (/ default %.3f, medians %.3f); sym / simd = "
+              "%.3f (medians %.3f); zmm gathers %d, scatters %d  [all: %s]" % (
+                  scene, min(y), min(y) / min(d), statistics.median(y) / statistics.median(d),
+                  min(y) / min(s), statistics.median(y) / statistics.median(s),
+                  gathers(exes["sym"]), gathers(exes["sym"], "vscatterdpd"),
+                  " ".join("%.4f" % v for v in y)))
         if args.base_sphc:
             b = per["simd_base"]
             print("%-15s --simd-pairs of --base-sphc: %.4f s (/ default %.3f, medians %.3f); "

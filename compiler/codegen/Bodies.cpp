@@ -42,6 +42,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   registerSums_ = opts.registerSums && opts.backend != Backend::OpenCL && !singlePrecision_ &&
                   !mpi_;
   simdPairs_ = opts.simdPairs && registerSums_;  // SimdPairs.cpp: on the sums in locals
+  simdSymmetric_ = simdPairs_ && opts.simdSymmetric;
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {

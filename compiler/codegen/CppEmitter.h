@@ -83,6 +83,11 @@ struct EmitOptions {
   // reassociated across the SIMD lanes: not bitwise the scalar loop's (serial and OpenMP with
   // the switch are bitwise equal).
   bool simdPairs = false;
+  // --simd-symmetric (with simdPairs): a same-array pair loop of each pair once is printed
+  // each pair once in SIMD lanes (codegen/SimdPairs.cpp, emitSymmetricSimdLoops) instead of
+  // per destination; the source side a masked scatter. Measured slower than per destination
+  // on this machine (docs/performance.md, "Each pair once in SIMD lanes"): off by default.
+  bool simdSymmetric = false;
 };
 
 // The lines around the out-of-class phases of a split solver (EmitOptions::splitUnits).

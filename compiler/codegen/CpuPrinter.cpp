@@ -388,7 +388,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, w, s) : "";
     listsRebuildCheck(lists, w, s);
-    if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty()) {
+    if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty() &&
+        (simdSymmetric_ || !simdPairsRefusal(w, pass).empty())) {  // --simd-pairs: per destination
       emitSymmetricPass(w, pass, lists, openmp_,
                         tuned() ? "verlet_radius2" : "VERLET_RADIUS2");  // codegen/SymmetricPairs.cpp
       scene_ << "      }\n";

@@ -303,6 +303,7 @@ class ScenePrinter {
   // After eq's loop function: its NAME_loop_simd form, where a SIMD loop calls it.
   void emitSimdFunction(const PlanEquation& eq, std::ostringstream& os);
   bool simdPairs_ = false;                    // EmitOptions::simdPairs (CPU double, not mpi)
+  bool simdSymmetric_ = false;                // EmitOptions::simdSymmetric (with simdPairs_)
   std::unique_ptr<std::set<int>> simdDecls_;  // equation declarations whose _simd form is used
 
   // ---- The host program (HostProgram.cpp) ----

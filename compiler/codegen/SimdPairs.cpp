@@ -471,7 +471,8 @@ void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& 
       if (simdPairsRefusal(w, pass).empty())
         for (const PlanEquation* e : pass.equations) {
           simdDecls_->insert(e->declIndex);
-          if (pass.source == w.array) simdDecls_->insert(-1 - e->declIndex);  // each pair once
+          if (simdSymmetric_ && pass.source == w.array)  // each pair once: the mirrored form
+            simdDecls_->insert(-1 - e->declIndex);
         }
     });
   }

@@ -272,7 +272,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   const std::string pragma = openmp ? "        #pragma omp parallel for schedule(static) "
                                       "default(firstprivate) shared(cells)\n"
                                     : "";
-  const bool simd = simdPairsRefusal(w, pass).empty();  // --simd-pairs: SimdPairs.cpp
+  const bool simd = simdSymmetric_ && simdPairsRefusal(w, pass).empty();  // SimdPairs.cpp
   if (simd)
     scene_ << "        // Each pair once for both particles in SIMD lanes (codegen/SimdPairs.cpp;\n"
               "        // sphc --simd-pairs): the sums reassociated across the lanes.\n";

@@ -145,6 +145,12 @@ static cl::opt<bool> SimdPairs(
              "off; the sums are reassociated, so the results differ from the scalar loop's "
              "in the last bits)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> SimdSymmetric(
+    "simd-symmetric",
+    cl::desc("With --simd-pairs: print a pair loop that evaluates each pair once for both "
+             "particles in SIMD lanes too (the source side's sums a masked scatter; serial "
+             "and openmp bitwise equal) instead of per destination (default: off)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoLazyCells(
     "no-lazy-cells",
     cl::desc("With kept neighbour lists, build the search domain and cell lists at every "
@@ -462,6 +468,7 @@ int main(int argc, char** argv) {
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;
   emitOpts.simdPairs = SimdPairs;
+  emitOpts.simdSymmetric = SimdSymmetric;
   if (Report && Emit != EmitKind::OpenCL)
     for (const std::string& note : sphc::symmetricPairsNotes(*schedule, emitOpts))
       llvm::outs() << "note: " << note << "\n";
