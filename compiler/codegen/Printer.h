@@ -234,6 +234,10 @@ class ScenePrinter {
   // the destination-only values of every particle (dhoisted_all_*); the pair quantities of
   // a neighbour s_idx, with `both` the mirrored ones too (XIJ_ji, DWIJ_ji, ...).
   void emitKeptListsBuild(const std::string& lists, bool openmp, const std::string& listRadius2);
+  // In a destination loop of each pair once: d_idx's values (xi, ...), its destination-only
+  // values, its kept list (kept, k_end).
+  void emitSymmetricDestination(const std::string& in, const NeighbourPass& pass,
+                                const std::set<std::string>& q, const std::string& lists);
   void emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma);
   void emitPairQuantitiesOnce(const std::set<std::string>& q, bool both, const std::string& body);
   // The members holding the destination-only values of every particle (dhoist_eqN_K).
@@ -292,10 +296,10 @@ class ScenePrinter {
                               const std::string& lists, bool openmp,
                               const std::set<std::string>& q, const RegisterSums& sums);
   // Pieces of it: the pair quantities as scalars (with `both` the mirrored ones, XIJ_ji_0,
-  // ...) and the cut-off as a mask (in_support); the destination's other values (dval_NAME);
+  // ...) and, with `mask`, the cut-off as a mask (in_support); the destination's other values (dval_NAME);
   // the mirrored call of eq in its _simd form, on the locals sumsPrefix + acc_NAME.
   void emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q, bool both,
-                              const std::string& body) const;
+                              const std::string& body, bool mask = true) const;
   void emitDestinationValueLoads(std::ostream& os, const DestinationWork& w,
                                  const NeighbourPass& pass, const std::string& in) const;
   std::string simdMirroredCall(const PlanEquation& eq, int d, const RegisterSums& sums,

@@ -223,6 +223,31 @@ static bool valueSites(const std::string& text, const std::string& prop,
   return true;
 }
 
+// Property p of a body's text as a value (destinationValues, sourceValues): its stride and
+// components, where every site outside the hoisted expressions is `X_p[S * X_idx + k]` of
+// one stride and the values' names (`name`) are free.
+static void addValue(const std::string& text, const std::string& p,
+                     const std::vector<SourceOnlySite>& hoisted, bool source,
+                     std::string (*name)(const std::string&, int, int),
+                     std::map<std::string, std::pair<int, std::set<int>>>& values) {
+  std::vector<DestinationSite> sites;
+  if (!valueSites(text, p, hoisted, sites, source) || sites.empty()) return;
+  auto& entry = values[p];
+  for (const DestinationSite& site : sites) {
+    if (entry.first != 0 && entry.first != site.stride) {
+      values.erase(p);
+      return;
+    }
+    entry.first = site.stride;
+    entry.second.insert(site.comp);
+  }
+  for (int k : entry.second)
+    if (identifierOccurrences(text, name(p, entry.first, k))) {
+      values.erase(p);
+      return;
+    }
+}
+
 std::vector<SourceOnlySite> ScenePrinter::allHoistedSites(const PlanBody& b) const {
   std::vector<SourceOnlySite> hoisted = hoistedSites(b, host_);
   for (const SourceOnlySite& h : hoistedDestinationSites(b, host_)) hoisted.push_back(h);
@@ -238,23 +263,7 @@ std::map<std::string, std::pair<int, std::set<int>>> ScenePrinter::destinationVa
     const std::string& p = r.prop;
     if (own.count(p) || values.count(p) || !arr(d).find(p) || propType(d, p, host_) != host_.real)
       continue;
-    std::vector<DestinationSite> sites;
-    if (!valueSites(b.source.text, p, hoisted, sites) || sites.empty()) continue;
-    auto& entry = values[p];
-    for (const DestinationSite& site : sites) {
-      if (entry.first != 0 && entry.first != site.stride) {
-        values.erase(p);
-        break;
-      }
-      entry.first = site.stride;
-      entry.second.insert(site.comp);
-    }
-    if (values.count(p))
-      for (int k : entry.second)
-        if (identifierOccurrences(b.source.text, destinationValueName(p, entry.first, k))) {
-          values.erase(p);
-          break;
-        }
+    addValue(b.source.text, p, hoisted, false, &ScenePrinter::destinationValueName, values);
   }
   return values;
 }
@@ -266,23 +275,7 @@ std::map<std::string, std::pair<int, std::set<int>>> ScenePrinter::sourceValues(
   for (const PropAccess& r : b.facts.sReads) {
     const std::string& p = r.prop;
     if (values.count(p)) continue;
-    std::vector<DestinationSite> sites;
-    if (!valueSites(b.source.text, p, hoisted, sites, /*source=*/true) || sites.empty()) continue;
-    auto& entry = values[p];
-    for (const DestinationSite& site : sites) {
-      if (entry.first != 0 && entry.first != site.stride) {
-        values.erase(p);
-        break;
-      }
-      entry.first = site.stride;
-      entry.second.insert(site.comp);
-    }
-    if (values.count(p))
-      for (int k : entry.second)
-        if (identifierOccurrences(b.source.text, sourceValueName(p, entry.first, k))) {
-          values.erase(p);
-          break;
-        }
+    addValue(b.source.text, p, hoisted, true, &ScenePrinter::sourceValueName, values);
   }
   return values;
 }

@@ -155,36 +155,8 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
   os << in << "for (int k_nbr = 0; k_nbr < n_nbrs; ++k_nbr) {\n";
   const std::string body = in + "  ";
   os << body << "const int s_idx = static_cast<int>(NBRS[k_nbr]);\n";
-  os << body << "const " << host_.real << " hj = sj_h[s_idx];\n";
   // The pair quantities as scalars: vectors by component, gradients as a factor times XIJ.
-  const PairDialect dialect = pairDialectOf(host_);
-  for (const PairQuantity& pq : pairQuantityTable()) {
-    if (!(pq.when == PairWhen::BeforeTest || pq.when == PairWhen::EveryNeighbour ||
-          pass.pairQuantities.count(pq.name)))
-      continue;
-    if (pq.form == PairForm::Difference) {
-      for (int k = 0; k < 3; ++k)
-        os << body << "const " << host_.real << " " << pq.name << "_" << k << " = "
-           << (k < plan_.dim ? pq.components[k] + "i - sj_" + pq.components[k] + "[s_idx]"
-                             : std::string("0.0"))
-           << ";\n";
-    } else if (pq.form == PairForm::Gradient) {
-      os << body << "const " << host_.real << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
-         << pq.h << ");\n";
-      for (int k = 0; k < 3; ++k)
-        os << body << "const " << host_.real << " " << pq.name << "_" << k << " = " << pq.name
-           << "_f * XIJ_" << k << ";\n";
-    } else {
-      std::string s = pairQuantityStatement(pq, plan_.dim, dialect, body);
-      std::vector<TextEdit> edits;
-      std::string unused;
-      scalarPairEdits(s, edits, unused);
-      std::sort(edits.begin(), edits.end(),
-                [](const TextEdit& a, const TextEdit& b) { return a.begin > b.begin; });
-      for (const TextEdit& e : edits) s.replace(e.begin, e.end - e.begin, e.replacement);
-      os << s;
-    }
-  }
+  emitLanePairQuantities(os, pass.pairQuantities, /*both=*/false, body, /*mask=*/false);
   for (const PlanEquation* eq : pass.equations)
     os << body << pairCall(*eq, w.array, sums, /*scalarPairs=*/true);
   os << in << "}\n";
@@ -276,7 +248,7 @@ std::string ScenePrinter::simdMirroredCall(const PlanEquation& eq, int d,
 }
 
 void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q,
-                                          bool both, const std::string& body) const {
+                                          bool both, const std::string& body, bool mask) const {
   const std::string& R = host_.real;
   const PairDialect dialect = pairDialectOf(host_);
   os << body << "const " << R << " hj = sj_h[s_idx];\n";
@@ -321,6 +293,7 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
       os << s;
     }
   }
+  if (!mask) return;
   os << body << "const " << R << " hmax = hi > hj ? hi : hj;\n";
   os << body << "const bool in_support = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
 }
@@ -358,17 +331,7 @@ void ScenePrinter::emitSymmetricSimdLoops(const DestinationWork& w, const Neighb
     scene_ << indent << "for (int d_idx = " << begin << "; d_idx < " << end << "; ++d_idx) {"
            << comment << "\n";
     const std::string in = indent + "  ";
-    emitDestLocals(scene_, in, q, host_);
-    for (const PlanEquation* eq : pass.equations) {
-      const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
-      for (size_t k = 0; k < sites.size(); ++k) {
-        const std::string K = std::to_string(k);
-        scene_ << in << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
-               << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
-      }
-    }
-    scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
-    scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
+    emitSymmetricDestination(in, pass, q, lists);  // SymmetricPairs.cpp
     if (!skip.empty()) scene_ << in << "if (" << skip << ") continue;\n";
     emitSumsLoad(scene_, in, sums);  // codegen/RegisterSums.cpp
     emitDestinationValueLoads(scene_, w, pass, in);

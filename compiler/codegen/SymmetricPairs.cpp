@@ -305,21 +305,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     scene_ << indent << "for (int d_idx = " << begin << "; d_idx < " << end << "; ++d_idx) {"
            << comment << "\n";
     const std::string in = indent + "  ";
-    std::ostringstream locals;
-    emitDestLocals(locals, in, q, host_);
-    scene_ << locals.str();
-    // The destination-only values as they were before the pass (a body may write what they
-    // read: at i's turn, i has already had the contributions of the particles before it).
-    for (const PlanEquation* eq : pass.equations) {
-      const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
-      for (size_t k = 0; k < sites.size(); ++k) {
-        const std::string K = std::to_string(k);
-        scene_ << in << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
-               << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
-      }
-    }
-    scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
-    scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
+    emitSymmetricDestination(in, pass, q, lists);
     if (!skip.empty()) scene_ << in << "if (" << skip << ") continue;  // no neighbour in [from, to)\n";
     emitSumsLoad(scene_, in, sums);  // codegen/RegisterSums.cpp
     const std::string body = in + "  ";
@@ -378,6 +364,26 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
             "          // neighbours in later blocks, per destination, in the same loop\n";
   segment("          ", "b_begin", "b_end", upper, "b_end", true, "", true);
   scene_ << "        }\n";
+}
+
+void ScenePrinter::emitSymmetricDestination(const std::string& in, const NeighbourPass& pass,
+                                            const std::set<std::string>& q,
+                                            const std::string& lists) {
+  std::ostringstream locals;
+  emitDestLocals(locals, in, q, host_);
+  scene_ << locals.str();
+  // The destination-only values as they were before the pass (a body may write what they
+  // read: at i's turn, i has already had the contributions of the particles before it).
+  for (const PlanEquation* eq : pass.equations) {
+    const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const std::string K = std::to_string(k);
+      scene_ << in << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
+             << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+    }
+  }
+  scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+  scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
 }
 
 void ScenePrinter::emitKeptListsBuild(const std::string& lists, bool openmp,
