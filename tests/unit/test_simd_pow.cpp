@@ -103,30 +103,24 @@ __attribute__((noinline)) void simdLoop(const double* x, const double* y, double
 #pragma omp simd
   for (int i = 0; i < n; ++i) out[i] = sphc::simd_pow(x[i], y[i]);
 }
-// As in FourtakasDensityDiffusion's SIMD body: the power in a branch, a sum across lanes.
-__attribute__((noinline, optimize("no-tree-vectorize"))) void scalarBranch(const double* x, double y,
-                                                                   double* out, int n) {
-  for (int i = 0; i < n; ++i) {
-    double r = 0.0;
-    if (std::fabs(x[i] - 1.0) < 0.01) {
-      r = 1.0 + y * (x[i] - 1.0);
-    } else {
-      r = x[i] > 0.0 ? 3.0 * sphc::simd_pow(x[i], y) : 0.0;
-    }
-    out[i] = r;
+// As in FourtakasDensityDiffusion's SIMD body: the power in a branch.
+inline double branchBody(double x, double y) {
+  double r = 0.0;
+  if (std::fabs(x - 1.0) < 0.01) {
+    r = 1.0 + y * (x - 1.0);
+  } else {
+    r = x > 0.0 ? 3.0 * sphc::simd_pow(x, y) : 0.0;
   }
+  return r;
+}
+__attribute__((noinline, optimize("no-tree-vectorize"))) void scalarBranch(const double* x,
+                                                                             double y, double* out,
+                                                                             int n) {
+  for (int i = 0; i < n; ++i) out[i] = branchBody(x[i], y);
 }
 __attribute__((noinline)) void simdBranch(const double* x, double y, double* out, int n) {
 #pragma omp simd
-  for (int i = 0; i < n; ++i) {
-    double r = 0.0;
-    if (std::fabs(x[i] - 1.0) < 0.01) {
-      r = 1.0 + y * (x[i] - 1.0);
-    } else {
-      r = x[i] > 0.0 ? 3.0 * sphc::simd_pow(x[i], y) : 0.0;
-    }
-    out[i] = r;
-  }
+  for (int i = 0; i < n; ++i) out[i] = branchBody(x[i], y);
 }
 
 TEST(SimdPow, SimdLanesGiveTheScalarBits) {
