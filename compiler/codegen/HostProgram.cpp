@@ -790,7 +790,6 @@ std::string ScenePrinter::run() {
             "#include \"sphc/mpi/output.h\"\n";
   runtimeIncludes();
   if (intPowUsed()) out_ << "#include \"sphc/pow.h\"\n";
-  if (simdPowUsed()) out_ << "#include \"sphc/simd_pow.h\"\n";
   out_ << "\n#include <math.h>\n#include <cmath>\n#include <cstdint>\n#include <vector>\n";
   systemIncludes();
   out_ << "\n";

@@ -62,8 +62,7 @@ struct PairDialect;  // analysis/PairQuantityTable.h
 PairDialect pairDialectOf(const Dialect& dl);
 // The vector pair quantities of a body's text as scalars (SimdPairs.cpp): an edit
 // `XIJ[k]` -> `XIJ_k` per indexing by a literal k < 3, appended to `edits`; false (and `why`)
-// where one is named otherwise (a pointer passed on, a computed index); and `pow(` ->
-// `sphc::simd_pow(` (sphc/simd_pow.h).
+// where one is named otherwise (a pointer passed on, a computed index).
 bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std::string& why);
 
 class ScenePrinter {
@@ -281,8 +280,6 @@ class ScenePrinter {
                           const RegisterSums& sums);
   // After eq's loop function: its NAME_loop_simd form, where a SIMD loop calls it.
   void emitSimdFunction(const PlanEquation& eq, std::ostringstream& os);
-  // Whether a body printed in SIMD lanes calls pow (printed sphc::simd_pow: sphc/simd_pow.h).
-  bool simdPowUsed() const;
   bool simdPairs_ = false;                    // EmitOptions::simdPairs (CPU double, not mpi)
   std::unique_ptr<std::set<int>> simdDecls_;  // equation declarations whose _simd form is used
 

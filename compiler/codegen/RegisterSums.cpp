@@ -347,10 +347,7 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
                        "pair loops,\n// codegen/SimdPairs.cpp)\n"
                      : "// codegen/RegisterSums.cpp)\n");
   if (host_.lineDirectives) emitLineDirective(os, b.source.start);
-  // The _simd form always inlined: GCC vectorises the SIMD loop only with every body in it,
-  // and a body with sphc::simd_pow (sphc/simd_pow.h) inlined is past its size limit.
-  os << host_.functionPrefix << (scalarPairs ? "__attribute__((always_inline)) " : "") << "void "
-     << name << "(";
+  os << host_.functionPrefix << "void " << name << "(";
   bool first = true;
   for (const BodyParam& p : bodyParams(b, eq.dest, host_)) {
     if (scalarPairs && p.kind == BodyParam::Pair && findPairQuantity(p.name)->vector) {

@@ -65,31 +65,18 @@ void scanIdentifiers(const std::string& text,
   }
 }
 
-// Whether the identifier at [at, end) of text is called by its plain name (`pow(`, not
-// `std::pow(` or `x.pow(`).
-bool plainCall(const std::string& text, size_t at, size_t end) {
-  const size_t open = skipBlanks(text, end);
-  if (open >= text.size() || text[open] != '(') return false;
-  size_t before = at;
-  while (before > 0 && (text[before - 1] == ' ' || text[before - 1] == '\t')) --before;
-  return before == 0 || (text[before - 1] != ':' && text[before - 1] != '.' &&
-                         text[before - 1] != '>');
-}
-
 // The first call in `text` of a math function GCC does not vectorise without -ffast-math
 // (no SIMD clone in glibc then), "" if none. With one in a body the loop may or may not
 // vectorise depending on where GCC inlines it (the serial and the OpenMP builds would differ
-// in their bits): refused instead. A plain `pow(` is not one: the _simd bodies call
-// sphc::simd_pow for it (sphc/simd_pow.h: plain arithmetic, the same bits in every lane).
+// in their bits): refused instead.
 std::string scalarMathCall(const std::string& text) {
   static const std::set<std::string> scalarOnly = {
       "pow",  "exp",  "exp2", "expm1", "log",   "log2",  "log10", "log1p", "sin",    "cos",
       "tan",  "asin", "acos", "atan",  "atan2", "sinh",  "cosh",  "tanh",  "cbrt",   "erf",
       "erfc", "tgamma", "lgamma", "hypot", "fmod"};
   std::string found;
-  scanIdentifiers(text, [&](const std::string& word, size_t at, size_t end) {
+  scanIdentifiers(text, [&](const std::string& word, size_t, size_t end) {
     const size_t open = skipBlanks(text, end);
-    if (word == "pow" && plainCall(text, at, end)) return end;
     if (open < text.size() && text[open] == '(' && scalarOnly.count(word)) {
       found = word;
       return std::string::npos;
@@ -103,10 +90,6 @@ std::string scalarMathCall(const std::string& text) {
 
 bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std::string& why) {
   scanIdentifiers(text, [&](const std::string& word, size_t at, size_t end) {
-    if (word == "pow" && plainCall(text, at, end)) {  // sphc/simd_pow.h
-      edits.push_back({static_cast<unsigned>(at), static_cast<unsigned>(end), "sphc::simd_pow"});
-      return end;
-    }
     const PairQuantity* pq = findPairQuantity(word);
     if (!pq || !pq->vector) return end;
     const size_t open = skipBlanks(text, end), digit = skipBlanks(text, open + 1),
@@ -211,23 +194,6 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
     os << body << pairCall(*eq, w.array, sums, /*scalarPairs=*/true);
   os << in << "}\n";
   return true;
-}
-
-bool ScenePrinter::simdPowUsed() const {
-  if (!simdPairs_) return false;
-  bool used = false;
-  walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
-                                   const NeighbourPass& pass) {
-    if (used || !simdPairsRefusal(w, pass).empty()) return;
-    for (const PlanEquation* e : pass.equations)
-      scanIdentifiers(methodBody(*e, ast::Method::Loop).source.text,
-                      [&](const std::string& word, size_t at, size_t end) {
-                        used = used || (word == "pow" && plainCall(
-                                            methodBody(*e, ast::Method::Loop).source.text, at, end));
-                        return used ? std::string::npos : end;
-                      });
-  });
-  return used;
 }
 
 void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& os) {
