@@ -1,14 +1,15 @@
 // sphc/simd_pow.h: pow(x, y) that GCC can put in SIMD lanes, with the same bits in a lane
 // and in a scalar loop.
 //
-// The SIMD pair loops (sphc --simd-pairs, codegen/SimdPairs.cpp) call it in place of pow in
-// the bodies' NAME_loop_simd form: the C library's pow has no SIMD form without -ffast-math
-// (GCC then keeps the loop scalar, or vectorises it in one build and not in another), and
-// glibc's vector pow (libmvec) need not give its scalar pow's bits. Everything here is plain
-// double arithmetic (+ - * /, comparisons, selects, integer shifts of the bits) in a fixed
-// order, so a vector lane, the loop's scalar remainder and a serial or OpenMP build round
-// alike (the generated code is built with -ffp-contract=off: no fused multiply-adds).
-// The default printing keeps the C library's pow (through sphc/pow.h).
+// For the SIMD pair loops (sphc --simd-pairs, codegen/SimdPairs.cpp), which refuse bodies
+// calling pow: the C library's pow has no SIMD form without -ffast-math (GCC keeps the loop
+// scalar, or vectorises it in one build and not in another), and glibc's vector pow
+// (libmvec) need not give its scalar pow's bits. Not printed today: with it the dam break's
+// fluid <- fluid pass vectorised but ran slower than with the pass refused
+// (docs/performance.md, "Bodies calling pow in SIMD lanes"). Everything here is plain
+// double arithmetic (+ - * /, quiet comparisons, selects, integer shifts of the bits) in a
+// fixed order, so a vector lane, the loop's scalar remainder and a serial or OpenMP build
+// round alike (the generated code is built with -ffp-contract=off: no fused multiply-adds).
 //
 // Method (written from the series, no tables, no branches):
 //   x = 2^e m, m in [sqrt(1/2), sqrt(2)), f = m - 1 (exact), s = f / (2 + f), z = s^2:
