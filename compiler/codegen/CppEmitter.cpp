@@ -21,6 +21,13 @@ std::string emitCpp(const Schedule& sched, const DiagnosticEngine& diags,
   return printer->run();
 }
 
+std::vector<std::string> pairLoopNotes(const Schedule& sched, const DiagnosticEngine& diags,
+                                       const EmitOptions& opts) {
+  auto printer = opts.backend == Backend::OpenCL ? makeOpenCLPrinter(sched, diags, opts)
+                                                 : makeCpuPrinter(sched, diags, opts);
+  return printer->pairLoopNotes(opts);
+}
+
 std::string emitOpenCL(const Schedule& sched, const DiagnosticEngine& diags, EmitOptions opts) {
   opts.backend = Backend::OpenCL;
   return makeOpenCLPrinter(sched, diags, opts)->kernelSource();

@@ -10,6 +10,7 @@
 #include "sema/Plan.h"
 
 #include <string>
+#include <vector>
 
 namespace sphc {
 
@@ -93,6 +94,10 @@ inline constexpr const char* kPhasesEndMarker = "// ---- sphc: end of the phases
 // The solver's C++ for a schedule (codegen/Schedule.h) of an analysed plan.
 std::string emitCpp(const Schedule& sched, const DiagnosticEngine& diags,
                     const EmitOptions& opts);
+// --report: a note per pair loop, each pair once for both particles or per destination and
+// why, as the backend's printer prints it (codegen/SymmetricPairs.cpp).
+std::vector<std::string> pairLoopNotes(const Schedule& sched, const DiagnosticEngine& diags,
+                                       const EmitOptions& opts);
 // --backend=opencl: the OpenCL C of the scene's kernels alone (what --emit=opencl prints).
 std::string emitOpenCL(const Schedule& sched, const DiagnosticEngine& diags, EmitOptions opts);
 

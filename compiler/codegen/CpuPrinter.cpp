@@ -79,25 +79,19 @@ class CpuPrinter : public ScenePrinter {
   // name of B (their member LISTS_by_source, sphc/cross_pairs.h, found again after a build).
   std::map<std::string, std::string> crossSourceLists() const {
     std::map<std::string, std::string> out;
-    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-      for (const Phase& ph : g.phases)
-        for (const DestinationWork& w : ph.destinations)
-          if (openmp_ && crossPair(w).first == &w)
-            out.emplace(verletLists(ph.name, w, w.passes.back().source),
-                        arr(w.passes.back().source).name);
-      for (const auto& sub : g.subgroups) walk(*sub);
-    };
-    walk(sched_.equations);
+    walkPhases(sched_.equations, [&](const Phase& ph) {
+      for (const DestinationWork& w : ph.destinations)
+        if (openmp_ && crossPair(w).first == &w)
+          out.emplace(verletLists(ph.name, w, w.passes.back().source),
+                      arr(w.passes.back().source).name);
+    });
     return out;
   }
   bool anyCrossPair() const {
     bool any = false;
-    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-      for (const Phase& ph : g.phases)
-        for (const DestinationWork& w : ph.destinations) any |= crossPair(w).first != nullptr;
-      for (const auto& sub : g.subgroups) walk(*sub);
-    };
-    walk(sched_.equations);
+    walkPhases(sched_.equations, [&](const Phase& ph) {
+      for (const DestinationWork& w : ph.destinations) any |= crossPair(w).first != nullptr;
+    });
     return any;
   }
   // --verlet-skin=auto: the skin and the re-sort chosen at run time (sphc/verlet_tune.h;
@@ -130,13 +124,10 @@ class CpuPrinter : public ScenePrinter {
   // kept lists there (the driver's ghostPairLoops on the plan).
   bool ghostPairLoops() const {
     bool any = false;
-    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-      for (const Phase& ph : g.phases)
-        for (const DestinationWork& w : ph.destinations)
-          for (const NeighbourPass& pass : w.passes) any |= w.onGhosts && pass.searches();
-      for (const auto& sub : g.subgroups) walk(*sub);
-    };
-    walk(sched_.equations);
+    walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
+                                     const NeighbourPass& pass) {
+      any |= w.onGhosts && pass.searches();
+    });
     return any;
   }
   // --verlet-skin with a periodic or mirror domain (the lists and ghosts kept together).
@@ -303,18 +294,13 @@ void CpuPrinter::forEachVerletLists(
     const std::function<void(const std::string&, const Phase&, const DestinationWork&,
                              const NeighbourPass&)>& f) const {
   std::set<std::string> declared;  // one member per set of lists (verletLists)
-  std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-    for (const Phase& ph : g.phases)
-      for (const DestinationWork& w : ph.destinations)
-        for (const NeighbourPass& pass : w.passes) {
-          // B <- A run in A <- B's pass (crossPair) reads A <- B's lists: none of its own.
-          if (crossPair(w).second == &w && &pass == &w.passes.front()) continue;
-          const std::string lists = verletLists(ph.name, w, pass.source);
-          if (pass.searches() && declared.insert(lists).second) f(lists, ph, w, pass);
-        }
-    for (const auto& sub : g.subgroups) walk(*sub);
-  };
-  walk(sched_.equations);
+  walkPasses(sched_.equations, [&](const Phase& ph, const DestinationWork& w,
+                                   const NeighbourPass& pass) {
+    // B <- A run in A <- B's pass (crossPair) reads A <- B's lists: none of its own.
+    if (crossPair(w).second == &w && &pass == &w.passes.front()) return;
+    const std::string lists = verletLists(ph.name, w, pass.source);
+    if (pass.searches() && declared.insert(lists).second) f(lists, ph, w, pass);
+  });
 }
 
 void CpuPrinter::searchMembers() {
@@ -563,22 +549,19 @@ std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
     const DestinationWork& w) const {
   if (!symmetric_ || !verlet() || hasDomain()) return {};
   std::pair<const DestinationWork*, const DestinationWork*> found{};
-  std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-    for (const Phase& ph : g.phases)
-      for (size_t a = 0; a + 1 < ph.destinations.size(); ++a) {
-        const DestinationWork& A = ph.destinations[a];
-        const DestinationWork& B = ph.destinations[a + 1];
-        if ((&w == &A || &w == &B) && A.array != B.array && !A.passes.empty() &&
-            !B.passes.empty() && A.passes.back().source == B.array &&
-            B.passes.front().source == A.array && A.passes.back().searches() &&
-            B.passes.front().searches() && crossPairsRefusal(plan_, ph, a, a + 1, true).empty() &&
-            !simdPairsRefusal(A, A.passes.back()).empty() &&  // --simd-pairs: per destination,
-            !simdPairsRefusal(B, B.passes.front()).empty())   // as the OpenMP backend's
-          found = {&A, &B};
-      }
-    for (const auto& sub : g.subgroups) walk(*sub);
-  };
-  walk(sched_.equations);
+  walkPhases(sched_.equations, [&](const Phase& ph) {
+    for (size_t a = 0; a + 1 < ph.destinations.size(); ++a) {
+      const DestinationWork& A = ph.destinations[a];
+      const DestinationWork& B = ph.destinations[a + 1];
+      if ((&w == &A || &w == &B) && A.array != B.array && !A.passes.empty() &&
+          !B.passes.empty() && A.passes.back().source == B.array &&
+          B.passes.front().source == A.array && A.passes.back().searches() &&
+          B.passes.front().searches() && crossPairsRefusal(plan_, ph, a, a + 1, true).empty() &&
+          !simdPairsRefusal(A, A.passes.back()).empty() &&  // --simd-pairs: per destination,
+          !simdPairsRefusal(B, B.passes.front()).empty())   // as the OpenMP backend's
+        found = {&A, &B};
+    }
+  });
   return found;
 }
 

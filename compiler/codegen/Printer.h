@@ -74,6 +74,9 @@ class ScenePrinter {
   // The OpenCL C of the kernels alone (--emit=opencl; empty for a CPU printer): the bodies
   // and scene functions printed, without the host program around them.
   std::string kernelSource();
+  // --report's notes on the pair loops (SymmetricPairs.cpp): each pair once or per
+  // destination, and why, as this printer prints them.
+  std::vector<std::string> pairLoopNotes(const EmitOptions& opts) const;
 
  protected:
   // ---- What each backend prints (hooks) ----

@@ -90,13 +90,10 @@ std::unique_ptr<Schedule> ScheduleBuilder::run() {
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) s_->setupArrays.push_back(a);
   group(plan_.root, unique("equations"), s_->equations);
   for (const auto& n : sourceNames_) s_->cellLists.push_back(plan_.arrayIndex(n));
-  std::function<void(const ScheduleGroup&)> ranged = [&](const ScheduleGroup& g) {
-    for (const auto& ph : g.phases)
-      for (const auto& w : ph.destinations)
-        if (w.ranged()) s_->keepOrder.insert(w.array);
-    for (const auto& sub : g.subgroups) ranged(*sub);
-  };
-  ranged(s_->equations);
+  walkPhases(s_->equations, [&](const Phase& ph) {
+    for (const auto& w : ph.destinations)
+      if (w.ranged()) s_->keepOrder.insert(w.array);
+  });
   for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
     if (loopNames_.count(plan_.arrays[a].name)) s_->searchArrays.push_back(a);
   postStepNeighbours();
@@ -663,13 +660,18 @@ void printSchedule(const Schedule& s, const DiagnosticEngine& diags, llvm::raw_o
   SchedulePrinter(s, diags, os).print();
 }
 
+void walkPhases(const ScheduleGroup& g, const std::function<void(const Phase&)>& fn) {
+  for (const Phase& ph : g.phases) fn(ph);
+  for (const auto& sub : g.subgroups) walkPhases(*sub, fn);
+}
+
 void walkPasses(const ScheduleGroup& g,
                 const std::function<void(const Phase&, const DestinationWork&,
                                          const NeighbourPass&)>& fn) {
-  for (const Phase& ph : g.phases)
+  walkPhases(g, [&](const Phase& ph) {
     for (const DestinationWork& w : ph.destinations)
       for (const NeighbourPass& pass : w.passes) fn(ph, w, pass);
-  for (const auto& sub : g.subgroups) walkPasses(*sub, fn);
+  });
 }
 
 }  // namespace sphc

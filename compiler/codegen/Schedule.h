@@ -140,6 +140,9 @@ struct ScheduleGroup {
   std::vector<const PlanGroup*> fused;
 };
 
+// Calls fn for every phase of g and of its subgroups at any depth, in order.
+void walkPhases(const ScheduleGroup& g, const std::function<void(const Phase&)>& fn);
+
 // Calls fn for every neighbour pass of g's phases and of its subgroups at any depth, in order.
 void walkPasses(const ScheduleGroup& g,
                 const std::function<void(const Phase&, const DestinationWork&,

@@ -168,7 +168,10 @@ std::string crossPairsRefusal(const Plan& plan, const Phase& ph, size_t a, size_
   return "";
 }
 
-std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOptions& opts) {
+std::vector<std::string> symmetricPairsNotes(
+    const Schedule& sched, const EmitOptions& opts,
+    const std::function<bool(const DestinationWork&, const NeighbourPass&)>& inLanes) {
+  const std::string lanes = "--simd-pairs puts its neighbours in SIMD lanes per destination";
   std::vector<std::string> notes;
   const Plan& plan = *sched.plan;
   // The CPU printer keeps lists where --verlet-skin is on for it (CpuPrinter's verlet()).
@@ -185,37 +188,41 @@ std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOp
     // Ghosts of periodic or mirror sides are sources only: their mirrored calls would sum
     // into images, not particles (not written for yet; CpuPrinter keeps the gather there).
     if (why.empty() && sched.domain) why = "the sources include periodic or mirror ghosts";
+    if (why.empty() && inLanes && inLanes(w, pass)) why = lanes;
     if (opts.backend == Backend::OpenCL) why = "the OpenCL backend gathers per destination";
     notes.push_back(why.empty() ? "each pair once for both particles: " + loop
                                 : "pairs per destination particle: " + loop + ": " + why);
   });
   // Pair loops of two arrays, A <- B and B <- A in one phase.
-  std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-    for (const Phase& ph : g.phases)
-      for (size_t a = 0; a < ph.destinations.size(); ++a)
-        for (size_t b = a + 1; b < ph.destinations.size(); ++b) {
-          auto loopOver = [](const DestinationWork& w, int s) {
-            for (const NeighbourPass& p : w.passes)
-              if (p.source == s && p.searches()) return true;
-            return false;
-          };
-          const DestinationWork& A = ph.destinations[a];
-          const DestinationWork& B = ph.destinations[b];
-          if (A.array == B.array || !loopOver(A, B.array) || !loopOver(B, A.array)) continue;
-          const std::string loop = plan.arrays[A.array].name + " <- " +
-                                   plan.arrays[B.array].name + " with " +
-                                   plan.arrays[B.array].name + " <- " +
-                                   plan.arrays[A.array].name + " in " + ph.name;
-          std::string why = opts.symmetricPairs ? crossPairsRefusal(plan, ph, a, b, listsKept)
-                                                : "--no-symmetric-pairs";
-          if (why.empty() && sched.domain) why = "the sources include periodic or mirror ghosts";
-          if (opts.backend == Backend::OpenCL) why = "the OpenCL backend gathers per destination";
-          notes.push_back(why.empty() ? "each pair once for both particles: " + loop
-                                      : "pairs per destination particle: " + loop + ": " + why);
-        }
-    for (const auto& sub : g.subgroups) walk(*sub);
-  };
-  walk(sched.equations);
+  walkPhases(sched.equations, [&](const Phase& ph) {
+    for (size_t a = 0; a < ph.destinations.size(); ++a)
+      for (size_t b = a + 1; b < ph.destinations.size(); ++b) {
+        auto loopOver = [](const DestinationWork& w, int s) -> const NeighbourPass* {
+          for (const NeighbourPass& p : w.passes)
+            if (p.source == s && p.searches()) return &p;
+          return nullptr;
+        };
+        const DestinationWork& A = ph.destinations[a];
+        const DestinationWork& B = ph.destinations[b];
+        const NeighbourPass* ab = loopOver(A, B.array);
+        const NeighbourPass* ba = loopOver(B, A.array);
+        if (A.array == B.array || !ab || !ba) continue;
+        const std::string loop = plan.arrays[A.array].name + " <- " +
+                                 plan.arrays[B.array].name + " with " +
+                                 plan.arrays[B.array].name + " <- " +
+                                 plan.arrays[A.array].name + " in " + ph.name;
+        std::string why = opts.symmetricPairs ? crossPairsRefusal(plan, ph, a, b, listsKept)
+                                              : "--no-symmetric-pairs";
+        if (why.empty() && sched.domain) why = "the sources include periodic or mirror ghosts";
+        if (why.empty() && inLanes && (inLanes(A, *ab) || inLanes(B, *ba)))
+          why = "--simd-pairs puts the neighbours of " +
+                plan.arrays[inLanes(A, *ab) ? A.array : B.array].name +
+                " in SIMD lanes per destination";
+        if (opts.backend == Backend::OpenCL) why = "the OpenCL backend gathers per destination";
+        notes.push_back(why.empty() ? "each pair once for both particles: " + loop
+                                    : "pairs per destination particle: " + loop + ": " + why);
+      }
+  });
   return notes;
 }
 
@@ -588,6 +595,15 @@ void ScenePrinter::emitCrossSpanning(const NeighbourPass& ba, int b, const std::
   emitPairQuantitiesOnce(q, true, body);
   for (const PlanEquation* eq : ba.equations) scene_ << body << callBodyMirrored(*eq, b, "mirror_");
   scene_ << "          }\n        }\n";
+}
+
+// --report's notes as this printer prints the loops: a pass it puts in SIMD lanes per
+// destination (simdPairsRefusal "") is named so, not as each pair once.
+std::vector<std::string> ScenePrinter::pairLoopNotes(const EmitOptions& opts) const {
+  return symmetricPairsNotes(sched_, opts, [this](const DestinationWork& w,
+                                                  const NeighbourPass& pass) {
+    return simdPairsRefusal(w, pass).empty();
+  });
 }
 
 }  // namespace sphc

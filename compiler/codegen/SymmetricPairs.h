@@ -16,6 +16,7 @@
 #include "codegen/CppEmitter.h"
 #include "codegen/Schedule.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -37,7 +38,11 @@ std::string crossPairsRefusal(const Plan& plan, const Phase& ph, size_t a, size_
                               bool listsKept);
 
 // --report: one note per same-array pair loop of the schedule, whether it evaluates each pair
-// once and, where not, why; then one per pair of loops A <- B, B <- A of one phase.
-std::vector<std::string> symmetricPairsNotes(const Schedule& sched, const EmitOptions& opts);
+// once and, where not, why; then one per pair of loops A <- B, B <- A of one phase. inLanes,
+// where given, says which passes the printer puts in SIMD lanes per destination instead
+// (--simd-pairs; ScenePrinter::pairLoopNotes).
+std::vector<std::string> symmetricPairsNotes(
+    const Schedule& sched, const EmitOptions& opts,
+    const std::function<bool(const DestinationWork&, const NeighbourPass&)>& inLanes = {});
 
 }  // namespace sphc

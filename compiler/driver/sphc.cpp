@@ -5,7 +5,6 @@
 #include "analysis/Passes.h"
 #include "body/BodyAnalysis.h"
 #include "codegen/CppEmitter.h"
-#include "codegen/SymmetricPairs.h"
 #include "driver/Build.h"
 #include "driver/Study.h"
 #include "frontend/ASTPrinter.h"
@@ -463,7 +462,7 @@ int main(int argc, char** argv) {
   emitOpts.registerSums = !NoRegisterSums;
   emitOpts.simdPairs = SimdPairs;
   if (Report && Emit != EmitKind::OpenCL)
-    for (const std::string& note : sphc::symmetricPairsNotes(*schedule, emitOpts))
+    for (const std::string& note : sphc::pairLoopNotes(*schedule, diags, emitOpts))
       llvm::outs() << "note: " << note << "\n";
   if (Emit == EmitKind::OpenCL) {
     llvm::outs() << emitOpenCL(*schedule, diags, emitOpts);
