@@ -294,12 +294,24 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   // the same destination loop: d_idx's sums are complete but for these once its turn in the
   // block has come (later turns write only s_idx > their d_idx), so they come in the same
   // order as from a loop of their own after the block.
-  auto segment = [&](const std::string& indent, const std::string& begin, const std::string& end,
-                     const std::string& from, const std::string& to, bool both,
-                     const std::string& comment, bool tail = false,
-                     const std::string& skip = "") {
-    scene_ << indent << "for (int d_idx = " << begin << "; d_idx < " << end << "; ++d_idx) {"
-           << comment << "\n";
+  struct Segment {
+    std::string indent;
+    std::string begin, end;  // the destinations d_idx in [begin, end)
+    std::string from;        // the first entry of the list walked
+    std::string to;          // appended to `k != k_end` (a bound on k); with tail the block's end
+    bool both = true;        // the bodies for s_idx too (each pair once)
+    std::string comment;     // after the destination loop's opening line
+    bool tail = false;
+    std::string skip;        // a condition under which d_idx has nothing in [from, to)
+  };
+  auto segment = [&](const Segment& sg) {
+    const std::string& indent = sg.indent;
+    const std::string& from = sg.from;
+    const std::string& to = sg.to;
+    const std::string& skip = sg.skip;
+    const bool both = sg.both;
+    scene_ << indent << "for (int d_idx = " << sg.begin << "; d_idx < " << sg.end << "; ++d_idx) {"
+           << sg.comment << "\n";
     const std::string in = indent + "  ";
     std::ostringstream locals;
     emitDestLocals(locals, in, q, host_);
@@ -332,7 +344,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       }
       scene_ << in << "}\n";
     };
-    if (!tail) {
+    if (!sg.tail) {
       scene_ << in << "for (const std::uint32_t* k = " << from << "; k != k_end" << to
              << "; ++k) {\n";
       pairs(both);
@@ -354,7 +366,13 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   };
   const std::string upper = "kept.data() + " + lists + ".upper[d_idx]";  // s_idx >= d_idx
   if (!openmp) {
-    segment("        ", "0", "n", upper, "", true, "  // pairs (d_idx, s_idx >= d_idx)");
+    Segment all;
+    all.indent = "        ";
+    all.begin = "0";
+    all.end = "n";
+    all.from = upper;
+    all.comment = "  // pairs (d_idx, s_idx >= d_idx)";
+    segment(all);
     return;
   }
   // OpenMP: contiguous blocks, one per thread; each particle's contributions in the serial
@@ -366,13 +384,26 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   scene_ << "          const int b_end = static_cast<int>(static_cast<long>(n) * (blk + 1) / n_blocks);\n";
   scene_ << "          // (1) from the neighbours in earlier blocks, per destination (none in the first)\n";
   scene_ << "          if (b_begin > 0) {\n";
-  segment("            ", "b_begin", "b_end", "kept.data()",
-          " && *k < static_cast<std::uint32_t>(b_begin)", false, "", false,
-          "k_end == kept.data() || kept.front() >= static_cast<std::uint32_t>(b_begin)");
+  Segment earlier;
+  earlier.indent = "            ";
+  earlier.begin = "b_begin";
+  earlier.end = "b_end";
+  earlier.from = "kept.data()";
+  earlier.to = " && *k < static_cast<std::uint32_t>(b_begin)";
+  earlier.both = false;
+  earlier.skip = "k_end == kept.data() || kept.front() >= static_cast<std::uint32_t>(b_begin)";
+  segment(earlier);
   scene_ << "          }\n";
   scene_ << "          // (2) the pairs within the block, once for both particles, then (3) from the\n"
             "          // neighbours in later blocks, per destination, in the same loop\n";
-  segment("          ", "b_begin", "b_end", upper, "b_end", true, "", true);
+  Segment block;
+  block.indent = "          ";
+  block.begin = "b_begin";
+  block.end = "b_end";
+  block.from = upper;
+  block.to = "b_end";
+  block.tail = true;
+  segment(block);
   scene_ << "        }\n";
 }
 
