@@ -366,11 +366,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   };
   const std::string upper = "kept.data() + " + lists + ".upper[d_idx]";  // s_idx >= d_idx
   if (!openmp) {
-    Segment all;
-    all.indent = "        ";
-    all.begin = "0";
-    all.end = "n";
-    all.from = upper;
+    Segment all{"        ", "0", "n", upper};
     all.comment = "  // pairs (d_idx, s_idx >= d_idx)";
     segment(all);
     return;
@@ -384,11 +380,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   scene_ << "          const int b_end = static_cast<int>(static_cast<long>(n) * (blk + 1) / n_blocks);\n";
   scene_ << "          // (1) from the neighbours in earlier blocks, per destination (none in the first)\n";
   scene_ << "          if (b_begin > 0) {\n";
-  Segment earlier;
-  earlier.indent = "            ";
-  earlier.begin = "b_begin";
-  earlier.end = "b_end";
-  earlier.from = "kept.data()";
+  Segment earlier{"            ", "b_begin", "b_end", "kept.data()"};
   earlier.to = " && *k < static_cast<std::uint32_t>(b_begin)";
   earlier.both = false;
   earlier.skip = "k_end == kept.data() || kept.front() >= static_cast<std::uint32_t>(b_begin)";
@@ -396,11 +388,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   scene_ << "          }\n";
   scene_ << "          // (2) the pairs within the block, once for both particles, then (3) from the\n"
             "          // neighbours in later blocks, per destination, in the same loop\n";
-  Segment block;
-  block.indent = "          ";
-  block.begin = "b_begin";
-  block.end = "b_end";
-  block.from = upper;
+  Segment block{"          ", "b_begin", "b_end", upper};
   block.to = "b_end";
   block.tail = true;
   segment(block);
