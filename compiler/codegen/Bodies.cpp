@@ -42,6 +42,8 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   registerSums_ = opts.registerSums && opts.backend != Backend::OpenCL && !singlePrecision_ &&
                   !mpi_;
   simdPairs_ = opts.simdPairs && registerSums_;  // SimdPairs.cpp: on the sums in locals
+  simdAuto_ = opts.simdPairsAuto;
+  simdSymmetric_ = opts.symmetricPairs && opts.verletSkin > 0 && !hasZones() && !hasDomain();
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {

@@ -84,7 +84,18 @@ struct EmitOptions {
   // reassociated across the SIMD lanes: not bitwise the scalar loop's (serial and OpenMP with
   // the switch are bitwise equal).
   bool simdPairs = false;
+  // --simd-pairs=auto (the driver's default; with simdPairs true): the SIMD form only for the
+  // loops where it pays (codegen/SimdPairs.cpp, simdPairsAutoChoice): those whose expected
+  // neighbour count reaches kSimdAutoNeighbours.
+  bool simdPairsAuto = false;
 };
+
+// --simd-pairs=auto: a pair loop is put in SIMD lanes where its expected neighbour count
+// (the kernel support's ball over dx^dim) reaches this (docs/performance.md, "SIMD pair loops
+// chosen by the compiler": the measurements between which it lies). Where h or dx is not
+// known before the run, by the dimension: 3D yes, 1D and 2D no (with h = 1.3 dx and a support
+// of 2 h, 74 and 21 neighbours).
+inline constexpr double kSimdAutoNeighbours = 40.0;
 
 // The lines around the out-of-class phases of a split solver (EmitOptions::splitUnits).
 inline constexpr const char* kPhasesBeginMarker =

@@ -294,6 +294,19 @@ class ScenePrinter {
   // After eq's loop function: its NAME_loop_simd form, where a SIMD loop calls it.
   void emitSimdFunction(const PlanEquation& eq, std::ostringstream& os);
   bool simdPairs_ = false;                    // EmitOptions::simdPairs (CPU double, not mpi)
+  // --simd-pairs=auto (SimdPairs.cpp): whether pass is put in SIMD lanes, and why (the
+  // expected neighbour count, or the loop being per destination anyway).
+  struct SimdAutoChoice {
+    bool lanes = false;
+    std::string why;
+  };
+  SimdAutoChoice simdPairsAutoChoice(const DestinationWork& w, const NeighbourPass& pass) const;
+  // Whether the CPU printer would evaluate pass (destination w) once per pair without SIMD.
+  bool eachPairOncePossible(const DestinationWork& w, const NeighbourPass& pass) const;
+  // --report: per pair loop, whether it is in SIMD lanes and why (nothing with the switch off).
+  std::vector<std::string> simdPairsNotes() const;
+  bool simdAuto_ = false;           // EmitOptions::simdPairsAuto
+  bool simdSymmetric_ = false;      // EmitOptions::symmetricPairs, kept lists (for the choice)
   std::unique_ptr<std::set<int>> simdDecls_;  // equation declarations whose _simd form is used
 
   // ---- The host program (HostProgram.cpp) ----

@@ -23,12 +23,23 @@
 // a body writing a destination property that is not one of those sums (every lane would
 // store it), a body writing a scalar state, a loop_all in the pass, a vector pair quantity
 // named otherwise than indexed by a literal component.
+//
+// --simd-pairs=auto (the default): the SIMD form only where it pays (simdPairsAutoChoice;
+// docs/performance.md "SIMD pair loops chosen by the compiler"): where the loop's expected
+// neighbour count (the kernel support's ball over dx^dim, from the scene's defaults) reaches
+// kSimdAutoNeighbours. Below it, each pair once saves more than the lanes (the 2D dam
+// breaks); a loop that is per destination anyway stays scalar there too (measured to pay on
+// one 2D scene only; --simd-pairs=on).
 #include "analysis/PairQuantityTable.h"
 #include "codegen/CppText.h"
 #include "codegen/Printer.h"
+#include "codegen/SymmetricPairs.h"
+#include "sema/ConstEval.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
+#include <optional>
 #include <set>
 
 namespace sphc {
@@ -86,7 +97,87 @@ std::string scalarMathCall(const std::string& text) {
   return found;
 }
 
+// The neighbours a destination of array d finds among the particles of array s in a full
+// support: the volume of the ball of radius kernelRadiusScale * h (h: the larger initial h of
+// the two arrays) over dx^dim (dx: the smallest spacing of s's geometry), with every param
+// at its default; nothing where h or dx is no expression of params (a file's particles, the
+// particles of an inlet, an h set elsewhere). `how` says what it used.
+std::optional<double> expectedNeighbours(const Plan& plan, int d, int s, std::string& how) {
+  ConstEval eval(plan);
+  std::optional<double> h, dx;
+  for (int a : {d, s}) {
+    const PlanProperty* p = plan.arrays[a].find("h");
+    std::optional<double> v = p && p->init ? eval(*p->init) : std::nullopt;
+    if (!v || !(*v > 0) || !std::isfinite(*v)) {
+      h.reset();
+      break;
+    }
+    h = h ? std::fmax(*h, *v) : *v;
+  }
+  const ast::ArrayDecl* decl = plan.arrays[s].decl;
+  if (decl && decl->loads.empty())
+    for (const ast::GeometryDecl& g : decl->geometry)
+      for (const ast::KwArg& kw : g.args)
+        if (kw.name.name == "dx" && kw.value)
+          if (std::optional<double> v = eval(*kw.value); v && *v > 0 && std::isfinite(*v))
+            dx = dx ? std::fmin(*dx, *v) : *v;
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%dD, support %g h", plan.dim, plan.kernelRadiusScale);
+  how = buf;
+  if (!h || !dx) return std::nullopt;
+  const double hdx = *h / *dx;
+  std::snprintf(buf, sizeof buf, ", h = %.3g dx", hdx);
+  how += buf;
+  const double r = plan.kernelRadiusScale * hdx;
+  return plan.dim == 3 ? 4.0 / 3.0 * M_PI * r * r * r
+         : plan.dim == 2 ? M_PI * r * r
+                         : 2.0 * r;
+}
+
 }  // namespace
+
+bool ScenePrinter::eachPairOncePossible(const DestinationWork& w,
+                                        const NeighbourPass& pass) const {
+  if (!simdSymmetric_) return false;
+  if (pass.source == w.array) return symmetricPairsRefusal(plan_, w, pass, true).empty();
+  // Two arrays: A <- B as A's last pair loop and B <- A as B's first (CpuPrinter::crossPair).
+  bool found = false;
+  walkPhases(sched_.equations, [&](const Phase& ph) {
+    for (size_t a = 0; a + 1 < ph.destinations.size(); ++a) {
+      const DestinationWork& A = ph.destinations[a];
+      const DestinationWork& B = ph.destinations[a + 1];
+      if (A.array == B.array || A.passes.empty() || B.passes.empty()) continue;
+      if (!((&w == &A && &pass == &A.passes.back()) || (&w == &B && &pass == &B.passes.front())))
+        continue;
+      found |= A.passes.back().source == B.array && B.passes.front().source == A.array &&
+               A.passes.back().searches() && B.passes.front().searches() &&
+               crossPairsRefusal(plan_, ph, a, a + 1, true).empty();
+    }
+  });
+  return found;
+}
+
+ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const DestinationWork& w,
+                                                               const NeighbourPass& pass) const {
+  std::string how;
+  const std::optional<double> n = expectedNeighbours(plan_, w.array, pass.source, how);
+  // h/dx not known before the run: by the dimension (h = 1.3 dx: 3D 74 neighbours, 2D 21).
+  const bool lanes = n ? *n >= kSimdAutoNeighbours : plan_.dim == 3;
+  char buf[160];
+  if (n)
+    std::snprintf(buf, sizeof buf, "~%.0f neighbours expected (%s) %s %g: ", *n, how.c_str(),
+                  lanes ? ">=" : "<", kSimdAutoNeighbours);
+  else
+    std::snprintf(buf, sizeof buf, "h/dx not known before the run, by the dimension (%s): ",
+                  how.c_str());
+  std::string why = buf;
+  if (eachPairOncePossible(w, pass))
+    why += lanes ? "the lanes pay more than each pair once" : "each pair once pays more";
+  else
+    why += lanes ? "the lanes pay more than the scalar loop per destination"
+                 : "scalar per destination (--simd-pairs=on puts it in lanes)";
+  return {lanes, why};
+}
 
 bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std::string& why) {
   scanIdentifiers(text, [&](const std::string& word, size_t at, size_t end) {
@@ -130,7 +221,30 @@ std::string ScenePrinter::simdPairsRefusal(const DestinationWork& w,
       return eq->name + " calls " + call + ", which GCC does not vectorise (its loop would be "
              "scalar or not depending on inlining)";
   }
+  if (simdAuto_) {  // --simd-pairs=auto: where the lanes pay
+    const SimdAutoChoice c = simdPairsAutoChoice(w, pass);
+    if (!c.lanes) return "--simd-pairs=auto: " + c.why;
+  }
   return "";
+}
+
+std::vector<std::string> ScenePrinter::simdPairsNotes() const {
+  std::vector<std::string> notes;
+  if (!simdPairs_) return notes;
+  walkPasses(sched_.equations, [&](const Phase& ph, const DestinationWork& w,
+                                   const NeighbourPass& pass) {
+    if (!pass.searches() || pass.equations.empty()) return;
+    const std::string loop =
+        arr(w.array).name + " <- " + arr(pass.source).name + " in " + ph.name;
+    const std::string why = simdPairsRefusal(w, pass);
+    if (!why.empty())
+      notes.push_back("pair loop not in SIMD lanes: " + loop + ": " + why);
+    else
+      notes.push_back("pair loop in SIMD lanes: " + loop + ": " +
+                      (simdAuto_ ? "--simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why
+                                 : std::string("--simd-pairs=on")));
+  });
+  return notes;
 }
 
 bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w,
@@ -139,7 +253,8 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
   const std::string why = simdPairsRefusal(w, pass);
   const std::string in = "          ";
   if (!why.empty()) {
-    os << in << "// Not in SIMD lanes (codegen/SimdPairs.cpp): " << why << ".\n";
+    if (!simdAuto_)  // auto: --report says why (its scalar loops are --simd-pairs=off's)
+      os << in << "// Not in SIMD lanes (codegen/SimdPairs.cpp): " << why << ".\n";
     return false;
   }
   std::string reduction;

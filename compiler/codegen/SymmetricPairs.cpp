@@ -619,10 +619,12 @@ void ScenePrinter::emitCrossSpanning(const NeighbourPass& ba, int b, const std::
 // --report's notes as this printer prints the loops: a pass it puts in SIMD lanes per
 // destination (simdPairsRefusal "") is named so, not as each pair once.
 std::vector<std::string> ScenePrinter::pairLoopNotes(const EmitOptions& opts) const {
-  return symmetricPairsNotes(sched_, opts, [this](const DestinationWork& w,
-                                                  const NeighbourPass& pass) {
-    return simdPairsRefusal(w, pass).empty();
-  });
+  std::vector<std::string> notes = symmetricPairsNotes(
+      sched_, opts, [this](const DestinationWork& w, const NeighbourPass& pass) {
+        return simdPairsRefusal(w, pass).empty();
+      });
+  for (std::string& note : simdPairsNotes()) notes.push_back(std::move(note));  // SimdPairs.cpp
+  return notes;
 }
 
 }  // namespace sphc

@@ -135,15 +135,21 @@ static cl::opt<bool> NoRegisterSums(
              "bodies allow it; serial and openmp, double precision; the results are the same "
              "bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
-static cl::opt<bool> SimdPairs(
+static cl::opt<std::string> SimdPairs(
     "simd-pairs",
-    cl::desc("In the CPU pair loops (serial and openmp, double precision) whose bodies allow "
-             "it, process the neighbours of a destination in SIMD lanes: `#pragma omp simd` "
-             "with the destination's sums as reductions, built with -fopenmp-simd; such a "
-             "loop is per destination even where each pair could be evaluated once (default: "
-             "off; the sums are reassociated, so the results differ from the scalar loop's "
-             "in the last bits)"),
-    cl::init(false), cl::cat(SphcCat));
+    cl::desc("The CPU pair loops (serial and openmp, double precision) whose bodies allow it "
+             "may process the neighbours of a destination in SIMD lanes: `#pragma omp simd` "
+             "with the destination's sums as reductions, built with -fopenmp-simd; such a loop "
+             "is per destination even where each pair could be evaluated once. auto "
+             "(default): where it pays, the loops where 40 or more neighbours are expected in "
+             "the support (from the dimension, the kernel's support and h/dx with the scene's "
+             "defaults; where they are not known before the run, 3D yes, 2D no: with h = 1.3 "
+             "dx and a support of 2 h, 74 and 21 neighbours; below 40, each pair once pays "
+             "more); on (or --simd-pairs alone): every loop that allows it; off: the "
+             "scalar loops. --report says per loop which and why. The sums are reassociated "
+             "in the lanes, so results differ from the scalar loop's in the last bits "
+             "(serial and openmp stay bitwise equal)"),
+    cl::value_desc("auto|on|off"), cl::ValueOptional, cl::init("auto"), cl::cat(SphcCat));
 static cl::opt<bool> NoLazyCells(
     "no-lazy-cells",
     cl::desc("With kept neighbour lists, build the search domain and cell lists at every "
@@ -460,7 +466,14 @@ int main(int argc, char** argv) {
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;
-  emitOpts.simdPairs = SimdPairs;
+  // --simd-pairs: auto (the default), on (also bare), off; the lanes only on the CPU backends.
+  const std::string simdMode = SimdPairs.empty() ? std::string("on") : SimdPairs.getValue();
+  if (simdMode != "auto" && simdMode != "on" && simdMode != "off") {
+    llvm::errs() << "sphc: error: --simd-pairs=" << simdMode << ": it is auto, on or off\n";
+    return fail();
+  }
+  emitOpts.simdPairs = simdMode != "off";
+  emitOpts.simdPairsAuto = simdMode == "auto";
   if (Report && Emit != EmitKind::OpenCL)
     for (const std::string& note : sphc::pairLoopNotes(*schedule, diags, emitOpts))
       llvm::outs() << "note: " << note << "\n";
@@ -486,7 +499,8 @@ int main(int argc, char** argv) {
   req.backend = backendName(Backend);
   req.mpi = Mpi;
   req.useCache = !NoCache;
-  req.simd = SimdPairs && !Mpi && backendName(Backend) != std::string("opencl");
+  // -fopenmp-simd where a loop is printed in SIMD lanes (codegen/SimdPairs.cpp).
+  req.simd = cpp.find("#pragma omp simd reduction") != std::string::npos;
   req.verbose = Verbose;
   BuildResult res = buildExecutable(install, req);
   log("build");

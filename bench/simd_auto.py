@@ -1,0 +1,134 @@
+#!/usr/bin/env python3
+"""Per-step cost of the generated solvers with and without the SIMD pair loops, the matrix
+behind `sphc --simd-pairs=auto` (issue 16; docs/performance.md "SIMD pair loops chosen by the
+compiler"): prints figures, is not a test.
+
+For each scene and each variant (by default: off = the scalar loops, each pair once where the
+bodies allow it; on = `--simd-pairs`, every loop that allows it in SIMD lanes; auto = the
+compiler's choice), serial and OpenMP:
+
+- instructions per step of the serial build by callgrind (not OpenMP: the openmp builds do
+  not start under valgrind 3.19 here), (long - short run) / the steps between them, built for AVX2 + FMA so that
+  valgrind 3.19 can run it (`-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno
+  -ffp-contract=off -g`; the driver adds -fopenmp-simd where it prints `omp simd` loops); instruction counts do not depend on the machine's load, but AVX2 lanes hold 4
+  doubles where the default -march=native build's AVX-512 lanes hold 8;
+- CPU seconds (user + system) per step of the default builds (-march=native), (long - short
+  run) / steps, the variants interleaved, --rounds times (serial: OMP_NUM_THREADS=1, OpenMP:
+  2 threads); min and median over the rounds. On a loaded machine only ratios of interleaved
+  runs mean something.
+
+Usage: python3 bench/simd_auto.py [--scenes cube20,cube47,...] [--variants off,on,auto]
+       [--rounds 3] [--no-callgrind] [--no-cpu] [--backends serial,openmp]
+"""
+
+import os
+import statistics
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from common import (ROOT, SCENE_FILES, instruction_parser, instructions,  # noqa: E402
+                    load_average, remove_tmp, run)
+
+CG_FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
+PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
+DB3 = os.path.join(ROOT, "examples", "dambreak3d.sph")
+DSPH = os.path.join(ROOT, "bench", "dambreak3d_dualsphysics.sph")
+# scene: (file, sphc flags, run-time options, (callgrind short, long steps),
+#         (CPU short, long steps), CPU run-time options (None: the same))
+SCENES = {
+    "cube20": (SCENE_FILES["cube"], [], ["--set", "nx=20", "--tf", "1"], (3, 8), (2, 42), None),
+    "cube47": (SCENE_FILES["cube"], [], ["--set", "nx=47", "--tf", "1"], None, (2, 12), None),
+    "dambreak3d": (DB3, [], [], (5, 15), (5, 105), None),
+    "dsph": (DSPH, [], ["--set", "dp=0.02"], (3, 8), (3, 33), None),
+    "dambreak": (SCENE_FILES["dambreak"], [], [], (20, 60), (20, 220), None),
+    "dambreak_pysph": (SCENE_FILES["dambreak"], PYSPH_EFFECTS, ["--set", "cfl=0.3"], (20, 60),
+                       (20, 320), None),
+    "taylor_green": (SCENE_FILES["taylor_green"], [], [], (20, 60), (20, 420), None),
+    # Neighbour counts between the 2D dam break's ~21 and the 3D scenes' 74-174: h/dx set at
+    # run time (the support ball 4/3 pi (2 hdx)^3 in 3D, pi (2 hdx)^2 in 2D).
+    "cube20_h10": (SCENE_FILES["cube"], [], ["--set", "nx=20", "--set", "hdx=1.0", "--tf", "1"],
+                   (3, 8), (2, 42), None),
+    "cube20_h12": (SCENE_FILES["cube"], [], ["--set", "nx=20", "--set", "hdx=1.2", "--tf", "1"],
+                   (3, 8), (2, 42), None),
+    "dambreak_pysph_h16": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
+                           ["--set", "cfl=0.3", "--set", "hdx=1.6"], (20, 60), (20, 320), None),
+    "dambreak_pysph_h20": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
+                           ["--set", "cfl=0.3", "--set", "hdx=2.0"], (20, 60), (20, 320), None),
+}
+VARIANT_FLAGS = {"off": ["--simd-pairs=off"], "on": ["--simd-pairs=on"], "auto": [],
+                 "legacy_off": [], "legacy_on": ["--simd-pairs"]}
+
+
+def exec_run(exe, options, steps, threads, tool=None):
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    cmd = (tool or []) + [exe] + options + ["--max-steps", str(steps), "--no-output", "--quiet",
+                                            "-d", exe + "_out"]
+    run(cmd, env=env)
+    return run.cpu
+
+
+def main():
+    ap = instruction_parser(__doc__)
+    ap.set_defaults(scenes=",".join(SCENES))
+    ap.add_argument("--variants", default="off,on")
+    ap.add_argument("--backends", default="serial,openmp")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--no-callgrind", action="store_true")
+    ap.add_argument("--no-cpu", action="store_true")
+    args = ap.parse_args()
+    variants = args.variants.split(",")
+    tmp = tempfile.mkdtemp(prefix="sphc_simdauto_")
+    print("load average before: %s" % load_average())
+    for scene in args.scenes.split(","):
+        path, sflags, options, cg_steps, cpu_steps, cpu_options = SCENES[scene]
+        cpu_options = options if cpu_options is None else cpu_options
+        for backend in args.backends.split(","):
+            threads = 2 if backend == "openmp" else 1
+            bflags = ["--backend=" + backend]
+            if cg_steps and not args.no_callgrind and backend == "serial":
+                ins = {}
+                for v in variants:
+                    exe = os.path.join(tmp, "%s_%s_%s_cg" % (scene, backend, v))
+                    flags = sflags + bflags + VARIANT_FLAGS[v]
+                    run([args.sphc, path, "-o", exe, "--cxxflags=" + CG_FLAGS] + flags)
+                    n = []
+                    for steps in cg_steps:
+                        cg = "%s_%d.callgrind" % (exe, steps)
+                        exec_run(exe, options, steps, threads,
+                                 ["valgrind", "--tool=callgrind", "--callgrind-out-file=" + cg])
+                        n.append(instructions(cg))
+                    ins[v] = (n[1] - n[0]) / (cg_steps[1] - cg_steps[0])
+                base = ins[variants[0]]
+                print("%-15s %-6s callgrind (AVX2) instructions / step, steps %d-%d: %s" % (
+                    scene, backend, cg_steps[0], cg_steps[1], "; ".join(
+                        "%s %.4g (%.3f)" % (v, ins[v], ins[v] / base) for v in variants)))
+                sys.stdout.flush()
+            if args.no_cpu:
+                continue
+            exes = {}
+            for v in variants:
+                exes[v] = os.path.join(tmp, "%s_%s_%s" % (scene, backend, v))
+                run([args.sphc, path, "-o", exes[v]] + sflags + bflags + VARIANT_FLAGS[v])
+            per = {v: [] for v in variants}
+            short, long_ = cpu_steps
+            for _ in range(args.rounds):
+                for v in variants:
+                    a = exec_run(exes[v], cpu_options, short, threads)
+                    b = exec_run(exes[v], cpu_options, long_, threads)
+                    per[v].append((b - a) / (long_ - short))
+            base = per[variants[0]]
+            print("%-15s %-6s CPU s / step, steps %d-%d, %d rounds: %s  [all: %s]" % (
+                scene, backend, short, long_, args.rounds, "; ".join(
+                    "%s min %.4g (%.3f) median (%.3f)" % (
+                        v, min(per[v]), min(per[v]) / min(base),
+                        statistics.median(per[v]) / statistics.median(base)) for v in variants),
+                " | ".join(v + " " + " ".join("%.4g" % x for x in per[v]) for v in variants)))
+            sys.stdout.flush()
+    print("load average after: %s" % load_average())
+    remove_tmp(tmp, args.keep)
+
+
+if __name__ == "__main__":
+    main()
