@@ -95,7 +95,7 @@ struct EmitOptions {
 // chosen by the compiler": the measurements between which it lies). Where h or dx is not
 // known before the run, by the dimension: 3D yes, 1D and 2D no (with h = 1.3 dx and a support
 // of 2 h, 74 and 21 neighbours).
-inline constexpr double kSimdAutoNeighbours = 40.0;
+inline constexpr double kSimdAutoNeighbours = 30.0;
 
 // The lines around the out-of-class phases of a split solver (EmitOptions::splitUnits).
 inline constexpr const char* kPhasesBeginMarker =
