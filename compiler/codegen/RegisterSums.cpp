@@ -275,6 +275,8 @@ std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const Register
   if (!any && !scalarPairs) return equationCall(eq, ast::Method::Loop, d);
   const auto values = scalarPairs ? destinationValues(b, d) : decltype(destinationValues(b, d))();
   auto argument = [&](const BodyParam& p) -> std::string {
+    if (scalarPairs && host_.floatBodies && !floatScalarName(eqStruct(eq), p).empty())
+      return floatScalarName(eqStruct(eq), p);
     if (scalarPairs && p.kind == BodyParam::Pair && findPairQuantity(p.name)->vector)
       return p.name + "_0, " + p.name + "_1, " + p.name + "_2";
     if (p.kind == BodyParam::DProp && values.count(p.name)) {
@@ -377,6 +379,7 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
   }
   os << ") {";
   std::string text = hoistedBodyText(b, host_, edits);
+  if (host_.floatBodies) text = singlePrecisionBody(text);  // as bodyText: float, 0.5f
   os << text;
   if (text.empty() || text.back() != '\n') os << "\n";
   os << "}\n";
