@@ -1,5 +1,6 @@
-// The destination's sums in locals across its neighbours (CPU backends, double precision, not
-// --mpi; sphc --no-register-sums: in memory at every pair).
+// The destination's sums in locals across its neighbours (CPU backends, double and single
+// precision, not --mpi; sphc --no-register-sums: in memory at every pair). The locals have
+// the arrays' type (float in single precision: the sums accumulate in float, as in memory).
 //
 // A loop body accumulates into its destination's arrays: `d_au[d_idx] += ...`,
 // `d_binv[4 * d_idx + 1] = fma(..., d_binv[4 * d_idx + 1])`. Printed as written, every pair

@@ -1,5 +1,6 @@
-// SIMD pair loops (sphc --simd-pairs; CPU backends, double precision, not --mpi; off by
-// default): the neighbours of one destination in SIMD lanes.
+// SIMD pair loops (sphc --simd-pairs; CPU backends, double or single precision, not --mpi;
+// off by default): the neighbours of one destination in SIMD lanes (8 doubles or 16 floats
+// per zmm register).
 //
 // A per-destination pair loop whose destination's sums are locals (codegen/RegisterSums.cpp)
 // is printed with its neighbour loop under
@@ -12,7 +13,9 @@
 // destination); local arrays passed by pointer (XIJ[3]) it does not (docs/performance.md,
 // "SIMD pair loops: measured"). The bodies' `if`s are left to GCC's if-conversion: where it
 // cannot, the loop stays scalar, with the same results. The build adds -fopenmp-simd
-// (driver/Build.cpp).
+// (driver/Build.cpp). In single precision the bodies' double arguments (t, dt, the equations'
+// scalars) are float locals converted before the loop (f_t, f_eq2_alpha): GCC does not
+// if-convert a conversion it sank into an `if` (it may trap), which kept the loop scalar.
 //
 // Results: each sum is reassociated (one partial sum per lane, added at the end), so they
 // differ from the scalar loop's in the last bits; the same loop in serial and OpenMP

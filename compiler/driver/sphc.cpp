@@ -132,13 +132,13 @@ static cl::opt<bool> NoRegisterSums(
     cl::desc("In the CPU pair loops, update the destination's sums in memory at every pair "
              "(default: the d_ properties the loop bodies accumulate at d_idx are locals "
              "across the neighbours, loaded before them and stored after them, where the "
-             "bodies allow it; serial and openmp, double precision; the results are the same "
-             "bit for bit)"),
+             "bodies allow it; serial and openmp, double and single precision (float locals "
+             "in single); the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> SimdPairs(
     "simd-pairs",
-    cl::desc("In the CPU pair loops (serial and openmp, double precision) whose bodies allow "
-             "it, process the neighbours of a destination in SIMD lanes: `#pragma omp simd` "
+    cl::desc("In the CPU pair loops (serial and openmp, double and single precision) whose "
+             "bodies allow it, process the neighbours of a destination in SIMD lanes: `#pragma omp simd` "
              "with the destination's sums as reductions, built with -fopenmp-simd; such a "
              "loop is per destination even where each pair could be evaluated once (default: "
              "off; the sums are reassociated, so the results differ from the scalar loop's "
