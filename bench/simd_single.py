@@ -51,9 +51,14 @@ CPU_SCENES = {
                        ["--set", "dx=0.0047", "--set", "cfl=0.3"], 5, 45),
     "dambreak3d": (DAMBREAK3D, [], [], 5, 25),
 }
-VARIANTS = [("double", []), ("double_simd", ["--simd-pairs"]),
-            ("single", ["--precision=single"]),
-            ("single_simd", ["--precision=single", "--simd-pairs"])]
+ALL_VARIANTS = {
+    "double": [], "double_simd": ["--simd-pairs"],
+    "single": ["--precision=single"], "single_simd": ["--precision=single", "--simd-pairs"],
+    # Double without kept lists (so per destination, as single precision, which has none).
+    "double_nolists": ["--verlet-skin=off"],
+    "double_nolists_simd": ["--verlet-skin=off", "--simd-pairs"],
+}
+VARIANTS = [(n, ALL_VARIANTS[n]) for n in ("double", "double_simd", "single", "single_simd")]
 
 
 def gathers(exe):
@@ -73,7 +78,8 @@ def callgrind(exe, options, steps):
 def instructions_per_step(args, tmp):
     print("built with --cxxflags \"%s\"; instructions per step under callgrind, "
           "(long - short) / steps" % FLAGS)
-    print("%-15s %-12s %-9s %12s %9s" % ("scene", "variant", "steps", "Ir / step", "/ double"))
+    print("%-15s %-12s %-9s %12s %9s" % ("scene", "variant", "steps", "Ir / step",
+                                          "/ " + VARIANTS[0][0]))
     for scene in args.scenes.split(","):
         path, sflags, options, short, long_ = SCENES[scene]
         base = None
@@ -102,7 +108,8 @@ def cpu_per_step(args, tmp):
         print("%s steps %d-%d:" % (scene, short, long_))
         for name, _ in VARIANTS:
             print("  %-12s %.4f s (%.3f; median %.3f)  zmm gathers %d  [all: %s]" % (
-                name, lo[name], lo[name] / lo["double"], med[name] / med["double"],
+                name, lo[name], lo[name] / lo[VARIANTS[0][0]],
+                med[name] / med[VARIANTS[0][0]],
                 gathers(exes[name]), " ".join("%.4f" % v for v in per[name])))
         sys.stdout.flush()
 
@@ -112,7 +119,13 @@ def main():
     ap.set_defaults(scenes=None)
     ap.add_argument("--cpu", action="store_true", help="CPU time per step")
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--variants", default=None,
+                    help="comma-separated, the first the base of the ratios (default: "
+                    "double,double_simd,single,single_simd; also double_nolists, "
+                    "double_nolists_simd)")
     args = ap.parse_args()
+    if args.variants:
+        VARIANTS[:] = [(n, ALL_VARIANTS[n]) for n in args.variants.split(",")]
     if args.scenes is None:
         args.scenes = ",".join(CPU_SCENES if args.cpu else SCENES)
     tmp = tempfile.mkdtemp(prefix="sphc_simdsingle_")
