@@ -39,8 +39,9 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   globalIds_ = opts.globalIds || mpi_;
   splitPhases_ = opts.splitUnits && opts.backend != Backend::OpenCL && !mpi_;
   intPow_ = opts.intPow && !singlePrecision_;
-  registerSums_ = opts.registerSums && opts.backend != Backend::OpenCL && !singlePrecision_ &&
-                  !mpi_;
+  // In single precision too: the locals are of the scene's real type (float), as the sums in
+  // memory, so the same operations round alike (RegisterSums.cpp).
+  registerSums_ = opts.registerSums && opts.backend != Backend::OpenCL && !mpi_;
   simdPairs_ = opts.simdPairs && registerSums_;  // SimdPairs.cpp: on the sums in locals
   simdAuto_ = opts.simdPairsAuto;
   simdSymmetric_ = opts.symmetricPairs && opts.verletSkin > 0 && !hasZones() && !hasDomain();

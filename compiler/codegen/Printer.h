@@ -269,7 +269,7 @@ class ScenePrinter {
                        bool scalarPairs = false) const;
   // After eq's loop function: its form on the locals (NAME_loop_sums), where a loop uses it.
   void emitSumsFunction(const PlanEquation& eq, std::ostringstream& os);
-  bool registerSums_ = false;                // EmitOptions::registerSums (CPU double, not mpi)
+  bool registerSums_ = false;                // EmitOptions::registerSums (CPU, not mpi)
   std::unique_ptr<std::set<int>> sumsDecls_;  // equation declarations whose _sums form is used
   // eq's loop on the locals, named NAME_loop_sums; `scalarPairs`: NAME_loop_simd, its vector
   // pair quantities three scalars each (XIJ_0, XIJ_1, XIJ_2; SimdPairs.cpp).
@@ -293,7 +293,11 @@ class ScenePrinter {
                           const RegisterSums& sums);
   // After eq's loop function: its NAME_loop_simd form, where a SIMD loop calls it.
   void emitSimdFunction(const PlanEquation& eq, std::ostringstream& os);
-  bool simdPairs_ = false;                    // EmitOptions::simdPairs (CPU double, not mpi)
+  // --precision=single: the float local a SIMD loop passes for a body's double argument (t,
+  // dt, an equation's scalar: f_t, f_eq2_alpha), converted once before the loop; "" for
+  // other parameters.
+  static std::string floatScalarName(const std::string& eqValues, const BodyParam& p);
+  bool simdPairs_ = false;                    // EmitOptions::simdPairs (CPU, not mpi)
   // --simd-pairs=auto (SimdPairs.cpp): whether pass is put in SIMD lanes, and why (the
   // expected neighbour count, or the loop being per destination anyway).
   struct SimdAutoChoice {

@@ -1,5 +1,6 @@
-// The destination's sums in locals across its neighbours (CPU backends, double precision, not
-// --mpi; sphc --no-register-sums: in memory at every pair).
+// The destination's sums in locals across its neighbours (CPU backends, double and single
+// precision, not --mpi; sphc --no-register-sums: in memory at every pair). The locals have
+// the arrays' type (float in single precision: the sums accumulate in float, as in memory).
 //
 // A loop body accumulates into its destination's arrays: `d_au[d_idx] += ...`,
 // `d_binv[4 * d_idx + 1] = fma(..., d_binv[4 * d_idx + 1])`. Printed as written, every pair
@@ -275,6 +276,8 @@ std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const Register
   if (!any && !scalarPairs) return equationCall(eq, ast::Method::Loop, d);
   const auto values = scalarPairs ? destinationValues(b, d) : decltype(destinationValues(b, d))();
   auto argument = [&](const BodyParam& p) -> std::string {
+    if (scalarPairs && host_.floatBodies && !floatScalarName(eqStruct(eq), p).empty())
+      return floatScalarName(eqStruct(eq), p);
     if (scalarPairs && p.kind == BodyParam::Pair && findPairQuantity(p.name)->vector)
       return p.name + "_0, " + p.name + "_1, " + p.name + "_2";
     if (p.kind == BodyParam::DProp && values.count(p.name)) {
@@ -377,6 +380,7 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
   }
   os << ") {";
   std::string text = hoistedBodyText(b, host_, edits);
+  if (host_.floatBodies) text = singlePrecisionBody(text);  // as bodyText: float, 0.5f
   os << text;
   if (text.empty() || text.back() != '\n') os << "\n";
   os << "}\n";

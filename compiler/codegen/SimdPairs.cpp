@@ -1,5 +1,6 @@
-// SIMD pair loops (sphc --simd-pairs; CPU backends, double precision, not --mpi; off by
-// default): the neighbours of one destination in SIMD lanes.
+// SIMD pair loops (sphc --simd-pairs; CPU backends, double or single precision, not --mpi;
+// off by default): the neighbours of one destination in SIMD lanes (8 doubles or 16 floats
+// per zmm register).
 //
 // A per-destination pair loop whose destination's sums are locals (codegen/RegisterSums.cpp)
 // is printed with its neighbour loop under
@@ -12,7 +13,9 @@
 // destination); local arrays passed by pointer (XIJ[3]) it does not (docs/performance.md,
 // "SIMD pair loops: measured"). The bodies' `if`s are left to GCC's if-conversion: where it
 // cannot, the loop stays scalar, with the same results. The build adds -fopenmp-simd
-// (driver/Build.cpp).
+// (driver/Build.cpp). In single precision the bodies' double arguments (t, dt, the equations'
+// scalars) are float locals converted before the loop (f_t, f_eq2_alpha): GCC does not
+// if-convert a conversion it sank into an `if` (it may trap), which kept the loop scalar.
 //
 // Results: each sum is reassociated (one partial sum per lane, added at the end), so they
 // differ from the scalar loop's in the last bits; the same loop in serial and OpenMP
@@ -271,6 +274,20 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
       for (int k : sc.second)
         if (loads.insert(destinationValueName(p, sc.first, k)).second)
           os << in << destinationValueLoad(p, sc.first, k) << "\n";
+  // Single precision: the double arguments (t, dt, the equations' scalars) as float locals;
+  // converted in the loop, GCC would not if-convert a conversion under an `if` (it may trap).
+  if (host_.floatBodies) {
+    std::set<std::string> converted;
+    for (const PlanEquation* eq : pass.equations)
+      for (const BodyParam& p : bodyParams(methodBody(*eq, ast::Method::Loop), w.array, host_)) {
+        const std::string name = floatScalarName(eqStruct(*eq), p);
+        if (!name.empty() && converted.insert(name).second)
+          os << in << "const float " << name << " = static_cast<float>("
+             << (p.kind == BodyParam::Scalar ? eqStruct(*eq) + "." + p.name
+                                             : std::string(p.kind == BodyParam::T ? "t" : "dt"))
+             << ");\n";
+      }
+  }
   os << in << "#pragma omp simd reduction(+: " << reduction << ")\n";
   os << in << "for (int k_nbr = 0; k_nbr < n_nbrs; ++k_nbr) {\n";
   const std::string body = in + "  ";
@@ -286,7 +303,7 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
       for (int k = 0; k < 3; ++k)
         os << body << "const " << host_.real << " " << pq.name << "_" << k << " = "
            << (k < plan_.dim ? pq.components[k] + "i - sj_" + pq.components[k] + "[s_idx]"
-                             : std::string("0.0"))
+                             : std::string(host_.floatBodies ? "0.0f" : "0.0"))
            << ";\n";
     } else if (pq.form == PairForm::Gradient) {
       os << body << "const " << host_.real << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
@@ -309,6 +326,15 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
     os << body << pairCall(*eq, w.array, sums, /*scalarPairs=*/true);
   os << in << "}\n";
   return true;
+}
+
+std::string ScenePrinter::floatScalarName(const std::string& eqValues, const BodyParam& p) {
+  switch (p.kind) {
+    case BodyParam::T: return "f_t";
+    case BodyParam::Dt: return "f_dt";
+    case BodyParam::Scalar: return "f_" + eqValues + "_" + p.name;
+    default: return "";
+  }
 }
 
 void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& os) {

@@ -132,12 +132,12 @@ static cl::opt<bool> NoRegisterSums(
     cl::desc("In the CPU pair loops, update the destination's sums in memory at every pair "
              "(default: the d_ properties the loop bodies accumulate at d_idx are locals "
              "across the neighbours, loaded before them and stored after them, where the "
-             "bodies allow it; serial and openmp, double precision; the results are the same "
-             "bit for bit)"),
+             "bodies allow it; serial and openmp, double and single precision (float locals "
+             "in single); the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
 static cl::opt<std::string> SimdPairs(
     "simd-pairs",
-    cl::desc("The CPU pair loops (serial and openmp, double precision) whose bodies allow it "
+    cl::desc("The CPU pair loops (serial and openmp, double and single precision) whose bodies allow it "
              "may process the neighbours of a destination in SIMD lanes: `#pragma omp simd` "
              "with the destination's sums as reductions, built with -fopenmp-simd; such a loop "
              "is per destination even where each pair could be evaluated once. auto "

@@ -10,8 +10,10 @@ the property (a relative error per value means nothing for values that cross zer
 velocities). --scale NAME=S (NAME as printed, e.g. fluid/arho) makes the scale of that
 dataset at least S: for a property that is exactly zero up to round-off (a patch test), its
 own largest value is round-off and says nothing; S is then its physical scale. Integers and strings must be equal. --sorted compares the sorted values of each
-floating point dataset (for runs whose particle order may differ, e.g. single precision). Exit 0 if they agree, else 1 naming each
-property that does not.
+floating point dataset (for runs whose particle order may differ, e.g. single precision). --key
+NAME (e.g. gid, written by sphc --global-ids) compares the particles of each array in the order
+of its dataset NAME (the same particle with itself where the runs sorted them differently).
+Exit 0 if they agree, else 1 naming each property that does not.
 """
 import re
 import subprocess
@@ -52,8 +54,23 @@ def read(path):
     return items
 
 
+def by_key(items, key):
+    """Each array's datasets (GROUP/NAME) in the order of its dataset GROUP/key; a dataset of
+    S values per particle keeps its S values together."""
+    orders = {}
+    for name, (_, ids) in items.items():
+        if '@' not in name and name.endswith('/' + key) and ids:
+            orders[name[:-len(key) - 1]] = sorted(range(len(ids)), key=lambda k: float(ids[k]))
+    for name, entry in items.items():
+        order = orders.get(name.rsplit('/', 1)[0]) if '@' not in name else None
+        if not order or len(entry[1]) % len(order):
+            continue
+        stride = len(entry[1]) // len(order)
+        entry[1] = [entry[1][k * stride + c] for k in order for c in range(stride)]
+
+
 def main(argv):
-    rtol, verbose, ordered, files, floor = 1e-10, False, True, [], {}
+    rtol, verbose, ordered, files, floor, key = 1e-10, False, True, [], {}, None
     i = 1
     while i < len(argv):
         if argv[i] == '--rtol':
@@ -67,10 +84,16 @@ def main(argv):
             verbose = True
         elif argv[i] == '--sorted':
             ordered = False
+        elif argv[i] == '--key':
+            key = argv[i + 1]
+            i += 1
         else:
             files.append(argv[i])
         i += 1
     a_items, b_items = read(files[0]), read(files[1])
+    if key:
+        by_key(a_items, key)
+        by_key(b_items, key)
     bad, worst = [], (0.0, '')
     for name, (is_float, va) in sorted(a_items.items()):
         if name not in b_items:

@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""Instructions and CPU time per step in single against double precision, each with and
+without the SIMD pair loops of `sphc --simd-pairs` (issue 16; docs/performance.md "SIMD pair
+loops in single precision"): prints figures, is not a test.
+
+Variants: double (the default), double --simd-pairs, --precision=single (the destination's
+sums in float locals), --precision=single --simd-pairs (the neighbours in float SIMD lanes:
+16 per zmm register against 8 doubles).
+
+Instructions (the default): each scene built for AVX2 + FMA so that valgrind 3.19 can run it
+(`-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g`), run for a short and
+a long number of steps without output under `valgrind --tool=callgrind`; per step = (long -
+short) / the steps between them. Instruction counts do not depend on the machine's load.
+
+With --cpu, instead: CPU time per step (user + system) of the default (-march=native) builds,
+(long - short run) / steps, the variants interleaved, --rounds times; the minimum and the
+median over the rounds (on a loaded machine only ratios of interleaved runs mean something).
+Also the zmm gathers (vgatherdpd, vgatherdps) in each executable.
+
+Usage: python3 bench/simd_single.py [--scenes cube,dambreak,dambreak_pysph,dambreak3d]
+       python3 bench/simd_single.py --cpu [--rounds 3] [--scenes cube47,...]
+"""
+
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from common import (ROOT, SCENE_FILES, cpu_per_step_rounds, instruction_parser,  # noqa: E402
+                    instructions, load_average, remove_tmp, run)
+
+FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
+PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
+DAMBREAK3D = os.path.join(ROOT, "examples", "dambreak3d.sph")
+# scene: (file, sphc flags, run-time options, short steps, long steps)
+SCENES = {
+    "cube": (SCENE_FILES["cube"], [], ["--set", "nx=20", "--tf", "1"], 5, 15),
+    "dambreak": (SCENE_FILES["dambreak"], [], [], 50, 150),
+    "dambreak_pysph": (SCENE_FILES["dambreak"], PYSPH_EFFECTS, ["--set", "cfl=0.3"], 50, 150),
+    "dambreak3d": (DAMBREAK3D, [], [], 5, 15),
+}
+# --cpu: the cube at nx = 20 and 47 (PySPH's ~100k), the dam breaks at ~100k particles.
+CPU_SCENES = {
+    "cube20": (SCENE_FILES["cube"], [], ["--set", "nx=20", "--tf", "1"], 5, 45),
+    "cube47": (SCENE_FILES["cube"], [], ["--set", "nx=47", "--tf", "1"], 2, 12),
+    "dambreak": (SCENE_FILES["dambreak"], [], ["--set", "dx=0.0047"], 5, 25),
+    "dambreak_pysph": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
+                       ["--set", "dx=0.0047", "--set", "cfl=0.3"], 5, 45),
+    "dambreak3d": (DAMBREAK3D, [], [], 5, 25),
+}
+ALL_VARIANTS = {
+    "double": [], "double_simd": ["--simd-pairs"],
+    "single": ["--precision=single"], "single_simd": ["--precision=single", "--simd-pairs"],
+    # Double without kept lists (so per destination, as single precision, which has none).
+    "double_nolists": ["--verlet-skin=off"],
+    "double_nolists_simd": ["--verlet-skin=off", "--simd-pairs"],
+}
+VARIANTS = [(n, ALL_VARIANTS[n]) for n in ("double", "double_simd", "single", "single_simd")]
+
+
+def gathers(exe):
+    dis = subprocess.run(["objdump", "-d", "--no-show-raw-insn", exe], stdout=subprocess.PIPE,
+                         universal_newlines=True).stdout
+    return sum(1 for line in dis.splitlines()
+               if ("vgatherdpd" in line or "vgatherdps" in line) and "zmm" in line)
+
+
+def callgrind(exe, options, steps):
+    cg = "%s_%d.callgrind" % (exe, steps)
+    run(["valgrind", "--tool=callgrind", "--callgrind-out-file=" + cg, exe] + options +
+        ["--max-steps", str(steps), "--no-output", "-d", exe + "_out", "--quiet"])
+    return instructions(cg)
+
+
+def instructions_per_step(args, tmp):
+    print("built with --cxxflags \"%s\"; instructions per step under callgrind, "
+          "(long - short) / steps" % FLAGS)
+    print("%-15s %-12s %-9s %12s %9s" % ("scene", "variant", "steps", "Ir / step",
+                                          "/ " + VARIANTS[0][0]))
+    for scene in args.scenes.split(","):
+        path, sflags, options, short, long_ = SCENES[scene]
+        base = None
+        for name, flags in VARIANTS:
+            exe = os.path.join(tmp, "%s_%s" % (scene, name))
+            run([args.sphc, path, "-o", exe, "--cxxflags", FLAGS] + sflags + flags)
+            n = (callgrind(exe, options, long_) - callgrind(exe, options, short)) / (long_ - short)
+            base = base or n
+            print("%-15s %-12s %-9s %12.4g %9.3f" % (scene, name, "%d-%d" % (short, long_), n,
+                                                     n / base))
+            sys.stdout.flush()
+
+
+def cpu_per_step(args, tmp):
+    print("CPU s per step (user + system; (long - short) / steps), default -march=native "
+          "builds, variants interleaved; min (median) over %d rounds, / double" % args.rounds)
+    for scene in args.scenes.split(","):
+        path, sflags, options, short, long_ = CPU_SCENES[scene]
+        exes = {}
+        for name, flags in VARIANTS:
+            exes[name] = os.path.join(tmp, "%s_%s" % (scene, name))
+            run([args.sphc, path, "-o", exes[name]] + sflags + flags)
+        per = cpu_per_step_rounds(exes, options, short, long_, args.rounds)
+        lo = {n: min(v) for n, v in per.items()}
+        med = {n: statistics.median(v) for n, v in per.items()}
+        print("%s steps %d-%d:" % (scene, short, long_))
+        for name, _ in VARIANTS:
+            print("  %-12s %.4f s (%.3f; median %.3f)  zmm gathers %d  [all: %s]" % (
+                name, lo[name], lo[name] / lo[VARIANTS[0][0]],
+                med[name] / med[VARIANTS[0][0]],
+                gathers(exes[name]), " ".join("%.4f" % v for v in per[name])))
+        sys.stdout.flush()
+
+
+def main():
+    ap = instruction_parser(__doc__)
+    ap.set_defaults(scenes=None)
+    ap.add_argument("--cpu", action="store_true", help="CPU time per step")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--variants", default=None,
+                    help="comma-separated, the first the base of the ratios (default: "
+                    "double,double_simd,single,single_simd; also double_nolists, "
+                    "double_nolists_simd)")
+    args = ap.parse_args()
+    if args.variants:
+        VARIANTS[:] = [(n, ALL_VARIANTS[n]) for n in args.variants.split(",")]
+    if args.scenes is None:
+        args.scenes = ",".join(CPU_SCENES if args.cpu else SCENES)
+    tmp = tempfile.mkdtemp(prefix="sphc_simdsingle_")
+    print("load average before: %s" % load_average())
+    if args.cpu:
+        cpu_per_step(args, tmp)
+    else:
+        instructions_per_step(args, tmp)
+    print("load average after: %s" % load_average())
+    remove_tmp(tmp, args.keep)
+
+
+if __name__ == "__main__":
+    main()
