@@ -219,6 +219,16 @@ std::vector<SourceOnlySite> findDestinationOnlySites(const BodySource& body,
                                                      clang::FunctionDecl* fn,
                                                      const SourceRangeOf& rangeOf,
                                                      const std::set<std::string>& written);
+// A site's use of a body parameter `name`: t, dt or one of the scalars (SourceOnlySite's
+// usesT, usesDt, scalars; SourceOnly.cpp, PairShared.cpp).
+inline void noteParameterUse(const BodySource& body, const std::string& name, SourceOnlySite& site) {
+  switch (nameRole(body, name)) {
+    case NameRole::Time: site.usesT = true; break;
+    case NameRole::TimeStep: site.usesDt = true; break;
+    case NameRole::Scalar: site.scalars.insert(name); break;
+    default: break;
+  }
+}
 // The values of a loop body the mirrored pair shares (BodyFacts::pairShared; PairShared.cpp).
 std::vector<SourceOnlySite> findPairSharedSites(const BodySource& body, clang::FunctionDecl* fn,
                                                 const SourceRangeOf& rangeOf);

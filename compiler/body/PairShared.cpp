@@ -403,12 +403,7 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
       if (auto* v = llvm::dyn_cast<clang::VarDecl>(d); v && !llvm::isa<clang::ParmVarDecl>(v)) {
         if (!inside.count(v) && locals.insert(v).second && v->getInit()) todo.push_back(v->getInit());
       } else {
-        switch (nameRole(body_, name)) {
-          case NameRole::Time: site.usesT = true; break;
-          case NameRole::TimeStep: site.usesDt = true; break;
-          case NameRole::Scalar: site.scalars.insert(name); break;
-          default: break;
-        }
+        noteParameterUse(body_, name, site);
       }
     }
     for (const clang::Stmt* c : s->children())

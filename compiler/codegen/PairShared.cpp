@@ -51,6 +51,9 @@ std::vector<SourceOnlySite> ScenePrinter::pairSharedSites(const PlanBody& b, con
   if (!pairShared_ || !d.hoist || b.source.kind != BodyKind::Loop || !b.facts.ok ||
       b.facts.pairShared.empty() || b.source.text.find("pair_shared") != std::string::npos)
     return {};
+  if (!pairSharedBodies_)
+    pairSharedBodies_ = std::make_unique<std::set<const PlanBody*>>(pairSharedBodies());
+  if (!pairSharedBodies_->count(&b)) return {};  // no loop calls it both ways: as before
   std::set<std::string> written;  // by any pair loop of the plan (as Hoist.cpp)
   for (const PlanBody& other : plan_.bodies)
     if (other.source.kind == BodyKind::Loop || other.source.kind == BodyKind::LoopAll)

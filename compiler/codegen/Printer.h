@@ -93,6 +93,9 @@ class ScenePrinter {
   virtual void systemIncludes() {}                  // <omp.h>, ...
   // Where the body of an equation method or stepper runs: its dialect and stream.
   virtual bool bodyOnDevice(bool converged) const { return false; }
+  // The loop bodies some pair loop calls for (d_idx, s_idx) and mirrored for (s_idx, d_idx)
+  // in one iteration (each pair once; codegen/PairShared.cpp uses values of those only).
+  virtual std::set<const PlanBody*> pairSharedBodies() const { return {}; }
   virtual void deviceKernelFunctions() {}
   virtual void devicePowFunction() {}  // sphc::pow_int in the kernels' language
   virtual void beforeScene() {}                     // before "The scene" (OpenCL: SCENE_CL)
@@ -223,6 +226,7 @@ class ScenePrinter {
   mutable std::map<std::string, std::string> pairSharedScope_;
   mutable std::map<std::string, int> pairSharedSign_;  // the same keys: 1 or -1
   bool pairShared_ = false;  // EmitOptions::pairShared (CPU double, not mpi, not --simd-pairs)
+  mutable std::unique_ptr<std::set<const PlanBody*>> pairSharedBodies_;  // (once)
 
   // ---- Source-only values hoisted out of the pair loops (Hoist.cpp) ----
   // The sites of a loop body computed once per source particle (none unless d.hoist), and
