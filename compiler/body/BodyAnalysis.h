@@ -117,6 +117,14 @@ struct SourceOnlySite {
   std::vector<Local> locals;         // in order of declaration (each after those it reads)
   std::set<std::string> scalars;     // of BodySource::scalars, through the locals too
   bool usesT = false, usesDt = false;
+  // BodyFacts::pairShared only: 1 if the mirrored pair's value is the same, -1 if it is its
+  // negation; with `result` (an `if` that sets a local, body/PairShared.cpp): the statement
+  // text[stmtBegin, stmtEnd), the local's name, and [begin, end) its initial value; id: the
+  // site's place in BodyFacts::pairShared (kept when text edits move or drop sites).
+  int sign = 1;
+  std::string result;
+  unsigned stmtBegin = 0, stmtEnd = 0;
+  int id = 0;
 };
 
 struct BodyFacts {
@@ -134,6 +142,9 @@ struct BodyFacts {
   std::vector<SourceOnlySite> sourceOnly;     // loop bodies: what may be hoisted
   std::vector<SourceOnlySite> destinationOnly;  // the same of the destination (d_NAME[d_idx]
                                                 // of properties the body does not write)
+  // Loop bodies: values the same (or negated) for the mirrored pair (body/PairShared.cpp),
+  // computed once per pair where the pair is evaluated once for both particles.
+  std::vector<SourceOnlySite> pairShared;
 };
 
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given

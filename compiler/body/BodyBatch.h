@@ -209,7 +209,7 @@ void checkBodyFunction(Batch& batch, int index, const clang::SourceManager& sm,
                        clang::FunctionDecl* fn);
 
 // text[begin, end) of an expression of the body being checked; false where it has none.
-using SourceRangeOf = std::function<bool(const clang::Expr*, unsigned&, unsigned&)>;
+using SourceRangeOf = std::function<bool(const clang::Stmt*, unsigned&, unsigned&)>;
 // The source-only subexpressions of a loop body worth computing once per source particle
 // (SourceOnly.cpp; BodyFacts::sourceOnly).
 std::vector<SourceOnlySite> findSourceOnlySites(const BodySource& body, clang::FunctionDecl* fn,
@@ -219,5 +219,18 @@ std::vector<SourceOnlySite> findDestinationOnlySites(const BodySource& body,
                                                      clang::FunctionDecl* fn,
                                                      const SourceRangeOf& rangeOf,
                                                      const std::set<std::string>& written);
+// A site's use of a body parameter `name`: t, dt or one of the scalars (SourceOnlySite's
+// usesT, usesDt, scalars; SourceOnly.cpp, PairShared.cpp).
+inline void noteParameterUse(const BodySource& body, const std::string& name, SourceOnlySite& site) {
+  switch (nameRole(body, name)) {
+    case NameRole::Time: site.usesT = true; break;
+    case NameRole::TimeStep: site.usesDt = true; break;
+    case NameRole::Scalar: site.scalars.insert(name); break;
+    default: break;
+  }
+}
+// The values of a loop body the mirrored pair shares (BodyFacts::pairShared; PairShared.cpp).
+std::vector<SourceOnlySite> findPairSharedSites(const BodySource& body, clang::FunctionDecl* fn,
+                                                const SourceRangeOf& rangeOf);
 
 }  // namespace sphc::body_detail

@@ -30,13 +30,15 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     for (clang::ParmVarDecl* p : fn->parameters()) namesFma_ |= p->getName() == "fma";
     if (namesFma_) facts_.multiplyAdds.clear();
     if (batch_.state[i_].errors == 0) {
-      SourceRangeOf range = [&](const clang::Expr* e, unsigned& b, unsigned& en) {
+      SourceRangeOf range = [&](const clang::Stmt* e, unsigned& b, unsigned& en) {
         return textRange(e, b, en);
       };
       facts_.sourceOnly = findSourceOnlySites(body_, fn, range);
       std::set<std::string> written;
       for (const PropAccess& w : facts_.dWrites) written.insert(w.prop);
       facts_.destinationOnly = findDestinationOnlySites(body_, fn, range, written);
+      facts_.pairShared = findPairSharedSites(body_, fn, range);
+      for (size_t k = 0; k < facts_.pairShared.size(); ++k) facts_.pairShared[k].id = static_cast<int>(k);
     }
   }
 
@@ -325,7 +327,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   }
 
   // text[begin, end) is the expression, from its first token to the end of its last.
-  bool textRange(const clang::Expr* e, unsigned& begin, unsigned& end) const {
+  bool textRange(const clang::Stmt* e, unsigned& begin, unsigned& end) const {
     clang::SourceLocation last = sm_.getExpansionLoc(e->getEndLoc());
     if (!textOffset(e->getBeginLoc(), begin) || !textOffset(last, end)) return false;
     end += clang::Lexer::MeasureTokenLength(last, sm_, ctx_->getLangOpts());

@@ -202,12 +202,7 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
       if (auto* v = llvm::dyn_cast<clang::VarDecl>(d); v && !llvm::isa<clang::ParmVarDecl>(v)) {
         if (locals.insert(v).second) todo.push_back(v->getInit());
       } else {
-        switch (nameRole(body_, name)) {
-          case NameRole::Time: site.usesT = true; break;
-          case NameRole::TimeStep: site.usesDt = true; break;
-          case NameRole::Scalar: site.scalars.insert(name); break;
-          default: break;
-        }
+        noteParameterUse(body_, name, site);
       }
     }
     for (const clang::Stmt* c : s->children())

@@ -75,10 +75,11 @@ bool applyTextEdits(std::string& text, std::vector<TextEdit> edits, BodyFacts& f
   facts.multiplyAdds = kept;
   // A source-only expression (and the initial values of its locals) moves with its text; one
   // an edit cuts into is dropped (computed in the pair loop as written).
-  for (auto* list : {&facts.sourceOnly, &facts.destinationOnly}) {
+  for (auto* list : {&facts.sourceOnly, &facts.destinationOnly, &facts.pairShared}) {
     std::vector<SourceOnlySite> kept;
     for (SourceOnlySite s : *list) {
       bool ok = map.moveRange(s.begin, s.end);
+      if (s.stmtBegin < s.stmtEnd) ok = ok && map.moveRange(s.stmtBegin, s.stmtEnd);
       for (auto& l : s.locals) ok = ok && map.moveRange(l.initBegin, l.initEnd);
       if (ok) kept.push_back(s);
     }

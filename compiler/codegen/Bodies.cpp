@@ -45,6 +45,9 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   simdPairs_ = opts.simdPairs && registerSums_;  // SimdPairs.cpp: on the sums in locals
   simdAuto_ = opts.simdPairsAuto;
   simdSymmetric_ = opts.symmetricPairs && opts.verletSkin > 0 && !hasZones() && !hasDomain();
+  // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in
+  // lanes); --simd-pairs=on prints every loop that allows it per destination.
+  pairShared_ = opts.pairShared && host_.hoist && (!simdPairs_ || simdAuto_);
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {
@@ -129,6 +132,11 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b,
   for (size_t k = 0; k < dHoisted.size(); ++k)
     ps.push_back({real + " d_hoisted" + std::to_string(k), BodyParam::DHoisted,
                   std::to_string(k)});
+  // ... and once per pair for both particles (codegen/PairShared.cpp): pair_shared0, ...
+  const auto shared = pairSharedSites(b, d);
+  for (size_t k = 0; k < shared.size(); ++k)
+    ps.push_back({real + " pair_shared" + std::to_string(k), BodyParam::PairShared,
+                  std::to_string(k)});
   return ps;
 }
 
@@ -151,12 +159,14 @@ void ScenePrinter::emitBodyFunction(const PlanBody& b, const std::string& name,
   if (d.lineDirectives) resetLineDirective(os, d);
   os << "\n";
   emitHoistFunctions(b, name, d, os);
+  emitPairSharedFunctions(b, name, destArray, d, os);
 }
 
 // A body's or helper's text in a dialect: its multiply-adds fused, in float for
 // --precision=single on the CPU.
 std::string ScenePrinter::bodyText(const PlanBody& b, const Dialect& d) const {
-  if (!hoistedSites(b, d).empty() || !hoistedDestinationSites(b, d).empty())
+  if (!hoistedSites(b, d).empty() || !hoistedDestinationSites(b, d).empty() ||
+      !pairSharedSites(b, d).empty())
     return hoistedBodyText(b, d);
   std::string text = fuseMultiplyAdds(b.source.text, b.facts.multiplyAdds, d.fma);
   return d.floatBodies ? singlePrecisionBody(text) : text;
@@ -303,6 +313,42 @@ std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int
         continue;
       }
     }
+    if (p.kind == BodyParam::PairShared) {
+      // The value computed once for the pair (emitPairSharedLocals), else computed here by
+      // the site's function on the call's own arguments.
+      auto it = pairSharedScope_.find(eqValues + "/" + p.name);
+      if (it != pairSharedScope_.end()) {
+        s += it->second;
+        continue;
+      }
+      std::string base = fn;
+      for (const char* suffix : {"_sums", "_simd"})
+        if (base.size() > 5 && base.compare(base.size() - 5, 5, suffix) == 0)
+          base.erase(base.size() - 5);
+      std::string call = base + "_pairshared" + p.name + "(";
+      bool firstArg = true;
+      for (const auto& q : pairSharedParams(b, dest, host_)) {
+        call += firstArg ? "" : ", ";
+        firstArg = false;
+        const std::string a = argument ? argument(q) : "";
+        if (!a.empty()) {
+          call += a;
+          continue;
+        }
+        call += callBodyDefault(q, eqValues, time, sep);
+      }
+      s += call + ")";
+      continue;
+    }
+    s += callBodyDefault(p, eqValues, time, sep);
+  }
+  return s + ")";
+}
+
+std::string ScenePrinter::callBodyDefault(const BodyParam& p, const std::string& eqValues,
+                                          const std::string& time, const std::string& sep) const {
+  std::string s;
+  {
     switch (p.kind) {
       case BodyParam::Idx: s += "d_idx"; break;
       case BodyParam::SIdx: s += "s_idx"; break;
@@ -317,9 +363,10 @@ std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int
       case BodyParam::N: s += "N"; break;
       case BodyParam::Hoisted: s += hoistArgument(eqValues, p.name); break;
       case BodyParam::DHoisted: s += hoistDestinationArgument(eqValues, p.name); break;
+      case BodyParam::PairShared: break;  // (callBody)
     }
   }
-  return s + ")";
+  return s;
 }
 
 void ScenePrinter::emitDestLocals(std::ostream& os, const std::string& indent,

@@ -56,6 +56,12 @@ struct EmitOptions {
   // neighbour lists); false (--no-symmetric-pairs): each destination gathers from all its
   // neighbours. The values are the same bit for bit.
   bool symmetricPairs = true;
+  // Where a pair is evaluated once for both particles, the values of its loop bodies that are
+  // the same (or negated) for the mirrored pair (body/PairShared.cpp) are computed once and
+  // passed to both calls (codegen/PairShared.cpp; CPU backends, double precision, not --mpi,
+  // not --simd-pairs); false (--no-pair-shared-values): each call computes them. The values
+  // are the same bit for bit.
+  bool pairShared = true;
   // `pow` in the bodies of the CPU backends (double precision) is sphc::pow_int (sphc/pow.h):
   // by multiplications where the exponent is an integer of magnitude <= 8, the C library's
   // pow otherwise; false (--int-pow=off): the C library's pow everywhere.

@@ -73,6 +73,7 @@ class CpuPrinter : public ScenePrinter {
   bool phaseDisplacements_ = false;
   // The destinations {A, B} of w's phase whose pair loops A <- B and B <- A run as one pass
   // (crossPairsRefusal; kept lists; OpenMP in blocks), where w is A or B; {} elsewhere.
+  std::set<const PlanBody*> pairSharedBodies() const override;
   std::pair<const DestinationWork*, const DestinationWork*> crossPair(
       const DestinationWork& w) const;
   // OpenMP: the kept lists of the A <- B loops run with B <- A as one pass, each with the
@@ -563,6 +564,24 @@ std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
     }
   });
   return found;
+}
+
+// The bodies the each-pair-once loops call both ways (the conditions of the printing above):
+// those of a pass over its own array, and those of one declaration on both sides of a cross
+// pass.
+std::set<const PlanBody*> CpuPrinter::pairSharedBodies() const {
+  std::set<const PlanBody*> bodies;
+  walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w, const NeighbourPass& pass) {
+    if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty() &&
+        !simdPairsRefusal(w, pass).empty())
+      for (const PlanEquation* eq : pass.equations) bodies.insert(&methodBody(*eq, ast::Method::Loop));
+    const auto [A, B] = crossPair(w);
+    if (A && &w == A)
+      for (const PlanEquation* eq : A->passes.back().equations)
+        for (const PlanEquation* m : B->passes.front().equations)
+          if (m->declIndex == eq->declIndex) bodies.insert(&methodBody(*eq, ast::Method::Loop));
+  });
+  return bodies;
 }
 
 // A reduction of the destination's real particles into one of its constants.

@@ -34,8 +34,6 @@
 
 namespace sphc {
 
-namespace {
-
 // text[begin, end) with the multiply-adds inside it fused (as they are in the whole body).
 std::string fusedRange(const std::string& text, const BodyFacts& f, unsigned begin, unsigned end,
                        const std::string& fma) {
@@ -68,6 +66,8 @@ std::string endStatement(const std::string& expr) {
   size_t nl = expr.rfind('\n');
   return expr.find("//", nl == std::string::npos ? 0 : nl) != std::string::npos ? "\n;" : ";";
 }
+
+namespace {
 
 bool within(unsigned b, unsigned e, unsigned begin, unsigned end) {
   return begin <= b && e <= end;
@@ -142,8 +142,18 @@ std::vector<SourceOnlySite> ScenePrinter::hoistedSites(const PlanBody& b, const 
 
 std::string ScenePrinter::hoistedBodyText(const PlanBody& b, const Dialect& d,
                                           const std::vector<TextEdit>& extra) const {
-  std::string text = b.source.text;
-  BodyFacts facts = b.facts;
+  std::string text;
+  BodyFacts facts;
+  hoistedText(b, d, extra, text, facts);
+  replacePairShared(b, d, text, facts);  // codegen/PairShared.cpp
+  return fuseMultiplyAdds(text, facts.multiplyAdds, d.fma);
+}
+
+void ScenePrinter::hoistedText(const PlanBody& b, const Dialect& d,
+                               const std::vector<TextEdit>& extra, std::string& text,
+                               BodyFacts& facts) const {
+  text = b.source.text;
+  facts = b.facts;
   std::vector<TextEdit> edits = extra;
   auto replace = [&](const std::vector<SourceOnlySite>& sites, const std::string& name,
                      const std::string& index) {
@@ -160,7 +170,6 @@ std::string ScenePrinter::hoistedBodyText(const PlanBody& b, const Dialect& d,
   replace(hoistedDestinationSites(b, d), "d_hoisted", "");
   if (!applyTextEdits(text, edits, facts))
     SPHC_INTERNAL("overlapping hoisted expressions in " + b.source.label);
-  return fuseMultiplyAdds(text, facts.multiplyAdds, d.fma);
 }
 
 void ScenePrinter::emitHoistFunctions(const PlanBody& b, const std::string& name, const Dialect& d,

@@ -57,6 +57,14 @@ struct RegisterSums {
   bool active() const { return !props.empty(); }
 };
 
+// Text helpers of the functions printed beside a body (Hoist.cpp, PairShared.cpp):
+// text[begin, end) with the multiply-adds inside it fused as in the whole body; an
+// expression on one line (for a comment); the end of a statement after an expression.
+std::string fusedRange(const std::string& text, const BodyFacts& f, unsigned begin, unsigned end,
+                       const std::string& fma);
+std::string oneLine(const std::string& text);
+std::string endStatement(const std::string& expr);
+
 struct PairDialect;  // analysis/PairQuantityTable.h
 // The spellings the pair-quantity statements take in a dialect (codegen/Bodies.cpp).
 PairDialect pairDialectOf(const Dialect& dl);
@@ -85,6 +93,9 @@ class ScenePrinter {
   virtual void systemIncludes() {}                  // <omp.h>, ...
   // Where the body of an equation method or stepper runs: its dialect and stream.
   virtual bool bodyOnDevice(bool converged) const { return false; }
+  // The loop bodies some pair loop calls for (d_idx, s_idx) and mirrored for (s_idx, d_idx)
+  // in one iteration (each pair once; codegen/PairShared.cpp uses values of those only).
+  virtual std::set<const PlanBody*> pairSharedBodies() const { return {}; }
   virtual void deviceKernelFunctions() {}
   virtual void devicePowFunction() {}  // sphc::pow_int in the kernels' language
   virtual void beforeScene() {}                     // before "The scene" (OpenCL: SCENE_CL)
@@ -139,7 +150,7 @@ class ScenePrinter {
   struct BodyParam {
     std::string decl;  // e.g. "const double* s_m"
     enum Kind { Idx, SIdx, T, Dt, Pair, Scalar, DProp, SProp, Nbrs, NNbrs, N, Hoisted,
-                DHoisted } kind;
+                DHoisted, PairShared } kind;
     std::string name;  // property, pair quantity or scalar name; Hoisted: the site's number
   };
   // The body-parameter types: what each property, pair quantity and scalar is declared as.
@@ -161,6 +172,9 @@ class ScenePrinter {
                        const std::string& eqValues, const std::string& time,
                        const std::string& sep = ".",
                        const std::function<std::string(const BodyParam&)>& argument = {}) const;
+  // callBody's argument for a parameter without `argument`'s.
+  std::string callBodyDefault(const BodyParam& p, const std::string& eqValues,
+                              const std::string& time, const std::string& sep) const;
   // The destination particle's position, h (and velocity) as locals xi, yi, zi, hi (ui...).
   void emitDestLocals(std::ostream& os, const std::string& indent,
                       const std::set<std::string>& q, const Dialect& d) const;
@@ -184,6 +198,36 @@ class ScenePrinter {
   // A property's type in a dialect (constants and floating properties: its real).
   std::string propType(int array, const std::string& prop, const Dialect& d) const;
 
+  // ---- Values a pair shares, computed once for both particles (PairShared.cpp) ----
+  // The sites of a loop body (BodyFacts::pairShared) the printer uses: none unless
+  // pairShared_ and d.hoist; of properties no pair loop writes.
+  std::vector<SourceOnlySite> pairSharedSites(const PlanBody& b, const Dialect& d) const;
+  // Stage two of hoistedBodyText: each site replaced by `pair_sharedK` (an `if` site by
+  // `NAME = pair_sharedK;`), `text` and `facts` already moved by the other edits.
+  void replacePairShared(const PlanBody& b, const Dialect& d, std::string& text,
+                         BodyFacts& facts) const;
+  // After a loop body's function `name`: NAME_pairsharedK(...) per site, the body's
+  // parameters but the written properties, returning the site's value for (d_idx, s_idx).
+  void emitPairSharedFunctions(const PlanBody& b, const std::string& name, int destArray,
+                               const Dialect& d, std::ostringstream& os) const;
+  // The parameters of those functions (bodyParams without pair_sharedK and written d_).
+  std::vector<BodyParam> pairSharedParams(const PlanBody& b, int destArray, const Dialect& d) const;
+  // In a pair loop that calls `direct` for (d_idx, s_idx) and `mirrored` for (s_idx, d_idx):
+  // the locals `pshared_eqN_K` of the values both share, computed once, and the scope that
+  // makes callBody pass them (pairSharedScope_); endPairShared clears it.
+  void emitPairSharedLocals(std::ostream& os, const std::string& indent, int dest,
+                            const std::vector<const PlanEquation*>& direct,
+                            const std::vector<const PlanEquation*>& mirrored) const;
+  void endPairShared() const {
+    pairSharedScope_.clear();
+    pairSharedSign_.clear();
+  }
+  // eqValues + "/" + K -> the local (mirrored calls: "-" before it for an antisymmetric one).
+  mutable std::map<std::string, std::string> pairSharedScope_;
+  mutable std::map<std::string, int> pairSharedSign_;  // the same keys: 1 or -1
+  bool pairShared_ = false;  // EmitOptions::pairShared (CPU double, not mpi, not --simd-pairs)
+  mutable std::unique_ptr<std::set<const PlanBody*>> pairSharedBodies_;  // (once)
+
   // ---- Source-only values hoisted out of the pair loops (Hoist.cpp) ----
   // The sites of a loop body computed once per source particle (none unless d.hoist), and
   // those computed once per destination particle (of properties no pair loop writes).
@@ -194,6 +238,10 @@ class ScenePrinter {
   // `extra`: further edits of the text (RegisterSums.cpp), none overlapping a hoisted site.
   std::string hoistedBodyText(const PlanBody& b, const Dialect& d,
                               const std::vector<TextEdit>& extra = {}) const;
+  // Its first stage: the text with the hoisted sites and `extra` replaced, not fused, and
+  // the facts moved with it.
+  void hoistedText(const PlanBody& b, const Dialect& d, const std::vector<TextEdit>& extra,
+                   std::string& text, BodyFacts& facts) const;
   // After a loop body's function `name`: one function per hoisted site, NAME_hoistedK(s_idx,
   // ...), returning the site's value for a source particle.
   void emitHoistFunctions(const PlanBody& b, const std::string& name, const Dialect& d,

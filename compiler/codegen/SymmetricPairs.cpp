@@ -240,6 +240,11 @@ std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest,
       case BodyParam::SIdx: return "d_idx";
       case BodyParam::Pair: return mirrored(p.name);
       case BodyParam::DHoisted: return symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]";
+      case BodyParam::PairShared: {  // computed once for the pair (codegen/PairShared.cpp)
+        auto it = pairSharedScope_.find(eqValues + "/" + p.name);
+        if (it == pairSharedScope_.end()) return "";  // callBody: computed in the call
+        return (pairSharedSign_.at(it->first) < 0 ? "-" : "") + it->second;
+      }
       case BodyParam::DProp: return pointers.empty() ? "" : pointers + "d_" + p.name;
       case BodyParam::SProp: return pointers.empty() ? "" : pointers + "s_" + p.name;
       case BodyParam::Nbrs:
@@ -335,6 +340,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
       emitNeighbourTest(scene_, host_, "continue;", body);
       emitPairQuantitiesOnce(q, bothSides, body);
+      if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
       for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
       if (bothSides) {
         scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
@@ -342,6 +348,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
           scene_ << body << "  " << callBodyMirrored(*eq, d);
         scene_ << body << "}\n";
       }
+      endPairShared();
       scene_ << in << "}\n";
     };
     if (!sg.tail) {
@@ -550,6 +557,7 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
   emitNeighbourTest(scene_, host_, "continue;", body);
   emitPairQuantitiesOnce(q, true, body);
+  emitPairSharedLocals(scene_, body, A.array, ab.equations, ba.equations);
   for (const PlanEquation* eq : ab.equations) scene_ << body << pairCall(*eq, A.array, sums);
   if (openmp)
     scene_ << body << "if (by_source_first[s_idx] >= u_begin && by_source_last[s_idx] < u_end) {  "
@@ -557,6 +565,7 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   for (const PlanEquation* eq : ba.equations)
     scene_ << body << (openmp ? "  " : "") << callBodyMirrored(*eq, B.array, "mirror_");
   if (openmp) scene_ << body << "}\n";
+  endPairShared();
   scene_ << in << "          }\n";
   emitSumsStore(scene_, in + "          ", sums);
   scene_ << in << "        }\n";

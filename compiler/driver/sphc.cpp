@@ -127,6 +127,13 @@ static cl::opt<bool> NoSymmetricPairs(
              "both particles, on the CPU backends with kept neighbour lists; --report says "
              "which loops; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoPairSharedValues(
+    "no-pair-shared-values",
+    cl::desc("Where a pair loop evaluates each pair once for both particles, let each of the "
+             "two calls compute the values of its body that are the same (or negated) for the "
+             "mirrored pair (default: computed once per pair and passed to both; serial and "
+             "openmp, double precision; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoRegisterSums(
     "no-register-sums",
     cl::desc("In the CPU pair loops, update the destination's sums in memory at every pair "
@@ -463,6 +470,7 @@ int main(int argc, char** argv) {
   emitOpts.batchedTables = !NoBatchedTables;
   emitOpts.splitUnits = !SingleUnit && Emit == EmitKind::Exe;
   emitOpts.symmetricPairs = !NoSymmetricPairs;
+  emitOpts.pairShared = !NoPairSharedValues;
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;

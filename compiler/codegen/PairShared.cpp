@@ -1,0 +1,192 @@
+// Values a pair shares, computed once for both particles (CPU backends, double precision, not
+// --mpi, not --simd-pairs; `sphc --no-pair-shared-values` turns it off).
+//
+// Where a pair loop evaluates each pair once for both particles (codegen/SymmetricPairs.cpp)
+// it calls each loop body twice per pair, for (d_idx, s_idx) and mirrored for (s_idx, d_idx).
+// The body analysis records the values of a body that are the same, or exactly the negation,
+// in the mirrored call (body/PairShared.cpp: BodyFacts::pairShared), e.g. the continuity
+// equation's VIJ . DWIJ or the viscosity's piij. Here:
+//
+//   - after the body's function, one function per site, NAME_loop_pairsharedK, with the
+//     body's parameters but its written d_ properties, returning the site's value (its locals
+//     declared first, as the body declares them; an `if` site runs the `if` on its local);
+//   - the body takes `double pair_sharedK` and reads it where it had the expression (an `if`
+//     site: `piij = pair_sharedK;` where it had the `if`);
+//   - in a pair loop that calls the body both ways, a local `pshared_eqN_K` computed once per
+//     pair is passed to both calls (negated to the mirrored call for an antisymmetric value);
+//     elsewhere (per-destination loops, the mirrored calls alone) each call passes
+//     NAME_loop_pairsharedK(...) of its own arguments: the value the body computed before.
+//
+// The values are the same bit for bit: the analysis allows only exact IEEE identities (see
+// body/PairShared.cpp, also for the sign of a zero), the site's function computes the
+// expression with the body's own operations and fused multiply-adds (a site that would split
+// a multiply-add is not used), and the properties a site reads are written by no pair loop.
+#include "codegen/Printer.h"
+
+#include "body/TextEdits.h"
+
+#include <algorithm>
+
+namespace sphc {
+
+namespace {
+
+bool overlapRange(unsigned b0, unsigned e0, unsigned b1, unsigned e1) { return b0 < e1 && b1 < e0; }
+bool inside(unsigned b, unsigned e, unsigned begin, unsigned end) { return begin <= b && e <= end; }
+
+// The ranges of a site's text: its expression (an if site: its local's initial value), its
+// statement, its locals' initial values.
+std::vector<std::pair<unsigned, unsigned>> siteRanges(const SourceOnlySite& s) {
+  std::vector<std::pair<unsigned, unsigned>> r = {{s.begin, s.end}};
+  if (s.stmtBegin < s.stmtEnd) r.push_back({s.stmtBegin, s.stmtEnd});
+  for (const auto& l : s.locals) r.push_back({l.initBegin, l.initEnd});
+  return r;
+}
+
+std::string K(size_t k) { return std::to_string(k); }
+
+}  // namespace
+
+std::vector<SourceOnlySite> ScenePrinter::pairSharedSites(const PlanBody& b, const Dialect& d) const {
+  if (!pairShared_ || !d.hoist || b.source.kind != BodyKind::Loop || !b.facts.ok ||
+      b.facts.pairShared.empty() || b.source.text.find("pair_shared") != std::string::npos)
+    return {};
+  if (!pairSharedBodies_)
+    pairSharedBodies_ = std::make_unique<std::set<const PlanBody*>>(pairSharedBodies());
+  if (!pairSharedBodies_->count(&b)) return {};  // no loop calls it both ways: as before
+  std::set<std::string> written;  // by any pair loop of the plan (as Hoist.cpp)
+  for (const PlanBody& other : plan_.bodies)
+    if (other.source.kind == BodyKind::Loop || other.source.kind == BodyKind::LoopAll)
+      for (const PropAccess& w : other.facts.dWrites) written.insert(w.prop);
+  std::vector<SourceOnlySite> kept;
+  for (const SourceOnlySite& s : b.facts.pairShared) {
+    bool ok = true;
+    for (const PropSite& p : b.facts.sites)
+      for (const auto& [rb, re] : siteRanges(s))
+        if (inside(p.begin, p.end, rb, re) && written.count(p.prop)) ok = false;
+    // A site must not split a multiply-add: it holds the whole sum, or lies within a factor
+    // or the addend, or outside it.
+    for (const MultiplyAddSite& m : b.facts.multiplyAdds)
+      for (const auto& [rb, re] : siteRanges(s)) {
+        if (!overlapRange(rb, re, m.begin, m.end) || inside(m.begin, m.end, rb, re)) continue;
+        if (inside(rb, re, m.aBegin, m.aEnd) || inside(rb, re, m.bBegin, m.bEnd) ||
+            inside(rb, re, m.cBegin, m.cEnd))
+          continue;
+        ok = false;
+      }
+    if (ok) kept.push_back(s);
+  }
+  return kept;
+}
+
+void ScenePrinter::replacePairShared(const PlanBody& b, const Dialect& d, std::string& text,
+                                     BodyFacts& facts) const {
+  const std::vector<SourceOnlySite> sites = pairSharedSites(b, d);
+  if (sites.empty()) return;
+  std::vector<TextEdit> edits;
+  for (size_t k = 0; k < sites.size(); ++k) {
+    auto it = std::find_if(facts.pairShared.begin(), facts.pairShared.end(),
+                           [&](const SourceOnlySite& s) { return s.id == sites[k].id; });
+    if (it == facts.pairShared.end())
+      SPHC_INTERNAL("a pair-shared value cut by another edit in " + b.source.label);
+    const SourceOnlySite& s = *it;
+    const unsigned begin = s.result.empty() ? s.begin : s.stmtBegin;
+    const unsigned end = s.result.empty() ? s.end : s.stmtEnd;
+    // The lines after it keep their numbers (#line): its line breaks follow it.
+    const long lines = std::count(text.begin() + begin, text.begin() + end, '\n');
+    const std::string name = "pair_shared" + K(k);
+    edits.push_back({begin, end,
+                     (s.result.empty() ? name : s.result + " = " + name + ";") +
+                         std::string(static_cast<size_t>(lines), '\n')});
+  }
+  if (!applyTextEdits(text, edits, facts))
+    SPHC_INTERNAL("overlapping pair-shared values in " + b.source.label);
+}
+
+std::vector<ScenePrinter::BodyParam> ScenePrinter::pairSharedParams(const PlanBody& b, int destArray,
+                                                                    const Dialect& d) const {
+  std::set<std::string> written;
+  for (const PropAccess& w : b.facts.dWrites) written.insert(w.prop);
+  std::vector<BodyParam> ps;
+  for (const BodyParam& p : bodyParams(b, destArray, d))
+    if (p.kind != BodyParam::PairShared && !(p.kind == BodyParam::DProp && written.count(p.name)))
+      ps.push_back(p);
+  return ps;
+}
+
+void ScenePrinter::emitPairSharedFunctions(const PlanBody& b, const std::string& name,
+                                           int destArray, const Dialect& d,
+                                           std::ostringstream& os) const {
+  const std::vector<SourceOnlySite> sites = pairSharedSites(b, d);
+  if (sites.empty()) return;
+  std::string text;
+  BodyFacts facts;
+  hoistedText(b, d, {}, text, facts);  // the hoisted values as the body reads them
+  std::string params;
+  for (const BodyParam& p : pairSharedParams(b, destArray, d)) params += (params.empty() ? "" : ", ") + p.decl;
+  for (size_t k = 0; k < sites.size(); ++k) {
+    auto it = std::find_if(facts.pairShared.begin(), facts.pairShared.end(),
+                           [&](const SourceOnlySite& s) { return s.id == sites[k].id; });
+    if (it == facts.pairShared.end())
+      SPHC_INTERNAL("a pair-shared value cut by a hoisted one in " + b.source.label);
+    const SourceOnlySite& s = *it;
+    const std::string value = fusedRange(text, facts, s.begin, s.end, d.fma);
+    os << "// " << b.source.label << ", from " << loc(b.source.start)
+       << ": a value the pair shares, " << (s.sign < 0 ? "negated" : "the same")
+       << " for the mirrored pair (once per pair\n// where each pair is evaluated once; "
+          "codegen/PairShared.cpp; --no-pair-shared-values: in each call)\n";
+    if (s.result.empty())
+      os << "//   " << oneLine(text.substr(s.begin, s.end - s.begin)) << "\n";
+    else
+      os << "//   " << s.result << " after " << oneLine(text.substr(s.stmtBegin, s.stmtEnd - s.stmtBegin))
+         << "\n";
+    os << d.functionPrefix << d.real << " " << name << "_pairshared" << k << "(" << params << ") {\n";
+    for (const auto& l : s.locals) {
+      std::string init = fusedRange(text, facts, l.initBegin, l.initEnd, d.fma);
+      os << "  const " << l.type << " " << l.name << " = " << init << endStatement(init) << "\n";
+    }
+    if (s.result.empty()) {
+      os << "  return " << value << endStatement(value) << "\n}\n\n";
+    } else {
+      os << "  double " << s.result << " = " << value << endStatement(value) << "\n";
+      os << "  " << fusedRange(text, facts, s.stmtBegin, s.stmtEnd, d.fma) << "\n";
+      os << "  return " << s.result << ";\n}\n\n";
+    }
+  }
+}
+
+void ScenePrinter::emitPairSharedLocals(std::ostream& os, const std::string& indent, int dest,
+                                        const std::vector<const PlanEquation*>& direct,
+                                        const std::vector<const PlanEquation*>& mirrored) const {
+  for (const PlanEquation* eq : direct) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    const std::vector<SourceOnlySite> sites = pairSharedSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k) {
+      // The mirrored calls that take it: the same equation, or (the pairs of two arrays)
+      // another of the same declaration where the value reads none of its parameters.
+      std::vector<const PlanEquation*> users;
+      for (const PlanEquation* m : mirrored)
+        if (m == eq || (m->declIndex == eq->declIndex && sites[k].scalars.empty()))
+          users.push_back(m);
+      if (users.empty()) continue;
+      const std::string local = "pshared_" + eqStruct(*eq) + "_" + K(k);
+      const std::string fn = bodyFunctionName(eq->name, "loop") + "_pairshared" + K(k);
+      std::string call = fn + "(";
+      bool first = true;
+      for (const BodyParam& p : pairSharedParams(b, dest, host_)) {
+        call += (first ? "" : ", ") + callBodyDefault(p, eqStruct(*eq), "t", ".");
+        first = false;
+      }
+      os << indent << "const double " << local << " = " << call << ");  // " << eq->name
+         << ": " << (sites[k].sign < 0 ? "minus this" : "the same") << " for (s_idx, d_idx)\n";
+      pairSharedScope_[eqStruct(*eq) + "/" + K(k)] = local;
+      pairSharedSign_[eqStruct(*eq) + "/" + K(k)] = sites[k].sign;
+      for (const PlanEquation* m : users) {
+        pairSharedScope_[eqStruct(*m) + "/" + K(k)] = local;
+        pairSharedSign_[eqStruct(*m) + "/" + K(k)] = sites[k].sign;
+      }
+    }
+  }
+}
+
+}  // namespace sphc
