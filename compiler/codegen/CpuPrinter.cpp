@@ -6,6 +6,7 @@
 // give the serial result bit for bit.
 #include "codegen/CpuLazyCells.h"
 #include "codegen/CpuVerletTune.h"
+#include "codegen/KeptListsText.h"
 #include "codegen/Printer.h"
 #include "codegen/SymmetricPairs.h"
 
@@ -447,7 +448,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     if (verlet()) {
       // The kept list of d_idx (built first if due, in the thread's scratch list, kept in
       // increasing index at its exact size), filtered with the support's test.
-      scene_ << "          std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+      scene_ << "          sphc::KeptList kept;\n";
       scene_ << "          if (verlet_build) {\n";
       scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
                 "nbrs_list, [&](std::uint32_t j) {\n";
@@ -455,7 +456,10 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       emitNeighbourTest(scene_, host_, "return false;", "              ",
                         tuned() ? "verlet_radius2" : "VERLET_RADIUS2");
       scene_ << "              return true;\n            });\n";
-      scene_ << "            sphc::keep_in_index_order(kept, nbrs_list.data(), n_kept);\n";
+      scene_ << "            kept = " << kept_lists::keep(lists, openmp_, "nbrs_list.data()", "n_kept")
+             << ";\n";
+      scene_ << "          } else {\n";
+      scene_ << "            kept = " << kept_lists::listOf(lists) << ";\n";
       scene_ << "          }\n";
       scene_ << "          const int n_nbrs = static_cast<int>(sphc::filter_neighbours(kept.data(), "
                 "kept.size(), nbrs_list, [&](std::uint32_t j) {\n";
@@ -491,6 +495,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       emitSumsStore(scene_, "          ", sums);
     }
     scene_ << "        }\n";
+    if (verlet()) scene_ << "        if (verlet_build) " << kept_lists::finishBuild(lists) << "\n";
     if (mpi_)
       scene_ << "        sphc::mpi::count_work(decomposition, " << d << ", n_pairs * " << loops
              << ", n_candidates);  // " << loops << " loop(s) over the pairs\n";
@@ -535,7 +540,7 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
       scene_ << "          " << lists << ".skin.mark(" << arrays << phase << ");\n";
     scene_ << "          " << lists << ".begin = " << rangeBegin(w) << ";\n";
     scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
-    scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
+    scene_ << "          " << kept_lists::startBuild(lists, D + ".n", openmp_) << "\n";
     if (d == s && symmetric_ && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
     if (crossSourceLists().count(lists))
       scene_ << "          " << lists << "_by_source.clear();  // found again by the pass over pairs of two arrays once\n";
@@ -1037,6 +1042,7 @@ void CpuPrinter::tunedRebuildCheck(const std::string& lists, const DestinationWo
                                    int s) {
   verlet_tune::KeptLoop loop;
   loop.lists = lists;
+  loop.openmp = openmp_;
   loop.begin = rangeBegin(w);
   loop.end = rangeEnd(w);
   loop.dest = arr(d).name;

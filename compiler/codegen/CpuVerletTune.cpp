@@ -2,6 +2,7 @@
 // cell-order re-sort chosen at run time (runtime sphc/verlet_tune.h); --verlet-skin=F prints
 // the fixed skin's code of CpuPrinter.cpp.
 #include "codegen/CpuVerletTune.h"
+#include "codegen/KeptListsText.h"
 
 namespace sphc::verlet_tune {
 
@@ -56,7 +57,7 @@ void rebuildCheck(std::ostream& scene, const KeptLoop& loop) {
   }
   scene << "          " << lists << ".begin = " << loop.begin << ";\n";
   scene << "          " << lists << ".end = " << loop.end << ";\n";
-  scene << "          " << lists << ".lists.resize(" << loop.dest << ".n);\n";
+  scene << "          " << kept_lists::startBuild(lists, loop.dest + ".n", loop.openmp) << "\n";
   if (loop.clearUpper) scene << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
   if (loop.clearCross) scene << "          " << lists << "_by_source.clear();  // found again by the pass over pairs of two arrays once\n";
   scene << "        }\n";

@@ -21,6 +21,7 @@
 
 #include "analysis/PairQuantityTable.h"
 #include "codegen/CppText.h"
+#include "codegen/KeptListsText.h"
 #include "codegen/Printer.h"
 
 #include <algorithm>
@@ -283,7 +284,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
             "starts in each kept list\n";
   scene_ << "          " << lists << ".upper.resize(n);\n" << (openmp ? "  " + pragma : "");
   scene_ << "          for (int d_idx = 0; d_idx < n; ++d_idx) " << lists
-         << ".upper[d_idx] = sphc::upper_start(" << lists << ".lists[d_idx], d_idx);\n";
+         << ".upper[d_idx] = sphc::upper_start(" << kept_lists::listOf(lists) << ", d_idx);\n";
   scene_ << "        }\n";
   // The destination-only values of every particle, for the mirrored calls.
   emitDestinationHoistedAll(pass, pragma);
@@ -326,7 +327,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
                << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
       }
     }
-    scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+    scene_ << kept_lists::declareKept(in, lists);
     scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
     if (!skip.empty()) scene_ << in << "if (" << skip << ") continue;  // no neighbour in [from, to)\n";
     emitSumsLoad(scene_, in, sums);  // codegen/RegisterSums.cpp
@@ -413,9 +414,9 @@ void ScenePrinter::emitKeptListsBuild(const std::string& lists, bool openmp,
   scene_ << "              const int s_idx = static_cast<int>(j);\n";
   emitNeighbourTest(scene_, host_, "return false;", "              ", listRadius2);
   scene_ << "              return true;\n            });\n";
-  scene_ << "            sphc::keep_in_index_order(" << lists
-         << ".lists[d_idx], nbrs_list.data(), n_kept);\n";
-  scene_ << "          }\n        }\n";
+  scene_ << "            " << kept_lists::keep(lists, openmp, "nbrs_list.data()", "n_kept") << ";\n";
+  scene_ << "          }\n";
+  scene_ << "          " << kept_lists::finishBuild(lists) << "\n        }\n";
 }
 
 void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma) {
@@ -541,7 +542,7 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
          << ", s_idx of " << nameB << ")\n";
   emitDestLocals(scene_, in + "          ", q, host_);
   emitDestinationHoisted(scene_, ab, in + "          ");
-  scene_ << in << "          const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+  scene_ << kept_lists::declareKept(in + "          ", lists);
   scene_ << in << "          const std::uint32_t* const k_end = kept.data() + kept.size();\n";
   const RegisterSums sums = registerSums(A, ab, &ba);  // codegen/RegisterSums.cpp
   emitSumsLoad(scene_, in + "          ", sums);
@@ -552,7 +553,7 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   emitPairQuantitiesOnce(q, true, body);
   for (const PlanEquation* eq : ab.equations) scene_ << body << pairCall(*eq, A.array, sums);
   if (openmp)
-    scene_ << body << "if (by_source_first[s_idx] >= u_begin && by_source_last[s_idx] < u_end) {  "
+    scene_ << body << "if (by_source_block[s_idx] == blk) {  "
               "// all of " << nameB << " s_idx's candidates in this block\n";
   for (const PlanEquation* eq : ba.equations)
     scene_ << body << (openmp ? "  " : "") << callBodyMirrored(*eq, B.array, "mirror_");
@@ -574,16 +575,15 @@ void ScenePrinter::emitCrossBlocksHead(const std::string& lists, const std::stri
          << "'s side, again after a build\n"
             "        // (by whichever loop builds the lists):\n";
   scene_ << "        if (" << lists << "_by_source.empty()) " << lists << "_by_source.build("
-         << lists << ".lists, " << nameB << ".n);\n";
-  scene_ << "        const std::uint32_t* const by_source_first = " << lists << "_by_source.first.data();\n";
-  scene_ << "        const std::uint32_t* const by_source_last = " << lists << "_by_source.last.data();\n";
+         << lists << ".lists, " << nameB << ".n, omp_get_max_threads());\n";
   scene_ << "        const int n_blocks = std::max(1, std::min(n, omp_get_max_threads()));\n";
+  scene_ << "        // Per " << nameB << " particle the block holding all its candidates (-1: several)\n";
+  scene_ << "        const int* const by_source_block = " << lists
+         << "_by_source.owner_blocks(n, n_blocks).data();\n";
   scene_ << "        #pragma omp parallel for schedule(static) default(firstprivate) shared(cells)\n";
   scene_ << "        for (int blk = 0; blk < n_blocks; ++blk) {\n";
   scene_ << "          const int b_begin = static_cast<int>(static_cast<long>(n) * blk / n_blocks);\n";
   scene_ << "          const int b_end = static_cast<int>(static_cast<long>(n) * (blk + 1) / n_blocks);\n";
-  scene_ << "          const std::uint32_t u_begin = static_cast<std::uint32_t>(b_begin), "
-            "u_end = static_cast<std::uint32_t>(b_end);\n";
 }
 
 void ScenePrinter::emitCrossSpanning(const NeighbourPass& ba, int b, const std::set<std::string>& q,

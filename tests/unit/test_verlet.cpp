@@ -427,7 +427,7 @@ TEST(VerletSkin, UpperStartIsTheFirstIndexNotBelowTheParticle) {
   EXPECT_EQ(sphc::upper_start(kept, 4), 1u);  // i itself
   EXPECT_EQ(sphc::upper_start(kept, 6), 3u);
   EXPECT_EQ(sphc::upper_start(kept, 10), 4u);  // none: the end
-  EXPECT_EQ(sphc::upper_start({}, 3), 0u);
+  EXPECT_EQ(sphc::upper_start(std::vector<std::uint32_t>{}, 3), 0u);
 }
 
 // The sort criterion: the share of places where the cell order breaks the present order.

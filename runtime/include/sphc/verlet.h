@@ -236,15 +236,139 @@ class VerletSkin {
   mutable long checks_ = 0;
 };
 
+// The kept list of one particle: a view [begin, end) into KeptLists' index array.
+struct KeptList {
+  const std::uint32_t* b = nullptr;
+  const std::uint32_t* e = nullptr;
+  const std::uint32_t* data() const { return b; }
+  const std::uint32_t* begin() const { return b; }
+  const std::uint32_t* end() const { return e; }
+  std::size_t size() const { return static_cast<std::size_t>(e - b); }
+  bool empty() const { return b == e; }
+  std::uint32_t front() const { return *b; }
+};
+
+// keep_in_index_order: lists up to this length are sorted by insertion.
+constexpr std::size_t kInsertionSortMax = 64;
+
+// a[0, n) (distinct particle indices) in increasing order. In particles sorted into the
+// cells' order the candidates often come sorted already, and otherwise as a few ascending
+// runs (one per cell, or per row of cells). Short lists (2D, ~25 candidates; 3D with few
+// neighbours) by insertion, which costs n compares on a sorted list and one move per
+// inversion; long ones by std::sort. The indices are distinct, so both give the one
+// increasing order: the lists, and every sum over them, are the same bit for bit.
+inline void sort_index_order(std::uint32_t* a, std::size_t n) {
+  if (n <= kInsertionSortMax) {
+    for (std::size_t i = 1; i < n; ++i) {
+      const std::uint32_t v = a[i];
+      std::size_t j = i;
+      for (; j > 0 && a[j - 1] > v; --j) a[j] = a[j - 1];
+      a[j] = v;
+    }
+  } else if (!std::is_sorted(a, a + n)) {
+    std::sort(a, a + n);
+  }
+}
+
+// The kept lists of one loop in one contiguous array (CSR: per particle i its list is
+// index[start[i], start[i + 1])), docs/performance.md "Kept lists in one contiguous array".
+// A build: start_build(n, threads); then, once for each particle i listed (any thread t of
+// `threads`, any order), keep(t, i, candidates) appends i's candidates, sorted, to thread t's
+// part and returns them (valid until t's next keep); finish_build() makes the CSR: the lists
+// in particle order, each that of keep_in_index_order, element for element, whichever thread
+// kept it. A particle not kept in a build has an empty list. Where the parts hold contiguous
+// runs of particles in increasing order (a static schedule), the CSR is the parts end to end:
+// thread 0's part takes the index array's storage, the others are appended (one copy each).
+class KeptLists {
+ public:
+  std::size_t size() const { return start_.empty() ? 0 : start_.size() - 1; }  // particles
+  std::size_t total() const { return start_.empty() ? 0 : start_.back(); }     // entries
+  KeptList operator[](std::size_t i) const {
+    return {index_.data() + start_[i], index_.data() + start_[i + 1]};
+  }
+  const std::vector<std::size_t>& starts() const { return start_; }
+  const std::vector<std::uint32_t>& index() const { return index_; }
+
+  void start_build(std::size_t n, int threads) {
+    if (threads < 1) threads = 1;
+    if (parts_.size() < static_cast<std::size_t>(threads)) parts_.resize(threads);
+    threads_ = threads;
+    parts_[0].part.swap(index_);  // thread 0 fills the index array's storage
+    for (int t = 0; t < threads; ++t) {
+      parts_[t].part.clear();
+      parts_[t].first = parts_[t].last = -1;
+      parts_[t].runs = true;
+    }
+    start_.assign(n + 1, 0);  // the counts first (at i + 1), then their prefix sums
+    where_.resize(n);
+    owner_.resize(n);
+  }
+  KeptList keep(int t, std::uint32_t i, const std::uint32_t* cand, std::size_t n) {
+    Part& p = parts_[t];
+    const std::size_t at = p.part.size();
+    p.part.insert(p.part.end(), cand, cand + n);
+    std::uint32_t* a = p.part.data() + at;
+    sort_index_order(a, n);
+    start_[i + 1] = n;
+    where_[i] = at;
+    owner_[i] = t;
+    const long li = static_cast<long>(i);
+    if (p.first < 0) p.first = li;
+    else if (li <= p.last) p.runs = false;
+    p.last = li;
+    return {a, a + n};
+  }
+  void finish_build() {
+    const std::size_t n = size();
+    for (std::size_t i = 0; i < n; ++i) start_[i + 1] += start_[i];
+    // The parts used, in order of their first particle: one after the other where each is
+    // an increasing run of particles and they do not interleave.
+    std::vector<int> used;
+    for (int t = 0; t < threads_; ++t)
+      if (parts_[t].first >= 0) used.push_back(t);
+    std::sort(used.begin(), used.end(),
+              [&](int a, int b) { return parts_[a].first < parts_[b].first; });
+    bool runs = used.empty() || used[0] == 0;
+    for (std::size_t u = 0; runs && u < used.size(); ++u)
+      runs = parts_[used[u]].runs && (u == 0 || parts_[used[u - 1]].last < parts_[used[u]].first);
+    if (runs) {
+      index_.swap(parts_[0].part);  // thread 0's part, then the others after it
+      for (std::size_t u = 1; u < used.size(); ++u)
+        index_.insert(index_.end(), parts_[used[u]].part.begin(), parts_[used[u]].part.end());
+      return;
+    }
+    // Otherwise each particle's list from its part (e.g. a dynamic schedule).
+    index_.resize(total());
+    const long nl = static_cast<long>(n);
+#pragma omp parallel for schedule(static) if (nl > 16384)
+    for (long i = 0; i < nl; ++i)
+      std::copy_n(parts_[owner_[i]].part.data() + where_[i], start_[i + 1] - start_[i],
+                  index_.data() + start_[i]);
+  }
+
+ private:
+  struct Part {
+    std::vector<std::uint32_t> part;
+    long first = -1, last = -1;  // the first and last particle kept
+    bool runs = true;            // in increasing particle order
+  };
+  std::vector<std::size_t> start_;
+  std::vector<std::uint32_t> index_;
+  std::vector<std::size_t> where_;  // during a build: i's position in its part
+  std::vector<int> owner_;          // and the thread that kept it
+  std::vector<Part> parts_;
+  int threads_ = 1;
+};
+
 // The kept lists of the pair loops of one destination and source array: per destination
-// particle its candidates, and the positions they were built from. Each loop checks them at
-// every evaluation (skin.must_rebuild over its destination and source arrays) and rebuilds
-// them from the cell lists when due; a permutation of the particles into cell order moves
-// them far and so rebuilds them too.
+// particle its candidates (KeptLists, one contiguous array), and the positions they were
+// built from. Each loop checks them at every evaluation (skin.must_rebuild over its
+// destination and source arrays) and rebuilds them from the cell lists when due; a
+// permutation of the particles into cell order moves them far and so rebuilds them too.
 struct VerletLists {
   explicit VerletLists(double skin_fraction) : skin(skin_fraction) {}
   VerletSkin skin;
-  std::vector<std::vector<std::uint32_t>> lists;
+  KeptLists lists;
   // The destination particles [begin, end) the lists were built for (a group with start_idx
   // or stop_idx builds its range only; another range rebuilds them).
   long begin = 0, end = -1;
@@ -258,32 +382,17 @@ struct VerletLists {
 inline std::uint32_t upper_start(const std::vector<std::uint32_t>& kept, std::uint32_t i) {
   return static_cast<std::uint32_t>(std::lower_bound(kept.begin(), kept.end(), i) - kept.begin());
 }
-
-// keep_in_index_order: lists up to this length are sorted by insertion.
-constexpr std::size_t kInsertionSortMax = 64;
+inline std::uint32_t upper_start(const KeptList& kept, std::uint32_t i) {
+  return static_cast<std::uint32_t>(std::lower_bound(kept.begin(), kept.end(), i) - kept.begin());
+}
 
 // kept = the candidates cand[0, n) (one destination particle's, within the lists' radius)
-// in increasing particle index: the order in which the filtered neighbours are summed does
-// not depend on when, or from which cells, the lists were built.
+// in increasing particle index (sort_index_order): the order in which the filtered
+// neighbours are summed does not depend on when, or from which cells, the lists were built.
 inline void keep_in_index_order(std::vector<std::uint32_t>& kept, const std::uint32_t* cand,
                                 std::size_t n) {
   kept.assign(cand, cand + n);
-  // In particles sorted into the cells' order the candidates often come sorted already, and
-  // otherwise as a few ascending runs (one per cell, or per row of cells). Short lists (2D,
-  // ~25 candidates; 3D with few neighbours) by insertion, which costs n compares on a sorted
-  // list and one move per inversion; long ones by std::sort. The indices are distinct, so both
-  // give the one increasing order: the lists, and every sum over them, are the same bit for bit.
-  if (n <= kInsertionSortMax) {
-    std::uint32_t* a = kept.data();
-    for (std::size_t i = 1; i < n; ++i) {
-      const std::uint32_t v = a[i];
-      std::size_t j = i;
-      for (; j > 0 && a[j - 1] > v; --j) a[j] = a[j - 1];
-      a[j] = v;
-    }
-  } else if (!std::is_sorted(kept.begin(), kept.end())) {
-    std::sort(kept.begin(), kept.end());
-  }
+  sort_index_order(kept.data(), n);
 }
 
 // out[0, count) = the candidates j of cand[0, n) with keep(j), in their order; returns count.
