@@ -8,6 +8,8 @@
 #include <random>
 #include <vector>
 
+#include "kept_lists_checks.h"
+
 namespace {
 
 // block_of against the blocks the generated loop makes: [n t / nb, n (t + 1) / nb).
@@ -64,6 +66,50 @@ TEST(CrossPairs, ListsFromTheSourcesSide) {
   lists[299] = {5};
   cs.build(lists, nb);
   EXPECT_EQ(cs.spanning_blocks(na, 2), std::vector<std::uint32_t>{5});
+}
+
+// The same arrays from the contiguous kept lists (KeptLists) as from a list per particle, in
+// one block and in 2, 3 and 7 blocks of A (the counts and fills per block; above 16,384
+// candidates, where the build goes in blocks); owner_blocks: per b the block holding all its
+// candidates, -1 where they span blocks or there are none.
+TEST(CrossPairs, FromContiguousListsAsFromAListPerParticle) {
+  for (std::size_t na : {300u, 3000u}) {
+    const std::uint32_t nb = 400;
+    std::mt19937 rng(11);
+    std::vector<std::vector<std::uint32_t>> lists(na);
+    for (std::size_t a = 0; a < na; ++a)
+      for (std::uint32_t b = 0; b < nb; ++b)  // b near a's position along the wall; 399 none
+        if (b != 399 && std::abs(static_cast<long>(b) - static_cast<long>(a * nb / na)) <= 6 && rng() % 4)
+          lists[a].push_back(b);
+    sphc::KeptLists kl;
+    kl.start_build(na, 1);
+    for (std::size_t a = 0; a < na; ++a)
+      kl.keep(0, static_cast<std::uint32_t>(a), lists[a].data(), lists[a].size());
+    kl.finish_build();
+    sphc_test::expect_same_lists(kl, lists);
+    if (na == 3000u) ASSERT_GT(kl.total(), 16384u);  // built in blocks
+    sphc::CrossSources want;
+    want.build(lists, nb);
+    for (int threads : {1, 2, 3, 7}) {
+      sphc::CrossSources got;
+      got.build(kl, nb, threads);
+      EXPECT_EQ(got.starts, want.starts) << threads;
+      EXPECT_EQ(got.dests, want.dests) << threads;
+      EXPECT_EQ(got.first, want.first) << threads;
+      EXPECT_EQ(got.last, want.last) << threads;
+      for (long blocks : {1L, 2L, 5L}) {
+        const std::vector<int> owner = got.owner_blocks(static_cast<long>(na), blocks);
+        EXPECT_EQ(got.spanning, want.spanning_blocks(static_cast<long>(na), blocks));
+        for (std::uint32_t b = 0; b < nb; ++b) {
+          const long s = want.starts[b], e = want.starts[b + 1];
+          int blk = s == e ? -1 : sphc::block_of(want.dests[s], static_cast<long>(na), blocks);
+          for (long k = s; k < e; ++k)
+            if (sphc::block_of(want.dests[k], static_cast<long>(na), blocks) != blk) blk = -1;
+          ASSERT_EQ(owner[b], blk) << "b " << b << " blocks " << blocks;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -8,12 +8,14 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "sphc/particle_array.h"
 #include "sphc/verlet.h"
 #include "sphc/verlet_tune.h"
 
+#include "kept_lists_checks.h"
 #include "random_particles.h"
 
 namespace {
@@ -421,6 +423,66 @@ TEST(SkinTuner, ListsStayCompleteWhileTheSkinChanges) {
 }
 
 // The symmetric loops' start in a kept list: the first j >= i (the self pair included).
+// KeptLists (one contiguous array per loop) holds the lists of the builder it replaced
+// (keep_in_index_order per particle), element for element, whichever thread keeps which
+// particle and in which order: one thread in particle order (the index array's storage
+// reused), threads in contiguous blocks as a static schedule gives them (the parts end to
+// end), blocks in another thread order and particles handed out round robin or backwards
+// (each list copied from its part); a range of particles only (the others empty); and again
+// after a build of other sizes (nothing left of the last build).
+TEST(VerletSkin, ContiguousKeptListsAreThoseOfTheListPerParticle) {
+  const std::size_t n = 500;
+  for (unsigned seed : {1u, 2u}) {
+    const auto cand = sphc_test::random_candidates(n, 900, seed);
+    sphc::KeptLists kl;
+    struct Order {
+      int threads;
+      std::size_t begin, end;
+      int kind;  // 0: blocks in thread order, 1: blocks in reverse thread order,
+                 // 2: round robin, 3: backwards on one thread
+    };
+    for (const Order& o : {Order{1, 0, n, 0}, Order{3, 0, n, 0}, Order{4, 0, n, 1},
+                           Order{3, 0, n, 2}, Order{1, 0, n, 3}, Order{2, 17, 433, 0},
+                           Order{5, 17, 433, 2}, Order{1, 0, 0, 0}, Order{8, 0, 5, 0}}) {
+      kl.start_build(n, o.threads);
+      const std::size_t m = o.end - o.begin;
+      auto keep = [&](int t, std::size_t i) {
+        const sphc::KeptList got = kl.keep(t, static_cast<std::uint32_t>(i), cand[i].data(), cand[i].size());
+        std::vector<std::uint32_t> want;
+        sphc::keep_in_index_order(want, cand[i].data(), cand[i].size());
+        ASSERT_EQ(std::vector<std::uint32_t>(got.begin(), got.end()), want);  // as kept
+      };
+      if (o.kind == 0 || o.kind == 1) {
+        for (int b = 0; b < o.threads; ++b) {
+          const int t = o.kind == 0 ? b : o.threads - 1 - b;
+          for (std::size_t i = o.begin + m * b / o.threads; i < o.begin + m * (b + 1) / o.threads; ++i)
+            keep(t, i);
+        }
+      } else if (o.kind == 2) {
+        for (std::size_t i = o.begin; i < o.end; ++i) keep(static_cast<int>(i % o.threads), i);
+      } else {
+        for (std::size_t i = o.end; i-- > o.begin;) keep(0, i);
+      }
+      kl.finish_build();
+      SCOPED_TRACE("threads " + std::to_string(o.threads) + " kind " + std::to_string(o.kind) +
+                   " range " + std::to_string(o.begin) + ".." + std::to_string(o.end));
+      sphc_test::expect_same_lists(kl, sphc_test::old_lists(cand, o.begin, o.end));
+      EXPECT_EQ(sphc::upper_start(kl[300], 300), o.begin <= 300 && 300 < o.end
+                                                     ? sphc::upper_start(sphc_test::old_lists(cand, 300, 301)[300], 300)
+                                                     : 0u);
+    }
+  }
+  sphc::KeptLists small;  // a build of fewer particles after a larger one
+  const auto cand = sphc_test::random_candidates(40, 60, 3);
+  small.start_build(40, 2);
+  for (std::size_t i = 0; i < 40; ++i) small.keep(i < 20 ? 0 : 1, static_cast<std::uint32_t>(i), cand[i].data(), cand[i].size());
+  small.finish_build();
+  small.start_build(10, 1);
+  for (std::size_t i = 0; i < 10; ++i) small.keep(0, static_cast<std::uint32_t>(i), cand[i].data(), cand[i].size());
+  small.finish_build();
+  sphc_test::expect_same_lists(small, sphc_test::old_lists({cand.begin(), cand.begin() + 10}, 0, 10));
+}
+
 TEST(VerletSkin, UpperStartIsTheFirstIndexNotBelowTheParticle) {
   const std::vector<std::uint32_t> kept = {1, 4, 5, 9};
   EXPECT_EQ(sphc::upper_start(kept, 0), 0u);

@@ -8,10 +8,13 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
+#include "../kept_lists_checks.h"
 #include "../random_particles.h"
+#include "sphc/cross_pairs.h"
 #include "sphc/particle_array.h"
 #include "sphc/verlet.h"
 
@@ -110,6 +113,48 @@ TEST_F(OmpVerlet, DisplacementCheckEqualsThePlainLoop) {
         EXPECT_EQ(skin.last_moved(), -1.0);
         a.f64("x")[n - 1] = ma.x[n - 1];
       }
+    }
+  }
+}
+
+// KeptLists built by threads, as the generated loops build them (each particle's list kept
+// by the thread that has it, in a static schedule or, for the general case, a dynamic one),
+// holds the lists of the builder it replaced element for element, with 1 to 4 threads; and
+// CrossSources built from it in blocks on threads gives the arrays of the serial build.
+TEST_F(OmpVerlet, ContiguousKeptListsOnThreadsAreThoseOfTheListPerParticle) {
+  const std::size_t n = 20000;
+  const auto cand = sphc_test::random_candidates(n, 3000, 9);
+  const auto want = sphc_test::old_lists(cand, 0, n);
+  std::vector<std::vector<std::uint32_t>> by_list(n);  // the candidates as a list per particle
+  for (std::size_t i = 0; i < n; ++i) by_list[i] = want[i];
+  sphc::CrossSources serial;
+  serial.build(by_list, 3000);
+  for (int threads = 1; threads <= 4; ++threads) {
+    omp_set_num_threads(threads);
+    for (bool dynamic : {false, true}) {
+      sphc::KeptLists kl;
+      for (int build = 0; build < 2; ++build) {  // twice: the storage reused
+        kl.start_build(n, omp_get_max_threads());
+        const long nl = static_cast<long>(n);
+        if (!dynamic) {
+#pragma omp parallel for schedule(static)
+          for (long i = 0; i < nl; ++i)
+            kl.keep(omp_get_thread_num(), static_cast<std::uint32_t>(i), cand[i].data(), cand[i].size());
+        } else {
+#pragma omp parallel for schedule(dynamic, 7)
+          for (long i = 0; i < nl; ++i)
+            kl.keep(omp_get_thread_num(), static_cast<std::uint32_t>(i), cand[i].data(), cand[i].size());
+        }
+        kl.finish_build();
+        SCOPED_TRACE(std::to_string(threads) + (dynamic ? " threads, dynamic" : " threads, static"));
+        sphc_test::expect_same_lists(kl, want);
+      }
+      sphc::CrossSources cs;
+      cs.build(kl, 3000, omp_get_max_threads());
+      EXPECT_EQ(cs.starts, serial.starts);
+      EXPECT_EQ(cs.dests, serial.dests);
+      EXPECT_EQ(cs.first, serial.first);
+      EXPECT_EQ(cs.last, serial.last);
     }
   }
 }
