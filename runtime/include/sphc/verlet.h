@@ -289,7 +289,9 @@ class KeptLists {
   const std::vector<std::size_t>& starts() const { return start_; }
   const std::vector<std::uint32_t>& index() const { return index_; }
 
-  void start_build(std::size_t n, int threads) {
+  // Out of line (noinline): once per particle and build, they stay out of the pair loops
+  // that build the lists as they use them.
+  [[gnu::noinline]] void start_build(std::size_t n, int threads) {
     if (threads < 1) threads = 1;
     if (parts_.size() < static_cast<std::size_t>(threads)) parts_.resize(threads);
     threads_ = threads;
@@ -303,7 +305,7 @@ class KeptLists {
     where_.resize(n);
     owner_.resize(n);
   }
-  KeptList keep(int t, std::uint32_t i, const std::uint32_t* cand, std::size_t n) {
+  [[gnu::noinline]] KeptList keep(int t, std::uint32_t i, const std::uint32_t* cand, std::size_t n) {
     Part& p = parts_[t];
     const std::size_t at = p.part.size();
     p.part.insert(p.part.end(), cand, cand + n);
@@ -318,7 +320,7 @@ class KeptLists {
     p.last = li;
     return {a, a + n};
   }
-  void finish_build() {
+  [[gnu::noinline]] void finish_build() {
     const std::size_t n = size();
     for (std::size_t i = 0; i < n; ++i) start_[i + 1] += start_[i];
     // The parts used, in order of their first particle: one after the other where each is
