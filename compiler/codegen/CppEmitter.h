@@ -64,6 +64,10 @@ struct EmitOptions {
   // sources' cell lists are built only at the updates where a pair loop rebuilds its lists
   // (codegen/CpuLazyCells.inc); false (--no-lazy-cells): at every update. Bitwise the same.
   bool lazyCells = true;
+  // The particle re-sort's order (CPU backends): the cells' Z (Morton) order, ascending
+  // index within a cell (sphc::CellList::locality_order: a compact block of cells per range of
+  // particles); false (--particle-order=cells): the cells' linear order, x fastest.
+  bool zOrder = true;
   // The phases (the pair loops), and compute_accelerations, step and adaptive_dt (the
   // per-step code inlined into them), are defined out of struct Scene, after it, between the
   // marker lines below, and the scene's namespace is named (sphc_scene) so that the build

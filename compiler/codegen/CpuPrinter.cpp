@@ -28,7 +28,8 @@ class CpuPrinter : public ScenePrinter {
                         : 0.0),
         tuned_(verletSkin_ > 0 && opts.verletAuto && !hasDomain()),
         symmetric_(opts.symmetricPairs),
-        lazyCells_(opts.lazyCells) {}
+        lazyCells_(opts.lazyCells),
+        zOrder_(opts.zOrder) {}
 
  private:
   std::string backendComment() const override {
@@ -238,10 +239,15 @@ class CpuPrinter : public ScenePrinter {
     return false;
   }
   void emitStaticCells();
-  // Reorders source S into the cell order of cells_S.
+  // The particle order of source S that its re-sort uses, from cells_S: the cells' Z order
+  // (sphc::locality_order) or, with --particle-order=cells, their row order.
+  std::string sortOrder(const std::string& S) const {
+    return zOrder_ ? "sphc::locality_order(cells_" + S + ")" : "cells_" + S + ".cell_order()";
+  }
+  // Reorders source S into that order.
   std::string permuteInCellOrder(const std::string& S) const {
-    return cpuSingle_ ? "f32_" + S + ".permute(cells_" + S + ".cell_order(), " + S + ");"
-                      : S + ".permute(cells_" + S + ".cell_order());";
+    return cpuSingle_ ? "f32_" + S + ".permute(" + sortOrder(S) + ", " + S + ");"
+                      : S + ".permute(" + sortOrder(S) + ");";
   }
   // The statement that builds the cell list of source S over its first `count` particles
   // on the grid of search domain `dom`.
@@ -254,6 +260,7 @@ class CpuPrinter : public ScenePrinter {
   bool tuned_ = false;       // --verlet-skin=auto: skin and re-sort chosen at run time
   bool symmetric_ = true;    // each pair once where it may (--no-symmetric-pairs: false)
   bool lazyCells_ = true;    // cells only where kept lists are rebuilt (--no-lazy-cells: false)
+  bool zOrder_ = true;       // re-sort in the cells' Z order (--particle-order=cells: false)
 };
 
 // --verlet-skin: the skin and, per pair loop (phase, destination, source), each destination
@@ -1073,6 +1080,7 @@ void CpuPrinter::tunedUpdateNeighbours() {
     src.orderCells = cellListBuild(S, S + ".n", "order_domain");
     src.cells = cellListBuild(S, S + ".n");
     src.permute = permuteInCellOrder(S);
+    src.order = sortOrder(S);
     src.lists = listsOf(S);
     u.sources.push_back(src);
   }

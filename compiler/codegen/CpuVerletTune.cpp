@@ -96,8 +96,8 @@ void updateNeighbours(std::ostream& scene, const Update& u,
     if (S.isStatic) continue;  // build_static_cells
     if (S.reorders) {
       scene << "    if (sort_check) {\n      " << S.orderCells << "\n";
-      scene << "      if (builds == 1 ? (verlet_tune.sorted(), true) : verlet_tune.sort_due(cells_"
-            << S.name << ".cell_order())) {\n";
+      scene << "      if (builds == 1 ? (verlet_tune.sorted(), true) : verlet_tune.sort_due("
+            << S.order << ")) {\n";
       scene << "        " << S.permute << "\n";
       for (const auto& lists : S.lists) scene << "        " << lists << ".skin.forget();\n";
       scene << "      }\n    }\n";

@@ -35,7 +35,8 @@ struct Source {
   bool isStatic = false;           // cells of build_static_cells
   bool reorders = false;           // sorted into cell order (not a ranged group's source)
   std::string orderCells, cells;   // its cell-list build on order_domain / on domain
-  std::string permute;             // its permutation into cell order
+  std::string permute;             // its permutation into the sort order
+  std::string order;               // that order (an expression)
   std::vector<std::string> lists;  // the kept lists it is in (forgotten after a sort)
 };
 struct Update {

@@ -150,6 +150,16 @@ static cl::opt<bool> NoLazyCells(
              "neighbour update (default: only at the updates where a pair loop rebuilds its "
              "kept lists, the only ones that read them; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+enum class ParticleOrder { Z, Cells };
+static cl::opt<ParticleOrder> ParticleOrderOpt(
+    "particle-order",
+    cl::desc("The order the CPU solvers re-sort the particles in (every few neighbour "
+             "updates) so that neighbours are close in memory: z (default): the cells of the "
+             "support's grid in Z (Morton) order, which keeps the pair loops' working set a "
+             "compact block of cells; cells: the cells' row order, x fastest"),
+    cl::values(clEnumValN(ParticleOrder::Z, "z", "cells in Z (Morton) order"),
+               clEnumValN(ParticleOrder::Cells, "cells", "cells in row order, x fastest")),
+    cl::init(ParticleOrder::Z), cl::cat(SphcCat));
 static cl::opt<bool> SingleUnit(
     "single-unit",
     cl::desc("Generate the solver as one translation unit (default, serial and openmp without "
@@ -459,6 +469,7 @@ int main(int argc, char** argv) {
   emitOpts.symmetricPairs = !NoSymmetricPairs;
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
+  emitOpts.zOrder = ParticleOrderOpt == ParticleOrder::Z;
   emitOpts.registerSums = !NoRegisterSums;
   emitOpts.simdPairs = SimdPairs;
   if (Report && Emit != EmitKind::OpenCL)

@@ -391,4 +391,44 @@ void CellList::neighbors(double xi, double yi, double zi, double hi, const doubl
   });
 }
 
+// The bits of v (21 used) spread to every third bit: bit k of v at bit 3k.
+static inline std::uint64_t spread3(std::uint64_t v) {
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffull;
+  v = (v | v << 16) & 0x1f0000ff0000ffull;
+  v = (v | v << 8) & 0x100f00f00f00f00full;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+  v = (v | v << 2) & 0x1249249249249249ull;
+  return v;
+}
+
+void CellList::locality_order(std::vector<std::uint32_t>& out) const {
+  out.resize(n_);
+  zcells_.clear();
+  const auto z_key = [](std::uint64_t cx, std::uint64_t cy, std::uint64_t cz) {
+    return spread3(cx) | spread3(cy) << 1 | spread3(cz) << 2;
+  };
+  if (dense_) {
+    const std::size_t nx = static_cast<std::size_t>(ncell_[0]);
+    const std::size_t nxy = nx * static_cast<std::size_t>(ncell_[1]);
+    for (std::size_t c = 0; c + 1 < start_.size(); ++c) {
+      if (start_[c + 1] == start_[c]) continue;  // empty
+      zcells_.emplace_back(z_key(c % nx, (c % nxy) / nx, c / nxy), static_cast<std::uint32_t>(c));
+    }
+  } else {
+    const std::uint64_t mask = (std::uint64_t{1} << kCellBits) - 1;
+    for (std::size_t s = 0; s < keys_.size(); ++s) {
+      const std::uint64_t k = keys_[s];
+      if (k == kEmptyKey) continue;
+      zcells_.emplace_back(z_key(k & mask, (k >> kCellBits) & mask, k >> (2 * kCellBits)),
+                           slot_cell_[s]);
+    }
+  }
+  // The keys are distinct (one per cell): the order is a function of the cells alone.
+  std::sort(zcells_.begin(), zcells_.end());
+  std::size_t k = 0;
+  for (const auto& zc : zcells_)
+    for (std::uint32_t i = start_[zc.second]; i < start_[zc.second + 1]; ++i) out[k++] = order_[i];
+}
+
 }  // namespace sphc

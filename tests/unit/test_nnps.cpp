@@ -296,6 +296,91 @@ TEST(Nnps, DeterministicOrderAndRebuild) {
   check_against_brute_force(b, pa);
 }
 
+// The Z (Morton) key of cell (cx, cy, cz), bit by bit: bit k of cx, cy, cz at bits 3k, 3k + 1,
+// 3k + 2 (the reference for CellList::locality_order, which spreads the bits by masks).
+std::uint64_t z_key_bitwise(std::uint64_t cx, std::uint64_t cy, std::uint64_t cz) {
+  std::uint64_t key = 0;
+  for (int k = 0; k < 21; ++k)
+    key |= ((cx >> k) & 1u) << (3 * k) | ((cy >> k) & 1u) << (3 * k + 1) |
+           ((cz >> k) & 1u) << (3 * k + 2);
+  return key;
+}
+
+TEST(Nnps, LocalityOrderOnALattice) {
+  // One particle at the centre of each cell of a 4 x 4 grid (cells of 1, the particles
+  // numbered row by row, x fastest): Z order visits 2 x 2 blocks, x as the lowest bit.
+  ParticleArray pa;
+  pa.name = "fluid";
+  pa.add_property("x");
+  pa.add_property("y");
+  pa.add_property("z");
+  pa.add_property("h");
+  pa.resize(16);
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      pa.f64("x")[4 * j + i] = i + 0.5;
+      pa.f64("y")[4 * j + i] = j + 0.5;
+      pa.f64("h")[4 * j + i] = 0.5;  // cell = radius_scale * h = 1
+    }
+  SearchDomain dom;
+  dom.dim = 2;
+  dom.hi[0] = dom.hi[1] = 4.0;
+  dom.cell_size = 1.0;
+  for (CellList::Mode mode : {CellList::Mode::Dense, CellList::Mode::Hash}) {
+    CellList cl;
+    cl.set_mode(mode);
+    build(cl, dom, pa);
+    std::vector<std::uint32_t> order;
+    cl.locality_order(order);
+    const std::vector<std::uint32_t> want = {0, 1, 4, 5, 2, 3, 6, 7, 8, 9, 12, 13, 10, 11, 14, 15};
+    EXPECT_EQ(order, want) << (mode == CellList::Mode::Dense ? "dense" : "hashed");
+  }
+}
+
+TEST(Nnps, LocalityOrderIsZOrderOfTheCells) {
+  // Random particles in 1, 2 and 3 dimensions, dense and hashed storage: a permutation of
+  // 0..n-1 whose cells' Z keys (computed here from the coordinates) never decrease, and
+  // ascending index within a cell; both storages give the same order.
+  for (int dim : {1, 2, 3}) {
+    SCOPED_TRACE("dim " + std::to_string(dim));
+    ParticleArray pa = random_array(3000, dim, 3.0, 0.1, 21);
+    const SearchDomain dom = domain_of(pa, dim);
+    std::vector<std::uint32_t> orders[2];
+    int m = 0;
+    for (CellList::Mode mode : {CellList::Mode::Dense, CellList::Mode::Hash}) {
+      CellList cl;
+      cl.set_mode(mode);
+      build(cl, dom, pa);
+      ASSERT_EQ(cl.is_dense(), mode == CellList::Mode::Dense);
+      cl.locality_order(orders[m]);
+      EXPECT_EQ(sphc::locality_order(cl), orders[m]);
+      ++m;
+    }
+    EXPECT_EQ(orders[0], orders[1]) << "dense and hashed storage differ";
+    const std::vector<std::uint32_t>& order = orders[0];
+    ASSERT_EQ(order.size(), pa.n);
+    EXPECT_TRUE(sphc::is_permutation_of(order, pa.n));
+    const double* xyz[3] = {pa.f64("x"), pa.f64("y"), pa.f64("z")};
+    const auto key = [&](std::uint32_t i) {
+      std::uint64_t c[3] = {0, 0, 0};
+      for (int a = 0; a < dim; ++a)
+        c[a] = static_cast<std::uint64_t>(std::floor((xyz[a][i] - dom.lo[a]) / dom.cell_size));
+      return z_key_bitwise(c[0], c[1], c[2]);
+    };
+    std::size_t cells = 1;
+    for (std::size_t k = 1; k < order.size(); ++k) {
+      const std::uint64_t k0 = key(order[k - 1]), k1 = key(order[k]);
+      ASSERT_LE(k0, k1) << "at " << k;
+      if (k0 == k1) {
+        ASSERT_LT(order[k - 1], order[k]) << "within a cell, at " << k;
+      } else {
+        ++cells;
+      }
+    }
+    EXPECT_GT(cells, 8u);  // the particles span many cells: the order was tested
+  }
+}
+
 TEST(Nnps, SearchDomainAndErrors) {
   ParticleArray pa = random_array(100, 2, 1.0, 0.1, 13);
   const SearchDomain dom = domain_of(pa, 2);

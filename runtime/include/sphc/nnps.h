@@ -27,6 +27,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "sphc/particle_array.h"
@@ -120,6 +121,14 @@ class CellList {
   // that makes neighbours close in memory (see ParticleArray::permute).
   const std::vector<std::uint32_t>& cell_order() const { return order_; }
 
+  // Particle indices with the cells visited in Z order (Morton order of the cells' grid
+  // coordinates: the bits of x, y, z interleaved), ascending within a cell. A sweep over the
+  // particles in this order reads its neighbours from a compact block of nearby cells, where
+  // cell_order() (x fastest, then y, then z) reads three whole layers of cells: what the
+  // particle re-sort uses (ParticleArray::permute), so that the pair loops' working set stays
+  // in cache at 1M particles. Written to out (resized; its buffer reused); deterministic.
+  void locality_order(std::vector<std::uint32_t>& out) const;
+
   // Cell c holds cell_order()[cell_start()[c] .. cell_start()[c + 1]) (num_cells() + 1
   // entries).
   const std::vector<std::uint32_t>& cell_start() const { return start_; }
@@ -192,6 +201,8 @@ class CellList {
   std::vector<std::uint32_t> start_ = {0, 0};
   std::vector<std::uint32_t> order_;
   std::vector<std::uint32_t> cell_of_;  // build scratch: cell of each particle
+  // locality_order's scratch: (Z key, cell) of the occupied cells.
+  mutable std::vector<std::pair<std::uint64_t, std::uint32_t>> zcells_;
   // Parallel sort scratch, per chunk: the counts, then write positions, of the cells
   // chunk_lo_[k] .. chunk_lo_[k] + chunk_hist_[k].size() - 1 (the chunk's window); the
   // particles of each of the chunks' cell ranges.
@@ -239,6 +250,13 @@ inline void CellList::for_each_candidate_range(double xi, double yi, double zi, 
       }
     }
   }
+}
+
+// The particle order of CellList::locality_order, returned (for the generated re-sorts).
+inline std::vector<std::uint32_t> locality_order(const CellList& cells) {
+  std::vector<std::uint32_t> out;
+  cells.locality_order(out);
+  return out;
 }
 
 template <class F>
