@@ -66,6 +66,7 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
     TraverseStmt(fn->getBody());  // locals and what is assigned
     auto* top = llvm::dyn_cast<clang::CompoundStmt>(fn->getBody());
     if (!top) return {};
+    zeroSignMatters_ = zeroSignMatters(fn->getBody());
     for (clang::Stmt* s : top->body()) {
       if (auto* i = llvm::dyn_cast<clang::IfStmt>(s); i && ifSite(i, top)) continue;
       walk(s, false);
@@ -276,7 +277,10 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
     if (l.sign == rs) {
       c.s = "(" + std::min(l.s, r.s) + plus + std::max(l.s, r.s) + ")";
       c.sign = l.sign;
-    } else if (l.s < r.s) {  // l.sign * (l - r)
+      return c;
+    }
+    c.taint = true;  // a difference: x - x is +0 both ways, not a zero of the other sign
+    if (l.s < r.s) {  // l.sign * (l - r)
       c.s = "(" + l.s + minus + r.s + ")";
       c.sign = l.sign;
     } else {  // rs * (r - l)
@@ -314,7 +318,40 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
   int shared(const clang::Expr* e) {
     Canon a = canon(e, false), b = canon(e, true);
     if (!a.ok || !b.ok || a.s != b.s || !a.pair) return 0;
+    if (a.taint && zeroSignMatters_) return 0;  // see zeroSignMatters
     return a.sign * b.sign;
+  }
+
+  // A value built from the differences (XIJ, VIJ, DWIJ, d_X - s_X) may be a zero whose sign
+  // the mirrored call would see flipped. Such a value is shared only where no zero's sign can
+  // reach a result: the body divides by nothing, passes nothing to a function (but fabs and
+  // fma) and stores nothing with `=` that is not known untouched by the differences. (Sums
+  // are safe: +0 + -0 = +0.)
+  bool zeroSignMatters(const clang::Stmt* s) {
+    if (!s) return false;
+    const auto unsafe = [&](const clang::Expr* e) {
+      Canon c = canon(e, false);
+      return !c.ok || c.taint;
+    };
+    if (auto* b = llvm::dyn_cast<clang::BinaryOperator>(s)) {
+      if ((b->getOpcode() == clang::BO_Div || b->getOpcode() == clang::BO_DivAssign) &&
+          unsafe(b->getRHS()))
+        return true;
+      if (b->getOpcode() == clang::BO_Assign &&
+          llvm::isa<clang::ArraySubscriptExpr>(b->getLHS()->IgnoreParenImpCasts()) &&
+          unsafe(b->getRHS()))
+        return true;
+    }
+    if (auto* call = llvm::dyn_cast<clang::CallExpr>(s)) {
+      const clang::FunctionDecl* fn = call->getDirectCallee();
+      const std::string name = fn ? fn->getName().str() : "";
+      if (name != "fabs" && name != "fma")
+        for (const clang::Expr* arg : call->arguments())
+          if (unsafe(arg)) return true;
+    }
+    for (const clang::Stmt* c : s->children())
+      if (zeroSignMatters(c)) return true;
+    return false;
   }
 
   // Operations in the expression's own text (not through its locals).
@@ -454,6 +491,7 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
     if (!i0.ok || !i1.ok || i0.s != i1.s || i0.sign != i1.sign) return false;
     Canon v0 = canon(value, false), v1 = canon(value, true);
     if (!v0.ok || !v1.ok || v0.s != v1.s || v0.sign != v1.sign || !v0.pair) return false;
+    if ((v0.taint || i0.taint) && zeroSignMatters_) return false;
     SourceOnlySite site;
     site.sign = 1;
     site.result = result->getName().str();
@@ -480,6 +518,7 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
   std::map<const clang::VarDecl*, std::vector<clang::BinaryOperator*>> assignments_;
   std::map<std::pair<const clang::Expr*, bool>, Canon> memo_;
   std::vector<SourceOnlySite> sites_;
+  bool zeroSignMatters_ = true;
 };
 
 }  // namespace
