@@ -325,8 +325,8 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
   // A value built from the differences (XIJ, VIJ, DWIJ, d_X - s_X) may be a zero whose sign
   // the mirrored call would see flipped. Such a value is shared only where no zero's sign can
   // reach a result: the body divides by nothing, passes nothing to a function (but fabs and
-  // fma) and stores nothing with `=` that is not known untouched by the differences. (Sums
-  // are safe: +0 + -0 = +0.)
+  // fma) and stores (`=`, `*=`) nothing that is not known untouched by the differences.
+  // (Sums are safe: +0 + -0 = +0.)
   bool zeroSignMatters(const clang::Stmt* s) {
     if (!s) return false;
     const auto unsafe = [&](const clang::Expr* e) {
@@ -337,7 +337,7 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
       if ((b->getOpcode() == clang::BO_Div || b->getOpcode() == clang::BO_DivAssign) &&
           unsafe(b->getRHS()))
         return true;
-      if (b->getOpcode() == clang::BO_Assign &&
+      if ((b->getOpcode() == clang::BO_Assign || b->getOpcode() == clang::BO_MulAssign) &&
           llvm::isa<clang::ArraySubscriptExpr>(b->getLHS()->IgnoreParenImpCasts()) &&
           unsafe(b->getRHS()))
         return true;
