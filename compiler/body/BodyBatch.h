@@ -6,6 +6,7 @@
 #include "analysis/PairQuantityTable.h"
 
 #include "clang/AST/Decl.h"
+#include "clang/AST/Expr.h"
 #include "clang/Basic/SourceManager.h"
 #include "llvm/ADT/StringRef.h"
 #include "llvm/Support/SourceMgr.h"
@@ -228,6 +229,28 @@ inline void noteParameterUse(const BodySource& body, const std::string& name, So
     case NameRole::Scalar: site.scalars.insert(name); break;
     default: break;
   }
+}
+// A site's locals (SourceOnlySite::locals: name, type, the range of the initial value) from
+// `locals`, in order of declaration (`order`: a local's position in the body); false where
+// two have one name (shadowing) or an initial value has no range in the body (SourceOnly.cpp,
+// PairShared.cpp).
+template <class Order>
+bool appendSiteLocals(const std::set<const clang::VarDecl*>& locals, const Order& order,
+                      const SourceRangeOf& rangeOf, SourceOnlySite& site) {
+  std::vector<const clang::VarDecl*> ordered(locals.begin(), locals.end());
+  std::sort(ordered.begin(), ordered.end(), [&](const clang::VarDecl* a, const clang::VarDecl* b) {
+    return order.at(a) < order.at(b);
+  });
+  std::set<std::string> names;
+  for (const clang::VarDecl* v : ordered) {
+    SourceOnlySite::Local l;
+    l.name = v->getName().str();
+    l.type = v->getType().getUnqualifiedType().getAsString();
+    if (!names.insert(l.name).second) return false;  // shadowed: two locals of one name
+    if (!rangeOf(v->getInit(), l.initBegin, l.initEnd)) return false;
+    site.locals.push_back(l);
+  }
+  return true;
 }
 // The values of a loop body the mirrored pair shares (BodyFacts::pairShared; PairShared.cpp).
 std::vector<SourceOnlySite> findPairSharedSites(const BodySource& body, clang::FunctionDecl* fn,

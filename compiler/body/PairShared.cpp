@@ -415,21 +415,9 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
       todo.pop_back();
       collect(x, locals, site, todo, inside);
     }
-    std::vector<const clang::VarDecl*> ordered(locals.begin(), locals.end());
-    std::sort(ordered.begin(), ordered.end(), [&](const clang::VarDecl* a, const clang::VarDecl* b) {
-      return order_.at(a) < order_.at(b);
-    });
-    std::set<std::string> names;
-    for (const clang::VarDecl* v : ordered) {
+    for (const clang::VarDecl* v : locals)
       if (!fixedLocal(v)) return false;
-      SourceOnlySite::Local l;
-      l.name = v->getName().str();
-      l.type = v->getType().getUnqualifiedType().getAsString();
-      if (!names.insert(l.name).second) return false;  // shadowed: two locals of one name
-      if (!rangeOf_(v->getInit(), l.initBegin, l.initEnd)) return false;
-      site.locals.push_back(l);
-    }
-    return true;
+    return appendSiteLocals(locals, order_, rangeOf_, site);
   }
 
   void collect(const clang::Stmt* s, std::set<const clang::VarDecl*>& locals, SourceOnlySite& site,

@@ -177,19 +177,7 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
       todo.pop_back();
       collect(x, locals, site, todo);
     }
-    std::vector<const clang::VarDecl*> ordered(locals.begin(), locals.end());
-    std::sort(ordered.begin(), ordered.end(), [&](const clang::VarDecl* a, const clang::VarDecl* b) {
-      return order_.at(a) < order_.at(b);
-    });
-    std::set<std::string> names;
-    for (const clang::VarDecl* v : ordered) {
-      SourceOnlySite::Local l;
-      l.name = v->getName().str();
-      l.type = v->getType().getUnqualifiedType().getAsString();
-      if (!names.insert(l.name).second) return false;  // shadowed: two locals of one name
-      if (!rangeOf_(v->getInit(), l.initBegin, l.initEnd)) return false;
-      site.locals.push_back(l);
-    }
+    if (!appendSiteLocals(locals, order_, rangeOf_, site)) return false;
     sites_.push_back(site);
     return true;
   }
