@@ -61,7 +61,7 @@ struct EmitOptions {
   // passed to both calls (codegen/PairShared.cpp; CPU backends, double precision, not --mpi,
   // not --simd-pairs); false (--no-pair-shared-values): each call computes them. The values
   // are the same bit for bit.
-  bool pairShared = true;
+  bool pairShared = false;
   // `pow` in the bodies of the CPU backends (double precision) is sphc::pow_int (sphc/pow.h):
   // by multiplications where the exponent is an integer of magnitude <= 8, the C library's
   // pow otherwise; false (--int-pow=off): the C library's pow everywhere.
