@@ -10,6 +10,7 @@ import resource
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -121,6 +122,25 @@ def cpu_per_step_rounds(exes, options, short, long_, rounds):
                 cpu.append(run.cpu)
             per[name].append((cpu[1] - cpu[0]) / (long_ - short))
     return per
+
+
+# The C++ flags of the callgrind builds: valgrind 3.19 cannot run AVX-512, so x86-64-v3; -g for
+# callgrind_annotate; no contraction, so the counts compare the printed arithmetic.
+CALLGRIND_FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
+
+
+def cpu_or_instructions(args, prefix, cpu_per_step, instructions_per_step):
+    """The body of a benchmark that measures CPU per step (--cpu) or instructions per step:
+    a temporary directory, the load average before and after, the directory removed (or kept
+    with --keep)."""
+    tmp = tempfile.mkdtemp(prefix=prefix)
+    print("load average before: %s" % load_average())
+    if args.cpu:
+        cpu_per_step(args, tmp)
+    else:
+        instructions_per_step(args, tmp)
+    print("load average after: %s" % load_average())
+    remove_tmp(tmp, args.keep)
 
 
 def instruction_parser(doc):

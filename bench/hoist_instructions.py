@@ -29,10 +29,10 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (SCENE_FILES, callgrind_build_run, group_instructions,  # noqa: E402
-                    instruction_parser, instructions, load_average, remove_tmp, run)
+from common import (CALLGRIND_FLAGS, SCENE_FILES, callgrind_build_run,  # noqa: E402
+                    group_instructions, instruction_parser, instructions,
+                    load_average, remove_tmp, run)
 
-FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
 # scene: (file, run-time options)
 SCENES = {
     "dambreak": (SCENE_FILES["dambreak"], ["--set", "dx=0.03", "--max-steps", "100"]),
@@ -87,7 +87,7 @@ def main():
         print("load average after: %s" % load_average())
         remove_tmp(tmp, args.keep)
         return
-    print("built with --cxxflags \"%s\"; instructions under callgrind" % FLAGS)
+    print("built with --cxxflags \"%s\"; instructions under callgrind" % CALLGRIND_FLAGS)
     print("%-13s %-9s %-18s %15s %9s %15s %9s" % ("scene", "variant", "run", "instructions",
                                                   "/ off", "group_* (self)", "/ off"))
     for scene in args.scenes.split(","):
@@ -95,7 +95,7 @@ def main():
         base = gbase = None
         for name, flags in VARIANTS:
             exe = os.path.join(tmp, "%s_%s" % (scene, name))
-            cg = callgrind_build_run(args.sphc, path, exe, ["--cxxflags", FLAGS] + flags, options)
+            cg = callgrind_build_run(args.sphc, path, exe, ["--cxxflags", CALLGRIND_FLAGS] + flags, options)
             n = instructions(cg)
             g = group_instructions(cg)
             base = base or n

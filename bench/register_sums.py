@@ -26,14 +26,13 @@ Needs valgrind and callgrind_annotate (not with --cpu).
 
 import os
 import sys
-import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (SCENE_FILES, cpu_per_step_rounds, group_instructions,  # noqa: E402
-                    instruction_parser, instructions, load_average, remove_tmp, run)
+from common import (CALLGRIND_FLAGS, cpu_or_instructions, SCENE_FILES,  # noqa: E402
+                    cpu_per_step_rounds, group_instructions, instruction_parser,
+                    instructions, run)
 
-FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
 # The dam break with PySPH's effects (bench/time_to_solution.py): its sphc defines and options.
 PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
 # scene: (file, sphc flags, run-time options, short steps, long steps)
@@ -61,7 +60,7 @@ def callgrind(exe, options, steps):
 
 def instructions_per_step(args, tmp):
     print("built with --cxxflags \"%s\"; instructions per step under callgrind, "
-          "(long - short) / steps" % FLAGS)
+          "(long - short) / steps" % CALLGRIND_FLAGS)
     print("%-15s %-8s %-11s %15s %9s %15s %9s" % ("scene", "variant", "steps", "Ir / step",
                                                   "/ memory", "group_* / step", "/ memory"))
     for scene in args.scenes.split(","):
@@ -69,7 +68,7 @@ def instructions_per_step(args, tmp):
         base = gbase = None
         for name, flags in VARIANTS:
             exe = os.path.join(tmp, "%s_%s" % (scene, name))
-            run([args.sphc, path, "-o", exe, "--cxxflags", FLAGS] + sflags + flags)
+            run([args.sphc, path, "-o", exe, "--cxxflags", CALLGRIND_FLAGS] + sflags + flags)
             n0, g0 = callgrind(exe, options, short)
             n1, g1 = callgrind(exe, options, long_)
             n = (n1 - n0) / (long_ - short)
@@ -108,14 +107,7 @@ def main():
     ap.add_argument("--cpu", action="store_true", help="CPU time per step at ~100k particles")
     ap.add_argument("--rounds", type=int, default=5)
     args = ap.parse_args()
-    tmp = tempfile.mkdtemp(prefix="sphc_regsums_")
-    print("load average before: %s" % load_average())
-    if args.cpu:
-        cpu_per_step(args, tmp)
-    else:
-        instructions_per_step(args, tmp)
-    print("load average after: %s" % load_average())
-    remove_tmp(tmp, args.keep)
+    cpu_or_instructions(args, "sphc_regsums_", cpu_per_step, instructions_per_step)
 
 
 if __name__ == "__main__":

@@ -28,10 +28,9 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (ROOT, SCENE_FILES, instruction_parser, instructions,  # noqa: E402
-                    load_average, remove_tmp, run)
+from common import (CALLGRIND_FLAGS, ROOT, SCENE_FILES, instruction_parser,  # noqa: E402
+                    instructions, load_average, remove_tmp, run)
 
-CG_FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
 PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
 DB3 = os.path.join(ROOT, "examples", "dambreak3d.sph")
 DSPH = os.path.join(ROOT, "bench", "dambreak3d_dualsphysics.sph")
@@ -92,7 +91,7 @@ def main():
                 for v in variants:
                     exe = os.path.join(tmp, "%s_%s_%s_cg" % (scene, backend, v))
                     flags = sflags + bflags + VARIANT_FLAGS[v]
-                    run([args.sphc, path, "-o", exe, "--cxxflags=" + CG_FLAGS] + flags)
+                    run([args.sphc, path, "-o", exe, "--cxxflags=" + CALLGRIND_FLAGS] + flags)
                     n = []
                     for steps in cg_steps:
                         cg = "%s_%d.callgrind" % (exe, steps)

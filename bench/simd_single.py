@@ -25,14 +25,12 @@ import os
 import statistics
 import subprocess
 import sys
-import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (ROOT, SCENE_FILES, cpu_per_step_rounds, instruction_parser,  # noqa: E402
-                    instructions, load_average, remove_tmp, run)
+from common import (CALLGRIND_FLAGS, cpu_or_instructions, ROOT, SCENE_FILES,  # noqa: E402
+                    cpu_per_step_rounds, instruction_parser, instructions, run)
 
-FLAGS = "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -g"
 PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
 DAMBREAK3D = os.path.join(ROOT, "examples", "dambreak3d.sph")
 # scene: (file, sphc flags, run-time options, short steps, long steps)
@@ -77,7 +75,7 @@ def callgrind(exe, options, steps):
 
 def instructions_per_step(args, tmp):
     print("built with --cxxflags \"%s\"; instructions per step under callgrind, "
-          "(long - short) / steps" % FLAGS)
+          "(long - short) / steps" % CALLGRIND_FLAGS)
     print("%-15s %-12s %-9s %12s %9s" % ("scene", "variant", "steps", "Ir / step",
                                           "/ " + VARIANTS[0][0]))
     for scene in args.scenes.split(","):
@@ -85,7 +83,7 @@ def instructions_per_step(args, tmp):
         base = None
         for name, flags in VARIANTS:
             exe = os.path.join(tmp, "%s_%s" % (scene, name))
-            run([args.sphc, path, "-o", exe, "--cxxflags", FLAGS] + sflags + flags)
+            run([args.sphc, path, "-o", exe, "--cxxflags", CALLGRIND_FLAGS] + sflags + flags)
             n = (callgrind(exe, options, long_) - callgrind(exe, options, short)) / (long_ - short)
             base = base or n
             print("%-15s %-12s %-9s %12.4g %9.3f" % (scene, name, "%d-%d" % (short, long_), n,
@@ -128,14 +126,7 @@ def main():
         VARIANTS[:] = [(n, ALL_VARIANTS[n]) for n in args.variants.split(",")]
     if args.scenes is None:
         args.scenes = ",".join(CPU_SCENES if args.cpu else SCENES)
-    tmp = tempfile.mkdtemp(prefix="sphc_simdsingle_")
-    print("load average before: %s" % load_average())
-    if args.cpu:
-        cpu_per_step(args, tmp)
-    else:
-        instructions_per_step(args, tmp)
-    print("load average after: %s" % load_average())
-    remove_tmp(tmp, args.keep)
+    cpu_or_instructions(args, "sphc_simdsingle_", cpu_per_step, instructions_per_step)
 
 
 if __name__ == "__main__":

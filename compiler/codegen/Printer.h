@@ -332,9 +332,12 @@ class ScenePrinter {
   std::string destinationValueLoad(const std::string& prop, int stride, int comp) const;
 
   // ---- SIMD pair loops (SimdPairs.cpp; sphc --simd-pairs) ----
-  // Why pass (destination w) cannot be printed in SIMD lanes, "" if it can (the switch off:
-  // "off").
+  // Why pass (destination w) is not printed in SIMD lanes, "" if it is (the switch off:
+  // "off"): what the lanes cannot do (simdPairsBlocker), then under --simd-pairs=auto the
+  // choice (simdPairsAutoChoice).
   std::string simdPairsRefusal(const DestinationWork& w, const NeighbourPass& pass) const;
+  // What in pass (its bodies, its sums) the SIMD form cannot print, "" if nothing.
+  std::string simdPairsBlocker(const DestinationWork& w, const NeighbourPass& pass) const;
   // The neighbour loop of a per-destination pass in SIMD lanes (true), or a comment why not
   // (false: the caller prints the scalar loop); nothing with the switch off.
   bool emitSimdNeighbours(std::ostream& os, const DestinationWork& w, const NeighbourPass& pass,

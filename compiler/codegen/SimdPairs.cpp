@@ -203,6 +203,17 @@ bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std:
 std::string ScenePrinter::simdPairsRefusal(const DestinationWork& w,
                                            const NeighbourPass& pass) const {
   if (!simdPairs_) return "off";
+  const std::string blocker = simdPairsBlocker(w, pass);
+  if (!blocker.empty()) return blocker;
+  if (simdAuto_) {  // --simd-pairs=auto: where the lanes pay
+    const SimdAutoChoice c = simdPairsAutoChoice(w, pass);
+    if (!c.lanes) return "--simd-pairs=auto: " + c.why;
+  }
+  return "";
+}
+
+std::string ScenePrinter::simdPairsBlocker(const DestinationWork& w,
+                                           const NeighbourPass& pass) const {
   if (pass.equations.empty()) return "no loop bodies";
   if (!pass.loopAll.empty()) return pass.loopAll[0]->name + " has a loop_all";
   const RegisterSums rs = registerSums(w, pass);
@@ -223,10 +234,6 @@ std::string ScenePrinter::simdPairsRefusal(const DestinationWork& w,
     if (!call.empty())
       return eq->name + " calls " + call + ", which GCC does not vectorise (its loop would be "
              "scalar or not depending on inlining)";
-  }
-  if (simdAuto_) {  // --simd-pairs=auto: where the lanes pay
-    const SimdAutoChoice c = simdPairsAutoChoice(w, pass);
-    if (!c.lanes) return "--simd-pairs=auto: " + c.why;
   }
   return "";
 }

@@ -63,6 +63,16 @@ struct Mover {
     };
     prog.output = {{"fluid", {"u"}}};
   }
+
+  // Output at the given times only (no output interval), as a scene's `output at`.
+  void output_only_at(std::vector<double> at) {
+    const auto setup = prog.setup;
+    prog.setup = [setup, at](const std::vector<double>& params, SceneTimes& times) {
+      setup(params, times);
+      times.output_every = 0;
+      times.output_at = at;
+    };
+  }
 };
 
 int run(SceneProgram& prog, std::vector<std::string> args) {
@@ -134,12 +144,7 @@ TEST(Solver, StepsLandOnOutputAtTimes) {
   // one is shortened to end on tf = 1 (PySPH's rule, pysph/solver/solver.py).
   const fs::path dir = fresh_dir();
   Mover m;
-  const auto setup = m.prog.setup;
-  m.prog.setup = [&](const std::vector<double>& params, SceneTimes& times) {
-    setup(params, times);
-    times.output_every = 0;
-    times.output_at = {0.305, 0.3};
-  };
+  m.output_only_at({0.305, 0.3});
   EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string()}), 0);
   EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000030.h5",
                                                      "mover_000031.h5", "mover_000101.h5"}));
@@ -182,12 +187,7 @@ TEST(Solver, NearMissesAreMergedNotTinySteps) {
   {
     const fs::path dir = fresh_dir();
     Mover m;
-    const auto setup = m.prog.setup;
-    m.prog.setup = [&](const std::vector<double>& params, SceneTimes& times) {
-      setup(params, times);
-      times.output_every = 0;
-      times.output_at = {0.5, 0.500001};
-    };
+    m.output_only_at({0.5, 0.500001});
     EXPECT_EQ(run(m.prog, {"--quiet", "-d", dir.string()}), 0);
     // Then 49 steps of 0.01 and a last one of 0.009999 to tf.
     EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000050.h5",
