@@ -35,6 +35,7 @@ For each scene (the 3D cube and the 2D dam break by default):
                    time those bytes take at the measured bandwidth.
 
 Usage: python3 bench/roofline.py [--scenes cube,dambreak2d] [--sphc build/bin/sphc] [--keep]
+                                  [--count-flags=--simd-pairs=off]
 Needs valgrind, objdump (binutils), perf (linux-perf; without it the callgrind instruction
 share stands in for the time share), scipy, h5py.
 """
@@ -190,6 +191,12 @@ def main():
     ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
     ap.add_argument("--scenes", default="cube,dambreak2d")
     ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--count-flags", default="",
+                    help="sphc options of the counted (callgrind) build only, e.g. "
+                    "'--simd-pairs=off': the flops of the scalar loops, i.e. the useful "
+                    "arithmetic per pair, where the default counts every executed lane "
+                    "(a SIMD loop's masked tail lanes included); the timed build is the "
+                    "default either way")
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="sphc-roofline-")
     env = dict(os.environ)
@@ -212,8 +219,8 @@ def main():
             print("%s: counting flops under callgrind (%d and %d steps) ..." % (scene, s1, s2),
                   flush=True)
             run([args.sphc, src, "-o", exe, "--cxxflags",
-                 "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -no-pie"] + SCENES[scene][1],
-                env)
+                 "-std=c++17 -O3 -march=x86-64-v3 -fno-math-errno -ffp-contract=off -no-pie"]
+                + SCENES[scene][1] + args.count_flags.split(), env)
             table = disassemble(exe)
             funcs = {}
             outdir = os.path.join(tmp, scene + "-cg-out")
@@ -293,8 +300,9 @@ def main():
     print()
     for r in rows:
         print("== %s: interaction function %s" % (r["scene"], r["fn"]))
-        print("  counted (callgrind, AVX2 build): %.1f flops and %.0f instructions per pair "
-              "within the support" % (r["fpp"], r["ipp"]))
+        print("  counted (callgrind, AVX2 build%s): %.1f flops and %.0f instructions per pair "
+              "within the support" % (", sphc " + args.count_flags if args.count_flags else "",
+                                      r["fpp"], r["ipp"]))
         print("  timed: %d particles, %d steps, %.0f pairs/step (%s neighbours per destination),"
               " loop %.2f s wall; the function: %.1f%% of the samples, %.3f s CPU"
               % (r["particles"], r["steps"], r["pairs"],
