@@ -10,6 +10,8 @@
 // only what holds bit for bit in IEEE round-to-nearest, node by node, never regrouping:
 //   a * b = b * a, a + b = b + a, (-a) * b = -(a * b), (-a) / b = -(a / b),
 //   a - b = -(b - a), fma(a, b, c) = fma(b, a, c), fma(-a, b, -c) = -fma(a, b, c),
+//   but a * b + c (which the printer fuses into fma(a, b, c)) keeps its product and its
+//   addend in their places: fma(a, b, c * d) is not fma(c, d, a * b),
 //   f(x) of the same x (sqrt, exp, ... and the kernel), fabs(-x) = fabs(x),
 //   a comparison of the same operands (c ? x : y where c is the same both ways).
 // Locals declared once and never assigned stand for their initial values. An expression is
@@ -207,8 +209,18 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
           c.sign = l.sign * r.sign;
           return c;
         case clang::BO_Add:
-        case clang::BO_Sub:
-          return sum(l, r, op == clang::BO_Sub ? -1 : 1, "+", "-");
+        case clang::BO_Sub: {
+          // A product and an addend: the printer may fuse them (left product first, as
+          // BodyChecker's recordMultiplyAdd), and fma(a, b, c * d) is not fma(c, d, a * b).
+          const int rs = op == clang::BO_Sub ? -1 : 1;
+          if (product(b->getLHS())) return fused(l, r, rs);
+          if (product(b->getRHS())) {
+            Canon p = r;
+            p.sign = rs * r.sign;
+            return fused(p, l, 1);
+          }
+          return sum(l, r, rs, "+", "-");
+        }
         default: return fail();
       }
     }
@@ -241,8 +253,7 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
         p.sign = args[0].sign * args[1].sign;
         p.taint = args[0].taint || args[1].taint;
         p.pair = args[0].pair || args[1].pair;
-        Canon c = sum(p, args[2], 1, "fma+", "fma-");
-        return c;
+        return fused(p, args[2], 1);
       }
       Canon c;
       c.ok = true;
@@ -288,6 +299,28 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
       c.sign = rs;
     }
     return c;
+  }
+
+  // A product that the printer may fuse with what is added to it (codegen/FusedMultiplyAdd.cpp).
+  static bool product(const clang::Expr* e) {
+    auto* m = llvm::dyn_cast<clang::BinaryOperator>(e->IgnoreParenImpCasts());
+    return m && m->getOpcode() == clang::BO_Mul;
+  }
+
+  // p + rsign * c where p is a product that may be fused with c: fma(a, b, c) rounds once, so
+  // a + b = b + a does not hold there (fma(a, b, c * d) and fma(c, d, a * b) differ). The form
+  // keeps the product and the addend in their places; signs move as fma(-a, b, -c) =
+  // -fma(a, b, c). (Unfused, round(round(a * b) + c) keeps them in place too.)
+  static Canon fused(const Canon& p, const Canon& c, int rsign) {
+    Canon f;
+    f.ok = true;
+    f.taint = p.taint || c.taint;
+    f.pair = p.pair || c.pair;
+    const int cs = c.sign * rsign;
+    f.sign = p.sign;
+    f.s = "fma(" + p.s + (p.sign == cs ? "+" : "-") + c.s + ")";
+    if (p.sign != cs) f.taint = true;  // a difference: x - x is +0 both ways
+    return f;
   }
 
   // A condition whose value is the same both ways: comparisons of operands that are the

@@ -59,7 +59,7 @@ struct EmitOptions {
   // Where a pair is evaluated once for both particles, the values of its loop bodies that are
   // the same (or negated) for the mirrored pair (body/PairShared.cpp) are computed once and
   // passed to both calls (codegen/PairShared.cpp; CPU backends, double precision, not --mpi,
-  // not --simd-pairs); false (--no-pair-shared-values): each call computes them. The values
+  // not --simd-pairs); false (--pair-shared-values=off): each call computes them. The values
   // are the same bit for bit.
   bool pairShared = false;
   // `pow` in the bodies of the CPU backends (double precision) is sphc::pow_int (sphc/pow.h):

@@ -105,6 +105,16 @@ std::string passHoisted(const std::string& eqStruct, size_t k) {
 
 }  // namespace
 
+const std::set<std::string>& ScenePrinter::pairLoopWrites() const {
+  if (!pairLoopWrites_) {
+    pairLoopWrites_ = std::make_unique<std::set<std::string>>();
+    for (const PlanBody& other : plan_.bodies)
+      if (other.source.kind == BodyKind::Loop || other.source.kind == BodyKind::LoopAll)
+        for (const PropAccess& w : other.facts.dWrites) pairLoopWrites_->insert(w.prop);
+  }
+  return *pairLoopWrites_;
+}
+
 std::vector<SourceOnlySite> ScenePrinter::hoistedDestinationSites(const PlanBody& b,
                                                                   const Dialect& d) const {
   if (!d.hoist || b.source.kind != BodyKind::Loop || !b.facts.ok ||
@@ -112,10 +122,7 @@ std::vector<SourceOnlySite> ScenePrinter::hoistedDestinationSites(const PlanBody
     return {};
   // A property some pair loop writes (an accumulator such as au) changes during the
   // neighbour loop of its destination: not hoisted. Checked over every loop of the plan.
-  std::set<std::string> written;
-  for (const PlanBody& other : plan_.bodies)
-    if (other.source.kind == BodyKind::Loop || other.source.kind == BodyKind::LoopAll)
-      for (const PropAccess& w : other.facts.dWrites) written.insert(w.prop);
+  const std::set<std::string>& written = pairLoopWrites();
   std::vector<SourceOnlySite> kept;
   for (const SourceOnlySite& s : b.facts.destinationOnly) {
     bool ok = true;

@@ -1,5 +1,5 @@
 // Values a pair shares, computed once for both particles (CPU backends, double precision, not
-// --mpi, not --simd-pairs; `sphc --no-pair-shared-values` turns it off).
+// --mpi, not --simd-pairs; `sphc --pair-shared-values=off` turns it off).
 //
 // Where a pair loop evaluates each pair once for both particles (codegen/SymmetricPairs.cpp)
 // it calls each loop body twice per pair, for (d_idx, s_idx) and mirrored for (s_idx, d_idx).
@@ -45,6 +45,15 @@ std::vector<std::pair<unsigned, unsigned>> siteRanges(const SourceOnlySite& s) {
 
 std::string K(size_t k) { return std::to_string(k); }
 
+// The site of `facts` (its offsets moved by the other edits of the text) with the id of
+// `site`; a copy, so that no later edit of `facts` can move it under the caller.
+SourceOnlySite movedSite(const BodyFacts& facts, const SourceOnlySite& site, const std::string& cut) {
+  auto it = std::find_if(facts.pairShared.begin(), facts.pairShared.end(),
+                         [&](const SourceOnlySite& s) { return s.id == site.id; });
+  if (it == facts.pairShared.end()) SPHC_INTERNAL(cut);
+  return *it;
+}
+
 }  // namespace
 
 std::vector<SourceOnlySite> ScenePrinter::pairSharedSites(const PlanBody& b, const Dialect& d) const {
@@ -54,10 +63,7 @@ std::vector<SourceOnlySite> ScenePrinter::pairSharedSites(const PlanBody& b, con
   if (!pairSharedBodies_)
     pairSharedBodies_ = std::make_unique<std::set<const PlanBody*>>(pairSharedBodies());
   if (!pairSharedBodies_->count(&b)) return {};  // no loop calls it both ways: as before
-  std::set<std::string> written;  // by any pair loop of the plan (as Hoist.cpp)
-  for (const PlanBody& other : plan_.bodies)
-    if (other.source.kind == BodyKind::Loop || other.source.kind == BodyKind::LoopAll)
-      for (const PropAccess& w : other.facts.dWrites) written.insert(w.prop);
+  const std::set<std::string>& written = pairLoopWrites();  // by any pair loop of the plan
   std::vector<SourceOnlySite> kept;
   for (const SourceOnlySite& s : b.facts.pairShared) {
     bool ok = true;
@@ -85,11 +91,8 @@ void ScenePrinter::replacePairShared(const PlanBody& b, const Dialect& d, std::s
   if (sites.empty()) return;
   std::vector<TextEdit> edits;
   for (size_t k = 0; k < sites.size(); ++k) {
-    auto it = std::find_if(facts.pairShared.begin(), facts.pairShared.end(),
-                           [&](const SourceOnlySite& s) { return s.id == sites[k].id; });
-    if (it == facts.pairShared.end())
-      SPHC_INTERNAL("a pair-shared value cut by another edit in " + b.source.label);
-    const SourceOnlySite& s = *it;
+    const SourceOnlySite s =
+        movedSite(facts, sites[k], "a pair-shared value cut by another edit in " + b.source.label);
     const unsigned begin = s.result.empty() ? s.begin : s.stmtBegin;
     const unsigned end = s.result.empty() ? s.end : s.stmtEnd;
     // The lines after it keep their numbers (#line): its line breaks follow it.
@@ -125,16 +128,13 @@ void ScenePrinter::emitPairSharedFunctions(const PlanBody& b, const std::string&
   std::string params;
   for (const BodyParam& p : pairSharedParams(b, destArray, d)) params += (params.empty() ? "" : ", ") + p.decl;
   for (size_t k = 0; k < sites.size(); ++k) {
-    auto it = std::find_if(facts.pairShared.begin(), facts.pairShared.end(),
-                           [&](const SourceOnlySite& s) { return s.id == sites[k].id; });
-    if (it == facts.pairShared.end())
-      SPHC_INTERNAL("a pair-shared value cut by a hoisted one in " + b.source.label);
-    const SourceOnlySite& s = *it;
+    const SourceOnlySite s =
+        movedSite(facts, sites[k], "a pair-shared value cut by a hoisted one in " + b.source.label);
     const std::string value = fusedRange(text, facts, s.begin, s.end, d.fma);
     os << "// " << b.source.label << ", from " << loc(b.source.start)
        << ": a value the pair shares, " << (s.sign < 0 ? "negated" : "the same")
        << " for the mirrored pair (once per pair\n// where each pair is evaluated once; "
-          "codegen/PairShared.cpp; --no-pair-shared-values: in each call)\n";
+          "codegen/PairShared.cpp; --pair-shared-values=off: in each call)\n";
     if (s.result.empty())
       os << "//   " << oneLine(text.substr(s.begin, s.end - s.begin)) << "\n";
     else

@@ -233,6 +233,10 @@ class ScenePrinter {
   // those computed once per destination particle (of properties no pair loop writes).
   std::vector<SourceOnlySite> hoistedSites(const PlanBody& b, const Dialect& d) const;
   std::vector<SourceOnlySite> hoistedDestinationSites(const PlanBody& b, const Dialect& d) const;
+  // The properties some pair loop of the plan writes (an accumulator such as au changes
+  // during the neighbour loop): neither hoisted per destination nor shared by a pair.
+  const std::set<std::string>& pairLoopWrites() const;
+  mutable std::unique_ptr<std::set<std::string>> pairLoopWrites_;  // (once)
   // The body's text with each hoisted site replaced by `s_hoistedK[s_idx]` (and its facts
   // moved with it), its multiply-adds fused.
   // `extra`: further edits of the text (RegisterSums.cpp), none overlapping a hoisted site.

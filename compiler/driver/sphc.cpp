@@ -127,19 +127,14 @@ static cl::opt<bool> NoSymmetricPairs(
              "both particles, on the CPU backends with kept neighbour lists; --report says "
              "which loops; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
-static cl::opt<bool> PairSharedValues(
+static cl::opt<std::string> PairSharedValues(
     "pair-shared-values",
     cl::desc("Where a pair loop evaluates each pair once for both particles, compute the "
              "values of its bodies that are the same (or negated) for the mirrored pair once "
-             "per pair and pass them to both calls (serial and openmp, double precision; "
-             "meant to give the same results bit for bit: so on the dam breaks and the cube, "
-             "not yet on the lid-driven cavity, hence off by default; docs/performance.md)"),
-    cl::init(false), cl::cat(SphcCat));
-static cl::opt<bool> NoPairSharedValues(
-    "no-pair-shared-values",
-    cl::desc("Each of the two calls of a pair computes its own values (the default; overrides "
-             "--pair-shared-values)"),
-    cl::init(false), cl::cat(SphcCat));
+             "per pair and pass them to both calls (serial and openmp, double precision). on "
+             "(default, or --pair-shared-values alone); off: each of the two calls computes "
+             "its own values. The results are the same bit for bit (docs/performance.md)"),
+    cl::value_desc("on|off"), cl::ValueOptional, cl::init("on"), cl::cat(SphcCat));
 static cl::opt<bool> NoRegisterSums(
     "no-register-sums",
     cl::desc("In the CPU pair loops, update the destination's sums in memory at every pair "
@@ -476,7 +471,13 @@ int main(int argc, char** argv) {
   emitOpts.batchedTables = !NoBatchedTables;
   emitOpts.splitUnits = !SingleUnit && Emit == EmitKind::Exe;
   emitOpts.symmetricPairs = !NoSymmetricPairs;
-  emitOpts.pairShared = PairSharedValues && !NoPairSharedValues;
+  // --pair-shared-values: on (the default, also bare) or off.
+  const std::string sharedMode = PairSharedValues.empty() ? std::string("on") : PairSharedValues.getValue();
+  if (sharedMode != "on" && sharedMode != "off") {
+    llvm::errs() << "sphc: error: --pair-shared-values=" << sharedMode << ": it is on or off\n";
+    return fail();
+  }
+  emitOpts.pairShared = sharedMode == "on";
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;
