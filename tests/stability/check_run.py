@@ -57,6 +57,8 @@ Case invariants (options):
   --box XMIN XMAX YMIN [YMAX]   wall penetration: no fluid particle outside the box (the
                 inner faces of the walls) by more than --box-tol dx (default 0.5 dx: a
                 particle whose centre is half a spacing behind a wall face has crossed it).
+                In 3D (the floor at z = ZMIN): --box XMIN XMAX YMIN YMAX ZMIN [ZMAX]; the
+                2D form checks x and y only.
   --min-pair F  fluid-fluid pair distance >= F dx at every snapshot outside the time windows
                 --pair-skip T0 T1 (repeatable; e.g. an impact).
                 --pair-bulk N: judge only pairs of particles in the bulk of the fluid, those
@@ -103,6 +105,21 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from snapshots import lattice_spacing, particle_arrays, snapshots  # noqa: E402
 
 WHO = "check_run.py"
+
+
+def box_excess(b, pos):
+    """How far each particle lies outside the box b (the inner faces of the walls), per face
+    (positive outside): b = XMIN XMAX YMIN [YMAX] in 2D; in 3D, where the floor is z,
+    XMIN XMAX YMIN YMAX ZMIN [ZMAX] (side walls at y = YMIN and YMAX), or the 2D form,
+    which leaves z unchecked."""
+    out = [b[0] - pos[0], pos[0] - b[1], b[2] - pos[1]]
+    if len(b) > 3:
+        out.append(pos[1] - b[3])
+    if len(b) > 4:
+        out.append(b[4] - pos[2])
+    if len(b) > 5:
+        out.append(pos[2] - b[5])
+    return out
 
 
 def min_pair_distance(pos, cell):
@@ -335,6 +352,11 @@ def main():
                 sys.stderr.write("%s: %s has no /%s/%s\n" % (WHO, name, args.fluid, k))
                 return 2
         vert = "z" if dim == 3 else "y"
+        if args.box is not None and not 3 <= len(args.box) <= (6 if dim == 3 else 4):
+            sys.stderr.write("%s: --box takes XMIN XMAX YMIN [YMAX]%s (%d values given)\n"
+                             % (WHO, " [ZMIN [ZMAX]] in 3D" if dim == 3 else " in 2D",
+                                len(args.box)))
+            return 2
         if args.eos == "edac" and "p" not in fl:
             sys.stderr.write("%s: --eos edac: %s has no /%s/p (the EDAC pressure)\n"
                              % (WHO, name, args.fluid))
@@ -457,9 +479,7 @@ def main():
             dts.append(mean_dt)
         # wall penetration
         if box is not None:
-            b = args.box
-            out = np.maximum.reduce([b[0] - pos[0], pos[0] - b[1], b[2] - pos[1]]
-                                    + ([pos[1] - b[3]] if len(b) > 3 else [])) / dx
+            out = np.maximum.reduce(box_excess(args.box, pos)) / dx
             box.record(float(max(out.max(), 0.0)), lambda a, b_: a > b_)
             bad = out > args.box_tol
             if np.any(bad):
