@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 
 #include "sphc/hdf5_io.h"
+#include "sphc/huge_pages.h"
 #include "sphc/memory.h"
 #include "sphc/restart.h"
 
@@ -204,6 +205,12 @@ Options parse_command_line(int argc, char** argv, const SceneProgram& prog) {
         throw UsageError("--max-memory expects a size such as 4G, 500M or 1e9 (bytes), not '" +
                          v + "'");
     }
+    else if (option == "--huge-pages") {  // acted on now: before the arrays are allocated
+      const std::string v = value();
+      const int on = parse_huge_pages(v.c_str());
+      if (on < 0) throw UsageError("--huge-pages expects on or off, not '" + v + "'");
+      set_huge_pages(on == 1);
+    }
     else if (option == "--estimate-memory") flag(o.estimate_memory);
     else if (option == "--restartable") flag(o.restartable);
     else if (option == "--restart") {
@@ -272,6 +279,10 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        500M, bytes; default: MemAvailable of /proc/meminfo, or a\n"
       "                        lower cgroup limit)\n"
       "  --estimate-memory     print the memory estimate of the run, item by item, and stop\n"
+      "  --huge-pages on|off   place each allocation of 2 MiB or more (particle properties,\n"
+      "                        cell tables) on 2 MiB boundaries advised for transparent huge\n"
+      "                        pages (Linux madvise; same results; default off, or\n"
+      "                        SPHC_HUGE_PAGES=on|off)\n"
       "  --limits on|warn|off  the scene's limits (limits {{ }}; without any, a box around the\n"
       "                        particles at set-up): warn once outside warn bounds and stop\n"
       "                        outside stop bounds (on, the default); only warn; not checked\n"
@@ -298,6 +309,9 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "                        timing-group: name=FILE:LINE s=S share=F equations=E,...\n"
       "                        and timing-split: wall_s=W groups_s=G nnps_s=N\n"
       "                        integrator_s=I outside_steps_s=O (G+N+I+O = W)\n"
+      "                        [timing-huge-pages: blocks=B advised=A: with\n"
+      "                        --huge-pages=on, blocks of 2 MiB or more allocated, and\n"
+      "                        those madvise accepted]\n"
       "                        and, per iterated group, the iterations of its evaluations:\n"
       "                        iterations: group=FILE:LINE evaluations=E total=N mean=M\n"
       "                        min=A max=B unconverged=U\n"
@@ -1149,6 +1163,10 @@ class Simulation {
     fmt::print("timing-split: wall_s={:.6g} groups_s={:.6g} nnps_s={:.6g} integrator_s={:.6g} "
                "outside_steps_s={:.6g}\n",
                wall_s, groups, nnps, step_seconds_ - groups - nnps, wall_s - step_seconds_);
+    if (huge_pages_enabled()) {  // --huge-pages=on only: the default's output is unchanged
+      const HugePageCounts c = huge_page_counts();
+      fmt::print("timing-huge-pages: blocks={} advised={}\n", c.large_blocks, c.advised_blocks);
+    }
   }
 
   SceneProgram& prog_;
