@@ -8,6 +8,7 @@
 
 #include <cerrno>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <vector>
@@ -19,17 +20,6 @@ using sphc::kHugePageBytes;
 bool aligned_2m(const void* p) {
   return reinterpret_cast<std::uintptr_t>(p) % kHugePageBytes == 0;
 }
-
-// Restores the switch and the system's madvise after each test.
-class HugePages : public ::testing::Test {
- protected:
-  void SetUp() override { was_on_ = sphc::huge_pages_enabled(); }
-  void TearDown() override {
-    sphc::set_huge_pages(was_on_);
-    sphc::detail::set_madvise_for_tests(nullptr);
-  }
-  bool was_on_ = false;
-};
 
 struct Advice {
   std::uintptr_t start = 0;
@@ -53,6 +43,25 @@ int accept(void* start, std::size_t bytes, int) {
   return 0;
 }
 
+// Restores the switch and the system's madvise after each test.
+class HugePages : public ::testing::Test {
+ protected:
+  void SetUp() override { was_on_ = sphc::huge_pages_enabled(); }
+  void TearDown() override {
+    sphc::set_huge_pages(was_on_);
+    sphc::detail::set_madvise_for_tests(nullptr);
+  }
+  // The switch, the madvise allocate() calls, no advice seen yet, the counts now.
+  void start(bool on, sphc::detail::MadviseFn fn) {
+    sphc::set_huge_pages(on);
+    sphc::detail::set_madvise_for_tests(fn);
+    g_advice = {};
+    before_ = sphc::huge_page_counts();
+  }
+  bool was_on_ = false;
+  sphc::HugePageCounts before_;
+};
+
 TEST_F(HugePages, ParsesTheSwitch) {
   EXPECT_EQ(sphc::parse_huge_pages("on"), 1);
   EXPECT_EQ(sphc::parse_huge_pages("1"), 1);
@@ -64,10 +73,7 @@ TEST_F(HugePages, ParsesTheSwitch) {
 }
 
 TEST_F(HugePages, LargeBlocksAreAlignedRoundedAndAdvised) {
-  sphc::set_huge_pages(true);
-  sphc::detail::set_madvise_for_tests(accept);
-  g_advice = {};
-  const sphc::HugePageCounts before = sphc::huge_page_counts();
+  start(true, accept);
   const std::size_t bytes = 3 * kHugePageBytes + 12345;
   void* p = sphc::allocate(bytes);
   ASSERT_NE(p, nullptr);
@@ -78,50 +84,41 @@ TEST_F(HugePages, LargeBlocksAreAlignedRoundedAndAdvised) {
   EXPECT_EQ(g_advice.start, reinterpret_cast<std::uintptr_t>(p));
   EXPECT_EQ(g_advice.bytes, 4 * kHugePageBytes);
   const sphc::HugePageCounts after = sphc::huge_page_counts();
-  EXPECT_EQ(after.large_blocks, before.large_blocks + 1);
-  EXPECT_EQ(after.advised_blocks, before.advised_blocks + 1);
+  EXPECT_EQ(after.large_blocks, before_.large_blocks + 1);
+  EXPECT_EQ(after.advised_blocks, before_.advised_blocks + 1);
   std::memset(p, 7, bytes);
   std::free(p);
 }
 
 TEST_F(HugePages, BelowTheThresholdIsMallocs) {
-  sphc::set_huge_pages(true);
-  sphc::detail::set_madvise_for_tests(accept);
-  g_advice = {};
-  const sphc::HugePageCounts before = sphc::huge_page_counts();
+  start(true, accept);
   void* p = sphc::allocate(kHugePageBytes - 1);
   ASSERT_NE(p, nullptr);
   EXPECT_EQ(g_advice.calls, 0);
-  EXPECT_EQ(sphc::huge_page_counts().large_blocks, before.large_blocks);
+  EXPECT_EQ(sphc::huge_page_counts().large_blocks, before_.large_blocks);
   std::free(p);
   void* q = sphc::allocate(kHugePageBytes);  // the threshold itself is large
   ASSERT_NE(q, nullptr);
   EXPECT_TRUE(aligned_2m(q));
   EXPECT_EQ(g_advice.calls, 1);
-  EXPECT_EQ(sphc::huge_page_counts().large_blocks, before.large_blocks + 1);
+  EXPECT_EQ(sphc::huge_page_counts().large_blocks, before_.large_blocks + 1);
   std::free(q);
 }
 
 TEST_F(HugePages, OffMeansNoAdviceAndNoRounding) {
-  sphc::set_huge_pages(false);
+  start(false, accept);
   EXPECT_FALSE(sphc::huge_pages_enabled());
-  sphc::detail::set_madvise_for_tests(accept);
-  g_advice = {};
-  const sphc::HugePageCounts before = sphc::huge_page_counts();
   const std::size_t bytes = 3 * kHugePageBytes + 12345;
   void* p = sphc::allocate(bytes);
   ASSERT_NE(p, nullptr);
   EXPECT_EQ(g_advice.calls, 0);
   EXPECT_LT(malloc_usable_size(p), 4 * kHugePageBytes);  // malloc's size, not whole pages
-  EXPECT_EQ(sphc::huge_page_counts().large_blocks, before.large_blocks);
+  EXPECT_EQ(sphc::huge_page_counts().large_blocks, before_.large_blocks);
   std::free(p);
 }
 
 TEST_F(HugePages, RefusedAdviceLeavesAUsableBlock) {
-  sphc::set_huge_pages(true);
-  sphc::detail::set_madvise_for_tests(refuse);
-  g_advice = {};
-  const sphc::HugePageCounts before = sphc::huge_page_counts();
+  start(true, refuse);
   errno = 0;
   const std::size_t bytes = 5 * kHugePageBytes;
   auto* p = static_cast<unsigned char*>(sphc::allocate(bytes));
@@ -129,8 +126,8 @@ TEST_F(HugePages, RefusedAdviceLeavesAUsableBlock) {
   EXPECT_EQ(errno, 0);  // the refusal is not reported as an error of the allocation
   EXPECT_EQ(g_advice.calls, 1);
   const sphc::HugePageCounts after = sphc::huge_page_counts();
-  EXPECT_EQ(after.large_blocks, before.large_blocks + 1);
-  EXPECT_EQ(after.advised_blocks, before.advised_blocks);
+  EXPECT_EQ(after.large_blocks, before_.large_blocks + 1);
+  EXPECT_EQ(after.advised_blocks, before_.advised_blocks);
   std::memset(p, 3, bytes);
   EXPECT_EQ(p[bytes - 1], 3);
   std::free(p);
@@ -161,11 +158,10 @@ TEST_F(HugePages, TheKernelAcceptsTheAdvice) {
     std::fclose(f);
   else
     GTEST_SKIP() << "no transparent huge pages in this kernel";
-  sphc::set_huge_pages(true);
-  const sphc::HugePageCounts before = sphc::huge_page_counts();
+  start(true, nullptr);  // the system's madvise
   void* p = sphc::allocate(2 * kHugePageBytes);
   ASSERT_NE(p, nullptr);
-  EXPECT_EQ(sphc::huge_page_counts().advised_blocks, before.advised_blocks + 1);
+  EXPECT_EQ(sphc::huge_page_counts().advised_blocks, before_.advised_blocks + 1);
   std::free(p);
 }
 #endif
