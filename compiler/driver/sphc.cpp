@@ -331,10 +331,9 @@ int main(int argc, char** argv) {
     if (!p.zones.empty()) return "inlets or outlets";
     return "";
   };
-  if (!verletAuto && verletSkin > 0.0 && (Mpi || Backend == sphc::Backend::OpenCL ||
-                                          PrecisionOpt == sphc::Precision::Single)) {
-    llvm::errs() << "sphc: error: --verlet-skin works with --backend=serial or openmp in double "
-                    "precision (not with --backend=opencl, --precision=single or --mpi)\n";
+  if (!verletAuto && verletSkin > 0.0 && (Mpi || Backend == sphc::Backend::OpenCL)) {
+    llvm::errs() << "sphc: error: --verlet-skin works with --backend=serial or openmp "
+                    "(not with --backend=opencl or --mpi)\n";
     return fail();
   }
   if (Mpi && Emit == EmitKind::Exe) {
@@ -459,6 +458,12 @@ int main(int argc, char** argv) {
   if (DumpAfter == Pass::Schedule) {
     printSchedule(*schedule, diags, llvm::outs());
     return 0;
+  }
+  if (verletSkin > 0.0 && PrecisionOpt == sphc::Precision::Single && schedule->domain) {
+    llvm::errs() << "sphc: error: --verlet-skin with --precision=single: " << InputFile
+                 << " has a periodic or mirror domain (kept lists in single precision are "
+                    "written for scenes without one)\n";
+    return fail();
   }
   if (verletSkin > 0.0 && ((schedule->domain && ghostPairLoops(*plan)) || !plan->zones.empty())) {
     llvm::errs() << "sphc: error: --verlet-skin: " << InputFile << " has "
