@@ -87,7 +87,8 @@ static cl::opt<std::string> VerletSkin(
              "particles move between rebuilds and the sort when they left cell order (no "
              "periodic/mirror domain); both where the lists are written for (serial and openmp, double precision, "
              "no periodic/mirror domain, inlets, outlets or --mpi), off elsewhere (--report "
-             "says which); F in (0, 1]: that skin, an error elsewhere; off or 0: "
+             "says which); F in (0, 1]: that skin (also in single precision without "
+             "periodic/mirror domain), an error elsewhere; off or 0: "
              "the cell lists' neighbours at every evaluation. Sums over neighbours round "
              "differently with and without lists"),
     cl::value_desc("auto|F|off"), cl::init("auto"), cl::cat(SphcCat));
@@ -319,7 +320,12 @@ int main(int argc, char** argv) {
   auto verletUnsupported = [&](const Plan& p) -> std::string {
     if (Mpi) return "--mpi";
     if (Backend == sphc::Backend::OpenCL) return "--backend=opencl";
-    if (PrecisionOpt == sphc::Precision::Single) return "--precision=single";
+    // Single precision: written for (scenes without periodic or mirror sides), off by
+    // default: no faster than double with them (docs/performance.md, "Kept lists in single
+    // precision").
+    if (PrecisionOpt == sphc::Precision::Single)
+      return "--precision=single by default (--verlet-skin=F opts in where there is no "
+             "periodic or mirror domain)";
     if (p.domain.any() && ghostPairLoops(p))
       return "a periodic or mirror domain with a neighbour loop in a `real = false` group";
     // Kept with the lists, the ghosts let a particle sit up to half a support outside a

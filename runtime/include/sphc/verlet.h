@@ -232,8 +232,7 @@ class VerletSkin {
     moved_since_mark<true, true>(x ? x : s.x.data(), y ? y : s.y.data(), z ? z : s.z.data(), h,
                                  s, n, d2m, gm, nan);
   }
-  // Single precision: an axis missing below a present one does not occur (make_search_domain
-  // needs x, y, z in order); 2 d is then measured on the present axes with the zeros saved.
+  // Single precision: the same, with float zeros read for a missing axis (0 - 0 = +0).
   static void moved_since_missing(const float* x, const float* y, const float* z,
                                   const float* h, const MarkedPositions& s, long n, double& d2m,
                                   double& gm, bool& nan) {
