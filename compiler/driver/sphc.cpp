@@ -85,10 +85,9 @@ static cl::opt<std::string> VerletSkin(
              "(default): F = 0.1, the particles sorted in cell order every 50 neighbour "
              "updates; tuned: as auto, with F chosen at run time (from 0.1) from how far "
              "particles move between rebuilds and the sort when they left cell order (no "
-             "periodic/mirror domain); both where the lists are written for (serial and openmp, double precision, "
+             "periodic/mirror domain); both where the lists are written for (serial and openmp, "
              "no periodic/mirror domain, inlets, outlets or --mpi), off elsewhere (--report "
-             "says which); F in (0, 1]: that skin (also in single precision without "
-             "periodic/mirror domain), an error elsewhere; off or 0: "
+             "says which); F in (0, 1]: that skin, an error elsewhere; off or 0: "
              "the cell lists' neighbours at every evaluation. Sums over neighbours round "
              "differently with and without lists"),
     cl::value_desc("auto|F|off"), cl::init("auto"), cl::cat(SphcCat));
@@ -297,7 +296,8 @@ int main(int argc, char** argv) {
                     "precision (not with --backend=opencl or --precision=single yet)\n";
     return fail();
   }
-  // --verlet-skin: the host pair loops of one process, in double precision. auto: there,
+  // --verlet-skin: the host pair loops of one process (single precision: no periodic or
+  // mirror domain). auto: there,
   // with kAutoVerletSkin; a number: there only (an error elsewhere).
   // tuned: auto's support, with the skin and the sort chosen at run time (sphc/verlet_tune.h;
   // not the default: ~1% fewer instructions on the dam break, not seen in CPU time, and its
@@ -320,12 +320,10 @@ int main(int argc, char** argv) {
   auto verletUnsupported = [&](const Plan& p) -> std::string {
     if (Mpi) return "--mpi";
     if (Backend == sphc::Backend::OpenCL) return "--backend=opencl";
-    // Single precision: written for (scenes without periodic or mirror sides), off by
-    // default: no faster than double with them (docs/performance.md, "Kept lists in single
-    // precision").
-    if (PrecisionOpt == sphc::Precision::Single)
-      return "--precision=single by default (--verlet-skin=F opts in where there is no "
-             "periodic or mirror domain)";
+    // Single precision: written for scenes without periodic or mirror sides
+    // (docs/performance.md, "Kept lists in single precision").
+    if (PrecisionOpt == sphc::Precision::Single && p.domain.any())
+      return "--precision=single with a periodic or mirror domain";
     if (p.domain.any() && ghostPairLoops(p))
       return "a periodic or mirror domain with a neighbour loop in a `real = false` group";
     // Kept with the lists, the ghosts let a particle sit up to half a support outside a
