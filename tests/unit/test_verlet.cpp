@@ -464,10 +464,9 @@ TEST(VerletSkin, FloatCopiesAnswerAsTheirDoubles) {
   fa.upload(pa);
   VerletSkin on_doubles(skin), on_floats(skin);
   const std::vector<const ParticleArray*> d = {&pa};
-  const std::vector<const sphc::FloatArray*> f = {&fa};
-  EXPECT_TRUE(on_floats.must_rebuild(f, kRadiusScale));  // never built
+  EXPECT_TRUE(on_floats.must_rebuild({&fa}, kRadiusScale));  // never built
   on_doubles.mark(d);
-  on_floats.mark(f);
+  on_floats.mark({&fa});
   EXPECT_EQ(on_doubles.hmin(), on_floats.hmin());
   std::mt19937_64 rng(3);
   std::normal_distribution<double> step(0.0, 0.003 * h0);
@@ -480,17 +479,17 @@ TEST(VerletSkin, FloatCopiesAnswerAsTheirDoubles) {
       fa.f(ix)[i] = moved;
     }
     const bool a = on_doubles.must_rebuild(d, kRadiusScale);
-    const bool b = on_floats.must_rebuild(f, kRadiusScale);
+    const bool b = on_floats.must_rebuild({&fa}, kRadiusScale);
     EXPECT_EQ(a, b);
     EXPECT_EQ(on_doubles.last_moved(), on_floats.last_moved());
     if (a) {
       on_doubles.mark(d);
-      on_floats.mark(f);
+      on_floats.mark({&fa});
       ++rebuilds;
     }
   }
   EXPECT_GT(rebuilds, 0);  // the walk moved past the skin
   // A particle count change rebuilds, as over the doubles.
   fa.n += 1;
-  EXPECT_TRUE(on_floats.must_rebuild(f, kRadiusScale));
+  EXPECT_TRUE(on_floats.must_rebuild({&fa}, kRadiusScale));
 }

@@ -28,6 +28,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
@@ -109,10 +110,12 @@ class VerletSkin {
     return must_rebuild_of(arrays, radius_scale, phase);
   }
   // --precision=single: the same over the float copies the scene computes on (their floats
-  // read as doubles, exactly; the bound as above).
-  bool must_rebuild(const std::vector<const FloatArray*>& arrays, double radius_scale,
+  // read as doubles, exactly; the bound as above). An initializer list, not a vector: a
+  // vector's constructor from two iterators would make `{&a, &b}` of two ParticleArrays
+  // match it too (ambiguous).
+  bool must_rebuild(std::initializer_list<const FloatArray*> arrays, double radius_scale,
                     PhaseDisplacements* phase = nullptr) const {
-    return must_rebuild_of(arrays, radius_scale, phase);
+    return must_rebuild_of(std::vector<const FloatArray*>(arrays), radius_scale, phase);
   }
 
   // Records the positions and h of the arrays the lists are built from now (with `phase`: the
@@ -121,8 +124,8 @@ class VerletSkin {
             PhaseDisplacements* phase = nullptr) {
     mark_of(arrays, phase);
   }
-  void mark(const std::vector<const FloatArray*>& arrays, PhaseDisplacements* phase = nullptr) {
-    mark_of(arrays, phase);
+  void mark(std::initializer_list<const FloatArray*> arrays, PhaseDisplacements* phase = nullptr) {
+    mark_of(std::vector<const FloatArray*>(arrays), phase);
   }
 
  private:
