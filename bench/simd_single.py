@@ -55,6 +55,11 @@ ALL_VARIANTS = {
     # Double without kept lists (so per destination, as single precision, which has none).
     "double_nolists": ["--verlet-skin=off"],
     "double_nolists_simd": ["--verlet-skin=off", "--simd-pairs"],
+    # Single precision with and without kept lists (stop 34; docs/performance.md "Kept lists
+    # in single precision"): 0.1 is --verlet-skin=auto's skin.
+    "single_nolists": ["--precision=single", "--verlet-skin=off"],
+    "single_lists": ["--precision=single", "--verlet-skin=0.1"],
+    "single_lists_simd": ["--precision=single", "--verlet-skin=0.1", "--simd-pairs"],
 }
 VARIANTS = [(n, ALL_VARIANTS[n]) for n in ("double", "double_simd", "single", "single_simd")]
 
@@ -120,7 +125,7 @@ def main():
     ap.add_argument("--variants", default=None,
                     help="comma-separated, the first the base of the ratios (default: "
                     "double,double_simd,single,single_simd; also double_nolists, "
-                    "double_nolists_simd)")
+                    "double_nolists_simd, single_nolists, single_lists, single_lists_simd)")
     args = ap.parse_args()
     if args.variants:
         VARIANTS[:] = [(n, ALL_VARIANTS[n]) for n in args.variants.split(",")]

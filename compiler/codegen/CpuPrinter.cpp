@@ -23,7 +23,7 @@ class CpuPrinter : public ScenePrinter {
       : ScenePrinter(sched, diags, opts),
         openmp_(opts.backend == Backend::OpenMP),
         ompMinParticles_(opts.ompMinParticles),
-        verletSkin_(opts.verletSkin > 0 && !cpuSingle_ && !mpi_ && !ghostPairLoops() && !hasZones()
+        verletSkin_(opts.verletSkin > 0 && !(cpuSingle_ && hasDomain()) && !mpi_ && !ghostPairLoops() && !hasZones()
                         ? opts.verletSkin
                         : 0.0),
         tuned_(verletSkin_ > 0 && opts.verletAuto && !hasDomain()),
@@ -226,9 +226,19 @@ class CpuPrinter : public ScenePrinter {
   std::string hostData(int a) const {
     return (cpuSingle_ ? "f32_" + arr(a).name + ", " : std::string()) + arr(a).name;
   }
+  // The array whose positions and h the kept lists' displacement checks read: the host
+  // array, or (--precision=single) its float copy, which the scene computes on.
+  std::string positions(int a) const { return (cpuSingle_ ? "f32_" : "") + arr(a).name; }
+  // The statement that makes order_domain, the support's grid that permutations sort on
+  // (--verlet-skin): from `all` (loopArraysDecl), or (single) from the float positions.
+  std::string orderDomain() const;
   // `domain` = the search domain of every array in a neighbour loop, from its doubles or
   // (single) floats; with `only`, `dom` = the box of that array alone.
   void searchDomain(const std::string& only = "", const std::string& dom = "domain");
+  // --precision=single: the statement `dom = make_search_domain_float(...)` (its newline
+  // included) over `only` or every array of a neighbour loop, with cells of `radius`.
+  std::string floatDomain(const std::string& only, const std::string& dom,
+                          const std::string& radius) const;
   // Whether source S is static: nothing moves, adds or removes its particles, nor changes h
   // of any array in a neighbour loop (so the cell size is fixed), and it has no ghosts. Its
   // cell list is built once (build_static_cells), on a grid of its own box.
@@ -517,7 +527,7 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
     // --verlet-skin=tuned (CpuVerletTune.cpp's rebuildCheck); with neither array moving the
     // lists are built once.
     std::string arrays;
-    for (int a : movingArrays(d, s)) arrays += (arrays.empty() ? "{&" : ", &") + arr(a).name;
+    for (int a : movingArrays(d, s)) arrays += (arrays.empty() ? "{&" : ", &") + positions(a);
     const std::string range = rangeBegin(w) + ", " + rangeEnd(w);
     const std::string phase = phaseDisplacements_ ? ", &phase_moved" : "";
     if (arrays.empty()) {
@@ -525,7 +535,8 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
       scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ");\n";
     } else {
       arrays += "}";
-      if (arrays != (d == s ? "{&" + D + "}" : "{&" + D + ", &" + S + "}"))
+      if (arrays != (d == s ? "{&" + positions(d) + "}"
+                            : "{&" + positions(d) + ", &" + positions(s) + "}"))
         scene_ << "        // Checked over the array that moves (the other is static).\n";
       scene_ << "        const bool verlet_build = !" << lists << ".built_for(" << range << ") || "
              << lists << ".skin.must_rebuild(" << arrays << ", Kernel::radius_scale" << phase
@@ -709,23 +720,17 @@ void CpuPrinter::steppers() {
 }
 
 void CpuPrinter::searchDomain(const std::string& only, const std::string& dom) {
-  auto spans = [&](const std::string& a) {
-    return only.empty() ? loopArrays_.count(a) != 0 : a == only;
-  };
+  if (cpuSingle_ && verlet()) {
+    // Kept lists: cells as large as the lists' radius, as in double below (the static
+    // sources' grids and order_domain: the support's).
+    scene_ << "    " << floatDomain(only, dom,
+                                    only.empty() ? std::string("Kernel::radius_scale * (1.0 + ") +
+                                                       (tuned() ? "verlet_skin" : "VERLET_SKIN") + ")"
+                                                 : "Kernel::radius_scale");
+    return;
+  }
   if (cpuSingle_) {
-    // The search domain spans every array that takes part in a neighbour loop (float data).
-    const char* axes[3] = {"x", "y", "z"};
-    scene_ << "    " << dom << " = sphc::make_search_domain_float({";
-    bool first = true;
-    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
-      if (!spans(arr(a).name)) continue;
-      scene_ << (first ? "" : ",\n                                             ") << "{";
-      for (int k = 0; k < 3; ++k)
-        scene_ << (k < plan_.dim ? propPtr(a, axes[k]) : std::string("nullptr")) << ", ";
-      scene_ << propPtr(a, "h") << ", " << arr(a).name << ".n}";
-      first = false;
-    }
-    scene_ << "}, DIM, Kernel::radius_scale);\n";
+    scene_ << "    " << floatDomain(only, dom, "Kernel::radius_scale");
     return;
   }
   // The search domain spans every array that takes part in a neighbour loop.
@@ -742,6 +747,34 @@ void CpuPrinter::searchDomain(const std::string& only, const std::string& dom) {
     return;
   }
   scene_ << "    domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
+}
+
+std::string CpuPrinter::floatDomain(const std::string& only, const std::string& dom,
+                                    const std::string& radius) const {
+  auto spans = [&](const std::string& a) {
+    return only.empty() ? loopArrays_.count(a) != 0 : a == only;
+  };
+  // The search domain spans every array that takes part in a neighbour loop (float data).
+  const char* axes[3] = {"x", "y", "z"};
+  std::string r = dom + " = sphc::make_search_domain_float({";
+  bool first = true;
+  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+    if (!spans(arr(a).name)) continue;
+    r += std::string(first ? "" : ",\n                                             ") + "{";
+    for (int k = 0; k < 3; ++k)
+      r += (k < plan_.dim ? propPtr(a, axes[k]) : std::string("nullptr")) + ", ";
+    r += propPtr(a, "h") + ", " + arr(a).name + ".n}";
+    first = false;
+  }
+  return r + "}, DIM, " + radius + ");\n";
+}
+
+std::string CpuPrinter::orderDomain() const {
+  if (cpuSingle_) {
+    std::string r = floatDomain("", "order_domain", "Kernel::radius_scale");
+    return r.substr(0, r.size() - 1);  // one statement, without its newline
+  }
+  return "order_domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);";
 }
 
 std::string CpuPrinter::cellListBuild(const std::string& S, const std::string& count,
@@ -912,8 +945,7 @@ void CpuPrinter::updateNeighbours() {
   // --verlet-skin: permutations sort into the cell order of the support's grid (order_domain,
   // made as `domain` is without lists), so that the particles are in the order they have
   // without lists; the cell lists are then built on the lists' grid (`domain`).
-  const std::string orderDomain =
-      "order_domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);";
+  const std::string orderDomain = this->orderDomain();
   if (anyStatic()) {
     if (lazyCells())  // build_static_cells reads the lists' cell size
       scene_ << "    if (!static_cells_built) {  // once: they never move\n      make_domain();\n      "
@@ -1059,9 +1091,9 @@ void CpuPrinter::tunedRebuildCheck(const std::string& lists, const DestinationWo
   loop.begin = rangeBegin(w);
   loop.end = rangeEnd(w);
   loop.dest = arr(d).name;
-  for (int a : movingArrays(d, s)) loop.moving.push_back(arr(a).name);
+  for (int a : movingArrays(d, s)) loop.moving.push_back(positions(a));
   if (d != s && loop.moving.size() == 1)
-    loop.staticArray = loop.moving[0] == arr(d).name ? arr(s).name : arr(d).name;
+    loop.staticArray = loop.moving[0] == positions(d) ? arr(s).name : arr(d).name;
   loop.ranged = w.ranged();
   loop.clearUpper = d == s && symmetric_;
   loop.clearCross = crossSourceLists().count(lists) > 0;
@@ -1084,6 +1116,7 @@ void CpuPrinter::tunedUpdateNeighbours() {
   u.anyStatic = anyStatic();
   u.anyReorders = anyReorders();
   u.loopArraysDecl = loopArraysDecl();
+  u.orderDomain = orderDomain();
   for (const auto& S : sourceArrays_) {
     verlet_tune::Source src;
     src.name = S;
@@ -1107,6 +1140,7 @@ std::vector<std::string> CpuPrinter::movingSources() const {
 }
 
 std::string CpuPrinter::loopArraysDecl() const {
+  if (cpuSingle_) return "";  // the float domains name their arrays (floatDomain)
   std::vector<std::string> names;
   for (const auto& a : plan_.arrays)
     if (loopArrays_.count(a.name)) names.push_back(a.name);

@@ -77,8 +77,7 @@ void updateNeighbours(std::ostream& scene, const Update& u,
       scene << u.loopArraysDecl;  // for order_domain; the domain: make_domain (CpuLazyCells.cpp)
   }
   // Sorts go into the cell order of the support's grid (order_domain), as without lists.
-  const std::string orderDomain =
-      "order_domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);";
+  const std::string& orderDomain = u.orderDomain;
   if (u.anyStatic)
     scene << "    if (!static_cells_built) {  // once: they never move\n      " << orderDomain
           << "\n      build_static_cells();\n    }\n";

@@ -44,6 +44,7 @@ struct Update {
   bool anyStatic = false;
   bool anyReorders = false;
   std::string loopArraysDecl;  // lazy_cells::loopArraysDecl
+  std::string orderDomain;     // the statement that makes order_domain (CpuPrinter::orderDomain)
   std::vector<Source> sources;
 };
 // update_neighbours of a scene without periodic or mirror domain: the skin of the lists built

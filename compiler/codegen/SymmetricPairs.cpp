@@ -458,11 +458,11 @@ void ScenePrinter::emitPairQuantitiesOnce(const std::set<std::string>& q, bool b
                                           const std::string& body) {
   const PairDialect dialect = pairDialectOf(host_);
   auto difference = [&](const PairQuantity& pq, bool mirror) {
-    scene_ << body << "const double " << pq.name << (mirror ? "_ji" : "") << "[3] = {";
+    scene_ << body << "const " << dialect.real << " " << pq.name << (mirror ? "_ji" : "") << "[3] = {";
     for (int c = 0; c < 3; ++c) {
       scene_ << (c ? ", " : "");
       if (c >= plan_.dim)
-        scene_ << "0.0";
+        scene_ << "0.0" << dialect.literalSuffix;
       else if (mirror)
         scene_ << "sj_" << pq.components[c] << "[s_idx] - " << pq.components[c] << "i";
       else
@@ -482,7 +482,7 @@ void ScenePrinter::emitPairQuantitiesOnce(const std::set<std::string>& q, bool b
       // (h_j) -> DWI_ji.
       const std::string partner =
           pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
-      scene_ << body << "double " << pq.name << "[3], " << partner << "[3];\n";
+      scene_ << body << dialect.real << " " << pq.name << "[3], " << partner << "[3];\n";
       scene_ << body << "Kernel::gradient_pair(XIJ, XIJ_ji, RIJ, " << pq.h << ", " << pq.name
              << ", " << partner << ");\n";
     } else {

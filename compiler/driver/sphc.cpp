@@ -85,7 +85,7 @@ static cl::opt<std::string> VerletSkin(
              "(default): F = 0.1, the particles sorted in cell order every 50 neighbour "
              "updates; tuned: as auto, with F chosen at run time (from 0.1) from how far "
              "particles move between rebuilds and the sort when they left cell order (no "
-             "periodic/mirror domain); both where the lists are written for (serial and openmp, double precision, "
+             "periodic/mirror domain); both where the lists are written for (serial and openmp, "
              "no periodic/mirror domain, inlets, outlets or --mpi), off elsewhere (--report "
              "says which); F in (0, 1]: that skin, an error elsewhere; off or 0: "
              "the cell lists' neighbours at every evaluation. Sums over neighbours round "
@@ -291,7 +291,8 @@ int main(int argc, char** argv) {
                     "precision (not with --backend=opencl or --precision=single yet)\n";
     return fail();
   }
-  // --verlet-skin: the host pair loops of one process, in double precision. auto: there,
+  // --verlet-skin: the host pair loops of one process (single precision: no periodic or
+  // mirror domain). auto: there,
   // with kAutoVerletSkin; a number: there only (an error elsewhere).
   // tuned: auto's support, with the skin and the sort chosen at run time (sphc/verlet_tune.h;
   // not the default: ~1% fewer instructions on the dam break, not seen in CPU time, and its
@@ -314,7 +315,10 @@ int main(int argc, char** argv) {
   auto verletUnsupported = [&](const Plan& p) -> std::string {
     if (Mpi) return "--mpi";
     if (Backend == sphc::Backend::OpenCL) return "--backend=opencl";
-    if (PrecisionOpt == sphc::Precision::Single) return "--precision=single";
+    // Single precision: written for scenes without periodic or mirror sides
+    // (docs/performance.md, "Kept lists in single precision").
+    if (PrecisionOpt == sphc::Precision::Single && p.domain.any())
+      return "--precision=single with a periodic or mirror domain";
     if (p.domain.any() && ghostPairLoops(p))
       return "a periodic or mirror domain with a neighbour loop in a `real = false` group";
     // Kept with the lists, the ghosts let a particle sit up to half a support outside a
@@ -326,10 +330,9 @@ int main(int argc, char** argv) {
     if (!p.zones.empty()) return "inlets or outlets";
     return "";
   };
-  if (!verletAuto && verletSkin > 0.0 && (Mpi || Backend == sphc::Backend::OpenCL ||
-                                          PrecisionOpt == sphc::Precision::Single)) {
-    llvm::errs() << "sphc: error: --verlet-skin works with --backend=serial or openmp in double "
-                    "precision (not with --backend=opencl, --precision=single or --mpi)\n";
+  if (!verletAuto && verletSkin > 0.0 && (Mpi || Backend == sphc::Backend::OpenCL)) {
+    llvm::errs() << "sphc: error: --verlet-skin works with --backend=serial or openmp "
+                    "(not with --backend=opencl or --mpi)\n";
     return fail();
   }
   if (Mpi && Emit == EmitKind::Exe) {
@@ -454,6 +457,12 @@ int main(int argc, char** argv) {
   if (DumpAfter == Pass::Schedule) {
     printSchedule(*schedule, diags, llvm::outs());
     return 0;
+  }
+  if (verletSkin > 0.0 && PrecisionOpt == sphc::Precision::Single && schedule->domain) {
+    llvm::errs() << "sphc: error: --verlet-skin with --precision=single: " << InputFile
+                 << " has a periodic or mirror domain (kept lists in single precision are "
+                    "written for scenes without one)\n";
+    return fail();
   }
   if (verletSkin > 0.0 && ((schedule->domain && ghostPairLoops(*plan)) || !plan->zones.empty())) {
     llvm::errs() << "sphc: error: --verlet-skin: " << InputFile << " has "

@@ -34,6 +34,11 @@ void FloatArray::upload(const ParticleArray& a) {
   }
   constants.resize(a.constants.size());
   for (std::size_t c = 0; c < a.constants.size(); ++c) convert(a.constants[c].values, constants[c]);
+  const char* names[4] = {"x", "y", "z", "h"};
+  for (int k = 0; k < 4; ++k) {
+    const int i = a.find(names[k]);
+    position[k] = i >= 0 && a.props[i].type == PropType::F64 ? i : -1;
+  }
 }
 
 void FloatArray::download(ParticleArray& a) const {

@@ -449,3 +449,47 @@ TEST(SkinTuner, SortWhenTheParticlesLeftCellOrder) {
 }
 
 }  // namespace
+
+// --precision=single: the skin over the float copies (sphc::FloatArray) answers as over the
+// doubles the floats are (the same displacements, last_moved bit for bit), with its own
+// marked copy per array in a phase.
+TEST(VerletSkin, FloatCopiesAnswerAsTheirDoubles) {
+  const double skin = 0.1, h0 = 0.1;
+  ParticleArray pa = random_array(200, 3, 1.0, h0, 5, 0.8, 1.2);
+  // The host doubles rounded to float, so that both arrays hold the same values.
+  for (const char* p : {"x", "y", "z", "h"})
+    for (std::size_t i = 0; i < pa.n; ++i)
+      pa.f64(p)[i] = static_cast<float>(pa.f64(p)[i]);
+  sphc::FloatArray fa;
+  fa.upload(pa);
+  VerletSkin on_doubles(skin), on_floats(skin);
+  const std::vector<const ParticleArray*> d = {&pa};
+  EXPECT_TRUE(on_floats.must_rebuild({&fa}, kRadiusScale));  // never built
+  on_doubles.mark(d);
+  on_floats.mark({&fa});
+  EXPECT_EQ(on_doubles.hmin(), on_floats.hmin());
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> step(0.0, 0.003 * h0);
+  const int ix = pa.find("x");
+  int rebuilds = 0;
+  for (int s = 0; s < 100; ++s) {
+    for (std::size_t i = 0; i < pa.n; ++i) {
+      const float moved = static_cast<float>(pa.f64(ix)[i] + step(rng));
+      pa.f64(ix)[i] = moved;
+      fa.f(ix)[i] = moved;
+    }
+    const bool a = on_doubles.must_rebuild(d, kRadiusScale);
+    const bool b = on_floats.must_rebuild({&fa}, kRadiusScale);
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(on_doubles.last_moved(), on_floats.last_moved());
+    if (a) {
+      on_doubles.mark(d);
+      on_floats.mark({&fa});
+      ++rebuilds;
+    }
+  }
+  EXPECT_GT(rebuilds, 0);  // the walk moved past the skin
+  // A particle count change rebuilds, as over the doubles.
+  fa.n += 1;
+  EXPECT_TRUE(on_floats.must_rebuild({&fa}, kRadiusScale));
+}

@@ -23,9 +23,16 @@ struct FloatArray {
   std::vector<std::vector<float>> props;
   std::vector<std::vector<float>> constants;
   std::size_t n = 0;
+  // The host indices of x, y, z and h (-1 where absent), set by upload(): the kept lists'
+  // displacement checks read the float positions (sphc/verlet.h).
+  int position[4] = {-1, -1, -1, -1};
 
   float* f(int i) { return props[i].data(); }
   const float* f(int i) const { return props[i].data(); }
+  // Coordinate k (0 x, 1 y, 2 z) or h (3); nullptr where the array has none.
+  const float* position_of(int k) const {
+    return position[k] < 0 ? nullptr : props[position[k]].data();
+  }
   float* constant(int c) { return constants[c].data(); }
 
   // Sizes the copies as `a` and rounds its doubles (properties and constants) to float.

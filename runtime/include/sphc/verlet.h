@@ -28,9 +28,11 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
+#include "sphc/float_arrays.h"
 #include "sphc/particle_array.h"
 
 namespace sphc {
@@ -66,19 +68,21 @@ class PhaseDisplacements {
   }
   void add(const Moved& m) { moved_.push_back(m); }
   std::size_t scans() const { return moved_.size(); }  // the arrays measured in this phase
-  // The copy marked for `pa` in this phase (nullptr if none): the same positions now.
-  std::shared_ptr<const MarkedPositions> marked(const ParticleArray* pa) const {
+  // The copy marked for `pa` in this phase (nullptr if none): the same positions now. `pa` is
+  // a ParticleArray or (--precision=single) the FloatArray the scene computes on.
+  template <class Array>
+  std::shared_ptr<const MarkedPositions> marked(const Array* pa) const {
     for (const auto& m : marked_)
       if (m.first == pa && m.second->n == pa->n) return m.second;
     return nullptr;
   }
-  void add(const ParticleArray* pa, std::shared_ptr<const MarkedPositions> s) {
+  void add(const void* pa, std::shared_ptr<const MarkedPositions> s) {
     marked_.emplace_back(pa, std::move(s));
   }
 
  private:
   std::vector<Moved> moved_;
-  std::vector<std::pair<const ParticleArray*, std::shared_ptr<const MarkedPositions>>> marked_;
+  std::vector<std::pair<const void*, std::shared_ptr<const MarkedPositions>>> marked_;
 };
 
 class VerletSkin {
@@ -103,12 +107,37 @@ class VerletSkin {
   // already measured in this phase from the same marked copy is not scanned again.
   bool must_rebuild(const std::vector<const ParticleArray*>& arrays, double radius_scale,
                     PhaseDisplacements* phase = nullptr) const {
+    return must_rebuild_of(arrays, radius_scale, phase);
+  }
+  // --precision=single: the same over the float copies the scene computes on (their floats
+  // read as doubles, exactly; the bound as above). An initializer list, not a vector: a
+  // vector's constructor from two iterators would make `{&a, &b}` of two ParticleArrays
+  // match it too (ambiguous).
+  bool must_rebuild(std::initializer_list<const FloatArray*> arrays, double radius_scale,
+                    PhaseDisplacements* phase = nullptr) const {
+    return must_rebuild_of(std::vector<const FloatArray*>(arrays), radius_scale, phase);
+  }
+
+  // Records the positions and h of the arrays the lists are built from now (with `phase`: the
+  // copy another skin marked in this phase, the same positions, where there is one).
+  void mark(const std::vector<const ParticleArray*>& arrays,
+            PhaseDisplacements* phase = nullptr) {
+    mark_of(arrays, phase);
+  }
+  void mark(std::initializer_list<const FloatArray*> arrays, PhaseDisplacements* phase = nullptr) {
+    mark_of(std::vector<const FloatArray*>(arrays), phase);
+  }
+
+ private:
+  template <class Array>
+  bool must_rebuild_of(const std::vector<const Array*>& arrays, double radius_scale,
+                       PhaseDisplacements* phase) const {
     ++checks_;
     last_moved_ = -1.0;
     if (saved_.size() != arrays.size()) return true;
     double d2max = 0.0, growth = 0.0;
     for (std::size_t a = 0; a < arrays.size(); ++a) {
-      const ParticleArray& pa = *arrays[a];
+      const Array& pa = *arrays[a];
       const MarkedPositions& s = *saved_[a];
       if (pa.n != s.n) return true;
       const PhaseDisplacements::Moved* known = phase ? phase->find(&s) : nullptr;
@@ -131,15 +160,13 @@ class VerletSkin {
     return !(moved <= skin_ * radius_scale * hmin_);
   }
 
-  // Records the positions and h of the arrays the lists are built from now (with `phase`: the
-  // copy another skin marked in this phase, the same positions, where there is one).
-  void mark(const std::vector<const ParticleArray*>& arrays,
-            PhaseDisplacements* phase = nullptr) {
+  template <class Array>
+  void mark_of(const std::vector<const Array*>& arrays, PhaseDisplacements* phase) {
     checks_ = 0;
     saved_.resize(arrays.size());
     hmin_ = HUGE_VAL;
     for (std::size_t a = 0; a < arrays.size(); ++a) {
-      const ParticleArray& pa = *arrays[a];
+      const Array& pa = *arrays[a];
       std::shared_ptr<const MarkedPositions> s = phase ? phase->marked(&pa) : nullptr;
       if (!s) {
         s = copy_positions(pa);
@@ -150,35 +177,42 @@ class VerletSkin {
     }
   }
 
- private:
   // A coordinate array, nullptr if the array has none (y and z below 3D may be absent).
   static const double* coordinate(const ParticleArray& pa, const char* axis) {
     const int k = pa.find(axis);
     return k < 0 ? nullptr : pa.f64(k);
   }
-  static std::shared_ptr<const MarkedPositions> copy_positions(const ParticleArray& pa) {
+  static const double* h_of(const ParticleArray& pa) { return pa.f64("h"); }
+  static const float* coordinate(const FloatArray& pa, const char* axis) {
+    return pa.position_of(axis[0] - 'x');
+  }
+  static const float* h_of(const FloatArray& pa) { return pa.position_of(3); }
+  template <class Array>
+  static std::shared_ptr<const MarkedPositions> copy_positions(const Array& pa) {
     auto s = std::make_shared<MarkedPositions>();
     s->n = pa.n;
     const char* axes[3] = {"x", "y", "z"};
     std::vector<double>* to[3] = {&s->x, &s->y, &s->z};
     for (int k = 0; k < 3; ++k) {
-      const double* c = coordinate(pa, axes[k]);
+      const auto* c = coordinate(pa, axes[k]);
       if (c)
         to[k]->assign(c, c + pa.n);
       else
         to[k]->assign(pa.n, 0.0);
     }
-    s->h.assign(pa.f64("h"), pa.f64("h") + pa.n);
+    s->h.assign(h_of(pa), h_of(pa) + pa.n);
     for (double h : s->h) s->hmin = h < s->hmin ? h : s->hmin;
     return s;
   }
   // The largest squared displacement and growth of h of one array since its mark.
-  static void moved_since(const ParticleArray& pa, const MarkedPositions& s, double& d2m,
+  template <class Array>
+  static void moved_since(const Array& pa, const MarkedPositions& s, double& d2m,
                           double& gm, bool& nan) {
-    const double* x = coordinate(pa, "x");
-    const double* y = coordinate(pa, "y");
-    const double* z = coordinate(pa, "z");
-    const double* h = pa.f64("h");
+    const auto* x = coordinate(pa, "x");
+    const auto* y = coordinate(pa, "y");
+    const auto* z = coordinate(pa, "z");
+    const auto* h = h_of(pa);
+    const decltype(h) none = nullptr;  // a missing axis, of the array's type
     const long n = static_cast<long>(pa.n);
     // One loop per set of coordinates present (1D, 2D, 3D): no test of a missing axis per
     // particle. A missing axis was saved as zeros by mark(), so its term was +0 and d2, hence
@@ -188,19 +222,34 @@ class VerletSkin {
     if (x && y && z)
       moved_since_mark<true, true>(x, y, z, h, s, n, d2m, gm, nan);
     else if (x && y && !z)
-      moved_since_mark<true, false>(x, y, nullptr, h, s, n, d2m, gm, nan);
+      moved_since_mark<true, false>(x, y, none, h, s, n, d2m, gm, nan);
     else if (x && !y && !z)
-      moved_since_mark<false, false>(x, nullptr, nullptr, h, s, n, d2m, gm, nan);
+      moved_since_mark<false, false>(x, none, none, h, s, n, d2m, gm, nan);
     else
-      moved_since_mark<true, true>(x ? x : s.x.data(), y ? y : s.y.data(), z ? z : s.z.data(),
-                                   h, s, n, d2m, gm, nan);
+      moved_since_missing(x, y, z, h, s, n, d2m, gm, nan);
+  }
+  // An axis missing below a present one: the 3D loop with the saved zeros read for it.
+  static void moved_since_missing(const double* x, const double* y, const double* z,
+                                  const double* h, const MarkedPositions& s, long n, double& d2m,
+                                  double& gm, bool& nan) {
+    moved_since_mark<true, true>(x ? x : s.x.data(), y ? y : s.y.data(), z ? z : s.z.data(), h,
+                                 s, n, d2m, gm, nan);
+  }
+  // Single precision: the same, with float zeros read for a missing axis (0 - 0 = +0).
+  static void moved_since_missing(const float* x, const float* y, const float* z,
+                                  const float* h, const MarkedPositions& s, long n, double& d2m,
+                                  double& gm, bool& nan) {
+    std::vector<float> zeros(static_cast<std::size_t>(n), 0.0f);
+    moved_since_mark<true, true>(x ? x : zeros.data(), y ? y : zeros.data(),
+                                 z ? z : zeros.data(), h, s, n, d2m, gm, nan);
   }
   // The largest squared displacement and growth of h of one array since mark(), and whether
   // a NaN was met. OpenMP (from 16,384 particles, the runtime's threshold): a max reduction,
-  // whose value does not depend on the order.
-  template <bool HasY, bool HasZ>
-  static void moved_since_mark(const double* x, const double* y, const double* z,
-                               const double* h, const MarkedPositions& s, long n,
+  // whose value does not depend on the order. T: double, or float (--precision=single; each
+  // float read as the double it is).
+  template <bool HasY, bool HasZ, class T>
+  static void moved_since_mark(const T* x, const T* y, const T* z,
+                               const T* h, const MarkedPositions& s, long n,
                                double& d2max, double& growth, bool& nan_met) {
     const double* sx = s.x.data();
     const double* sy = s.y.data();
@@ -210,17 +259,17 @@ class VerletSkin {
     bool nan = false;
 #pragma omp parallel for schedule(static) reduction(max : d2m, gm) reduction(| : nan) if (n > 16384)
     for (long i = 0; i < n; ++i) {
-      const double dx = x[i] - sx[i];
+      const double dx = static_cast<double>(x[i]) - sx[i];
       double d2 = dx * dx;
       if (HasY) {
-        const double dy = y[i] - sy[i];
+        const double dy = static_cast<double>(y[i]) - sy[i];
         d2 = dx * dx + dy * dy;
         if (HasZ) {
-          const double dz = z[i] - sz[i];
+          const double dz = static_cast<double>(z[i]) - sz[i];
           d2 = dx * dx + dy * dy + dz * dz;
         }
       }
-      const double dh = h[i] - sh[i];
+      const double dh = static_cast<double>(h[i]) - sh[i];
       d2m = d2 > d2m ? d2 : d2m;
       gm = dh > gm ? dh : gm;
       nan = nan | (d2 != d2) | (dh != dh);
