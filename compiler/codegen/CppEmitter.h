@@ -51,6 +51,11 @@ struct EmitOptions {
   // of launches (sphc::ocl::build_tables); false (--no-batched-tables): CellTable::build per
   // source. The same tables, the same results bit for bit.
   bool batchedTables = true;
+  // --backend=opencl: the cell tables kept across neighbour updates on cells of (1 + skin)
+  // times the support while no source particle moved farther than the skin
+  // (sphc::ocl::KeptTables, --kept-cells=F); 0 (the default): built at every update.
+  // Needs batchedTables; scenes with periodic or mirror sides rebuild at every update.
+  double keptCellsSkin = 0.0;
   // Pair loops whose destination array is their source evaluate each pair once for both
   // particles where the bodies allow it (codegen/SymmetricPairs.cpp; CPU backends with kept
   // neighbour lists); false (--no-symmetric-pairs): each destination gathers from all its

@@ -3,6 +3,9 @@
 // the OpenMP loops), a kernel per group phase, destination and method, and per neighbour
 // pass (destination <- source). Only the buffers and scalars the bodies use are arguments.
 // Particle data stays on the device; `converged` tests run on the host.
+#include <algorithm>
+#include <cstdio>
+
 #include "codegen/Printer.h"
 
 namespace sphc {
@@ -12,7 +15,9 @@ namespace {
 class OpenCLPrinter : public ScenePrinter {
  public:
   OpenCLPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
-      : ScenePrinter(sched, diags, opts), batchedTables_(opts.batchedTables) {
+      : ScenePrinter(sched, diags, opts), batchedTables_(opts.batchedTables),
+        keptCells_(opts.keptCellsSkin > 0.0 && opts.batchedTables),
+        keptSkin_(opts.keptCellsSkin) {
     // Line 1 of the kernel source is this directive, so lines are the source's own.
     cl_ << "#line 2 \"" << plan_.sceneName << ".cl\"\n";
   }
@@ -146,6 +151,12 @@ class OpenCLPrinter : public ScenePrinter {
   std::string cellTablesBuild(const std::vector<std::pair<std::string, std::string>>& sources,
                               const std::string& indent) const;
   bool batchedTables_ = true;
+  bool keptCells_ = false;  // EmitOptions::keptCellsSkin > 0 (with batchedTables_)
+  double keptSkin_ = 0.0;
+  // update_neighbours with the cell tables kept across updates (keptCells_).
+  void updateNeighboursKept();
+  // The arrays of deviceExtents: whether each is a source ("{true, false}").
+  std::string extentSources() const;
   // The extents of the arrays in neighbour loops, for ocl.search_domain / ocl.make_grid.
   std::string deviceExtents(const std::string& indent) const;
 };
@@ -209,6 +220,12 @@ void OpenCLPrinter::searchMembers() {
   for (const auto& a : plan_.arrays) out_ << "  sphc::ocl::DeviceArray dev_" << a.name << ";\n";
   out_ << "  sphc::ocl::Grid grid;\n";
   for (const auto& S : sourceArrays_) out_ << "  sphc::ocl::CellTable cells_" << S << ";\n";
+  if (keptCells_ && !sourceArrays_.empty() && !hasDomain()) {
+    char skin[64];
+    std::snprintf(skin, sizeof skin, "%.17g", keptSkin_);
+    out_ << "  sphc::ocl::KeptTables kept{" << skin
+         << "};  // the cell tables kept across updates (--kept-cells)\n";
+  }
 }
 
 void OpenCLPrinter::dataMovement() {
@@ -261,6 +278,7 @@ std::string OpenCLPrinter::cellTablesBuild(
 // domain from min/max reductions, then a cell table per source (cell keys, bitonic sort, cell
 // start/end). Positions never leave the device.
 void OpenCLPrinter::updateNeighbours() {
+  if (keptCells_ && !sourceArrays_.empty()) return updateNeighboursKept();
   if (!loopArrays_.empty())
     scene_ << "    grid = ocl.make_grid(" << deviceExtents("                          ")
            << ", DIM, Kernel::radius_scale);\n";
@@ -289,6 +307,52 @@ void OpenCLPrinter::updateNeighbours() {
     scene_ << "    if (reorder) {\n      dev_" << S << ".permute(ocl, cells_" << S << ", " << S
            << ");\n      " << build << "\n    }\n";
   }
+}
+
+std::string OpenCLPrinter::extentSources() const {
+  std::string r = "{";
+  bool first = true;
+  for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a) {
+    if (!loopArrays_.count(arr(a).name)) continue;
+    const bool source = std::find(sourceArrays_.begin(), sourceArrays_.end(), arr(a).name) !=
+                        sourceArrays_.end();
+    r += std::string(first ? "" : ", ") + (source ? "true" : "false");
+    first = false;
+  }
+  return r + "}";
+}
+
+// update_neighbours with the cell tables kept (sphc::ocl::KeptTables): one kernel and one read
+// per update test how far the sources moved since the tables were built; the tables are built
+// again, on cells of (1 + skin) times the support, only when one moved too far, and at the
+// re-sort every REORDER_EVERY updates (in the cell order of cells of the support, as without
+// kept tables, so the particles' order is the same).
+void OpenCLPrinter::updateNeighboursKept() {
+  scene_ << "    // The cell tables are kept while no source particle moved past the cells' skin.\n";
+  scene_ << "    const bool rebuild = kept.update(ocl, " << deviceExtents(std::string(41, ' '))
+         << ",\n" << std::string(37, ' ') << extentSources() << ", DIM, Kernel::radius_scale);\n";
+  if (anyReorders())
+    scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n"
+           << "    if (!rebuild && !reorder) return;\n";
+  else
+    scene_ << "    if (!rebuild) return;\n";
+  std::vector<std::pair<std::string, std::string>> all, reordered;
+  for (const auto& S : sourceArrays_) {
+    all.push_back({S, S + ".n"});
+    if (reorders(S)) reordered.push_back({S, S + ".n"});  // not a ranged group's source
+  }
+  if (!reordered.empty()) {
+    scene_ << "    if (reorder) {  // in the cell order of cells of the support\n";
+    scene_ << "      grid = kept.grid(ocl, 0.0);\n";
+    scene_ << cellTablesBuild(reordered, "      ");
+    for (const auto& [S, count] : reordered)
+      scene_ << "      dev_" << S << ".permute(ocl, cells_" << S << ", " << S << ");\n";
+    scene_ << "    }\n";
+  }
+  scene_ << "    grid = kept.grid(ocl, kept.skin);\n";
+  scene_ << cellTablesBuild(all, "    ");
+  scene_ << "    kept.built(ocl, " << deviceExtents(std::string(20, ' ')) << ",\n"
+         << std::string(20, ' ') << extentSources() << ");\n";
 }
 
 // A run of stepper statements: its function, with each statement's time.

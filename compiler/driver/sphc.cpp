@@ -120,6 +120,15 @@ static cl::opt<bool> NoBatchedTables(
              "(default: the tables of all sources of an update in four launches per two "
              "sources; the same tables, the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<std::string> KeptCells(
+    "kept-cells",
+    cl::desc("--backend=opencl without periodic or mirror sides: keep the device's cell tables "
+             "across neighbour updates, on cells of (1 + F) times the support, until a source "
+             "particle moved farther than F times the support (a check kernel per update: 20 "
+             "launches per dam-break step, not 26); off (default): built at every update. Sums "
+             "over neighbours round differently with and without (not measured to pay on PoCL: "
+             "docs/performance.md)"),
+    cl::value_desc("off|F"), cl::init("off"), cl::cat(SphcCat));
 static cl::opt<bool> NoSymmetricPairs(
     "no-symmetric-pairs",
     cl::desc("Evaluate every pair of a pair loop for each of its two particles (default: where "
@@ -311,6 +320,15 @@ int main(int argc, char** argv) {
       return fail();
     }
   }
+  // --kept-cells: off, or the skin of the device's kept cell tables.
+  double keptCellsSkin = 0.0;
+  if (KeptCells != "off" &&
+      (llvm::StringRef(KeptCells).getAsDouble(keptCellsSkin) ||
+       !(keptCellsSkin > 0.0 && keptCellsSkin <= 1.0))) {
+    llvm::errs() << "sphc: error: --kept-cells=" << KeptCells
+                 << ": off, or the skin as a fraction of the support radius, in (0, 1]\n";
+    return fail();
+  }
   // Why the lists cannot be kept in this build or scene ("": they can).
   auto verletUnsupported = [&](const Plan& p) -> std::string {
     if (Mpi) return "--mpi";
@@ -478,6 +496,7 @@ int main(int argc, char** argv) {
   emitOpts.ompMinParticles = OmpMinParticles;
   emitOpts.verletAuto = verletTuned;  // --verlet-skin=tuned: the skin and re-sort chosen at run time
   emitOpts.batchedTables = !NoBatchedTables;
+  emitOpts.keptCellsSkin = keptCellsSkin;
   emitOpts.splitUnits = !SingleUnit && Emit == EmitKind::Exe;
   emitOpts.symmetricPairs = !NoSymmetricPairs;
   // --pair-shared-values: on (the default, also bare) or off.

@@ -299,6 +299,48 @@ __kernel void sphc_extent(const int dim, const uint na, __global const real* xa,
   partial[6] = hmax;
 }
 
+// sphc_extent with the largest squared displacement since the kept cell tables' build
+// (KeptTables): 8 values per work item, the 8th the max over the particles of a tracked array
+// (track_a, track_b) of |x - x0|^2 (infinity where it is not finite).
+inline void sphc_moved_of(const uint n, const int dim, const int track, __global const real* x,
+                          __global const real* y, __global const real* z,
+                          __global const real* x0, __global const real* y0,
+                          __global const real* z0, real* moved) {
+  if (!track) return;
+  const uint g = get_global_id(0), G = get_global_size(0);
+  for (uint i = g; i < n; i += G) {
+    const real dx = x[i] - x0[i], dy = dim > 1 ? y[i] - y0[i] : (real)0,
+               dz = dim > 2 ? z[i] - z0[i] : (real)0;
+    const real d2 = dx * dx + dy * dy + dz * dz;
+    *moved = isfinite(d2) ? fmax(*moved, d2) : (real)INFINITY;
+  }
+}
+__kernel void sphc_extent_moved(const int dim, const uint na, __global const real* xa,
+                                __global const real* ya, __global const real* za,
+                                __global const real* ha, const int track_a,
+                                __global const real* x0a, __global const real* y0a,
+                                __global const real* z0a, const uint nb,
+                                __global const real* xb, __global const real* yb,
+                                __global const real* zb, __global const real* hb,
+                                const int track_b, __global const real* x0b,
+                                __global const real* y0b, __global const real* z0b,
+                                const uint offset, __global real* partial) {
+  const uint g = get_global_id(0);
+  real lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  real hmax = -INFINITY, moved = 0;
+  sphc_extent_of(na, dim, xa, ya, za, ha, lo, hi, &hmax);
+  sphc_extent_of(nb, dim, xb, yb, zb, hb, lo, hi, &hmax);
+  sphc_moved_of(na, dim, track_a, xa, ya, za, x0a, y0a, z0a, &moved);
+  sphc_moved_of(nb, dim, track_b, xb, yb, zb, x0b, y0b, z0b, &moved);
+  partial += offset + 8 * g;
+  for (int a = 0; a < 3; ++a) {
+    partial[2 * a] = lo[a];
+    partial[2 * a + 1] = hi[a];
+  }
+  partial[6] = hmax;
+  partial[7] = moved;
+}
+
 // Partial reductions: work item g combines v[g], v[g + G], ... (G work items).
 __kernel void sphc_reduce(__global const real* v, const uint n, const int op,
                           const int finite_only, const uint offset, __global real* partial) {
@@ -994,6 +1036,115 @@ int real_prop(const ParticleArray& a, const char* name) {
   return i >= 0 && a.props[i].type == PropType::F64 && a.props[i].stride == 1 ? i : -1;
 }
 }  // namespace
+
+// ---- KeptTables ----------------------------------------------------------------------------
+
+bool KeptTables::update(Context& ctx, const std::vector<Extent>& arrays,
+                        const std::vector<bool>& sources, int dim, double radius_scale) {
+  ++updates;
+  dim_ = dim;
+  radius_scale_ = radius_scale;
+  if (pos_.size() != arrays.size()) {
+    release();
+    pos_.resize(arrays.size());
+    valid_ = false;
+  }
+  // One kernel per two arrays (as Context::search_domain), one read of all partial results.
+  const std::size_t per = 8 * Context::kPartials;
+  const std::size_t launches = (arrays.size() + 1) / 2;
+  cl_mem partial = ctx.scratch(per * (launches ? launches : 1), -3);
+  for (std::size_t k = 0; k < launches; ++k) {
+    cl_kernel kern = ctx.kernel("sphc_extent_moved");
+    cl_uint i = 0;
+    ctx.set_arg(kern, i, dim);
+    for (std::size_t j = 2 * k; j < 2 * k + 2; ++j) {
+      const bool real = j < arrays.size();
+      const Extent& e = arrays[real ? j : 2 * k];  // none: n = 0
+      // Tracked: a source whose positions were recorded at the last build (same count).
+      const bool track = real && valid_ && j < sources.size() && sources[j] && pos_[j].x0;
+      const Positions& p = pos_[real ? j : 2 * k];
+      ctx.set_arg(kern, i, static_cast<unsigned>(real ? e.n : 0));
+      for (cl_mem m : {e.x, e.y ? e.y : e.x, e.z ? e.z : e.x, e.h}) ctx.set_arg(kern, i, m);
+      ctx.set_arg(kern, i, track ? 1 : 0);
+      for (cl_mem m : {p.x0, p.y0, p.z0}) ctx.set_arg(kern, i, m ? m : e.x);
+    }
+    ctx.set_arg(kern, i, static_cast<unsigned>(k * per));
+    ctx.set_arg(kern, i, partial);
+    ctx.launch(kern, Context::kPartials, "sphc_extent_moved");
+  }
+  std::vector<double> values(per * launches);
+  ctx.read_reals(partial, values.data(), values.size());
+  for (int a = 0; a < 3; ++a) {
+    lo_[a] = HUGE_VAL;
+    hi_[a] = -HUGE_VAL;
+  }
+  hmax_ = -HUGE_VAL;
+  double moved2 = 0.0;
+  for (std::size_t j = 0; j < values.size(); j += 8) {
+    for (int a = 0; a < dim; ++a) {
+      lo_[a] = std::fmin(lo_[a], values[j + 2 * a]);
+      hi_[a] = std::fmax(hi_[a], values[j + 2 * a + 1]);
+    }
+    hmax_ = std::fmax(hmax_, values[j + 6]);
+    moved2 = std::isnan(values[j + 7]) ? HUGE_VAL : std::fmax(moved2, values[j + 7]);
+  }
+  if (!valid_) return true;
+  for (std::size_t j = 0; j < arrays.size(); ++j)
+    if (arrays[j].n != pos_[j].n) return true;  // particles added or removed
+  // A source particle within the support of a destination now was within support + moved of
+  // it at the build: within one cell of it while that is at most the cell side. A small
+  // margin for the rounding of the cell coordinates.
+  const double support = radius_scale * hmax_;
+  const double margin = ctx.double_precision() ? 1e-9 : 1e-4;
+  return !(std::sqrt(moved2) + support <= cell_ * (1.0 - margin));
+}
+
+Grid KeptTables::grid(const Context& ctx, double cell_skin) const {
+  return ctx.grid_of(search_domain_of_box(lo_, hi_, hmax_, dim_, radius_scale_ * (1.0 + cell_skin)));
+}
+
+void KeptTables::built(Context& ctx, const std::vector<Extent>& arrays,
+                       const std::vector<bool>& sources) {
+  ++builds;
+  const std::size_t rs = ctx.real_size();
+  const SearchDomain dom = search_domain_of_box(lo_, hi_, hmax_, dim_, radius_scale_ * (1.0 + skin));
+  cell_ = dom.cell_size;
+  for (std::size_t j = 0; j < arrays.size() && j < pos_.size(); ++j) {
+    const Extent& e = arrays[j];
+    Positions& p = pos_[j];
+    p.n = e.n;
+    if (j >= sources.size() || !sources[j] || e.n == 0) continue;
+    if (p.capacity < e.n) {
+      p.release();
+      p.capacity = e.n;
+      p.x0 = ctx.alloc(e.n * rs);
+      if (e.y) p.y0 = ctx.alloc(e.n * rs);
+      if (e.z) p.z0 = ctx.alloc(e.n * rs);
+    }
+    const cl_mem from[3] = {e.x, e.y, e.z}, to[3] = {p.x0, p.y0, p.z0};
+    for (int a = 0; a < 3; ++a)
+      if (from[a])
+        check(clEnqueueCopyBuffer(ctx.queue(), from[a], to[a], 0, 0, e.n * rs, 0, nullptr,
+                                  nullptr),
+              "clEnqueueCopyBuffer (kept positions)");
+  }
+  valid_ = true;
+}
+
+void KeptTables::Positions::release() {
+  for (cl_mem* m : {&x0, &y0, &z0})
+    if (*m) {
+      clReleaseMemObject(*m);
+      *m = nullptr;
+    }
+  capacity = 0;
+}
+
+void KeptTables::release() {
+  for (Positions& p : pos_) p.release();
+  pos_.clear();
+  valid_ = false;
+}
 
 void check_neighbour_lists(Context& ctx, cl_mem counts, std::size_t n, int capacity,
                            const char* what) {

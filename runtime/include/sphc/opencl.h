@@ -219,6 +219,44 @@ class Context {
   std::map<std::string, std::pair<double, long>> profile_times_;
 };
 
+// Cell tables kept across neighbour updates (the update_neighbours of --backend=opencl without
+// periodic or mirror sides; sphc --no-kept-cells rebuilds at every update): the tables are
+// built on cells of (1 + skin) times the support and kept while no source particle has moved
+// farther than the cell side minus the support since the build. The pair kernels keep their
+// exact test r < support, so the 3^dim cells around a destination's current cell still hold
+// every neighbour. The check is one kernel per two arrays (the search domain's extents, max h
+// and the sources' largest displacement) and one read, as Context::search_domain.
+struct KeptTables {
+  explicit KeptTables(double skin_ = 0.1) : skin(skin_) {}
+  double skin;  // as a fraction of the support (sphc --kept-cells=F)
+  long updates = 0, builds = 0;
+  // Whether the tables must be built again: the first update, a count changed, a source
+  // particle moved too far (or to a non-finite position), or the support grew past the cells.
+  // `sources`: per array of `arrays`, whether it is a source (its positions are tracked).
+  bool update(Context& ctx, const std::vector<Extent>& arrays, const std::vector<bool>& sources,
+              int dim, double radius_scale);
+  // The grid of the last update's extents with cells of (1 + cell_skin) times the support
+  // (0: Context::make_grid's grid, the cell order of a re-sort).
+  Grid grid(const Context& ctx, double cell_skin) const;
+  // After the tables were built on grid(ctx, skin) (and the particles re-sorted): records the
+  // positions of the sources (a device copy per axis) and the cell side.
+  void built(Context& ctx, const std::vector<Extent>& arrays, const std::vector<bool>& sources);
+  void release();
+  ~KeptTables() { release(); }
+
+ private:
+  struct Positions {
+    cl_mem x0 = nullptr, y0 = nullptr, z0 = nullptr;
+    std::size_t capacity = 0, n = 0;
+    void release();
+  };
+  std::vector<Positions> pos_;
+  bool valid_ = false;
+  int dim_ = 1;
+  double radius_scale_ = 1.0, cell_ = 0.0, hmax_ = 0.0;
+  double lo_[3] = {0.0, 0.0, 0.0}, hi_[3] = {0.0, 0.0, 0.0};
+};
+
 // loop_all on the device: each work item gathers its neighbour list in private memory of
 // `capacity` entries and writes how many neighbours it found to `counts` (n reals). Throws
 // std::runtime_error naming the pass (`what`: "fluid <- fluid") and the largest count when
