@@ -107,6 +107,16 @@ SCENE_FILES = {
 }
 
 
+def build_variants(sphc, scene, path, flags, variants, tmp):
+    """Builds scene (the file path, sphc flags common to all) once per variant ([(name, sphc
+    flags)]) into tmp/SCENE_NAME: {name: executable}, in the variants' order."""
+    exes = {}
+    for name, vflags in variants:
+        exes[name] = os.path.join(tmp, "%s_%s" % (scene, name))
+        run([sphc, path, "-o", exes[name]] + flags + vflags)
+    return exes
+
+
 def cpu_per_step_rounds(exes, options, short, long_, rounds):
     """CPU seconds (user + system) per step of each executable ({name: path}), (long - short
     run) / steps, without output, on one OpenMP thread; the executables interleaved, `rounds`

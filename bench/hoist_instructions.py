@@ -29,9 +29,9 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (CALLGRIND_FLAGS, SCENE_FILES, callgrind_build_run,  # noqa: E402
-                    group_instructions, instruction_parser, instructions,
-                    load_average, remove_tmp, run)
+from common import (build_variants, CALLGRIND_FLAGS, SCENE_FILES,  # noqa: E402
+                    callgrind_build_run, group_instructions, instruction_parser,
+                    instructions, load_average, remove_tmp, run)
 
 # scene: (file, run-time options)
 SCENES = {
@@ -53,10 +53,7 @@ def cpu_per_step(args, tmp):
                                         "us / particle-step"))
     for scene in args.scenes.split(","):
         path, options, particles, short, long_ = CPU_SCENES[scene]
-        exes = {}
-        for name, flags in VARIANTS:
-            exes[name] = os.path.join(tmp, "%s_%s" % (scene, name))
-            run([args.sphc, path, "-o", exes[name]] + flags)
+        exes = build_variants(args.sphc, scene, path, [], VARIANTS, tmp)
         per = {name: [] for name, _ in VARIANTS}
         for r in range(args.rounds):
             for name, _ in VARIANTS:
@@ -95,7 +92,8 @@ def main():
         base = gbase = None
         for name, flags in VARIANTS:
             exe = os.path.join(tmp, "%s_%s" % (scene, name))
-            cg = callgrind_build_run(args.sphc, path, exe, ["--cxxflags", CALLGRIND_FLAGS] + flags, options)
+            cg = callgrind_build_run(args.sphc, path, exe,
+                                     ["--cxxflags", CALLGRIND_FLAGS] + flags, options)
             n = instructions(cg)
             g = group_instructions(cg)
             base = base or n

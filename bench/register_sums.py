@@ -29,9 +29,9 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (CALLGRIND_FLAGS, cpu_or_instructions, SCENE_FILES,  # noqa: E402
-                    cpu_per_step_rounds, group_instructions, instruction_parser,
-                    instructions, run)
+from common import (build_variants, CALLGRIND_FLAGS, cpu_or_instructions,  # noqa: E402
+                    SCENE_FILES, cpu_per_step_rounds, group_instructions,
+                    instruction_parser, instructions, run)
 
 # The dam break with PySPH's effects (bench/time_to_solution.py): its sphc defines and options.
 PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
@@ -86,10 +86,7 @@ def cpu_per_step(args, tmp):
           "builds, variants interleaved")
     for scene in args.scenes.split(","):
         path, sflags, options, short, long_ = CPU_SCENES[scene]
-        exes = {}
-        for name, flags in VARIANTS:
-            exes[name] = os.path.join(tmp, "%s_%s" % (scene, name))
-            run([args.sphc, path, "-o", exes[name]] + sflags + flags)
+        exes = build_variants(args.sphc, scene, path, sflags, VARIANTS, tmp)
         per = cpu_per_step_rounds(exes, options, short, long_, args.rounds)
         best = {name: min(v) for name, v in per.items()}
         print("%-15s memory %.4f s, locals %.4f s per step (min of %d): locals / memory = %.3f"

@@ -22,8 +22,8 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (SCENE_FILES, cpu_per_step_rounds, instruction_parser,  # noqa: E402
-                    load_average, remove_tmp, run)
+from common import (build_variants, SCENE_FILES, cpu_per_step_rounds,  # noqa: E402
+                    instruction_parser, load_average, remove_tmp)
 
 PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
 # scene: (file, sphc flags, run-time options, short steps, long steps); ~100k particles
@@ -53,11 +53,8 @@ def main():
     print("load average before: %s" % load_average())
     for scene in args.scenes.split(","):
         path, sflags, options, short, long_ = SCENES[scene]
-        exes = {}
         variants = VARIANTS + ([("ns", ["--no-symmetric-pairs"])] if args.with_ns else [])
-        for name, flags in variants:
-            exes[name] = os.path.join(tmp, "%s_%s" % (scene, name))
-            run([args.sphc, path, "-o", exes[name]] + sflags + flags)
+        exes = build_variants(args.sphc, scene, path, sflags, variants, tmp)
         per = cpu_per_step_rounds(exes, options, short, long_, args.rounds)
         d, s = per["default"], per["simd"]
         print("%-15s steps %d-%d, min of %d: default %.4f s, simd %.4f s per step: simd / default "

@@ -28,8 +28,9 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from common import (CALLGRIND_FLAGS, cpu_or_instructions, ROOT, SCENE_FILES,  # noqa: E402
-                    cpu_per_step_rounds, instruction_parser, instructions, run)
+from common import (build_variants, CALLGRIND_FLAGS, cpu_or_instructions, ROOT,  # noqa: E402
+                    SCENE_FILES, cpu_per_step_rounds, instruction_parser,
+                    instructions, run)
 
 PYSPH_EFFECTS = ["-D", "density_diffusion=off", "-D", "shifting=off"]
 DAMBREAK3D = os.path.join(ROOT, "examples", "dambreak3d.sph")
@@ -101,10 +102,7 @@ def cpu_per_step(args, tmp):
           "builds, variants interleaved; min (median) over %d rounds, / double" % args.rounds)
     for scene in args.scenes.split(","):
         path, sflags, options, short, long_ = CPU_SCENES[scene]
-        exes = {}
-        for name, flags in VARIANTS:
-            exes[name] = os.path.join(tmp, "%s_%s" % (scene, name))
-            run([args.sphc, path, "-o", exes[name]] + sflags + flags)
+        exes = build_variants(args.sphc, scene, path, sflags, VARIANTS, tmp)
         per = cpu_per_step_rounds(exes, options, short, long_, args.rounds)
         lo = {n: min(v) for n, v in per.items()}
         med = {n: statistics.median(v) for n, v in per.items()}
