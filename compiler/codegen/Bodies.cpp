@@ -318,7 +318,7 @@ std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int
       // the site's function on the call's own arguments.
       auto it = pairSharedScope_.find(eqValues + "/" + p.name);
       if (it != pairSharedScope_.end()) {
-        s += it->second;
+        s += it->second.local;
         continue;
       }
       std::string base = fn;

@@ -71,9 +71,12 @@ class CpuPrinter : public ScenePrinter {
   // then pass it.
   void phasePrologue(const Phase& ph) override;
   bool phaseDisplacements_ = false;
+  // The loop bodies called both ways by the each-pair-once loops (codegen/PairShared.cpp).
+  std::set<const PlanBody*> pairSharedBodies() const override;
+  // Whether the pass over w's own array is printed each pair once (emitSymmetricPass).
+  bool symmetricPass(const DestinationWork& w, const NeighbourPass& pass) const;
   // The destinations {A, B} of w's phase whose pair loops A <- B and B <- A run as one pass
   // (crossPairsRefusal; kept lists; OpenMP in blocks), where w is A or B; {} elsewhere.
-  std::set<const PlanBody*> pairSharedBodies() const override;
   std::pair<const DestinationWork*, const DestinationWork*> crossPair(
       const DestinationWork& w) const;
   // OpenMP: the kept lists of the A <- B loops run with B <- A as one pass, each with the
@@ -420,8 +423,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, w, s) : "";
     listsRebuildCheck(lists, w, s);
-    if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty() &&
-        !simdPairsRefusal(w, pass).empty()) {  // --simd-pairs: per destination in SIMD lanes
+    if (symmetricPass(w, pass)) {
       emitSymmetricPass(w, pass, lists, openmp_,
                         tuned() ? "verlet_radius2" : "VERLET_RADIUS2");  // codegen/SymmetricPairs.cpp
       scene_ << "      }\n";
@@ -577,14 +579,20 @@ std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
   return found;
 }
 
+// Whether the pass over w's own array is printed each pair once (SymmetricPairs.cpp): not in
+// SIMD lanes per destination (--simd-pairs), not with periodic or mirror ghosts.
+bool CpuPrinter::symmetricPass(const DestinationWork& w, const NeighbourPass& pass) const {
+  return symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty() &&
+         !simdPairsRefusal(w, pass).empty();
+}
+
 // The bodies the each-pair-once loops call both ways (the conditions of the printing above):
 // those of a pass over its own array, and those of one declaration on both sides of a cross
 // pass.
 std::set<const PlanBody*> CpuPrinter::pairSharedBodies() const {
   std::set<const PlanBody*> bodies;
   walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w, const NeighbourPass& pass) {
-    if (symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty() &&
-        !simdPairsRefusal(w, pass).empty())
+    if (symmetricPass(w, pass))
       for (const PlanEquation* eq : pass.equations) bodies.insert(&methodBody(*eq, ast::Method::Loop));
     const auto [A, B] = crossPair(w);
     if (A && &w == A)

@@ -179,12 +179,9 @@ void ScenePrinter::emitPairSharedLocals(std::ostream& os, const std::string& ind
       }
       os << indent << "const double " << local << " = " << call << ");  // " << eq->name
          << ": " << (sites[k].sign < 0 ? "minus this" : "the same") << " for (s_idx, d_idx)\n";
-      pairSharedScope_[eqStruct(*eq) + "/" + K(k)] = local;
-      pairSharedSign_[eqStruct(*eq) + "/" + K(k)] = sites[k].sign;
-      for (const PlanEquation* m : users) {
-        pairSharedScope_[eqStruct(*m) + "/" + K(k)] = local;
-        pairSharedSign_[eqStruct(*m) + "/" + K(k)] = sites[k].sign;
-      }
+      pairSharedScope_[eqStruct(*eq) + "/" + K(k)] = {local, sites[k].sign};
+      for (const PlanEquation* m : users)
+        pairSharedScope_[eqStruct(*m) + "/" + K(k)] = {local, sites[k].sign};
     }
   }
 }

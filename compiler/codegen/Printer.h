@@ -218,13 +218,14 @@ class ScenePrinter {
   void emitPairSharedLocals(std::ostream& os, const std::string& indent, int dest,
                             const std::vector<const PlanEquation*>& direct,
                             const std::vector<const PlanEquation*>& mirrored) const;
-  void endPairShared() const {
-    pairSharedScope_.clear();
-    pairSharedSign_.clear();
-  }
-  // eqValues + "/" + K -> the local (mirrored calls: "-" before it for an antisymmetric one).
-  mutable std::map<std::string, std::string> pairSharedScope_;
-  mutable std::map<std::string, int> pairSharedSign_;  // the same keys: 1 or -1
+  void endPairShared() const { pairSharedScope_.clear(); }
+  // A value computed once for the pair: its local, and 1 or -1 (the mirrored calls pass "-"
+  // before the local of an antisymmetric one).
+  struct PairSharedLocal {
+    std::string local;
+    int sign = 1;
+  };
+  mutable std::map<std::string, PairSharedLocal> pairSharedScope_;  // eqValues + "/" + K
   bool pairShared_ = false;  // EmitOptions::pairShared (CPU double, not mpi, not --simd-pairs)
   mutable std::unique_ptr<std::set<const PlanBody*>> pairSharedBodies_;  // (once)
 

@@ -243,7 +243,7 @@ std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest,
       case BodyParam::PairShared: {  // computed once for the pair (codegen/PairShared.cpp)
         auto it = pairSharedScope_.find(eqValues + "/" + p.name);
         if (it == pairSharedScope_.end()) return "";  // callBody: computed in the call
-        return (pairSharedSign_.at(it->first) < 0 ? "-" : "") + it->second;
+        return (it->second.sign < 0 ? "-" : "") + it->second.local;
       }
       case BodyParam::DProp: return pointers.empty() ? "" : pointers + "d_" + p.name;
       case BodyParam::SProp: return pointers.empty() ? "" : pointers + "s_" + p.name;
