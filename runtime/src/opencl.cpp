@@ -418,6 +418,27 @@ int env_int(const char* name) {
   return v && *v ? std::atoi(v) : -1;
 }
 
+// The search domain's extents from the partial results of sphc_extent (stride 7) or
+// sphc_extent_moved (stride 8: the 8th the squared displacement, its largest in *moved2, a
+// NaN read as infinite): lo, hi over the first dim axes and the largest h.
+void combine_extents(const std::vector<double>& values, std::size_t stride, int dim,
+                     double lo[3], double hi[3], double& hmax, double* moved2 = nullptr) {
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = HUGE_VAL;
+    hi[a] = -HUGE_VAL;
+  }
+  hmax = -HUGE_VAL;
+  if (moved2) *moved2 = 0.0;
+  for (std::size_t j = 0; j < values.size(); j += stride) {
+    for (int a = 0; a < dim; ++a) {
+      lo[a] = std::fmin(lo[a], values[j + 2 * a]);
+      hi[a] = std::fmax(hi[a], values[j + 2 * a + 1]);
+    }
+    hmax = std::fmax(hmax, values[j + 6]);
+    if (moved2) *moved2 = std::isnan(values[j + 7]) ? HUGE_VAL : std::fmax(*moved2, values[j + 7]);
+  }
+}
+
 }  // namespace
 
 const char* error_name(cl_int err) {
@@ -736,8 +757,6 @@ void Context::read_reals(cl_mem m, double* out, std::size_t n) {
 
 SearchDomain Context::search_domain(const std::vector<Extent>& arrays, int dim,
                                     double radius_scale) {
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-  double hmax = -HUGE_VAL;
   // One partial-extent kernel per two arrays, one read of all partial results.
   const std::size_t per = 7 * kReduceItems;
   const std::size_t launches = (arrays.size() + 1) / 2;
@@ -760,13 +779,8 @@ SearchDomain Context::search_domain(const std::vector<Extent>& arrays, int dim,
   }
   std::vector<double> values(per * launches);
   read_reals(partial, values.data(), values.size());
-  for (std::size_t j = 0; j < values.size(); j += 7) {
-    for (int a = 0; a < dim; ++a) {
-      lo[a] = std::fmin(lo[a], values[j + 2 * a]);
-      hi[a] = std::fmax(hi[a], values[j + 2 * a + 1]);
-    }
-    hmax = std::fmax(hmax, values[j + 6]);
-  }
+  double lo[3], hi[3], hmax;
+  combine_extents(values, 7, dim, lo, hi, hmax);
   // As sphc::make_search_domain, so that in double precision the grid, hence the cell order
   // and the particle order after a reorder, is the CPU one.
   return search_domain_of_box(lo, hi, hmax, dim, radius_scale);
@@ -1074,20 +1088,8 @@ bool KeptTables::update(Context& ctx, const std::vector<Extent>& arrays,
   }
   std::vector<double> values(per * launches);
   ctx.read_reals(partial, values.data(), values.size());
-  for (int a = 0; a < 3; ++a) {
-    lo_[a] = HUGE_VAL;
-    hi_[a] = -HUGE_VAL;
-  }
-  hmax_ = -HUGE_VAL;
   double moved2 = 0.0;
-  for (std::size_t j = 0; j < values.size(); j += 8) {
-    for (int a = 0; a < dim; ++a) {
-      lo_[a] = std::fmin(lo_[a], values[j + 2 * a]);
-      hi_[a] = std::fmax(hi_[a], values[j + 2 * a + 1]);
-    }
-    hmax_ = std::fmax(hmax_, values[j + 6]);
-    moved2 = std::isnan(values[j + 7]) ? HUGE_VAL : std::fmax(moved2, values[j + 7]);
-  }
+  combine_extents(values, 8, dim, lo_, hi_, hmax_, &moved2);
   if (!valid_) return true;
   for (std::size_t j = 0; j < arrays.size(); ++j)
     if (arrays[j].n != pos_[j].n) return true;  // particles added or removed
