@@ -1,14 +1,19 @@
 // --simd-pairs=auto by the CPU the solver is built for (SimdCpu.h).
 //
-// What was measured (docs/performance.md), CPU of the cube (bench/cube.sph, 103,823
-// particles), the lanes against the scalar loops that evaluate each pair once:
-//   AMD EPYC Zen 5 (family 0x1A, stop 33): 0.82-0.86 of the scalar step; the 3D dam breaks
+// What was measured (docs/performance.md, "SIMD pair loops by the CPU"), CPU per step of the
+// lanes against the scalar loops that evaluate each pair once, serial:
+//   AMD EPYC Zen 5 (family 0x1A, AVX-512; stop 33): the cube 0.82-0.86, the 3D dam breaks
 //     0.86-0.93.
-//   Intel Xeon Emerald Rapids (family 6, model 207, stop 35): 1.43x the scalar step.
-// The rule goes by the vendor and the family: the lanes on AMD family 0x1A and later; the
-// scalar loops on Intel (every model: their 512-bit and 256-bit dividers and square roots
-// deliver a lane's result no faster than twice the scalar unit's, stop 35) and on every CPU
-// not measured (the scalar loops were the default before stop 33 on every machine).
+//   Intel Xeon Emerald Rapids (family 6, model 207, AVX-512; stop 35): the cube, dambreak3d
+//     and the DualSPHysics scene 1.56-1.60: GCC 12 does not know the model, tunes for
+//     `generic`, which has no gathers, and leaves the loop scalar (each pair twice). Forced
+//     to gather (-mtune=sapphirerapids) the lanes take 1.00-1.12 of the cube's step and
+//     0.85-0.90 of the dam breaks'; the build does not do that (not kept).
+//   Without AVX-512 (-march=x86-64-v3) GCC 12 does not vectorise the loops at all: the
+//     bodies' divisions under an `if` need masked divisions to be if-converted.
+// The rule: the lanes on AMD family 0x1A and later with AVX-512F; the scalar loops on Intel,
+// without AVX-512F, and on every CPU not measured (the scalar loops were the default before
+// stop 33 on every machine).
 #include "codegen/SimdCpu.h"
 
 #include <cstdio>

@@ -172,11 +172,12 @@ static cl::opt<std::string> SimdCpuOpt(
     "simd-cpu",
     cl::desc("The CPU --simd-pairs=auto chooses for (codegen/SimdCpu.cpp): host (default: "
              "this machine's cpuid, the CPU that -march=native builds for) or "
-             "VENDOR:FAMILY:MODEL as cpuid gives them (GenuineIntel:6:207, AuthenticAMD:26:2). "
-             "The lanes where they were measured to pay: AMD family 26 (Zen 5) and later; the "
-             "scalar loops on Intel (they lose there) and on CPUs not measured. sphc -v and "
-             "--report say which and why"),
-    cl::value_desc("host|VENDOR:FAMILY:MODEL"), cl::init("host"), cl::cat(SphcCat));
+             "VENDOR:FAMILY:MODEL as cpuid gives them (GenuineIntel:6:207, AuthenticAMD:26:2), "
+             "with :noavx512 for a CPU without AVX-512F. The lanes where they were measured "
+             "to pay: AMD family 26 (Zen 5) and later with AVX-512F; the scalar loops on "
+             "Intel (they lose there), without AVX-512F (GCC does not vectorise them) and on "
+             "CPUs not measured. sphc -v and --report say which and why"),
+    cl::value_desc("host|VENDOR:FAMILY:MODEL[:noavx512]"), cl::init("host"), cl::cat(SphcCat));
 static cl::opt<bool> NoLazyCells(
     "no-lazy-cells",
     cl::desc("With kept neighbour lists, build the search domain and cell lists at every "
