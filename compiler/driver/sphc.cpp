@@ -545,7 +545,8 @@ int main(int argc, char** argv) {
       emitOpts.simdCpu.why = "--cxxflags without -march=native build for a CPU sphc does not "
                              "know (--simd-cpu names it): the scalar loops";
     }
-    if (Verbose && emitOpts.simdPairsAuto && emitOpts.simdPairs)
+    if (Verbose && emitOpts.simdPairsAuto && emitOpts.simdPairs &&
+        Backend != sphc::Backend::OpenCL && !Mpi)  // the CPU backends' lanes
       llvm::errs() << "sphc: --simd-pairs=auto: " << emitOpts.simdCpu.why
                    << (emitOpts.simdCpu.lanes ? ": pair loops with 30 or more neighbours "
                                                 "expected in SIMD lanes"
