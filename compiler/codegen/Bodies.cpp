@@ -44,6 +44,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   registerSums_ = opts.registerSums && opts.backend != Backend::OpenCL && !mpi_;
   simdPairs_ = opts.simdPairs && registerSums_;  // SimdPairs.cpp: on the sums in locals
   simdAuto_ = opts.simdPairsAuto;
+  simdCpu_ = opts.simdCpu;
   simdSymmetric_ = opts.symmetricPairs && opts.verletSkin > 0 && !hasZones() && !hasDomain();
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in
   // lanes); --simd-pairs=on prints every loop that allows it per destination.

@@ -5,6 +5,7 @@
 // holding the body as written (with `// from file.sph:line` provenance and `#line`).
 #pragma once
 
+#include "codegen/SimdCpu.h"
 #include "codegen/Schedule.h"
 #include "frontend/Diagnostics.h"
 #include "sema/Plan.h"
@@ -99,6 +100,9 @@ struct EmitOptions {
   // loops where it pays (codegen/SimdPairs.cpp, simdPairsAutoChoice): those whose expected
   // neighbour count reaches kSimdAutoNeighbours.
   bool simdPairsAuto = false;
+  // --simd-pairs=auto: whether the lanes pay on the CPU the solver is built for, and why
+  // (codegen/SimdCpu.h; the driver reads the host's cpuid, or --simd-cpu).
+  SimdCpuVerdict simdCpu;
 };
 
 // --simd-pairs=auto: a pair loop is put in SIMD lanes where its expected neighbour count

@@ -366,6 +366,7 @@ class ScenePrinter {
   // --report: per pair loop, whether it is in SIMD lanes and why (nothing with the switch off).
   std::vector<std::string> simdPairsNotes() const;
   bool simdAuto_ = false;           // EmitOptions::simdPairsAuto
+  SimdCpuVerdict simdCpu_;          // EmitOptions::simdCpu: the lanes on this CPU (auto)
   bool simdSymmetric_ = false;      // EmitOptions::symmetricPairs, kept lists (for the choice)
   std::unique_ptr<std::set<int>> simdDecls_;  // equation declarations whose _simd form is used
 

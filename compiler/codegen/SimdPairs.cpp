@@ -165,7 +165,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   std::string how;
   const std::optional<double> n = expectedNeighbours(plan_, w.array, pass.source, how);
   // h/dx not known before the run: by the dimension (h = 1.3 dx: 3D 74 neighbours, 2D 21).
-  const bool lanes = n ? *n >= kSimdAutoNeighbours : plan_.dim == 3;
+  bool lanes = n ? *n >= kSimdAutoNeighbours : plan_.dim == 3;
   char buf[160];
   if (n)
     std::snprintf(buf, sizeof buf, "~%.0f neighbours expected (%s) %s %g: ", *n, how.c_str(),
@@ -174,11 +174,17 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
     std::snprintf(buf, sizeof buf, "h/dx not known before the run, by the dimension (%s): ",
                   how.c_str());
   std::string why = buf;
+  // The CPU the solver is built for (SimdCpu.cpp): where the lanes lose, the scalar loops.
+  if (lanes && !simdCpu_.lanes) {
+    lanes = false;
+    why.replace(why.size() - 2, 2, ", but " + simdCpu_.why + ": ");
+  }
   if (eachPairOncePossible(w, pass))
     why += lanes ? "the lanes pay more than each pair once" : "each pair once pays more";
   else
     why += lanes ? "the lanes pay more than the scalar loop per destination"
                  : "scalar per destination (--simd-pairs=on puts it in lanes)";
+  if (lanes && !simdCpu_.why.empty()) why += " (" + simdCpu_.why + ")";
   return {lanes, why};
 }
 

@@ -158,7 +158,8 @@ static cl::opt<std::string> SimdPairs(
              "may process the neighbours of a destination in SIMD lanes: `#pragma omp simd` "
              "with the destination's sums as reductions, built with -fopenmp-simd; such a loop "
              "is per destination even where each pair could be evaluated once. auto "
-             "(default): where it pays, the loops where 30 or more neighbours are expected in "
+             "(default): where it pays, on a CPU where the lanes pay (--simd-cpu), the loops "
+             "where 30 or more neighbours are expected in "
              "the support (from the dimension, the kernel's support and h/dx with the scene's "
              "defaults; where they are not known before the run, 3D yes, 2D no: with h = 1.3 "
              "dx and a support of 2 h, 74 and 21 neighbours; below 30, each pair once pays "
@@ -167,6 +168,16 @@ static cl::opt<std::string> SimdPairs(
              "in the lanes, so results differ from the scalar loop's in the last bits "
              "(serial and openmp stay bitwise equal)"),
     cl::value_desc("auto|on|off"), cl::ValueOptional, cl::init("auto"), cl::cat(SphcCat));
+static cl::opt<std::string> SimdCpuOpt(
+    "simd-cpu",
+    cl::desc("The CPU --simd-pairs=auto chooses for (codegen/SimdCpu.cpp): host (default: "
+             "this machine's cpuid, the CPU that -march=native builds for) or "
+             "VENDOR:FAMILY:MODEL as cpuid gives them (GenuineIntel:6:207, AuthenticAMD:26:2), "
+             "with :noavx512 for a CPU without AVX-512F. The lanes where they were measured "
+             "to pay: AMD family 26 (Zen 5) and later with AVX-512F; the scalar loops on "
+             "Intel (they lose there), without AVX-512F (GCC does not vectorise them) and on "
+             "CPUs not measured. sphc -v and --report say which and why"),
+    cl::value_desc("host|VENDOR:FAMILY:MODEL[:noavx512]"), cl::init("host"), cl::cat(SphcCat));
 static cl::opt<bool> NoLazyCells(
     "no-lazy-cells",
     cl::desc("With kept neighbour lists, build the search domain and cell lists at every "
@@ -517,6 +528,31 @@ int main(int argc, char** argv) {
   }
   emitOpts.simdPairs = simdMode != "off";
   emitOpts.simdPairsAuto = simdMode == "auto";
+  // --simd-pairs=auto goes by the CPU the solver is built for: this machine's (the default
+  // flags have -march=native), or the one --simd-cpu names (codegen/SimdCpu.cpp).
+  {
+    SimdCpu cpu;
+    if (SimdCpuOpt == "host") {
+      cpu = hostSimdCpu();
+    } else if (std::string why; !parseSimdCpu(SimdCpuOpt, cpu, why)) {
+      llvm::errs() << "sphc: error: --simd-cpu=" << SimdCpuOpt << ": " << why << "\n";
+      return fail();
+    }
+    emitOpts.simdCpu = simdLanesOnCpu(cpu);
+    if (SimdCpuOpt == "host" && !CxxFlags.empty() &&
+        CxxFlags.find("-march=native") == std::string::npos) {
+      emitOpts.simdCpu.lanes = false;
+      emitOpts.simdCpu.why = "--cxxflags without -march=native build for a CPU sphc does not "
+                             "know (--simd-cpu names it): the scalar loops";
+    }
+    if (Verbose && emitOpts.simdPairsAuto && emitOpts.simdPairs &&
+        Backend != sphc::Backend::OpenCL && !Mpi)  // the CPU backends' lanes
+      llvm::errs() << "sphc: --simd-pairs=auto: " << emitOpts.simdCpu.why
+                   << (emitOpts.simdCpu.lanes ? ": pair loops with 30 or more neighbours "
+                                                "expected in SIMD lanes"
+                                              : ": no pair loop in SIMD lanes")
+                   << " (--simd-pairs=on|off override it; --report says per loop)\n";
+  }
   if (Report && Emit != EmitKind::OpenCL)
     for (const std::string& note : sphc::pairLoopNotes(*schedule, diags, emitOpts))
       llvm::outs() << "note: " << note << "\n";

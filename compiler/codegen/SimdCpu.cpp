@@ -1,0 +1,109 @@
+// --simd-pairs=auto by the CPU the solver is built for (SimdCpu.h).
+//
+// What was measured (docs/performance.md, "SIMD pair loops by the CPU"), CPU per step of the
+// lanes against the scalar loops that evaluate each pair once, serial:
+//   AMD EPYC Zen 5 (family 0x1A, AVX-512; stop 33): the cube 0.82-0.86, the 3D dam breaks
+//     0.86-0.93.
+//   Intel Xeon Emerald Rapids (family 6, model 207, AVX-512; stop 35): the cube, dambreak3d
+//     and the DualSPHysics scene 1.56-1.60: GCC 12 does not know the model, tunes for
+//     `generic`, which has no gathers, and leaves the loop scalar (each pair twice). Forced
+//     to gather (-mtune=sapphirerapids) the lanes take 1.00-1.12 of the cube's step and
+//     0.85-0.90 of the dam breaks'; the build does not do that (not kept).
+//   Without AVX-512 (-march=x86-64-v3) GCC 12 does not vectorise the loops at all: the
+//     bodies' divisions under an `if` need masked divisions to be if-converted.
+// The rule: the lanes on AMD family 0x1A and later with AVX-512F; the scalar loops on Intel,
+// without AVX-512F, and on every CPU not measured (the scalar loops were the default before
+// stop 33 on every machine).
+#include "codegen/SimdCpu.h"
+
+#include <cstdio>
+#include <cstdlib>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <cpuid.h>
+#endif
+
+namespace sphc {
+
+std::string SimdCpu::describe() const {
+  std::string s = vendor.empty() ? std::string("a CPU that is not x86") : vendor;
+  if (!vendor.empty())
+    s += " family " + std::to_string(family) + " model " + std::to_string(model);
+  if (!vendor.empty() && !avx512f) s += " without AVX-512";
+  if (!origin.empty()) s += " (" + origin + ")";
+  return s;
+}
+
+SimdCpu hostSimdCpu() {
+  SimdCpu cpu;
+  cpu.origin = "this machine";
+#if defined(__x86_64__) || defined(__i386__)
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  if (!__get_cpuid(0, &eax, &ebx, &ecx, &edx)) return cpu;
+  char v[13];
+  for (int i = 0; i < 4; ++i) {
+    v[i] = static_cast<char>(ebx >> (8 * i));
+    v[4 + i] = static_cast<char>(edx >> (8 * i));
+    v[8 + i] = static_cast<char>(ecx >> (8 * i));
+  }
+  v[12] = 0;
+  cpu.vendor = v;
+  if (!__get_cpuid(1, &eax, &ebx, &ecx, &edx)) return cpu;
+  const int base = (eax >> 8) & 0xf, ext = (eax >> 20) & 0xff;
+  const int model = (eax >> 4) & 0xf, extModel = (eax >> 16) & 0xf;
+  cpu.family = base == 0xf ? base + ext : base;
+  cpu.model = base == 0x6 || base == 0xf ? (extModel << 4) + model : model;
+  __builtin_cpu_init();
+  cpu.avx512f = __builtin_cpu_supports("avx512f");
+#endif
+  return cpu;
+}
+
+bool parseSimdCpu(const std::string& input, SimdCpu& cpu, std::string& why) {
+  const std::string suffix = ":noavx512";
+  const bool noAvx512 = input.size() > suffix.size() &&
+                        input.compare(input.size() - suffix.size(), suffix.size(), suffix) == 0;
+  const std::string text = noAvx512 ? input.substr(0, input.size() - suffix.size()) : input;
+  const size_t a = text.find(':'), b = a == std::string::npos ? a : text.find(':', a + 1);
+  auto number = [](const std::string& s, int& out) {
+    if (s.empty()) return false;
+    char* end = nullptr;
+    const long v = std::strtol(s.c_str(), &end, 0);
+    if (*end || v < 0 || v > 0xffff) return false;
+    out = static_cast<int>(v);
+    return true;
+  };
+  SimdCpu c;
+  c.origin = "--simd-cpu";
+  if (a == 0 || b == std::string::npos || text.find(':', b + 1) != std::string::npos ||
+      !number(text.substr(a + 1, b - a - 1), c.family) || !number(text.substr(b + 1), c.model)) {
+    why = "it is VENDOR:FAMILY:MODEL as cpuid gives them (GenuineIntel:6:207, "
+          "AuthenticAMD:0x1a:2), :noavx512 after them for a CPU without AVX-512F";
+    return false;
+  }
+  c.vendor = text.substr(0, a);
+  c.avx512f = !noAvx512;
+  cpu = c;
+  return true;
+}
+
+SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu) {
+  SimdCpuVerdict v;
+  if (!cpu.vendor.empty() && !cpu.avx512f) {
+    v.lanes = false;
+    v.why = "on " + cpu.describe() + " GCC does not vectorise the loops (no masked divisions "
+            "to if-convert the bodies' branches): the scalar loops";
+  } else if (cpu.vendor == "AuthenticAMD" && cpu.family >= 0x1a) {
+    v.lanes = true;
+    v.why = "on " + cpu.describe() + " (AMD Zen 5 and later) the lanes pay";
+  } else if (cpu.vendor == "GenuineIntel") {
+    v.lanes = false;
+    v.why = "on " + cpu.describe() + " (Intel) the lanes cost more than the scalar loops";
+  } else {
+    v.lanes = false;
+    v.why = "on " + cpu.describe() + " the lanes were not measured: the scalar loops";
+  }
+  return v;
+}
+
+}  // namespace sphc
