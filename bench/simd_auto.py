@@ -17,7 +17,7 @@ compiler's choice), serial and OpenMP:
   2 threads); min and median over the rounds. On a loaded machine only ratios of interleaved
   runs mean something.
 
-Usage: python3 bench/simd_auto.py [--scenes cube20,cube47,...] [--variants off,on,auto]
+Usage: python3 bench/simd_auto.py [--scenes cube20,cube47,...] [--variants off,on,auto,once]
        [--rounds 3] [--no-callgrind] [--no-cpu] [--backends serial,openmp]
 """
 
@@ -57,6 +57,7 @@ SCENES = {
                            ["--set", "cfl=0.3", "--set", "hdx=2.0"], (20, 60), (20, 320), None),
 }
 VARIANT_FLAGS = {"off": ["--simd-pairs=off"], "on": ["--simd-pairs=on"], "auto": [],
+                 "once": ["--simd-pairs=once"],
                  "legacy_off": [], "legacy_on": ["--simd-pairs"]}
 
 
