@@ -59,7 +59,8 @@ SCENES = {
 GATHER_FLAGS = ("-std=c++17 -O3 -march=native -mtune-ctrl=use_gather -fno-math-errno "
                 "-ffp-contract=off")
 VARIANT_FLAGS = {"off": ["--simd-pairs=off"], "on": ["--simd-pairs=on"], "auto": [],
-                 "once": ["--simd-pairs=once"],
+                 "once": ["--simd-pairs=once"], "perdest": ["--simd-pairs=perdest"],
+                 "perdest_gather": ["--simd-pairs=perdest", "--cxxflags=" + GATHER_FLAGS],
                  # The driver's flags with GCC's gathers allowed (-mtune-ctrl=use_gather): GCC
                  # 12.2 (Debian 12.2.0-14+deb12u1) tuning for `generic` (what -march=native
                  # gives on the stop-35 Intel machine, cooperlake) uses no gathers, and the

@@ -99,7 +99,8 @@ struct EmitOptions {
   // loops where it pays (codegen/SimdPairs.cpp, simdPairsAutoChoice): those whose expected
   // neighbour count reaches kSimdAutoNeighbours.
   bool simdPairsAuto = false;
-  // --simd-pairs=once (with simdPairs and simdPairsAuto: auto's choice of loops): a loop in
+  // --simd-pairs=auto or once (with simdPairs and simdPairsAuto: auto's choice of loops; not
+  // --simd-pairs=perdest, stop 33-34's auto): a loop in
   // lanes that may evaluate each pair once (same array, kept lists, double precision) is
   // printed each pair once in the lanes, the values the pair shares once per pair, the source
   // side added by a masked scatter (codegen/SimdPairs.cpp, emitSymmetricSimdLoops).

@@ -179,7 +179,9 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
                   how.c_str());
   std::string why = buf;
   if (eachPairOncePossible(w, pass))
-    why += lanes ? "the lanes pay more than each pair once" : "each pair once pays more";
+    why += lanes ? (simdOnce_ && pass.source == w.array ? "the lanes pay, each pair once in them"
+                                                         : "the lanes pay more than each pair once")
+                 : "each pair once pays more";
   else
     why += lanes ? "the lanes pay more than the scalar loop per destination"
                  : "scalar per destination (--simd-pairs=on puts it in lanes)";
@@ -271,7 +273,7 @@ std::vector<std::string> ScenePrinter::simdPairsNotes() const {
       notes.push_back("pair loop not in SIMD lanes: " + loop + ": " + why);
     else if (onceLanes(w, pass))
       notes.push_back("pair loop in SIMD lanes, each pair once: " + loop +
-                      ": --simd-pairs=once: " + simdPairsAutoChoice(w, pass).why);
+                      ": --simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why);
     else
       notes.push_back("pair loop in SIMD lanes: " + loop + ": " +
                       (simdAuto_ ? "--simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why

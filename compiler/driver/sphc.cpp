@@ -163,12 +163,14 @@ static cl::opt<std::string> SimdPairs(
              "defaults; where they are not known before the run, 3D yes, 2D no: with h = 1.3 "
              "dx and a support of 2 h, 74 and 21 neighbours; below 30, each pair once pays "
              "more); on (or --simd-pairs alone): every loop that allows it; off: the "
-             "scalar loops; once: auto's loops, those over their own array (kept lists, double "
-             "precision) each pair once in the lanes, the source side scattered (measured: "
-             "docs/performance.md, stop 35). --report says per loop which and why. The sums are reassociated "
+             "scalar loops. Under auto a loop in lanes over its own array (kept lists, double "
+             "precision) evaluates each pair once in them, the values the pair shares once, "
+             "the source side gathered and scattered (once: the same; perdest: auto's loops "
+             "per destination, the default before stop 35; docs/performance.md). --report says "
+             "per loop which and why. The sums are reassociated "
              "in the lanes, so results differ from the scalar loop's in the last bits "
              "(serial and openmp stay bitwise equal)"),
-    cl::value_desc("auto|on|off|once"), cl::ValueOptional, cl::init("auto"), cl::cat(SphcCat));
+    cl::value_desc("auto|on|off|once|perdest"), cl::ValueOptional, cl::init("auto"), cl::cat(SphcCat));
 static cl::opt<bool> NoLazyCells(
     "no-lazy-cells",
     cl::desc("With kept neighbour lists, build the search domain and cell lists at every "
@@ -513,13 +515,17 @@ int main(int argc, char** argv) {
   emitOpts.registerSums = !NoRegisterSums;
   // --simd-pairs: auto (the default), on (also bare), off; the lanes only on the CPU backends.
   const std::string simdMode = SimdPairs.empty() ? std::string("on") : SimdPairs.getValue();
-  if (simdMode != "auto" && simdMode != "on" && simdMode != "off" && simdMode != "once") {
-    llvm::errs() << "sphc: error: --simd-pairs=" << simdMode << ": it is auto, on, off or once\n";
+  if (simdMode != "auto" && simdMode != "on" && simdMode != "off" && simdMode != "once" &&
+      simdMode != "perdest") {
+    llvm::errs() << "sphc: error: --simd-pairs=" << simdMode
+                 << ": it is auto, on, off, once or perdest\n";
     return fail();
   }
   emitOpts.simdPairs = simdMode != "off";
-  emitOpts.simdPairsAuto = simdMode == "auto" || simdMode == "once";
-  emitOpts.simdPairsOnce = simdMode == "once";
+  // auto (= once since stop 35): the loops that pay in lanes, each pair once in them where
+  // they may; perdest: the same loops per destination (stops 33-34's auto).
+  emitOpts.simdPairsAuto = simdMode == "auto" || simdMode == "once" || simdMode == "perdest";
+  emitOpts.simdPairsOnce = simdMode == "auto" || simdMode == "once";
   if (Report && Emit != EmitKind::OpenCL)
     for (const std::string& note : sphc::pairLoopNotes(*schedule, diags, emitOpts))
       llvm::outs() << "note: " << note << "\n";
