@@ -17,7 +17,7 @@ compiler's choice), serial and OpenMP:
   2 threads); min and median over the rounds. On a loaded machine only ratios of interleaved
   runs mean something.
 
-Usage: python3 bench/simd_auto.py [--scenes cube20,cube47,...] [--variants off,on,auto]
+Usage: python3 bench/simd_auto.py [--scenes cube20,cube47,...] [--variants off,on,auto,once]
        [--rounds 3] [--no-callgrind] [--no-cpu] [--backends serial,openmp]
 """
 
@@ -56,7 +56,17 @@ SCENES = {
     "dambreak_pysph_h20": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
                            ["--set", "cfl=0.3", "--set", "hdx=2.0"], (20, 60), (20, 320), None),
 }
+GATHER_FLAGS = ("-std=c++17 -O3 -march=native -mtune-ctrl=use_gather -fno-math-errno "
+                "-ffp-contract=off")
 VARIANT_FLAGS = {"off": ["--simd-pairs=off"], "on": ["--simd-pairs=on"], "auto": [],
+                 "once": ["--simd-pairs=once"], "perdest": ["--simd-pairs=perdest"],
+                 "perdest_gather": ["--simd-pairs=perdest", "--cxxflags=" + GATHER_FLAGS],
+                 # The driver's flags with GCC's gathers allowed (-mtune-ctrl=use_gather): GCC
+                 # 12.2 (Debian 12.2.0-14+deb12u1) tuning for `generic` (what -march=native
+                 # gives on the stop-35 Intel machine, cooperlake) uses no gathers, and the
+                 # loops printed in lanes stay scalar without it.
+                 "auto_gather": ["--cxxflags=" + GATHER_FLAGS],
+                 "once_gather": ["--simd-pairs=once", "--cxxflags=" + GATHER_FLAGS],
                  "legacy_off": [], "legacy_on": ["--simd-pairs"]}
 
 

@@ -46,6 +46,8 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   simdAuto_ = opts.simdPairsAuto;
   simdCpu_ = opts.simdCpu;
   simdSymmetric_ = opts.symmetricPairs && opts.verletSkin > 0 && !hasZones() && !hasDomain();
+  // SimdPairs.cpp: each pair once in the lanes (double precision: the pair-shared values).
+  simdOnce_ = opts.simdPairsOnce && simdPairs_ && simdSymmetric_ && !singlePrecision_;
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in
   // lanes); --simd-pairs=on prints every loop that allows it per destination.
   pairShared_ = opts.pairShared && host_.hoist && (!simdPairs_ || simdAuto_);
@@ -323,10 +325,13 @@ std::string ScenePrinter::callBody(const std::string& fn, const PlanBody& b, int
         continue;
       }
       std::string base = fn;
+      bool simd = false;  // NAME_loop_simd: the value's _simd form (PairShared.cpp)
       for (const char* suffix : {"_sums", "_simd"})
-        if (base.size() > 5 && base.compare(base.size() - 5, 5, suffix) == 0)
+        if (base.size() > 5 && base.compare(base.size() - 5, 5, suffix) == 0) {
+          simd = std::string(suffix) == "_simd";
           base.erase(base.size() - 5);
-      std::string call = base + "_pairshared" + p.name + "(";
+        }
+      std::string call = base + "_pairshared" + p.name + (simd ? "_simd" : "") + "(";
       bool firstArg = true;
       for (const auto& q : pairSharedParams(b, dest, host_)) {
         call += firstArg ? "" : ", ";

@@ -103,6 +103,12 @@ struct EmitOptions {
   // --simd-pairs=auto: whether the lanes pay on the CPU the solver is built for, and why
   // (codegen/SimdCpu.h; the driver reads the host's cpuid, or --simd-cpu).
   SimdCpuVerdict simdCpu;
+  // --simd-pairs=auto or once (with simdPairs and simdPairsAuto: auto's choice of loops; not
+  // --simd-pairs=perdest, stop 33-34's auto): a loop in
+  // lanes that may evaluate each pair once (same array, kept lists, double precision) is
+  // printed each pair once in the lanes, the values the pair shares once per pair, the source
+  // side added by a masked scatter (codegen/SimdPairs.cpp, emitSymmetricSimdLoops).
+  bool simdPairsOnce = false;
 };
 
 // --simd-pairs=auto: a pair loop is put in SIMD lanes where its expected neighbour count

@@ -580,10 +580,11 @@ std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
 }
 
 // Whether the pass over w's own array is printed each pair once (SymmetricPairs.cpp): not in
-// SIMD lanes per destination (--simd-pairs), not with periodic or mirror ghosts.
+// SIMD lanes per destination (--simd-pairs; under --simd-pairs=once each pair once in the
+// lanes, SimdPairs.cpp), not with periodic or mirror ghosts.
 bool CpuPrinter::symmetricPass(const DestinationWork& w, const NeighbourPass& pass) const {
   return symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty() &&
-         !simdPairsRefusal(w, pass).empty();
+         (!simdPairsRefusal(w, pass).empty() || onceLanes(w, pass));
 }
 
 // The bodies the each-pair-once loops call both ways (the conditions of the printing above):

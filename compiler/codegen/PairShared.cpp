@@ -23,6 +23,7 @@
 // a multiply-add is not used), and the properties a site reads are written by no pair loop.
 #include "codegen/Printer.h"
 
+#include "analysis/PairQuantityTable.h"
 #include "body/TextEdits.h"
 
 #include <algorithm>
@@ -120,13 +121,41 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::pairSharedParams(const PlanBo
 void ScenePrinter::emitPairSharedFunctions(const PlanBody& b, const std::string& name,
                                            int destArray, const Dialect& d,
                                            std::ostringstream& os) const {
+  printPairShared(b, name, destArray, d, false, os);
+}
+
+void ScenePrinter::emitPairSharedSimdFunctions(const PlanBody& b, const std::string& name,
+                                               int destArray, std::ostringstream& os) const {
+  printPairShared(b, name, destArray, host_, true, os);
+}
+
+// The _simd form (SimdPairs.cpp): the vector pair quantities three scalars (XIJ_0), the
+// destination's other properties values (dval_NAME), as the body's NAME_loop_simd takes them.
+void ScenePrinter::printPairShared(const PlanBody& b, const std::string& name, int destArray,
+                                   const Dialect& d, bool simd, std::ostringstream& os) const {
   const std::vector<SourceOnlySite> sites = pairSharedSites(b, d);
   if (sites.empty()) return;
   std::string text;
   BodyFacts facts;
-  hoistedText(b, d, {}, text, facts);  // the hoisted values as the body reads them
+  // the hoisted values as the body reads them
+  hoistedText(b, d, simd ? simdValueEdits(b, destArray) : std::vector<TextEdit>(), text, facts);
   std::string params;
-  for (const BodyParam& p : pairSharedParams(b, destArray, d)) params += (params.empty() ? "" : ", ") + p.decl;
+  const auto values = simd ? destinationValues(b, destArray)
+                           : decltype(destinationValues(b, destArray))();
+  for (const BodyParam& p : pairSharedParams(b, destArray, d)) {
+    std::string decl = p.decl;
+    if (simd && p.kind == BodyParam::Pair && findPairQuantity(p.name)->vector) {
+      decl.clear();
+      for (int c = 0; c < 3; ++c)
+        decl += (c ? ", " : "") + d.real + " " + p.name + "_" + std::to_string(c);
+    } else if (simd && p.kind == BodyParam::DProp && values.count(p.name)) {
+      decl.clear();
+      const auto& sc = values.at(p.name);
+      for (int c : sc.second)
+        decl += (decl.empty() ? "" : ", ") + d.real + " " + destinationValueName(p.name, sc.first, c);
+    }
+    params += (params.empty() ? "" : ", ") + decl;
+  }
   for (size_t k = 0; k < sites.size(); ++k) {
     const SourceOnlySite s =
         movedSite(facts, sites[k], "a pair-shared value cut by a hoisted one in " + b.source.label);
@@ -140,7 +169,8 @@ void ScenePrinter::emitPairSharedFunctions(const PlanBody& b, const std::string&
     else
       os << "//   " << s.result << " after " << oneLine(text.substr(s.stmtBegin, s.stmtEnd - s.stmtBegin))
          << "\n";
-    os << d.functionPrefix << d.real << " " << name << "_pairshared" << k << "(" << params << ") {\n";
+    os << d.functionPrefix << d.real << " " << name << "_pairshared" << k << (simd ? "_simd" : "")
+       << "(" << params << ") {\n";
     for (const auto& l : s.locals) {
       std::string init = fusedRange(text, facts, l.initBegin, l.initEnd, d.fma);
       os << "  const " << l.type << " " << l.name << " = " << init << endStatement(init) << "\n";
@@ -157,7 +187,8 @@ void ScenePrinter::emitPairSharedFunctions(const PlanBody& b, const std::string&
 
 void ScenePrinter::emitPairSharedLocals(std::ostream& os, const std::string& indent, int dest,
                                         const std::vector<const PlanEquation*>& direct,
-                                        const std::vector<const PlanEquation*>& mirrored) const {
+                                        const std::vector<const PlanEquation*>& mirrored,
+                                        bool simd) const {
   for (const PlanEquation* eq : direct) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     const std::vector<SourceOnlySite> sites = pairSharedSites(b, host_);
@@ -170,12 +201,25 @@ void ScenePrinter::emitPairSharedLocals(std::ostream& os, const std::string& ind
           users.push_back(m);
       if (users.empty()) continue;
       const std::string local = "pshared_" + eqStruct(*eq) + "_" + K(k);
-      const std::string fn = bodyFunctionName(eq->name, "loop") + "_pairshared" + K(k);
+      const std::string fn =
+          bodyFunctionName(eq->name, "loop") + "_pairshared" + K(k) + (simd ? "_simd" : "");
       std::string call = fn + "(";
       bool first = true;
+      const auto values = simd ? destinationValues(b, dest) : decltype(destinationValues(b, dest))();
       for (const BodyParam& p : pairSharedParams(b, dest, host_)) {
-        call += (first ? "" : ", ") + callBodyDefault(p, eqStruct(*eq), "t", ".");
+        call += first ? "" : ", ";
         first = false;
+        if (simd && p.kind == BodyParam::Pair && findPairQuantity(p.name)->vector) {
+          call += p.name + "_0, " + p.name + "_1, " + p.name + "_2";
+        } else if (simd && p.kind == BodyParam::DProp && values.count(p.name)) {
+          const auto& sc = values.at(p.name);
+          std::string args;
+          for (int c : sc.second)
+            args += (args.empty() ? "" : ", ") + destinationValueName(p.name, sc.first, c);
+          call += args;
+        } else {
+          call += callBodyDefault(p, eqStruct(*eq), "t", ".");
+        }
       }
       os << indent << "const double " << local << " = " << call << ");  // " << eq->name
          << ": " << (sites[k].sign < 0 ? "minus this" : "the same") << " for (s_idx, d_idx)\n";

@@ -215,9 +215,16 @@ class ScenePrinter {
   // In a pair loop that calls `direct` for (d_idx, s_idx) and `mirrored` for (s_idx, d_idx):
   // the locals `pshared_eqN_K` of the values both share, computed once, and the scope that
   // makes callBody pass them (pairSharedScope_); endPairShared clears it.
+  // `simd`: in SIMD lanes, by the functions' _simd forms (scalar pair components, dval_).
   void emitPairSharedLocals(std::ostream& os, const std::string& indent, int dest,
                             const std::vector<const PlanEquation*>& direct,
-                            const std::vector<const PlanEquation*>& mirrored) const;
+                            const std::vector<const PlanEquation*>& mirrored,
+                            bool simd = false) const;
+  // The _simd forms of b's NAME_pairsharedK (NAME_pairsharedK_simd), for SIMD lanes.
+  void emitPairSharedSimdFunctions(const PlanBody& b, const std::string& name, int destArray,
+                                   std::ostringstream& os) const;
+  void printPairShared(const PlanBody& b, const std::string& name, int destArray,
+                       const Dialect& d, bool simd, std::ostringstream& os) const;
   void endPairShared() const { pairSharedScope_.clear(); }
   // A value computed once for the pair: its local, and 1 or -1 (the mirrored calls pass "-"
   // before the local of an antisymmetric one).
@@ -317,16 +324,24 @@ class ScenePrinter {
   // after it: stored.
   void emitSumsLoad(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
   void emitSumsStore(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
-  // The call of eq's loop for destination d: with rs active, of its function on the locals.
+  // The call of eq's loop for destination d: with rs active, of its function on the locals
+  // (named sumsPrefix + acc_NAME); `first`, where it returns an argument, overrides the others
+  // (SimdPairs.cpp: the mirrored call of each pair once in SIMD lanes).
   std::string pairCall(const PlanEquation& eq, int d, const RegisterSums& rs,
-                       bool scalarPairs = false) const;
+                       bool scalarPairs = false, const std::string& sumsPrefix = "",
+                       const std::function<std::string(const BodyParam&)>& first = nullptr) const;
   // After eq's loop function: its form on the locals (NAME_loop_sums), where a loop uses it.
   void emitSumsFunction(const PlanEquation& eq, std::ostringstream& os);
   bool registerSums_ = false;                // EmitOptions::registerSums (CPU, not mpi)
   std::unique_ptr<std::set<int>> sumsDecls_;  // equation declarations whose _sums form is used
   // eq's loop on the locals, named NAME_loop_sums; `scalarPairs`: NAME_loop_simd, its vector
   // pair quantities three scalars each (XIJ_0, XIJ_1, XIJ_2; SimdPairs.cpp).
-  void printSumsFunction(const PlanEquation& eq, bool scalarPairs, std::ostringstream& os) const;
+  // `mirror`: NAME_loop_simd_mirror, also its source properties values (sval_NAME).
+  void printSumsFunction(const PlanEquation& eq, bool scalarPairs, std::ostringstream& os,
+                         bool mirror = false) const;
+  // The edits of b's text for its _simd form but the sums: XIJ[k] -> XIJ_k, the destination
+  // values dval_NAME (the pair-shared values' _simd functions, PairShared.cpp).
+  std::vector<TextEdit> simdValueEdits(const PlanBody& b, int d) const;
   // The destination properties a loop body reads and writes not, indexed `S * d_idx + k`
   // only (floating): name -> stride, components; in its _simd form values (dval_NAME,
   // dvalK_NAME) loaded before the loop.
@@ -334,6 +349,9 @@ class ScenePrinter {
                                                                          int d) const;
   std::vector<SourceOnlySite> allHoistedSites(const PlanBody& b) const;  // source and destination
   static std::string destinationValueName(const std::string& prop, int stride, int comp);
+  // The source properties a loop body reads, indexed `S * s_idx + k` only (sval_NAME).
+  std::map<std::string, std::pair<int, std::set<int>>> sourceValues(const PlanBody& b) const;
+  static std::string sourceValueName(const std::string& prop, int stride, int comp);
   std::string destinationValueLoad(const std::string& prop, int stride, int comp) const;
 
   // ---- SIMD pair loops (SimdPairs.cpp; sphc --simd-pairs) ----
@@ -347,8 +365,29 @@ class ScenePrinter {
   // (false: the caller prints the scalar loop); nothing with the switch off.
   bool emitSimdNeighbours(std::ostream& os, const DestinationWork& w, const NeighbourPass& pass,
                           const RegisterSums& sums);
-  // After eq's loop function: its NAME_loop_simd form, where a SIMD loop calls it.
+  // After eq's loop function: its NAME_loop_simd form, where a SIMD loop calls it (and its
+  // NAME_loop_simd_mirror form and pair-shared values' _simd functions for each pair once).
   void emitSimdFunction(const PlanEquation& eq, std::ostringstream& os);
+  // --simd-pairs=once: whether pass (destination w) is printed each pair once in SIMD lanes
+  // (emitSymmetricSimdLoops): a pass over w's own array that may be each pair once and that
+  // simdPairsRefusal() puts in lanes.
+  bool onceLanes(const DestinationWork& w, const NeighbourPass& pass) const;
+  // Each pair once in SIMD lanes (the rest of emitSymmetricPass): serial, or OpenMP blocks,
+  // bitwise equal; q the pair quantities with their mirrors.
+  void emitSymmetricSimdLoops(const DestinationWork& w, const NeighbourPass& pass,
+                              const std::string& lists, bool openmp,
+                              const std::set<std::string>& q, const RegisterSums& sums);
+  // Pieces of it: the pair quantities as scalars (with `both` the mirrored ones, XIJ_ji_0,
+  // ...) and, with `mask`, the cut-off as a mask (in_support); the destination's other
+  // values (dval_NAME); the mirrored call of eq in its _simd form on the locals
+  // sumsPrefix + acc_NAME.
+  void emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q, bool both,
+                              const std::string& body, bool mask) const;
+  void emitDestinationValueLoads(std::ostream& os, const DestinationWork& w,
+                                 const NeighbourPass& pass, const std::string& in) const;
+  std::string simdMirroredCall(const PlanEquation& eq, int d, const RegisterSums& sums,
+                               const std::string& sumsPrefix) const;
+  bool simdOnce_ = false;  // EmitOptions::simdPairsOnce (double, kept lists)
   // --precision=single: the float local a SIMD loop passes for a body's double argument (t,
   // dt, an equation's scalar: f_t, f_eq2_alpha), converted once before the loop; "" for
   // other parameters.

@@ -38,11 +38,12 @@ namespace sphc {
 namespace {
 
 // `d_idx`, `S * d_idx`, `S * d_idx + k` -> stride S (1 for d_idx), component k < S; false
-// otherwise.
-bool destinationComponent(const std::string& index, int& stride, int& comp) {
+// otherwise. `source`: the same with s_idx.
+bool destinationComponent(const std::string& index, int& stride, int& comp, bool source = false) {
   static const std::regex form(R"(^\s*(?:(\d+)\s*\*\s*)?d_idx\s*(?:\+\s*(\d+)\s*)?$)");
+  static const std::regex sform(R"(^\s*(?:(\d+)\s*\*\s*)?s_idx\s*(?:\+\s*(\d+)\s*)?$)");
   std::smatch m;
-  if (!std::regex_match(index, m, form)) return false;
+  if (!std::regex_match(index, m, source ? sform : form)) return false;
   stride = m[1].matched ? std::stoi(m[1].str()) : 1;
   comp = m[2].matched ? std::stoi(m[2].str()) : 0;
   return stride >= 1 && stride <= 64 && comp < stride;
@@ -67,8 +68,8 @@ std::set<std::string> written(const PlanBody& b, const PlanArray* a = nullptr) {
 // Every indexing of d_NAME in text, or false if one is not `d_NAME[S * d_idx + k]` or the
 // name occurs otherwise (a bare pointer).
 bool destinationSites(const std::string& text, const std::string& prop,
-                      std::vector<DestinationSite>& out) {
-  const std::string name = "d_" + prop;
+                      std::vector<DestinationSite>& out, bool source = false) {
+  const std::string name = (source ? "s_" : "d_") + prop;
   out.clear();
   for (size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1)) {
     if ((at > 0 && isIdentifierChar(text[at - 1])) ||
@@ -80,7 +81,8 @@ bool destinationSites(const std::string& text, const std::string& prop,
     size_t close = text.find_first_of("[]", open + 1);
     if (close == std::string::npos || text[close] != ']') return false;
     DestinationSite site;
-    if (!destinationComponent(text.substr(open + 1, close - open - 1), site.stride, site.comp))
+    if (!destinationComponent(text.substr(open + 1, close - open - 1), site.stride, site.comp,
+                              source))
       return false;
     site.begin = static_cast<unsigned>(at);
     site.end = static_cast<unsigned>(close + 1);
@@ -210,8 +212,8 @@ void ScenePrinter::emitSumsStore(std::ostream& os, const std::string& indent,
 // The sites of d_NAME outside the hoisted expressions (which the body's text loses).
 static bool valueSites(const std::string& text, const std::string& prop,
                        const std::vector<SourceOnlySite>& hoisted,
-                       std::vector<DestinationSite>& sites) {
-  if (!destinationSites(text, prop, sites)) return false;
+                       std::vector<DestinationSite>& sites, bool source = false) {
+  if (!destinationSites(text, prop, sites, source)) return false;
   sites.erase(std::remove_if(sites.begin(), sites.end(),
                              [&](const DestinationSite& s) {
                                for (const SourceOnlySite& h : hoisted)
@@ -220,6 +222,31 @@ static bool valueSites(const std::string& text, const std::string& prop,
                              }),
               sites.end());
   return true;
+}
+
+// Property p of a body's text as a value (destinationValues, sourceValues): its stride and
+// components, where every site outside the hoisted expressions is `X_p[S * X_idx + k]` of
+// one stride and the values' names (`name`) are free.
+static void addValue(const std::string& text, const std::string& p,
+                     const std::vector<SourceOnlySite>& hoisted, bool source,
+                     std::string (*name)(const std::string&, int, int),
+                     std::map<std::string, std::pair<int, std::set<int>>>& values) {
+  std::vector<DestinationSite> sites;
+  if (!valueSites(text, p, hoisted, sites, source) || sites.empty()) return;
+  auto& entry = values[p];
+  for (const DestinationSite& site : sites) {
+    if (entry.first != 0 && entry.first != site.stride) {
+      values.erase(p);
+      return;
+    }
+    entry.first = site.stride;
+    entry.second.insert(site.comp);
+  }
+  for (int k : entry.second)
+    if (identifierOccurrences(text, name(p, entry.first, k))) {
+      values.erase(p);
+      return;
+    }
 }
 
 std::vector<SourceOnlySite> ScenePrinter::allHoistedSites(const PlanBody& b) const {
@@ -237,25 +264,25 @@ std::map<std::string, std::pair<int, std::set<int>>> ScenePrinter::destinationVa
     const std::string& p = r.prop;
     if (own.count(p) || values.count(p) || !arr(d).find(p) || propType(d, p, host_) != host_.real)
       continue;
-    std::vector<DestinationSite> sites;
-    if (!valueSites(b.source.text, p, hoisted, sites) || sites.empty()) continue;
-    auto& entry = values[p];
-    for (const DestinationSite& site : sites) {
-      if (entry.first != 0 && entry.first != site.stride) {
-        values.erase(p);
-        break;
-      }
-      entry.first = site.stride;
-      entry.second.insert(site.comp);
-    }
-    if (values.count(p))
-      for (int k : entry.second)
-        if (identifierOccurrences(b.source.text, destinationValueName(p, entry.first, k))) {
-          values.erase(p);
-          break;
-        }
+    addValue(b.source.text, p, hoisted, false, &ScenePrinter::destinationValueName, values);
   }
   return values;
+}
+
+std::map<std::string, std::pair<int, std::set<int>>> ScenePrinter::sourceValues(
+    const PlanBody& b) const {
+  std::map<std::string, std::pair<int, std::set<int>>> values;
+  const std::vector<SourceOnlySite> hoisted = allHoistedSites(b);
+  for (const PropAccess& r : b.facts.sReads) {
+    const std::string& p = r.prop;
+    if (values.count(p)) continue;
+    addValue(b.source.text, p, hoisted, true, &ScenePrinter::sourceValueName, values);
+  }
+  return values;
+}
+
+std::string ScenePrinter::sourceValueName(const std::string& prop, int stride, int comp) {
+  return stride == 1 ? "sval_" + prop : "sval" + std::to_string(comp) + "_" + prop;
 }
 
 std::string ScenePrinter::destinationValueName(const std::string& prop, int stride, int comp) {
@@ -268,7 +295,8 @@ std::string ScenePrinter::destinationValueLoad(const std::string& prop, int stri
 }
 
 std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const RegisterSums& rs,
-                                   bool scalarPairs) const {
+                                   bool scalarPairs, const std::string& sumsPrefix,
+                                   const std::function<std::string(const BodyParam&)>& first) const {
   const PlanBody& b = methodBody(eq, ast::Method::Loop);
   const std::set<std::string> own = written(b, &arr(d));
   bool any = false;
@@ -276,6 +304,10 @@ std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const Register
   if (!any && !scalarPairs) return equationCall(eq, ast::Method::Loop, d);
   const auto values = scalarPairs ? destinationValues(b, d) : decltype(destinationValues(b, d))();
   auto argument = [&](const BodyParam& p) -> std::string {
+    if (first) {
+      const std::string a = first(p);
+      if (!a.empty()) return a;
+    }
     if (scalarPairs && host_.floatBodies && !floatScalarName(eqStruct(eq), p).empty())
       return floatScalarName(eqStruct(eq), p);
     if (scalarPairs && p.kind == BodyParam::Pair && findPairQuantity(p.name)->vector)
@@ -291,7 +323,7 @@ std::string ScenePrinter::pairCall(const PlanEquation& eq, int d, const Register
     int stride = 1;
     std::string args;
     for (int k : bodyComponents(b.source.text, p.name, stride))
-      args += (args.empty() ? "" : ", ") + localName(p.name, stride, k);
+      args += (args.empty() ? "" : ", ") + sumsPrefix + localName(p.name, stride, k);
     return args;
   };
   return callBody(bodyFunctionName(eq.name, "loop") + (scalarPairs ? "_simd" : "_sums"), b, d,
@@ -318,8 +350,22 @@ void ScenePrinter::emitSumsFunction(const PlanEquation& eq, std::ostringstream& 
   printSumsFunction(eq, false, os);
 }
 
+std::vector<TextEdit> ScenePrinter::simdValueEdits(const PlanBody& b, int d) const {
+  std::vector<TextEdit> edits;
+  std::string why;
+  if (!scalarPairEdits(b.source.text, edits, why)) return {};
+  const std::vector<SourceOnlySite> hoisted = allHoistedSites(b);
+  for (const auto& [p, sc] : destinationValues(b, d)) {
+    std::vector<DestinationSite> sites;
+    valueSites(b.source.text, p, hoisted, sites);
+    for (const DestinationSite& site : sites)
+      edits.push_back({site.begin, site.end, destinationValueName(p, site.stride, site.comp)});
+  }
+  return edits;
+}
+
 void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
-                                     std::ostringstream& os) const {
+                                     std::ostringstream& os, bool mirror) const {
   const PlanBody& b = methodBody(eq, ast::Method::Loop);
   const std::set<std::string> own = written(b, &arr(eq.dest));
   std::vector<TextEdit> edits;
@@ -343,12 +389,26 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
     for (const DestinationSite& site : sites)
       edits.push_back({site.begin, site.end, destinationValueName(p, site.stride, site.comp)});
   }
-  const std::string name = bodyFunctionName(eq.name, "loop") + (scalarPairs ? "_simd" : "_sums");
+  // The mirrored calls' form (SimdPairs.cpp, each pair once in lanes): the source's
+  // properties as values too (the source of those calls is the lanes' common d_idx: a load
+  // under an `if` GCC does not vectorise either).
+  const auto svalues = mirror ? sourceValues(b) : decltype(sourceValues(b))();
+  for (const auto& [p, sc] : svalues) {
+    std::vector<DestinationSite> sites;
+    valueSites(b.source.text, p, allHoistedSites(b), sites, /*source=*/true);
+    for (const DestinationSite& site : sites)
+      edits.push_back({site.begin, site.end, sourceValueName(p, site.stride, site.comp)});
+  }
+  const std::string name = bodyFunctionName(eq.name, "loop") +
+                           (mirror ? "_simd_mirror" : scalarPairs ? "_simd" : "_sums");
   os << "// " << b.source.label << ", from " << loc(b.source.start)
      << ": the destination's sums in locals (acc_NAME, accK_NAME: component K;\n"
      << (scalarPairs ? "// the pair quantities' components scalars, XIJ_0 for XIJ[0]: the SIMD "
                        "pair loops,\n// codegen/SimdPairs.cpp)\n"
-                     : "// codegen/RegisterSums.cpp)\n");
+                     : "// codegen/RegisterSums.cpp)\n")
+     << (mirror ? "// For the mirrored calls of each pair once in SIMD lanes: the source's "
+                  "properties as values\n// (sval_NAME, particle d_idx's).\n"
+                : "");
   if (host_.lineDirectives) emitLineDirective(os, b.source.start);
   os << host_.functionPrefix << "void " << name << "(";
   bool first = true;
@@ -363,6 +423,14 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
       const auto& sc = values.at(p.name);
       for (int k : sc.second) {
         os << (first ? "" : ", ") << host_.real << " " << destinationValueName(p.name, sc.first, k);
+        first = false;
+      }
+      continue;
+    }
+    if (p.kind == BodyParam::SProp && svalues.count(p.name)) {
+      const auto& sc = svalues.at(p.name);
+      for (int k : sc.second) {
+        os << (first ? "" : ", ") << host_.real << " " << sourceValueName(p.name, sc.first, k);
         first = false;
       }
       continue;

@@ -33,6 +33,10 @@
 // kSimdAutoNeighbours. Below it, each pair once saves more than the lanes (the 2D dam
 // breaks); a loop that is per destination anyway stays scalar there too (measured to pay on
 // one 2D scene only; --simd-pairs=on).
+//
+// --simd-pairs=once: auto's loops, but a loop that could be each pair once is printed each
+// pair once in the lanes (emitSymmetricSimdLoops, below): the values the pair shares once per
+// pair, the source side scattered.
 #include "analysis/PairQuantityTable.h"
 #include "codegen/CppText.h"
 #include "codegen/Printer.h"
@@ -180,7 +184,9 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
     why.replace(why.size() - 2, 2, ", but " + simdCpu_.why + ": ");
   }
   if (eachPairOncePossible(w, pass))
-    why += lanes ? "the lanes pay more than each pair once" : "each pair once pays more";
+    why += lanes ? (simdOnce_ && pass.source == w.array ? "the lanes pay, each pair once in them"
+                                                         : "the lanes pay more than each pair once")
+                 : "each pair once pays more";
   else
     why += lanes ? "the lanes pay more than the scalar loop per destination"
                  : "scalar per destination (--simd-pairs=on puts it in lanes)";
@@ -271,6 +277,9 @@ std::vector<std::string> ScenePrinter::simdPairsNotes() const {
     const std::string why = simdPairsRefusal(w, pass);
     if (!why.empty())
       notes.push_back("pair loop not in SIMD lanes: " + loop + ": " + why);
+    else if (onceLanes(w, pass))
+      notes.push_back("pair loop in SIMD lanes, each pair once: " + loop +
+                      ": --simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why);
     else
       notes.push_back("pair loop in SIMD lanes: " + loop + ": " +
                       (simdAuto_ ? "--simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why
@@ -373,10 +382,327 @@ void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& 
     walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
                                      const NeighbourPass& pass) {
       if (simdPairsRefusal(w, pass).empty())
-        for (const PlanEquation* e : pass.equations) simdDecls_->insert(e->declIndex);
+        for (const PlanEquation* e : pass.equations) {
+          simdDecls_->insert(e->declIndex);
+          if (onceLanes(w, pass))  // each pair once in the lanes: the mirrored form too
+            simdDecls_->insert(-1 - e->declIndex);
+        }
     });
   }
-  if (simdDecls_->count(eq.declIndex)) printSumsFunction(eq, true, os);
+  if (simdDecls_->count(eq.declIndex)) {
+    printSumsFunction(eq, true, os);
+    emitPairSharedSimdFunctions(methodBody(eq, ast::Method::Loop),
+                                bodyFunctionName(eq.name, "loop"), eq.dest, os);
+  }
+  if (simdDecls_->count(-1 - eq.declIndex)) printSumsFunction(eq, true, os, /*mirror=*/true);
+}
+
+// ---- Each pair once in SIMD lanes (--simd-pairs=once) ----
+//
+// A same-array pass that may be each pair once (SymmetricPairs.cpp) and that the lanes take
+// (simdPairsRefusal) is printed, after emitSymmetricPass's kept lists and destination-only
+// values of every particle, as: per destination d_idx (increasing), its sums loaded in
+// locals; the self pair, scalar, for d_idx alone (it has no mirrored call); then the rest of
+// the list's upper part (every s_idx > d_idx) under
+//   #pragma omp simd reduction(+: acc_...)
+// with the pair quantities and their mirrors as scalars, the cut-off a mask (the kept lists
+// hold the skin), the values the pair shares (body/PairShared.cpp) computed once per pair
+// (pshared_eqN_K, NAME_loop_pairsharedK_simd), and each body's _simd form called twice on
+// them: for d_idx on the pair's terms pd_acc_NAME (from 0), acc_NAME += in_support ?
+// pd_acc_NAME : 0.0 (the lane reduction); mirrored, for s_idx on its sums gathered (ps_acc_NAME,
+// an antisymmetric shared value negated), stored back under the mask (a gather and a masked
+// scatter per sum). The scatter is legal in omp simd: the s_idx of one list are distinct (no
+// two lanes write one particle) and none is d_idx (whose sums are locals).
+//
+// Serial and OpenMP give the same bits. Particle j receives the calls of every i < j, in
+// increasing i, each on d_NAME[j], then at its own turn its sums loaded, the self pair, the lanes' reduction over its upper list. OpenMP (contiguous blocks of destinations,
+// one per thread): (1) for the destinations of the block, their neighbours in earlier
+// blocks, scalar, in list order: the same _simd call for (j, i) on j's sums in locals when
+// in support: bitwise i's mirrored call on them (the mirrored quantities are the (j, i)
+// values, computed as differences; a shared value is the same double or its negation both
+// ways; IEEE arithmetic alike in lanes and scalar: no contraction, no fast math); (2) the
+// serial loop over the block, its scatter also masked to s_idx < b_end (later blocks have
+// had theirs in their (1)); serial prints the same loop with b_end = n.
+bool ScenePrinter::onceLanes(const DestinationWork& w, const NeighbourPass& pass) const {
+  if (!simdOnce_ || pass.source != w.array || !pass.searches()) return false;
+  if (!symmetricPairsRefusal(plan_, w, pass, true).empty()) return false;
+  if (!simdPairsRefusal(w, pass).empty()) return false;
+  // The sums only added to (`d_NAME[...] +=` or `-=`): the pair's terms from 0 are added to
+  // the sums after the bodies.
+  const RegisterSums rs = registerSums(w, pass);
+  for (const PlanEquation* eq : pass.equations) {
+    const std::string& text = methodBody(*eq, ast::Method::Loop).source.text;
+    for (const auto& [p, sc] : rs.props) {
+      const std::string name = "d_" + p;
+      for (size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1)) {
+        if ((at > 0 && isIdentifierChar(text[at - 1])) ||
+            (at + name.size() < text.size() && isIdentifierChar(text[at + name.size()])))
+          continue;
+        const size_t close = text.find(']', at);
+        if (close == std::string::npos) return false;
+        const size_t op = skipBlanks(text, close + 1);
+        if (text.compare(op, 2, "+=") != 0 && text.compare(op, 2, "-=") != 0) return false;
+      }
+    }
+  }
+  return true;
+}
+
+// The destination's other properties the bodies read, loaded once.
+void ScenePrinter::emitDestinationValueLoads(std::ostream& os, const DestinationWork& w,
+                                             const NeighbourPass& pass,
+                                             const std::string& in) const {
+  std::set<std::string> loads;
+  for (const PlanEquation* eq : pass.equations)
+    for (const auto& [p, sc] : destinationValues(methodBody(*eq, ast::Method::Loop), w.array))
+      for (int k : sc.second)
+        if (loads.insert(destinationValueName(p, sc.first, k)).second)
+          os << in << destinationValueLoad(p, sc.first, k) << "\n";
+}
+
+std::string ScenePrinter::simdMirroredCall(const PlanEquation& eq, int d,
+                                           const RegisterSums& sums,
+                                           const std::string& sumsPrefix) const {
+  const PlanBody& b = methodBody(eq, ast::Method::Loop);
+  const auto values = destinationValues(b, d);
+  const auto svalues = sourceValues(b);
+  const std::string eqValues = eqStruct(eq);
+  auto argument = [&](const BodyParam& p) -> std::string {
+    switch (p.kind) {
+      case BodyParam::Idx: return "s_idx";
+      case BodyParam::SIdx: return "d_idx";
+      case BodyParam::Pair: {
+        const std::string m = mirroredPairQuantity(p.name);
+        return findPairQuantity(p.name)->vector ? m + "_0, " + m + "_1, " + m + "_2" : m;
+      }
+      case BodyParam::DHoisted: return symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]";
+      case BodyParam::PairShared: {  // computed once for the pair in the lanes
+        auto it = pairSharedScope_.find(eqValues + "/" + p.name);
+        if (it == pairSharedScope_.end())
+          SPHC_INTERNAL("a pair-shared value with no local in the lanes: " + eq.name);
+        return (it->second.sign < 0 ? "-" : "") + it->second.local;
+      }
+      case BodyParam::SProp: {  // particle d_idx's values, loaded before the lanes
+        std::string args;
+        if (svalues.count(p.name))
+          for (int k : svalues.at(p.name).second)
+            args += (args.empty() ? "" : ", ") +
+                    sourceValueName(p.name, svalues.at(p.name).first, k);
+        return args;
+      }
+      case BodyParam::DProp: {
+        if (!values.count(p.name)) return "";
+        // Particle s_idx's values: gathers, through s_NAME where the body reads it too (the
+        // same array: one gather for both calls).
+        bool viaSource = false;
+        for (const PropAccess& r : b.facts.sReads) viaSource |= r.prop == p.name;
+        std::string args;
+        const auto& sc = values.at(p.name);
+        for (int k : sc.second)
+          args += (args.empty() ? "" : ", ") + std::string(viaSource ? "s_" : "d_") + p.name + "[" +
+                  (sc.first == 1 ? std::string("s_idx")
+                                 : std::to_string(sc.first) + " * s_idx + " + std::to_string(k)) +
+                  "]";
+        return args;
+      }
+      default: return "";
+    }
+  };
+  const std::string fn = bodyFunctionName(eq.name, "loop") + "_simd";
+  std::string call = pairCall(eq, d, sums, /*scalarPairs=*/true, sumsPrefix, argument);
+  call.replace(0, fn.size(), fn + "_mirror");  // the form taking the source's values
+  const size_t at = call.rfind('\n');  // its comment: say which destination
+  return call.substr(0, at) + ": destination s_idx, source d_idx\n";
+}
+
+void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q,
+                                          bool both, const std::string& body, bool mask) const {
+  const std::string& R = host_.real;
+  const PairDialect dialect = pairDialectOf(host_);
+  os << body << "const " << R << " hj = sj_h[s_idx];\n";
+  for (const PairQuantity& pq : pairQuantityTable()) {
+    if (!(pq.when == PairWhen::BeforeTest || pq.when == PairWhen::EveryNeighbour ||
+          q.count(pq.name)))
+      continue;
+    if (pq.form == PairForm::Difference) {
+      for (int k = 0; k < 3; ++k)
+        os << body << "const " << R << " " << pq.name << "_" << k << " = "
+           << (k < plan_.dim ? pq.components[k] + "i - sj_" + pq.components[k] + "[s_idx]"
+                             : std::string("0.0"))
+           << ";\n";
+      if (both)  // as a difference: a zero keeps the scalar form's sign
+        for (int k = 0; k < 3; ++k)
+          os << body << "const " << R << " " << pq.name << "_ji_" << k << " = "
+             << (k < plan_.dim ? "sj_" + pq.components[k] + "[s_idx] - " + pq.components[k] + "i"
+                               : std::string("0.0"))
+             << ";\n";
+    } else if (pq.form == PairForm::Gradient) {
+      // grad_j of the mirrored call: DWIJ -> DWIJ_ji (same h), DWI (h_i) -> DWJ_ji, DWJ
+      // (h_j) -> DWI_ji; the factor of (RIJ, h) once for both.
+      const std::string partner =
+          pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
+      os << body << "const " << R << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
+         << pq.h << ");\n";
+      for (int k = 0; k < 3; ++k)
+        os << body << "const " << R << " " << pq.name << "_" << k << " = " << pq.name
+           << "_f * XIJ_" << k << ";\n";
+      if (both)
+        for (int k = 0; k < 3; ++k)
+          os << body << "const " << R << " " << partner << "_" << k << " = " << pq.name
+             << "_f * XIJ_ji_" << k << ";\n";
+    } else {
+      std::string s = pairQuantityStatement(pq, plan_.dim, dialect, body);
+      std::vector<TextEdit> edits;
+      std::string unused;
+      scalarPairEdits(s, edits, unused);
+      std::sort(edits.begin(), edits.end(),
+                [](const TextEdit& a, const TextEdit& b) { return a.begin > b.begin; });
+      for (const TextEdit& e : edits) s.replace(e.begin, e.end - e.begin, e.replacement);
+      os << s;
+    }
+  }
+  if (!mask) return;
+  os << body << "const " << R << " hmax = hi > hj ? hi : hj;\n";
+  os << body << "const bool in_support = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
+}
+
+void ScenePrinter::emitSymmetricSimdLoops(const DestinationWork& w, const NeighbourPass& pass,
+                                          const std::string& lists, bool openmp,
+                                          const std::set<std::string>& q,
+                                          const RegisterSums& sums) {
+  const int d = w.array;
+  std::string reduction, pdZeros, psGathers, sumsOf, scatter;
+  for (const auto& [p, sc] : sums.props)
+    for (int k : sc.second) {
+      const std::string acc = sc.first == 1 ? "acc_" + p : "acc" + std::to_string(k) + "_" + p;
+      const std::string at = sc.first == 1 ? std::string("s_idx")
+                                           : std::to_string(sc.first) + " * s_idx + " +
+                                                 std::to_string(k);
+      reduction += (reduction.empty() ? "" : ", ") + acc;
+      pdZeros += (pdZeros.empty() ? "" : ", ") + std::string("pd_") + acc + " = 0.0";
+      psGathers += "@double ps_" + acc + " = s_idx < b_end ? d_" + p + "[" + at + "] : 0.0;\n";
+      sumsOf += "@" + acc + " += in_support ? pd_" + acc + " : 0.0;\n";
+      scatter += "@  d_" + p + "[" + at + "] = ps_" + acc + ";\n";
+    }
+  auto lines = [](const std::string& text, const std::string& indent) {
+    std::string out;
+    for (size_t at = 0; at < text.size();) {
+      const size_t nl = text.find('\n', at);
+      out += indent + text.substr(at + 1, nl - at);  // past the '@'
+      at = nl + 1;
+    }
+    return out;
+  };
+  // One destination loop's head: its values, its destination-only values as they were
+  // before the pass, its kept list, its sums in locals, its other values (dval_NAME).
+  auto head = [&](const std::string& indent, const std::string& begin, const std::string& end,
+                  const std::string& comment, const std::string& skip) {
+    scene_ << indent << "for (int d_idx = " << begin << "; d_idx < " << end << "; ++d_idx) {"
+           << comment << "\n";
+    const std::string in = indent + "  ";
+    emitDestLocals(scene_, in, q, host_);
+    for (const PlanEquation* eq : pass.equations) {
+      const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
+      for (size_t k = 0; k < sites.size(); ++k) {
+        const std::string K = std::to_string(k);
+        scene_ << in << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
+               << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+      }
+    }
+    scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
+    scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
+    if (!skip.empty()) scene_ << in << "if (" << skip << ") continue;\n";
+    emitSumsLoad(scene_, in, sums);  // codegen/RegisterSums.cpp
+    emitDestinationValueLoads(scene_, w, pass, in);
+  };
+  // The calls of one pair, the values it shares computed once: `lanes`, d_idx's on the
+  // pair's terms pd_ (added to its sums under the mask) and s_idx's on its sums gathered
+  // (ps_, scattered back under the mask by the caller); else d_idx's on its sums (a
+  // destination's neighbours in earlier blocks, OpenMP; the self pair).
+  auto calls = [&](const std::string& body, bool lanes) {
+    emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
+    if (lanes) {
+      scene_ << body << "double " << pdZeros << ";  // the pair's terms for d_idx\n";
+      scene_ << body << "// s_idx's sums (in this block; a later block adds the pair in its (1))\n";
+      scene_ << lines(psGathers, body);
+    }
+    for (const PlanEquation* eq : pass.equations)
+      scene_ << body << pairCall(*eq, d, sums, /*scalarPairs=*/true, lanes ? "pd_" : "");
+    if (lanes)
+      for (const PlanEquation* eq : pass.equations)
+        scene_ << body << simdMirroredCall(*eq, d, sums, "ps_");
+    endPairShared();
+    if (lanes) scene_ << lines(sumsOf, body);
+  };
+  // The destinations [begin, end) of a block (serial: one block, b_end = n).
+  auto lanes = [&](const std::string& indent, const std::string& begin, const std::string& end) {
+    head(indent, begin, end, "  // pairs (d_idx, s_idx >= d_idx)", "");
+    const std::string in = indent + "  ", body = in + "  ";
+    scene_ << in << "const std::uint32_t* k_lanes = kept.data() + " << lists
+           << ".upper[d_idx];  // s_idx >= d_idx\n";
+    scene_ << in << "if (k_lanes != k_end && *k_lanes == static_cast<std::uint32_t>(d_idx)) {"
+           << "  // the self pair, scalar: d_idx alone\n";
+    scene_ << body << "++k_lanes;\n" << body << "const int s_idx = d_idx;\n";
+    emitLanePairQuantities(scene_, q, false, body, true);
+    scene_ << body << "if (in_support) {\n";
+    calls(body + "  ", false);
+    scene_ << body << "}\n" << in << "}\n";
+    scene_ << in << "const int n_lanes = static_cast<int>(k_end - k_lanes);\n";
+    std::set<std::string> loads;  // the mirrored calls' source values: particle d_idx's
+    for (const PlanEquation* eq : pass.equations)
+      for (const auto& [p, sc] : sourceValues(methodBody(*eq, ast::Method::Loop)))
+        for (int k : sc.second)
+          if (loads.insert(sourceValueName(p, sc.first, k)).second)
+            scene_ << in << "const " << host_.real << " " << sourceValueName(p, sc.first, k)
+                   << " = s_" << p << "["
+                   << (sc.first == 1 ? std::string("d_idx")
+                                     : std::to_string(sc.first) + " * d_idx + " +
+                                           std::to_string(k))
+                   << "];\n";
+    scene_ << in << "// The neighbours s_idx > d_idx in SIMD lanes, each pair once: d_idx's sums reduced\n"
+           << in << "// across the lanes, s_idx's added at s_idx (a masked scatter: the s_idx of one\n"
+           << in << "// list are distinct and none is d_idx, so no two lanes write one particle).\n";
+    scene_ << in << "#pragma omp simd reduction(+: " << reduction << ")\n";
+    scene_ << in << "for (int k_nbr = 0; k_nbr < n_lanes; ++k_nbr) {\n";
+    scene_ << body << "const int s_idx = static_cast<int>(k_lanes[k_nbr]);\n";
+    emitLanePairQuantities(scene_, q, true, body, true);
+    calls(body, true);
+    scene_ << body << "if (in_support && s_idx < b_end) {  // later blocks: in their (1)\n"
+           << lines(scatter, body) << body << "}\n";
+    scene_ << in << "}\n";
+    emitSumsStore(scene_, in, sums);
+    scene_ << indent << "}\n";
+  };
+  if (!openmp) {
+    scene_ << "        {\n          const int b_end = n;  // one block: the OpenMP form's loop\n";
+    lanes("          ", "0", "n");
+    scene_ << "        }\n";
+    return;
+  }
+  scene_ << "        const int n_blocks = std::max(1, std::min(n, omp_get_max_threads()));\n";
+  scene_ << "        #pragma omp parallel for schedule(static) default(firstprivate) shared(cells)\n";
+  scene_ << "        for (int blk = 0; blk < n_blocks; ++blk) {\n";
+  scene_ << "          const int b_begin = static_cast<int>(static_cast<long>(n) * blk / n_blocks);\n";
+  scene_ << "          const int b_end = static_cast<int>(static_cast<long>(n) * (blk + 1) / n_blocks);\n";
+  scene_ << "          // (1) from the neighbours in earlier blocks, per destination, scalar, in list\n"
+            "          // order: bitwise the terms the serial loop's lanes scatter\n";
+  scene_ << "          if (b_begin > 0) {\n";
+  const std::string ind = "            ", in = ind + "  ", body = in + "  ";
+  head(ind, "b_begin", "b_end", "",
+       "k_end == kept.data() || kept.front() >= static_cast<std::uint32_t>(b_begin)");
+  scene_ << in << "for (const std::uint32_t* k = kept.data(); k != k_end && *k < "
+                  "static_cast<std::uint32_t>(b_begin); ++k) {\n";
+  scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
+  emitLanePairQuantities(scene_, q, false, body, true);
+  scene_ << body << "if (!in_support) continue;\n";
+  calls(body, false);
+  scene_ << in << "}\n";
+  emitSumsStore(scene_, in, sums);
+  scene_ << ind << "}\n";
+  scene_ << "          }\n";
+  scene_ << "          // (2) the block, as the serial loop; its scatter kept to the block\n";
+  lanes("          ", "b_begin", "b_end");
+  scene_ << "        }\n";
 }
 
 }  // namespace sphc

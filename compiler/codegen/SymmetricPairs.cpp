@@ -108,6 +108,8 @@ std::string pairBodiesRefusal(const Plan& plan, const DestinationWork& w,
 
 }  // namespace
 
+std::string mirroredPairQuantity(const std::string& q) { return mirrored(q); }
+
 std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
                                   const NeighbourPass& pass, bool listsKept) {
   if (pass.source != w.array) return "the source is another array";
@@ -279,8 +281,13 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   const std::string pragma = openmp ? "        #pragma omp parallel for schedule(static) "
                                       "default(firstprivate) shared(cells)\n"
                                     : "";
-  scene_ << "        // Each pair once for both particles (codegen/SymmetricPairs.cpp; sphc\n"
-            "        // --no-symmetric-pairs: per destination particle): the same sums bit for bit.\n";
+  const bool simd = onceLanes(w, pass);  // --simd-pairs=once (SimdPairs.cpp)
+  if (simd)
+    scene_ << "        // Each pair once for both particles in SIMD lanes (codegen/SimdPairs.cpp;\n"
+              "        // sphc --simd-pairs=once): the sums reassociated across the lanes.\n";
+  else
+    scene_ << "        // Each pair once for both particles (codegen/SymmetricPairs.cpp; sphc\n"
+              "        // --no-symmetric-pairs: per destination particle): the same sums bit for bit.\n";
   // The kept lists first, all of them: a pair is visited from its lower particle's list.
   emitKeptListsBuild(lists, openmp, listRadius2);
   // Where s_idx >= d_idx starts in each kept list: once per build (whichever loop built).
@@ -293,6 +300,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   // The destination-only values of every particle, for the mirrored calls.
   emitDestinationHoistedAll(pass, pragma);
   const RegisterSums sums = registerSums(w, pass);
+  if (simd) return emitSymmetricSimdLoops(w, pass, lists, openmp, q, sums);
   // One destination's neighbours in [from, to) of its kept list (sorted): the pair
   // quantities, the bodies for d_idx and, with `both`, for s_idx (unless the self pair).
   // With `tail` (OpenMP blocks), the rest of the list after `to` follows for d_idx alone, in
@@ -630,7 +638,7 @@ void ScenePrinter::emitCrossSpanning(const NeighbourPass& ba, int b, const std::
 std::vector<std::string> ScenePrinter::pairLoopNotes(const EmitOptions& opts) const {
   std::vector<std::string> notes = symmetricPairsNotes(
       sched_, opts, [this](const DestinationWork& w, const NeighbourPass& pass) {
-        return simdPairsRefusal(w, pass).empty();
+        return simdPairsRefusal(w, pass).empty() && !onceLanes(w, pass);
       });
   for (std::string& note : simdPairsNotes()) notes.push_back(std::move(note));  // SimdPairs.cpp
   return notes;

@@ -22,9 +22,14 @@
 
 namespace sphc {
 
+// The name of a pair quantity in the mirrored call (destination j, source i): XIJ_ji, WJ for
+// WI, ...; a symmetric one its own.
+std::string mirroredPairQuantity(const std::string& q);
+
 // Why the neighbour pass `pass` of destination work `w` cannot evaluate each pair once for
 // both particles ("" where it can). listsKept: the printer keeps neighbour lists (in index
 // order) for the pass.
+
 std::string symmetricPairsRefusal(const Plan& plan, const DestinationWork& w,
                                   const NeighbourPass& pass, bool listsKept);
 

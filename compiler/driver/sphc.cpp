@@ -164,10 +164,14 @@ static cl::opt<std::string> SimdPairs(
              "defaults; where they are not known before the run, 3D yes, 2D no: with h = 1.3 "
              "dx and a support of 2 h, 74 and 21 neighbours; below 30, each pair once pays "
              "more); on (or --simd-pairs alone): every loop that allows it; off: the "
-             "scalar loops. --report says per loop which and why. The sums are reassociated "
+             "scalar loops. Under auto a loop in lanes over its own array (kept lists, double "
+             "precision) evaluates each pair once in them, the values the pair shares once, "
+             "the source side gathered and scattered (once: the same; perdest: auto's loops "
+             "per destination, the default before stop 35; docs/performance.md). --report says "
+             "per loop which and why. The sums are reassociated "
              "in the lanes, so results differ from the scalar loop's in the last bits "
              "(serial and openmp stay bitwise equal)"),
-    cl::value_desc("auto|on|off"), cl::ValueOptional, cl::init("auto"), cl::cat(SphcCat));
+    cl::value_desc("auto|on|off|once|perdest"), cl::ValueOptional, cl::init("auto"), cl::cat(SphcCat));
 static cl::opt<std::string> SimdCpuOpt(
     "simd-cpu",
     cl::desc("The CPU --simd-pairs=auto chooses for (codegen/SimdCpu.cpp): host (default: "
@@ -522,12 +526,17 @@ int main(int argc, char** argv) {
   emitOpts.registerSums = !NoRegisterSums;
   // --simd-pairs: auto (the default), on (also bare), off; the lanes only on the CPU backends.
   const std::string simdMode = SimdPairs.empty() ? std::string("on") : SimdPairs.getValue();
-  if (simdMode != "auto" && simdMode != "on" && simdMode != "off") {
-    llvm::errs() << "sphc: error: --simd-pairs=" << simdMode << ": it is auto, on or off\n";
+  if (simdMode != "auto" && simdMode != "on" && simdMode != "off" && simdMode != "once" &&
+      simdMode != "perdest") {
+    llvm::errs() << "sphc: error: --simd-pairs=" << simdMode
+                 << ": it is auto, on, off, once or perdest\n";
     return fail();
   }
   emitOpts.simdPairs = simdMode != "off";
-  emitOpts.simdPairsAuto = simdMode == "auto";
+  // auto (= once since stop 35): the loops that pay in lanes, each pair once in them where
+  // they may; perdest: the same loops per destination (stops 33-34's auto).
+  emitOpts.simdPairsAuto = simdMode == "auto" || simdMode == "once" || simdMode == "perdest";
+  emitOpts.simdPairsOnce = simdMode == "auto" || simdMode == "once";
   // --simd-pairs=auto goes by the CPU the solver is built for: this machine's (the default
   // flags have -march=native), or the one --simd-cpu names (codegen/SimdCpu.cpp).
   {
@@ -539,6 +548,10 @@ int main(int argc, char** argv) {
       return fail();
     }
     emitOpts.simdCpu = simdLanesOnCpu(cpu);
+    if (simdMode == "once" || simdMode == "perdest") {  // named: the lanes, whatever the CPU
+      emitOpts.simdCpu.lanes = true;
+      emitOpts.simdCpu.why = "--simd-pairs=" + simdMode + " names the lanes";
+    }
     if (SimdCpuOpt == "host" && !CxxFlags.empty() &&
         CxxFlags.find("-march=native") == std::string::npos) {
       emitOpts.simdCpu.lanes = false;
