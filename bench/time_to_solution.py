@@ -32,6 +32,8 @@ Cases (both codes run the same numerics; see bench/README.md for the details of 
   dambreak  examples/dambreak.sph (adaptive dt, WCSPH) vs PySPH dam_break_2d (wcsph,
             adaptive dt), dx = 0.03, to t = 0.5 s, snapshots every 0.02 s (sphc) / 50 steps
             (PySPH); --dambreak-large-tf T adds dx = 0.0047 (~100k particles) to t = T
+  dambreak-pysph-numerics  the same with PySPH's effects and cfl (no density diffusion, no
+            shifting, cfl 0.3); with --dambreak-large-tf T also at dx = 0.0047 to t = T
   cube      bench/cube.sph vs PySPH cube, 47^3 = 103,823 particles, to t = 2.5e-3 (25 steps)
   tg        examples/taylor_green.sph -D scheme=edac vs PySPH taylor_green --scheme edac,
             Re = 100, nx = 100, to t = 1
@@ -394,7 +396,8 @@ def main():
     ap.add_argument("--repeat", type=int, default=1, help="rounds; the fastest is kept")
     ap.add_argument("--tf-dambreak", type=float, default=None)
     ap.add_argument("--dambreak-large-tf", type=float, default=0.0,
-                    help="also the dam break at dx = 0.0047 (~100k particles) to this t")
+                    help="also the dam break at dx = 0.0047 (~100k particles) to this t "
+                         "(with dambreak-pysph-numerics: that case at dx = 0.0047 too)")
     ap.add_argument("--tf-cube", type=float, default=None)
     ap.add_argument("--nx-tg", type=int, default=None)
     ap.add_argument("--tf-tg", type=float, default=None)
@@ -420,6 +423,9 @@ def main():
                 cases.append(dambreak_case(0.0047, args.dambreak_large_tf, "dambreak100k"))
         elif c == "dambreak-pysph-numerics":
             cases.append(dambreak_case(0.03, tf_db, "dambreak_pn", pysph_numerics=True))
+            if args.dambreak_large_tf > 0:
+                cases.append(dambreak_case(0.0047, args.dambreak_large_tf, "dambreak_pn100k",
+                                           pysph_numerics=True))
         elif c == "cube":
             cases.append(cube_case(tf_cube))
         elif c == "tg":

@@ -145,6 +145,10 @@ struct BodyFacts {
   // Loop bodies: values the same (or negated) for the mirrored pair (body/PairShared.cpp),
   // computed once per pair where the pair is evaluated once for both particles.
   std::vector<SourceOnlySite> pairShared;
+  // Loop bodies: at the self pair (d_idx = s_idx, r = 0) the body only adds zeros to
+  // properties (body/SelfPair.cpp), so an each-pair-once loop of bodies that all do may skip
+  // that pair (codegen/SymmetricPairs.cpp).
+  bool vanishesOnSelfPair = false;
 };
 
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given

@@ -255,5 +255,8 @@ bool appendSiteLocals(const std::set<const clang::VarDecl*>& locals, const Order
 // The values of a loop body the mirrored pair shares (BodyFacts::pairShared; PairShared.cpp).
 std::vector<SourceOnlySite> findPairSharedSites(const BodySource& body, clang::FunctionDecl* fn,
                                                 const SourceRangeOf& rangeOf);
+// Whether a loop body adds only zeros to properties at the self pair (BodyFacts::
+// vanishesOnSelfPair; SelfPair.cpp).
+bool vanishesOnSelfPair(const BodySource& body, clang::FunctionDecl* fn);
 
 }  // namespace sphc::body_detail

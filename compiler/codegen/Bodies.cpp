@@ -51,6 +51,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in
   // lanes); --simd-pairs=on prints every loop that allows it per destination.
   pairShared_ = opts.pairShared && host_.hoist && (!simdPairs_ || simdAuto_);
+  skipSelfPairs_ = opts.skipSelfPairs;
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {

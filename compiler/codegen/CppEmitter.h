@@ -89,6 +89,12 @@ struct EmitOptions {
   // precision, not --mpi); false (--no-register-sums): updated in memory at every pair, as
   // before. The values are the same bit for bit.
   bool registerSums = true;
+  // In the each-pair-once loops of one array (codegen/SymmetricPairs.cpp) whose bodies all
+  // add only zeros at the self pair (body/SelfPair.cpp: momentum, continuity, XSPH, the
+  // shifting's sums, ...), particle i's pairs start after i itself; false
+  // (--no-self-pair-skip): the self pair is evaluated as before. The values are the same bit
+  // for bit but for the sign of a sum that is -0 when its self pair comes (docs/performance.md).
+  bool skipSelfPairs = true;
   // --simd-pairs: the CPU pair loops that allow it (codegen/SimdPairs.cpp) are printed per
   // destination with the neighbour loop under `#pragma omp simd reduction(+: sums)`, the pair
   // quantities scalars (XIJ_0, ...), the bodies' calls of their NAME_loop_simd form; the

@@ -234,6 +234,7 @@ class ScenePrinter {
   };
   mutable std::map<std::string, PairSharedLocal> pairSharedScope_;  // eqValues + "/" + K
   bool pairShared_ = false;  // EmitOptions::pairShared (CPU double, not mpi, not --simd-pairs)
+  bool skipSelfPairs_ = false;  // EmitOptions::skipSelfPairs (SymmetricPairs.cpp)
   mutable std::unique_ptr<std::set<const PlanBody*>> pairSharedBodies_;  // (once)
 
   // ---- Source-only values hoisted out of the pair loops (Hoist.cpp) ----
@@ -309,6 +310,9 @@ class ScenePrinter {
   void emitKeptListsBuild(const std::string& lists, bool openmp, const std::string& listRadius2);
   void emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma);
   void emitPairQuantitiesOnce(const std::set<std::string>& q, bool both, const std::string& body);
+  // Whether an each-pair-once pass leaves out the self pair: every body adds zeros there
+  // (BodyFacts::vanishesOnSelfPair, body/SelfPair.cpp) and EmitOptions::skipSelfPairs.
+  bool skipsSelfPair(const NeighbourPass& pass) const;
   // The members holding the destination-only values of every particle (dhoist_eqN_K).
   void emitSymmetricMembers(std::ostream& os) const;
   std::string symmetricDestinationHoisted(const std::string& eqValues, const std::string& k) const {

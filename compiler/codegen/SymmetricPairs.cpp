@@ -316,7 +316,9 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     std::string comment;     // after the destination loop's opening line
     bool tail = false;
     std::string skip;        // a condition under which d_idx has nothing in [from, to)
+    bool skipSelf = false;   // from is where s_idx >= d_idx starts: past d_idx itself
   };
+  const bool skipSelf = skipsSelfPair(pass);
   auto segment = [&](const Segment& sg) {
     const std::string& indent = sg.indent;
     const std::string& from = sg.from;
@@ -342,6 +344,13 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
     scene_ << in << "const std::uint32_t* const k_end = kept.data() + kept.size();\n";
     if (!skip.empty()) scene_ << in << "if (" << skip << ") continue;  // no neighbour in [from, to)\n";
+    if (sg.skipSelf) {
+      scene_ << in << "const std::uint32_t* k_first = " << from << ";\n";
+      scene_ << in << "if (k_first != k_end && *k_first == static_cast<std::uint32_t>(d_idx)) "
+                      "++k_first;  // the self pair: every body adds zeros there (sphc\n"
+             << in << "// --no-self-pair-skip: evaluated; body/SelfPair.cpp)\n";
+    }
+    const std::string first = sg.skipSelf ? std::string("k_first") : from;
     emitSumsLoad(scene_, in, sums);  // codegen/RegisterSums.cpp
     const std::string body = in + "  ";
     auto pairs = [&](bool bothSides) {
@@ -350,7 +359,10 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       emitPairQuantitiesOnce(q, bothSides, body);
       if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
       for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
-      if (bothSides) {
+      if (bothSides && sg.skipSelf) {  // s_idx > d_idx: the self pair is not in [k_first, ...)
+        scene_ << body << "// the same pair for particle s_idx\n";
+        for (const PlanEquation* eq : pass.equations) scene_ << body << callBodyMirrored(*eq, d);
+      } else if (bothSides) {
         scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
         for (const PlanEquation* eq : pass.equations)
           scene_ << body << "  " << callBodyMirrored(*eq, d);
@@ -360,13 +372,13 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       scene_ << in << "}\n";
     };
     if (!sg.tail) {
-      scene_ << in << "for (const std::uint32_t* k = " << from << "; k != k_end" << to
+      scene_ << in << "for (const std::uint32_t* k = " << first << "; k != k_end" << to
              << "; ++k) {\n";
       pairs(both);
     } else {
       // `to` is the block's end: where the list passes it (found once; the last block's
       // lists end there).
-      scene_ << in << "const std::uint32_t* k = " << from << ";\n";
+      scene_ << in << "const std::uint32_t* k = " << first << ";\n";
       scene_ << in << "const std::uint32_t* const k_mid = " << to << " == n || k == k_end || "
              << "k_end[-1] < static_cast<std::uint32_t>(" << to << ")\n"
              << in << "    ? k_end : std::lower_bound(k, k_end, static_cast<std::uint32_t>(" << to
@@ -382,7 +394,8 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   const std::string upper = "kept.data() + " + lists + ".upper[d_idx]";  // s_idx >= d_idx
   if (!openmp) {
     Segment all{"        ", "0", "n", upper};
-    all.comment = "  // pairs (d_idx, s_idx >= d_idx)";
+    all.comment = skipSelf ? "  // pairs (d_idx, s_idx > d_idx)" : "  // pairs (d_idx, s_idx >= d_idx)";
+    all.skipSelf = skipSelf;
     segment(all);
     return;
   }
@@ -406,8 +419,16 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   Segment block{"          ", "b_begin", "b_end", upper};
   block.to = "b_end";
   block.tail = true;
+  block.skipSelf = skipSelf;
   segment(block);
   scene_ << "        }\n";
+}
+
+bool ScenePrinter::skipsSelfPair(const NeighbourPass& pass) const {
+  if (!skipSelfPairs_ || pass.equations.empty()) return false;
+  for (const PlanEquation* eq : pass.equations)
+    if (!loopBody(plan_, *eq).facts.vanishesOnSelfPair) return false;
+  return true;
 }
 
 void ScenePrinter::emitKeptListsBuild(const std::string& lists, bool openmp,

@@ -152,6 +152,14 @@ static cl::opt<bool> NoRegisterSums(
              "bodies allow it; serial and openmp, double and single precision (float locals "
              "in single); the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoSelfPairSkip(
+    "no-self-pair-skip",
+    cl::desc("Evaluate the self pair (a particle with itself, r = 0) in the each-pair-once "
+             "loops too (default: where every body of such a loop only adds zeros at r = 0, "
+             "e.g. the momentum, continuity and XSPH equations, a particle's pairs start after "
+             "it; the results are the same bit for bit but for the sign of a sum that is -0 "
+             "there)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<std::string> SimdPairs(
     "simd-pairs",
     cl::desc("The CPU pair loops (serial and openmp, double and single precision) whose bodies allow it "
@@ -524,6 +532,7 @@ int main(int argc, char** argv) {
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;
+  emitOpts.skipSelfPairs = !NoSelfPairSkip;
   // --simd-pairs: auto (the default), on (also bare), off; the lanes only on the CPU backends.
   const std::string simdMode = SimdPairs.empty() ? std::string("on") : SimdPairs.getValue();
   if (simdMode != "auto" && simdMode != "on" && simdMode != "off" && simdMode != "once" &&
