@@ -666,21 +666,40 @@ void ScenePrinter::emitMain() {
   out_ << "  prog.dim = DIM;\n";
   out_ << "  prog.backend = \"" << backendName_ << "\";\n";
   mainBackendOptions();
+  // The parameters, options and effects' parameters: one call each with a list of plain data
+  // (sphc::add_params, ...: the runtime fills the vectors), no code per entry to compile.
+  std::vector<std::string> entries;
+  auto list = [&](const char* call, const char* what) {
+    if (entries.empty()) return;
+    out_ << "  " << call << "{  // " << what << "\n";
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      const std::string& e = entries[k];
+      const std::size_t comment = e.find("  //");  // after the entry's comma
+      const std::string end = k + 1 == entries.size() ? "});" : ",";
+      out_ << "      "
+           << (comment == std::string::npos ? e + end
+                                            : e.substr(0, comment) + end + e.substr(comment))
+           << "\n";
+    }
+    entries.clear();
+  };
   for (const auto* p : plan_.params) {
     if (p->derived) continue;  // `let`: not overridable
     // A literal default is printed as setup() prints it (the .sph spelling, `0.03`).
     bool lit = isLiteral(*p->value);
     auto none = [](const std::string& n) -> std::string { SPHC_INTERNAL("name in literal " + n); };
-    out_ << "  prog.params.push_back({\"" << p->name.name << "\", "
-         << (lit ? exprCpp(*p->value, none) : "std::nan(\"\")") << ", \""
-         << (lit ? std::string("") : "= " + exprText(*p->value)) << "\"});\n";
+    entries.push_back("{\"" + p->name.name + "\", " +
+                      (lit ? exprCpp(*p->value, none) : "std::nan(\"\")") + ", \"" +
+                      (lit ? std::string("") : "= " + exprText(*p->value)) + "\"}");
   }
+  list("sphc::add_params(prog.params, ", "name, default, help");
   for (const auto& o : plan_.options) {
     std::string choices;
     for (const auto& c : o.choices) choices += (choices.empty() ? "" : ", ") + c;
-    out_ << "  prog.options.push_back({\"" << o.name << "\", \"" << o.value << "\", \"" << choices
-         << "\"});  // sphc -D " << o.name << "=...\n";
+    entries.push_back("{\"" + o.name + "\", \"" + o.value + "\", \"" + choices +
+                      "\"}  // sphc -D " + o.name + "=...");
   }
+  list("sphc::add_options(prog.options, ", "name, value, choices");
   for (const auto& o : plan_.options) {
     if (!o.isEffect || o.on()) continue;
     // The sphc command that turns the effect on, with the effects it needs that are off.
@@ -697,9 +716,9 @@ void ScenePrinter::emitMain() {
     std::string cmd = "sphc " + llvm::sys::path::filename(plan_.mainFile).str();
     for (const auto& n : turnOn) cmd += " -D " + n + "=on";
     for (const auto& p : o.params)
-      out_ << "  prog.effect_params.push_back({\"" << p << "\", \"" << o.name << "\", \"" << cmd
-           << "\"});\n";
+      entries.push_back("{\"" + p + "\", \"" + o.name + "\", \"" + cmd + "\"}");
   }
+  list("sphc::add_effect_params(prog.effect_params, ", "name, effect, sphc command");
   if (singlePrecision_) out_ << "  prog.precision = \"single\";\n";
   out_ << "  prog.setup = [](const std::vector<double>& v, sphc::SceneTimes& times) {\n"
           "    scene.setup(v, times);\n"

@@ -172,7 +172,7 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
   // compiler only.
   const std::string linkerFlags = cxx == info["cxx"] ? info["link_flags"] : "";
   // Split units with the default flags: the unit without the phases and the time step (set-up,
-  // output, main: code that runs once or at outputs) is compiled at -O1 (cold_flags, which
+  // output, main: code that runs once or at outputs) is compiled at -Og (cold_flags, which
   // GCC's precompiled header accepts); the phases' unit keeps the default flags.
   const std::string coldFlags =
       usesDefaultFlags(info, cxx, flags, req) ? info["cold_flags"] : "";

@@ -1256,6 +1256,19 @@ void choose_omp_wait(int argc, char** argv) {
   execv("/proc/self/exe", argv);  // returns only on failure: go on as we are
 }
 
+void add_params(std::vector<ParamInfo>& to, std::initializer_list<ParamSpec> specs) {
+  for (const ParamSpec& s : specs) to.push_back({s.name, s.value, s.help});
+}
+
+void add_options(std::vector<OptionInfo>& to, std::initializer_list<OptionSpec> specs) {
+  for (const OptionSpec& s : specs) to.push_back({s.name, s.value, s.choices});
+}
+
+void add_effect_params(std::vector<EffectParamInfo>& to,
+                       std::initializer_list<EffectParamSpec> specs) {
+  for (const EffectParamSpec& s : specs) to.push_back({s.name, s.effect, s.command});
+}
+
 int run_main(int argc, char** argv, SceneProgram& prog) {
   Options opt;
   try {

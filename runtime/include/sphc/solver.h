@@ -50,6 +50,30 @@ struct EffectParamInfo {
   std::string command;  // "sphc dambreak.sph -D density_gradient=on -D delta_sph=on"
 };
 
+// The generated main's lists of parameters, options and effects' parameters, as plain data
+// appended in order: `sphc::add_params(prog.params, {{"dx", 0.03, ""}, ...})` puts no code per
+// entry in the solver's text, as a push_back of each would (docs/performance.md, "Compile
+// time: the runtime's code in its library").
+struct ParamSpec {
+  const char* name;
+  double value;
+  const char* help;
+};
+struct OptionSpec {
+  const char* name;
+  const char* value;
+  const char* choices;
+};
+struct EffectParamSpec {
+  const char* name;
+  const char* effect;
+  const char* command;
+};
+void add_params(std::vector<ParamInfo>& to, std::initializer_list<ParamSpec> specs);
+void add_options(std::vector<OptionInfo>& to, std::initializer_list<OptionSpec> specs);
+void add_effect_params(std::vector<EffectParamInfo>& to,
+                       std::initializer_list<EffectParamSpec> specs);
+
 // Times a scene computes from its parameters; the command line may override them.
 struct SceneTimes {
   double tf = 1.0;                 // final time
