@@ -40,6 +40,8 @@ SCENES = {
     "dambreak": (SCENE_FILES["dambreak"], [], [], 50, 150),
     "dambreak_pysph": (SCENE_FILES["dambreak"], PYSPH_EFFECTS, ["--set", "cfl=0.3"], 50, 150),
     "dambreak3d": (DAMBREAK3D, [], [], 5, 15),
+    # Periodic (the kept lists opt in with a number: the *_skin variants).
+    "taylor_green": (SCENE_FILES["taylor_green"], [], [], 20, 60),
 }
 # --cpu: the cube at nx = 20 and 47 (PySPH's ~100k), the dam breaks at ~100k particles.
 CPU_SCENES = {
@@ -49,6 +51,7 @@ CPU_SCENES = {
     "dambreak_pysph": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
                        ["--set", "dx=0.0047", "--set", "cfl=0.3"], 5, 45),
     "dambreak3d": (DAMBREAK3D, [], [], 5, 25),
+    "taylor_green": (SCENE_FILES["taylor_green"], [], ["--set", "nx=100"], 5, 45),
 }
 ALL_VARIANTS = {
     "double": [], "double_simd": ["--simd-pairs"],
@@ -61,6 +64,12 @@ ALL_VARIANTS = {
     "single_nolists": ["--precision=single", "--verlet-skin=off"],
     "single_lists": ["--precision=single", "--verlet-skin=0.1"],
     "single_lists_simd": ["--precision=single", "--verlet-skin=0.1", "--simd-pairs"],
+    # Stop 35: single precision without hoisting, without the lanes, and the kept lists of a
+    # periodic or mirror scene (opt in with a number, in double too).
+    "single_nohoist": ["--precision=single", "--no-hoist"],
+    "single_simd_off": ["--precision=single", "--simd-pairs=off"],
+    "double_skin": ["--verlet-skin=0.1"],
+    "single_skin": ["--precision=single", "--verlet-skin=0.1"],
 }
 VARIANTS = [(n, ALL_VARIANTS[n]) for n in ("double", "double_simd", "single", "single_simd")]
 
@@ -123,7 +132,8 @@ def main():
     ap.add_argument("--variants", default=None,
                     help="comma-separated, the first the base of the ratios (default: "
                     "double,double_simd,single,single_simd; also double_nolists, "
-                    "double_nolists_simd, single_nolists, single_lists, single_lists_simd)")
+                    "double_nolists_simd, single_nolists, single_lists, single_lists_simd, "
+                    "single_nohoist, single_simd_off, double_skin, single_skin)")
     args = ap.parse_args()
     if args.variants:
         VARIANTS[:] = [(n, ALL_VARIANTS[n]) for n in args.variants.split(",")]

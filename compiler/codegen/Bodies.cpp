@@ -31,8 +31,8 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
     host_.fma = "std::fma";
     device_.fma = "fma";
   }
-  host_.hoist = opts.hoist && opts.backend != Backend::OpenCL && !singlePrecision_ &&
-                !sched.distribution.enabled;
+  // Single precision too (the values' own types, Hoist.cpp).
+  host_.hoist = opts.hoist && opts.backend != Backend::OpenCL && !sched.distribution.enabled;
   for (int a : sched.cellLists) sourceArrays_.push_back(arr(a).name);
   for (int a : sched.searchArrays) loopArrays_.insert(arr(a).name);
   mpi_ = sched.distribution.enabled;
@@ -129,18 +129,18 @@ std::vector<ScenePrinter::BodyParam> ScenePrinter::bodyParams(const PlanBody& b,
   // Values computed once per source particle (codegen/Hoist.cpp): s_hoisted0, ...
   const auto hoisted = hoistedSites(b, d);
   for (size_t k = 0; k < hoisted.size(); ++k)
-    ps.push_back({"const " + real + "* s_hoisted" + std::to_string(k), BodyParam::Hoisted,
-                  std::to_string(k)});
+    ps.push_back({"const " + hoistedValueType(b, d, true, k) + "* s_hoisted" + std::to_string(k),
+                  BodyParam::Hoisted, std::to_string(k)});
   // ... and once per destination particle: d_hoisted0, ...
   const auto dHoisted = hoistedDestinationSites(b, d);
   for (size_t k = 0; k < dHoisted.size(); ++k)
-    ps.push_back({real + " d_hoisted" + std::to_string(k), BodyParam::DHoisted,
-                  std::to_string(k)});
+    ps.push_back({hoistedValueType(b, d, false, k) + " d_hoisted" + std::to_string(k),
+                  BodyParam::DHoisted, std::to_string(k)});
   // ... and once per pair for both particles (codegen/PairShared.cpp): pair_shared0, ...
   const auto shared = pairSharedSites(b, d);
   for (size_t k = 0; k < shared.size(); ++k)
-    ps.push_back({real + " pair_shared" + std::to_string(k), BodyParam::PairShared,
-                  std::to_string(k)});
+    ps.push_back({pairSharedValueType(b, d, k) + " pair_shared" + std::to_string(k),
+                  BodyParam::PairShared, std::to_string(k)});
   return ps;
 }
 
@@ -148,6 +148,12 @@ void ScenePrinter::emitBodyFunction(const PlanBody& b, const std::string& name,
                                     const std::string& ret, int destArray, const Dialect& d,
                                     std::ostringstream& os) {
   auto params = bodyParams(b, destArray, d);
+  // Single precision: the hoisted and pair-shared values' functions first, their types name
+  // the body's parameters (Hoist.cpp, PairShared.cpp).
+  if (d.floatBodies) {
+    emitHoistFunctions(b, name, d, os);
+    emitPairSharedFunctions(b, name, destArray, d, os);
+  }
   os << "// " << b.source.label << ", from " << loc(b.source.start) << "\n";
   // OpenCL build errors in the body name the .sph line (the program is built at run time).
   if (d.lineDirectives) emitLineDirective(os, b.source.start);
@@ -162,8 +168,10 @@ void ScenePrinter::emitBodyFunction(const PlanBody& b, const std::string& name,
   os << "}\n";
   if (d.lineDirectives) resetLineDirective(os, d);
   os << "\n";
-  emitHoistFunctions(b, name, d, os);
-  emitPairSharedFunctions(b, name, destArray, d, os);
+  if (!d.floatBodies) {
+    emitHoistFunctions(b, name, d, os);
+    emitPairSharedFunctions(b, name, destArray, d, os);
+  }
 }
 
 // A body's or helper's text in a dialect: its multiply-adds fused, in float for
@@ -171,7 +179,7 @@ void ScenePrinter::emitBodyFunction(const PlanBody& b, const std::string& name,
 std::string ScenePrinter::bodyText(const PlanBody& b, const Dialect& d) const {
   if (!hoistedSites(b, d).empty() || !hoistedDestinationSites(b, d).empty() ||
       !pairSharedSites(b, d).empty())
-    return hoistedBodyText(b, d);
+    return d.floatBodies ? singlePrecisionBody(hoistedBodyText(b, d)) : hoistedBodyText(b, d);
   std::string text = fuseMultiplyAdds(b.source.text, b.facts.multiplyAdds, d.fma);
   return d.floatBodies ? singlePrecisionBody(text) : text;
 }

@@ -23,7 +23,7 @@ class CpuPrinter : public ScenePrinter {
       : ScenePrinter(sched, diags, opts),
         openmp_(opts.backend == Backend::OpenMP),
         ompMinParticles_(opts.ompMinParticles),
-        verletSkin_(opts.verletSkin > 0 && !(cpuSingle_ && hasDomain()) && !mpi_ && !ghostPairLoops() && !hasZones()
+        verletSkin_(opts.verletSkin > 0 && !mpi_ && !ghostPairLoops() && !hasZones()
                         ? opts.verletSkin
                         : 0.0),
         tuned_(verletSkin_ > 0 && opts.verletAuto && !hasDomain()),
@@ -176,7 +176,11 @@ class CpuPrinter : public ScenePrinter {
               "(sphc/solver.h)\n";
   }
   void mainBackendOptions() override {
-    if (verlet() && hasDomain()) out_ << "  prog.before_output = [] { scene.wrap_into_box(); };\n";
+    // Single precision: the host doubles the output writes taken again after the wrap.
+    if (verlet() && hasDomain())
+      out_ << (cpuSingle_ ? "  prog.before_output = [] {\n    scene.wrap_into_box();\n"
+                            "    scene.to_host();\n  };\n"
+                          : "  prog.before_output = [] { scene.wrap_into_box(); };\n");
     if (openmp_)
       out_ << "  prog.set_threads = [](int n) {\n"
               "    if (n > 0) omp_set_num_threads(n);\n"
@@ -828,7 +832,8 @@ void CpuPrinter::updateNeighboursWithGhosts() {
 std::string CpuPrinter::removeGhosts() const {
   std::string r;
   if (verlet()) {  // the ghosts are kept for the next evaluation (updateNeighboursKeptGhosts)
-    for (const auto& S : sourceArrays_) r += "    sphc::hide_ghosts(" + S + ");\n";
+    for (const auto& S : sourceArrays_)
+      r += "    sphc::hide_ghosts(" + hostData(plan_.arrayIndex(S)) + ");\n";
     return r;
   }
   for (const auto& S : sourceArrays_)
@@ -850,13 +855,22 @@ void CpuPrinter::updateNeighboursKeptGhosts() {
   searchDomain();
   if (sourceArrays_.empty()) return;
   scene_ << "    const bool reorder = builds++ % REORDER_EVERY == 0;\n";
-  scene_ << "    const bool new_ghosts = reorder || ghost_skin.must_rebuild(all, "
+  // The arrays of the pair loops: `all` (searchDomain), or in single precision their float
+  // copies, whose positions the scene computes on.
+  std::string all = "all";
+  if (cpuSingle_) {
+    all.clear();
+    for (const auto& a : plan_.arrays)
+      if (loopArrays_.count(a.name)) all += (all.empty() ? "{&f32_" : ", &f32_") + a.name;
+    all += "}";
+  }
+  scene_ << "    const bool new_ghosts = reorder || ghost_skin.must_rebuild(" << all << ", "
             "Kernel::radius_scale);\n";
   scene_ << "    if (reorder) {\n";
   scene_ << "      // Every REORDER_EVERY builds the real particles are wrapped into the box and sorted\n"
             "      // in the cell order of the support's grid (as without lists).\n";
   scene_ << "      wrap_into_box();\n";
-  scene_ << "      order_domain = sphc::make_search_domain(all, DIM, Kernel::radius_scale);\n";
+  scene_ << "      " << orderDomain() << "\n";
   for (const auto& S : sourceArrays_)
     if (reorders(S))
       scene_ << "      " << cellListBuild(S, S + ".n", "order_domain") << "\n      "
@@ -868,12 +882,12 @@ void CpuPrinter::updateNeighboursKeptGhosts() {
   scene_ << "    if (new_ghosts) {\n";
   for (const auto& S : sourceArrays_) {
     int s = plan_.arrayIndex(S);
-    scene_ << "      sphc::add_ghosts(box, " << S << ", cutoff, ghosts_" << S << ", "
+    scene_ << "      sphc::add_ghosts(box, " << hostData(s) << ", cutoff, ghosts_" << S << ", "
            << propIndexList(s, arr(s).ghostProps) << ");  //";
     for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
     scene_ << "\n";
   }
-  scene_ << "      ghost_skin.mark(all);\n";
+  scene_ << "      ghost_skin.mark(" << all << ");\n";
   forEachVerletLists([&](const std::string& lists, const Phase&, const DestinationWork&,
                          const NeighbourPass&) {
     scene_ << "      " << lists << ".end = -1;  // not built: the ghosts were renumbered\n";
@@ -881,7 +895,7 @@ void CpuPrinter::updateNeighboursKeptGhosts() {
   scene_ << "    } else {  // the same ghosts, from their originals now\n";
   for (const auto& S : sourceArrays_) {
     int s = plan_.arrayIndex(S);
-    scene_ << "      sphc::restore_ghosts(box, " << S << ", ghosts_" << S << ", "
+    scene_ << "      sphc::restore_ghosts(box, " << hostData(s) << ", ghosts_" << S << ", "
            << propIndexList(s, arr(s).ghostProps) << ");\n";
   }
   scene_ << "    }\n";

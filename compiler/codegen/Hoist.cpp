@@ -1,4 +1,4 @@
-// Values hoisted out of the pair loops (CPU backends, double precision, not --mpi).
+// Values hoisted out of the pair loops (CPU backends, double and single precision, not --mpi).
 //
 // The body analysis records the subexpressions of a loop body that depend on the source
 // particle alone and divide or call sqrt, pow, ... (body/SourceOnly.cpp: BodyFacts::
@@ -25,7 +25,15 @@
 // in it as they were in the body), and the solvers are built with -ffp-contract=off. The
 // source properties it reads are not written while the pass runs (analysis/Hazards.cpp), and
 // initialize, which may write them for the same array, has finished. `sphc --no-hoist` keeps
-// the bodies as written. OpenCL, --precision=single and --mpi keep the bodies as written.
+// the bodies as written. OpenCL and --mpi keep the bodies as written.
+//
+// Single precision (--precision=single on the CPU): the functions are the site's float text
+// (singlePrecisionBody, as the body's), returning `auto`: a site's type in that text is float,
+// or double where it calls a double function (KERNEL_W: `1.0f / KERNEL_W(...)` is a double),
+// and the value must keep it to round as the body did. Each function is followed by its type,
+// `using NAME_hoistedK_t = decltype(NAME_hoistedK(...))`, which the body's parameter, the
+// scratch arrays and the locals are declared with; the functions and types come before the
+// body's function. The same bits as --no-hoist, as in double.
 #include "body/TextEdits.h"
 #include "codegen/FusedMultiplyAdd.h"
 #include "codegen/Printer.h"
@@ -182,35 +190,46 @@ void ScenePrinter::hoistedText(const PlanBody& b, const Dialect& d,
 void ScenePrinter::emitHoistFunctions(const PlanBody& b, const std::string& name, const Dialect& d,
                                       std::ostringstream& os) const {
   const std::string& text = b.source.text;
+  // Single precision: the body's float text (as bodyText), the value's own type (above).
+  const bool single = d.floatBodies;
+  auto inDialect = [&](const std::string& t) { return single ? singlePrecisionBody(t) : t; };
   auto emit = [&](const std::vector<SourceOnlySite>& sites, bool source) {
     const std::string side = source ? "s" : "d";
     for (size_t k = 0; k < sites.size(); ++k) {
       const SourceOnlySite& s = sites[k];
+      const std::string fn = name + "_" + (source ? "" : "d") + "hoisted" + std::to_string(k);
+      std::vector<std::string> types = {"int"};  // of its parameters, for its type (single)
       os << "// " << b.source.label << ", from " << loc(b.source.start) << ": once per "
          << (source ? "source" : "destination")
          << " particle (hoisted out of the pair loop; --no-hoist: per pair)\n";
       os << "//   " << oneLine(text.substr(s.begin, s.end - s.begin)) << "\n";
-      os << d.functionPrefix << d.real << " " << name << "_" << (source ? "" : "d") << "hoisted"
-         << k << "(int " << side << "_idx";
-      if (s.usesT) os << ", " << d.real << " t";
-      if (s.usesDt) os << ", " << d.real << " dt";
-      for (const auto& sc : s.scalars) os << ", " << d.real << " " << sc;
+      os << d.functionPrefix << (single ? "auto" : d.real) << " " << fn << "(int " << side
+         << "_idx";
+      auto param = [&](const std::string& type, const std::string& pname) {
+        os << ", " << type << " " << pname;
+        types.push_back(type);
+      };
+      if (s.usesT) param(d.real, "t");
+      if (s.usesDt) param(d.real, "dt");
+      for (const auto& sc : s.scalars) param(d.real, sc);
       for (const auto& p : sideReads(b.facts, s, source)) {
         auto shape = b.source.props.find(p);
         std::string t = shape == b.source.props.end() ? "double" : shape->second.type;
-        os << ", const " << (t == "int" ? d.intType : t == "uint" ? d.uintType : d.real) << "* "
-           << side << "_" << p;
+        param("const " + (t == "int" ? d.intType : t == "uint" ? d.uintType : d.real) + "*",
+              side + "_" + p);
       }
       os << ") {\n";
       if (!source && s.locals.empty() && sideReads(b.facts, s, false).empty())
         os << "  (void)d_idx;  // scalars only\n";
       for (const auto& l : s.locals) {
-        std::string init = fusedRange(text, b.facts, l.initBegin, l.initEnd, d.fma);
-        os << "  const " << l.type << " " << l.name << " = " << init << endStatement(init)
-           << "\n";
+        std::string init = inDialect(fusedRange(text, b.facts, l.initBegin, l.initEnd, d.fma));
+        os << "  const " << inDialect(l.type) << " " << l.name << " = " << init
+           << endStatement(init) << "\n";
       }
-      std::string value = fusedRange(text, b.facts, s.begin, s.end, d.fma);
-      os << "  return " << value << endStatement(value) << "\n}\n\n";
+      std::string value = inDialect(fusedRange(text, b.facts, s.begin, s.end, d.fma));
+      os << "  return " << value << endStatement(value) << "\n}\n";
+      if (single) os << valueTypeAlias(fn, types);
+      os << "\n";
     }
   };
   emit(hoistedSites(b, d), true);
@@ -235,12 +254,13 @@ void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass&
     const auto sites = hoistedDestinationSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k) {
       const std::string local = hoistDestinationArgument(eqStruct(*eq), std::to_string(k));
+      const std::string type = hoistedValueType(b, host_, false, k);
       if (particleFree(b.source.text, b.facts, sites[k])) {  // emitHoistedValues computed it
-        os << indent << "const double " << local << " = " << passHoisted(eqStruct(*eq), k)
+        os << indent << "const " << type << " " << local << " = " << passHoisted(eqStruct(*eq), k)
            << ";  // " << eq->name << ": once per pass\n";
         continue;
       }
-      os << indent << "const double " << local
+      os << indent << "const " << type << " " << local
          << " = " << bodyFunctionName(eq->name, "loop") << "_dhoisted" << k << "(d_idx"
          << hoistArguments(sites[k], b.facts, false, eqStruct(*eq)) << ");  // " << eq->name
          << ": " << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
@@ -258,7 +278,8 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
     const auto sites = hoistedDestinationSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k)
       if (particleFree(b.source.text, b.facts, sites[k]))
-        os << "        const double " << passHoisted(eqStruct(*eq), k) << " = "
+        os << "        const " << hoistedValueType(b, host_, false, k) << " "
+           << passHoisted(eqStruct(*eq), k) << " = "
            << bodyFunctionName(eq->name, "loop") << "_dhoisted" << k << "(0"
            << hoistArguments(sites[k], b.facts, false, eqStruct(*eq)) << ");  // " << eq->name
            << ": "
@@ -280,7 +301,8 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
       const std::string member = "hoist_" + eqStruct(*eq) + "_" + K;
       os << "        " << member << ".resize(n_src);  // " << eq->name << ": "
          << oneLine(b.source.text.substr(s.begin, s.end - s.begin)) << "\n";
-      os << "        double* const " << ptr << " = " << member << ".data();\n";
+      os << "        " << hoistedValueType(b, host_, true, k) << "* const " << ptr << " = "
+         << member << ".data();\n";
       calls.push_back(ptr + "[s_idx] = " + bodyFunctionName(eq->name, "loop") + "_hoisted" + K +
                       "(s_idx" + hoistArguments(s, b.facts, true, eqStruct(*eq)) + ");");
     }
@@ -292,6 +314,30 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
   os << "        }\n";
 }
 
+std::string ScenePrinter::valueTypeAlias(const std::string& fn,
+                                         const std::vector<std::string>& types) {
+  std::string r = "using " + fn + "_t = decltype(" + fn + "(";
+  for (size_t i = 0; i < types.size(); ++i)
+    r += (i ? ", std::declval<" : "std::declval<") + types[i] + ">()";
+  return r + "));  // the value's type in the float text\n";
+}
+
+std::string ScenePrinter::loopFunctionName(const PlanBody& b) const {
+  // Named after the first live equation of its declaration (emitBodies), which every
+  // equation of the declaration names it by.
+  for (const PlanEquation& eq : plan_.equations)
+    if (eq.live && plan_.equationDecls[eq.declIndex].methods.count(ast::Method::Loop) &&
+        &methodBody(eq, ast::Method::Loop) == &b)
+      return bodyFunctionName(eq.name, "loop");
+  SPHC_INTERNAL("the loop " + b.source.label + " of no live equation");
+}
+
+std::string ScenePrinter::hoistedValueType(const PlanBody& b, const Dialect& d, bool source,
+                                           size_t k) const {
+  if (!d.floatBodies) return d.real;
+  return loopFunctionName(b) + (source ? "_hoisted" : "_dhoisted") + std::to_string(k) + "_t";
+}
+
 void ScenePrinter::emitHoistMembers(std::ostream& os) const {
   for (const PlanEquation& eq : plan_.equations) {
     if (!eq.live) continue;
@@ -300,7 +346,8 @@ void ScenePrinter::emitHoistMembers(std::ostream& os) const {
     const PlanBody& b = methodBody(eq, ast::Method::Loop);
     const auto sites = hoistedSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k)
-      os << "  std::vector<double> hoist_" << eqStruct(eq) << "_" << k << ";  // " << eq.name
+      os << "  std::vector<" << hoistedValueType(b, host_, true, k) << "> hoist_" << eqStruct(eq)
+         << "_" << k << ";  // " << eq.name
          << ": " << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
          << " per source particle\n";
   }

@@ -1,5 +1,5 @@
-// Values a pair shares, computed once for both particles (CPU backends, double precision, not
-// --mpi, not --simd-pairs; `sphc --pair-shared-values=off` turns it off).
+// Values a pair shares, computed once for both particles (CPU backends, double and single
+// precision, not --mpi, not --simd-pairs; `sphc --pair-shared-values=off` turns it off).
 //
 // Where a pair loop evaluates each pair once for both particles (codegen/SymmetricPairs.cpp)
 // it calls each loop body twice per pair, for (d_idx, s_idx) and mirrored for (s_idx, d_idx).
@@ -21,6 +21,10 @@
 // body/PairShared.cpp, also for the sign of a zero), the site's function computes the
 // expression with the body's own operations and fused multiply-adds (a site that would split
 // a multiply-add is not used), and the properties a site reads are written by no pair loop.
+//
+// Single precision: as the hoisted values (codegen/Hoist.cpp), the functions are the float
+// text, return `auto` and are followed by their type (NAME_loop_pairsharedK_t), which the
+// body's parameter and the pair's local take; they come before the body's function.
 #include "codegen/Printer.h"
 
 #include "analysis/PairQuantityTable.h"
@@ -142,6 +146,7 @@ void ScenePrinter::printPairShared(const PlanBody& b, const std::string& name, i
   std::string params;
   const auto values = simd ? destinationValues(b, destArray)
                            : decltype(destinationValues(b, destArray))();
+  std::vector<std::string> types;  // of the parameters (single: the value's type)
   for (const BodyParam& p : pairSharedParams(b, destArray, d)) {
     std::string decl = p.decl;
     if (simd && p.kind == BodyParam::Pair && findPairQuantity(p.name)->vector) {
@@ -155,11 +160,14 @@ void ScenePrinter::printPairShared(const PlanBody& b, const std::string& name, i
         decl += (decl.empty() ? "" : ", ") + d.real + " " + destinationValueName(p.name, sc.first, c);
     }
     params += (params.empty() ? "" : ", ") + decl;
+    types.push_back(p.decl.substr(0, p.decl.rfind(' ')));
   }
+  const bool single = d.floatBodies;
+  auto inDialect = [&](const std::string& t) { return single ? singlePrecisionBody(t) : t; };
   for (size_t k = 0; k < sites.size(); ++k) {
     const SourceOnlySite s =
         movedSite(facts, sites[k], "a pair-shared value cut by a hoisted one in " + b.source.label);
-    const std::string value = fusedRange(text, facts, s.begin, s.end, d.fma);
+    const std::string value = inDialect(fusedRange(text, facts, s.begin, s.end, d.fma));
     os << "// " << b.source.label << ", from " << loc(b.source.start)
        << ": a value the pair shares, " << (s.sign < 0 ? "negated" : "the same")
        << " for the mirrored pair (once per pair\n// where each pair is evaluated once; "
@@ -169,19 +177,23 @@ void ScenePrinter::printPairShared(const PlanBody& b, const std::string& name, i
     else
       os << "//   " << s.result << " after " << oneLine(text.substr(s.stmtBegin, s.stmtEnd - s.stmtBegin))
          << "\n";
-    os << d.functionPrefix << d.real << " " << name << "_pairshared" << k << (simd ? "_simd" : "")
-       << "(" << params << ") {\n";
+    const std::string fn = name + "_pairshared" + K(k) + (simd ? "_simd" : "");
+    os << d.functionPrefix << (single ? "auto" : d.real) << " " << fn << "(" << params << ") {
     for (const auto& l : s.locals) {
-      std::string init = fusedRange(text, facts, l.initBegin, l.initEnd, d.fma);
-      os << "  const " << l.type << " " << l.name << " = " << init << endStatement(init) << "\n";
+      std::string init = inDialect(fusedRange(text, facts, l.initBegin, l.initEnd, d.fma));
+      os << "  const " << inDialect(l.type) << " " << l.name << " = " << init
+         << endStatement(init) << "\n";
     }
     if (s.result.empty()) {
-      os << "  return " << value << endStatement(value) << "\n}\n\n";
+      os << "  return " << value << endStatement(value) << "\n}\n";
     } else {
-      os << "  double " << s.result << " = " << value << endStatement(value) << "\n";
-      os << "  " << fusedRange(text, facts, s.stmtBegin, s.stmtEnd, d.fma) << "\n";
-      os << "  return " << s.result << ";\n}\n\n";
+      os << "  " << inDialect("double") << " " << s.result << " = " << value
+         << endStatement(value) << "\n";
+      os << "  " << inDialect(fusedRange(text, facts, s.stmtBegin, s.stmtEnd, d.fma)) << "\n";
+      os << "  return " << s.result << ";\n}\n";
     }
+    if (single) os << valueTypeAlias(fn, types);
+    os << "\n";
   }
 }
 
@@ -221,13 +233,19 @@ void ScenePrinter::emitPairSharedLocals(std::ostream& os, const std::string& ind
           call += callBodyDefault(p, eqStruct(*eq), "t", ".");
         }
       }
-      os << indent << "const double " << local << " = " << call << ");  // " << eq->name
+      os << indent << "const " << pairSharedValueType(b, host_, k) << " " << local << " = "
+         << call << ");  // " << eq->name
          << ": " << (sites[k].sign < 0 ? "minus this" : "the same") << " for (s_idx, d_idx)\n";
       pairSharedScope_[eqStruct(*eq) + "/" + K(k)] = {local, sites[k].sign};
       for (const PlanEquation* m : users)
         pairSharedScope_[eqStruct(*m) + "/" + K(k)] = {local, sites[k].sign};
     }
   }
+}
+
+std::string ScenePrinter::pairSharedValueType(const PlanBody& b, const Dialect& d, size_t k) const {
+  if (!d.floatBodies) return d.real;
+  return loopFunctionName(b) + "_pairshared" + K(k) + "_t";
 }
 
 }  // namespace sphc

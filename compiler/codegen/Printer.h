@@ -270,6 +270,18 @@ class ScenePrinter {
                               const std::string& indent) const;
   // The members of struct Scene that hold them.
   void emitHoistMembers(std::ostream& os) const;
+  // The C++ type of the value of b's hoisted site k (source: once per source particle, else
+  // per destination): double; in single precision (d.floatBodies) the type the expression
+  // has in the body's float text (float, or double where it calls KERNEL_W, ...), named
+  // NAME_hoistedK_t / NAME_dhoistedK_t after its function (emitHoistFunctions).
+  std::string hoistedValueType(const PlanBody& b, const Dialect& d, bool source, size_t k) const;
+  // The same for b's pair-shared value k (NAME_pairsharedK_t; PairShared.cpp).
+  std::string pairSharedValueType(const PlanBody& b, const Dialect& d, size_t k) const;
+  // The name of the function of loop body b (NAME_loop).
+  std::string loopFunctionName(const PlanBody& b) const;
+  // `using NAME_t = decltype(NAME(...))` for a function whose parameters have the types
+  // `types`, printed after it in single precision: the type of its value.
+  static std::string valueTypeAlias(const std::string& fn, const std::vector<std::string>& types);
   std::string hoistArgument(const std::string& eqValues, const std::string& k) const {
     return "hoisted_" + eqValues + "_" + k;
   }

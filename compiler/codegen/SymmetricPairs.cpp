@@ -267,7 +267,8 @@ void ScenePrinter::emitSymmetricMembers(std::ostream& os) const {
     const PlanBody& b = methodBody(eq, ast::Method::Loop);
     const auto sites = hoistedDestinationSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k)
-      os << "  std::vector<double> dhoist_" << eqStruct(eq) << "_" << k << ";  // " << eq.name
+      os << "  std::vector<" << hoistedValueType(b, host_, false, k) << "> dhoist_" << eqStruct(eq)
+         << "_" << k << ";  // " << eq.name
          << ": its loop's destination-only value " << k
          << " per particle (each pair once for both particles)\n";
   }
@@ -334,10 +335,12 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     // The destination-only values as they were before the pass (a body may write what they
     // read: at i's turn, i has already had the contributions of the particles before it).
     for (const PlanEquation* eq : pass.equations) {
-      const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
+      const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+      const auto sites = hoistedDestinationSites(b, host_);
       for (size_t k = 0; k < sites.size(); ++k) {
         const std::string K = std::to_string(k);
-        scene_ << in << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
+        scene_ << in << "const " << hoistedValueType(b, host_, false, k) << " "
+               << hoistDestinationArgument(eqStruct(*eq), K) << " = "
                << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
       }
     }
@@ -463,7 +466,8 @@ void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const st
       const std::string K = std::to_string(k), E = eqStruct(*eq);
       const std::string ptr = symmetricDestinationHoisted(E, K);
       scene_ << "        dhoist_" << E << "_" << K << ".resize(n);\n";
-      scene_ << "        double* const " << ptr << " = dhoist_" << E << "_" << K << ".data();\n";
+      scene_ << "        " << hoistedValueType(b, host_, false, k) << "* const " << ptr
+             << " = dhoist_" << E << "_" << K << ".data();\n";
       fills.push_back(E + "_" + K);
     }
   }

@@ -102,7 +102,7 @@ static cl::opt<bool> NoHoist(
     cl::desc("Compute every subexpression of a pair-loop body per pair, as written (default: "
              "those that depend on the source particle only and divide or call sqrt, pow, ... "
              "are computed once per particle before the neighbour pass; serial and openmp, "
-             "double precision; the results are the same bit for bit)"),
+             "double and single precision; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
 // --omp-min-particles (default): measured in docs/performance.md, "OpenMP on small scenes".
 static constexpr unsigned kDefaultOmpMinParticles = 10000;
@@ -140,7 +140,8 @@ static cl::opt<std::string> PairSharedValues(
     "pair-shared-values",
     cl::desc("Where a pair loop evaluates each pair once for both particles, compute the "
              "values of its bodies that are the same (or negated) for the mirrored pair once "
-             "per pair and pass them to both calls (serial and openmp, double precision). on "
+             "per pair and pass them to both calls (serial and openmp, double and single "
+             "precision). on "
              "(default, or --pair-shared-values alone); off: each of the two calls computes "
              "its own values. The results are the same bit for bit (docs/performance.md)"),
     cl::value_desc("on|off"), cl::ValueOptional, cl::init("on"), cl::cat(SphcCat));
@@ -323,8 +324,7 @@ int main(int argc, char** argv) {
                     "precision (not with --backend=opencl or --precision=single yet)\n";
     return fail();
   }
-  // --verlet-skin: the host pair loops of one process (single precision: no periodic or
-  // mirror domain). auto: there,
+  // --verlet-skin: the host pair loops of one process. auto: there,
   // with kAutoVerletSkin; a number: there only (an error elsewhere).
   // tuned: auto's support, with the skin and the sort chosen at run time (sphc/verlet_tune.h;
   // not the default: ~1% fewer instructions on the dam break, not seen in CPU time, and its
@@ -356,10 +356,6 @@ int main(int argc, char** argv) {
   auto verletUnsupported = [&](const Plan& p) -> std::string {
     if (Mpi) return "--mpi";
     if (Backend == sphc::Backend::OpenCL) return "--backend=opencl";
-    // Single precision: written for scenes without periodic or mirror sides
-    // (docs/performance.md, "Kept lists in single precision").
-    if (PrecisionOpt == sphc::Precision::Single && p.domain.any())
-      return "--precision=single with a periodic or mirror domain";
     if (p.domain.any() && ghostPairLoops(p))
       return "a periodic or mirror domain with a neighbour loop in a `real = false` group";
     // Kept with the lists, the ghosts let a particle sit up to half a support outside a
@@ -498,12 +494,6 @@ int main(int argc, char** argv) {
   if (DumpAfter == Pass::Schedule) {
     printSchedule(*schedule, diags, llvm::outs());
     return 0;
-  }
-  if (verletSkin > 0.0 && PrecisionOpt == sphc::Precision::Single && schedule->domain) {
-    llvm::errs() << "sphc: error: --verlet-skin with --precision=single: " << InputFile
-                 << " has a periodic or mirror domain (kept lists in single precision are "
-                    "written for scenes without one)\n";
-    return fail();
   }
   if (verletSkin > 0.0 && ((schedule->domain && ghostPairLoops(*plan)) || !plan->zones.empty())) {
     llvm::errs() << "sphc: error: --verlet-skin: " << InputFile << " has "

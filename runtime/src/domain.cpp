@@ -97,7 +97,7 @@ void copy_property(const Domain& d, Reals reals, ParticleArray& a, const Ghosts&
 // wrap_periodic of n coordinates x along axis ax, in the arithmetic of T. With h: only the
 // particles further than margin * h[i] outside [lo, hi) (wrap_periodic_far).
 template <class T>
-void wrap_axis(const Domain& d, int ax, T* x, std::size_t n, const double* h = nullptr,
+void wrap_axis(const Domain& d, int ax, T* x, std::size_t n, const T* h = nullptr,
                double margin = 0.0) {
   const T lo = static_cast<T>(d.lo[ax]), hi = static_cast<T>(d.hi[ax]), period = hi - lo;
 #pragma omp parallel for schedule(static)
@@ -258,25 +258,48 @@ void wrap_periodic(const Domain& d, FloatArray& f, const ParticleArray& a) {
   wrap_all(d, FloatReals{f}, a);
 }
 
-void wrap_periodic_far(const Domain& d, ParticleArray& a, double margin) {
+template <class Reals>
+void wrap_far(const Domain& d, Reals reals, const ParticleArray& a, double margin) {
   const int h = a.find("h");
-  if (h < 0 || a.props[h].type != PropType::F64) return wrap_periodic(d, a);
+  if (h < 0 || a.props[h].type != PropType::F64) return wrap_all(d, reals, a);
   for (int ax = 0; ax < d.dim && ax < 3; ++ax) {
     if (!d.periodic(ax)) continue;
     const int idx = a.find(kAxis[ax]);
     if (idx < 0 || a.props[idx].type != PropType::F64) continue;
-    wrap_axis(d, ax, a.props[idx].f64.data(), a.n, a.props[h].f64.data(), margin);
+    wrap_axis(d, ax, reals.of(static_cast<std::size_t>(idx)).data(), a.n,
+              reals.of(static_cast<std::size_t>(h)).data(), margin);
   }
+}
+
+template <class Reals>
+std::size_t restore_all(const Domain& d, Reals reals, ParticleArray& a, const Ghosts& g,
+                        const std::vector<int>& carried) {
+  resize_storage(reals, a, a.n + g.size());
+  for (int idx : carried) copy_property(d, reals, a, g, idx);
+  return g.size();
+}
+
+void wrap_periodic_far(const Domain& d, ParticleArray& a, double margin) {
+  wrap_far(d, HostReals{a}, a, margin);
+}
+
+void wrap_periodic_far(const Domain& d, FloatArray& f, const ParticleArray& a, double margin) {
+  wrap_far(d, FloatReals{f}, a, margin);
 }
 
 std::size_t restore_ghosts(const Domain& d, ParticleArray& a, const Ghosts& g,
                            const std::vector<int>& carried) {
-  resize_storage(HostReals{a}, a, a.n + g.size());
-  for (int idx : carried) copy_property(d, HostReals{a}, a, g, idx);
-  return g.size();
+  return restore_all(d, HostReals{a}, a, g, carried);
+}
+
+std::size_t restore_ghosts(const Domain& d, FloatArray& f, ParticleArray& a, const Ghosts& g,
+                           const std::vector<int>& carried) {
+  return restore_all(d, FloatReals{f}, a, g, carried);
 }
 
 void hide_ghosts(ParticleArray& a) { resize_storage(HostReals{a}, a, a.n); }
+
+void hide_ghosts(FloatArray& f, ParticleArray& a) { resize_storage(FloatReals{f}, a, a.n); }
 
 std::size_t find_ghosts(const Domain& d, const double* const pos[3], std::size_t n,
                         double cutoff, Ghosts& g, const std::string& array) {

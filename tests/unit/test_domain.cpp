@@ -376,6 +376,61 @@ TEST(Domain, FloatWrapStaysInTheFloatBox) {
   EXPECT_EQ(pa.f64("x")[0], -0.25);  // the host doubles are left alone
 }
 
+TEST(Domain, FloatKeptGhostsFollowTheirOriginals) {
+  // Kept ghosts in single precision (--verlet-skin with a domain): hide_ghosts ends an
+  // evaluation on the float copy (its storage and the host's integers back to n, the ghost
+  // list kept), restore_ghosts makes the same ghosts again from the moved originals: each
+  // value what add_ghosts would give now, in the same order. wrap_periodic_far wraps the
+  // float positions beyond margin * h only.
+  const Domain d = mixed_box();
+  ParticleArray pa = make_array(random_points<float>(11), 0.05);
+  const int tag = pa.add_property("tag", sphc::PropType::I32);
+  for (std::size_t i = 0; i < pa.n; ++i) pa.i32(tag)[i] = static_cast<std::int32_t>(i);
+  sphc::FloatArray f;
+  f.upload(pa);
+  const std::size_t n = pa.n;
+  Ghosts g;
+  sphc::add_ghosts(d, f, pa, 0.1, g, all_props(pa));
+  ASSERT_GE(g.size(), 7u);
+  sphc::hide_ghosts(f, pa);
+  EXPECT_GE(g.size(), 7u);  // the list is kept
+  for (std::size_t i = 0; i < pa.props.size(); ++i)
+    EXPECT_EQ(pa.props[i].type == sphc::PropType::F64 ? f.props[i].size() : pa.props[i].i32.size(),
+              n)
+        << pa.props[i].name;
+  // The originals move a little (less than a skin): the same ghosts follow them.
+  float* x = f.f(pa.find("x"));
+  for (std::size_t i = 0; i < n; ++i) x[i] += 0.001f;
+  ASSERT_EQ(sphc::restore_ghosts(d, f, pa, g, all_props(pa)), g.size());
+  sphc::FloatArray fresh = f;
+  ParticleArray host = pa;
+  sphc::hide_ghosts(fresh, host);
+  Ghosts gref;
+  sphc::add_ghosts(d, fresh, host, 0.1, gref, all_props(host));
+  for (std::size_t i = 0; i < pa.props.size(); ++i) {
+    if (pa.props[i].type != sphc::PropType::F64) continue;
+    for (std::size_t k = 0; k < g.size(); ++k) {
+      // The same (particle, image) in the fresh list, where it is found there too.
+      for (std::size_t j = 0; j < gref.size(); ++j)
+        if (gref.source[j] == g.source[k] && gref.image[j] == g.image[k])
+          ASSERT_EQ(f.props[i][n + k], fresh.props[i][n + j]) << pa.props[i].name << " " << k;
+    }
+  }
+  for (std::size_t k = 0; k < g.size(); ++k)
+    EXPECT_EQ(pa.i32(tag)[n + k], static_cast<std::int32_t>(g.source[k]));
+  sphc::hide_ghosts(f, pa);
+  EXPECT_NO_THROW(f.download(pa));
+  // wrap_periodic_far: 0.4 h outside stays, 0.6 h outside is wrapped (margin 0.5).
+  ParticleArray w = make_array({{1.0 + 0.4 * 0.1, 0.5, 0}, {1.0 + 0.6 * 0.1, 0.5, 0}}, 0.1);
+  sphc::FloatArray fw;
+  fw.upload(w);
+  sphc::wrap_periodic_far(periodic_box(2, 1.0), fw, w, 0.5);
+  EXPECT_EQ(fw.f(w.find("x"))[0], static_cast<float>(1.0 + 0.4 * 0.1));
+  EXPECT_LT(fw.f(w.find("x"))[1], 1.0f);
+  EXPECT_GE(fw.f(w.find("x"))[1], 0.0f);
+  EXPECT_EQ(w.f64("x")[1], 1.0 + 0.6 * 0.1);  // the host doubles are left alone
+}
+
 TEST(Domain, RejectsBadDomains) {
   Domain d = periodic_box(2, 1.0);
   EXPECT_NO_THROW(sphc::check_domain(d));

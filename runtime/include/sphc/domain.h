@@ -156,6 +156,10 @@ std::size_t add_ghosts(const Domain& d, FloatArray& f, ParticleArray& a, double 
 void refresh_ghosts(const Domain& d, FloatArray& f, ParticleArray& a, const Ghosts& g,
                     const std::vector<int>& props);
 void remove_ghosts(FloatArray& f, ParticleArray& a, Ghosts& g);
+void wrap_periodic_far(const Domain& d, FloatArray& f, const ParticleArray& a, double margin);
+void hide_ghosts(FloatArray& f, ParticleArray& a);
+std::size_t restore_ghosts(const Domain& d, FloatArray& f, ParticleArray& a, const Ghosts& g,
+                           const std::vector<int>& carried);
 
 // Widens a search domain made from the real particles so that it covers the ghosts too:
 // `cutoff` beyond each periodic or mirror plane.
