@@ -178,7 +178,7 @@ void ScenePrinter::printPairShared(const PlanBody& b, const std::string& name, i
       os << "//   " << s.result << " after " << oneLine(text.substr(s.stmtBegin, s.stmtEnd - s.stmtBegin))
          << "\n";
     const std::string fn = name + "_pairshared" + K(k) + (simd ? "_simd" : "");
-    os << d.functionPrefix << (single ? "auto" : d.real) << " " << fn << "(" << params << ") {
+    os << d.functionPrefix << (single ? "auto" : d.real) << " " << fn << "(" << params << ") {\n";
     for (const auto& l : s.locals) {
       std::string init = inDialect(fusedRange(text, facts, l.initBegin, l.initEnd, d.fma));
       os << "  const " << inDialect(l.type) << " " << l.name << " = " << init
