@@ -9,11 +9,15 @@
 //     `generic`, which has no gathers, and leaves the loop scalar (each pair twice). Forced
 //     to gather (-mtune=sapphirerapids) the lanes take 1.00-1.12 of the cube's step and
 //     0.85-0.90 of the dam breaks'; the build does not do that (not kept).
+//     Since the build allows gathers (buildinfo's simd_flags: -mtune-ctrl=use_gather with
+//     GCC; runtime/CMakeLists.txt), the each-pair-once lanes take 0.80-0.82 of the cube's
+//     scalar step (idle), 0.91 of dambreak3d's and 0.66 of the DualSPHysics scene's.
 //   Without AVX-512 (-march=x86-64-v3) GCC 12 does not vectorise the loops at all: the
 //     bodies' divisions under an `if` need masked divisions to be if-converted.
-// The rule: the lanes on AMD family 0x1A and later with AVX-512F; the scalar loops on Intel,
-// without AVX-512F, and on every CPU not measured (the scalar loops were the default before
-// stop 33 on every machine).
+// The rule: the lanes on AMD family 0x1A and later and on Intel family 6 models 207 (Emerald
+// Rapids, measured) and 143 (Sapphire Rapids, the same cores), with AVX-512F; the scalar
+// loops on other Intel CPUs, without AVX-512F, and on every CPU not measured (the scalar loops
+// were the default before stop 33 on every machine).
 #include "codegen/SimdCpu.h"
 
 #include <cstdio>
@@ -96,9 +100,14 @@ SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu) {
   } else if (cpu.vendor == "AuthenticAMD" && cpu.family >= 0x1a) {
     v.lanes = true;
     v.why = "on " + cpu.describe() + " (AMD Zen 5 and later) the lanes pay";
+  } else if (cpu.vendor == "GenuineIntel" && cpu.family == 6 &&
+             (cpu.model == 207 || cpu.model == 143)) {
+    v.lanes = true;
+    v.why = "on " + cpu.describe() +
+            " (Intel Sapphire/Emerald Rapids) the lanes pay with gathers allowed";
   } else if (cpu.vendor == "GenuineIntel") {
     v.lanes = false;
-    v.why = "on " + cpu.describe() + " (Intel) the lanes cost more than the scalar loops";
+    v.why = "on " + cpu.describe() + " (Intel) the lanes were not measured to pay: the scalar loops";
   } else {
     v.lanes = false;
     v.why = "on " + cpu.describe() + " the lanes were not measured: the scalar loops";

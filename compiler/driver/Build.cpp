@@ -105,6 +105,15 @@ std::vector<std::string> splitUnits(const std::string& cpp) {
               cpp.substr(end + 1)};
 }
 
+// The flags of a build with pair loops in SIMD lanes: buildinfo's simd_flags for its own
+// compiler (GCC: -mtune-ctrl=use_gather too), -fopenmp-simd for another (--cxx) or an older
+// buildinfo.
+std::string simdFlags(std::map<std::string, std::string>& info, const std::string& cxx) {
+  return cxx == info["cxx"] && info.count("simd_flags") && !info["simd_flags"].empty()
+             ? info["simd_flags"]
+             : "-fopenmp-simd";
+}
+
 // Whether the build can use the precompiled runtime headers: buildinfo's compiler and
 // default flags (plus the OpenMP flag), a serial or OpenMP solver, and the .gch in place.
 bool usesDefaultFlags(std::map<std::string, std::string>& info, const std::string& cxx,
@@ -115,7 +124,7 @@ bool usesDefaultFlags(std::map<std::string, std::string>& info, const std::strin
     expected += " " + (info.count("openmp_flags") ? info["openmp_flags"] : "-fopenmp");
   else if (req.backend != "serial")
     return false;
-  if (req.simd) expected += " -fopenmp-simd";  // --simd-pairs
+  if (req.simd) expected += " " + simdFlags(info, cxx);  // --simd-pairs
   return flags == expected;
 }
 bool usesScenePch(const Install& install, std::map<std::string, std::string>& info,
@@ -152,8 +161,9 @@ BuildResult buildExecutable(const Install& install, const BuildRequest& req) {
                                                 : std::string("-DCL_TARGET_OPENCL_VERSION=120"));
     libs += " " + info["opencl_libs"];
   }
-  // --simd-pairs: the pair loops' `#pragma omp simd` (codegen/SimdPairs.cpp).
-  if (req.simd) flags += " -fopenmp-simd";
+  // --simd-pairs: the pair loops' `#pragma omp simd` (codegen/SimdPairs.cpp), with GCC
+  // gathers allowed (buildinfo's simd_flags; runtime/CMakeLists.txt says why).
+  if (req.simd) flags += " " + simdFlags(info, cxx);
   // --mpi: libsphc_mpi (before the runtime it uses), MPI and Zoltan.
   const std::string mpiLib = install.libDir + "/libsphc_mpi.a";
   if (req.mpi) {

@@ -187,9 +187,10 @@ static cl::opt<std::string> SimdCpuOpt(
              "this machine's cpuid, the CPU that -march=native builds for) or "
              "VENDOR:FAMILY:MODEL as cpuid gives them (GenuineIntel:6:207, AuthenticAMD:26:2), "
              "with :noavx512 for a CPU without AVX-512F. The lanes where they were measured "
-             "to pay: AMD family 26 (Zen 5) and later with AVX-512F; the scalar loops on "
-             "Intel (they lose there), without AVX-512F (GCC does not vectorise them) and on "
-             "CPUs not measured. sphc -v and --report say which and why"),
+             "to pay: AMD family 26 (Zen 5) and later and Intel family 6 models 207 and 143 "
+             "(Emerald and Sapphire Rapids; the build allows GCC gathers), with AVX-512F; the "
+             "scalar loops on other Intel CPUs, without AVX-512F (GCC does not vectorise them) "
+             "and on CPUs not measured. sphc -v and --report say which and why"),
     cl::value_desc("host|VENDOR:FAMILY:MODEL[:noavx512]"), cl::init("host"), cl::cat(SphcCat));
 static cl::opt<bool> NoLazyCells(
     "no-lazy-cells",

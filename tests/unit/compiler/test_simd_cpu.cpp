@@ -1,5 +1,6 @@
 // --simd-pairs=auto by the CPU (codegen/SimdCpu.h): the host's cpuid, --simd-cpu's form and
-// the rule (the lanes on AMD family 26 and later; the scalar loops on Intel and elsewhere).
+// the rule (the lanes on AMD family 26 and later and on Intel models 207 and 143, with gathers
+// allowed by the build; the scalar loops on other Intel CPUs and elsewhere).
 #include "codegen/SimdCpu.h"
 
 #include <gtest/gtest.h>
@@ -43,8 +44,11 @@ TEST(SimdCpu, LanesWhereMeasuredToPay) {
   };
   EXPECT_TRUE(lanes("AuthenticAMD:26:2"));     // Zen 5 (stop 33: 0.82-0.86 of a cube step)
   EXPECT_TRUE(lanes("AuthenticAMD:27:0"));     // later AMD families
-  EXPECT_FALSE(lanes("GenuineIntel:6:207"));   // Emerald Rapids (stop 35: 1.43x)
-  EXPECT_FALSE(lanes("GenuineIntel:6:143"));   // other Intel models: the same vector units
+  EXPECT_TRUE(lanes("GenuineIntel:6:207"));    // Emerald Rapids (stop 35, gathers: 0.80-0.82)
+  EXPECT_TRUE(lanes("GenuineIntel:6:143"));    // Sapphire Rapids: the same cores
+  EXPECT_FALSE(lanes("GenuineIntel:6:85"));    // Skylake-SP / Cascade Lake: not measured
+  EXPECT_FALSE(lanes("GenuineIntel:6:106"));   // Ice Lake-SP: not measured
+  EXPECT_FALSE(lanes("GenuineIntel:6:207:noavx512"));
   EXPECT_FALSE(lanes("AuthenticAMD:25:17"));   // Zen 4: not measured
   EXPECT_FALSE(lanes("HygonGenuine:24:0"));    // not measured
   // Without AVX-512F GCC 12 does not if-convert the bodies' divisions: no lanes anywhere.
