@@ -122,13 +122,10 @@ def box_excess(b, pos):
     return out
 
 
-def min_pair_distance(pos, cell):
-    """(d, i, j): the smallest distance between two of the points pos = (x, y[, z]) and the
-    pair, using cells of size `cell` (pairs farther apart than `cell` may be missed; then
-    d = inf is returned when no pair is closer than `cell`)."""
+def cell_pairs(pos, cell):
+    """The candidate pairs of the points pos = (x, y[, z]) in the same or neighbouring cells of
+    size `cell`: yields (i, j) index arrays, i < j, one cell offset at a time."""
     n = len(pos[0])
-    if n < 2:
-        return math.inf, -1, -1
     dim = len(pos)
     ic = [np.floor(c / cell).astype(np.int64) for c in pos]
     lo = [a.min() - 1 for a in ic]
@@ -141,7 +138,6 @@ def min_pair_distance(pos, cell):
     own = key([0] * dim)
     order = np.argsort(own, kind="stable")
     sk = own[order]
-    best = (math.inf, -1, -1)
     offsets = [[a, b, c][:dim] for a in (-1, 0, 1) for b in (-1, 0, 1)
                for c in ((-1, 0, 1) if dim == 3 else (0,))]
     if dim == 1:
@@ -163,9 +159,18 @@ def min_pair_distance(pos, cell):
         within = np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)
         j = order[first + within]
         keep = i < j
-        i, j = i[keep], j[keep]
-        if len(i) == 0:
-            continue
+        if np.any(keep):
+            yield i[keep], j[keep]
+
+
+def min_pair_distance(pos, cell):
+    """(d, i, j): the smallest distance between two of the points pos = (x, y[, z]) and the
+    pair, using cells of size `cell` (pairs farther apart than `cell` may be missed; then
+    d = inf is returned when no pair is closer than `cell`)."""
+    if len(pos[0]) < 2:
+        return math.inf, -1, -1
+    best = (math.inf, -1, -1)
+    for i, j in cell_pairs(pos, cell):
         r2 = np.zeros(len(i))
         for c in pos:
             r2 += (c[i] - c[j]) ** 2
@@ -626,16 +631,17 @@ def count_close(pos, r):
     return int(close.sum())
 
 
-def neighbour_counts(pos, r):
-    """The number of other points closer than r, for every point."""
+def neighbour_counts(pos, r, idx=None):
+    """The number of other points closer than r, for every point (or the points idx)."""
     n = len(pos[0])
-    counts = np.zeros(n, dtype=np.int64)
-    for i0 in range(0, n, 512):
-        sl = slice(i0, min(n, i0 + 512))
-        r2 = np.zeros((sl.stop - sl.start, n))
+    idx = np.arange(n) if idx is None else np.asarray(idx)
+    counts = np.zeros(len(idx), dtype=np.int64)
+    for i0 in range(0, len(idx), 512):
+        sl = idx[i0:i0 + 512]
+        r2 = np.zeros((len(sl), n))
         for c in pos:
             r2 += (c[sl, None] - c[None, :]) ** 2
-        counts[sl] = (r2 < r * r).sum(axis=1) - 1
+        counts[i0:i0 + len(sl)] = (r2 < r * r).sum(axis=1) - 1
     return counts
 
 

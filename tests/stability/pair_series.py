@@ -30,55 +30,20 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(HERE, "..", "validation"))
 from snapshots import lattice_spacing, particle_arrays, snapshots  # noqa: E402
+from check_run import cell_pairs, neighbour_counts  # noqa: E402
 
 
 def close_pairs(pos, r):
     """(i, j, d) of every pair of the points pos = (x, y[, z]) closer than r (cells of size r)."""
-    n = len(pos[0])
-    dim = len(pos)
-    ic = [np.floor(c / r).astype(np.int64) for c in pos]
-    lo = [a.min() - 1 for a in ic]
-    ext = [a.max() - l + 3 for a, l in zip(ic, lo)]
-
-    def key(offs):
-        k = np.zeros(n, dtype=np.int64)
-        for d in range(dim):
-            k = k * ext[d] + (ic[d] - lo[d] + offs[d])
-        return k
-    own = key([0] * dim)
-    order = np.argsort(own, kind="stable")
-    sk = own[order]
-    out_i, out_j = [], []
-    for off in ([a, b, c][:dim] for a in (-1, 0, 1) for b in (-1, 0, 1)
-                for c in ((-1, 0, 1) if dim == 3 else (0,))):
-        nk = key(off)
-        start = np.searchsorted(sk, nk, side="left")
-        cnt = np.searchsorted(sk, nk, side="right") - start
-        if cnt.sum() == 0:
-            continue
-        i = np.repeat(np.arange(n), cnt)
-        j = order[np.repeat(start, cnt) + np.arange(cnt.sum()) - np.repeat(np.cumsum(cnt) - cnt, cnt)]
-        keep = i < j
-        out_i.append(i[keep])
-        out_j.append(j[keep])
-    i = np.concatenate(out_i)
-    j = np.concatenate(out_j)
+    pairs = list(cell_pairs(pos, r))
+    if not pairs:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty, np.zeros(0)
+    i = np.concatenate([p[0] for p in pairs])
+    j = np.concatenate([p[1] for p in pairs])
     d = np.sqrt(sum((c[i] - c[j]) ** 2 for c in pos))
     keep = d < r
     return i[keep], j[keep], d[keep]
-
-
-def bulk_counts(pos, idx, r):
-    """The number of other points closer than r, for the points idx (check_run.py's
-    neighbour_counts for a subset)."""
-    counts = np.zeros(len(idx), dtype=np.int64)
-    for i0 in range(0, len(idx), 512):
-        sl = idx[i0:i0 + 512]
-        r2 = np.zeros((len(sl), len(pos[0])))
-        for c in pos:
-            r2 += (c[sl, None] - c[None, :]) ** 2
-        counts[i0:i0 + len(sl)] = (r2 < r * r).sum(axis=1) - 1
-    return counts
 
 
 def main():
@@ -116,7 +81,7 @@ def main():
         cand = np.unique(np.concatenate([pi, pj]))
         isbulk = np.zeros(len(pos[0]), dtype=bool)
         if len(cand):
-            isbulk[cand] = bulk_counts(pos, cand, 2.6 * dx) >= args.pair_bulk
+            isbulk[cand] = neighbour_counts(pos, 2.6 * dx, cand) >= args.pair_bulk
         ok = isbulk[pi] & isbulk[pj]
         if np.any(ok):
             k = int(np.flatnonzero(ok)[np.argmin(pd[ok])])
