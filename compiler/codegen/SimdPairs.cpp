@@ -212,6 +212,19 @@ bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std:
   return why.empty();
 }
 
+// A pair quantity's statement with its vector quantities read as their scalar components
+// (scalarPairEdits), as the lane loops print it.
+static std::string scalarPairStatement(std::string s) {
+  std::vector<TextEdit> edits;
+  std::string unused;
+  scalarPairEdits(s, edits, unused);
+  std::sort(edits.begin(), edits.end(),
+            [](const TextEdit& a, const TextEdit& b) { return a.begin > b.begin; });
+  for (const TextEdit& e : edits) s.replace(e.begin, e.end - e.begin, e.replacement);
+  return s;
+}
+
+
 std::string ScenePrinter::simdPairsRefusal(const DestinationWork& w,
                                            const NeighbourPass& pass) const {
   if (!simdPairs_) return "off";
@@ -350,14 +363,7 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
         os << body << "const " << host_.real << " " << pq.name << "_" << k << " = " << pq.name
            << "_f * XIJ_" << k << ";\n";
     } else {
-      std::string s = pairQuantityStatement(pq, plan_.dim, dialect, body);
-      std::vector<TextEdit> edits;
-      std::string unused;
-      scalarPairEdits(s, edits, unused);
-      std::sort(edits.begin(), edits.end(),
-                [](const TextEdit& a, const TextEdit& b) { return a.begin > b.begin; });
-      for (const TextEdit& e : edits) s.replace(e.begin, e.end - e.begin, e.replacement);
-      os << s;
+      os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
     }
   }
   for (const PlanEquation* eq : pass.equations)
@@ -551,14 +557,7 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
           os << body << "const " << R << " " << partner << "_" << k << " = " << pq.name
              << "_f * XIJ_ji_" << k << ";\n";
     } else {
-      std::string s = pairQuantityStatement(pq, plan_.dim, dialect, body);
-      std::vector<TextEdit> edits;
-      std::string unused;
-      scalarPairEdits(s, edits, unused);
-      std::sort(edits.begin(), edits.end(),
-                [](const TextEdit& a, const TextEdit& b) { return a.begin > b.begin; });
-      for (const TextEdit& e : edits) s.replace(e.begin, e.end - e.begin, e.replacement);
-      os << s;
+      os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
     }
   }
   if (!mask) return;
