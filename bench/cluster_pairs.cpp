@@ -1097,6 +1097,7 @@ __attribute__((noinline)) void form_c_omp(Clusters& cl, const PairList& pl, cons
   struct { double alpha, beta; } eq2{eqc.alpha, eqc.beta};
   struct { double eps; } eq3{eqc.eps};
   const int nci = static_cast<int>(pl.start.size()) - 1;
+  const int n_lanes = pl.ci_size > 0 ? CJ : 0;  // CJ
   for (int ci = 0; ci < nci; ++ci) {
     const int i0 = ci * CI;
     if (pl.start[ci] == pl.start[ci + 1]) continue;
@@ -1116,8 +1117,10 @@ __attribute__((noinline)) void form_c_omp(Clusters& cl, const PairList& pl, cons
         double* ia3 = iacc[ii][3]; double* ia4 = iacc[ii][4]; double* ia5 = iacc[ii][5];
         double* ia6 = iacc[ii][6];
         const int j_min = diagonal ? d_idx : -1;  // the diagonal tile: j > i only
-        #pragma omp simd simdlen(8)
-        for (int l = 0; l < CJ; ++l) {
+        // (a trip count GCC 12 cannot see as 8: with `l < CJ` it does not vectorise the loop,
+        // "control flow in loop"; so it does, in pairs of 256-bit vectors)
+        #pragma omp simd
+        for (int l = 0; l < n_lanes; ++l) {
           const int s_idx = j0 + l;
           const double hj = sj_h[s_idx];
           const double XIJ_0 = xi - sj_x[s_idx];
