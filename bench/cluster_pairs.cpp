@@ -906,10 +906,13 @@ inline V rsqrt(V x) {
 
 // One sweep of form (c): tiles of CI i's x 8 j's. Arithmetic: EXACT, the divisions and the
 // square root of (a); RCP, rcp / rsqrt with Newton steps for all of them; RCP_DIV, the
-// divisions by rcp, the square root exact (which of the two limits). The j sums of a tile are accumulated over its
+// divisions by rcp, the square root exact (which of the two limits); LEAN, RCP with fewer
+// vector operations per row (not the operations of (a): the cubic as 0.25 (2-q)^3 - (1-q)^3
+// with the pieces clamped at 0, no selects; -m_i and -eps m_i per particle, not per row; the
+// selects folded into zero-masked multiplications): how far the operation count moves it. The j sums of a tile are accumulated over its
 // i's in registers and added to memory once (a contiguous load-add-store per sum); the i
 // sums in 8 lane partial sums across the i-cluster's list, reduced at its end.
-enum Arith { EXACT, RCP, RCP_DIV };
+enum Arith { EXACT, RCP, RCP_DIV, LEAN };
 template <int CI, int ARITH>
 __attribute__((noinline)) void form_c(Clusters& cl, const PairList& pl, const Constants& eq) {
   Fluid& f = cl.f;
@@ -922,6 +925,14 @@ __attribute__((noinline)) void form_c(Clusters& cl, const PairList& pl, const Co
   const double *MS = f.m.data(), *CS = f.cs.data(), *HO = f.hoisted.data();
   double* S[7];
   for (int k = 0; k < 7; ++k) S[k] = f.sums[k].data();
+  // LEAN: -m and -eps m per particle (as the printer hoists a source's values)
+  static Doubles negm, negepsm;
+  if (ARITH == LEAN) {
+    negm.resize(f.n);
+    negepsm.resize(f.n);
+    for (int i = 0; i < f.n; ++i) negm[i] = -MS[i], negepsm[i] = -eq.eps * MS[i];
+  }
+  const double *NEGM = negm.data(), *NEGEPSM = negepsm.data();
   const int nci = static_cast<int>(pl.start.size()) - 1;
   const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
   for (int ci = 0; ci < nci; ++ci) {
@@ -967,25 +978,34 @@ __attribute__((noinline)) void form_c(Clusters& cl, const PairList& pl, const Co
           q = mul(RIJ, ih);
         } else {
           const V rinv = rsqrt(R2IJ);
-          RIJ = sel(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), mul(R2IJ, rinv), zero);
+          RIJ = ARITH == LEAN ? _mm512_maskz_mul_pd(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), R2IJ, rinv)
+                              : sel(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), mul(R2IJ, rinv), zero);
           ih = rcp(HIJ);
           q = mul(RIJ, ih);
           s_den_inv = mul(ih, rinv);  // 1 / (h rij)
         }
         const V sk = mul(bc(sigma), mul(mul(ih, ih), ih));
-        const M lt1 = _mm512_cmp_pd_mask(q, one, _CMP_LT_OQ), lt2 = _mm512_cmp_pd_mask(q, two, _CMP_LT_OQ);
-        const V tq = sub(two, q);
-        const V f1 = sub(one, mul(mul(mul(bc(1.5), q), q), sub(one, mul(half, q))));
-        const V f2 = mul(mul(mul(bc(0.25), tq), tq), tq);
-        const V df1 = mul(q, sub(mul(bc(2.25), q), bc(3.0)));
-        const V df2 = mul(mul(bc(-0.75), tq), tq);
-        const V WIJ = mul(sk, sel(lt1, f1, sel(lt2, f2, zero)));
-        const V dwdq = mul(sk, sel(lt1, df1, sel(lt2, df2, zero)));
+        V WIJ, dwdq;
+        if (ARITH == LEAN) {  // f = t2^3 / 4 - t1^3, f' = 3 t1^2 - 3 t2^2 / 4, t2 = max(2 - q, 0), t1 = max(1 - q, 0)
+          const V t2 = _mm512_max_pd(sub(two, q), zero), t1 = _mm512_max_pd(sub(one, q), zero);
+          const V t22 = mul(t2, t2), t12 = mul(t1, t1);
+          WIJ = mul(sk, _mm512_fmsub_pd(bc(0.25), mul(t22, t2), mul(t12, t1)));
+          dwdq = mul(sk, fma(bc(3.0), t12, mul(bc(-0.75), t22)));
+        } else {
+          const M lt1 = _mm512_cmp_pd_mask(q, one, _CMP_LT_OQ), lt2 = _mm512_cmp_pd_mask(q, two, _CMP_LT_OQ);
+          const V tq = sub(two, q);
+          const V f1 = sub(one, mul(mul(mul(bc(1.5), q), q), sub(one, mul(half, q))));
+          const V f2 = mul(mul(mul(bc(0.25), tq), tq), tq);
+          const V df1 = mul(q, sub(mul(bc(2.25), q), bc(3.0)));
+          const V df2 = mul(mul(bc(-0.75), tq), tq);
+          WIJ = mul(sk, sel(lt1, f1, sel(lt2, f2, zero)));
+          dwdq = mul(sk, sel(lt1, df1, sel(lt2, df2, zero)));
+        }
         const M apart = _mm512_cmp_pd_mask(RIJ, bc(1e-12), _CMP_GT_OQ);
         const V s = ARITH == EXACT     ? div(dwdq, mul(HIJ, sel(apart, RIJ, one)))
                     : ARITH == RCP_DIV ? mul(dwdq, rcp(mul(HIJ, sel(apart, RIJ, one))))
                                        : mul(dwdq, s_den_inv);
-        const V DWIJ_f = sel(apart, s, zero);
+        const V DWIJ_f = ARITH == LEAN ? _mm512_maskz_mul_pd(apart, dwdq, s_den_inv) : sel(apart, s, zero);
         const V DWIJ_0 = mul(DWIJ_f, XIJ_0), DWIJ_1 = mul(DWIJ_f, XIJ_1), DWIJ_2 = mul(DWIJ_f, XIJ_2);
         const V RHOIJ = mul(half, add(bc(RHO[i]), rhoj));
         const V RHOIJ1 = ARITH == EXACT ? div(one, RHOIJ) : rcp(RHOIJ);
@@ -996,8 +1016,9 @@ __attribute__((noinline)) void form_c(Clusters& cl, const PairList& pl, const Co
         const V vdx = fma(VIJ_2, XIJ_2, fma(VIJ_0, XIJ_0, mul(VIJ_1, XIJ_1)));
         const V cij = mul(half, add(bc(CS[i]), csj));
         const V muij = ARITH == EXACT ? div(mul(HIJ, vdx), add(R2IJ, EPS)) : mul(mul(HIJ, vdx), rcp(add(R2IJ, EPS)));
-        const V pi_v = mul(fma(mul(neg_alpha, cij), muij, mul(mul(beta, muij), muij)), RHOIJ1);
-        const V piij = sel(_mm512_cmp_pd_mask(vdx, zero, _CMP_LT_OQ), pi_v, zero);
+        const V pi_f = fma(mul(neg_alpha, cij), muij, mul(mul(beta, muij), muij));
+        const M visc = _mm512_cmp_pd_mask(vdx, zero, _CMP_LT_OQ);
+        const V piij = ARITH == LEAN ? _mm512_maskz_mul_pd(visc, pi_f, RHOIJ1) : sel(visc, mul(pi_f, RHOIJ1), zero);
         const V tp = add(tmp, piij);
         // i's terms (destination i, source j), under the mask
         const V fi = mul(neg_mj, tp);
@@ -1012,8 +1033,8 @@ __attribute__((noinline)) void form_c(Clusters& cl, const PairList& pl, const Co
         ia[6] = _mm512_mask3_fmadd_pd(xi_f, VIJ_2, ia[6], in);
         // j's terms (destination j, source i): DWIJ_ji = -DWIJ, VIJ_ji = -VIJ exactly
         const V mi = bc(MS[i]);
-        const V fj = mul(sub(zero, mi), tp);
-        const V xj_f = mul(mul(mul(neg_eps, mi), RHOIJ1), WIJ);
+        const V fj = ARITH == LEAN ? mul(bc(NEGM[i]), tp) : mul(sub(zero, mi), tp);
+        const V xj_f = ARITH == LEAN ? mul(mul(bc(NEGEPSM[i]), RHOIJ1), WIJ) : mul(mul(mul(neg_eps, mi), RHOIJ1), WIJ);
         jacc[0] = _mm512_mask3_fmadd_pd(mi, vdw, jacc[0], in);
         jacc[1] = _mm512_mask3_fnmadd_pd(fj, DWIJ_0, jacc[1], in);
         jacc[2] = _mm512_mask3_fnmadd_pd(fj, DWIJ_1, jacc[2], in);
@@ -1029,6 +1050,23 @@ __attribute__((noinline)) void form_c(Clusters& cl, const PairList& pl, const Co
   }
 }
 
+// The core's clock while it runs 512-bit FMAs: a chain of dependent vfmadd (4 cycles each on
+// this core) timed by the thread's CPU time. The table's cycles are at the nominal clock.
+double clock_estimate() {
+  const long n = 30000000;
+  __m512d x = _mm512_set1_pd(1.0);
+  const __m512d b = _mm512_set1_pd(0.999999), c = _mm512_set1_pd(1e-9);
+  double best = 1e30;
+  for (int r = 0; r < 3; ++r) {
+    const double t0 = cpu_now();
+    for (long i = 0; i < n; ++i) {
+      x = _mm512_fmadd_pd(x, b, c);
+      __asm__ volatile("" : "+v"(x));
+    }
+    best = std::min(best, cpu_now() - t0);
+  }
+  return _mm512_reduce_add_pd(x) > 0 ? 4.0 * n / best : 0.0;
+}
 #endif  // __AVX512F__
 
 // Dynamic pruning (GROMACS): the list kept with a skin, pruned every step to the cluster
@@ -1426,10 +1464,11 @@ int main(int argc, char** argv) {
 #ifdef __AVX512F__
   // c<CI>x8[rcp|rcpdiv][cut]: every tile size, arithmetic and list.
   for (const ListSet& l : lists)
-    for (int arith : {EXACT, RCP, RCP_DIV}) {
+    for (int arith : {EXACT, RCP, RCP_DIV, LEAN}) {
       const bool cut = l.rlist < Kernel::radius_scale * hmax * (1.0 + 0.5 * skin);
       const std::string name = "c" + std::to_string(l.ci) + "x8" +
-                               (arith == RCP ? "rcp" : arith == RCP_DIV ? "rcpdiv" : "") + (cut ? "cut" : "");
+                               (arith == RCP ? "rcp" : arith == RCP_DIV ? "rcpdiv" : arith == LEAN ? "lean" : "") +
+                               (cut ? "cut" : "");
       Clusters* c = &cl;
       const Constants* e = &eq;
       const ListSet* ls = &l;
@@ -1439,6 +1478,7 @@ int main(int argc, char** argv) {
         if (arith == EXACT) run = [c, ls, e] { form_c<CI, EXACT>(*c, ls->pl, *e); };
         if (arith == RCP) run = [c, ls, e] { form_c<CI, RCP>(*c, ls->pl, *e); };
         if (arith == RCP_DIV) run = [c, ls, e] { form_c<CI, RCP_DIV>(*c, ls->pl, *e); };
+        if (arith == LEAN) run = [c, ls, e] { form_c<CI, LEAN>(*c, ls->pl, *e); };
       };
       if (l.ci == 1) pick(std::integral_constant<int, 1>());
       if (l.ci == 2) pick(std::integral_constant<int, 2>());
@@ -1500,6 +1540,10 @@ int main(int argc, char** argv) {
                 tmin, median(r.times), rate * 1e-6, tmin * clock / (2.0 * pairs), gflops, 100.0 * gflops * 1e9 / peak,
                 in, cyc, r.diff, r.diff_sum);
   }
+#ifdef __AVX512F__
+  std::printf("clock while running 512-bit FMAs (a chain of dependent vfmadd, 4 cycles each): %.2f GHz\n",
+              clock_estimate() * 1e-9);
+#endif
   std::printf("(peak %.1f GFLOP/s at %.1f GHz; useful = pairs within the support x %.2f flops of form (a); thread CPU\n"
               " time, best of %d interleaved rounds; cycles at the nominal clock, per ordered pair within the support\n"
               " and per vector of 8 lanes computed)\n",
