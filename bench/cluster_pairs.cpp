@@ -21,7 +21,10 @@
 //       once. No gathers, no scatters. AVX-512 intrinsics.
 //       Arithmetic: "exact" = the operations of (a) (correctly rounded div and sqrt, the same
 //       fma's); "rcp" = the divisions and the square root replaced by vrcp14pd / vrsqrt14pd
-//       and two Newton steps each (results within a few ulp of the exact ones).
+//       and two Newton steps each (results within a few ulp of the exact ones); "rcpdiv" the
+//       divisions only; "lean" rcp with fewer vector operations. Lists at (1 + skin) 2h or,
+//       "cut", at 2h (a per-step pruning's list). Also "omp": the tile as `#pragma omp simd`
+//       over the 8 j's with the generated lane body verbatim (what GCC makes of it).
 //
 // The bodies of (a) and (b) are the generated C++ of `sphc bench/cube.sph` (main 6e571af,
 // --simd-pairs=auto on this Intel Xeon: the lanes; --simd-pairs=off: the scalar loop),
@@ -36,9 +39,10 @@
 // compared, not the initial values).
 //
 // Build (the flags of a solver with lanes: buildinfo cxxflags + simd_flags):
-//   c++ -std=c++17 -O3 -march=native -fno-math-errno -ffp-contract=off -fopenmp-simd \
+//   c++ -std=c++17 -O3 -march=native -fno-math-errno -ffp-contract=off -fopenmp-simd
 //       -mtune-ctrl=use_gather -I runtime/include bench/cluster_pairs.cpp -o cluster_pairs
-// Run: ./cluster_pairs [--nx 47] [--hdx 1.5] [--reps 7] [--pert 0.05] [--skin 0.1] [--forms LIST]
+// Run: ./cluster_pairs [--nx 47] [--hdx 1.5] [--uniform-velocity] [--reps 7] [--pert 0.05]
+//                      [--skin 0.1] [--column DX] [--forms LIST] (--help: the forms' names)
 // Built for AVX-512F, needs it (exits 77 without it); built without, it has forms (a), (b) and
 // the `omp` tiles only.
 #include <immintrin.h>
@@ -1366,8 +1370,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr,
                    "usage: %s [--nx 47] [--hdx 1.5] [--uniform-velocity] [--reps 7] [--pert 0.05] [--skin 0.1] [--column DX] [--tol 1e-12]\n"
                    "          [--forms a,b,c4x8,c8x8,c4x8rcp,c8x8rcp,c4x8cut,...]\n"
-                   "  c<CI>x8: cluster-pair tiles, CI i's x 8 j's; rcp: reciprocal approximations (rcpdiv: for\n"
-                   "  the divisions only);\n"
+                   "  c<CI>x8[rcp|rcpdiv|lean][cut], CI = 1, 2, 4, 8: cluster-pair tiles, CI i's x 8 j's; rcp:\n"
+                   "  reciprocal approximations (rcpdiv: for the divisions only; lean: rcp, fewer operations);\n"
                    "  cut: the cluster-pair list pruned at the support (no skin); omp: the tile as `omp simd`\n"
                    "  over the 8 j's with the generated lane body (no intrinsics)\n",
                    argv[0]);
