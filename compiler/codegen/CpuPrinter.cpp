@@ -482,6 +482,9 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          }\n";
       const RegisterSums sums = registerSums(w, pass);  // codegen/RegisterSums.cpp
       emitSumsLoad(scene_, "          ", sums);
+      if (simdPairs_ && !simdAuto_)  // as emitSimdNeighbours says it (auto: --report does)
+        scene_ << "          // Not in SIMD lanes (codegen/SimdPairs.cpp): " << simdPairsRefusal(w, pass)
+               << ".\n";
       scene_ << "          for (const std::uint32_t* k = kept.data(), *const k_end = k + kept.size(); "
                 "k != k_end; ++k) {  // the support's test inline\n";
       scene_ << "            const int s_idx = static_cast<int>(*k);\n";
