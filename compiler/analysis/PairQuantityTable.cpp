@@ -164,6 +164,14 @@ std::string pairQuantityStatement(const PairQuantity& q, int dim, const PairDial
       return s + "};\n";
     }
     case PairForm::Formula:
+      if (q.name == "R2IJ" && dim >= 1 && dim < 3) {
+        // The axes of the scene only: the others' XIJ[k] is the literal 0, whose square adds
+        // +0 to a sum of squares, which is never -0: the same value bit for bit (NaN and
+        // inf too), without the addition.
+        std::string s = "XIJ[0] * XIJ[0]";
+        if (dim == 2) s += " + XIJ[1] * XIJ[1]";
+        return indent + "const " + R + " " + q.name + " = " + s + ";\n";
+      }
       return indent + "const " + R + " " + q.name + " = " + spell(q.formula, d) + ";\n";
     case PairForm::Kernel:
       return indent + "const " + R + " " + q.name + " = " + d.kernelW + "(RIJ, " + q.h + ");\n";

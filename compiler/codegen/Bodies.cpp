@@ -52,6 +52,8 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   // lanes); --simd-pairs=on prints every loop that allows it per destination.
   pairShared_ = opts.pairShared && host_.hoist && (!simdPairs_ || simdAuto_);
   skipSelfPairs_ = opts.skipSelfPairs;
+  filteredLists_ = opts.filteredLists;
+  constantValues_ = opts.constantValues;
 }
 
 int ScenePrinter::propIndex(int a, const std::string& p) const {
@@ -427,11 +429,11 @@ void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const 
 // The pair quantities of one candidate, from the table (analysis/PairQuantityTable): those
 // before the neighbour test (XIJ, R2IJ), the test, then every-neighbour and used ones.
 void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::string>& q,
-                                      const Dialect& dl, bool test) {
+                                      const Dialect& dl, bool test, const std::string& skip) {
   const std::string indent = "            ";
   const PairDialect dialect = pairDialectOf(dl);
   if (test) {
-    emitNeighbourTest(os, dl, dl.skipCandidate, indent);
+    emitNeighbourTest(os, dl, skip.empty() ? dl.skipCandidate : skip, indent);
   } else {  // a neighbour: what the test computes, without the test
     os << indent << "const " << dl.real << " hj = sj_h[s_idx];\n";
     for (const PairQuantity& pq : pairQuantityTable())
@@ -445,8 +447,9 @@ void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::stri
 
 void ScenePrinter::emitCandidate(std::ostream& os, const std::set<std::string>& q,
                                  const std::vector<const PlanEquation*>& loopers, int d,
-                                 const Dialect& dl, bool test, const RegisterSums* sums) {
-  emitPairQuantities(os, q, dl, test);
+                                 const Dialect& dl, bool test, const RegisterSums* sums,
+                                 const std::string& skip) {
+  emitPairQuantities(os, q, dl, test, skip);
   for (const auto* eq : loopers)
     os << "            "
        << (sums ? pairCall(*eq, d, *sums) : equationCall(*eq, ast::Method::Loop, d, dl.scalarSep));

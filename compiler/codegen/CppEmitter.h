@@ -95,6 +95,12 @@ struct EmitOptions {
   // (--no-self-pair-skip): the self pair is evaluated as before. The values are the same bit
   // for bit but for the sign of a sum that is -0 when its self pair comes (docs/performance.md).
   bool skipSelfPairs = true;
+  // --filtered-lists: the per-destination loops filter the kept list, then loop (CpuPrinter.cpp).
+  bool filteredLists = false;
+  // The equation instances' values that are literals (`dim = 2`, defaults such as R = 0.2)
+  // as constants of the C++ (HostProgram.cpp); false (--no-constant-values): members set at
+  // set-up, as the others. The values are the same bit for bit.
+  bool constantValues = true;
   // --simd-pairs: the CPU pair loops that allow it (codegen/SimdPairs.cpp) are printed per
   // destination with the neighbour loop under `#pragma omp simd reduction(+: sums)`, the pair
   // quantities scalars (XIJ_0, ...), the bodies' calls of their NAME_loop_simd form; the

@@ -39,6 +39,7 @@
 #include "codegen/Printer.h"
 
 #include <algorithm>
+#include <map>
 
 namespace sphc {
 
@@ -287,21 +288,37 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
            << ", of the parameters only: once per pass\n";
   }
   std::vector<std::string> calls;
+  // A value another equation of the pass already computes (the same function of the same
+  // source properties: e.g. the shifting's two bodies' s_m[s_idx] / s_rho[s_idx]) reads that
+  // equation's array: the same doubles, computed once.
+  std::map<std::string, std::string> computed;  // hoistedSiteKey -> the array's pointer
+  bool any = false;
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     const auto sites = hoistedSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k) {
       const SourceOnlySite& s = sites[k];
-      if (calls.empty())
+      if (!any)
         os << "        // Values of the loop bodies that depend on the source particle only, once "
               "per\n        // particle (codegen/Hoist.cpp; sphc --no-hoist: per pair).\n"
            << "        const int n_src = static_cast<int>(" << count << ");\n";
+      any = true;
       const std::string K = std::to_string(k);
       const std::string ptr = hoistArgument(eqStruct(*eq), K);
+      const std::string type = hoistedValueType(b, host_, true, k);
+      const std::string key = hoistedSiteKey(b, s, type);
+      auto same = key.empty() ? computed.end() : computed.find(key);
+      if (same != computed.end()) {
+        os << "        " << type << "* const " << ptr << " = " << same->second << ";  // "
+           << eq->name << ": " << oneLine(b.source.text.substr(s.begin, s.end - s.begin))
+           << ", computed above\n";
+        continue;
+      }
+      if (!key.empty()) computed.emplace(key, ptr);
       const std::string member = "hoist_" + eqStruct(*eq) + "_" + K;
       os << "        " << member << ".resize(n_src);  // " << eq->name << ": "
          << oneLine(b.source.text.substr(s.begin, s.end - s.begin)) << "\n";
-      os << "        " << hoistedValueType(b, host_, true, k) << "* const " << ptr << " = "
+      os << "        " << type << "* const " << ptr << " = "
          << member << ".data();\n";
       calls.push_back(ptr + "[s_idx] = " + bodyFunctionName(eq->name, "loop") + "_hoisted" + K +
                       "(s_idx" + hoistArguments(s, b.facts, true, eqStruct(*eq)) + ");");
@@ -312,6 +329,21 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
   os << "        for (int s_idx = 0; s_idx < n_src; ++s_idx) {\n";
   for (const auto& c : calls) os << "          " << c << "\n";
   os << "        }\n";
+}
+
+std::string ScenePrinter::hoistedSiteKey(const PlanBody& b, const SourceOnlySite& s,
+                                         const std::string& type) const {
+  // The equation's scalars are its own (eqN.k): not compared, such a value is not shared.
+  if (!s.scalars.empty()) return "";
+  const std::string& text = b.source.text;
+  // Single precision: the type is the function's decltype alias, named per equation; the same
+  // float text gives the same type.
+  std::string key = (host_.floatBodies ? std::string("float text") : type) + "|" + (s.usesT ? "t" : "") + (s.usesDt ? "dt" : "") + "|";
+  for (const auto& p : sideReads(b.facts, s, true)) key += p + ",";
+  for (const auto& l : s.locals)
+    key += "|" + l.type + " " + l.name + " = " +
+           fusedRange(text, b.facts, l.initBegin, l.initEnd, host_.fma);
+  return key + "|" + fusedRange(text, b.facts, s.begin, s.end, host_.fma);
 }
 
 std::string ScenePrinter::valueTypeAlias(const std::string& fn,

@@ -16,17 +16,53 @@
 
 namespace sphc {
 
+// A parameter or const of an equation instance whose value is a literal (`dim = 2`, `beta =
+// 0.0`, a default `R = 0.2`; also -literal, true, false) and not a state (which `converged`
+// and a host `reduce` write): the C++ literal, printed as a `static constexpr` member of the
+// instance's values, so that the C++ compiler sees the value in the loops (e.g. folds
+// DeltaPlusShiftingSums' `dim == 1 ? ... : dim == 2 ? HIJ * HIJ : ...` and keeps it out of
+// memory, where every store through a d_ pointer could change it as far as the compiler
+// knows). The same double as the member assigned at set-up from the same literal, so the
+// same operations on the same values. "" otherwise (a scene parameter, an expression).
+std::string ScenePrinter::literalValue(const PlanEquation& eq, const std::string& name,
+                                       const ast::Expr& v) const {
+  if (!constantValues_) return "";
+  const auto* decl = plan_.equationDecls[eq.declIndex].decl;
+  for (const auto& s : decl->states)
+    if (s.name.name == name) return "";
+  const ast::Expr* e = &v;
+  std::string sign;
+  if (e->kind == ast::Expr::Unary && (e->op == "-" || e->op == "+") && e->args.size() == 1) {
+    sign = e->op;
+    e = e->args[0].get();
+  }
+  auto none = [](const std::string&) { return std::string(); };
+  if (e->kind == ast::Expr::Number) return "(" + sign + exprCpp(*e, none) + ")";
+  if (e->kind == ast::Expr::Name && (e->text == "true" || e->text == "false"))
+    return "(" + sign + exprCpp(*e, none) + ")";
+  return "";
+}
+
 void ScenePrinter::emitParams() {
   scene_ << "  struct Params {\n";
   for (const auto* p : plan_.params)
     scene_ << "    double " << p->name.name << " = 0.0;  // from " << loc(p->name.loc) << "\n";
   scene_ << "  } P;\n\n";
-  // Equation instances: their parameters and constants, evaluated at set-up.
+  // Equation instances: their parameters and constants, evaluated at set-up; those of a
+  // literal value constants of the C++ (literalValue; a named struct: an anonymous one may
+  // not hold a static member).
   for (const auto& eq : plan_.equations) {
     if (!eq.live) continue;
-    scene_ << "  struct {";
-    for (const auto& [n, v] : eq.values) scene_ << " double " << n << " = 0.0;";
-    scene_ << " } " << eqStruct(eq) << ";  // " << eq.name << "(dest = " << arr(eq.dest).name
+    std::string members;
+    bool literal = false;
+    for (const auto& [n, v] : eq.values) {
+      const std::string lit = literalValue(eq, n, *v);
+      literal |= !lit.empty();
+      members += lit.empty() ? " double " + n + " = 0.0;"
+                             : " static constexpr double " + n + " = " + lit + ";";
+    }
+    scene_ << "  struct " << (literal ? eqStruct(eq) + "_values " : "") << "{" << members
+           << " } " << eqStruct(eq) << ";  // " << eq.name << "(dest = " << arr(eq.dest).name
            << "), from " << loc(eq.loc) << "\n";
   }
   scene_ << "\n";
@@ -208,8 +244,9 @@ void ScenePrinter::emitSetup() {
       auto names = [&](const std::string& x) {
         return own && earlier.count(x) ? s + "." + x : paramRef(x);
       };
-      scene_ << "    " << s << "." << n << " = " << exprCpp(*v, names) << ";\n";
       earlier.insert(n);
+      if (!literalValue(eq, n, *v).empty()) continue;  // a constant of the C++ (emitParams)
+      scene_ << "    " << s << "." << n << " = " << exprCpp(*v, names) << ";\n";
     }
   }
   for (int a : sched_.setupArrays) emitArraySetup(arr(a));

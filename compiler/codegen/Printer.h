@@ -184,15 +184,17 @@ class ScenePrinter {
   // gathered neighbour list), the quantities without the cut-off test.
   void emitCandidate(std::ostream& os, const std::set<std::string>& q,
                      const std::vector<const PlanEquation*>& loopers, int d, const Dialect& dl,
-                     bool test = true, const RegisterSums* sums = nullptr);
+                     bool test = true, const RegisterSums* sums = nullptr,
+                     const std::string& skip = "");
   // loop_all: the neighbour test of one candidate s_idx (hj, XIJ, R2IJ and the cut-off,
   // leaving with `skip`), before it joins the neighbour list. `radius2`: the squared radius
   // in units of hmax (RADIUS2, the support; VERLET_RADIUS2 for the lists of --verlet-skin).
   void emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
                          const std::string& indent, const std::string& radius2 = "RADIUS2");
-  // The pair quantities of one candidate (XIJ, R2IJ, the cut-off test, HIJ, RIJ, ...).
+  // The pair quantities of one candidate (XIJ, R2IJ, the cut-off test, HIJ, RIJ, ...); the
+  // test leaves with `skip` (empty: the dialect's skipCandidate).
   void emitPairQuantities(std::ostream& os, const std::set<std::string>& q, const Dialect& dl,
-                          bool test = true);
+                          bool test = true, const std::string& skip = "");
   void emitLineDirective(std::ostringstream& os, llvm::SMLoc l) const;
   void resetLineDirective(std::ostringstream& os, const Dialect& d) const;
   // A property's type in a dialect (constants and floating properties: its real).
@@ -235,6 +237,8 @@ class ScenePrinter {
   mutable std::map<std::string, PairSharedLocal> pairSharedScope_;  // eqValues + "/" + K
   bool pairShared_ = false;  // EmitOptions::pairShared (CPU double, not mpi, not --simd-pairs)
   bool skipSelfPairs_ = false;  // EmitOptions::skipSelfPairs (SymmetricPairs.cpp)
+  bool filteredLists_ = false;  // EmitOptions::filteredLists (CpuPrinter.cpp)
+  bool constantValues_ = true;  // EmitOptions::constantValues (HostProgram.cpp)
   mutable std::unique_ptr<std::set<const PlanBody*>> pairSharedBodies_;  // (once)
 
   // ---- Source-only values hoisted out of the pair loops (Hoist.cpp) ----
@@ -282,6 +286,11 @@ class ScenePrinter {
   // `using NAME_t = decltype(NAME(...))` for a function whose parameters have the types
   // `types`, printed after it in single precision: the type of its value.
   static std::string valueTypeAlias(const std::string& fn, const std::vector<std::string>& types);
+  // What identifies a source-hoisted value across the equations of a pass (Hoist.cpp): its
+  // type, t/dt, the properties it reads, its locals and its expression as printed; "" where
+  // it reads an equation's scalars (not shared).
+  std::string hoistedSiteKey(const PlanBody& b, const SourceOnlySite& s,
+                             const std::string& type) const;
   std::string hoistArgument(const std::string& eqValues, const std::string& k) const {
     return "hoisted_" + eqValues + "_" + k;
   }
@@ -429,6 +438,10 @@ class ScenePrinter {
   void emitBodies();
   void emitSceneFunctions();
   void emitParams();
+  // The C++ literal of an equation instance's value known at compile time, "" if none
+  // (HostProgram.cpp; EmitOptions::constantValues).
+  std::string literalValue(const PlanEquation& eq, const std::string& name,
+                           const ast::Expr& v) const;
   void emitSetup();
   void emitArraySetup(const PlanArray& a);
   void emitDomainSetup();

@@ -161,6 +161,20 @@ static cl::opt<bool> NoSelfPairSkip(
              "it; the results are the same bit for bit but for the sign of a sum that is -0 "
              "there)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> FilteredLists(
+    "filtered-lists",
+    cl::desc("In the CPU per-destination pair loops with kept lists, filter each list to the "
+             "support first, then loop over the filtered list (default: walk the kept list "
+             "once with the support's test inline, where no loop_all, SIMD lanes or --mpi "
+             "need the filtered list; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoConstantValues(
+    "no-constant-values",
+    cl::desc("Set every parameter and const of the equation instances at set-up (default: "
+             "those whose value is a literal, e.g. dim = 2 or a default such as R = 0.2, are "
+             "constants of the generated C++, which the C++ compiler folds into the loops; "
+             "the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<std::string> SimdPairs(
     "simd-pairs",
     cl::desc("The CPU pair loops (serial and openmp, double and single precision) whose bodies allow it "
@@ -524,6 +538,8 @@ int main(int argc, char** argv) {
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;
   emitOpts.skipSelfPairs = !NoSelfPairSkip;
+  emitOpts.filteredLists = FilteredLists;
+  emitOpts.constantValues = !NoConstantValues;
   // --simd-pairs: auto (the default), on (also bare), off; the lanes only on the CPU backends.
   const std::string simdMode = SimdPairs.empty() ? std::string("on") : SimdPairs.getValue();
   if (simdMode != "auto" && simdMode != "on" && simdMode != "off" && simdMode != "once" &&

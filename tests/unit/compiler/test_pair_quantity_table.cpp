@@ -82,6 +82,11 @@ TEST(PairQuantityTable, StatementsInEachDialect) {
             "const float EPS = 0.01f * HIJ * HIJ;\n");
   EXPECT_EQ(pairQuantityStatement(*findPairQuantity("R2IJ"), 3, hostFloat, ""),
             "const float R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * XIJ[2];\n");
+  // The scene's axes only: the others' literal 0 squared adds +0 (exact).
+  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("R2IJ"), 2, host, ""),
+            "const double R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1];\n");
+  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("R2IJ"), 1, host, ""),
+            "const double R2IJ = XIJ[0] * XIJ[0];\n");
   EXPECT_EQ(pairQuantityStatement(*findPairQuantity("WJ"), 2, device, ""),
             "const real WJ = kernel_w(RIJ, hj);\n");
   EXPECT_EQ(pairQuantityStatement(*findPairQuantity("DWIJ"), 2, host, "  "),
