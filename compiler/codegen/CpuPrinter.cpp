@@ -7,6 +7,7 @@
 #include "codegen/CpuLazyCells.h"
 #include "codegen/CpuVerletTune.h"
 #include "codegen/Printer.h"
+#include "analysis/PositionReads.h"
 #include "codegen/SymmetricPairs.h"
 
 #include <cstdio>
@@ -168,6 +169,15 @@ class CpuPrinter : public ScenePrinter {
   }
   void updateNeighboursWithGhosts() override;
   std::string removeGhosts() const override;
+  std::string wrapBeforeEvaluation() const override {
+    if (!verlet() || !hasDomain()) return "";
+    std::string r;
+    for (const PlanGroup* g : positionReads(plan_).wrapBefore)
+      r += "    if (" + groupOptionCpp(*g->condition) + ") wrap_into_box();  // a group reading "
+           "positions runs now (condition = " + exprText(*g->condition) + "): every particle "
+           "into the box (analysis/PositionReads.cpp)\n";
+    return r;
+  }
   void timedNeighbourUpdate() override;
   void adaptiveDtArray(int a) override;
   void mainPrologue() override {
@@ -588,7 +598,7 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
     scene_ << "          " << lists << ".begin = " << rangeBegin(w) << ";\n";
     scene_ << "          " << lists << ".end = " << rangeEnd(w) << ";\n";
     scene_ << "          " << lists << ".lists.resize(" << D << ".n);\n";
-    if (d == s && symmetric_ && !hasDomain()) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
+    if (d == s && symmetric_ && (!hasDomain() || !cpuSingle_)) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
     if (crossSourceLists().count(lists))
       scene_ << "          " << lists << "_by_source.clear();  // found again by the pass over pairs of two arrays once\n";
     scene_ << "        }\n";
@@ -619,10 +629,13 @@ std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
 
 // Whether the pass over w's own array is printed each pair once (SymmetricPairs.cpp): not in
 // SIMD lanes per destination (--simd-pairs; under --simd-pairs=once each pair once in the
-// lanes, SimdPairs.cpp), not with periodic or mirror ghosts.
+// lanes, SimdPairs.cpp). With periodic or mirror ghosts (kept with the lists: verlet()) in
+// the scalar loops of double precision only, the pairs with a ghost per destination
+// (emitSymmetricPass).
 bool CpuPrinter::symmetricPass(const DestinationWork& w, const NeighbourPass& pass) const {
-  return symmetric_ && !hasDomain() && symmetricPairsRefusal(plan_, w, pass, verlet()).empty() &&
-         (!simdPairsRefusal(w, pass).empty() || onceLanes(w, pass));
+  if (!symmetric_ || !symmetricPairsRefusal(plan_, w, pass, verlet()).empty()) return false;
+  if (hasDomain()) return !cpuSingle_ && !simdPairsRefusal(w, pass).empty() && !onceLanes(w, pass);
+  return !simdPairsRefusal(w, pass).empty() || onceLanes(w, pass);
 }
 
 // The bodies the each-pair-once loops call both ways (the conditions of the printing above):

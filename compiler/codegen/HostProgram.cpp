@@ -570,6 +570,7 @@ void ScenePrinter::emitStep() {
     scene_ << "  }\n\n";
     scene_ << "  // Ghosts exist during an evaluation only: outside it arrays hold real particles.\n";
     scene_ << "  void compute_accelerations(double t, double dt) {\n";
+    scene_ << wrapBeforeEvaluation();
     scene_ << "    update_domain();\n";
     timedNeighbourUpdate();
     scene_ << "    equations(t, dt);\n";

@@ -124,6 +124,10 @@ class ScenePrinter {
   virtual void staticCellLists() {}  // members it calls, before it (CPU: build_static_cells)
   virtual void updateNeighboursWithGhosts() = 0;    // its body, with one
   virtual std::string removeGhosts() const = 0;
+  // compute_accelerations, before update_domain: the CPU printer's kept ghosts wrap every
+  // particle into the box before an evaluation where a group reading positions runs
+  // (analysis/PositionReads.cpp).
+  virtual std::string wrapBeforeEvaluation() const { return ""; }
   virtual void timedNeighbourUpdate() = 0;
   virtual void adaptiveDtArray(int a) = 0;          // the limits of one moving array
   virtual void mainPrologue() {}                    // before `static Scene scene;`

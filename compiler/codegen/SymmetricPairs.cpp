@@ -187,12 +187,16 @@ std::vector<std::string> symmetricPairsNotes(
                              " in " + ph.name;
     std::string why = opts.symmetricPairs ? symmetricPairsRefusal(plan, w, pass, listsKept)
                                           : "--no-symmetric-pairs";
-    // Ghosts of periodic or mirror sides are sources only: their mirrored calls would sum
-    // into images, not particles (not written for yet; CpuPrinter keeps the gather there).
-    if (why.empty() && sched.domain) why = "the sources include periodic or mirror ghosts";
+    // Ghosts of periodic or mirror sides are sources only: a pair with a ghost is evaluated
+    // for the real particle alone (its original has the pair through the other's image).
+    // Written for the scalar loops of double precision (CpuPrinter::symmetricPass; listsKept
+    // is false in single precision).
     if (why.empty() && inLanes && inLanes(w, pass)) why = lanes;
     if (opts.backend == Backend::OpenCL) why = "the OpenCL backend gathers per destination";
-    notes.push_back(why.empty() ? "each pair once for both particles: " + loop
+    notes.push_back(why.empty() ? "each pair once for both particles: " + loop +
+                                      (sched.domain ? " (a pair with a periodic or mirror ghost "
+                                                      "for the real particle only)"
+                                                    : "")
                                 : "pairs per destination particle: " + loop + ": " + why);
   });
   // Pair loops of two arrays, A <- B and B <- A in one phase.
@@ -319,6 +323,12 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     std::string skip;        // a condition under which d_idx has nothing in [from, to)
     bool skipSelf = false;   // from is where s_idx >= d_idx starts: past d_idx itself
   };
+  // Periodic or mirror ghosts (kept with the lists, CpuPrinter's updateNeighboursKeptGhosts):
+  // numbered after the n real particles, so they end each sorted list. A pair with a ghost
+  // is evaluated for the real particle only, in the tail after the real neighbours (the
+  // ghost's original gets the same pair from its own list, through the image of the real
+  // particle): each particle's sums in its list's order, as per destination.
+  const bool ghosts = hasDomain();
   const bool skipSelf = skipsSelfPair(pass);
   auto segment = [&](const Segment& sg) {
     const std::string& indent = sg.indent;
@@ -382,13 +392,16 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       // `to` is the block's end: where the list passes it (found once; the last block's
       // lists end there).
       scene_ << in << "const std::uint32_t* k = " << first << ";\n";
-      scene_ << in << "const std::uint32_t* const k_mid = " << to << " == n || k == k_end || "
+      scene_ << in << "const std::uint32_t* const k_mid = "
+             << (ghosts ? std::string() : to + " == n || ") << "k == k_end || "
              << "k_end[-1] < static_cast<std::uint32_t>(" << to << ")\n"
              << in << "    ? k_end : std::lower_bound(k, k_end, static_cast<std::uint32_t>(" << to
              << "));\n";
       scene_ << in << "for (; k != k_mid; ++k) {\n";
       pairs(both);
-      scene_ << in << "for (; k != k_end; ++k) {  // (3) the neighbours in later blocks: d_idx only\n";
+      scene_ << in << "for (; k != k_end; ++k) {  // "
+             << (openmp ? "(3) the neighbours in later blocks" : "the ghosts")
+             << (openmp && ghosts ? " and the ghosts" : "") << ": d_idx only\n";
       pairs(false);
     }
     emitSumsStore(scene_, in, sums);
@@ -399,6 +412,10 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     Segment all{"        ", "0", "n", upper};
     all.comment = skipSelf ? "  // pairs (d_idx, s_idx > d_idx)" : "  // pairs (d_idx, s_idx >= d_idx)";
     all.skipSelf = skipSelf;
+    if (ghosts) {  // the real neighbours each pair once, then the ghosts for d_idx only
+      all.to = "n";
+      all.tail = true;
+    }
     segment(all);
     return;
   }
@@ -663,7 +680,8 @@ void ScenePrinter::emitCrossSpanning(const NeighbourPass& ba, int b, const std::
 std::vector<std::string> ScenePrinter::pairLoopNotes(const EmitOptions& opts) const {
   std::vector<std::string> notes = symmetricPairsNotes(
       sched_, opts, [this](const DestinationWork& w, const NeighbourPass& pass) {
-        return simdPairsRefusal(w, pass).empty() && !onceLanes(w, pass);
+        // With ghosts the each-pair-once lanes are not written for: lanes per destination.
+        return simdPairsRefusal(w, pass).empty() && (hasDomain() || !onceLanes(w, pass));
       });
   for (std::string& note : simdPairsNotes()) notes.push_back(std::move(note));  // SimdPairs.cpp
   return notes;

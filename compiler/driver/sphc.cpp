@@ -3,6 +3,7 @@
 //   cpp = print(schedule, backend); exe = build
 // `--dump-after=PASS` prints the state after PASS and stops; `--report` prints the plan.
 #include "analysis/Passes.h"
+#include "analysis/PositionReads.h"
 #include "body/BodyAnalysis.h"
 #include "codegen/CppEmitter.h"
 #include "driver/Build.h"
@@ -375,10 +376,18 @@ int main(int argc, char** argv) {
       return "a periodic or mirror domain with a neighbour loop in a `real = false` group";
     // Kept with the lists, the ghosts let a particle sit up to half a support outside a
     // periodic box between sorts: an equation reading d_x then sees another value than the
-    // wrapped one (tests/mpi periodic_drift's r = x). Opt in with a number.
-    if (p.domain.any())
-      return "a periodic or mirror domain (positions wrapped lazily with kept lists: "
-             "--verlet-skin=F opts in)";
+    // wrapped one (tests/mpi periodic_drift's r = x). Kept by default where the scene reads
+    // positions only as copies and increments, or in groups with a condition before which
+    // the printer wraps every particle (analysis/PositionReads.cpp); else opt in with a number.
+    if (p.domain.any() && PrecisionOpt == sphc::Precision::Single)  // not measured there
+      return "a periodic or mirror domain in single precision (positions wrapped lazily with "
+             "kept lists: --verlet-skin=F opts in)";
+    if (p.domain.any()) {
+      const sphc::PositionReads reads = sphc::positionReads(p);
+      if (!reads.refusal.empty())
+        return "a periodic or mirror domain where " + reads.refusal +
+               " (positions wrapped lazily with kept lists: --verlet-skin=F opts in)";
+    }
     if (!p.zones.empty()) return "inlets or outlets";
     return "";
   };
@@ -495,6 +504,16 @@ int main(int argc, char** argv) {
     else
       plan->notes.push_back("neighbour lists gathered at every evaluation (--verlet-skin=auto): "
                             "lists kept across steps are not written for " + why);
+    if (why.empty() && plan->domain.any()) {
+      const sphc::PositionReads reads = sphc::positionReads(*plan);
+      plan->notes.push_back(
+          reads.wrapBefore.empty()
+              ? std::string("periodic or mirror domain: positions read only as copies and "
+                            "increments, wrapped into the box lazily (--verlet-skin=auto)")
+              : "periodic or mirror domain: positions wrapped into the box lazily, and every "
+                "particle before an evaluation where a group reading them runs (" +
+                    reads.reader + "; its group's condition)");
+    }
     if (!why.empty()) verletSkin = 0.0;
   }
   if (Report) printPlan(*plan, llvm::outs(), true);
