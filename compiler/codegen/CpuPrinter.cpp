@@ -7,8 +7,10 @@
 #include "codegen/CpuLazyCells.h"
 #include "codegen/CpuVerletTune.h"
 #include "codegen/Printer.h"
+#include "analysis/KeptGhostSpan.h"
 #include "analysis/PositionReads.h"
 #include "codegen/SymmetricPairs.h"
+#include "frontend/FormatNumber.h"
 
 #include <cstdio>
 #include <functional>
@@ -315,7 +317,7 @@ void CpuPrinter::verletMembers() {
             "  // permutations a periodic axis wraps only the particles further than\n"
             "  // WRAP_MARGIN supports outside the box (update_domain).\n"
             "  sphc::VerletSkin ghost_skin{VERLET_SKIN};\n"
-            "  static constexpr double WRAP_MARGIN = 0.5;\n";
+            "  static constexpr double WRAP_MARGIN = " << formatNumber(kKeptWrapMargin, 17) << ";\n";
 }
 
 void CpuPrinter::forEachVerletLists(
@@ -926,6 +928,9 @@ void CpuPrinter::updateNeighboursKeptGhosts() {
   scene_ << "    // Ghosts within the lists' radius plus WRAP_MARGIN supports of a periodic or mirror side.\n";
   scene_ << "    const double cutoff = domain.cell_size * (1.0 + VERLET_SKIN + WRAP_MARGIN) / "
             "(1.0 + VERLET_SKIN);\n";
+  scene_ << "    sphc::check_ghost_span(box, cutoff, \"the neighbour lists kept across steps "
+            "need (1 + VERLET_SKIN + WRAP_MARGIN) supports along a periodic or mirrored axis; "
+            "a solver built with sphc --verlet-skin=off needs one support\");\n";
   scene_ << "    if (new_ghosts) {\n";
   for (const auto& S : sourceArrays_) {
     int s = plan_.arrayIndex(S);

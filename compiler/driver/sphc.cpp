@@ -3,6 +3,7 @@
 //   cpp = print(schedule, backend); exe = build
 // `--dump-after=PASS` prints the state after PASS and stops; `--report` prints the plan.
 #include "analysis/Passes.h"
+#include "analysis/KeptGhostSpan.h"
 #include "analysis/PositionReads.h"
 #include "body/BodyAnalysis.h"
 #include "codegen/CppEmitter.h"
@@ -387,6 +388,10 @@ int main(int argc, char** argv) {
       if (!reads.refusal.empty())
         return "a periodic or mirror domain where " + reads.refusal +
                " (positions wrapped lazily with kept lists: --verlet-skin=F opts in)";
+      if (verletAuto) {
+        const std::string narrow = sphc::keptGhostSpanRefusal(p, verletSkin);
+        if (!narrow.empty()) return narrow;
+      }
     }
     if (!p.zones.empty()) return "inlets or outlets";
     return "";

@@ -221,6 +221,15 @@ void check_domain(const Domain& d) {
   }
 }
 
+void check_ghost_span(const Domain& d, double cutoff, const std::string& why) {
+  for (int a = 0; a < d.dim && a < 3; ++a)
+    if (d.lo_kind[a] != Boundary::Open && d.hi_kind[a] != Boundary::Open &&
+        d.hi[a] - d.lo[a] < cutoff)
+      throw std::invalid_argument("domain: " + axis_name(a) + " spans " +
+                                  std::to_string(d.hi[a] - d.lo[a]) + ", less than " +
+                                  std::to_string(cutoff) + ": " + why);
+}
+
 GhostTransform ghost_transform(const Domain& d, int axis, int side, bool position) {
   GhostTransform t;
   if (axis < 0 || axis >= 3 || side < 0 || side > 1) return t;

@@ -75,6 +75,11 @@ struct Domain {
 // axis with two boundaries.
 void check_domain(const Domain& d);
 
+// Throws std::invalid_argument unless every axis with images on both sides (periodic, or
+// mirrors on both) spans at least `cutoff`, the message naming the axis and ending in `why`
+// (the generated solver says which of its choices needs that span and how to do without).
+void check_ghost_span(const Domain& d, double cutoff, const std::string& why);
+
 // Ghost particles of one array: ghost g copies real particle source[g] through image[g].
 // image: 2 bits per axis (bits 2a, 2a+1): 0 = no image along axis a, 1 = the image through
 // the low side (periodic: x + L; mirror: 2 lo - x), 2 = through the high side (x - L;
