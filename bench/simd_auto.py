@@ -88,6 +88,8 @@ VARIANT_FLAGS = {"off": ["--simd-pairs=off"], "on": ["--simd-pairs=on"], "auto":
                  "once_only": ["--simd-pairs=once", "--simd-once-neighbours=0"],
                  # The same in 4-lane (ymm) vectors: 2D's ~12 neighbours above d_idx fill
                  # fewer 8-lane vectors (an experiment, stop 36).
+                 # The self pair evaluated in the each-pair-once lanes (before stop 36).
+                 "noskip": ["--no-self-pair-skip"],
                  # Only the loops per destination anyway (periodic, no kept lists) in lanes.
                  "perdest_only": ["--simd-perdest-neighbours=0"],
                  "once_only_256": ["--simd-pairs=once", "--simd-once-neighbours=0",
