@@ -135,8 +135,9 @@ struct EmitOptions {
 inline constexpr double kSimdAutoNeighbours = 30.0;
 // --simd-pairs=auto: a loop over its own array that is per destination anyway (no each pair
 // once to lose: a periodic or mirror domain, zones, no kept lists) goes in the lanes at any
-// expected count in 2D and 3D (stop 36, Intel with gathers: 0.79-0.97 of the scalar step at
-// ~21 and ~28 neighbours; stop 33, AMD Zen 5: 0.89 at ~28).
+// expected count in 2D and 3D (stop 36, Intel with gathers: 0.84-0.97 of the scalar step at
+// ~28 neighbours, 0.79-0.81 for a per-destination loop at ~21; stop 33, AMD Zen 5: 0.89 at
+// ~28).
 inline constexpr double kSimdPerDestNeighbours = 0.0;
 
 // The lines around the out-of-class phases of a split solver (EmitOptions::splitUnits).

@@ -33,10 +33,11 @@
 // kSimdAutoNeighbours. Below it, each pair once saves more than the lanes (the 2D dam
 // breaks: in the each-pair-once lane form too, stop 36: 1.19-1.24x the scalar step at dx =
 // 0.03, 1.02-1.35x at ~100k, on Intel with gathers; 0.84-0.86 from h = 1.6 dx, ~32). A loop
-// over its own array that is per destination anyway (a periodic or mirror domain, zones, no
-// kept lists) goes in the lanes at any count (kSimdPerDestNeighbours; stop 36: 0.79-0.97 of
-// the scalar step at ~21 and ~28 neighbours); one over another array (walls) keeps the
-// threshold (the dam break's shifting fluid <- boundary in lanes: 1.08-1.10x).
+// over its own array that is per destination anyway by the scene (a periodic or mirror
+// domain, zones) goes in the lanes at any count (kSimdPerDestNeighbours; stop 36: 0.84-0.97
+// of the scalar step at ~28 neighbours, 0.79-0.81 for a per-destination loop at ~21); one over
+// another array (walls) keeps the threshold (the dam break's shifting fluid <- boundary in
+// lanes: 1.08-1.10x).
 //
 // --simd-pairs=once: auto's loops, but a loop that could be each pair once is printed each
 // pair once in the lanes (emitSymmetricSimdLoops, below): the values the pair shares once per
@@ -175,7 +176,8 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   const bool onceAnyway = eachPairOncePossible(w, pass);
   // A loop over its own array that is per destination anyway by the scene (a periodic or
   // mirror domain, zones: no each pair once there): in the lanes from kSimdPerDestNeighbours
-  // (stop 36: 0.79-0.97 of the scalar step at ~21 and ~28 neighbours in 2D). Not where a
+  // (stop 36: 0.84-0.97 of the scalar step at ~28 neighbours in 2D; a per-destination loop at
+  // ~21, the dam break with --no-symmetric-pairs, 0.79-0.81). Not where a
   // switch makes it per destination (--no-symmetric-pairs: the reference of the each-pair-once
   // loops) nor where its bodies refuse each pair once (the tests' bitwise references; not
   // measured): scalar as before. A loop over another array (walls) keeps the threshold: most of
