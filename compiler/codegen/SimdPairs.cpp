@@ -34,7 +34,7 @@
 // breaks: in the each-pair-once lane form too, stop 36: 1.19-1.24x the scalar step at dx =
 // 0.03, 1.02-1.35x at ~100k, on Intel with gathers; 0.84-0.86 from h = 1.6 dx, ~32). A loop
 // over its own array that is per destination anyway by the scene (a periodic or mirror
-// domain, zones) goes in the lanes at any count (kSimdPerDestNeighbours; stop 36: 0.84-0.97
+// domain, no zones) goes in the lanes at any count (kSimdPerDestNeighbours; stop 36: 0.84-0.97
 // of the scalar step at ~28 neighbours, 0.79-0.81 for a per-destination loop at ~21); one over
 // another array (walls) keeps the threshold (the dam break's shifting fluid <- boundary in
 // lanes: 1.08-1.10x).
@@ -175,7 +175,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   const std::optional<double> n = expectedNeighbours(plan_, w.array, pass.source, how);
   const bool onceAnyway = eachPairOncePossible(w, pass);
   // A loop over its own array that is per destination anyway by the scene (a periodic or
-  // mirror domain, zones: no each pair once there): in the lanes from kSimdPerDestNeighbours
+  // mirror domain: no each pair once there): in the lanes from kSimdPerDestNeighbours
   // (stop 36: 0.84-0.97 of the scalar step at ~28 neighbours in 2D; a per-destination loop at
   // ~21, the dam break with --no-symmetric-pairs, 0.79-0.81). Not where a
   // switch makes it per destination (--no-symmetric-pairs: the reference of the each-pair-once
@@ -183,8 +183,11 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // measured): scalar as before. A loop over another array (walls) keeps the threshold: most of
   // its destinations have few or no neighbours there (the dam break's fluid <- boundary in
   // lanes: 1.08-1.10x).
+  // Not with zones (inlets, outlets): the channel's TVF scene (examples/channel_inlet_outlet.sph
+  // -D scheme=tvf) gave serial and OpenMP runs that differ in their bits with its loops in
+  // lanes (lit backends/every-example.sph, -single.sph; not found why in stop 36).
   const bool perDestOwn = !onceAnyway && pass.source == w.array && plan_.dim >= 2 &&
-                          simdSymmetricSwitch_ && (hasDomain() || hasZones());
+                          simdSymmetricSwitch_ && hasDomain() && !hasZones();
   // --simd-once-neighbours: a threshold of its own for a loop the lanes print each pair once.
   const bool once = simdOnce_ && onceForm(w, pass) && simdOnceNeighbours_ >= 0;
   const double threshold = once ? simdOnceNeighbours_

@@ -173,7 +173,7 @@ static cl::opt<std::string> SimdPairs(
              "defaults; where they are not known before the run, 3D yes, 2D no: with h = 1.3 "
              "dx and a support of 2 h, 74 and 21 neighbours; below 30, each pair once pays "
              "more), and a loop over its own array that is per destination anyway (a periodic "
-             "or mirror domain, zones) at any count; on (or --simd-pairs alone): every loop that allows it; off: the "
+             "or mirror domain, no zones) at any count; on (or --simd-pairs alone): every loop that allows it; off: the "
              "scalar loops. Under auto a loop in lanes over its own array (kept lists, double "
              "precision) evaluates each pair once in them, the values the pair shares once, "
              "the source side gathered and scattered (once: the same; perdest: auto's loops "
