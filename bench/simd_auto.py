@@ -51,6 +51,18 @@ SCENES = {
                    (3, 8), (2, 42), None),
     "cube20_h12": (SCENE_FILES["cube"], [], ["--set", "nx=20", "--set", "hdx=1.2", "--tf", "1"],
                    (3, 8), (2, 42), None),
+    # ~100k particles (dx = 0.0047, as bench/backends.py; stop 36).
+    "dambreak_100k": (SCENE_FILES["dambreak"], [], ["--set", "dx=0.0047"], None, (2, 12), None),
+    "dambreak_pysph_100k": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
+                            ["--set", "cfl=0.3", "--set", "dx=0.0047"], None, (2, 12), None),
+    "taylor_green_edac": (SCENE_FILES["taylor_green"], ["-D", "scheme=edac"],
+                          ["--set", "nx=100"], (5, 15), (10, 110), None),
+    # Scenes whose loops are per destination anyway (periodic, zones; stop 36).
+    "dambreak_pysph_nosym": (SCENE_FILES["dambreak"], PYSPH_EFFECTS + ["--no-symmetric-pairs"],
+                             ["--set", "cfl=0.3"], None, (20, 320), None),
+    "poiseuille": (os.path.join(ROOT, "examples", "poiseuille.sph"), [], [], None, (10, 110),
+                   None),
+    "cylinder": (os.path.join(ROOT, "examples", "cylinder.sph"), [], [], None, (10, 110), None),
     "dambreak_pysph_h16": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
                            ["--set", "cfl=0.3", "--set", "hdx=1.6"], (20, 60), (20, 320), None),
     "dambreak_pysph_h20": (SCENE_FILES["dambreak"], PYSPH_EFFECTS,
@@ -67,7 +79,21 @@ VARIANT_FLAGS = {"off": ["--simd-pairs=off"], "on": ["--simd-pairs=on"], "auto":
                  # loops printed in lanes stay scalar without it.
                  "auto_gather": ["--cxxflags=" + GATHER_FLAGS],
                  "once_gather": ["--simd-pairs=once", "--cxxflags=" + GATHER_FLAGS],
-                 "legacy_off": [], "legacy_on": ["--simd-pairs"]}
+                 "legacy_off": [], "legacy_on": ["--simd-pairs"],
+                 # Stop 36, the 2D scenes in the lanes on Intel with gathers: every loop that
+                 # allows them (each pair once where it may, the cross passes and loops per
+                 # destination anyway in lanes per destination), or only the loops printed
+                 # each pair once in the lanes (the others as auto leaves them).
+                 "once_all": ["--simd-pairs=once", "--simd-neighbours=0"],
+                 "once_only": ["--simd-pairs=once", "--simd-once-neighbours=0"],
+                 # The same in 4-lane (ymm) vectors: 2D's ~12 neighbours above d_idx fill
+                 # fewer 8-lane vectors (an experiment, stop 36).
+                 # The self pair evaluated in the each-pair-once lanes (before stop 36).
+                 "noskip": ["--no-self-pair-skip"],
+                 # Only the loops per destination anyway (periodic, no kept lists) in lanes.
+                 "perdest_only": ["--simd-perdest-neighbours=0"],
+                 "once_only_256": ["--simd-pairs=once", "--simd-once-neighbours=0",
+                                   "--cxxflags=" + GATHER_FLAGS + " -mprefer-vector-width=256"]}
 
 
 def exec_run(exe, options, steps, threads, tool=None):

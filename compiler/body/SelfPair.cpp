@@ -27,10 +27,10 @@
 // self pair comes (it starts as -0, e.g. set to a -0 velocity, and everything added before is
 // -0), and unless a factor of the product was not finite (inf * 0 = NaN: a sum the run's
 // checks would have stopped on). docs/performance.md, "The self pair" (stop 35).
+#include "body/AssignedLocals.h"
 #include "body/BodyBatch.h"
 
 #include "clang/AST/ASTContext.h"
-#include "clang/AST/RecursiveASTVisitor.h"
 
 #include <set>
 
@@ -38,7 +38,7 @@ namespace sphc::body_detail {
 
 namespace {
 
-class SelfPairCheck : public clang::RecursiveASTVisitor<SelfPairCheck> {
+class SelfPairCheck : public AssignedLocalsVisitor<SelfPairCheck> {
  public:
   explicit SelfPairCheck(const BodySource& body) : body_(body) {}
 
@@ -47,22 +47,7 @@ class SelfPairCheck : public clang::RecursiveASTVisitor<SelfPairCheck> {
     return vanishes(fn->getBody());
   }
 
-  bool VisitBinaryOperator(clang::BinaryOperator* op) {
-    if (op->isAssignmentOp()) markAssigned(op->getLHS());
-    return true;
-  }
-  bool VisitUnaryOperator(clang::UnaryOperator* op) {
-    if (op->isIncrementDecrementOp() || op->getOpcode() == clang::UO_AddrOf)
-      markAssigned(op->getSubExpr());
-    return true;
-  }
-
  private:
-  void markAssigned(clang::Expr* e) {
-    if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(e->IgnoreParenImpCasts()))
-      if (auto* v = llvm::dyn_cast<clang::VarDecl>(ref->getDecl())) assigned_.insert(v);
-  }
-
   // A property indexed: `d_NAME[...]` or `s_NAME[...]` with NAME's parameter.
   static const clang::DeclRefExpr* propertyBase(const clang::Expr* e) {
     auto* a = llvm::dyn_cast<clang::ArraySubscriptExpr>(e->IgnoreParenImpCasts());
@@ -118,7 +103,7 @@ class SelfPairCheck : public clang::RecursiveASTVisitor<SelfPairCheck> {
     if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(e)) {
       const clang::ValueDecl* d = ref->getDecl();
       if (auto* var = llvm::dyn_cast<clang::VarDecl>(d); var && !llvm::isa<clang::ParmVarDecl>(var))
-        return var->isLocalVarDecl() && !assigned_.count(var) && var->getInit() &&
+        return var->isLocalVarDecl() && !assigned(var) && var->getInit() &&
                var->getType()->isArithmeticType() && zero(var->getInit());
       const std::string name = d->getName().str();
       return llvm::isa<clang::ParmVarDecl>(d) && nameRole(body_, name) == NameRole::PairQuantity &&
@@ -224,7 +209,6 @@ class SelfPairCheck : public clang::RecursiveASTVisitor<SelfPairCheck> {
   }
 
   const BodySource& body_;
-  std::set<const clang::VarDecl*> assigned_;
 };
 
 }  // namespace

@@ -18,10 +18,10 @@
 // is recorded. Evaluating it for every source particle is harmless: floating-point
 // operations do not trap, and the value is the one the pair would compute, bit for bit (the
 // same operations in the same order, the solvers are built with -ffp-contract=off).
+#include "body/AssignedLocals.h"
 #include "body/BodyBatch.h"
 
 #include "clang/AST/ASTContext.h"
-#include "clang/AST/RecursiveASTVisitor.h"
 
 #include <algorithm>
 #include <map>
@@ -37,7 +37,7 @@ bool isCostly(llvm::StringRef name) {
   return !cheap.count(name.str());
 }
 
-class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
+class SourceOnlyFinder : public AssignedLocalsVisitor<SourceOnlyFinder> {
  public:
   // side: "s" (source-only: s_NAME[s_idx]) or "d" (destination-only: d_NAME[d_idx], of
   // properties the body does not write).
@@ -57,22 +57,9 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
     if (!llvm::isa<clang::ParmVarDecl>(v) && v->isLocalVarDecl()) order_[v] = order_.size();
     return true;
   }
-  bool VisitBinaryOperator(clang::BinaryOperator* op) {
-    if (op->isAssignmentOp()) markAssigned(op->getLHS());
-    return true;
-  }
-  bool VisitUnaryOperator(clang::UnaryOperator* op) {
-    if (op->isIncrementDecrementOp() || op->getOpcode() == clang::UO_AddrOf)
-      markAssigned(op->getSubExpr());
-    return true;
-  }
+  // (VisitBinaryOperator, VisitUnaryOperator: the assigned locals, AssignedLocals.h.)
 
  private:
-  void markAssigned(clang::Expr* e) {
-    if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(e->IgnoreParenImpCasts()))
-      if (auto* v = llvm::dyn_cast<clang::VarDecl>(ref->getDecl())) assigned_.insert(v);
-  }
-
   bool isParam(const clang::DeclRefExpr* ref, llvm::StringRef name) const {
     return llvm::isa<clang::ParmVarDecl>(ref->getDecl()) && ref->getDecl()->getName() == name;
   }
@@ -82,7 +69,7 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
   bool sourceOnlyLocal(const clang::VarDecl* v) {
     if (auto it = localMemo_.find(v); it != localMemo_.end()) return it->second;
     localMemo_[v] = false;  // (no cycles in C, but be safe)
-    bool ok = order_.count(v) && !assigned_.count(v) && v->getInit() &&
+    bool ok = order_.count(v) && !assigned(v) && v->getInit() &&
               v->getType()->isArithmeticType() && !v->getType().isVolatileQualified() &&
               rangeOf_(v->getInit(), dummyBegin_, dummyEnd_) && sourceOnly(v->getInit());
     return localMemo_[v] = ok;
@@ -202,7 +189,6 @@ class SourceOnlyFinder : public clang::RecursiveASTVisitor<SourceOnlyFinder> {
   const std::string prefix_, index_;        // s_ and s_idx, or d_ and d_idx
   const std::set<std::string>& written_;    // properties of that side the body writes
   std::map<const clang::VarDecl*, size_t> order_;  // local -> order of declaration
-  std::set<const clang::VarDecl*> assigned_;
   std::map<const clang::Expr*, bool> memo_;
   std::map<const clang::VarDecl*, bool> localMemo_;
   unsigned dummyBegin_ = 0, dummyEnd_ = 0;

@@ -45,7 +45,11 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   simdPairs_ = opts.simdPairs && registerSums_;  // SimdPairs.cpp: on the sums in locals
   simdAuto_ = opts.simdPairsAuto;
   simdCpu_ = opts.simdCpu;
+  simdNeighbours_ = opts.simdAutoNeighbours < 0 ? kSimdAutoNeighbours : opts.simdAutoNeighbours;
+  simdOnceNeighbours_ = opts.simdOnceNeighbours;
+  simdPerDestNeighbours_ = opts.simdPerDestNeighbours >= 0 ? opts.simdPerDestNeighbours : kSimdPerDestNeighbours;
   simdSymmetric_ = opts.symmetricPairs && opts.verletSkin > 0 && !hasZones() && !hasDomain();
+  simdSymmetricSwitch_ = opts.symmetricPairs;
   // SimdPairs.cpp: each pair once in the lanes (double precision: the pair-shared values).
   simdOnce_ = opts.simdPairsOnce && simdPairs_ && simdSymmetric_ && !singlePrecision_;
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in

@@ -121,6 +121,16 @@ struct EmitOptions {
   // printed each pair once in the lanes, the values the pair shares once per pair, the source
   // side added by a masked scatter (codegen/SimdPairs.cpp, emitSymmetricSimdLoops).
   bool simdPairsOnce = false;
+  // --simd-neighbours=N: auto's threshold on a loop's expected neighbour count
+  // (kSimdAutoNeighbours by default; a measurement knob: 0 puts every loop that allows it in
+  // lanes under auto's rule, e.g. with --simd-pairs=once the 2D scenes' loops).
+  double simdAutoNeighbours = -1;  // < 0: kSimdAutoNeighbours
+  // --simd-once-neighbours=N: the threshold of a loop the lanes print each pair once (< 0:
+  // simdAutoNeighbours); --simd-perdest-neighbours=N: of a loop over its own array that is per
+  // destination anyway (no each pair once: a periodic or mirror domain without zones; < 0:
+  // kSimdPerDestNeighbours). Measurement knobs.
+  double simdOnceNeighbours = -1;
+  double simdPerDestNeighbours = -1;
 };
 
 // --simd-pairs=auto: a pair loop is put in SIMD lanes where its expected neighbour count
@@ -129,6 +139,12 @@ struct EmitOptions {
 // known before the run, by the dimension: 3D yes, 1D and 2D no (with h = 1.3 dx and a support
 // of 2 h, 74 and 21 neighbours).
 inline constexpr double kSimdAutoNeighbours = 30.0;
+// --simd-pairs=auto: a loop over its own array that is per destination anyway (no each pair
+// once to lose: a periodic or mirror domain, without zones) goes in the lanes at any
+// expected count in 2D and 3D (stop 36, Intel with gathers: 0.84-0.97 of the scalar step at
+// ~28 neighbours, 0.79-0.81 for a per-destination loop at ~21; stop 33, AMD Zen 5: 0.89 at
+// ~28).
+inline constexpr double kSimdPerDestNeighbours = 0.0;
 
 // The lines around the out-of-class phases of a split solver (EmitOptions::splitUnits).
 inline constexpr const char* kPhasesBeginMarker =

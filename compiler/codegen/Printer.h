@@ -401,6 +401,9 @@ class ScenePrinter {
   // (emitSymmetricSimdLoops): a pass over w's own array that may be each pair once and that
   // simdPairsRefusal() puts in lanes.
   bool onceLanes(const DestinationWork& w, const NeighbourPass& pass) const;
+  // Whether pass would be each pair once if in lanes (onceLanes but for simdPairsRefusal):
+  // over w's own array, may be each pair once, the sums only added to.
+  bool onceForm(const DestinationWork& w, const NeighbourPass& pass) const;
   // Each pair once in SIMD lanes (the rest of emitSymmetricPass): serial, or OpenMP blocks,
   // bitwise equal; q the pair quantities with their mirrors.
   void emitSymmetricSimdLoops(const DestinationWork& w, const NeighbourPass& pass,
@@ -435,7 +438,11 @@ class ScenePrinter {
   std::vector<std::string> simdPairsNotes() const;
   bool simdAuto_ = false;           // EmitOptions::simdPairsAuto
   SimdCpuVerdict simdCpu_;          // EmitOptions::simdCpu: the lanes on this CPU (auto)
+  double simdNeighbours_ = 30;      // EmitOptions::simdAutoNeighbours (auto's threshold)
+  double simdOnceNeighbours_ = -1;  // of a loop each pair once in lanes (< 0: simdNeighbours_)
+  double simdPerDestNeighbours_ = 0;  // of a loop over its own array per destination anyway
   bool simdSymmetric_ = false;      // EmitOptions::symmetricPairs, kept lists (for the choice)
+  bool simdSymmetricSwitch_ = false;  // EmitOptions::symmetricPairs (--no-symmetric-pairs: false)
   std::unique_ptr<std::set<int>> simdDecls_;  // equation declarations whose _simd form is used
 
   // ---- The host program (HostProgram.cpp) ----

@@ -31,8 +31,13 @@
 // docs/performance.md "SIMD pair loops chosen by the compiler"): where the loop's expected
 // neighbour count (the kernel support's ball over dx^dim, from the scene's defaults) reaches
 // kSimdAutoNeighbours. Below it, each pair once saves more than the lanes (the 2D dam
-// breaks); a loop that is per destination anyway stays scalar there too (measured to pay on
-// one 2D scene only; --simd-pairs=on).
+// breaks: in the each-pair-once lane form too, stop 36: 1.19-1.24x the scalar step at dx =
+// 0.03, 1.02-1.35x at ~100k, on Intel with gathers; 0.84-0.86 from h = 1.6 dx, ~32). A loop
+// over its own array that is per destination anyway by the scene (a periodic or mirror
+// domain, no zones) goes in the lanes at any count (kSimdPerDestNeighbours; stop 36: 0.84-0.97
+// of the scalar step at ~28 neighbours, 0.79-0.81 for a per-destination loop at ~21); one over
+// another array (walls) keeps the threshold (the dam break's shifting fluid <- boundary in
+// lanes: 1.08-1.10x).
 //
 // --simd-pairs=once: auto's loops, but a loop that could be each pair once is printed each
 // pair once in the lanes (emitSymmetricSimdLoops, below): the values the pair shares once per
@@ -168,22 +173,47 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
                                                                const NeighbourPass& pass) const {
   std::string how;
   const std::optional<double> n = expectedNeighbours(plan_, w.array, pass.source, how);
+  const bool onceAnyway = eachPairOncePossible(w, pass);
+  // A loop over its own array that is per destination anyway by the scene (a periodic or
+  // mirror domain: no each pair once there): in the lanes from kSimdPerDestNeighbours
+  // (stop 36: 0.84-0.97 of the scalar step at ~28 neighbours in 2D; a per-destination loop at
+  // ~21, the dam break with --no-symmetric-pairs, 0.79-0.81). Not where a
+  // switch makes it per destination (--no-symmetric-pairs: the reference of the each-pair-once
+  // loops) nor where its bodies refuse each pair once (the tests' bitwise references; not
+  // measured): scalar as before. A loop over another array (walls) keeps the threshold: most of
+  // its destinations have few or no neighbours there (the dam break's fluid <- boundary in
+  // lanes: 1.08-1.10x).
+  // Not with zones (inlets, outlets): the channel's TVF scene (examples/channel_inlet_outlet.sph
+  // -D scheme=tvf) gave serial and OpenMP runs that differ in their bits with its loops in
+  // lanes (lit backends/every-example.sph, -single.sph; not found why in stop 36).
+  const bool perDestOwn = !onceAnyway && pass.source == w.array && plan_.dim >= 2 &&
+                          simdSymmetricSwitch_ && hasDomain() && !hasZones();
+  // --simd-once-neighbours: a threshold of its own for a loop the lanes print each pair once.
+  const bool once = simdOnce_ && onceForm(w, pass) && simdOnceNeighbours_ >= 0;
+  const double threshold = once ? simdOnceNeighbours_
+                           : perDestOwn ? simdPerDestNeighbours_
+                                        : simdNeighbours_;
   // h/dx not known before the run: by the dimension (h = 1.3 dx: 3D 74 neighbours, 2D 21).
-  bool lanes = n ? *n >= kSimdAutoNeighbours : plan_.dim == 3;
-  char buf[160];
-  if (n)
-    std::snprintf(buf, sizeof buf, "~%.0f neighbours expected (%s) %s %g: ", *n, how.c_str(),
-                  lanes ? ">=" : "<", kSimdAutoNeighbours);
+  bool lanes = n ? *n >= threshold : plan_.dim == 3 || (perDestOwn && threshold <= 0);
+  char buf[240];
+  if (n && perDestOwn && threshold <= 0)
+    std::snprintf(buf, sizeof buf, "~%.0f neighbours expected (%s), over its own array and per "
+                  "destination anyway (lanes at any count): ", *n, how.c_str());
+  else if (n)
+    std::snprintf(buf, sizeof buf, "~%.0f neighbours expected (%s) %s %g%s: ", *n, how.c_str(),
+                  lanes ? ">=" : "<", threshold,
+                  once ? " (each pair once in lanes)"
+                       : perDestOwn ? " (over its own array, per destination anyway)" : "");
   else
-    std::snprintf(buf, sizeof buf, "h/dx not known before the run, by the dimension (%s): ",
-                  how.c_str());
+    std::snprintf(buf, sizeof buf, "h/dx not known before the run, by the dimension (%s)%s: ",
+                  how.c_str(), perDestOwn ? " and the loop (over its own array, per destination anyway)" : "");
   std::string why = buf;
   // The CPU the solver is built for (SimdCpu.cpp): where the lanes lose, the scalar loops.
   if (lanes && !simdCpu_.lanes) {
     lanes = false;
     why.replace(why.size() - 2, 2, ", but " + simdCpu_.why + ": ");
   }
-  if (eachPairOncePossible(w, pass))
+  if (onceAnyway)
     why += lanes ? (simdOnce_ && pass.source == w.array ? "the lanes pay, each pair once in them"
                                                          : "the lanes pay more than each pair once")
                  : "each pair once pays more";
@@ -408,8 +438,10 @@ void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& 
 // A same-array pass that may be each pair once (SymmetricPairs.cpp) and that the lanes take
 // (simdPairsRefusal) is printed, after emitSymmetricPass's kept lists and destination-only
 // values of every particle, as: per destination d_idx (increasing), its sums loaded in
-// locals; the self pair, scalar, for d_idx alone (it has no mirrored call); then the rest of
-// the list's upper part (every s_idx > d_idx) under
+// locals; the self pair, scalar, for d_idx alone (it has no mirrored call), or skipped where
+// every body adds zeros there (skipsSelfPair, body/SelfPair.cpp; as the scalar loops, bit for
+// bit but for the sign of a sum that is -0 then; --no-self-pair-skip keeps it); then the rest
+// of the list's upper part (every s_idx > d_idx) under
 //   #pragma omp simd reduction(+: acc_...)
 // with the pair quantities and their mirrors as scalars, the cut-off a mask (the kept lists
 // hold the skin), the values the pair shares (body/PairShared.cpp) computed once per pair
@@ -430,9 +462,12 @@ void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& 
 // serial loop over the block, its scatter also masked to s_idx < b_end (later blocks have
 // had theirs in their (1)); serial prints the same loop with b_end = n.
 bool ScenePrinter::onceLanes(const DestinationWork& w, const NeighbourPass& pass) const {
+  return onceForm(w, pass) && simdPairsRefusal(w, pass).empty();
+}
+
+bool ScenePrinter::onceForm(const DestinationWork& w, const NeighbourPass& pass) const {
   if (!simdOnce_ || pass.source != w.array || !pass.searches()) return false;
   if (!symmetricPairsRefusal(plan_, w, pass, true).empty()) return false;
-  if (!simdPairsRefusal(w, pass).empty()) return false;
   // The sums only added to (`d_NAME[...] +=` or `-=`): the pair's terms from 0 are added to
   // the sums after the bodies.
   const RegisterSums rs = registerSums(w, pass);
@@ -635,17 +670,25 @@ void ScenePrinter::emitSymmetricSimdLoops(const DestinationWork& w, const Neighb
   };
   // The destinations [begin, end) of a block (serial: one block, b_end = n).
   auto lanes = [&](const std::string& indent, const std::string& begin, const std::string& end) {
-    head(indent, begin, end, "  // pairs (d_idx, s_idx >= d_idx)", "");
+    head(indent, begin, end,
+         skipsSelfPair(pass) ? "  // pairs (d_idx, s_idx > d_idx)" : "  // pairs (d_idx, s_idx >= d_idx)",
+         "");
     const std::string in = indent + "  ", body = in + "  ";
     scene_ << in << "const std::uint32_t* k_lanes = kept.data() + " << lists
            << ".upper[d_idx];  // s_idx >= d_idx\n";
-    scene_ << in << "if (k_lanes != k_end && *k_lanes == static_cast<std::uint32_t>(d_idx)) {"
-           << "  // the self pair, scalar: d_idx alone\n";
-    scene_ << body << "++k_lanes;\n" << body << "const int s_idx = d_idx;\n";
-    emitLanePairQuantities(scene_, q, false, body, true);
-    scene_ << body << "if (in_support) {\n";
-    calls(body + "  ", false);
-    scene_ << body << "}\n" << in << "}\n";
+    if (skipsSelfPair(pass)) {  // every body adds zeros there (SymmetricPairs.cpp's skip)
+      scene_ << in << "if (k_lanes != k_end && *k_lanes == static_cast<std::uint32_t>(d_idx)) "
+                      "++k_lanes;  // the self pair: every body adds zeros there (sphc\n"
+             << in << "// --no-self-pair-skip: evaluated; body/SelfPair.cpp)\n";
+    } else {
+      scene_ << in << "if (k_lanes != k_end && *k_lanes == static_cast<std::uint32_t>(d_idx)) {"
+             << "  // the self pair, scalar: d_idx alone\n";
+      scene_ << body << "++k_lanes;\n" << body << "const int s_idx = d_idx;\n";
+      emitLanePairQuantities(scene_, q, false, body, true);
+      scene_ << body << "if (in_support) {\n";
+      calls(body + "  ", false);
+      scene_ << body << "}\n" << in << "}\n";
+    }
     scene_ << in << "const int n_lanes = static_cast<int>(k_end - k_lanes);\n";
     std::set<std::string> loads;  // the mirrored calls' source values: particle d_idx's
     for (const PlanEquation* eq : pass.equations)

@@ -188,7 +188,8 @@ static cl::opt<std::string> SimdPairs(
              "the support (from the dimension, the kernel's support and h/dx with the scene's "
              "defaults; where they are not known before the run, 3D yes, 2D no: with h = 1.3 "
              "dx and a support of 2 h, 74 and 21 neighbours; below 30, each pair once pays "
-             "more); on (or --simd-pairs alone): every loop that allows it; off: the "
+             "more), and a loop over its own array that is per destination anyway (a periodic "
+             "or mirror domain, no zones) at any count; on (or --simd-pairs alone): every loop that allows it; off: the "
              "scalar loops. Under auto a loop in lanes over its own array (kept lists, double "
              "precision) evaluates each pair once in them, the values the pair shares once, "
              "the source side gathered and scattered (once: the same; perdest: auto's loops "
@@ -208,6 +209,24 @@ static cl::opt<std::string> SimdCpuOpt(
              "scalar loops on other Intel CPUs, without AVX-512F (GCC does not vectorise them) "
              "and on CPUs not measured. sphc -v and --report say which and why"),
     cl::value_desc("host|VENDOR:FAMILY:MODEL[:noavx512]"), cl::init("host"), cl::cat(SphcCat));
+static cl::opt<double> SimdNeighbours(
+    "simd-neighbours",
+    cl::desc("--simd-pairs=auto (and once, perdest): the expected neighbour count from which a "
+             "pair loop goes in SIMD lanes (default 30; codegen/SimdPairs.cpp). A measurement "
+             "knob: 0 with --simd-pairs=once puts the 2D scenes' loops in the lanes too"),
+    cl::value_desc("N"), cl::init(-1), cl::Hidden, cl::cat(SphcCat));
+static cl::opt<double> SimdOnceNeighbours(
+    "simd-once-neighbours",
+    cl::desc("--simd-pairs=auto: the expected neighbour count from which a pair loop that the "
+             "lanes print each pair once goes in them (default: --simd-neighbours'; a "
+             "measurement knob)"),
+    cl::value_desc("N"), cl::init(-1), cl::Hidden, cl::cat(SphcCat));
+static cl::opt<double> SimdPerDestNeighbours(
+    "simd-perdest-neighbours",
+    cl::desc("--simd-pairs=auto: the expected neighbour count from which a pair loop that is "
+             "per destination anyway (a periodic domain, no kept lists) goes in SIMD lanes "
+             "(a measurement knob)"),
+    cl::value_desc("N"), cl::init(-1), cl::Hidden, cl::cat(SphcCat));
 static cl::opt<bool> NoLazyCells(
     "no-lazy-cells",
     cl::desc("With kept neighbour lists, build the search domain and cell lists at every "
@@ -577,6 +596,9 @@ int main(int argc, char** argv) {
   // they may; perdest: the same loops per destination (stops 33-34's auto).
   emitOpts.simdPairsAuto = simdMode == "auto" || simdMode == "once" || simdMode == "perdest";
   emitOpts.simdPairsOnce = simdMode == "auto" || simdMode == "once";
+  emitOpts.simdAutoNeighbours = SimdNeighbours;
+  emitOpts.simdOnceNeighbours = SimdOnceNeighbours;
+  emitOpts.simdPerDestNeighbours = SimdPerDestNeighbours;
   // --simd-pairs=auto goes by the CPU the solver is built for: this machine's (the default
   // flags have -march=native), or the one --simd-cpu names (codegen/SimdCpu.cpp).
   {
@@ -602,7 +624,8 @@ int main(int argc, char** argv) {
         Backend != sphc::Backend::OpenCL && !Mpi)  // the CPU backends' lanes
       llvm::errs() << "sphc: --simd-pairs=auto: " << emitOpts.simdCpu.why
                    << (emitOpts.simdCpu.lanes ? ": pair loops with 30 or more neighbours "
-                                                "expected in SIMD lanes"
+                                                "expected, and those over their own array "
+                                                "per destination anyway, in SIMD lanes"
                                               : ": no pair loop in SIMD lanes")
                    << " (--simd-pairs=on|off override it; --report says per loop)\n";
   }
