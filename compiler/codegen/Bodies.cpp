@@ -50,6 +50,9 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   simdPerDestNeighbours_ = opts.simdPerDestNeighbours >= 0 ? opts.simdPerDestNeighbours : kSimdPerDestNeighbours;
   simdSymmetric_ = opts.symmetricPairs && opts.verletSkin > 0 && !hasZones() && !hasDomain();
   simdSymmetricSwitch_ = opts.symmetricPairs;
+  // The scalar loops of a periodic or mirror scene with kept lists evaluate each pair once,
+  // a pair with a ghost for the real particle only (CpuPrinter::symmetricPass; double only).
+  simdGhostOnce_ = opts.symmetricPairs && opts.verletSkin > 0 && hasDomain() && !singlePrecision_;
   // SimdPairs.cpp: each pair once in the lanes (double precision: the pair-shared values).
   simdOnce_ = opts.simdPairsOnce && simdPairs_ && simdSymmetric_ && !singlePrecision_;
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in

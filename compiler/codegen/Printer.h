@@ -443,6 +443,7 @@ class ScenePrinter {
   double simdPerDestNeighbours_ = 0;  // of a loop over its own array per destination anyway
   bool simdSymmetric_ = false;      // EmitOptions::symmetricPairs, kept lists (for the choice)
   bool simdSymmetricSwitch_ = false;  // EmitOptions::symmetricPairs (--no-symmetric-pairs: false)
+  bool simdGhostOnce_ = false;  // scalar each pair once with periodic or mirror ghosts (Bodies.cpp)
   std::unique_ptr<std::set<int>> simdDecls_;  // equation declarations whose _simd form is used
 
   // ---- The host program (HostProgram.cpp) ----

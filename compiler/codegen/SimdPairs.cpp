@@ -186,8 +186,15 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // Not with zones (inlets, outlets): the channel's TVF scene (examples/channel_inlet_outlet.sph
   // -D scheme=tvf) gave serial and OpenMP runs that differ in their bits with its loops in
   // lanes (lit backends/every-example.sph, -single.sph; not found why in stop 36).
-  const bool perDestOwn = !onceAnyway && pass.source == w.array && plan_.dim >= 2 &&
-                          simdSymmetricSwitch_ && hasDomain() && !hasZones();
+  // Not where the scalar loop evaluates each pair once with the ghosts kept with the lists
+  // (stop 36, CpuPrinter::symmetricPass): Taylor-Green EDAC nx = 100 took 1.05x the CPU of
+  // the scalar each-pair-once loops with these two loops per destination in lanes (3.19-3.23
+  // against 3.03-3.10 s for 110 steps, interleaved, load ~1).
+  const bool ghostOnceScalar =
+      simdGhostOnce_ && pass.source == w.array &&
+      symmetricPairsRefusal(plan_, w, pass, true).empty();
+  const bool perDestOwn = !onceAnyway && !ghostOnceScalar && pass.source == w.array &&
+                          plan_.dim >= 2 && simdSymmetricSwitch_ && hasDomain() && !hasZones();
   // --simd-once-neighbours: a threshold of its own for a loop the lanes print each pair once.
   const bool once = simdOnce_ && onceForm(w, pass) && simdOnceNeighbours_ >= 0;
   const double threshold = once ? simdOnceNeighbours_
@@ -213,7 +220,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
     lanes = false;
     why.replace(why.size() - 2, 2, ", but " + simdCpu_.why + ": ");
   }
-  if (onceAnyway)
+  if (onceAnyway || ghostOnceScalar)
     why += lanes ? (simdOnce_ && pass.source == w.array ? "the lanes pay, each pair once in them"
                                                          : "the lanes pay more than each pair once")
                  : "each pair once pays more";
