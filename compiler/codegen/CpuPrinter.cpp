@@ -473,15 +473,9 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "          std::vector<std::uint32_t>& nbrs_list = nbrs_lists["
            << (openmp_ ? "omp_get_thread_num()" : "0") << "];\n";
     if (mpi_) scene_ << "          long candidates = 0;\n";
-    // The kept list walked once with the support's test inline (as the each-pair-once loops,
-    // SymmetricPairs.cpp): XIJ and R2IJ once per candidate, no filtered list. Where nothing
-    // needs that list (no loop_all, not in SIMD lanes, not --mpi's counts); the same
-    // candidates in the same order, the same test and arithmetic: the same bits.
-    // --filtered-lists prints the filtered list and the loop over it.
-    const bool inlineTest = verlet() && !mpi_ && !filteredLists_ && pass.loopAll.empty() &&
-                            !pass.equations.empty() &&
-                            (!simdPairs_ || !simdPairsRefusal(w, pass).empty());
-    if (inlineTest) {
+    // The kept list of d_idx, built first if due (in the thread's scratch list, within the
+    // list's radius, kept in increasing index at its exact size).
+    auto emitKeptList = [&] {
       scene_ << "          std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
       scene_ << "          if (verlet_build) {\n";
       scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
@@ -492,6 +486,17 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "              return true;\n            });\n";
       scene_ << "            sphc::keep_in_index_order(kept, nbrs_list.data(), n_kept);\n";
       scene_ << "          }\n";
+    };
+    // The kept list walked once with the support's test inline (as the each-pair-once loops,
+    // SymmetricPairs.cpp): XIJ and R2IJ once per candidate, no filtered list. Where nothing
+    // needs that list (no loop_all, not in SIMD lanes, not --mpi's counts); the same
+    // candidates in the same order, the same test and arithmetic: the same bits.
+    // --filtered-lists prints the filtered list and the loop over it.
+    const bool inlineTest = verlet() && !mpi_ && !filteredLists_ && pass.loopAll.empty() &&
+                            !pass.equations.empty() &&
+                            (!simdPairs_ || !simdPairsRefusal(w, pass).empty());
+    if (inlineTest) {
+      emitKeptList();
       const RegisterSums sums = registerSums(w, pass);  // codegen/RegisterSums.cpp
       emitSumsLoad(scene_, "          ", sums);
       if (simdPairs_ && !simdAuto_)  // as emitSimdNeighbours says it (auto: --report does)
@@ -510,16 +515,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     if (verlet()) {
       // The kept list of d_idx (built first if due, in the thread's scratch list, kept in
       // increasing index at its exact size), filtered with the support's test.
-      scene_ << "          std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
-      scene_ << "          if (verlet_build) {\n";
-      scene_ << "            const std::size_t n_kept = cells.gather_neighbours(xi, yi, zi, "
-                "nbrs_list, [&](std::uint32_t j) {\n";
-      scene_ << "              const int s_idx = static_cast<int>(j);\n";
-      emitNeighbourTest(scene_, host_, "return false;", "              ",
-                        tuned() ? "verlet_radius2" : "VERLET_RADIUS2");
-      scene_ << "              return true;\n            });\n";
-      scene_ << "            sphc::keep_in_index_order(kept, nbrs_list.data(), n_kept);\n";
-      scene_ << "          }\n";
+      emitKeptList();
       scene_ << "          const int n_nbrs = static_cast<int>(sphc::filter_neighbours(kept.data(), "
                 "kept.size(), nbrs_list, [&](std::uint32_t j) {\n";
     } else {
