@@ -1,0 +1,141 @@
+// sphc runtime: cluster-pair lists for SIMD tile loops (GROMACS' nbnxm scheme, Pall & Hess
+// 2013; docs/performance.md, "A cluster-pair SIMD tile kernel, measured by hand (stop 36)" and
+// "Cluster-pair lists in the runtime (stop 37)"). Plain data and free functions.
+//
+// A pair loop in tiles sees one particle array in *cluster order*: the particles sorted into
+// columns (3D: squares of side `column_side` in the x-y plane, each column sorted by z; 2D:
+// strips of width `column_side` in x, each sorted by y), each column cut into clusters of
+// kClusterSize consecutive particles, the last cluster of a column padded. Slot s = 8 c + k is
+// lane k of cluster c (ClusterLayout). Per evaluation the loop copies the properties it reads
+// into slot order (gather_slots, gather_positions: contiguous vector loads of a cluster), runs
+// its tiles (one i of an i-cluster broadcast x the 8 lanes of a j-cluster, the cut-off a mask)
+// over a ClusterPairList, and adds its sums, accumulated in slot order, back (add_slots).
+//
+// Lists. The *outer* list (build_cluster_pairs) holds, per i-cluster, the j-clusters whose
+// bounding boxes lie within the list radius; the *pruned* list (prune_cluster_pairs) those of
+// the outer list whose boxes, recomputed from the positions now (update_boxes), lie within the
+// support radius. A box holds its cluster's real particles, so two particles at distance r
+// have boxes at distance <= r, and
+//
+//   THE RULE THAT KEEPS THE LISTS COMPLETE (the kept lists' rule, sphc/verlet.h, VerletSkin):
+//   build the layout and the outer list when VerletSkin::must_rebuild says yes (and mark),
+//   with the list radius  (1 + skin) * radius_scale * h_max,  h_max the largest h of the two
+//   arrays (destination and source) at the build. Until must_rebuild next says yes, any pair
+//   within its support now (radius_scale * max(h_i, h_j)) was within that radius at the
+//   build (its distance shrank by at most 2 d, its radius grew by at most radius_scale g, and
+//   2 d + radius_scale g <= skin * radius_scale * h_min), so its clusters' boxes at the build
+//   were within it: the pair's cluster pair is in the outer list. Per evaluation prune with
+//   the support radius radius_scale * h_max, h_max the largest h of the two arrays NOW: the
+//   boxes now hold the positions now, so every pair within its support now is in a cluster
+//   pair of the pruned list. A tile still tests each lane's pair with the loop's own cut-off
+//   (the lists hold more pairs than the support, never fewer). The box tests keep a pair of
+//   boxes at squared distance <= radius^2 (1 + 1e-12) (a margin over the rounding of the
+//   squared distances, computed from the same doubles), so they never drop a pair that the
+//   tile's test, computed in another order or with fma, would find inside.
+//
+// Each pair once (`once`, destination = source): a list holds only j-clusters j >= i, the
+// diagonal tile (j == i) included; a tile on it takes the lanes with slot j > slot i only (or
+// j >= i where the loop keeps the self pair). Two arrays (cross): i-clusters of the
+// destination's layout, j-clusters of the source's; every cluster pair within the radius.
+//
+// Padding: the last cluster of a column holds 1..8 real particles, real slots first
+// (real_mask). Padding slots take a real particle's values (gather_slots; so every lane's
+// arithmetic stays finite: masked lanes are still computed) and positions at least
+// `pad_offset` from every real particle of the layout (gather_positions): with pad_offset
+// beyond the support radius plus the distance between the two arrays' extents (cross loops)
+// no padding lane is within the cut-off of a real particle; add_slots never reads a padding
+// slot, so what padding lanes sum among themselves is dropped.
+//
+// Orders: the slot order depends only on the positions at the build (ties in the sort key
+// by particle index); the j-clusters of a list are in increasing index per i-cluster. The
+// OpenMP runtime (libsphc_runtime_omp) builds and prunes in blocks of i-clusters with the
+// same result as the serial one.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace sphc {
+
+// The width of a cluster: one AVX-512 register of doubles (the j-cluster of a tile).
+constexpr int kClusterSize = 8;
+// ClusterLayout::slot of a padding slot.
+constexpr std::uint32_t kPadSlot = 0xffffffffu;
+
+// One particle array in cluster order (the slot order of a pair loop's copies).
+struct ClusterLayout {
+  int dim = 3;                         // 2 or 3
+  std::size_t n = 0;                   // real particles
+  std::size_t n_clusters = 0;          // slots = n_clusters * kClusterSize
+  std::vector<std::uint32_t> slot;     // slot -> particle index, kPadSlot for padding
+  std::vector<std::uint32_t> slot_of;  // particle -> its slot
+  // Per cluster: bit k set where slot 8 c + k holds a real particle (its real slots come
+  // first: 0xff, or 2^m - 1 for the last cluster of a column with m real particles).
+  std::vector<std::uint8_t> real_mask;
+  // Per cluster: lo x, lo y, lo z, hi x, hi y, hi z of its real particles (2D: z 0, 0), from
+  // the positions given to build_cluster_layout or, since, to update_boxes.
+  std::vector<double> box;
+  // The grid of columns (build_cluster_pairs searches it): column (cx, cy) covers
+  // [origin[0] + cx side, + side) x [origin[1] + cy side, + side) (2D: cy = 0, x only) at
+  // the build; column index cy * columns[0] + cx; its clusters are
+  // [column_begin[col], column_begin[col + 1]) (an empty column has none).
+  double column_side = 0;
+  double origin[2] = {0, 0};
+  std::size_t columns[2] = {0, 0};
+  std::vector<std::uint32_t> column_begin;  // columns[0] * columns[1] + 1
+
+  std::size_t slots() const { return n_clusters * kClusterSize; }
+};
+
+// A column side giving clusters about as wide as tall: spacing * kClusterSize^(1/dim) (2
+// spacings in 3D, 2.83 in 2D), spacing the particles' typical distance (dx).
+double cluster_column_side(double spacing, int dim);
+
+// At a list rebuild: the layout of n particles at (x, y, z) (z unused, may be null, in 2D).
+// column_side <= 0: (kClusterSize * V / n)^(1/dim), V the volume (2D: area) of the particles'
+// bounding box (2 dx for a filled box on a lattice of spacing dx). Where the bounding box
+// would need more than 4 n + 16 columns (a stray particle), the columns are made wider.
+// Boxes from these positions.
+void build_cluster_layout(ClusterLayout& layout, const double* x, const double* y,
+                          const double* z, std::size_t n, int dim, double column_side);
+
+// Per evaluation: dst[s] = src[slot[s]] for every slot (dst: layout.slots() values); a
+// padding slot takes the value of the first slot of its cluster (a real particle).
+void gather_slots(const ClusterLayout& layout, const double* src, double* dst);
+void gather_slots(const ClusterLayout& layout, const float* src, float* dst);
+
+// Per evaluation: the positions in slot order (z, zs unused in 2D, may be null). Padding
+// slot k of its cluster (k = 1, 2, ... in the order of the padding slots) sits at
+// x = (largest x of the real particles) + k pad_offset, its y and z those of the cluster's
+// first particle: at least pad_offset from every real particle of the layout.
+void gather_positions(const ClusterLayout& layout, const double* x, const double* y,
+                      const double* z, double* xs, double* ys, double* zs, double pad_offset);
+
+// Per evaluation: dst[p] += sums[slot_of[p]] for every real particle p (padding never read).
+void add_slots(const ClusterLayout& layout, const double* sums, double* dst);
+void add_slots(const ClusterLayout& layout, const float* sums, float* dst);
+
+// The boxes from positions in slot order (gather_positions' xs, ys, zs; real slots only; zs
+// unused in 2D).
+void update_boxes(ClusterLayout& layout, const double* xs, const double* ys, const double* zs);
+
+// A list of cluster pairs: CSR over the i-clusters.
+struct ClusterPairList {
+  std::vector<std::uint32_t> begin;  // n_clusters of the i layout + 1
+  std::vector<std::uint32_t> j;      // j-cluster indices, increasing per i-cluster
+  std::size_t pairs() const { return j.size(); }
+};
+
+// The outer list: per i-cluster of `a`, the j-clusters of `b` whose boxes (as they are now)
+// lie within `radius` (box-to-box distance). once = true: a and b the same layout (&a == &b),
+// only j >= i. From the grid of b's columns (the columns within reach of each i box),
+// correct for boxes moved since the layout was built too.
+void build_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b, double radius,
+                         bool once, ClusterPairList& out);
+
+// Per evaluation: the pairs of `outer` whose boxes (as updated now) lie within `radius`.
+void prune_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b,
+                         const ClusterPairList& outer, double radius, ClusterPairList& out);
+
+}  // namespace sphc

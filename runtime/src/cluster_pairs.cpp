@@ -1,0 +1,404 @@
+// sphc runtime: cluster-pair lists for SIMD tile loops (see sphc/cluster_pairs.h).
+#include "sphc/cluster_pairs.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace sphc {
+
+namespace {
+
+constexpr int C = kClusterSize;
+// The box tests keep squared distances up to radius^2 (1 + kBoxMargin) (sphc/cluster_pairs.h).
+constexpr double kBoxMargin = 1e-12;
+
+// A coordinate as a sort or column key: NaN as +inf (a total order for the sort; a NaN
+// position lands in the last column and cluster, and must_rebuild rebuilds at every step).
+inline double key(double v) { return v == v ? v : HUGE_VAL; }
+
+// The column of coordinate v: floor((v - origin) / side) clamped to [0, count).
+inline std::size_t column_of(double v, double origin, double side, std::size_t count) {
+  const double t = (key(v) - origin) / side;
+  if (!(t > 0)) return 0;
+  if (t >= static_cast<double>(count)) return count - 1;
+  return std::min(static_cast<std::size_t>(t), count - 1);
+}
+
+inline double gap(double alo, double ahi, double blo, double bhi) {
+  return std::max({0.0, blo - ahi, alo - bhi});
+}
+
+// Squared distance between boxes a and b (6 doubles each), in 2D the z gap is 0.
+inline double box_distance2(const double* a, const double* b) {
+  const double gx = gap(a[0], a[3], b[0], b[3]);
+  const double gy = gap(a[1], a[4], b[1], b[4]);
+  const double gz = gap(a[2], a[5], b[2], b[5]);
+  return gx * gx + gy * gy + gz * gz;
+}
+
+}  // namespace
+
+double cluster_column_side(double spacing, int dim) {
+  return spacing * std::pow(static_cast<double>(C), 1.0 / dim);
+}
+
+void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, const double* z,
+                          std::size_t n, int dim, double column_side) {
+  assert(dim == 2 || dim == 3);
+  L.dim = dim;
+  L.n = n;
+  const int ncol_axes = dim - 1;  // 3D: x, y; 2D: x
+  const double* col_axis[2] = {x, y};
+  const double* sort_axis = dim == 3 ? z : y;
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  const double* axes[3] = {x, y, dim == 3 ? z : nullptr};
+  for (int a = 0; a < dim; ++a)
+    for (std::size_t p = 0; p < n; ++p) {
+      const double v = axes[a][p];
+      if (v == v) lo[a] = std::min(lo[a], v), hi[a] = std::max(hi[a], v);
+    }
+  for (int a = 0; a < dim; ++a)
+    if (!(lo[a] <= hi[a])) lo[a] = hi[a] = 0;  // no finite coordinate
+  double side = column_side;
+  if (!(side > 0)) {
+    double volume = 1;
+    for (int a = 0; a < dim; ++a) volume *= hi[a] - lo[a];
+    side = n > 0 && volume > 0 ? std::pow(C * volume / static_cast<double>(n), 1.0 / dim) : 1.0;
+    if (!(side > 0) || !std::isfinite(side)) side = 1.0;
+  }
+  // At most 4 n + 16 columns: wider columns where the extent would need more.
+  const double limit = 4.0 * static_cast<double>(n) + 16.0;
+  for (;;) {
+    double count = 1;
+    for (int a = 0; a < ncol_axes; ++a) count *= std::floor((hi[a] - lo[a]) / side) + 1;
+    if (count <= limit) break;
+    side *= 2;
+  }
+  L.column_side = side;
+  L.columns[0] = L.columns[1] = 1;
+  for (int a = 0; a < ncol_axes; ++a) {
+    L.origin[a] = lo[a];
+    L.columns[a] = static_cast<std::size_t>(std::floor((hi[a] - lo[a]) / side)) + 1;
+  }
+  if (ncol_axes == 1) L.origin[1] = 0;
+  const std::size_t ncol = L.columns[0] * L.columns[1];
+
+  // Counting sort into columns (stable: particle index order within a column).
+  std::vector<std::uint32_t> col(n);
+  std::vector<std::uint32_t> count(ncol + 1, 0);
+  for (std::size_t p = 0; p < n; ++p) {
+    std::size_t c = column_of(col_axis[0][p], L.origin[0], side, L.columns[0]);
+    if (ncol_axes == 2) c += L.columns[0] * column_of(col_axis[1][p], L.origin[1], side, L.columns[1]);
+    col[p] = static_cast<std::uint32_t>(c);
+    ++count[c + 1];
+  }
+  for (std::size_t c = 0; c < ncol; ++c) count[c + 1] += count[c];
+  std::vector<std::pair<double, std::uint32_t>> order(n);  // (sort key, particle)
+  {
+    std::vector<std::uint32_t> at(count.begin(), count.end() - 1);
+    for (std::size_t p = 0; p < n; ++p)
+      order[at[col[p]]++] = {key(sort_axis[p]), static_cast<std::uint32_t>(p)};
+  }
+  // Each column by its sort key (ties by particle index), then cut into clusters.
+  L.column_begin.assign(ncol + 1, 0);
+  std::size_t clusters = 0;
+  for (std::size_t c = 0; c < ncol; ++c) {
+    std::sort(order.begin() + count[c], order.begin() + count[c + 1]);
+    L.column_begin[c] = static_cast<std::uint32_t>(clusters);
+    clusters += (count[c + 1] - count[c] + C - 1) / C;
+  }
+  L.column_begin[ncol] = static_cast<std::uint32_t>(clusters);
+  L.n_clusters = clusters;
+  L.slot.assign(clusters * C, kPadSlot);
+  L.slot_of.assign(n, 0);
+  L.real_mask.assign(clusters, 0);
+  for (std::size_t c = 0; c < ncol; ++c) {
+    std::size_t s = static_cast<std::size_t>(L.column_begin[c]) * C;
+    for (std::size_t k = count[c]; k < count[c + 1]; ++k, ++s) {
+      const std::uint32_t p = order[k].second;
+      L.slot[s] = p;
+      L.slot_of[p] = static_cast<std::uint32_t>(s);
+      L.real_mask[s / C] |= static_cast<std::uint8_t>(1u << (s % C));
+    }
+  }
+  // Boxes from these positions.
+  L.box.assign(clusters * 6, 0.0);
+  std::vector<double> xs(L.slots()), ys(L.slots()), zs(dim == 3 ? L.slots() : 0);
+  for (std::size_t s = 0; s < L.slots(); ++s) {
+    const std::uint32_t p = L.slot[s];
+    if (p == kPadSlot) continue;
+    xs[s] = x[p];
+    ys[s] = y[p];
+    if (dim == 3) zs[s] = z[p];
+  }
+  update_boxes(L, xs.data(), ys.data(), dim == 3 ? zs.data() : nullptr);
+}
+
+namespace {
+
+template <class T>
+void gather_slots_of(const ClusterLayout& L, const T* src, T* dst) {
+  const std::uint32_t* slot = L.slot.data();
+  const std::size_t nc = L.n_clusters;
+#pragma omp parallel for schedule(static)
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::uint32_t* sl = slot + c * C;
+    T* d = dst + c * C;
+    if (L.real_mask[c] == 0xff) {
+      for (int k = 0; k < C; ++k) d[k] = src[sl[k]];
+    } else {
+      const T first = src[sl[0]];
+      for (int k = 0; k < C; ++k) d[k] = sl[k] == kPadSlot ? first : src[sl[k]];
+    }
+  }
+}
+
+template <class T>
+void add_slots_of(const ClusterLayout& L, const T* sums, T* dst) {
+  const std::uint32_t* slot_of = L.slot_of.data();
+  const std::size_t n = L.n;
+#pragma omp parallel for schedule(static)
+  for (std::size_t p = 0; p < n; ++p) dst[p] += sums[slot_of[p]];
+}
+
+}  // namespace
+
+void gather_slots(const ClusterLayout& L, const double* src, double* dst) {
+  gather_slots_of(L, src, dst);
+}
+void gather_slots(const ClusterLayout& L, const float* src, float* dst) {
+  gather_slots_of(L, src, dst);
+}
+void add_slots(const ClusterLayout& L, const double* sums, double* dst) {
+  add_slots_of(L, sums, dst);
+}
+void add_slots(const ClusterLayout& L, const float* sums, float* dst) {
+  add_slots_of(L, sums, dst);
+}
+
+void gather_positions(const ClusterLayout& L, const double* x, const double* y, const double* z,
+                      double* xs, double* ys, double* zs, double pad_offset) {
+  const bool three = L.dim == 3;
+  gather_slots_of(L, x, xs);
+  gather_slots_of(L, y, ys);
+  if (three) gather_slots_of(L, z, zs);
+  if (L.slots() == L.n) return;  // no padding
+  double xmax = -HUGE_VAL;
+  for (std::size_t p = 0; p < L.n; ++p) xmax = std::max(xmax, x[p]);
+  for (std::size_t c = 0; c < L.n_clusters; ++c) {
+    const unsigned m = L.real_mask[c];
+    if (m == 0xff) continue;
+    int k = 0;
+    for (int lane = 0; lane < C; ++lane)
+      if (!(m >> lane & 1u)) xs[c * C + lane] = xmax + (++k) * pad_offset;
+  }
+}
+
+void update_boxes(ClusterLayout& L, const double* xs, const double* ys, const double* zs) {
+  const bool three = L.dim == 3;
+  const std::size_t nc = L.n_clusters;
+  double* box = L.box.data();
+#pragma omp parallel for schedule(static)
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::size_t s0 = c * C;
+    double* b = box + 6 * c;
+    if (L.real_mask[c] == 0xff) {
+      double lx = xs[s0], hx = xs[s0], ly = ys[s0], hy = ys[s0];
+      for (int k = 1; k < C; ++k) {
+        lx = std::min(lx, xs[s0 + k]), hx = std::max(hx, xs[s0 + k]);
+        ly = std::min(ly, ys[s0 + k]), hy = std::max(hy, ys[s0 + k]);
+      }
+      double lz = 0, hz = 0;
+      if (three) {
+        lz = hz = zs[s0];
+        for (int k = 1; k < C; ++k) lz = std::min(lz, zs[s0 + k]), hz = std::max(hz, zs[s0 + k]);
+      }
+      b[0] = lx, b[1] = ly, b[2] = lz, b[3] = hx, b[4] = hy, b[5] = hz;
+    } else {
+      const int m = __builtin_popcount(L.real_mask[c]);  // the real slots come first
+      double lx = xs[s0], hx = xs[s0], ly = ys[s0], hy = ys[s0];
+      double lz = three ? zs[s0] : 0, hz = lz;
+      for (int k = 1; k < m; ++k) {
+        lx = std::min(lx, xs[s0 + k]), hx = std::max(hx, xs[s0 + k]);
+        ly = std::min(ly, ys[s0 + k]), hy = std::max(hy, ys[s0 + k]);
+        if (three) lz = std::min(lz, zs[s0 + k]), hz = std::max(hz, zs[s0 + k]);
+      }
+      b[0] = lx, b[1] = ly, b[2] = lz, b[3] = hx, b[4] = hy, b[5] = hz;
+    }
+  }
+}
+
+namespace {
+
+// Per column of b, running bounds along the sort axis: lo_up[k] = max of the clusters'
+// high sort coordinate up to k (from the column's first), lo_down[k] = min of their low sort
+// coordinate from k to the column's last. Both increase with k, so the j-clusters within
+// reach of [zlo, zhi] along the sort axis are within [first k with up[k] >= zlo, first k
+// with down[k] > zhi): exact for any boxes (the layout's own are sorted already).
+struct ColumnBounds {
+  std::vector<double> up, down;
+  double overhang = 0;  // the most a box sticks out of its column's x-y square
+};
+
+ColumnBounds column_bounds(const ClusterLayout& b) {
+  ColumnBounds cb;
+  const int sa = b.dim == 3 ? 2 : 1;
+  cb.up.resize(b.n_clusters);
+  cb.down.resize(b.n_clusters);
+  const std::size_t ncol = b.columns[0] * b.columns[1];
+  double over = 0;
+  for (std::size_t col = 0; col < ncol; ++col) {
+    const std::size_t c0 = b.column_begin[col], c1 = b.column_begin[col + 1];
+    if (c0 == c1) continue;
+    double run = -HUGE_VAL;
+    for (std::size_t c = c0; c < c1; ++c) run = std::max(run, b.box[6 * c + 3 + sa]), cb.up[c] = run;
+    run = HUGE_VAL;
+    for (std::size_t c = c1; c-- > c0;) run = std::min(run, b.box[6 * c + sa]), cb.down[c] = run;
+    const std::size_t cx = col % b.columns[0], cy = col / b.columns[0];
+    const double x0 = b.origin[0] + static_cast<double>(cx) * b.column_side, x1 = x0 + b.column_side;
+    const double y0 = b.origin[1] + static_cast<double>(cy) * b.column_side, y1 = y0 + b.column_side;
+    for (std::size_t c = c0; c < c1; ++c) {
+      const double* bx = &b.box[6 * c];
+      over = std::max({over, x0 - bx[0], bx[3] - x1});
+      if (b.dim == 3) over = std::max({over, y0 - bx[1], bx[4] - y1});
+    }
+  }
+  cb.overhang = over == over ? over : HUGE_VAL;
+  return cb;
+}
+
+// The column range [lo, hi] of b along axis a that may hold boxes reaching [vlo, vhi].
+inline void column_range(const ClusterLayout& b, int a, double vlo, double vhi, double reach,
+                         std::size_t& lo, std::size_t& hi) {
+  const double count = static_cast<double>(b.columns[a]);
+  // A box in column k lies within [origin + k side - overhang, origin + (k + 1) side +
+  // overhang]; 1e-9 columns of slack over the rounding of these bounds.
+  double t0 = std::floor((vlo - reach - b.origin[a]) / b.column_side - 1e-9);
+  double t1 = std::floor((vhi + reach - b.origin[a]) / b.column_side + 1e-9);
+  if (!(t0 > 0)) t0 = 0;
+  if (!(t1 < count)) t1 = count - 1;
+  if (!(t0 <= t1)) {  // none
+    lo = 1, hi = 0;
+    return;
+  }
+  lo = static_cast<std::size_t>(t0);
+  hi = static_cast<std::size_t>(t1);
+}
+
+// The j-clusters of b for i box `ib` (i-cluster ci of a; once: j >= ci), appended to out in
+// increasing order.
+void find_pairs(const ClusterLayout& b, const ColumnBounds& cb, const double* ib, double radius,
+                double r2, bool once, std::size_t ci, std::vector<std::uint32_t>& out) {
+  const int sa = b.dim == 3 ? 2 : 1;
+  const double reach = radius + cb.overhang;
+  std::size_t x0, x1, y0 = 0, y1 = 0;
+  column_range(b, 0, ib[0], ib[3], reach, x0, x1);
+  if (b.dim == 3) column_range(b, 1, ib[1], ib[4], reach, y0, y1);
+  if (x0 > x1 || y0 > y1) return;
+  const double zlo = ib[sa] - radius, zhi = ib[3 + sa] + radius;
+  for (std::size_t cy = y0; cy <= y1; ++cy) {
+    // The column's x-y square widened by the overhang: its distance to the i box.
+    double gy2 = 0;
+    if (b.dim == 3) {
+      const double c0 = b.origin[1] + static_cast<double>(cy) * b.column_side - cb.overhang;
+      const double g = gap(ib[1], ib[4], c0, c0 + b.column_side + 2 * cb.overhang);
+      gy2 = g * g;
+    }
+    for (std::size_t cx = x0; cx <= x1; ++cx) {
+      const double c0 = b.origin[0] + static_cast<double>(cx) * b.column_side - cb.overhang;
+      const double gx = gap(ib[0], ib[3], c0, c0 + b.column_side + 2 * cb.overhang);
+      if (gx * gx + gy2 > r2) continue;
+      const std::size_t col = cy * b.columns[0] + cx;
+      std::size_t k = b.column_begin[col];
+      const std::size_t end = b.column_begin[col + 1];
+      if (once && end <= ci) continue;
+      // First cluster whose running high bound reaches zlo.
+      k = static_cast<std::size_t>(
+          std::lower_bound(cb.up.begin() + k, cb.up.begin() + end, zlo) - cb.up.begin());
+      if (once && k < ci) k = ci;
+      for (; k < end && !(cb.down[k] > zhi); ++k)
+        if (box_distance2(ib, &b.box[6 * k]) <= r2) out.push_back(static_cast<std::uint32_t>(k));
+    }
+  }
+}
+
+}  // namespace
+
+void build_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b, double radius,
+                         bool once, ClusterPairList& out) {
+  assert(!once || &a == &b);
+  assert(a.dim == b.dim);
+  const ColumnBounds cb = column_bounds(b);
+  const double r2 = radius * radius * (1 + kBoxMargin);
+  const std::size_t nci = a.n_clusters;
+  out.begin.assign(nci + 1, 0);
+  out.j.clear();
+  if (b.n_clusters == 0) return;
+  // Blocks of i-clusters (one per thread under OpenMP), concatenated in order.
+#ifdef _OPENMP
+  const int nblocks = omp_get_max_threads();
+#else
+  const int nblocks = 1;
+#endif
+  std::vector<std::vector<std::uint32_t>> part(nblocks);
+#pragma omp parallel for schedule(static, 1)
+  for (int blk = 0; blk < nblocks; ++blk) {
+    const std::size_t c0 = nci * blk / nblocks, c1 = nci * (blk + 1) / nblocks;
+    std::vector<std::uint32_t>& o = part[blk];
+    o.reserve((c1 - c0) * 16);
+    for (std::size_t ci = c0; ci < c1; ++ci) {
+      find_pairs(b, cb, &a.box[6 * ci], radius, r2, once, ci, o);
+      out.begin[ci + 1] = static_cast<std::uint32_t>(o.size());
+    }
+  }
+  std::size_t total = 0;
+  for (int blk = 0; blk < nblocks; ++blk) {
+    const std::size_t c0 = nci * blk / nblocks, c1 = nci * (blk + 1) / nblocks;
+    for (std::size_t ci = c0; ci < c1; ++ci) out.begin[ci + 1] += static_cast<std::uint32_t>(total);
+    total += part[blk].size();
+  }
+  out.j.resize(total);
+  for (int blk = 0; blk < nblocks; ++blk) {
+    const std::size_t c0 = nci * blk / nblocks;
+    std::copy(part[blk].begin(), part[blk].end(), out.j.begin() + out.begin[c0]);
+  }
+}
+
+void prune_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b,
+                         const ClusterPairList& outer, double radius, ClusterPairList& out) {
+  const double r2 = radius * radius * (1 + kBoxMargin);
+  const std::size_t nci = a.n_clusters;
+  out.begin.assign(nci + 1, 0);
+  out.j.resize(outer.j.size());
+  const double* abox = a.box.data();
+  const double* bbox = b.box.data();
+  // Serial: in place into out.j, compacting.
+  std::size_t at = 0;
+  for (std::size_t ci = 0; ci < nci; ++ci) {
+    const double* ib = abox + 6 * ci;
+    const double ilx = ib[0], ily = ib[1], ilz = ib[2], ihx = ib[3], ihy = ib[4], ihz = ib[5];
+    for (std::uint32_t e = outer.begin[ci]; e < outer.begin[ci + 1]; ++e) {
+      const std::uint32_t cj = outer.j[e];
+      const double* jb = bbox + 6 * static_cast<std::size_t>(cj);
+      const double gx = std::max({0.0, jb[0] - ihx, ilx - jb[3]});
+      const double gy = std::max({0.0, jb[1] - ihy, ily - jb[4]});
+      const double gz = std::max({0.0, jb[2] - ihz, ilz - jb[5]});
+      out.j[at] = cj;
+      at += gx * gx + gy * gy + gz * gz <= r2 ? 1 : 0;
+    }
+    out.begin[ci + 1] = static_cast<std::uint32_t>(at);
+  }
+  out.j.resize(at);
+}
+
+}  // namespace sphc
