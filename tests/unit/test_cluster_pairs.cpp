@@ -1,0 +1,424 @@
+// Unit tests of the cluster-pair lists (runtime/include/sphc/cluster_pairs.h): the layout is a
+// permutation into columns of clusters of 8 with padding only at a column's end; every pair
+// of particles within the radius lies in a listed cluster pair (brute force over all pairs),
+// for one array (each pair once, j >= i) and two (cross), 2D and 3D, random positions and a
+// perturbed lattice, with padding and empty columns; the pruned list keeps every pair within
+// the pruning radius after the particles moved by up to half the skin; gather and add round-
+// trip exactly; padding positions lie at least pad_offset from every real particle.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "sphc/cluster_pairs.h"
+
+namespace {
+
+using sphc::build_cluster_layout;
+using sphc::build_cluster_pairs;
+using sphc::ClusterLayout;
+using sphc::ClusterPairList;
+using sphc::kClusterSize;
+using sphc::kPadSlot;
+using sphc::prune_cluster_pairs;
+
+struct Points {
+  int dim = 3;
+  std::vector<double> x, y, z;
+  std::size_t n() const { return x.size(); }
+  const double* zp() const { return dim == 3 ? z.data() : nullptr; }
+};
+
+// n points uniform in [0, L]^dim; with `blobs`, in two cubes of side L/4 at opposite corners
+// (most columns empty).
+Points random_points(std::size_t n, int dim, double L, unsigned seed, bool blobs = false) {
+  Points p;
+  p.dim = dim;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    double c[3];
+    const double off = blobs ? (i % 2 ? 0.75 * L : 0.0) : 0.0;
+    const double ext = blobs ? 0.25 * L : L;
+    for (int a = 0; a < 3; ++a) c[a] = a < dim ? off + ext * u(rng) : 0.0;
+    p.x.push_back(c[0]), p.y.push_back(c[1]), p.z.push_back(c[2]);
+  }
+  return p;
+}
+
+// A lattice of nx^dim points of spacing dx, each coordinate moved by up to +-pert dx, shuffled.
+Points lattice(int nx, int dim, double dx, double pert, unsigned seed) {
+  Points p;
+  p.dim = dim;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-pert, pert);
+  const int nz = dim == 3 ? nx : 1;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < nx; ++j)
+      for (int i = 0; i < nx; ++i) {
+        p.x.push_back((i + 0.5 + u(rng)) * dx);
+        p.y.push_back((j + 0.5 + u(rng)) * dx);
+        p.z.push_back(dim == 3 ? (k + 0.5 + u(rng)) * dx : 0.0);
+      }
+  std::vector<std::size_t> perm(p.n());
+  for (std::size_t i = 0; i < perm.size(); ++i) perm[i] = i;
+  std::shuffle(perm.begin(), perm.end(), rng);
+  Points q = p;
+  for (std::size_t i = 0; i < perm.size(); ++i)
+    q.x[i] = p.x[perm[i]], q.y[i] = p.y[perm[i]], q.z[i] = p.z[perm[i]];
+  return q;
+}
+
+ClusterLayout layout_of(const Points& p, double side) {
+  ClusterLayout L;
+  build_cluster_layout(L, p.x.data(), p.y.data(), p.zp(), p.n(), p.dim, side);
+  return L;
+}
+
+// Positions in slot order (padding far away), the boxes updated from them.
+void refresh(ClusterLayout& L, const Points& p, double pad_offset) {
+  std::vector<double> xs(L.slots()), ys(L.slots()), zs(L.slots());
+  sphc::gather_positions(L, p.x.data(), p.y.data(), p.zp(), xs.data(), ys.data(),
+                         p.dim == 3 ? zs.data() : nullptr, pad_offset);
+  sphc::update_boxes(L, xs.data(), ys.data(), p.dim == 3 ? zs.data() : nullptr);
+}
+
+double dist2(const Points& a, std::size_t i, const Points& b, std::size_t j) {
+  const double dx = a.x[i] - b.x[j], dy = a.y[i] - b.y[j], dz = a.z[i] - b.z[j];
+  return dx * dx + dy * dy + dz * dz;
+}
+
+bool listed(const ClusterPairList& l, std::uint32_t ci, std::uint32_t cj) {
+  return std::binary_search(l.j.begin() + l.begin[ci], l.j.begin() + l.begin[ci + 1], cj);
+}
+
+// The list's form: CSR of the right size, j increasing per i-cluster, j >= i for once.
+void expect_well_formed(const ClusterLayout& a, const ClusterLayout& b, const ClusterPairList& l,
+                        bool once) {
+  ASSERT_EQ(l.begin.size(), a.n_clusters + 1);
+  EXPECT_EQ(l.begin.front(), 0u);
+  EXPECT_EQ(l.begin.back(), l.j.size());
+  for (std::size_t ci = 0; ci < a.n_clusters; ++ci) {
+    ASSERT_LE(l.begin[ci], l.begin[ci + 1]);
+    for (std::uint32_t e = l.begin[ci]; e < l.begin[ci + 1]; ++e) {
+      ASSERT_LT(l.j[e], b.n_clusters);
+      if (e > l.begin[ci]) ASSERT_LT(l.j[e - 1], l.j[e]) << "i-cluster " << ci;
+      if (once) ASSERT_GE(l.j[e], ci);
+    }
+  }
+}
+
+// Every pair within `radius` (brute force) in a listed cluster pair; returns the pairs
+// (unordered for once, i in a x j in b for cross) within the radius.
+long expect_complete(const Points& pa, const ClusterLayout& a, const Points& pb,
+                     const ClusterLayout& b, const ClusterPairList& l, double radius, bool once) {
+  long inside = 0, missing = 0;
+  const double r2 = radius * radius;
+  for (std::size_t i = 0; i < pa.n(); ++i)
+    for (std::size_t j = once ? i : 0; j < pb.n(); ++j) {
+      if (!(dist2(pa, i, pb, j) < r2)) continue;
+      ++inside;
+      std::uint32_t ci = a.slot_of[i] / kClusterSize, cj = b.slot_of[j] / kClusterSize;
+      if (once && cj < ci) std::swap(ci, cj);
+      if (!listed(l, ci, cj)) {
+        if (++missing < 5) ADD_FAILURE() << "pair " << i << ", " << j << " (clusters " << ci << ", " << cj
+                                         << ") within the radius, not listed";
+      }
+    }
+  EXPECT_EQ(missing, 0);
+  return inside;
+}
+
+// The layout: a permutation into slots, padding only at the end of a column's last cluster,
+// real_mask consistent, each column's particles in the column's square, sorted by the last axis.
+void expect_layout(const Points& p, const ClusterLayout& L) {
+  ASSERT_EQ(L.n, p.n());
+  ASSERT_EQ(L.slot.size(), L.slots());
+  ASSERT_EQ(L.slot_of.size(), p.n());
+  ASSERT_EQ(L.real_mask.size(), L.n_clusters);
+  ASSERT_EQ(L.box.size(), 6 * L.n_clusters);
+  ASSERT_EQ(L.column_begin.size(), L.columns[0] * L.columns[1] + 1);
+  std::vector<int> seen(p.n(), 0);
+  for (std::size_t s = 0; s < L.slots(); ++s) {
+    const bool real = L.real_mask[s / kClusterSize] >> (s % kClusterSize) & 1u;
+    if (L.slot[s] == kPadSlot) {
+      ASSERT_FALSE(real);
+      continue;
+    }
+    ASSERT_TRUE(real);
+    ASSERT_LT(L.slot[s], p.n());
+    ++seen[L.slot[s]];
+    ASSERT_EQ(L.slot_of[L.slot[s]], s);
+  }
+  for (int c : seen) ASSERT_EQ(c, 1);
+  const std::vector<double>& key = p.dim == 3 ? p.z : p.y;
+  for (std::size_t col = 0; col + 1 < L.column_begin.size(); ++col) {
+    const std::size_t c0 = L.column_begin[col], c1 = L.column_begin[col + 1];
+    ASSERT_LE(c0, c1);
+    for (std::size_t c = c0; c < c1; ++c) {
+      const unsigned m = L.real_mask[c];
+      ASSERT_NE(m, 0u);
+      ASSERT_EQ(m & (m + 1), 0u) << "real slots first";
+      if (c + 1 < c1) ASSERT_EQ(m, 0xffu) << "padding only in a column's last cluster";
+    }
+    const std::size_t cx = col % L.columns[0], cy = col / L.columns[0];
+    double prev = -HUGE_VAL;
+    for (std::size_t s = c0 * kClusterSize; s < c1 * kClusterSize; ++s) {
+      if (L.slot[s] == kPadSlot) continue;
+      const std::uint32_t q = L.slot[s];
+      const double x0 = L.origin[0] + cx * L.column_side;
+      EXPECT_GE(p.x[q], x0 - 1e-12 * L.column_side);
+      EXPECT_LE(p.x[q], x0 + L.column_side * (1 + 1e-12));
+      if (p.dim == 3) {
+        const double y0 = L.origin[1] + cy * L.column_side;
+        EXPECT_GE(p.y[q], y0 - 1e-12 * L.column_side);
+        EXPECT_LE(p.y[q], y0 + L.column_side * (1 + 1e-12));
+      }
+      EXPECT_GE(key[q], prev);
+      prev = key[q];
+    }
+  }
+  // Boxes hold their real particles.
+  for (std::size_t s = 0; s < L.slots(); ++s) {
+    if (L.slot[s] == kPadSlot) continue;
+    const double* b = &L.box[6 * (s / kClusterSize)];
+    const double q[3] = {p.x[L.slot[s]], p.y[L.slot[s]], p.dim == 3 ? p.z[L.slot[s]] : 0.0};
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_LE(b[a], q[a]);
+      EXPECT_GE(b[3 + a], q[a]);
+    }
+  }
+}
+
+struct Case {
+  const char* name;
+  Points p;
+  double radius, side;
+};
+
+std::vector<Case> cases() {
+  std::vector<Case> cs;
+  // Random: ~30 neighbours within the radius in 3D, ~20 in 2D.
+  cs.push_back({"random 3D", random_points(3000, 3, 1.0, 1), 0.134, 0.0});
+  cs.push_back({"random 2D", random_points(2500, 2, 1.0, 2), 0.05, 0.0});
+  cs.push_back({"lattice 3D", lattice(14, 3, 1.0 / 14, 0.05, 3), 2.2 * 1.5 / 14, 2.0 / 14});
+  cs.push_back({"lattice 2D", lattice(50, 2, 1.0 / 50, 0.05, 4), 2.2 * 1.3 / 50, 0.0});
+  cs.push_back({"blobs 3D (empty columns)", random_points(2000, 3, 1.0, 5, true), 0.06, 0.03});
+  cs.push_back({"blobs 2D (empty columns)", random_points(2000, 2, 1.0, 6, true), 0.02, 0.01});
+  // Columns wider than the radius and narrower.
+  cs.push_back({"random 3D, wide columns", random_points(2000, 3, 1.0, 7), 0.1, 0.3});
+  cs.push_back({"random 3D, thin columns", random_points(2000, 3, 1.0, 8), 0.15, 0.02});
+  return cs;
+}
+
+TEST(ClusterPairs, LayoutIsAPermutationIntoSortedColumns) {
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const ClusterLayout L = layout_of(c.p, c.side);
+    expect_layout(c.p, L);
+    EXPECT_GT(L.slots(), L.n) << "the cases have padding";
+  }
+}
+
+TEST(ClusterPairs, OnceListsHoldEveryPairWithinTheRadius) {
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const ClusterLayout L = layout_of(c.p, c.side);
+    ClusterPairList l;
+    build_cluster_pairs(L, L, c.radius, true, l);
+    expect_well_formed(L, L, l, true);
+    const long inside = expect_complete(c.p, L, c.p, L, l, c.radius, true);
+    EXPECT_GT(inside, static_cast<long>(4 * c.p.n()));
+    // Every listed pair's boxes within the radius; the diagonal always listed.
+    for (std::size_t ci = 0; ci < L.n_clusters; ++ci) {
+      EXPECT_TRUE(listed(l, ci, ci));
+      for (std::uint32_t e = l.begin[ci]; e < l.begin[ci + 1]; ++e) {
+        const double *bi = &L.box[6 * ci], *bj = &L.box[6 * l.j[e]];
+        double d2 = 0;
+        for (int a = 0; a < 3; ++a) {
+          const double g = std::max({0.0, bj[a] - bi[3 + a], bi[a] - bj[3 + a]});
+          d2 += g * g;
+        }
+        EXPECT_LE(d2, c.radius * c.radius * (1 + 1e-9));
+      }
+    }
+  }
+}
+
+TEST(ClusterPairs, CrossListsHoldEveryPairWithinTheRadius) {
+  // Two arrays: a fluid block and a wall around it (a lattice and random points), 2D and 3D.
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const Points fluid = dim == 3 ? lattice(12, 3, 1.0 / 14, 0.05, 11) : lattice(40, 2, 1.0 / 50, 0.05, 12);
+    const Points wall = random_points(dim == 3 ? 1500 : 1200, dim, 1.0, 13);
+    const double radius = dim == 3 ? 2.2 * 1.5 / 14 : 2.2 * 1.3 / 50;
+    const ClusterLayout a = layout_of(fluid, 0.0), b = layout_of(wall, 0.0);
+    for (int dir = 0; dir < 2; ++dir) {
+      const ClusterLayout& A = dir ? b : a;
+      const ClusterLayout& B = dir ? a : b;
+      const Points& PA = dir ? wall : fluid;
+      const Points& PB = dir ? fluid : wall;
+      ClusterPairList l;
+      build_cluster_pairs(A, B, radius, false, l);
+      expect_well_formed(A, B, l, false);
+      EXPECT_GT(expect_complete(PA, A, PB, B, l, radius, false), 1000);
+    }
+  }
+}
+
+TEST(ClusterPairs, PrunedListsKeepEveryPairAfterMovingByHalfTheSkin) {
+  const double skin = 0.1;
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const double support = c.radius / (1 + skin);
+    ClusterLayout L = layout_of(c.p, c.side);
+    ClusterPairList outer, pruned, direct;
+    build_cluster_pairs(L, L, c.radius, true, outer);
+    // At the build's positions, pruning to the support gives the list built at the support.
+    refresh(L, c.p, 1e6);
+    prune_cluster_pairs(L, L, outer, support, pruned);
+    build_cluster_pairs(L, L, support, true, direct);
+    EXPECT_EQ(pruned.begin, direct.begin);
+    EXPECT_EQ(pruned.j, direct.j);
+    // Every particle moved by up to skin * support / 2 (a random direction and length).
+    Points moved = c.p;
+    std::mt19937_64 rng(99);
+    std::normal_distribution<double> g;
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (std::size_t i = 0; i < moved.n(); ++i) {
+      double d[3] = {g(rng), g(rng), c.p.dim == 3 ? g(rng) : 0.0};
+      const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      const double s = 0.5 * skin * support * std::cbrt(u(rng)) / len * (1 - 1e-12);
+      moved.x[i] += s * d[0], moved.y[i] += s * d[1], moved.z[i] += s * d[2];
+    }
+    refresh(L, moved, 1e6);
+    prune_cluster_pairs(L, L, outer, support, pruned);
+    expect_well_formed(L, L, pruned, true);
+    EXPECT_LE(pruned.j.size(), outer.j.size());
+    for (std::size_t ci = 0; ci < L.n_clusters; ++ci)
+      for (std::uint32_t e = pruned.begin[ci]; e < pruned.begin[ci + 1]; ++e)
+        ASSERT_TRUE(listed(outer, ci, pruned.j[e]));
+    expect_complete(moved, L, moved, L, pruned, support, true);
+    // The outer list rebuilt from the moved boxes (columns searched with their overhang)
+    // holds every pair too; so does one from boxes moved across several columns.
+    ClusterPairList again;
+    build_cluster_pairs(L, L, c.radius, true, again);
+    expect_complete(moved, L, moved, L, again, c.radius, true);
+    Points far = c.p;
+    for (std::size_t i = 0; i < far.n(); ++i) far.x[i] += 3 * L.column_side * std::sin(37.0 * i);
+    refresh(L, far, 1e6);
+    build_cluster_pairs(L, L, c.radius, true, again);
+    expect_well_formed(L, L, again, true);
+    expect_complete(far, L, far, L, again, c.radius, true);
+  }
+}
+
+TEST(ClusterPairs, GatherAndAddRoundTripExactly) {
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const ClusterLayout L = layout_of(c.p, c.side);
+    std::vector<double> v(c.p.n());
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (double& q : v) q = u(rng);
+    std::vector<double> s(L.slots(), -7.0), back(c.p.n(), 0.0);
+    sphc::gather_slots(L, v.data(), s.data());
+    for (std::size_t k = 0; k < L.slots(); ++k) {
+      const std::size_t first = k / kClusterSize * kClusterSize;
+      EXPECT_EQ(s[k], v[L.slot[k] == kPadSlot ? L.slot[first] : L.slot[k]]);
+    }
+    sphc::add_slots(L, s.data(), back.data());
+    EXPECT_EQ(back, v);
+    // add_slots adds to what is there; padding slots are never read.
+    for (std::size_t k = 0; k < L.slots(); ++k)
+      if (L.slot[k] == kPadSlot) s[k] = NAN;
+    sphc::add_slots(L, s.data(), back.data());
+    for (std::size_t i = 0; i < v.size(); ++i) EXPECT_EQ(back[i], 2 * v[i]);
+    // float
+    std::vector<float> vf(v.begin(), v.end()), sf(L.slots()), bf(c.p.n(), 0.0f);
+    sphc::gather_slots(L, vf.data(), sf.data());
+    sphc::add_slots(L, sf.data(), bf.data());
+    EXPECT_EQ(bf, vf);
+  }
+}
+
+TEST(ClusterPairs, PaddingPositionsLieFarFromEveryRealParticle) {
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    ClusterLayout L = layout_of(c.p, c.side);
+    const double pad = 3.0 * c.radius;
+    std::vector<double> xs(L.slots()), ys(L.slots()), zs(L.slots());
+    sphc::gather_positions(L, c.p.x.data(), c.p.y.data(), c.p.zp(), xs.data(), ys.data(),
+                           c.p.dim == 3 ? zs.data() : nullptr, pad);
+    long pads = 0;
+    for (std::size_t k = 0; k < L.slots(); ++k) {
+      if (L.slot[k] != kPadSlot) {
+        EXPECT_EQ(xs[k], c.p.x[L.slot[k]]);
+        EXPECT_EQ(ys[k], c.p.y[L.slot[k]]);
+        if (c.p.dim == 3) EXPECT_EQ(zs[k], c.p.z[L.slot[k]]);
+        continue;
+      }
+      ++pads;
+      ASSERT_TRUE(std::isfinite(xs[k]) && std::isfinite(ys[k]) && (c.p.dim == 2 || std::isfinite(zs[k])));
+      for (std::size_t i = 0; i < c.p.n(); ++i) {
+        const double dx = xs[k] - c.p.x[i], dy = ys[k] - c.p.y[i], dz = c.p.dim == 3 ? zs[k] - c.p.z[i] : 0.0;
+        ASSERT_GE(std::sqrt(dx * dx + dy * dy + dz * dz), pad);
+      }
+      // Distinct from the other padding slots of its cluster.
+      for (std::size_t q = k / kClusterSize * kClusterSize; q < k; ++q)
+        if (L.slot[q] == kPadSlot) EXPECT_GE(std::fabs(xs[k] - xs[q]), pad * (1 - 1e-12));
+    }
+    EXPECT_GT(pads, 0);
+    // The boxes from these positions are those of the build (padding not in a box).
+    const std::vector<double> built = L.box;
+    sphc::update_boxes(L, xs.data(), ys.data(), c.p.dim == 3 ? zs.data() : nullptr);
+    EXPECT_EQ(L.box, built);
+  }
+}
+
+TEST(ClusterPairs, SmallAndDegenerateInputs) {
+  // None, fewer than a cluster, all at one point, a stray particle far away (columns widened).
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    Points none;
+    none.dim = dim;
+    ClusterLayout L = layout_of(none, 0.0);
+    EXPECT_EQ(L.n_clusters, 0u);
+    ClusterPairList l;
+    build_cluster_pairs(L, L, 1.0, true, l);
+    EXPECT_EQ(l.begin.size(), 1u);
+    EXPECT_TRUE(l.j.empty());
+
+    Points few = random_points(5, dim, 1.0, 21);
+    L = layout_of(few, 0.0);
+    expect_layout(few, L);
+    build_cluster_pairs(L, L, 2.0, true, l);
+    expect_well_formed(L, L, l, true);
+    EXPECT_EQ(l.j.size(), L.n_clusters * (L.n_clusters + 1) / 2) << "all within the radius";
+    L = layout_of(few, 10.0);
+    EXPECT_EQ(L.n_clusters, 1u);
+    build_cluster_pairs(L, L, 0.1, true, l);
+    EXPECT_EQ(l.j, std::vector<std::uint32_t>{0});
+
+    Points same = random_points(20, dim, 1.0, 22);
+    for (std::size_t i = 0; i < same.n(); ++i) same.x[i] = 0.5, same.y[i] = 0.5, same.z[i] = dim == 3 ? 0.5 : 0;
+    L = layout_of(same, 0.0);
+    expect_layout(same, L);
+    build_cluster_pairs(L, L, 0.1, true, l);
+    expect_complete(same, L, same, L, l, 0.1, true);
+
+    Points stray = random_points(1000, dim, 1.0, 23);
+    stray.x[17] = 1e9, stray.y[17] = -1e9;
+    L = layout_of(stray, 0.01);
+    expect_layout(stray, L);
+    EXPECT_LE(L.columns[0] * L.columns[1], 4 * stray.n() + 16);
+    build_cluster_pairs(L, L, 0.12, true, l);
+    expect_well_formed(L, L, l, true);
+    expect_complete(stray, L, stray, L, l, 0.12, true);
+  }
+}
+
+}  // namespace
