@@ -34,6 +34,17 @@ inline std::size_t column_of(double v, double origin, double side, std::size_t c
   return std::min(static_cast<std::size_t>(t), count - 1);
 }
 
+// Blocks of i-clusters for the build and the prune: one per OpenMP thread (1 without OpenMP),
+// at most one per 64 clusters.
+inline int block_count(std::size_t clusters) {
+#ifdef _OPENMP
+  const std::size_t threads = static_cast<std::size_t>(omp_get_max_threads());
+#else
+  const std::size_t threads = 1;
+#endif
+  return static_cast<int>(std::max<std::size_t>(1, std::min(threads, clusters / 64)));
+}
+
 inline double gap(double alo, double ahi, double blo, double bhi) {
   return std::max({0.0, blo - ahi, alo - bhi});
 }
@@ -345,11 +356,7 @@ void build_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b, double 
   out.j.clear();
   if (b.n_clusters == 0) return;
   // Blocks of i-clusters (one per thread under OpenMP), concatenated in order.
-#ifdef _OPENMP
-  const int nblocks = omp_get_max_threads();
-#else
-  const int nblocks = 1;
-#endif
+  const int nblocks = block_count(nci);
   std::vector<std::vector<std::uint32_t>> part(nblocks);
 #pragma omp parallel for schedule(static, 1)
   for (int blk = 0; blk < nblocks; ++blk) {
@@ -376,29 +383,51 @@ void build_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b, double 
 
 void prune_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b,
                          const ClusterPairList& outer, double radius, ClusterPairList& out) {
+  assert(&out != &outer);
   const double r2 = radius * radius * (1 + kBoxMargin);
   const std::size_t nci = a.n_clusters;
   out.begin.assign(nci + 1, 0);
   out.j.resize(outer.j.size());
   const double* abox = a.box.data();
   const double* bbox = b.box.data();
-  // Serial: in place into out.j, compacting.
-  std::size_t at = 0;
-  for (std::size_t ci = 0; ci < nci; ++ci) {
-    const double* ib = abox + 6 * ci;
-    const double ilx = ib[0], ily = ib[1], ilz = ib[2], ihx = ib[3], ihy = ib[4], ihz = ib[5];
-    for (std::uint32_t e = outer.begin[ci]; e < outer.begin[ci + 1]; ++e) {
-      const std::uint32_t cj = outer.j[e];
-      const double* jb = bbox + 6 * static_cast<std::size_t>(cj);
-      const double gx = std::max({0.0, jb[0] - ihx, ilx - jb[3]});
-      const double gy = std::max({0.0, jb[1] - ihy, ily - jb[4]});
-      const double gz = std::max({0.0, jb[2] - ihz, ilz - jb[5]});
-      out.j[at] = cj;
-      at += gx * gx + gy * gy + gz * gz <= r2 ? 1 : 0;
+  // Blocks of i-clusters (one per thread under OpenMP): each compacts its kept pairs within
+  // its own part of out.j (the outer list's range), then the parts are moved together in
+  // order: the serial result.
+  const int nblocks = block_count(nci);
+  std::vector<std::size_t> kept(nblocks, 0);
+#pragma omp parallel for schedule(static, 1)
+  for (int blk = 0; blk < nblocks; ++blk) {
+    const std::size_t c0 = nci * blk / nblocks, c1 = nci * (blk + 1) / nblocks;
+    const std::size_t first = outer.begin[c0];
+    std::uint32_t* oj = out.j.data();
+    const std::uint32_t* ij = outer.j.data();
+    std::size_t at = first;
+    for (std::size_t ci = c0; ci < c1; ++ci) {
+      const double* ib = abox + 6 * ci;
+      const double ilx = ib[0], ily = ib[1], ilz = ib[2], ihx = ib[3], ihy = ib[4], ihz = ib[5];
+      for (std::uint32_t e = outer.begin[ci]; e < outer.begin[ci + 1]; ++e) {
+        const std::uint32_t cj = ij[e];
+        const double* jb = bbox + 6 * static_cast<std::size_t>(cj);
+        const double gx = std::max({0.0, jb[0] - ihx, ilx - jb[3]});
+        const double gy = std::max({0.0, jb[1] - ihy, ily - jb[4]});
+        const double gz = std::max({0.0, jb[2] - ihz, ilz - jb[5]});
+        oj[at] = cj;  // branch-free: written always, kept by advancing
+        at += gx * gx + gy * gy + gz * gz <= r2 ? 1 : 0;
+      }
+      out.begin[ci + 1] = static_cast<std::uint32_t>(at - first);  // within the block, for now
     }
-    out.begin[ci + 1] = static_cast<std::uint32_t>(at);
+    kept[blk] = at - first;
   }
-  out.j.resize(at);
+  std::size_t total = 0;
+  for (int blk = 0; blk < nblocks; ++blk) {
+    const std::size_t c0 = nci * blk / nblocks, c1 = nci * (blk + 1) / nblocks;
+    const std::size_t first = outer.begin[c0];
+    if (total != first)  // to the left: memmove's order is safe
+      std::copy(out.j.begin() + first, out.j.begin() + first + kept[blk], out.j.begin() + total);
+    for (std::size_t ci = c0; ci < c1; ++ci) out.begin[ci + 1] += static_cast<std::uint32_t>(total);
+    total += kept[blk];
+  }
+  out.j.resize(total);
 }
 
 }  // namespace sphc

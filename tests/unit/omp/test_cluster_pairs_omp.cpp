@@ -1,0 +1,76 @@
+// The OpenMP runtime's cluster-pair lists (sphc/cluster_pairs.h): the outer list's build and
+// the pruning in blocks of i-clusters, one per thread, give the lists of one thread exactly,
+// for 1..4 threads; gathers, adds and boxes too.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "sphc/cluster_pairs.h"
+
+namespace {
+
+class ClusterPairsOmp : public ::testing::Test {
+ protected:
+  void TearDown() override { omp_set_num_threads(saved_); }
+  int saved_ = omp_get_max_threads();
+};
+
+struct Lists {
+  sphc::ClusterLayout layout;
+  sphc::ClusterPairList outer, pruned, cross;
+  std::vector<double> gathered, added;
+};
+
+Lists lists_with(int threads, int dim) {
+  omp_set_num_threads(threads);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const std::size_t n = dim == 3 ? 4000 : 3000;
+  std::vector<double> x(n), y(n), z(n), v(n);
+  for (std::size_t i = 0; i < n; ++i) x[i] = u(rng), y[i] = u(rng), z[i] = dim == 3 ? u(rng) : 0.0, v[i] = u(rng);
+  const double radius = dim == 3 ? 0.12 : 0.045;
+  Lists l;
+  sphc::build_cluster_layout(l.layout, x.data(), y.data(), z.data(), n, dim, 0.0);
+  sphc::build_cluster_pairs(l.layout, l.layout, radius, true, l.outer);
+  for (std::size_t i = 0; i < n; ++i) x[i] += 0.02 * radius * std::sin(3.0 * i), y[i] += 0.02 * radius * std::cos(5.0 * i);
+  const std::size_t S = l.layout.slots();
+  std::vector<double> xs(S), ys(S), zs(S);
+  sphc::gather_positions(l.layout, x.data(), y.data(), z.data(), xs.data(), ys.data(), zs.data(), 10.0);
+  sphc::update_boxes(l.layout, xs.data(), ys.data(), zs.data());
+  sphc::prune_cluster_pairs(l.layout, l.layout, l.outer, radius / 1.1, l.pruned);
+  sphc::build_cluster_pairs(l.layout, l.layout, radius, false, l.cross);
+  l.gathered.resize(S);
+  sphc::gather_slots(l.layout, v.data(), l.gathered.data());
+  l.added.assign(n, 1.0);
+  sphc::add_slots(l.layout, l.gathered.data(), l.added.data());
+  return l;
+}
+
+TEST_F(ClusterPairsOmp, ListsOfAnyThreadCountEqualOneThreads) {
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    const Lists one = lists_with(1, dim);
+    EXPECT_GT(one.pruned.j.size(), 0u);
+    EXPECT_LT(one.pruned.j.size(), one.outer.j.size());
+    for (int t = 2; t <= 4; ++t) {
+      SCOPED_TRACE(t);
+      const Lists l = lists_with(t, dim);
+      EXPECT_EQ(l.layout.slot, one.layout.slot);
+      EXPECT_EQ(l.layout.box, one.layout.box);
+      EXPECT_EQ(l.outer.begin, one.outer.begin);
+      EXPECT_EQ(l.outer.j, one.outer.j);
+      EXPECT_EQ(l.pruned.begin, one.pruned.begin);
+      EXPECT_EQ(l.pruned.j, one.pruned.j);
+      EXPECT_EQ(l.cross.begin, one.cross.begin);
+      EXPECT_EQ(l.cross.j, one.cross.j);
+      EXPECT_EQ(l.gathered, one.gathered);
+      EXPECT_EQ(l.added, one.added);
+    }
+  }
+}
+
+}  // namespace
