@@ -258,7 +258,8 @@ namespace {
 // with down[k] > zhi): exact for any boxes (the layout's own are sorted already).
 struct ColumnBounds {
   std::vector<double> up, down;
-  double overhang = 0;  // the most a box sticks out of its column's x-y square
+  double overhang = 0;  // the most a box sticks out of its column's x-y square (+ slack)
+  double slack = 0;     // absolute slack of the reach along the sort axis
 };
 
 ColumnBounds column_bounds(const ClusterLayout& b) {
@@ -284,7 +285,14 @@ ColumnBounds column_bounds(const ClusterLayout& b) {
       if (b.dim == 3) over = std::max({over, y0 - bx[1], bx[4] - y1});
     }
   }
-  cb.overhang = over == over ? over : HUGE_VAL;
+  // Slack over the rounding of the column bounds and the reach (which the box tests, exact
+  // for the same doubles, do not need): 1e-9 of a column plus a few ulps of the coordinates.
+  double extent = std::fabs(b.origin[0]) + std::fabs(b.origin[1]) +
+                  static_cast<double>(b.columns[0] + b.columns[1]) * b.column_side;
+  for (std::size_t c = 0; c < b.n_clusters; ++c)
+    extent = std::max(extent, std::fabs(b.box[6 * c + sa]) + std::fabs(b.box[6 * c + 3 + sa]));
+  cb.slack = 1e-9 * b.column_side + 1e-14 * extent;
+  cb.overhang = over == over ? over + cb.slack : HUGE_VAL;
   return cb;
 }
 
@@ -311,12 +319,11 @@ inline void column_range(const ClusterLayout& b, int a, double vlo, double vhi, 
 void find_pairs(const ClusterLayout& b, const ColumnBounds& cb, const double* ib, double radius,
                 double r2, bool once, std::size_t ci, std::vector<std::uint32_t>& out) {
   const int sa = b.dim == 3 ? 2 : 1;
-  const double reach = radius + cb.overhang;
+  const double reach = radius * (1 + 1e-9) + cb.overhang;
   std::size_t x0, x1, y0 = 0, y1 = 0;
   column_range(b, 0, ib[0], ib[3], reach, x0, x1);
   if (b.dim == 3) column_range(b, 1, ib[1], ib[4], reach, y0, y1);
   if (x0 > x1 || y0 > y1) return;
-  const double zlo = ib[sa] - radius, zhi = ib[3 + sa] + radius;
   for (std::size_t cy = y0; cy <= y1; ++cy) {
     // The column's x-y square widened by the overhang: its distance to the i box.
     double gy2 = 0;
@@ -328,7 +335,11 @@ void find_pairs(const ClusterLayout& b, const ColumnBounds& cb, const double* ib
     for (std::size_t cx = x0; cx <= x1; ++cx) {
       const double c0 = b.origin[0] + static_cast<double>(cx) * b.column_side - cb.overhang;
       const double gx = gap(ib[0], ib[3], c0, c0 + b.column_side + 2 * cb.overhang);
-      if (gx * gx + gy2 > r2) continue;
+      const double gxy2 = gx * gx + gy2;
+      if (gxy2 > r2) continue;
+      // Along the sort axis a box of this column within r2 is within sqrt(r2 - gxy2).
+      const double reach_z = std::sqrt(r2 - gxy2) * (1 + 1e-9) + cb.slack;
+      const double zlo = ib[sa] - reach_z, zhi = ib[3 + sa] + reach_z;
       const std::size_t col = cy * b.columns[0] + cx;
       std::size_t k = b.column_begin[col];
       const std::size_t end = b.column_begin[col + 1];
@@ -358,24 +369,27 @@ void build_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b, double 
   // Blocks of i-clusters (one per thread under OpenMP), concatenated in order.
   const int nblocks = block_count(nci);
   std::vector<std::vector<std::uint32_t>> part(nblocks);
+  part[0].swap(out.j);  // the first block writes into out.j's storage (kept across rebuilds)
+  part[0].clear();
 #pragma omp parallel for schedule(static, 1)
   for (int blk = 0; blk < nblocks; ++blk) {
     const std::size_t c0 = nci * blk / nblocks, c1 = nci * (blk + 1) / nblocks;
     std::vector<std::uint32_t>& o = part[blk];
-    o.reserve((c1 - c0) * 16);
+    o.reserve((c1 - c0) * 32);
     for (std::size_t ci = c0; ci < c1; ++ci) {
       find_pairs(b, cb, &a.box[6 * ci], radius, r2, once, ci, o);
       out.begin[ci + 1] = static_cast<std::uint32_t>(o.size());
     }
   }
-  std::size_t total = 0;
-  for (int blk = 0; blk < nblocks; ++blk) {
+  std::size_t total = part[0].size();
+  for (int blk = 1; blk < nblocks; ++blk) {
     const std::size_t c0 = nci * blk / nblocks, c1 = nci * (blk + 1) / nblocks;
     for (std::size_t ci = c0; ci < c1; ++ci) out.begin[ci + 1] += static_cast<std::uint32_t>(total);
     total += part[blk].size();
   }
+  out.j.swap(part[0]);
   out.j.resize(total);
-  for (int blk = 0; blk < nblocks; ++blk) {
+  for (int blk = 1; blk < nblocks; ++blk) {
     const std::size_t c0 = nci * blk / nblocks;
     std::copy(part[blk].begin(), part[blk].end(), out.j.begin() + out.begin[c0]);
   }
