@@ -206,12 +206,12 @@ void gather_positions(const ClusterLayout& L, const double* x, const double* y, 
   if (L.slots() == L.n) return;  // no padding
   double xmax = -HUGE_VAL;
   for (std::size_t p = 0; p < L.n; ++p) xmax = std::max(xmax, x[p]);
+  double k = 0;  // the padding slots numbered 1, 2, ... in slot order
   for (std::size_t c = 0; c < L.n_clusters; ++c) {
     const unsigned m = L.real_mask[c];
     if (m == 0xff) continue;
-    int k = 0;
     for (int lane = 0; lane < C; ++lane)
-      if (!(m >> lane & 1u)) xs[c * C + lane] = xmax + (++k) * pad_offset;
+      if (!(m >> lane & 1u)) xs[c * C + lane] = xmax + (k += 1) * pad_offset;
   }
 }
 
