@@ -11,7 +11,9 @@
 // Built with the runtime (tests/CMakeLists.txt: cluster_lists_check, serial runtime; ctest
 // bench.cluster_lists at nx = 16). Run: cluster_lists [--nx 47] [--hdx 1.5] [--pert 0.05]
 //   [--skin 0.1] [--reps 7] [--column DX] [--fields 8] [--sums 7] [--move F] [--dim 3]
-// --dim 2: the nx x nx square (2D columns: strips in x sorted by y).
+// --dim 2: the nx x nx square (2D columns: strips in x sorted by y). --cluster-order: the
+// particles first permuted into the layout's slot order (what a solver that sorted its arrays
+// into cluster order at each rebuild would have; the gathers then read contiguous runs).
 // --move F: before the per-evaluation pieces every particle moves by up to F x skin x 2 h
 // (a random direction; F <= 0.5 keeps the outer list complete).
 #include <algorithm>
@@ -127,6 +129,7 @@ long pairs_in_tiles(const sphc::ClusterLayout& L, const sphc::ClusterPairList& l
 
 int main(int argc, char** argv) {
   int nx = 47, reps = 7, fields = 8, sums = 7, dim = 3;
+  bool cluster_order = false;
   double hdx = 1.5, pert = 0.05, skin = 0.1, column = 0, move = 0.5;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
@@ -144,16 +147,26 @@ int main(int argc, char** argv) {
     else if (a == "--sums") sums = std::atoi(next());
     else if (a == "--move") move = std::atof(next());
     else if (a == "--dim") dim = std::atoi(next());
+    else if (a == "--cluster-order") cluster_order = true;
     else {
       std::fprintf(stderr, "usage: %s [--nx 47] [--hdx 1.5] [--pert 0.05] [--skin 0.1] [--reps 7] [--column DX]"
-                           " [--fields 8] [--sums 7] [--move 0.5] [--dim 3]\n", argv[0]);
+                           " [--fields 8] [--sums 7] [--move 0.5] [--dim 3] [--cluster-order]\n", argv[0]);
       return 2;
     }
   }
   const double dx = 1.0 / nx, h = hdx * dx, support = 2.0 * h, rlist = (1.0 + skin) * support;
   if (dim != 2 && dim != 3) return 2;
-  const Cube cube = make_cube(nx, hdx, pert, 12345, dim);
+  const double side = column > 0 ? column * dx : 0.0;
+  Cube cube = make_cube(nx, hdx, pert, 12345, dim);
   const std::size_t n = cube.n();
+  if (cluster_order) {  // the particles permuted into the layout's slot order (padding left out)
+    sphc::ClusterLayout first;
+    sphc::build_cluster_layout(first, cube.x.data(), cube.y.data(), cube.z.data(), n, dim, side);
+    Cube sorted;
+    for (std::uint32_t p : first.slot)
+      if (p != sphc::kPadSlot) sorted.x.push_back(cube.x[p]), sorted.y.push_back(cube.y[p]), sorted.z.push_back(cube.z[p]);
+    cube = sorted;
+  }
   Cube moved = cube;
   {
     std::mt19937_64 rng(777);
@@ -166,7 +179,6 @@ int main(int argc, char** argv) {
       moved.x[i] += s * d[0], moved.y[i] += s * d[1], moved.z[i] += s * d[2];
     }
   }
-  const double side = column > 0 ? column * dx : 0.0;
   std::printf("%s nx = %d: %zu particles, h = %.3g dx, positions +-%.3g dx; list radius %.2f h, support 2 h;"
               " per evaluation %d source fields besides x, y, z and %d sums; particles moved by up to %.2f x skin x 2h\n",
               dim == 3 ? "cube" : "square (2D)", nx, n, hdx, pert, rlist / h, fields, sums, move);
