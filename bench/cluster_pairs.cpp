@@ -818,20 +818,25 @@ double box_distance2(const Box& a, const Box& b) {
 // counted only, j-clusters of 4) the pairs of the i-cluster's cluster of 8 filtered with the
 // smaller clusters' boxes (a smaller cluster's box lies within its cluster of 8's: none is
 // lost). Not timed.
-struct PairList : sphc::ClusterPairList {
+struct PairList {
   int ci_size = 4;
+  std::vector<std::uint32_t> start;  // per i-cluster, into cj (sphc::ClusterPairList::begin)
+  std::vector<std::uint32_t> cj;     // (sphc::ClusterPairList::j)
 };
 PairList build_pair_list(const Clusters& cl, int CI, double rlist, int cjs = CJ) {
+  sphc::ClusterPairList l8;
+  sphc::build_cluster_pairs(cl.layout, cl.layout, rlist, true, l8);
   PairList pl;
   pl.ci_size = CI;
-  sphc::build_cluster_pairs(cl.layout, cl.layout, rlist, true, pl);
-  if (CI == CJ && cjs == CJ) return pl;
-  const sphc::ClusterPairList l8 = pl;
+  if (CI == CJ && cjs == CJ) {
+    pl.start.swap(l8.begin);
+    pl.cj.swap(l8.j);
+    return pl;
+  }
   const int nci = cl.f.n / CI, ncj = cl.f.n / cjs, halves = CJ / cjs;
   std::vector<Box> jb(ncj);
   for (int c = 0; c < ncj; ++c) jb[c] = box_of(cl, c * cjs, cjs);
-  pl.begin.assign(nci + 1, 0);
-  pl.j.clear();
+  pl.start.assign(nci + 1, 0);
   const double r2 = rlist * rlist;
   for (int ci = 0; ci < nci; ++ci) {
     const Box ib = box_of(cl, ci * CI, CI);
@@ -840,9 +845,9 @@ PairList build_pair_list(const Clusters& cl, int CI, double rlist, int cjs = CJ)
       for (std::uint32_t e = l8.begin[parent]; e < l8.begin[parent + 1]; ++e)
         for (int q = 0; q < halves; ++q) {
           const int c = static_cast<int>(l8.j[e]) * halves + q;
-          if (c >= cj_min && !jb[c].empty && box_distance2(ib, jb[c]) < r2) pl.j.push_back(c);
+          if (c >= cj_min && !jb[c].empty && box_distance2(ib, jb[c]) < r2) pl.cj.push_back(c);
         }
-    pl.begin[ci + 1] = static_cast<std::uint32_t>(pl.j.size());
+    pl.start[ci + 1] = static_cast<std::uint32_t>(pl.cj.size());
   }
   return pl;
 }
@@ -905,16 +910,16 @@ __attribute__((noinline)) void form_c(Clusters& cl, const PairList& pl, const Co
     for (int i = 0; i < f.n; ++i) negm[i] = -MS[i], negepsm[i] = -eq.eps * MS[i];
   }
   const double *NEGM = negm.data(), *NEGEPSM = negepsm.data();
-  const int nci = static_cast<int>(pl.begin.size()) - 1;
+  const int nci = static_cast<int>(pl.start.size()) - 1;
   const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
   for (int ci = 0; ci < nci; ++ci) {
     const int i0 = ci * CI;
-    if (pl.begin[ci] == pl.begin[ci + 1]) continue;
+    if (pl.start[ci] == pl.start[ci + 1]) continue;
     V iacc[CI][7];
     for (int ii = 0; ii < CI; ++ii)
       for (int k = 0; k < 7; ++k) iacc[ii][k] = zero;
-    for (int e = pl.begin[ci]; e < pl.begin[ci + 1]; ++e) {
-      const int j0 = pl.j[e] * CJ;
+    for (int e = pl.start[ci]; e < pl.start[ci + 1]; ++e) {
+      const int j0 = pl.cj[e] * CJ;
       const V xj = _mm512_load_pd(X + j0), yj = _mm512_load_pd(Y + j0), zj = _mm512_load_pd(Z + j0);
       const V uj = _mm512_load_pd(U + j0), vj = _mm512_load_pd(VV + j0), wj = _mm512_load_pd(W + j0);
       const V hj = _mm512_load_pd(H + j0), rhoj = _mm512_load_pd(RHO + j0), mj = _mm512_load_pd(MS + j0);
@@ -1050,21 +1055,28 @@ PairList prune(Clusters& cl, const PairList& outer, double rcut) {
   PairList pl;
   pl.ci_size = outer.ci_size;
   if (outer.ci_size == CJ) {
+    // The runtime's form of the lists: the vectors swapped in and back (no copy; the lists
+    // themselves are not const).
+    PairList& o = const_cast<PairList&>(outer);
+    sphc::ClusterPairList in, out;
+    in.begin.swap(o.start), in.j.swap(o.cj);
     sphc::update_boxes(cl.layout, cl.f.x.data(), cl.f.y.data(), cl.f.z.data());
-    sphc::prune_cluster_pairs(cl.layout, cl.layout, outer, rcut, pl);
+    sphc::prune_cluster_pairs(cl.layout, cl.layout, in, rcut, out);
+    in.begin.swap(o.start), in.j.swap(o.cj);
+    pl.start.swap(out.begin), pl.cj.swap(out.j);
     return pl;
   }
-  const int CI = outer.ci_size, nci = static_cast<int>(outer.begin.size()) - 1;
+  const int CI = outer.ci_size, nci = static_cast<int>(outer.start.size()) - 1;
   std::vector<Box> ib(nci), jb(cl.ncj);
   for (int c = 0; c < nci; ++c) ib[c] = box_of(cl, c * CI, CI);
   for (int c = 0; c < cl.ncj; ++c) jb[c] = box_of(cl, c * CJ, CJ);
-  pl.begin.assign(nci + 1, 0);
-  pl.j.reserve(outer.j.size());
+  pl.start.assign(nci + 1, 0);
+  pl.cj.reserve(outer.cj.size());
   const double r2 = rcut * rcut;
   for (int ci = 0; ci < nci; ++ci) {
-    for (std::uint32_t e = outer.begin[ci]; e < outer.begin[ci + 1]; ++e)
-      if (box_distance2(ib[ci], jb[outer.j[e]]) < r2) pl.j.push_back(outer.j[e]);
-    pl.begin[ci + 1] = static_cast<std::uint32_t>(pl.j.size());
+    for (int e = outer.start[ci]; e < outer.start[ci + 1]; ++e)
+      if (box_distance2(ib[ci], jb[outer.cj[e]]) < r2) pl.cj.push_back(outer.cj[e]);
+    pl.start[ci + 1] = static_cast<std::uint32_t>(pl.cj.size());
   }
   return pl;
 }
@@ -1077,12 +1089,12 @@ PairList prune(Clusters& cl, const PairList& outer, double rcut) {
 std::pair<double, long> count_2xmm(const Clusters& cl, const PairList& pl4) {
   const Fluid& f = cl.f;
   long vectors = 0, inside = 0;
-  for (size_t ci = 0; ci + 1 < pl4.begin.size(); ++ci)
-    for (int e = pl4.begin[ci]; e < pl4.begin[ci + 1]; ++e)
+  for (size_t ci = 0; ci + 1 < pl4.start.size(); ++ci)
+    for (int e = pl4.start[ci]; e < pl4.start[ci + 1]; ++e)
       for (int half = 0; half < 2; ++half) {
         long in = 0;
         for (int i = static_cast<int>(ci) * 4 + 2 * half; i < static_cast<int>(ci) * 4 + 2 * half + 2; ++i)
-          for (int j = pl4.j[e] * 4; j < pl4.j[e] * 4 + 4; ++j) {
+          for (int j = pl4.cj[e] * 4; j < pl4.cj[e] * 4 + 4; ++j) {
             if (j <= i) continue;
             const double XIJ[3] = {f.x[i] - f.x[j], f.y[i] - f.y[j], f.z[i] - f.z[j]};
             const double R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * XIJ[2];
@@ -1113,14 +1125,14 @@ __attribute__((noinline)) void form_c_omp(Clusters& cl, const PairList& pl, cons
   for (int k = 0; k < 7; ++k) S[k] = fl.sums[k].data();
   struct { double alpha, beta; } eq2{eqc.alpha, eqc.beta};
   struct { double eps; } eq3{eqc.eps};
-  const int nci = static_cast<int>(pl.begin.size()) - 1;
+  const int nci = static_cast<int>(pl.start.size()) - 1;
   const int n_lanes = pl.ci_size > 0 ? CJ : 0;  // CJ
   for (int ci = 0; ci < nci; ++ci) {
     const int i0 = ci * CI;
-    if (pl.begin[ci] == pl.begin[ci + 1]) continue;
+    if (pl.start[ci] == pl.start[ci + 1]) continue;
     alignas(64) double iacc[CI][7][CJ] = {};
-    for (int e = pl.begin[ci]; e < pl.begin[ci + 1]; ++e) {
-      const int j0 = pl.j[e] * CJ;
+    for (int e = pl.start[ci]; e < pl.start[ci + 1]; ++e) {
+      const int j0 = pl.cj[e] * CJ;
       const bool diagonal = j0 < i0 + CI;
       alignas(64) double jacc[7][CJ] = {};
       for (int ii = 0; ii < CI; ++ii) {
@@ -1219,13 +1231,13 @@ TileCounts count_tiles(const Clusters& cl, const PairList& pl) {
   TileCounts tc;
   const Fluid& f = cl.f;
   const int CI = pl.ci_size;
-  for (size_t ci = 0; ci + 1 < pl.begin.size(); ++ci)
-    for (int e = pl.begin[ci]; e < pl.begin[ci + 1]; ++e) {
+  for (size_t ci = 0; ci + 1 < pl.start.size(); ++ci)
+    for (int e = pl.start[ci]; e < pl.start[ci + 1]; ++e) {
       ++tc.entries;
       tc.lanes += CI * CJ;
       for (int i = static_cast<int>(ci) * CI; i < static_cast<int>(ci) * CI + CI; ++i) {
         long row = 0;
-        for (int j = pl.j[e] * CJ; j < pl.j[e] * CJ + CJ; ++j) {
+        for (int j = pl.cj[e] * CJ; j < pl.cj[e] * CJ + CJ; ++j) {
           if (j <= i) continue;
           const double XIJ[3] = {f.x[i] - f.x[j], f.y[i] - f.y[j], f.z[i] - f.z[j]};
           const double R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * XIJ[2];
@@ -1402,10 +1414,10 @@ int main(int argc, char** argv) {
       t0 = cpu_now();
       const PairList pruned = prune(cl, ls.pl, Kernel::radius_scale * hmax);
       best = std::min(best, cpu_now() - t0);
-      kept = pruned.j.size();
+      kept = pruned.cj.size();
     }
     std::printf("  pruning the %dx8 list (radius %.2f h) to 2 h with the current boxes: %.4f s CPU, %zu of %zu cluster "
-                "pairs kept\n", ls.ci, ls.rlist / hmax, best, kept, ls.pl.j.size());
+                "pairs kept\n", ls.ci, ls.rlist / hmax, best, kept, ls.pl.cj.size());
   }
   {
     const PairList pl44 = build_pair_list(cl, 4, Kernel::radius_scale * hmax, 4);
@@ -1419,7 +1431,7 @@ int main(int argc, char** argv) {
     counts.push_back(tc);
     std::printf("  list %dx8, radius %.2f h: %ld cluster pairs (%.1f per i-cluster), %ld tile lanes, %.1f%% within "
                 "the support, %.1f%% of the rows computed (%.1f%% of their lanes within); build %.3f s CPU%s\n",
-                ls.ci, ls.rlist / hmax, tc.entries, double(tc.entries) / (ls.pl.begin.size() - 1), tc.lanes,
+                ls.ci, ls.rlist / hmax, tc.entries, double(tc.entries) / (ls.pl.start.size() - 1), tc.lanes,
                 100.0 * tc.in_support / tc.lanes, 100.0 * tc.rows * CJ / tc.lanes,
                 100.0 * tc.in_support / (tc.rows * CJ), ls.build,
                 tc.in_support == pairs ? "" : "  ** INCOMPLETE: pairs missing **");
