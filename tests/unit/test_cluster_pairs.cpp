@@ -379,6 +379,62 @@ TEST(ClusterPairs, PaddingPositionsLieFarFromEveryRealParticle) {
   }
 }
 
+// The way a tile loop uses the pieces: positions and a property into slot order, every lane of
+// every tile of the pruned list computed (padding lanes too, no test of real_mask: only the
+// cut-off), each pair once with i's and j's sums in slot order, added back: the sums of a brute
+// force over all pairs (the same terms, summed in another order: 1e-12 of the largest).
+TEST(ClusterPairs, TilesOverThePrunedListGiveTheBruteForceSums) {
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const double support = c.radius / 1.1, r2 = support * support;
+    ClusterLayout L = layout_of(c.p, c.side);
+    ClusterPairList outer, pruned;
+    build_cluster_pairs(L, L, c.radius, true, outer);
+    Points moved = c.p;
+    for (std::size_t i = 0; i < moved.n(); ++i) {
+      moved.x[i] += 0.04 * support * std::sin(1.7 * i);
+      moved.y[i] += 0.04 * support * std::cos(2.3 * i);
+      if (c.p.dim == 3) moved.z[i] += 0.04 * support * std::sin(0.9 * i + 1);
+    }
+    std::vector<double> m(moved.n());
+    for (std::size_t i = 0; i < m.size(); ++i) m[i] = 1.0 + 0.5 * std::sin(0.37 * i);
+    const std::size_t S = L.slots();
+    std::vector<double> xs(S), ys(S), zs(S, 0.0), ms(S), sums(S, 0.0);
+    sphc::gather_positions(L, moved.x.data(), moved.y.data(), moved.zp(), xs.data(), ys.data(),
+                           c.p.dim == 3 ? zs.data() : nullptr, 2 * support);
+    sphc::gather_slots(L, m.data(), ms.data());
+    sphc::update_boxes(L, xs.data(), ys.data(), c.p.dim == 3 ? zs.data() : nullptr);
+    prune_cluster_pairs(L, L, outer, support, pruned);
+    // Term of pair (i, j) for i: m_j (r2 - r^2); for j: m_i (r2 - r^2).
+    for (std::size_t ci = 0; ci < L.n_clusters; ++ci)
+      for (std::uint32_t e = pruned.begin[ci]; e < pruned.begin[ci + 1]; ++e) {
+        const std::size_t cj = pruned.j[e];
+        for (std::size_t i = ci * kClusterSize; i < (ci + 1) * kClusterSize; ++i)
+          for (std::size_t j = cj * kClusterSize; j < (cj + 1) * kClusterSize; ++j) {
+            const double dx = xs[i] - xs[j], dy = ys[i] - ys[j], dz = zs[i] - zs[j];
+            const double q = dx * dx + dy * dy + dz * dz;
+            const bool lane = q < r2 && (cj != ci || j > i);  // the mask
+            const double w = r2 - q;
+            sums[i] += lane ? ms[j] * w : 0.0;
+            sums[j] += lane ? ms[i] * w : 0.0;
+          }
+      }
+    std::vector<double> got(moved.n(), 0.0), want(moved.n(), 0.0);
+    sphc::add_slots(L, sums.data(), got.data());
+    double scale = 0;
+    for (std::size_t i = 0; i < moved.n(); ++i)
+      for (std::size_t j = i + 1; j < moved.n(); ++j) {
+        const double q = dist2(moved, i, moved, j);
+        if (!(q < r2)) continue;
+        want[i] += m[j] * (r2 - q);
+        want[j] += m[i] * (r2 - q);
+      }
+    for (double v : want) scale = std::max(scale, std::fabs(v));
+    ASSERT_GT(scale, 0);
+    for (std::size_t i = 0; i < moved.n(); ++i) ASSERT_NEAR(got[i], want[i], 1e-12 * scale) << "particle " << i;
+  }
+}
+
 TEST(ClusterPairs, SmallAndDegenerateInputs) {
   // None, fewer than a cluster, all at one point, a stray particle far away (columns widened).
   for (int dim : {2, 3}) {
