@@ -466,6 +466,22 @@ TEST(ClusterPairs, SmallAndDegenerateInputs) {
     build_cluster_pairs(L, L, 0.1, true, l);
     expect_complete(same, L, same, L, l, 0.1, true);
 
+    // A flat wall (3D: a lattice in the plane y = 0.3; 2D: the line y = 0.3): columns of
+    // about 8^(1/k) spacings over the k axes it extends along.
+    Points wall;
+    wall.dim = dim;
+    for (int i = 0; i < 30; ++i)
+      for (int k = 0; k < (dim == 3 ? 30 : 1); ++k) {
+        wall.x.push_back((i + 0.5) / 30);
+        wall.y.push_back(0.3);
+        wall.z.push_back(dim == 3 ? (k + 0.5) / 30 : 0.0);
+      }
+    L = layout_of(wall, 0.0);
+    expect_layout(wall, L);
+    EXPECT_NEAR(L.column_side * 30, dim == 3 ? std::sqrt(8.0) : 8.0, 0.5);
+    build_cluster_pairs(L, L, 0.1, true, l);
+    expect_complete(wall, L, wall, L, l, 0.1, true);
+
     Points stray = random_points(1000, dim, 1.0, 23);
     stray.x[17] = 1e9, stray.y[17] = -1e9;
     L = layout_of(stray, 0.01);

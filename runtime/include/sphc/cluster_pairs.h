@@ -93,8 +93,9 @@ struct ClusterLayout {
 double cluster_column_side(double spacing, int dim);
 
 // At a list rebuild: the layout of n particles at (x, y, z) (z unused, may be null, in 2D).
-// column_side <= 0: (kClusterSize * V / n)^(1/dim), V the volume (2D: area) of the particles'
-// bounding box (2 dx for a filled box on a lattice of spacing dx). Where the bounding box
+// column_side <= 0: (kClusterSize * V / n)^(1/k), V the volume (2D: area) of the particles'
+// bounding box over the k axes along which they extend (2 dx for a filled box on a lattice of
+// spacing dx; a flat wall of a 3D scene: its area, 2.83 dx). Where the bounding box
 // would need more than 4 n + 16 columns (a stray particle), the columns are made wider.
 // Boxes from these positions.
 void build_cluster_layout(ClusterLayout& layout, const double* x, const double* y,
