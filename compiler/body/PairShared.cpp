@@ -359,10 +359,12 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
   // the mirrored call would see flipped. Such a value is shared only where no zero's sign can
   // reach a result: the body divides by nothing, passes nothing to a function (but fabs and
   // fma) and stores (`=`, `*=`) nothing that is not known untouched by the differences.
-  // (Sums are safe: +0 + -0 = +0.)
+  // (Sums are safe: +0 + -0 = +0.) A sum of a nonzero literal and such a value is known
+  // untouched (absorbsZeroSign: c + 0 = c for either zero).
   bool zeroSignMatters(const clang::Stmt* s) {
     if (!s) return false;
     const auto unsafe = [&](const clang::Expr* e) {
+      if (absorbsZeroSign(e)) return false;
       Canon c = canon(e, false);
       return !c.ok || c.taint;
     };
@@ -385,6 +387,33 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
     for (const clang::Stmt* c : s->children())
       if (zeroSignMatters(c)) return true;
     return false;
+  }
+
+  // c + x, x + c, c - x or x - c (through locals that stand for their initial values) with c
+  // a nonzero finite literal and x an expression of the canonical forms (canon ok, tainted or
+  // not): where x is a zero, of either sign, the value is c; elsewhere x is the same (or the
+  // same shared value) both ways. So a zero's sign in x never reaches the value, and passing
+  // it to a function, dividing by it or storing it is safe (FourtakasDensityDiffusion's
+  // pow(1 + (p_a + dph) / B, 1 / gamma), whose dph and x . dw are then shared).
+  bool absorbsZeroSign(const clang::Expr* e) {
+    e = e->IgnoreParenImpCasts();
+    if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(e)) {
+      auto* v = llvm::dyn_cast<clang::VarDecl>(ref->getDecl());
+      return v && !llvm::isa<clang::ParmVarDecl>(v) && fixedLocal(v) &&
+             absorbsZeroSign(v->getInit());
+    }
+    auto* b = llvm::dyn_cast<clang::BinaryOperator>(e);
+    if (!b || (b->getOpcode() != clang::BO_Add && b->getOpcode() != clang::BO_Sub) ||
+        !b->getType()->isRealFloatingType())
+      return false;
+    const auto nonzeroLiteral = [](const clang::Expr* x) {
+      auto* f = llvm::dyn_cast<clang::FloatingLiteral>(x->IgnoreParenImpCasts());
+      return f && f->getValue().isFiniteNonZero();
+    };
+    const clang::Expr* other = nonzeroLiteral(b->getLHS())   ? b->getRHS()
+                               : nonzeroLiteral(b->getRHS()) ? b->getLHS()
+                                                             : nullptr;
+    return other && canon(other, false).ok && canon(other, true).ok;
   }
 
   // Operations in the expression's own text (not through its locals).

@@ -99,4 +99,16 @@ TEST(PowInt, FallbackIsStdPow) {
   }
 }
 
+// x = 1 returns 1 without calling std::pow (a wall at rest: rho0 (1 + p / B)^(1/gamma) with
+// p = 0), the bits std::pow gives for every y, NaN and infinities included (C99 F.9.4.4).
+TEST(PowInt, OneToAnyPowerIsStdPow) {
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (double y : {1.0 / 7.0, -1.0 / 7.0, 0.5, 1e300, -1e300, 9.0, 1e-300, 0.0, -0.0, inf, -inf,
+                   nan, -nan}) {
+    EXPECT_TRUE(sameBits(sphc::pow_int(1.0, y), std::pow(1.0, y))) << y;
+    EXPECT_TRUE(sameBits(sphc::pow_int(1.0, y), 1.0)) << y;
+  }
+}
+
 }  // namespace
