@@ -1242,8 +1242,9 @@ __attribute__((noinline)) void form_c_omp(Clusters& cl, const PairList& pl, cons
 // the loop), the trip count the constant 8, and no jump threading in the function (GCC's
 // threading of the kernel's branches before if-conversion leaves "control flow in loop":
 // TILE_OPTIMIZE, -DTILE_OPTIMIZE= to see it). SKIP: a row whose lanes are all beyond the
-// cut-off is skipped (a first `omp simd` loop over the 8 lanes: the cut-off only, an OR
-// reduction). ACC: the sums accumulated in the lane arrays in the calls (pd_acc_ = ia[l]; the
+// cut-off is skipped (a first `omp simd` loop over the 8 lanes: the cut-off only; SKIP = 1 a
+// double sum of 0 or 1 per lane, SKIP = 2 an int OR reduction, which makes GCC 12 take 8
+// lanes of int, so the loop in 256-bit vectors, and costs 12% more per sweep). ACC: the sums accumulated in the lane arrays in the calls (pd_acc_ = ia[l]; the
 // body's fma onto it; kept under the mask), else the pair's terms from 0 added under the mask
 // (as the lane form prints them). NEG: the mirrored vectors XIJ_ji, VIJ_ji as negations (the
 // same doubles as the differences: a - b = -(b - a) in IEEE arithmetic), else differences.
@@ -1286,7 +1287,7 @@ __attribute__((noinline)) TILE_OPTIMIZE void form_c_print(Clusters& cl, const Pa
         const double j_min = diagonal ? double(d_idx - j0) : -1.0;  // the diagonal tile: j > i only
         static constexpr double lane_d[CJ] = {0, 1, 2, 3, 4, 5, 6, 7};
         const double *jx = sj_x + j0, *jy = sj_y + j0, *jz = sj_z + j0, *ju = sj_u + j0, *jv = sj_v + j0, *jw = sj_w + j0, *jh = sj_h + j0, *jrho = s_rho + j0, *jcs = s_cs + j0, *jm = s_m + j0, *jp = s_p + j0, *jho = hoisted_eq2_0 + j0;
-        if (SKIP) {
+        if (SKIP == 2) {  // an int OR reduction: GCC takes 2 x 256-bit vectors for the loop
           int any = 0;
           #pragma omp simd reduction(|: any)
           for (int l = 0; l < n_lanes; ++l) {
@@ -1299,6 +1300,19 @@ __attribute__((noinline)) TILE_OPTIMIZE void form_c_print(Clusters& cl, const Pa
             any |= !(R2IJ >= RADIUS2 * hmax * hmax) & (lane_d[l] > j_min);
           }
           if (!any) continue;
+        } else if (SKIP) {  // a double sum of 0 / 1: one 512-bit vector
+          double any = 0.0;
+          #pragma omp simd reduction(+: any)
+          for (int l = 0; l < n_lanes; ++l) {
+            const double XIJ_0 = xi - jx[l];
+            const double XIJ_1 = yi - jy[l];
+            const double XIJ_2 = zi - jz[l];
+            const double R2IJ = XIJ_0 * XIJ_0 + XIJ_1 * XIJ_1 + XIJ_2 * XIJ_2;
+            const double hj = jh[l];
+            const double hmax = hi > hj ? hi : hj;
+            any += !(R2IJ >= RADIUS2 * hmax * hmax) & (lane_d[l] > j_min) ? 1.0 : 0.0;
+          }
+          if (!(any > 0.0)) continue;
         }
         // s_idx = the lane: the source's arrays offset to the j-cluster (an int s_idx = j0 + l
         // in the loop makes GCC 12 take 16 lanes for its ints, so 256-bit vectors for the
@@ -1642,8 +1656,8 @@ int main(int argc, char** argv) {
                                           : std::function<void()>([&cl, ls, &eq] { form_c_omp<8>(cl, ls->pl, eq); });
       all.push_back({std::string("c") + (ci == 4 ? "4" : "8") + "x8omp" + (cut ? "cut" : ""), run, &cl.f, ls});
     }
-  // The printable tiles: c<CI>x8print[skip][acc][neg]cut on the pruned lists (CI = 8: every
-  // variant; CI = 4: skip, acc and neg only).
+  // The printable tiles: c<CI>x8print[skip|skipor][acc][neg]cut on the pruned lists (CI = 8:
+  // every variant; CI = 4: skip, acc and neg only).
   {
     auto list_of = [&](int ci) {
       const ListSet* ls = nullptr;
@@ -1662,6 +1676,7 @@ int main(int argc, char** argv) {
     using O = std::integral_constant<int, 1>;
     add8(Z(), Z(), Z()); add8(O(), Z(), Z()); add8(Z(), O(), Z()); add8(O(), O(), Z());
     add8(Z(), Z(), O()); add8(O(), Z(), O()); add8(Z(), O(), O()); add8(O(), O(), O());
+    all.push_back({"c8x8printskiporaccnegcut", [&cl, l8, &eq] { form_c_print<8, 2, 1, 1>(cl, l8->pl, eq); }, &cl.f, l8});
     all.push_back({"c4x8printskipaccnegcut", [&cl, l4, &eq] { form_c_print<4, 1, 1, 1>(cl, l4->pl, eq); }, &cl.f, l4});
   }
   std::vector<Form> chosen;
