@@ -1244,10 +1244,11 @@ __attribute__((noinline)) void form_c_omp(Clusters& cl, const PairList& pl, cons
 // TILE_OPTIMIZE, -DTILE_OPTIMIZE= to see it). SKIP: a row whose lanes are all beyond the
 // cut-off is skipped (a first `omp simd` loop over the 8 lanes: the cut-off only; SKIP = 1 a
 // double sum of 0 or 1 per lane, SKIP = 2 an int OR reduction, which makes GCC 12 take 8
-// lanes of int, so the loop in 256-bit vectors, and costs 12% more per sweep). ACC: the sums accumulated in the lane arrays in the calls (pd_acc_ = ia[l]; the
-// body's fma onto it; kept under the mask), else the pair's terms from 0 added under the mask
-// (as the lane form prints them). NEG: the mirrored vectors XIJ_ji, VIJ_ji as negations (the
-// same doubles as the differences: a - b = -(b - a) in IEEE arithmetic), else differences.
+// lanes of int, so the loop in 256-bit vectors, and costs 10-12% more per sweep). ACC: the
+// sums accumulated in the lane arrays in the calls (pd_acc_ = ia[l]; the body's fma onto it;
+// kept under the mask), else the pair's terms from 0 added under the mask (as the lane form
+// prints them). NEG: the mirrored vectors XIJ_ji, VIJ_ji as negations (the same doubles as
+// the differences, a - b = -(b - a), but for the sign of a zero), else differences.
 #ifndef TILE_OPTIMIZE
 #define TILE_OPTIMIZE __attribute__((optimize("no-thread-jumps")))
 #endif

@@ -287,7 +287,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   scene_ << c3 << "const double lane_d = diagonal ? static_cast<double>(ii" << (selfPair ? " - 1" : "") << ") : -1.0;\n";
   // The row's cut-off alone first: a row with no pair within it is skipped.
   // (a double sum of 0 or 1: an int reduction makes GCC 12 take 8 int lanes, so this loop in
-  // 256-bit vectors, 12% more per sweep in bench/cluster_pairs.cpp)
+  // 256-bit vectors, 10-12% more per sweep in bench/cluster_pairs.cpp)
   scene_ << c3 << "double any = 0.0;\n";
   scene_ << c3 << "#pragma omp simd reduction(+: any)\n";
   scene_ << c3 << "for (int s_idx = 0; s_idx < 8; ++s_idx) {\n";
