@@ -30,8 +30,9 @@
 //
 // Results: the sums reassociated (per i: 8 lane partial sums across its cluster pairs, summed
 // in lane order; per j: the tile's i's first, then tile by tile; added to the value each sum
-// had before the pass), so not bitwise the lanes' or the scalar loops' (tests/numerics:
-// cluster_tiles_*). Serial only: the OpenMP build prints the pass as --simd-pairs=once does.
+// had before the pass), so not bitwise the lanes' or the scalar loops' (tests: lit
+// codegen/simd-pairs-cluster*.sph, stability.cluster_compare_*). Serial only: the OpenMP
+// build prints the pass as --simd-pairs=once does.
 #include "analysis/PairQuantityTable.h"
 #include "codegen/CppText.h"
 #include "codegen/Printer.h"
