@@ -10,7 +10,10 @@
 //
 // Built with the runtime (tests/CMakeLists.txt: cluster_lists_check, serial runtime; ctest
 // bench.cluster_lists at nx = 16). Run: cluster_lists [--nx 47] [--hdx 1.5] [--pert 0.05]
-//   [--skin 0.1] [--reps 7] [--column DX] [--fields 8] [--sums 7] [--move F]
+//   [--skin 0.1] [--reps 7] [--column DX] [--fields 8] [--sums 7] [--move F] [--dim 3]
+// --dim 2: the nx x nx square (2D columns: strips in x sorted by y). --cluster-order: the
+// particles first permuted into the layout's slot order (what a solver that sorted its arrays
+// into cluster order at each rebuild would have; the gathers then read contiguous runs).
 // --move F: before the per-evaluation pieces every particle moves by up to F x skin x 2 h
 // (a random direction; F <= 0.5 keeps the outer list complete).
 #include <algorithm>
@@ -41,18 +44,19 @@ struct Cube {
 };
 
 // The prototype's lattice (bench/cluster_pairs.cpp make_cube): the same draws for the positions.
-Cube make_cube(int nx, double hdx, double pert, unsigned seed) {
+// dim = 2: the nx x nx square (z = 0), the same draws per particle.
+Cube make_cube(int nx, double hdx, double pert, unsigned seed, int dim = 3) {
   const double dx = 1.0 / nx;
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> uni(-1.0, 1.0);
   Cube lat;
-  for (int iz = 0; iz < nx; ++iz)
+  for (int iz = 0; iz < (dim == 3 ? nx : 1); ++iz)
     for (int iy = 0; iy < nx; ++iy)
       for (int ix = 0; ix < nx; ++ix) {
         lat.x.push_back((ix + 0.5) * dx + pert * dx * uni(rng));
         lat.y.push_back((iy + 0.5) * dx + pert * dx * uni(rng));
-        lat.z.push_back((iz + 0.5) * dx + pert * dx * uni(rng));
-        for (int k = 0; k < 5; ++k) uni(rng);  // u, v, w, rho (as the prototype draws them)
+        lat.z.push_back(dim == 3 ? (iz + 0.5) * dx + pert * dx * uni(rng) : 0.0);
+        for (int k = 0; k < 4; ++k) uni(rng);  // u, v, w, rho (as the prototype draws them)
       }
   // The support's cells (side 2 h): the solver's order.
   const double cell = 2.0 * hdx * dx;
@@ -124,7 +128,8 @@ long pairs_in_tiles(const sphc::ClusterLayout& L, const sphc::ClusterPairList& l
 }  // namespace
 
 int main(int argc, char** argv) {
-  int nx = 47, reps = 7, fields = 8, sums = 7;
+  int nx = 47, reps = 7, fields = 8, sums = 7, dim = 3;
+  bool cluster_order = false;
   double hdx = 1.5, pert = 0.05, skin = 0.1, column = 0, move = 0.5;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
@@ -141,31 +146,42 @@ int main(int argc, char** argv) {
     else if (a == "--fields") fields = std::atoi(next());
     else if (a == "--sums") sums = std::atoi(next());
     else if (a == "--move") move = std::atof(next());
+    else if (a == "--dim") dim = std::atoi(next());
+    else if (a == "--cluster-order") cluster_order = true;
     else {
       std::fprintf(stderr, "usage: %s [--nx 47] [--hdx 1.5] [--pert 0.05] [--skin 0.1] [--reps 7] [--column DX]"
-                           " [--fields 8] [--sums 7] [--move 0.5]\n", argv[0]);
+                           " [--fields 8] [--sums 7] [--move 0.5] [--dim 3] [--cluster-order]\n", argv[0]);
       return 2;
     }
   }
   const double dx = 1.0 / nx, h = hdx * dx, support = 2.0 * h, rlist = (1.0 + skin) * support;
-  const Cube cube = make_cube(nx, hdx, pert, 12345);
+  if (dim != 2 && dim != 3) return 2;
+  const double side = column > 0 ? column * dx : 0.0;
+  Cube cube = make_cube(nx, hdx, pert, 12345, dim);
   const std::size_t n = cube.n();
+  if (cluster_order) {  // the particles permuted into the layout's slot order (padding left out)
+    sphc::ClusterLayout first;
+    sphc::build_cluster_layout(first, cube.x.data(), cube.y.data(), cube.z.data(), n, dim, side);
+    Cube sorted;
+    for (std::uint32_t p : first.slot)
+      if (p != sphc::kPadSlot) sorted.x.push_back(cube.x[p]), sorted.y.push_back(cube.y[p]), sorted.z.push_back(cube.z[p]);
+    cube = sorted;
+  }
   Cube moved = cube;
   {
     std::mt19937_64 rng(777);
     std::normal_distribution<double> g;
     std::uniform_real_distribution<double> u(0.0, 1.0);
     for (std::size_t i = 0; i < n; ++i) {
-      const double d[3] = {g(rng), g(rng), g(rng)};
+      const double d[3] = {g(rng), g(rng), dim == 3 ? g(rng) : 0.0};
       const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
       const double s = move * skin * support * u(rng) / len;
       moved.x[i] += s * d[0], moved.y[i] += s * d[1], moved.z[i] += s * d[2];
     }
   }
-  const double side = column > 0 ? column * dx : 0.0;
-  std::printf("cube nx = %d: %zu particles, h = %.3g dx, positions +-%.3g dx; list radius %.2f h, support 2 h;"
+  std::printf("%s nx = %d: %zu particles, h = %.3g dx, positions +-%.3g dx; list radius %.2f h, support 2 h;"
               " per evaluation %d source fields besides x, y, z and %d sums; particles moved by up to %.2f x skin x 2h\n",
-              nx, n, hdx, pert, rlist / h, fields, sums, move);
+              dim == 3 ? "cube" : "square (2D)", nx, n, hdx, pert, rlist / h, fields, sums, move);
 
   sphc::ClusterLayout L;
   sphc::ClusterPairList outer, pruned;
@@ -174,7 +190,7 @@ int main(int argc, char** argv) {
   std::vector<std::vector<double>> acc(sums), back(sums, std::vector<double>(n, 0.0));
   enum { LAYOUT, PAIRS, POSITIONS, FIELDS, BOXES, PRUNE, ADD, NPIECES };
   const char* names[NPIECES] = {"layout (sort into columns, clusters)", "outer list at (1 + skin) 2 h",
-                                "gather positions (3)", "gather other fields", "update boxes", "prune to 2 h",
+                                "gather positions (x, y, z in 3D)", "gather other fields", "update boxes", "prune to 2 h",
                                 "add sums back"};
   std::vector<double> best(NPIECES, 1e30);
   for (int r = 0; r < reps; ++r) {
@@ -184,7 +200,7 @@ int main(int argc, char** argv) {
       best[piece] = std::min(best[piece], t1 - t);
       t = t1;
     };
-    sphc::build_cluster_layout(L, cube.x.data(), cube.y.data(), cube.z.data(), n, 3, side);
+    sphc::build_cluster_layout(L, cube.x.data(), cube.y.data(), cube.z.data(), n, dim, side);
     lap(LAYOUT);
     sphc::build_cluster_pairs(L, L, rlist, true, outer);
     lap(PAIRS);
@@ -193,7 +209,7 @@ int main(int argc, char** argv) {
     for (auto& s : acc) s.assign(L.slots(), 1.0);
     t = cpu_now();
     sphc::gather_positions(L, moved.x.data(), moved.y.data(), moved.z.data(), xs.data(), ys.data(), zs.data(),
-                           1e6 * support);
+                           4 * support);
     lap(POSITIONS);
     for (int f = 0; f < fields; ++f) sphc::gather_slots(L, src[f].data(), dst[f].data());
     lap(FIELDS);

@@ -40,7 +40,10 @@
 //
 // Build (the flags of a solver with lanes: buildinfo cxxflags + simd_flags):
 //   c++ -std=c++17 -O3 -march=native -fno-math-errno -ffp-contract=off -fopenmp-simd
-//       -mtune-ctrl=use_gather -I runtime/include bench/cluster_pairs.cpp -o cluster_pairs
+//       -mtune-ctrl=use_gather -I runtime/include bench/cluster_pairs.cpp
+//       runtime/src/cluster_pairs.cpp -o cluster_pairs
+// (the sort into clusters, the 8 x 8 cluster-pair lists and their pruning are the runtime's,
+// sphc/cluster_pairs.h, since stop 37; tests/CMakeLists.txt links the runtime library)
 // Run: ./cluster_pairs [--nx 47] [--hdx 1.5] [--uniform-velocity] [--reps 7] [--pert 0.05]
 //                      [--skin 0.1] [--column DX] [--forms LIST] (--help: the forms' names)
 // Built for AVX-512F, needs it (exits 77 without it); built without, it has forms (a), (b) and
@@ -64,6 +67,7 @@
 
 #include <time.h>
 
+#include "sphc/cluster_pairs.h"
 #include "sphc/kernels.h"
 
 namespace {
@@ -748,65 +752,37 @@ __attribute__((noinline)) void form_b(Fluid& fl, const KeptLists& kl, const Cons
 
 constexpr int CJ = 8;  // the j-cluster: one zmm register of doubles
 
-// The particles in cluster order (a copy of the properties: what the runtime's sort would
-// make), padded per column to a multiple of 8 with particles far away from everything.
+// The particles in cluster order: the runtime's layout (sphc/cluster_pairs.h; GROMACS' grid,
+// Pall & Hess 2013: columns of side `col` in the x-y plane, x fastest, the particles of a
+// column sorted by z and cut into clusters of 8, a column's count padded to a multiple of 8, so
+// that every j-cluster (8) and i-cluster (1, 2, 4 or 8) lies in one column) and a copy of the
+// properties in its slot order (gather_slots). Padding slots take the values of their
+// cluster's first particle and positions (gather_positions) at least 4 supports from every
+// other slot, so every pair with one is beyond the cut-off: masked like any other.
 struct Clusters {
+  sphc::ClusterLayout layout;
   Fluid f;                        // properties in cluster order (f.n: padded count)
   std::vector<int> of_original;   // sorted position of original particle i
   std::vector<char> real;         // 0 for padding
   int ncj = 0;                    // j-clusters (8 particles each)
 };
 
-// GROMACS' grid (Pall & Hess 2013): columns of side `col` in the x-y plane (x
-// fastest), the particles of a column sorted by z and cut into clusters; a column's count is
-// padded to a multiple of 8, so that every j-cluster (8) and i-cluster (4 or 8) lies in one
-// column. Padding particles sit far apart from everything (10^6 h apart), so every pair with
-// one is beyond the cut-off: masked like any other.
 Clusters make_clusters(const Fluid& src, double col) {
-  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
-  for (int i = 0; i < src.n; ++i) {
-    lo[0] = std::min(lo[0], src.x[i]), hi[0] = std::max(hi[0], src.x[i]);
-    lo[1] = std::min(lo[1], src.y[i]), hi[1] = std::max(hi[1], src.y[i]);
-  }
-  const int ncx = static_cast<int>((hi[0] - lo[0]) / col) + 1;
-  const int ncy = static_cast<int>((hi[1] - lo[1]) / col) + 1;
-  std::vector<std::vector<int>> columns(ncx * ncy);
-  for (int i = 0; i < src.n; ++i) {
-    const int cx = std::min(ncx - 1, static_cast<int>((src.x[i] - lo[0]) / col));
-    const int cy = std::min(ncy - 1, static_cast<int>((src.y[i] - lo[1]) / col));
-    columns[cy * ncx + cx].push_back(i);
-  }
-  int total = 0;
-  for (std::vector<int>& c : columns) {
-    std::stable_sort(c.begin(), c.end(), [&](int a, int b) { return src.z[a] < src.z[b]; });
-    total += (static_cast<int>(c.size()) + CJ - 1) / CJ * CJ;
-  }
   Clusters cl;
+  sphc::build_cluster_layout(cl.layout, src.x.data(), src.y.data(), src.z.data(), src.n, 3, col);
+  const int total = static_cast<int>(cl.layout.slots());
   cl.f.resize(total);
-  cl.of_original.assign(src.n, -1);
-  cl.real.assign(total, 0);
   double hmax = 0;
   for (double hv : src.h) hmax = std::max(hmax, hv);
-  int at = 0, pad = 0;
-  for (const std::vector<int>& c : columns) {
-    const int end = at + (static_cast<int>(c.size()) + CJ - 1) / CJ * CJ;
-    for (int o : c) {
-      Fluid& f = cl.f;
-      f.x[at] = src.x[o]; f.y[at] = src.y[o]; f.z[at] = src.z[o];
-      f.u[at] = src.u[o]; f.v[at] = src.v[o]; f.w[at] = src.w[o];
-      f.h[at] = src.h[o]; f.rho[at] = src.rho[o]; f.m[at] = src.m[o];
-      f.cs[at] = src.cs[o]; f.p[at] = src.p[o]; f.hoisted[at] = src.hoisted[o];
-      cl.of_original[o] = at;
-      cl.real[at] = 1;
-      ++at;
-    }
-    for (; at < end; ++at, ++pad) {  // padding: far away, harmless values
-      Fluid& f = cl.f;
-      f.x[at] = 1e6 * hmax * (pad + 1); f.y[at] = -1e6 * hmax * (pad + 1); f.z[at] = 0;
-      f.h[at] = hmax; f.rho[at] = 1000.0; f.cs[at] = 10.0;
-    }
-  }
-  cl.ncj = total / CJ;
+  sphc::gather_positions(cl.layout, src.x.data(), src.y.data(), src.z.data(), cl.f.x.data(), cl.f.y.data(),
+                         cl.f.z.data(), 4 * Kernel::radius_scale * hmax);
+  Doubles Fluid::*const fields[] = {&Fluid::u, &Fluid::v, &Fluid::w, &Fluid::h, &Fluid::rho,
+                                    &Fluid::m, &Fluid::cs, &Fluid::p, &Fluid::hoisted};
+  for (Doubles Fluid::*q : fields) sphc::gather_slots(cl.layout, (src.*q).data(), (cl.f.*q).data());
+  cl.of_original.assign(cl.layout.slot_of.begin(), cl.layout.slot_of.end());
+  cl.real.assign(total, 0);
+  for (int s = 0; s < total; ++s) cl.real[s] = cl.layout.slot[s] != sphc::kPadSlot;
+  cl.ncj = static_cast<int>(cl.layout.n_clusters);
   return cl;
 }
 
@@ -837,44 +813,41 @@ double box_distance2(const Box& a, const Box& b) {
 // The cluster-pair list: per i-cluster (CI particles from ci * CI), the j-clusters cj whose
 // bounding box lies within `rlist` of its own, and only those with a particle after the
 // i-cluster's first (each pair once: j > i; the j-cluster that holds the i-cluster is the
-// diagonal tile, masked to j > i). Brute force over the j-clusters (sorted by their box's
-// low x for a quick cut): not timed.
+// diagonal tile, masked to j > i). The runtime's list of 8 x 8 cluster pairs
+// (build_cluster_pairs: from its grid of columns, j >= i); for i-clusters of 1, 2 or 4 (and,
+// counted only, j-clusters of 4) the pairs of the i-cluster's cluster of 8 filtered with the
+// smaller clusters' boxes (a smaller cluster's box lies within its cluster of 8's: none is
+// lost). Not timed.
 struct PairList {
   int ci_size = 4;
-  std::vector<int> start;  // per i-cluster, into cj
-  std::vector<int> cj;
+  std::vector<std::uint32_t> start;  // per i-cluster, into cj (sphc::ClusterPairList::begin)
+  std::vector<std::uint32_t> cj;     // (sphc::ClusterPairList::j)
 };
 PairList build_pair_list(const Clusters& cl, int CI, double rlist, int cjs = CJ) {
-  const int nci = cl.f.n / CI, ncj = cl.f.n / cjs;
-  std::vector<Box> jb(ncj);
-  for (int c = 0; c < ncj; ++c) jb[c] = box_of(cl, c * cjs, cjs);
-  std::vector<int> byx;  // j-clusters with particles, by low x
-  for (int c = 0; c < ncj; ++c)
-    if (!jb[c].empty) byx.push_back(c);
-  std::sort(byx.begin(), byx.end(), [&](int a, int b) { return jb[a].lo[0] < jb[b].lo[0]; });
-  std::vector<double> lox(byx.size());
-  for (size_t k = 0; k < byx.size(); ++k) lox[k] = jb[byx[k]].lo[0];
-  double wmax = 0;  // widest j box in x
-  for (int c : byx) wmax = std::max(wmax, jb[c].hi[0] - jb[c].lo[0]);
+  sphc::ClusterPairList l8;
+  sphc::build_cluster_pairs(cl.layout, cl.layout, rlist, true, l8);
   PairList pl;
   pl.ci_size = CI;
+  if (CI == CJ && cjs == CJ) {
+    pl.start.swap(l8.begin);
+    pl.cj.swap(l8.j);
+    return pl;
+  }
+  const int nci = cl.f.n / CI, ncj = cl.f.n / cjs, halves = CJ / cjs;
+  std::vector<Box> jb(ncj);
+  for (int c = 0; c < ncj; ++c) jb[c] = box_of(cl, c * cjs, cjs);
   pl.start.assign(nci + 1, 0);
   const double r2 = rlist * rlist;
-  std::vector<int> found;
   for (int ci = 0; ci < nci; ++ci) {
     const Box ib = box_of(cl, ci * CI, CI);
-    found.clear();
-    if (!ib.empty) {
-      const int cj_min = ci * CI / cjs;
-      auto first = std::lower_bound(lox.begin(), lox.end(), ib.lo[0] - rlist - wmax);
-      for (size_t k = first - lox.begin(); k < lox.size() && lox[k] <= ib.hi[0] + rlist; ++k) {
-        const int c = byx[k];
-        if (c >= cj_min && box_distance2(ib, jb[c]) < r2) found.push_back(c);
-      }
-      std::sort(found.begin(), found.end());
-    }
-    pl.cj.insert(pl.cj.end(), found.begin(), found.end());
-    pl.start[ci + 1] = static_cast<int>(pl.cj.size());
+    const int cj_min = ci * CI / cjs, parent = ci * CI / CJ;
+    if (!ib.empty)
+      for (std::uint32_t e = l8.begin[parent]; e < l8.begin[parent + 1]; ++e)
+        for (int q = 0; q < halves; ++q) {
+          const int c = static_cast<int>(l8.j[e]) * halves + q;
+          if (c >= cj_min && !jb[c].empty && box_distance2(ib, jb[c]) < r2) pl.cj.push_back(c);
+        }
+    pl.start[ci + 1] = static_cast<std::uint32_t>(pl.cj.size());
   }
   return pl;
 }
@@ -1075,21 +1048,35 @@ double clock_estimate() {
 
 // Dynamic pruning (GROMACS): the list kept with a skin, pruned every step to the cluster
 // pairs whose current bounding boxes lie within `rcut` (every box recomputed, then one box
-// test per kept cluster pair). What a step would pay to run the `cut` lists.
-PairList prune(const Clusters& cl, const PairList& outer, double rcut) {
+// test per kept cluster pair). What a step would pay to run the `cut` lists. Clusters of 8:
+// the runtime's (update_boxes from the positions in slot order, prune_cluster_pairs); smaller
+// i-clusters: the same test with their boxes.
+PairList prune(Clusters& cl, const PairList& outer, double rcut) {
+  PairList pl;
+  pl.ci_size = outer.ci_size;
+  if (outer.ci_size == CJ) {
+    // The runtime's form of the lists: the vectors swapped in and back (no copy; the lists
+    // themselves are not const).
+    PairList& o = const_cast<PairList&>(outer);
+    sphc::ClusterPairList in, out;
+    in.begin.swap(o.start), in.j.swap(o.cj);
+    sphc::update_boxes(cl.layout, cl.f.x.data(), cl.f.y.data(), cl.f.z.data());
+    sphc::prune_cluster_pairs(cl.layout, cl.layout, in, rcut, out);
+    in.begin.swap(o.start), in.j.swap(o.cj);
+    pl.start.swap(out.begin), pl.cj.swap(out.j);
+    return pl;
+  }
   const int CI = outer.ci_size, nci = static_cast<int>(outer.start.size()) - 1;
   std::vector<Box> ib(nci), jb(cl.ncj);
   for (int c = 0; c < nci; ++c) ib[c] = box_of(cl, c * CI, CI);
   for (int c = 0; c < cl.ncj; ++c) jb[c] = box_of(cl, c * CJ, CJ);
-  PairList pl;
-  pl.ci_size = CI;
   pl.start.assign(nci + 1, 0);
   pl.cj.reserve(outer.cj.size());
   const double r2 = rcut * rcut;
   for (int ci = 0; ci < nci; ++ci) {
     for (int e = outer.start[ci]; e < outer.start[ci + 1]; ++e)
       if (box_distance2(ib[ci], jb[outer.cj[e]]) < r2) pl.cj.push_back(outer.cj[e]);
-    pl.start[ci + 1] = static_cast<int>(pl.cj.size());
+    pl.start[ci + 1] = static_cast<std::uint32_t>(pl.cj.size());
   }
   return pl;
 }

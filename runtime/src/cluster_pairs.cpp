@@ -82,9 +82,13 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
     if (!(lo[a] <= hi[a])) lo[a] = hi[a] = 0;  // no finite coordinate
   double side = column_side;
   if (!(side > 0)) {
+    // (C V / n)^(1/k) over the k axes along which the particles extend (a flat wall of a 3D
+    // scene: its area; a line: its length).
     double volume = 1;
-    for (int a = 0; a < dim; ++a) volume *= hi[a] - lo[a];
-    side = n > 0 && volume > 0 ? std::pow(C * volume / static_cast<double>(n), 1.0 / dim) : 1.0;
+    int k = 0;
+    for (int a = 0; a < dim; ++a)
+      if (hi[a] > lo[a]) volume *= hi[a] - lo[a], ++k;
+    side = n > 0 && k > 0 ? std::pow(C * volume / static_cast<double>(n), 1.0 / k) : 1.0;
     if (!(side > 0) || !std::isfinite(side)) side = 1.0;
   }
   // At most 4 n + 16 columns: wider columns where the extent would need more.
@@ -206,12 +210,12 @@ void gather_positions(const ClusterLayout& L, const double* x, const double* y, 
   if (L.slots() == L.n) return;  // no padding
   double xmax = -HUGE_VAL;
   for (std::size_t p = 0; p < L.n; ++p) xmax = std::max(xmax, x[p]);
+  double k = 0;  // the padding slots numbered 1, 2, ... in slot order
   for (std::size_t c = 0; c < L.n_clusters; ++c) {
     const unsigned m = L.real_mask[c];
     if (m == 0xff) continue;
-    int k = 0;
     for (int lane = 0; lane < C; ++lane)
-      if (!(m >> lane & 1u)) xs[c * C + lane] = xmax + (++k) * pad_offset;
+      if (!(m >> lane & 1u)) xs[c * C + lane] = xmax + (k += 1) * pad_offset;
   }
 }
 

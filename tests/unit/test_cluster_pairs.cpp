@@ -367,15 +367,71 @@ TEST(ClusterPairs, PaddingPositionsLieFarFromEveryRealParticle) {
         const double dx = xs[k] - c.p.x[i], dy = ys[k] - c.p.y[i], dz = c.p.dim == 3 ? zs[k] - c.p.z[i] : 0.0;
         ASSERT_GE(std::sqrt(dx * dx + dy * dy + dz * dz), pad);
       }
-      // Distinct from the other padding slots of its cluster.
-      for (std::size_t q = k / kClusterSize * kClusterSize; q < k; ++q)
-        if (L.slot[q] == kPadSlot) EXPECT_GE(std::fabs(xs[k] - xs[q]), pad * (1 - 1e-12));
+      // As far from every other padding slot (up to the rounding of x + k pad_offset).
+      for (std::size_t q = 0; q < k; ++q)
+        if (L.slot[q] == kPadSlot) ASSERT_GE(std::fabs(xs[k] - xs[q]), pad * (1 - 1e-12));
     }
     EXPECT_GT(pads, 0);
     // The boxes from these positions are those of the build (padding not in a box).
     const std::vector<double> built = L.box;
     sphc::update_boxes(L, xs.data(), ys.data(), c.p.dim == 3 ? zs.data() : nullptr);
     EXPECT_EQ(L.box, built);
+  }
+}
+
+// The way a tile loop uses the pieces: positions and a property into slot order, every lane of
+// every tile of the pruned list computed (padding lanes too, no test of real_mask: only the
+// cut-off), each pair once with i's and j's sums in slot order, added back: the sums of a brute
+// force over all pairs (the same terms, summed in another order: 1e-12 of the largest).
+TEST(ClusterPairs, TilesOverThePrunedListGiveTheBruteForceSums) {
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    const double support = c.radius / 1.1, r2 = support * support;
+    ClusterLayout L = layout_of(c.p, c.side);
+    ClusterPairList outer, pruned;
+    build_cluster_pairs(L, L, c.radius, true, outer);
+    Points moved = c.p;
+    for (std::size_t i = 0; i < moved.n(); ++i) {
+      moved.x[i] += 0.04 * support * std::sin(1.7 * i);
+      moved.y[i] += 0.04 * support * std::cos(2.3 * i);
+      if (c.p.dim == 3) moved.z[i] += 0.04 * support * std::sin(0.9 * i + 1);
+    }
+    std::vector<double> m(moved.n());
+    for (std::size_t i = 0; i < m.size(); ++i) m[i] = 1.0 + 0.5 * std::sin(0.37 * i);
+    const std::size_t S = L.slots();
+    std::vector<double> xs(S), ys(S), zs(S, 0.0), ms(S), sums(S, 0.0);
+    sphc::gather_positions(L, moved.x.data(), moved.y.data(), moved.zp(), xs.data(), ys.data(),
+                           c.p.dim == 3 ? zs.data() : nullptr, 2 * support);
+    sphc::gather_slots(L, m.data(), ms.data());
+    sphc::update_boxes(L, xs.data(), ys.data(), c.p.dim == 3 ? zs.data() : nullptr);
+    prune_cluster_pairs(L, L, outer, support, pruned);
+    // Term of pair (i, j) for i: m_j (r2 - r^2); for j: m_i (r2 - r^2).
+    for (std::size_t ci = 0; ci < L.n_clusters; ++ci)
+      for (std::uint32_t e = pruned.begin[ci]; e < pruned.begin[ci + 1]; ++e) {
+        const std::size_t cj = pruned.j[e];
+        for (std::size_t i = ci * kClusterSize; i < (ci + 1) * kClusterSize; ++i)
+          for (std::size_t j = cj * kClusterSize; j < (cj + 1) * kClusterSize; ++j) {
+            const double dx = xs[i] - xs[j], dy = ys[i] - ys[j], dz = zs[i] - zs[j];
+            const double q = dx * dx + dy * dy + dz * dz;
+            const bool lane = q < r2 && (cj != ci || j > i);  // the mask
+            const double w = r2 - q;
+            sums[i] += lane ? ms[j] * w : 0.0;
+            sums[j] += lane ? ms[i] * w : 0.0;
+          }
+      }
+    std::vector<double> got(moved.n(), 0.0), want(moved.n(), 0.0);
+    sphc::add_slots(L, sums.data(), got.data());
+    double scale = 0;
+    for (std::size_t i = 0; i < moved.n(); ++i)
+      for (std::size_t j = i + 1; j < moved.n(); ++j) {
+        const double q = dist2(moved, i, moved, j);
+        if (!(q < r2)) continue;
+        want[i] += m[j] * (r2 - q);
+        want[j] += m[i] * (r2 - q);
+      }
+    for (double v : want) scale = std::max(scale, std::fabs(v));
+    ASSERT_GT(scale, 0);
+    for (std::size_t i = 0; i < moved.n(); ++i) ASSERT_NEAR(got[i], want[i], 1e-12 * scale) << "particle " << i;
   }
 }
 
@@ -409,6 +465,22 @@ TEST(ClusterPairs, SmallAndDegenerateInputs) {
     expect_layout(same, L);
     build_cluster_pairs(L, L, 0.1, true, l);
     expect_complete(same, L, same, L, l, 0.1, true);
+
+    // A flat wall (3D: a lattice in the plane y = 0.3; 2D: the line y = 0.3): columns of
+    // about 8^(1/k) spacings over the k axes it extends along.
+    Points wall;
+    wall.dim = dim;
+    for (int i = 0; i < 30; ++i)
+      for (int k = 0; k < (dim == 3 ? 30 : 1); ++k) {
+        wall.x.push_back((i + 0.5) / 30);
+        wall.y.push_back(0.3);
+        wall.z.push_back(dim == 3 ? (k + 0.5) / 30 : 0.0);
+      }
+    L = layout_of(wall, 0.0);
+    expect_layout(wall, L);
+    EXPECT_NEAR(L.column_side * 30, dim == 3 ? std::sqrt(8.0) : 8.0, 0.5);
+    build_cluster_pairs(L, L, 0.1, true, l);
+    expect_complete(wall, L, wall, L, l, 0.1, true);
 
     Points stray = random_points(1000, dim, 1.0, 23);
     stray.x[17] = 1e9, stray.y[17] = -1e9;

@@ -41,10 +41,10 @@
 // Padding: the last cluster of a column holds 1..8 real particles, real slots first
 // (real_mask). Padding slots take a real particle's values (gather_slots; so every lane's
 // arithmetic stays finite: masked lanes are still computed) and positions at least
-// `pad_offset` from every real particle of the layout (gather_positions): with pad_offset
-// beyond the support radius plus the distance between the two arrays' extents (cross loops)
-// no padding lane is within the cut-off of a real particle; add_slots never reads a padding
-// slot, so what padding lanes sum among themselves is dropped.
+// `pad_offset` from every real particle and every other padding slot of the layout
+// (gather_positions): with pad_offset beyond the support radius (plus, for a cross loop, how
+// far the other array reaches beyond this one in x) no padding lane is within the cut-off of
+// another lane; add_slots never reads a padding slot.
 //
 // Orders: the slot order depends only on the positions at the build (ties in the sort key
 // by particle index); the j-clusters of a list are in increasing index per i-cluster. The
@@ -93,8 +93,9 @@ struct ClusterLayout {
 double cluster_column_side(double spacing, int dim);
 
 // At a list rebuild: the layout of n particles at (x, y, z) (z unused, may be null, in 2D).
-// column_side <= 0: (kClusterSize * V / n)^(1/dim), V the volume (2D: area) of the particles'
-// bounding box (2 dx for a filled box on a lattice of spacing dx). Where the bounding box
+// column_side <= 0: (kClusterSize * V / n)^(1/k), V the volume (2D: area) of the particles'
+// bounding box over the k axes along which they extend (2 dx for a filled box on a lattice of
+// spacing dx; a flat wall of a 3D scene: its area, 2.83 dx). Where the bounding box
 // would need more than 4 n + 16 columns (a stray particle), the columns are made wider.
 // Boxes from these positions.
 void build_cluster_layout(ClusterLayout& layout, const double* x, const double* y,
@@ -105,10 +106,14 @@ void build_cluster_layout(ClusterLayout& layout, const double* x, const double* 
 void gather_slots(const ClusterLayout& layout, const double* src, double* dst);
 void gather_slots(const ClusterLayout& layout, const float* src, float* dst);
 
-// Per evaluation: the positions in slot order (z, zs unused in 2D, may be null). Padding
-// slot k of its cluster (k = 1, 2, ... in the order of the padding slots) sits at
-// x = (largest x of the real particles) + k pad_offset, its y and z those of the cluster's
-// first particle: at least pad_offset from every real particle of the layout.
+// Per evaluation: the positions in slot order (z, zs unused in 2D, may be null). The k-th
+// padding slot of the layout (k = 1, 2, ... in slot order; at most 7 per column) sits at
+// x = (largest x of the real particles) + k pad_offset, its y and z those of its cluster's
+// first particle: at least pad_offset from every real particle of the layout and from every
+// other padding slot (so with pad_offset beyond the cut-off no padding lane is within it of
+// any lane of the layout: a tile's mask holds real pairs only). Take pad_offset a few support
+// radii (plus, for a cross loop, how far the other array reaches beyond this one's largest
+// x), not a huge number: the coordinates stay finite and their differences exact enough.
 void gather_positions(const ClusterLayout& layout, const double* x, const double* y,
                       const double* z, double* xs, double* ys, double* zs, double pad_offset);
 
