@@ -1222,6 +1222,163 @@ __attribute__((noinline)) void form_c_omp(Clusters& cl, const PairList& pl, cons
   }
 }
 
+// The tile printable by sphc (stop 37, docs/performance.md "Cluster-pair tiles in the
+// printer"): form_c_omp's lane body (the generated _simd / _simd_mirror calls) under
+// `#pragma omp simd` over the 8 j's of a tile, with what makes GCC 12 vectorise it in 512-bit
+// vectors: s_idx the lane (the source arrays offset to the j-cluster: no int arithmetic in
+// the loop), the trip count the constant 8, and no jump threading in the function (GCC's
+// threading of the kernel's branches before if-conversion leaves "control flow in loop":
+// TILE_OPTIMIZE, -DTILE_OPTIMIZE= to see it). SKIP: a row whose lanes are all beyond the
+// cut-off is skipped (a first `omp simd` loop over the 8 lanes: the cut-off only; SKIP = 1 a
+// double sum of 0 or 1 per lane, SKIP = 2 an int OR reduction, which makes GCC 12 take 8
+// lanes of int, so the loop in 256-bit vectors, and costs 10-12% more per sweep). ACC: the
+// sums accumulated in the lane arrays in the calls (pd_acc_ = ia[l]; the body's fma onto it;
+// kept under the mask), else the pair's terms from 0 added under the mask (as the lane form
+// prints them). NEG: the mirrored vectors XIJ_ji, VIJ_ji as negations (the same doubles as
+// the differences, a - b = -(b - a), but for the sign of a zero), else differences.
+#ifndef TILE_OPTIMIZE
+#define TILE_OPTIMIZE __attribute__((optimize("no-thread-jumps")))
+#endif
+template <int CI, int SKIP, int ACC, int NEG>
+__attribute__((noinline)) TILE_OPTIMIZE void form_c_print(Clusters& cl, const PairList& pl, const Constants& eqc) {
+  Fluid& fl = cl.f;
+  const double t = 0.0, dt = 1e-4;
+  const double *sj_x = fl.x.data(), *sj_y = fl.y.data(), *sj_z = fl.z.data();
+  const double *sj_u = fl.u.data(), *sj_v = fl.v.data(), *sj_w = fl.w.data();
+  const double *sj_h = fl.h.data(), *sj_rho = fl.rho.data(), *di_rho = sj_rho;
+  const double *s_cs = fl.cs.data(), *s_m = fl.m.data(), *s_p = fl.p.data(), *s_rho = fl.rho.data();
+  const double *d_p = s_p, *hoisted_eq2_0 = fl.hoisted.data();
+  double* S[7];
+  for (int k = 0; k < 7; ++k) S[k] = fl.sums[k].data();
+  struct { double alpha, beta; } eq2{eqc.alpha, eqc.beta};
+  struct { double eps; } eq3{eqc.eps};
+  const int nci = static_cast<int>(pl.start.size()) - 1;
+  constexpr int n_lanes = CJ;  // a constant trip count (a runtime one: 32-byte vectors, a scalar epilogue)
+  for (int ci = 0; ci < nci; ++ci) {
+    const int i0 = ci * CI;
+    if (pl.start[ci] == pl.start[ci + 1]) continue;
+    alignas(64) double iacc[CI][7][CJ] = {};
+    for (int e = pl.start[ci]; e < pl.start[ci + 1]; ++e) {
+      const int j0 = pl.cj[e] * CJ;
+      const bool diagonal = j0 < i0 + CI;
+      alignas(64) double jacc[7][CJ] = {};
+      for (int ii = 0; ii < CI; ++ii) {
+        const int d_idx = i0 + ii;
+        const double xi = sj_x[d_idx], yi = sj_y[d_idx], zi = sj_z[d_idx], hi = sj_h[d_idx];
+        const double ui = sj_u[d_idx], vi = sj_v[d_idx], wi = sj_w[d_idx];
+        const double dhoisted_eq2_0 = hoisted_eq2_0[d_idx];
+        const double dval_cs = s_cs[d_idx], dval_rho = s_rho[d_idx];
+        const double sval_m = s_m[d_idx], sval_cs = s_cs[d_idx], sval_rho = s_rho[d_idx];
+        double* ia0 = iacc[ii][0]; double* ia1 = iacc[ii][1]; double* ia2 = iacc[ii][2];
+        double* ia3 = iacc[ii][3]; double* ia4 = iacc[ii][4]; double* ia5 = iacc[ii][5];
+        double* ia6 = iacc[ii][6];
+        const double j_min = diagonal ? double(d_idx - j0) : -1.0;  // the diagonal tile: j > i only
+        static constexpr double lane_d[CJ] = {0, 1, 2, 3, 4, 5, 6, 7};
+        const double *jx = sj_x + j0, *jy = sj_y + j0, *jz = sj_z + j0, *ju = sj_u + j0, *jv = sj_v + j0, *jw = sj_w + j0, *jh = sj_h + j0, *jrho = s_rho + j0, *jcs = s_cs + j0, *jm = s_m + j0, *jp = s_p + j0, *jho = hoisted_eq2_0 + j0;
+        if (SKIP == 2) {  // an int OR reduction: GCC takes 2 x 256-bit vectors for the loop
+          int any = 0;
+          #pragma omp simd reduction(|: any)
+          for (int l = 0; l < n_lanes; ++l) {
+            const double XIJ_0 = xi - jx[l];
+            const double XIJ_1 = yi - jy[l];
+            const double XIJ_2 = zi - jz[l];
+            const double R2IJ = XIJ_0 * XIJ_0 + XIJ_1 * XIJ_1 + XIJ_2 * XIJ_2;
+            const double hj = jh[l];
+            const double hmax = hi > hj ? hi : hj;
+            any |= !(R2IJ >= RADIUS2 * hmax * hmax) & (lane_d[l] > j_min);
+          }
+          if (!any) continue;
+        } else if (SKIP) {  // a double sum of 0 / 1: one 512-bit vector
+          double any = 0.0;
+          #pragma omp simd reduction(+: any)
+          for (int l = 0; l < n_lanes; ++l) {
+            const double XIJ_0 = xi - jx[l];
+            const double XIJ_1 = yi - jy[l];
+            const double XIJ_2 = zi - jz[l];
+            const double R2IJ = XIJ_0 * XIJ_0 + XIJ_1 * XIJ_1 + XIJ_2 * XIJ_2;
+            const double hj = jh[l];
+            const double hmax = hi > hj ? hi : hj;
+            any += !(R2IJ >= RADIUS2 * hmax * hmax) & (lane_d[l] > j_min) ? 1.0 : 0.0;
+          }
+          if (!(any > 0.0)) continue;
+        }
+        // s_idx = the lane: the source's arrays offset to the j-cluster (an int s_idx = j0 + l
+        // in the loop makes GCC 12 take 16 lanes for its ints, so 256-bit vectors for the
+        // doubles); vectorised in 512-bit vectors where jump threading is off (TILE_OPTIMIZE)
+        #pragma omp simd
+        for (int l = 0; l < n_lanes; ++l) {
+          const int s_idx = l;
+          const double hj = jh[s_idx];
+          const double XIJ_0 = xi - jx[s_idx];
+          const double XIJ_1 = yi - jy[s_idx];
+          const double XIJ_2 = zi - jz[s_idx];
+          const double XIJ_ji_0 = NEG ? -XIJ_0 : jx[s_idx] - xi;
+          const double XIJ_ji_1 = NEG ? -XIJ_1 : jy[s_idx] - yi;
+          const double XIJ_ji_2 = NEG ? -XIJ_2 : jz[s_idx] - zi;
+          const double R2IJ = XIJ_0 * XIJ_0 + XIJ_1 * XIJ_1 + XIJ_2 * XIJ_2;
+          const double HIJ = 0.5 * (hi + hj);
+          const double RIJ = std::sqrt(R2IJ);
+          const double VIJ_0 = ui - ju[s_idx];
+          const double VIJ_1 = vi - jv[s_idx];
+          const double VIJ_2 = wi - jw[s_idx];
+          const double VIJ_ji_0 = NEG ? -VIJ_0 : ju[s_idx] - ui;
+          const double VIJ_ji_1 = NEG ? -VIJ_1 : jv[s_idx] - vi;
+          const double VIJ_ji_2 = NEG ? -VIJ_2 : jw[s_idx] - wi;
+          const double WIJ = Kernel::w(RIJ, HIJ);
+          const double DWIJ_f = Kernel::gradient_factor(RIJ, HIJ);
+          const double DWIJ_0 = DWIJ_f * XIJ_0;
+          const double DWIJ_1 = DWIJ_f * XIJ_1;
+          const double DWIJ_2 = DWIJ_f * XIJ_2;
+          const double DWIJ_ji_0 = DWIJ_f * XIJ_ji_0;
+          const double DWIJ_ji_1 = DWIJ_f * XIJ_ji_1;
+          const double DWIJ_ji_2 = DWIJ_f * XIJ_ji_2;
+          const double RHOIJ = 0.5 * (di_rho[d_idx] + jrho[s_idx]);
+          const double RHOIJ1 = 1.0 / RHOIJ;
+          const double EPS = 0.01 * HIJ * HIJ;
+          const double hmax = hi > hj ? hi : hj;
+          const bool in_support = !(R2IJ >= RADIUS2 * hmax * hmax) & (lane_d[l] > j_min);
+          const double pshared_eq1_0 = ContinuityEquation_loop_pairshared0_simd(d_idx, s_idx, t, dt, VIJ_0, VIJ_1, VIJ_2, DWIJ_0, DWIJ_1, DWIJ_2, jm);
+          const double pshared_eq2_0 = MomentumEquation_loop_pairshared0_simd(d_idx, s_idx, t, dt, XIJ_0, XIJ_1, XIJ_2, VIJ_0, VIJ_1, VIJ_2, DWIJ_0, DWIJ_1, DWIJ_2, R2IJ, HIJ, RHOIJ1, EPS, eq2.alpha, eq2.beta, dval_cs, d_p, dval_rho, jcs, jm, jp, jrho, jho, dhoisted_eq2_0);
+          const double pshared_eq2_1 = MomentumEquation_loop_pairshared1_simd(d_idx, s_idx, t, dt, XIJ_0, XIJ_1, XIJ_2, VIJ_0, VIJ_1, VIJ_2, DWIJ_0, DWIJ_1, DWIJ_2, R2IJ, HIJ, RHOIJ1, EPS, eq2.alpha, eq2.beta, dval_cs, d_p, dval_rho, jcs, jm, jp, jrho, jho, dhoisted_eq2_0);
+          const double pshared_eq2_2 = MomentumEquation_loop_pairshared2_simd(d_idx, s_idx, t, dt, XIJ_0, XIJ_1, XIJ_2, VIJ_0, VIJ_1, VIJ_2, DWIJ_0, DWIJ_1, DWIJ_2, R2IJ, HIJ, RHOIJ1, EPS, eq2.alpha, eq2.beta, dval_cs, d_p, dval_rho, jcs, jm, jp, jrho, jho, dhoisted_eq2_0);
+          double pd_acc_arho = ACC ? ia0[l] : 0.0, pd_acc_au = ACC ? ia1[l] : 0.0, pd_acc_av = ACC ? ia2[l] : 0.0, pd_acc_aw = ACC ? ia3[l] : 0.0, pd_acc_ax = ACC ? ia4[l] : 0.0, pd_acc_ay = ACC ? ia5[l] : 0.0, pd_acc_az = ACC ? ia6[l] : 0.0;
+          double ps_acc_arho = ACC ? jacc[0][l] : 0.0, ps_acc_au = ACC ? jacc[1][l] : 0.0, ps_acc_av = ACC ? jacc[2][l] : 0.0, ps_acc_aw = ACC ? jacc[3][l] : 0.0, ps_acc_ax = ACC ? jacc[4][l] : 0.0, ps_acc_ay = ACC ? jacc[5][l] : 0.0, ps_acc_az = ACC ? jacc[6][l] : 0.0;
+          ContinuityEquation_loop_simd(d_idx, s_idx, t, dt, VIJ_0, VIJ_1, VIJ_2, DWIJ_0, DWIJ_1, DWIJ_2, pd_acc_arho, jm, pshared_eq1_0);
+          MomentumEquation_loop_simd(d_idx, s_idx, t, dt, XIJ_0, XIJ_1, XIJ_2, VIJ_0, VIJ_1, VIJ_2, DWIJ_0, DWIJ_1, DWIJ_2, R2IJ, HIJ, RHOIJ1, EPS, eq2.alpha, eq2.beta, pd_acc_au, pd_acc_av, pd_acc_aw, dval_cs, d_p, dval_rho, jcs, jm, jp, jrho, jho, dhoisted_eq2_0, pshared_eq2_0, pshared_eq2_1, pshared_eq2_2);
+          XSPHCorrection_loop_simd(d_idx, s_idx, t, dt, VIJ_0, VIJ_1, VIJ_2, WIJ, RHOIJ1, eq3.eps, pd_acc_ax, pd_acc_ay, pd_acc_az, jm);
+          ContinuityEquation_loop_simd_mirror(s_idx, d_idx, t, dt, VIJ_ji_0, VIJ_ji_1, VIJ_ji_2, DWIJ_ji_0, DWIJ_ji_1, DWIJ_ji_2, ps_acc_arho, sval_m, pshared_eq1_0);
+          MomentumEquation_loop_simd_mirror(s_idx, d_idx, t, dt, XIJ_ji_0, XIJ_ji_1, XIJ_ji_2, VIJ_ji_0, VIJ_ji_1, VIJ_ji_2, DWIJ_ji_0, DWIJ_ji_1, DWIJ_ji_2, R2IJ, HIJ, RHOIJ1, EPS, eq2.alpha, eq2.beta, ps_acc_au, ps_acc_av, ps_acc_aw, jcs[s_idx], d_p, jrho[s_idx], sval_cs, sval_m, s_p, sval_rho, jho, jho[s_idx], pshared_eq2_0, pshared_eq2_1, pshared_eq2_2);
+          XSPHCorrection_loop_simd_mirror(s_idx, d_idx, t, dt, VIJ_ji_0, VIJ_ji_1, VIJ_ji_2, WIJ, RHOIJ1, eq3.eps, ps_acc_ax, ps_acc_ay, ps_acc_az, sval_m);
+          if (ACC) ia0[l] = in_support ? pd_acc_arho : ia0[l]; else ia0[l] += in_support ? pd_acc_arho : 0.0;
+          if (ACC) ia1[l] = in_support ? pd_acc_au : ia1[l]; else ia1[l] += in_support ? pd_acc_au : 0.0;
+          if (ACC) ia2[l] = in_support ? pd_acc_av : ia2[l]; else ia2[l] += in_support ? pd_acc_av : 0.0;
+          if (ACC) ia3[l] = in_support ? pd_acc_aw : ia3[l]; else ia3[l] += in_support ? pd_acc_aw : 0.0;
+          if (ACC) ia4[l] = in_support ? pd_acc_ax : ia4[l]; else ia4[l] += in_support ? pd_acc_ax : 0.0;
+          if (ACC) ia5[l] = in_support ? pd_acc_ay : ia5[l]; else ia5[l] += in_support ? pd_acc_ay : 0.0;
+          if (ACC) ia6[l] = in_support ? pd_acc_az : ia6[l]; else ia6[l] += in_support ? pd_acc_az : 0.0;
+          if (ACC) jacc[0][l] = in_support ? ps_acc_arho : jacc[0][l]; else jacc[0][l] += in_support ? ps_acc_arho : 0.0;
+          if (ACC) jacc[1][l] = in_support ? ps_acc_au : jacc[1][l]; else jacc[1][l] += in_support ? ps_acc_au : 0.0;
+          if (ACC) jacc[2][l] = in_support ? ps_acc_av : jacc[2][l]; else jacc[2][l] += in_support ? ps_acc_av : 0.0;
+          if (ACC) jacc[3][l] = in_support ? ps_acc_aw : jacc[3][l]; else jacc[3][l] += in_support ? ps_acc_aw : 0.0;
+          if (ACC) jacc[4][l] = in_support ? ps_acc_ax : jacc[4][l]; else jacc[4][l] += in_support ? ps_acc_ax : 0.0;
+          if (ACC) jacc[5][l] = in_support ? ps_acc_ay : jacc[5][l]; else jacc[5][l] += in_support ? ps_acc_ay : 0.0;
+          if (ACC) jacc[6][l] = in_support ? ps_acc_az : jacc[6][l]; else jacc[6][l] += in_support ? ps_acc_az : 0.0;
+        }
+      }
+      for (int k = 0; k < 7; ++k) {
+        #pragma omp simd
+        for (int l = 0; l < CJ; ++l) S[k][j0 + l] += jacc[k][l];
+      }
+    }
+    for (int ii = 0; ii < CI; ++ii)
+      for (int k = 0; k < 7; ++k) {
+        double sum = 0;
+        for (int l = 0; l < CJ; ++l) sum += iacc[ii][k][l];
+        S[k][i0 + ii] += sum;
+      }
+  }
+}
+
 // Counts of one list: tile lanes (CI x 8 per entry), pairs within the support among them.
 struct TileCounts {
   long entries = 0, lanes = 0, in_support = 0;
@@ -1487,6 +1644,29 @@ int main(int argc, char** argv) {
                                           : std::function<void()>([&cl, ls, &eq] { form_c_omp<8>(cl, ls->pl, eq); });
       all.push_back({std::string("c") + (ci == 4 ? "4" : "8") + "x8omp" + (cut ? "cut" : ""), run, &cl.f, ls});
     }
+  // The printable tiles: c<CI>x8print[skip|skipor][acc][neg]cut on the pruned lists (CI = 8:
+  // every variant; CI = 4: skip, acc and neg only).
+  {
+    auto list_of = [&](int ci) {
+      const ListSet* ls = nullptr;
+      for (const ListSet& l : lists)
+        if (l.ci == ci && l.rlist < Kernel::radius_scale * hmax * (1.0 + 0.5 * skin)) ls = &l;
+      return ls;
+    };
+    const ListSet* l8 = list_of(8);
+    const ListSet* l4 = list_of(4);
+    auto add8 = [&](auto skip, auto acc, auto neg) {
+      constexpr int S = decltype(skip)::value, A = decltype(acc)::value, N = decltype(neg)::value;
+      all.push_back({std::string("c8x8print") + (S ? "skip" : "") + (A ? "acc" : "") + (N ? "neg" : "") + "cut",
+                     [&cl, l8, &eq] { form_c_print<8, S, A, N>(cl, l8->pl, eq); }, &cl.f, l8});
+    };
+    using Z = std::integral_constant<int, 0>;
+    using O = std::integral_constant<int, 1>;
+    add8(Z(), Z(), Z()); add8(O(), Z(), Z()); add8(Z(), O(), Z()); add8(O(), O(), Z());
+    add8(Z(), Z(), O()); add8(O(), Z(), O()); add8(Z(), O(), O()); add8(O(), O(), O());
+    all.push_back({"c8x8printskiporaccnegcut", [&cl, l8, &eq] { form_c_print<8, 2, 1, 1>(cl, l8->pl, eq); }, &cl.f, l8});
+    all.push_back({"c4x8printskipaccnegcut", [&cl, l4, &eq] { form_c_print<4, 1, 1, 1>(cl, l4->pl, eq); }, &cl.f, l4});
+  }
   std::vector<Form> chosen;
   for (const Form& fm : all)
     if (("," + forms + ",").find("," + fm.name + ",") != std::string::npos) chosen.push_back(fm);

@@ -55,6 +55,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   simdGhostOnce_ = opts.symmetricPairs && opts.verletSkin > 0 && hasDomain() && !singlePrecision_;
   // SimdPairs.cpp: each pair once in the lanes (double precision: the pair-shared values).
   simdOnce_ = opts.simdPairsOnce && simdPairs_ && simdSymmetric_ && !singlePrecision_;
+  simdCluster_ = opts.simdPairsCluster && simdOnce_;  // ClusterPairs.cpp
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in
   // lanes); --simd-pairs=on prints every loop that allows it per destination.
   pairShared_ = opts.pairShared && host_.hoist && (!simdPairs_ || simdAuto_);

@@ -121,6 +121,11 @@ struct EmitOptions {
   // printed each pair once in the lanes, the values the pair shares once per pair, the source
   // side added by a masked scatter (codegen/SimdPairs.cpp, emitSymmetricSimdLoops).
   bool simdPairsOnce = false;
+  // --simd-pairs=cluster (opt-in, stop 37; with simdPairsOnce): a loop that simdPairsOnce
+  // prints each pair once in lanes is printed as cluster-pair tiles where it can
+  // (codegen/ClusterPairs.cpp: serial, double precision, 2D and 3D; sphc/cluster_pairs.h),
+  // else as simdPairsOnce prints it, the generated code saying why.
+  bool simdPairsCluster = false;
   // --simd-neighbours=N: auto's threshold on a loop's expected neighbour count
   // (kSimdAutoNeighbours by default; a measurement knob: 0 puts every loop that allows it in
   // lanes under auto's rule, e.g. with --simd-pairs=once the 2D scenes' loops).

@@ -43,6 +43,19 @@ class CpuPrinter : public ScenePrinter {
     if (verlet()) out_ << "#include \"sphc/verlet.h\"\n";
     if (tuned_) out_ << "#include \"sphc/verlet_tune.h\"\n";
     if (openmp_ && anyCrossPair()) out_ << "#include \"sphc/cross_pairs.h\"\n";
+    if (anyClusterTiles()) out_ << "#include \"sphc/cluster_pairs.h\"\n";
+  }
+  // --simd-pairs=cluster (codegen/ClusterPairs.cpp): the base's conditions, then the CPU
+  // printer's: serial, the fixed skin, kept lists of the pass's own.
+  std::string clusterTilesRefusal(const DestinationWork& w,
+                                  const NeighbourPass& pass) const override;
+  bool anyClusterTiles() const {
+    bool any = false;
+    walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
+                                     const NeighbourPass& pass) {
+      any |= pass.searches() && clusterTilesRefusal(w, pass).empty();
+    });
+    return any;
   }
   void systemIncludes() override {
     if (openmp_) out_ << "\n#include <omp.h>\n";
@@ -306,6 +319,8 @@ void CpuPrinter::verletMembers() {
          << arr(w.array).name
          << " <- " << arr(pass.source).name
          << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase")) << "\n";
+    if (clusterTilesRefusal(w, pass).empty())  // codegen/ClusterPairs.cpp
+      clusterTilesMembers(out_, lists, arr(w.array).name + " <- " + arr(pass.source).name);
   });
   for (const auto& [lists, B] : crossSourceLists())
     out_ << "  sphc::CrossSources " << lists << "_by_source;  // the same lists from " << B
@@ -623,6 +638,28 @@ std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
     }
   });
   return found;
+}
+
+std::string CpuPrinter::clusterTilesRefusal(const DestinationWork& w,
+                                            const NeighbourPass& pass) const {
+  std::string why = ScenePrinter::clusterTilesRefusal(w, pass);
+  if (!why.empty()) return why;
+  if (openmp_) return "the OpenMP build (the tiles are serial in this version)";
+  if (tuned()) return "--verlet-skin=auto (the tiles take the fixed skin's radius)";
+  if (!verlet()) return "no kept lists";
+  // The tiles build no kept lists: none may be shared with another pass (verletLists).
+  std::string phase;
+  walkPasses(sched_.equations, [&](const Phase& ph, const DestinationWork& x, const NeighbourPass&) {
+    if (&x == &w) phase = ph.name;
+  });
+  const std::string lists = verletLists(phase, w, pass.source);
+  int users = 0;
+  walkPasses(sched_.equations, [&](const Phase& ph, const DestinationWork& x,
+                                   const NeighbourPass& p) {
+    users += p.searches() && verletLists(ph.name, x, p.source) == lists;
+  });
+  if (users > 1) return "its kept lists are shared with another pass";
+  return "";
 }
 
 // Whether the pass over w's own array is printed each pair once (SymmetricPairs.cpp): not in

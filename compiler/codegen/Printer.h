@@ -413,13 +413,35 @@ class ScenePrinter {
   // ...) and, with `mask`, the cut-off as a mask (in_support); the destination's other
   // values (dval_NAME); the mirrored call of eq in its _simd form on the locals
   // sumsPrefix + acc_NAME.
+  // `negatedMirrors`: the mirrored differences as negations (-XIJ_0: the same doubles but
+  // for the sign of a zero difference; the cluster-pair tiles).
   void emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q, bool both,
-                              const std::string& body, bool mask) const;
+                              const std::string& body, bool mask,
+                              bool negatedMirrors = false) const;
   void emitDestinationValueLoads(std::ostream& os, const DestinationWork& w,
                                  const NeighbourPass& pass, const std::string& in) const;
   std::string simdMirroredCall(const PlanEquation& eq, int d, const RegisterSums& sums,
                                const std::string& sumsPrefix) const;
   bool simdOnce_ = false;  // EmitOptions::simdPairsOnce (double, kept lists)
+
+  // ---- Each pair once in cluster-pair tiles (ClusterPairs.cpp; sphc --simd-pairs=cluster) ----
+  // Why the pass (destination w) that onceLanes() prints each pair once in lanes is not
+  // printed as cluster-pair tiles, "" if it is ("off" without the switch). The CPU printer
+  // adds its own conditions (the OpenMP build, kept lists shared with another pass, the
+  // tuned skin).
+  virtual std::string clusterTilesRefusal(const DestinationWork& w,
+                                          const NeighbourPass& pass) const;
+  // The pass as cluster-pair tiles (in emitSymmetricPass's place, after the kept lists'
+  // rebuild check: verlet_build): the cluster layout and list at a rebuild, the slot-order
+  // copies, the pruned list, the tiles, the sums added back. `state`: the prefix of its
+  // members (clusterTilesMembers).
+  void emitClusterTiles(const DestinationWork& w, const NeighbourPass& pass,
+                        const std::string& state, const std::string& listRadius2,
+                        const std::set<std::string>& q, const RegisterSums& sums);
+  // The members of struct Scene a pass in tiles keeps (state: its kept lists' member name).
+  static void clusterTilesMembers(std::ostream& os, const std::string& state,
+                                  const std::string& what);
+  bool simdCluster_ = false;  // EmitOptions::simdPairsCluster (with simdOnce_)
   // --precision=single: the float local a SIMD loop passes for a body's double argument (t,
   // dt, an equation's scalar: f_t, f_eq2_alpha), converted once before the loop; "" for
   // other parameters.

@@ -327,9 +327,15 @@ std::vector<std::string> ScenePrinter::simdPairsNotes() const {
     const std::string why = simdPairsRefusal(w, pass);
     if (!why.empty())
       notes.push_back("pair loop not in SIMD lanes: " + loop + ": " + why);
+    else if (onceLanes(w, pass) && clusterTilesRefusal(w, pass).empty())  // ClusterPairs.cpp
+      notes.push_back("pair loop in cluster-pair tiles, each pair once: " + loop +
+                      ": --simd-pairs=cluster");
     else if (onceLanes(w, pass))
       notes.push_back("pair loop in SIMD lanes, each pair once: " + loop +
-                      ": --simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why);
+                      ": --simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why +
+                      (simdCluster_ ? " (not in cluster-pair tiles: " +
+                                          clusterTilesRefusal(w, pass) + ")"
+                                    : std::string()));
     else
       notes.push_back("pair loop in SIMD lanes: " + loop + ": " +
                       (simdAuto_ ? "--simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why
@@ -564,7 +570,8 @@ std::string ScenePrinter::simdMirroredCall(const PlanEquation& eq, int d,
 }
 
 void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q,
-                                          bool both, const std::string& body, bool mask) const {
+                                          bool both, const std::string& body, bool mask,
+                                          bool negatedMirrors) const {
   const std::string& R = host_.real;
   const PairDialect dialect = pairDialectOf(host_);
   os << body << "const " << R << " hj = sj_h[s_idx];\n";
@@ -581,8 +588,9 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
       if (both)  // as a difference: a zero keeps the scalar form's sign
         for (int k = 0; k < 3; ++k)
           os << body << "const " << R << " " << pq.name << "_ji_" << k << " = "
-             << (k < plan_.dim ? "sj_" + pq.components[k] + "[s_idx] - " + pq.components[k] + "i"
-                               : std::string("0.0"))
+             << (k >= plan_.dim    ? std::string("0.0")
+                 : negatedMirrors ? "-" + pq.name + "_" + std::to_string(k)
+                                  : "sj_" + pq.components[k] + "[s_idx] - " + pq.components[k] + "i")
              << ";\n";
     } else if (pq.form == PairForm::Gradient) {
       // grad_j of the mirrored call: DWIJ -> DWIJ_ji (same h), DWI (h_i) -> DWJ_ji, DWJ

@@ -287,6 +287,12 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
                                       "default(firstprivate) shared(cells)\n"
                                     : "";
   const bool simd = onceLanes(w, pass);  // --simd-pairs=once (SimdPairs.cpp)
+  // --simd-pairs=cluster: in cluster-pair tiles where they can (ClusterPairs.cpp).
+  const std::string clusterWhy = simd ? clusterTilesRefusal(w, pass) : "off";
+  if (clusterWhy.empty())
+    return emitClusterTiles(w, pass, lists, listRadius2, q, registerSums(w, pass));
+  if (clusterWhy != "off")
+    scene_ << "        // Not in cluster-pair tiles (codegen/ClusterPairs.cpp): " << clusterWhy << ".\n";
   if (simd)
     scene_ << "        // Each pair once for both particles in SIMD lanes (codegen/SimdPairs.cpp;\n"
               "        // sphc --simd-pairs=once): the sums reassociated across the lanes.\n";

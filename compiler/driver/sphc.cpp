@@ -586,7 +586,7 @@ int main(int argc, char** argv) {
   // --simd-pairs: auto (the default), on (also bare), off; the lanes only on the CPU backends.
   const std::string simdMode = SimdPairs.empty() ? std::string("on") : SimdPairs.getValue();
   if (simdMode != "auto" && simdMode != "on" && simdMode != "off" && simdMode != "once" &&
-      simdMode != "perdest") {
+      simdMode != "perdest" && simdMode != "cluster") {
     llvm::errs() << "sphc: error: --simd-pairs=" << simdMode
                  << ": it is auto, on, off, once or perdest\n";
     return fail();
@@ -594,8 +594,13 @@ int main(int argc, char** argv) {
   emitOpts.simdPairs = simdMode != "off";
   // auto (= once since stop 35): the loops that pay in lanes, each pair once in them where
   // they may; perdest: the same loops per destination (stops 33-34's auto).
-  emitOpts.simdPairsAuto = simdMode == "auto" || simdMode == "once" || simdMode == "perdest";
-  emitOpts.simdPairsOnce = simdMode == "auto" || simdMode == "once";
+  // cluster (opt-in, not in the option's help while it is measured; stop 37): auto's loops,
+  // those each pair once in lanes as cluster-pair tiles where they can
+  // (codegen/ClusterPairs.cpp).
+  emitOpts.simdPairsAuto = simdMode == "auto" || simdMode == "once" || simdMode == "perdest" ||
+                           simdMode == "cluster";
+  emitOpts.simdPairsOnce = simdMode == "auto" || simdMode == "once" || simdMode == "cluster";
+  emitOpts.simdPairsCluster = simdMode == "cluster";
   emitOpts.simdAutoNeighbours = SimdNeighbours;
   emitOpts.simdOnceNeighbours = SimdOnceNeighbours;
   emitOpts.simdPerDestNeighbours = SimdPerDestNeighbours;
@@ -610,7 +615,7 @@ int main(int argc, char** argv) {
       return fail();
     }
     emitOpts.simdCpu = simdLanesOnCpu(cpu);
-    if (simdMode == "once" || simdMode == "perdest") {  // named: the lanes, whatever the CPU
+    if (simdMode == "once" || simdMode == "perdest" || simdMode == "cluster") {  // named: the lanes, whatever the CPU
       emitOpts.simdCpu.lanes = true;
       emitOpts.simdCpu.why = "--simd-pairs=" + simdMode + " names the lanes";
     }

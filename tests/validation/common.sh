@@ -42,7 +42,8 @@ scene_args() {
 }
 
 # sphc_options ARG...: the compile-time options at the front of ARG... (-D NAME=CHOICE,
-# --global-ids) as the words SPHC_OPTS, to pass to sphc; NARGS: how many arguments they took
+# --global-ids, --simd-pairs=MODE, --simd-once-neighbours=N) as the words SPHC_OPTS, to pass
+# to sphc; NARGS: how many arguments they took
 # (the caller then drops them: shift "$NARGS").
 sphc_options() {
   SPHC_OPTS=""
@@ -55,7 +56,7 @@ sphc_options() {
         NARGS=$((NARGS + 2))
         shift 2
         ;;
-      --global-ids)
+      --global-ids | --simd-pairs=* | --simd-once-neighbours=*)
         SPHC_OPTS="$SPHC_OPTS $1"
         NARGS=$((NARGS + 1))
         shift

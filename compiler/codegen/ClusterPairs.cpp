@@ -1,0 +1,362 @@
+// Each pair once in cluster-pair tiles (sphc --simd-pairs=cluster; opt-in since stop 37;
+// docs/performance.md "Cluster-pair tiles in the printer (stop 37)"; GROMACS' nbnxm scheme,
+// Pall & Hess 2013, as measured by hand in bench/cluster_pairs.cpp).
+//
+// A pass that --simd-pairs=once prints each pair once in SIMD lanes (onceLanes: same array,
+// kept lists, double precision, no periodic or mirror domain, no zones) is printed, where
+// clusterTilesRefusal() allows it, as tiles of 8 i's x 8 j's over the runtime's cluster-pair
+// lists (sphc/cluster_pairs.h):
+//   - at a rebuild of the pass's kept lists (verlet_build: the same VerletSkin; the kept lists
+//     themselves are not built), the cluster layout of the array and the outer list of
+//     cluster pairs at the kept lists' radius (1 + skin) radius_scale h_max (each pair once:
+//     j-clusters >= i);
+//   - per evaluation, the positions in slot order (padding far away), the boxes, the list
+//     pruned at the support radius radius_scale h_max (h_max now), and slot-order copies of
+//     every property and hoisted value the bodies read (cl_NAME);
+//   - per i-cluster ci and j-cluster of its list, per real i of ci (d_idx: its slot), a first
+//     `omp simd` loop over the 8 lanes finds whether any is within the cut-off (else the row
+//     is skipped), then the lanes under `#pragma omp simd`: s_idx is the LANE, the source's
+//     copies offset to the j-cluster (sj_x = cl_x + j0, s_m = cl_m + j0: no int arithmetic in
+//     the loop, which would make GCC 12 take 16 lanes for its ints and 256-bit vectors), the
+//     pair quantities and their mirrors (negations), the pair-shared values, each body's _simd
+//     call for d_idx on its lane sums (ti_NAME[ii][lane], across ci's list) and _simd_mirror
+//     call for the lane's particle on the tile's sums (tj_NAME[lane], across the tile's i's),
+//     each kept under its mask (the cut-off; on the diagonal tile the lanes j > i, and j == i
+//     for d_idx where the self pair is evaluated);
+//   - the tile's j sums added to the slot sums once per tile, i's lane sums once per
+//     i-cluster; the slot sums added to the particles' sums (add_slots).
+// The tiles are a lambda compiled without jump threading (GCC 12 threads the kernel's
+// branches before if-conversion, "control flow in loop": the lanes stay scalar).
+//
+// Results: the sums reassociated (per i: 8 lane partial sums across its cluster pairs, summed
+// in lane order; per j: the tile's i's first, then tile by tile; added to the value each sum
+// had before the pass), so not bitwise the lanes' or the scalar loops' (tests: lit
+// codegen/simd-pairs-cluster*.sph, stability.cluster_compare_*). Serial only: the OpenMP
+// build prints the pass as --simd-pairs=once does.
+#include "analysis/PairQuantityTable.h"
+#include "codegen/CppText.h"
+#include "codegen/Printer.h"
+
+#include <map>
+#include <set>
+#include <vector>
+
+namespace sphc {
+
+namespace {
+
+// Whether `text` names d_idx or s_idx other than as a whole subscript `[d_idx]` (with the
+// slot indices of the tiles, an index used as a number would change meaning).
+bool indexUsedAsNumber(const std::string& text) {
+  for (const char* name : {"d_idx", "s_idx"}) {
+    const std::string n = name;
+    for (size_t at = text.find(n); at != std::string::npos; at = text.find(n, at + 1)) {
+      if ((at > 0 && isIdentifierChar(text[at - 1])) ||
+          (at + n.size() < text.size() && isIdentifierChar(text[at + n.size()])))
+        continue;
+      size_t before = at;
+      while (before > 0 && (text[before - 1] == ' ' || text[before - 1] == '\t')) --before;
+      size_t after = at + n.size();
+      while (after < text.size() && (text[after] == ' ' || text[after] == '\t')) ++after;
+      if (before == 0 || text[before - 1] != '[' || after >= text.size() || text[after] != ']')
+        return true;
+    }
+  }
+  return false;
+}
+
+// `call` (NAME(a, b, ...);  // comment) with each argument that is a whole key of `rename`
+// replaced by its value.
+std::string withArguments(const std::string& call, const std::map<std::string, std::string>& rename) {
+  const size_t open = call.find('('), close = call.find(");");
+  if (open == std::string::npos || close == std::string::npos) return call;
+  std::string out = call.substr(0, open + 1);
+  size_t at = open + 1;
+  while (at <= close) {
+    size_t end = call.find(", ", at);
+    if (end == std::string::npos || end > close) end = close;
+    const std::string arg = call.substr(at, end - at);
+    auto it = rename.find(arg);
+    out += it == rename.end() ? arg : it->second;
+    if (end == close) break;
+    out += ", ";
+    at = end + 2;
+  }
+  return out + call.substr(close);
+}
+
+}  // namespace
+
+std::string ScenePrinter::clusterTilesRefusal(const DestinationWork& w,
+                                              const NeighbourPass& pass) const {
+  if (!simdCluster_) return "off";
+  if (!onceLanes(w, pass)) return "not each pair once in SIMD lanes";
+  if (plan_.dim < 2) return "a 1D scene";
+  const int d = w.array;
+  auto oneDouble = [&](const std::string& p) -> std::string {
+    const PlanProperty* prop = arr(d).find(p);
+    if (!prop) return "";
+    if (prop->stride != 1) return p + " has " + std::to_string(prop->stride) + " components";
+    if (hostType(d, p) != "double") return p + " is " + hostType(d, p);
+    return "";
+  };
+  for (const std::string& p : pass.shared)
+    if (std::string why = oneDouble(p); !why.empty()) return why;
+  for (const std::string& p : pass.sourceProps)
+    if (std::string why = oneDouble(p); !why.empty()) return why;
+  const RegisterSums rs = registerSums(w, pass);
+  for (const auto& [p, sc] : rs.props)
+    if (sc.first != 1) return "the sum " + p + " has " + std::to_string(sc.first) + " components";
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    for (const auto& [p, sc] : destinationValues(b, d))
+      if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
+    for (const auto& [p, sc] : sourceValues(b))
+      if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
+    if (indexUsedAsNumber(b.source.text))
+      return eq->name + " uses d_idx or s_idx otherwise than as a subscript";
+    const auto sites = hoistedSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k)
+      if (hoistedValueType(b, host_, true, k) != "double")
+        return eq->name + "'s hoisted value " + std::to_string(k) + " is no double";
+    const auto dsites = hoistedDestinationSites(b, host_);
+    for (size_t k = 0; k < dsites.size(); ++k)
+      if (hoistedValueType(b, host_, false, k) != "double")
+        return eq->name + "'s destination value " + std::to_string(k) + " is no double";
+  }
+  return "";
+}
+
+void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& state,
+                                       const std::string& what) {
+  os << "  // " << what << " in cluster-pair tiles (--simd-pairs=cluster, sphc/cluster_pairs.h): the\n"
+        "  // layout and outer list (built with the kept lists' skin), the pruned list, the\n"
+        "  // slot-order copies and sums.\n";
+  os << "  sphc::ClusterLayout " << state << "_layout;\n";
+  os << "  sphc::ClusterPairList " << state << "_outer, " << state << "_pruned;\n";
+  os << "  std::vector<double> " << state << "_slots;\n";
+}
+
+void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPass& pass,
+                                    const std::string& state, const std::string& listRadius2,
+                                    const std::set<std::string>& q, const RegisterSums& sums) {
+  const int d = w.array;
+  const std::string R = "double";
+  const bool selfPair = !skipsSelfPair(pass);
+  // The copies in slot order: positions first, then every property the lanes read (by name:
+  // di_NAME, sj_NAME, s_NAME and d_NAME of one array are one array), the hoisted values, the
+  // sums. name -> the array it is gathered from.
+  std::vector<std::pair<std::string, std::string>> copies;
+  std::set<std::string> named;
+  auto copy = [&](const std::string& name, const std::string& from) {
+    if (named.insert(name).second) copies.push_back({name, from});
+  };
+  const char* axes[3] = {"x", "y", "z"};
+  for (int k = 0; k < plan_.dim; ++k) copy(axes[k], "");
+  for (const std::string& p : pass.shared) copy(p, "di_" + p);
+  for (const std::string& p : pass.sourceProps) copy(p, "s_" + p);
+  std::set<std::string> dvals;  // the destination values (dval_NAME) the bodies read
+  for (const PlanEquation* eq : pass.equations)
+    for (const auto& [p, sc] : destinationValues(methodBody(*eq, ast::Method::Loop), d)) {
+      copy(p, "d_" + p);
+      dvals.insert(p);
+    }
+  std::vector<std::string> hoisted, dhoisted;  // pointers in the tiles: source, destination
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    for (size_t k = 0; k < hoistedSites(b, host_).size(); ++k) {
+      const std::string ptr = hoistArgument(eqStruct(*eq), std::to_string(k));
+      hoisted.push_back(ptr);
+      copy(ptr, ptr);
+    }
+    for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
+      const std::string ptr = symmetricDestinationHoisted(eqStruct(*eq), std::to_string(k));
+      dhoisted.push_back(ptr);
+      copy(ptr, ptr);
+    }
+  }
+  std::vector<std::string> accs;  // the sums: acc_NAME
+  for (const auto& [p, sc] : sums.props) accs.push_back(p);
+  const std::string in = "          ";
+  scene_ << "        // Each pair once for both particles in cluster-pair tiles (codegen/ClusterPairs.cpp;\n"
+            "        // sphc --simd-pairs=cluster): 8 i's x 8 j's of the runtime's cluster-pair lists\n"
+            "        // (sphc/cluster_pairs.h), rebuilt with the kept lists (verlet_build; the lists\n"
+            "        // themselves are not built), pruned at the support per evaluation; the sums\n"
+            "        // reassociated (lane sums per i across its list, per j across a tile).\n";
+  // The destination-only values of every particle, for the mirrored calls (gathered below).
+  emitDestinationHoistedAll(pass, "");
+  scene_ << "        {\n";
+  scene_ << in << "sphc::ClusterLayout& cl_layout = " << state << "_layout;\n";
+  scene_ << in << "double cl_hmax = 0.0;  // the largest h now\n";
+  scene_ << in << "for (int i = 0; i < n; ++i) cl_hmax = std::max(cl_hmax, di_h[i]);\n";
+  const std::string zIn = plan_.dim == 3 ? "di_z" : "nullptr";
+  scene_ << in << "if (verlet_build) sphc::build_cluster_layout(cl_layout, di_x, di_y, " << zIn
+         << ", static_cast<std::size_t>(n), DIM, 0.0);\n";
+  scene_ << in << "const std::size_t n_slots = cl_layout.slots();\n";
+  scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots;\n";
+  scene_ << in << "cl_buf.resize(" << copies.size() + accs.size() << " * n_slots);\n";
+  size_t at = 0;
+  for (const auto& c : copies)
+    scene_ << in << "double* const cl_" << c.first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  for (const std::string& p : accs)
+    scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  scene_ << in << "// The positions in slot order (padding slots 4 supports away from every particle),\n"
+         << in << "// the boxes, the outer list at a rebuild, the list pruned at the support now.\n";
+  scene_ << in << "sphc::gather_positions(cl_layout, di_x, di_y, " << zIn << ", cl_x, cl_y, "
+         << (plan_.dim == 3 ? "cl_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax);\n";
+  scene_ << in << "sphc::update_boxes(cl_layout, cl_x, cl_y, " << (plan_.dim == 3 ? "cl_z" : "nullptr")
+         << ");\n";
+  scene_ << in << "if (verlet_build) sphc::build_cluster_pairs(cl_layout, cl_layout, std::sqrt("
+         << listRadius2 << ") * cl_hmax, true, " << state << "_outer);\n";
+  scene_ << in << "sphc::prune_cluster_pairs(cl_layout, cl_layout, " << state
+         << "_outer, Kernel::radius_scale * cl_hmax, " << state << "_pruned);\n";
+  scene_ << in << "const sphc::ClusterPairList& cl_pruned = " << state << "_pruned;\n";
+  for (const auto& c : copies)
+    if (!c.second.empty())
+      scene_ << in << "sphc::gather_slots(cl_layout, " << c.second << ", cl_" << c.first << ");\n";
+  if (!accs.empty())
+    scene_ << in << "std::fill(cl_acc_" << accs.front() << ", cl_acc_" << accs.front() << " + "
+           << accs.size() << " * n_slots, 0.0);\n";
+  // The tiles, in a lambda without jump threading (see above).
+  scene_ << "#if defined(__GNUC__) && !defined(__clang__)\n"
+            "#define SPHC_TILES_OPTIMIZE __attribute__((optimize(\"no-thread-jumps\")))\n"
+            "#else\n"
+            "#define SPHC_TILES_OPTIMIZE\n"
+            "#endif\n";
+  scene_ << in << "auto tiles = [&]() SPHC_TILES_OPTIMIZE {\n";
+  const std::string t = in + "  ";
+  scene_ << t << "static constexpr double cl_lane[8] = {0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0};\n";
+  // The copies' pointers again, locals of the lambda (captured by reference, GCC reloads them
+  // in the loops), and the lists' arrays.
+  at = 0;
+  for (const auto& c : copies)
+    scene_ << t << "double* const cl_" << c.first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  for (const std::string& p : accs)
+    scene_ << t << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  scene_ << t << "const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
+  scene_ << t << "const std::uint32_t* const cl_j = cl_pruned.j.data();\n";
+  scene_ << t << "const std::uint8_t* const cl_real = cl_layout.real_mask.data();\n";
+  scene_ << t << "// The destination side: the copies at d_idx, the slot of particle i.\n";
+  for (const std::string& p : pass.shared)
+    scene_ << t << "const double* const di_" << p << " = cl_" << p << ";\n";
+  scene_ << t << "const int n_ci = static_cast<int>(cl_layout.n_clusters);\n";
+  scene_ << t << "for (int ci = 0; ci < n_ci; ++ci) {\n";
+  const std::string c1 = t + "  ";
+  scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
+  scene_ << c1 << "if (cl_begin[ci] == e_end) continue;\n";
+  scene_ << c1 << "const unsigned real_i = cl_real[ci];\n";
+  scene_ << c1 << "// i's sums: 8 lane partial sums per i across its cluster pairs\n";
+  for (const std::string& p : accs) scene_ << c1 << "alignas(64) double ti_" << p << "[8][8] = {};\n";
+  scene_ << c1 << "for (std::uint32_t e = cl_begin[ci]; e < e_end; ++e) {\n";
+  const std::string c2 = c1 + "  ";
+  scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * 8;\n";
+  scene_ << c2 << "const bool diagonal = cl_j[e] == static_cast<std::uint32_t>(ci);\n";
+  scene_ << c2 << "// The source side: the j-cluster's 8 slots, s_idx the lane.\n";
+  for (const std::string& p : pass.shared)
+    scene_ << c2 << "const double* const sj_" << p << " = cl_" << p << " + j0;\n";
+  for (const std::string& p : pass.sourceProps)
+    scene_ << c2 << "const double* const s_" << p << " = cl_" << p << " + j0;\n";
+  for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = cl_" << h << " + j0;\n";
+  // (the mirrored calls read particle s_idx's destination values through d_NAME)
+  for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = cl_" << p << " + j0;\n";
+  for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = cl_" << h << " + j0;\n";
+  scene_ << c2 << "// j's sums over the tile's i's\n";
+  for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[8] = {};\n";
+  scene_ << c2 << "for (int ii = 0; ii < 8 && (real_i >> ii & 1u); ++ii) {  // the real i's (first)\n";
+  const std::string c3 = c2 + "  ";
+  scene_ << c3 << "const int d_idx = ci * 8 + ii;\n";
+  emitDestLocals(scene_, c3, q, host_);
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
+      const std::string K = std::to_string(k);
+      scene_ << c3 << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = cl_"
+             << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+    }
+  }
+  for (const std::string& p : dvals)  // the destination's values (the d_NAME above are offset)
+    scene_ << c3 << "const double " << destinationValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
+  {  // the mirrored calls' source values: particle d_idx's
+    std::set<std::string> loads;
+    for (const PlanEquation* eq : pass.equations)
+      for (const auto& [p, sc] : sourceValues(methodBody(*eq, ast::Method::Loop)))
+        if (loads.insert(sourceValueName(p, 1, 0)).second)
+          scene_ << c3 << "const double " << sourceValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
+  }
+  scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
+  scene_ << c3 << "const double lane_s = diagonal ? static_cast<double>(ii) : -1.0;\n";
+  scene_ << c3 << "const double lane_d = diagonal ? static_cast<double>(ii" << (selfPair ? " - 1" : "") << ") : -1.0;\n";
+  // The row's cut-off alone first: a row with no pair within it is skipped.
+  // (a double sum of 0 or 1: an int reduction makes GCC 12 take 8 int lanes, so this loop in
+  // 256-bit vectors, 10-12% more per sweep in bench/cluster_pairs.cpp)
+  scene_ << c3 << "double any = 0.0;\n";
+  scene_ << c3 << "#pragma omp simd reduction(+: any)\n";
+  scene_ << c3 << "for (int s_idx = 0; s_idx < 8; ++s_idx) {\n";
+  {
+    const std::string b = c3 + "  ";
+    scene_ << b << "const double hj = sj_h[s_idx];\n";
+    std::string r2;
+    for (int k = 0; k < plan_.dim; ++k) {
+      scene_ << b << "const double XIJ_" << k << " = " << axes[k] << "i - sj_" << axes[k] << "[s_idx];\n";
+      r2 += (k ? " + " : "") + std::string("XIJ_") + std::to_string(k) + " * XIJ_" + std::to_string(k);
+    }
+    scene_ << b << "const double R2IJ = " << r2 << ";\n";
+    scene_ << b << "const double hmax = hi > hj ? hi : hj;\n";
+    scene_ << b << "any += !(R2IJ >= RADIUS2 * hmax * hmax) & (cl_lane[s_idx] > lane_d) ? 1.0 : 0.0;\n";
+  }
+  scene_ << c3 << "}\n";
+  scene_ << c3 << "if (!(any > 0.0)) continue;  // no pair of the row within the support\n";
+  for (const std::string& p : accs) scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[ii];\n";
+  scene_ << c3 << "#pragma omp simd\n";
+  scene_ << c3 << "for (int s_idx = 0; s_idx < 8; ++s_idx) {\n";
+  const std::string body = c3 + "  ";
+  emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
+  scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
+  scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
+  scene_ << body << "const bool in_d = in_cut & (cl_lane[s_idx] > lane_d);  // for d_idx\n";
+  scene_ << body << "const bool in_s = in_cut & (cl_lane[s_idx] > lane_s);  // for the lane's particle\n";
+  emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
+  for (const std::string& p : accs) {
+    scene_ << body << "double pd_acc_" << p << " = ti_" << p << "_i[s_idx];\n";
+    scene_ << body << "double ps_acc_" << p << " = tj_" << p << "[s_idx];\n";
+  }
+  for (const PlanEquation* eq : pass.equations)
+    scene_ << body << pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_");
+  // The mirrored calls index the source's arrays they are given as pointers (a source
+  // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
+  // not offset to the j-cluster.
+  std::map<std::string, std::string> absolute;
+  for (const std::string& p : pass.sourceProps) absolute["s_" + p] = "cl_" + p;
+  for (const std::string& h : hoisted) absolute[h] = "cl_" + h;
+  for (const PlanEquation* eq : pass.equations)
+    scene_ << body << withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute);
+  endPairShared();
+  for (const std::string& p : accs) {
+    scene_ << body << "ti_" << p << "_i[s_idx] = in_d ? pd_acc_" << p << " : ti_" << p << "_i[s_idx];\n";
+    scene_ << body << "tj_" << p << "[s_idx] = in_s ? ps_acc_" << p << " : tj_" << p << "[s_idx];\n";
+  }
+  scene_ << c3 << "}\n";
+  scene_ << c2 << "}\n";
+  scene_ << c2 << "#pragma omp simd  // (a vector: unrolled, the tj_ arrays would be scalars)\n";
+  scene_ << c2 << "for (int l = 0; l < 8; ++l) {\n";
+  for (const std::string& p : accs)
+    scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l];\n";
+  scene_ << c2 << "}\n";
+  scene_ << c1 << "}\n";
+  scene_ << c1 << "for (int ii = 0; ii < 8; ++ii) {\n";
+  for (const std::string& p : accs) {
+    scene_ << c1 << "  double s_" << p << " = 0.0;\n";
+    scene_ << c1 << "  for (int l = 0; l < 8; ++l) s_" << p << " += ti_" << p << "[ii][l];\n";
+    scene_ << c1 << "  cl_acc_" << p << "[ci * 8 + ii] += s_" << p << ";\n";
+  }
+  scene_ << c1 << "}\n";
+  scene_ << t << "}\n";
+  scene_ << in << "};\n";
+  scene_ << in << "tiles();\n";
+  scene_ << in << "// The slot sums onto the particles' sums (padding slots never read).\n";
+  for (const std::string& p : accs)
+    scene_ << in << "sphc::add_slots(cl_layout, cl_acc_" << p << ", d_" << p << ");\n";
+  scene_ << "        }\n";
+}
+
+}  // namespace sphc

@@ -1,0 +1,49 @@
+#!/bin/sh
+# A scene run with its same-array pair loop in cluster-pair tiles (sphc --simd-pairs=cluster,
+# codegen/ClusterPairs.cpp; docs/performance.md, "Cluster-pair tiles in the printer (stop
+# 37)") and as another --simd-pairs mode prints it, the two runs compared snapshot by
+# snapshot (compare_runs.py: positions in dx, density in rho0, velocities). The sums are
+# reassociated in the tiles, so the runs differ by round-off that the flow may amplify; the
+# limits are the caller's (--max-pos, --max-rho). Fails also where the generated code has no
+# loop in tiles (the form stopped applying).
+#
+# Usage: cluster_compare.sh SPHC SOURCE_DIR SCENE EXE OUT_DIR [--other MODE] [--sphc-opt OPT]...
+#                           [RUN OPTIONS...] -- [compare_runs.py OPTIONS...]
+#   --other MODE    the reference's --simd-pairs (default auto)
+#   --sphc-opt OPT  an sphc option for both builds (e.g. --simd-once-neighbours=0)
+set -eu
+
+. "$(dirname "$0")/../validation/common.sh"
+scene_args "SPHC SOURCE_DIR SCENE EXE OUT_DIR [--other MODE] [--sphc-opt OPT]... \
+[RUN OPTIONS...] -- [compare_runs.py OPTIONS...]" "$@"
+SCENE=$CASE
+shift 5
+OTHER=auto
+EXTRA=""
+while [ $# -gt 1 ]; do
+  case "$1" in
+    --other) OTHER=$2; shift 2 ;;
+    --sphc-opt) EXTRA="$EXTRA $2"; shift 2 ;;
+    *) break ;;
+  esac
+done
+run_options "$@"
+shift "$NARGS"
+find_python cluster_compare
+fresh_output "$EXE" "$OUT"
+# shellcheck disable=SC2086
+if ! "$SPHC" "$SRC/$SCENE" --emit=cpp --simd-pairs=cluster $EXTRA |
+    grep -q "both particles in cluster-pair tiles"; then
+  echo "cluster_compare: no pair loop of $SCENE in cluster-pair tiles" >&2
+  exit 1
+fi
+# shellcheck disable=SC2086
+"$SPHC" "$SRC/$SCENE" --global-ids --simd-pairs=cluster $EXTRA -o "$EXE.cluster"
+# shellcheck disable=SC2086
+"$SPHC" "$SRC/$SCENE" --global-ids --simd-pairs="$OTHER" $EXTRA -o "$EXE.ref"
+echo "== runs: $EXE.{cluster,ref} --quiet$RUN_OPTS"
+# shellcheck disable=SC2086
+"$EXE.cluster" --quiet -d "$OUT/cluster" $RUN_OPTS
+# shellcheck disable=SC2086
+"$EXE.ref" --quiet -d "$OUT/ref" $RUN_OPTS
+exec "$PY" "$SRC/tests/stability/compare_runs.py" "$OUT/cluster" "$OUT/ref" "$@"
