@@ -176,10 +176,12 @@ std::vector<std::string> symmetricPairsNotes(
   const std::string lanes = "--simd-pairs puts its neighbours in SIMD lanes per destination";
   std::vector<std::string> notes;
   const Plan& plan = *sched.plan;
-  // The CPU printer keeps lists where --verlet-skin is on for it (CpuPrinter's verlet()).
+  // The CPU printer keeps lists where --verlet-skin is on for it (CpuPrinter's verlet()), in
+  // double and single precision (until stop 37 this note said per destination for every
+  // single-precision loop, while the printer evaluated them each pair once).
   const bool listsKept = opts.verletSkin > 0 && opts.backend != Backend::OpenCL &&
-                         opts.precision == Precision::Double && !sched.distribution.enabled &&
-                         plan.zones.empty();
+                         !sched.distribution.enabled && plan.zones.empty();
+  const bool single = opts.precision == Precision::Single;
   walkPasses(sched.equations, [&](const Phase& ph, const DestinationWork& w,
                                   const NeighbourPass& pass) {
     if (pass.source != w.array || !pass.searches()) return;
@@ -189,9 +191,11 @@ std::vector<std::string> symmetricPairsNotes(
                                           : "--no-symmetric-pairs";
     // Ghosts of periodic or mirror sides are sources only: a pair with a ghost is evaluated
     // for the real particle alone (its original has the pair through the other's image).
-    // Written for the scalar loops of double precision (CpuPrinter::symmetricPass; listsKept
-    // is false in single precision).
+    // Written for the scalar loops of double precision (CpuPrinter::symmetricPass).
     if (why.empty() && inLanes && inLanes(w, pass)) why = lanes;
+    if (why.empty() && sched.domain && single)
+      why = "single precision with periodic or mirror ghosts (each pair once with them is "
+            "written for double)";
     if (opts.backend == Backend::OpenCL) why = "the OpenCL backend gathers per destination";
     notes.push_back(why.empty() ? "each pair once for both particles: " + loop +
                                       (sched.domain ? " (a pair with a periodic or mirror ghost "

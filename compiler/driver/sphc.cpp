@@ -189,7 +189,7 @@ static cl::opt<std::string> SimdPairs(
              "defaults; where they are not known before the run, 3D yes, 2D no: with h = 1.3 "
              "dx and a support of 2 h, 74 and 21 neighbours; below 30, each pair once pays "
              "more), and a loop over its own array that is per destination anyway (a periodic "
-             "or mirror domain, no zones) at any count; on (or --simd-pairs alone): every loop that allows it; off: the "
+             "or mirror domain, zones) at any count; on (or --simd-pairs alone): every loop that allows it; off: the "
              "scalar loops. Under auto a loop in lanes over its own array (kept lists, double "
              "precision) evaluates each pair once in them, the values the pair shares once, "
              "the source side gathered and scattered (once: the same; perdest: auto's loops "
@@ -399,9 +399,8 @@ int main(int argc, char** argv) {
     // wrapped one (tests/mpi periodic_drift's r = x). Kept by default where the scene reads
     // positions only as copies and increments, or in groups with a condition before which
     // the printer wraps every particle (analysis/PositionReads.cpp); else opt in with a number.
-    if (p.domain.any() && PrecisionOpt == sphc::Precision::Single)  // not measured there
-      return "a periodic or mirror domain in single precision (positions wrapped lazily with "
-             "kept lists: --verlet-skin=F opts in)";
+    // Single precision too since stop 37 (Taylor-Green nx = 100, EDAC and WCSPH: 0.96 of the
+    // gathered lists' CPU time; docs/performance.md, "Loose ends (stop 37)").
     if (p.domain.any()) {
       const sphc::PositionReads reads = sphc::positionReads(p);
       if (!reads.refusal.empty())

@@ -65,6 +65,21 @@ namespace sphc {
 
 namespace detail {
 
+// Every kernel function below is inlined wherever it is called (GCC, Clang). Plain `inline`
+// leaves it to the compiler's heuristics, and GCC splits a shape function (its `q >= 3`
+// test inlined, the rest a function `.part.0`) and stops inlining that part where the caller
+// has grown past its limits: the serial solver's phase, which holds every pair loop of a group
+// (the channel's TVF scene: its eight summation-density loops), calls it, while the OpenMP
+// solver, each loop in its own outlined function, inlines it. A call in a SIMD pair loop
+// (codegen/SimdPairs.cpp) keeps that loop scalar, and a scalar `omp simd` reduction sums in
+// another order than the vector one: serial and OpenMP then differed in the last bits
+// (docs/performance.md, "Loose ends (stop 37)").
+#if defined(__GNUC__)
+#define SPHC_KERNEL_INLINE inline __attribute__((always_inline))
+#else
+#define SPHC_KERNEL_INLINE inline
+#endif
+
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInvSqrtPi = 0.56418958354775628695;     // 1 / sqrt(pi)
 constexpr double kInvPi32 = 0.17958712212516656169;       // 1 / pi^(3/2)
@@ -73,7 +88,7 @@ constexpr double kInvPi32 = 0.17958712212516656169;       // 1 / pi^(3/2)
 // float for --precision=single): every literal is converted to T, so a float call computes in
 // float, and a double call does the operations of the plain double formulas.
 template <int Dim, class T>
-inline T inv_h_pow(T h) {
+SPHC_KERNEL_INLINE T inv_h_pow(T h) {
   static_assert(Dim >= 1 && Dim <= 3, "sphc kernels: Dim must be 1, 2 or 3");
   const T ih = T(1) / h;
   if constexpr (Dim == 1) {
@@ -89,7 +104,7 @@ inline T inv_h_pow(T h) {
 // (sphc/kernel_shapes.h: the same text is the OpenCL program's, see runtime/src/opencl.cpp).
 namespace shapes {
 #define SPHC_KERNEL_SHAPES(...) __VA_ARGS__
-#define SPHC_SHAPE_FN template <class real> inline real
+#define SPHC_SHAPE_FN template <class real> SPHC_KERNEL_INLINE real
 #define SPHC_R(x) real(x)
 #define SPHC_EXP(x) std::exp(x)
 #include "sphc/kernel_shapes.h"
@@ -109,15 +124,15 @@ struct RadialKernel {
   static constexpr double sigma = S::sigma;  // W = sigma / h^d f(r / h)
 
   template <class T>
-  static inline T w(T rij, T h) {
+  static SPHC_KERNEL_INLINE T w(T rij, T h) {
     return T(S::sigma) * inv_h_pow<Dim>(h) * S::f(rij / h);
   }
   template <class T>
-  static inline T dwdq(T rij, T h) {
+  static SPHC_KERNEL_INLINE T dwdq(T rij, T h) {
     return T(S::sigma) * inv_h_pow<Dim>(h) * S::df(rij / h);
   }
   template <class T>
-  static inline void gradient(const T xij[3], T rij, T h, T grad[3]) {
+  static SPHC_KERNEL_INLINE void gradient(const T xij[3], T rij, T h, T grad[3]) {
     // dW/dx_i = dW/dq * dq/dr * dr/dx_i = dwdq * (1/h) * xij / rij.
     const T s = rij > T(1e-12) ? dwdq(rij, h) / (h * rij) : T(0);
     grad[0] = s * xij[0];
@@ -127,7 +142,7 @@ struct RadialKernel {
   // The factor s of gradient() (grad = s * xij), its value bit for bit, as a select on a
   // safe divisor (no branch: the SIMD pair loops of sphc --simd-pairs, codegen/SimdPairs.cpp).
   template <class T>
-  static inline T gradient_factor(T rij, T h) {
+  static SPHC_KERNEL_INLINE T gradient_factor(T rij, T h) {
     const bool apart = rij > T(1e-12);
     const T s = dwdq(rij, h) / (h * (apart ? rij : T(1)));
     return apart ? s : T(0);
@@ -136,8 +151,8 @@ struct RadialKernel {
   // once): grad_ij = gradient(xij, rij, h) and grad_ji = gradient(xji, rij, h), xji = x_j -
   // x_i, with the factor s computed once; each is gradient()'s value bit for bit.
   template <class T>
-  static inline void gradient_pair(const T xij[3], const T xji[3], T rij, T h, T grad_ij[3],
-                                   T grad_ji[3]) {
+  static SPHC_KERNEL_INLINE void gradient_pair(const T xij[3], const T xji[3], T rij, T h,
+                                               T grad_ij[3], T grad_ji[3]) {
     const T s = rij > T(1e-12) ? dwdq(rij, h) / (h * rij) : T(0);
     grad_ij[0] = s * xij[0];
     grad_ij[1] = s * xij[1];
@@ -151,11 +166,11 @@ struct RadialKernel {
 // The members f(q) and df(q) of a shape: the functions NAME_f and NAME_df of kernel_shapes.h.
 #define SPHC_SHAPE_FUNCTIONS(NAME)                   \
   template <class T>                                 \
-  static inline T f(T q) {                           \
+  static SPHC_KERNEL_INLINE T f(T q) {               \
     return shapes::NAME##_f(q);                      \
   }                                                  \
   template <class T>                                 \
-  static inline T df(T q) {                          \
+  static SPHC_KERNEL_INLINE T df(T q) {              \
     return shapes::NAME##_df(q);                     \
   }
 
@@ -236,9 +251,13 @@ struct SuperGaussianShape {
   static constexpr double radius_scale = 3.0;
   static constexpr double sigma = GaussianShape<Dim>::sigma;
   template <class T>
-  static inline T f(T q) { return shapes::sphc_super_gaussian_f(q, T(1 + 0.5 * Dim)); }
+  static SPHC_KERNEL_INLINE T f(T q) {
+    return shapes::sphc_super_gaussian_f(q, T(1 + 0.5 * Dim));
+  }
   template <class T>
-  static inline T df(T q) { return shapes::sphc_super_gaussian_df(q, T(Dim + 4)); }
+  static SPHC_KERNEL_INLINE T df(T q) {
+    return shapes::sphc_super_gaussian_df(q, T(Dim + 4));
+  }
 };
 
 #undef SPHC_SHAPE_FUNCTIONS
