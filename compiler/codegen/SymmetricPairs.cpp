@@ -391,8 +391,11 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
           for (int k : sc.second)
             scene_ << mb << host_.real << " m_" << sumsLocalName(p, sc.first, k) << " = d_" << p
                    << "[" << sumsIndexText(sc.first, k, "s_idx") << "];\n";
-        for (const PlanEquation* eq : pass.equations)
-          scene_ << mb << pairCall(*eq, d, sums, false, "m_", mirroredArgument(*eq));
+        for (const PlanEquation* eq : pass.equations) {
+          std::string call = pairCall(*eq, d, sums, false, "m_", mirroredArgument(*eq));
+          call.insert(call.size() - 1, ": destination s_idx, source d_idx");
+          scene_ << mb << call;
+        }
         for (const auto& [p, sc] : sums.props)
           for (int k : sc.second)
             scene_ << mb << "d_" << p << "[" << sumsIndexText(sc.first, k, "s_idx") << "] = m_"
