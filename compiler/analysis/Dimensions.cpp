@@ -347,18 +347,18 @@ bool dropAbsentComponents(Plan& plan, DiagnosticEngine& diags, bool foldZeros) {
                          ": strided properties stored without their left-out components: " +
                          list);
   }
+  if (!dropped.empty()) {
+    std::string list;
+    for (const auto& p : dropped) list += (list.empty() ? "" : " ") + p;
+    plan.notes.push_back("dim " + std::to_string(plan.dim) +
+                         ": components left out of every body (read as 0, never stored): " + list);
+  }
   if (!folded.empty()) {
     std::string list;
     for (const auto& f : folded) list += (list.empty() ? "" : ", ") + f;
     plan.notes.push_back("dim " + std::to_string(plan.dim) +
                          ": terms with a zero factor dropped (--no-fold-zero-terms keeps them): " +
                          list);
-  }
-  if (!dropped.empty()) {
-    std::string list;
-    for (const auto& p : dropped) list += (list.empty() ? "" : " ") + p;
-    plan.notes.push_back("dim " + std::to_string(plan.dim) +
-                         ": components left out of every body (read as 0, never stored): " + list);
   }
   return true;
 }
