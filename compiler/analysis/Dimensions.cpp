@@ -222,14 +222,93 @@ bool rewrite(PlanBody& b, const std::set<std::string>& leftOut,
   return true;
 }
 
+// Terms with a zero factor (MultiplyAddSite::zeroWhen, body/ZeroTerms.cpp): a product one
+// of whose factors is a zero of the scene's dimension (XIJ[2], VIJ[2], DWIJ[2] and a
+// left-out component read as 0.0 in 2D) is dropped from its multiply-add: `a * b + c`,
+// `c + a * b` and `c - a * b` become `c`, `a * b - c` becomes `-(c)`, and a statement
+// `x += a * b;` or `x -= a * b;` becomes `(void)0;`. GCC cannot do it itself (0.0 * x is NaN
+// for an infinite x; fma(a, 0.0, c) is +0 for c = -0). The folded body differs from the
+// body as written only (1) where the other factor, or a value a factor is zero through
+// (x in 0.0 * x), is infinite or NaN: the written body's sum is NaN there, and (2) in the
+// sign of a zero: where c (x) is -0 and the product +0 (a - c: c = +0 and the product +0),
+// the written sum is +0 and the folded one -0. Anything else adds an exact zero to a value
+// it leaves unchanged. Returns the number of terms dropped; the multiply-add sites inside
+// the deleted text are dropped with it, those of the kept addend move (body/TextEdits.h).
+int foldZeroTerms(PlanBody& b, const std::set<std::string>& zeros) {
+  auto isZero = [&](const MultiplyAddSite& m) {
+    for (const auto& conj : m.zeroWhen) {
+      bool all = true;
+      for (const auto& leaf : conj) all = all && zeros.count(leaf);
+      if (all) return true;
+    }
+    return false;
+  };
+  std::vector<const MultiplyAddSite*> sites;
+  for (const auto& m : b.facts.multiplyAdds)
+    if (isZero(m) && ((m.form != MultiplyAddSite::AddAssign &&
+                       m.form != MultiplyAddSite::SubAssign) || m.statement))
+      sites.push_back(&m);
+  // Outermost first: a site inside text another deletes goes with it.
+  std::sort(sites.begin(), sites.end(), [](const MultiplyAddSite* x, const MultiplyAddSite* y) {
+    return x->end - x->begin > y->end - y->begin;
+  });
+  const std::string& text = b.source.text;
+  auto keepLines = [&](unsigned from, unsigned to, std::string r) {
+    return r + std::string(static_cast<size_t>(std::count(text.begin() + from, text.begin() + to, '\n')), '\n');
+  };
+  std::vector<std::pair<unsigned, unsigned>> deleted;
+  std::vector<TextEdit> edits;
+  int n = 0;
+  for (const MultiplyAddSite* m : sites) {
+    bool inside = false;
+    for (const auto& [db, de] : deleted) inside = inside || (db <= m->begin && m->end <= de);
+    if (inside) continue;
+    switch (m->form) {
+      case MultiplyAddSite::ProductPlus:
+        edits.push_back({m->begin, m->cBegin, keepLines(m->begin, m->cBegin, "")});
+        deleted.push_back({m->begin, m->cBegin});
+        break;
+      case MultiplyAddSite::PlusProduct:
+      case MultiplyAddSite::MinusProduct:
+        edits.push_back({m->cEnd, m->end, keepLines(m->cEnd, m->end, "")});
+        deleted.push_back({m->cEnd, m->end});
+        break;
+      case MultiplyAddSite::ProductMinus:
+        edits.push_back({m->begin, m->cBegin, keepLines(m->begin, m->cBegin, "-(")});
+        edits.push_back({m->cEnd, m->cEnd, ")"});
+        deleted.push_back({m->begin, m->cBegin});
+        break;
+      case MultiplyAddSite::AddAssign:
+      case MultiplyAddSite::SubAssign:
+        edits.push_back({m->begin, m->end, keepLines(m->begin, m->end, "(void)0")});
+        deleted.push_back({m->begin, m->end});
+        break;
+    }
+    ++n;
+  }
+  if (edits.empty()) return 0;
+  std::string out = text;
+  BodyFacts facts = b.facts;
+  if (!applyTextEdits(out, edits, facts)) return 0;  // (nested sites: not expected)
+  b.source.text = out;
+  b.facts = facts;
+  return n;
+}
+
 }  // namespace
 
-bool dropAbsentComponents(Plan& plan, DiagnosticEngine& diags) {
+bool dropAbsentComponents(Plan& plan, DiagnosticEngine& diags, bool foldZeros) {
   if (plan.dim >= 3) return true;
   std::set<std::string> leftOut = componentsLeftOut(plan);
   plan.leftOutComponents = leftOut;
   std::map<std::string, int> reduced = reducedStrides(plan);
   std::set<std::string> dropped;
+  // The zeros of the scene's dimension, as MultiplyAddSite::zeroWhen names them.
+  std::set<std::string> zeros;
+  for (int k = plan.dim; k < 3; ++k)
+    for (const char* v : {"XIJ", "VIJ", "DWIJ"}) zeros.insert(std::string(v) + "[" + std::to_string(k) + "]");
+  for (const auto& p : leftOut) zeros.insert("prop:" + p);
+  std::vector<std::string> folded;
   for (auto& b : plan.bodies) {
     if (!b.facts.ok) continue;
     std::set<std::string> here;
@@ -239,6 +318,10 @@ bool dropAbsentComponents(Plan& plan, DiagnosticEngine& diags) {
     for (const auto& s : b.facts.sites) strided |= reduced.count(s.prop) > 0;
     if (rewrite(b, leftOut, reduced, plan.dim)) {
       dropped.insert(here.begin(), here.end());
+      if (foldZeros) {
+        int k = foldZeroTerms(b, zeros);
+        if (k > 0) folded.push_back(b.source.label + " (" + std::to_string(k) + ")");
+      }
     } else if (strided) {
       // Its strided properties are stored with fewer components now: the text must follow.
       diags.error(b.source.start, "internal: " + b.source.label + ": the strided properties' " +
@@ -269,6 +352,13 @@ bool dropAbsentComponents(Plan& plan, DiagnosticEngine& diags) {
     for (const auto& p : dropped) list += (list.empty() ? "" : " ") + p;
     plan.notes.push_back("dim " + std::to_string(plan.dim) +
                          ": components left out of every body (read as 0, never stored): " + list);
+  }
+  if (!folded.empty()) {
+    std::string list;
+    for (const auto& f : folded) list += (list.empty() ? "" : ", ") + f;
+    plan.notes.push_back("dim " + std::to_string(plan.dim) +
+                         ": terms with a zero factor dropped (--no-fold-zero-terms keeps them): " +
+                         list);
   }
   return true;
 }

@@ -9,8 +9,10 @@
 namespace sphc {
 
 // analysis/Dimensions.cpp: in a 1D or 2D scene, rewrites the bodies so that the components
-// the dimension leaves out (z, w, az, aw, z0, w0, ...) are read as 0 and never stored.
-bool dropAbsentComponents(Plan& plan, DiagnosticEngine& diags);
+// the dimension leaves out (z, w, az, aw, z0, w0, ...) are read as 0 and never stored;
+// foldZeros: and drops the multiply-adds' terms with such a zero factor (sphc
+// --no-fold-zero-terms: false).
+bool dropAbsentComponents(Plan& plan, DiagnosticEngine& diags, bool foldZeros = true);
 // analysis/Pruning.cpp: marks equations whose results never reach integrated state (what
 // steppers read), output, the adaptive time step or a convergence test as not live.
 bool pruneEquations(Plan& plan, DiagnosticEngine& diags);

@@ -99,6 +99,11 @@ struct MultiplyAddSite {
   unsigned mulOp = 0, addOp = 0;     // the `*` and the `+`, `-`, `+=` or `-=`
   bool parenthesizeNegated = false;  // the negated operand (c of a*b - c, a of c - a*b and
                                      // x -= a*b) is not a primary expression: -(...)
+  // When the product is zero (body/ZeroTerms.cpp): where every leaf of one of these lists
+  // reads 0 ("XIJ[2]", "VIJ[2]", "DWIJ[2]", "prop:w"; an empty list: always), a factor is
+  // zero. The dimension pass drops such a term in a scene whose dimension leaves them out.
+  std::vector<std::vector<std::string>> zeroWhen;
+  bool statement = false;            // x += a*b, x -= a*b: a statement of its own
 };
 
 // A subexpression of a loop body that depends on the source particle only (s_NAME[s_idx],

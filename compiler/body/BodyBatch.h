@@ -255,6 +255,14 @@ bool appendSiteLocals(const std::set<const clang::VarDecl*>& locals, const Order
 // The values of a loop body the mirrored pair shares (BodyFacts::pairShared; PairShared.cpp).
 std::vector<SourceOnlySite> findPairSharedSites(const BodySource& body, clang::FunctionDecl* fn,
                                                 const SourceRangeOf& rangeOf);
+// The factors a and b of each multiply-add site's product, in the order of the sites.
+struct ProductFactors {
+  const clang::Expr* a = nullptr;
+  const clang::Expr* b = nullptr;
+};
+// MultiplyAddSite::zeroWhen of each site (ZeroTerms.cpp).
+void findZeroFactors(clang::FunctionDecl* fn, const std::vector<ProductFactors>& factors,
+                     std::vector<MultiplyAddSite>& sites);
 // Whether a loop body adds only zeros to properties at the self pair (BodyFacts::
 // vanishesOnSelfPair; SelfPair.cpp).
 bool vanishesOnSelfPair(const BodySource& body, clang::FunctionDecl* fn);

@@ -29,7 +29,9 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
     // A name `fma` of the body's own (a local, a scalar) would hide OpenCL's fma: as written.
     for (clang::ParmVarDecl* p : fn->parameters()) namesFma_ |= p->getName() == "fma";
     if (namesFma_) facts_.multiplyAdds.clear();
+    if (namesFma_) factors_.clear();
     if (batch_.state[i_].errors == 0) {
+      findZeroFactors(fn, factors_, facts_.multiplyAdds);
       SourceRangeOf range = [&](const clang::Stmt* e, unsigned& b, unsigned& en) {
         return textRange(e, b, en);
       };
@@ -48,6 +50,13 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   bool VisitBinaryOperator(clang::BinaryOperator* op) {
     if (op->isAssignmentOp()) markWritten(op->getLHS(), op->isCompoundAssignmentOp());
     if (recovering_ == 0) recordMultiplyAdd(op);
+    return true;
+  }
+
+  // The statements of a block (visited before them): a compound assignment among them is
+  // a statement of its own (MultiplyAddSite::statement).
+  bool VisitCompoundStmt(clang::CompoundStmt* c) {
+    for (clang::Stmt* s : c->body()) statements_.insert(s);
     return true;
   }
 
@@ -300,7 +309,9 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
                                ? a
                                : nullptr;
     if (negated) s.parenthesizeNegated = !isPrimary(negated);
+    s.statement = compound && statements_.count(op);
     facts_.multiplyAdds.push_back(s);
+    factors_.push_back({a, b});
   }
 
   bool sameType(clang::QualType x, clang::QualType y) const {
@@ -393,6 +404,8 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
   bool returnsValue_ = false;
   int recovering_ = 0;  // depth of RecoveryExprs being traversed
   bool namesFma_ = false;  // the body declares something named `fma`
+  std::vector<ProductFactors> factors_;
+  std::set<const clang::Stmt*> statements_;  // of the blocks visited (VisitCompoundStmt)  // of facts_.multiplyAdds, in order (ZeroTerms.cpp)
   std::map<const clang::ArraySubscriptExpr*, bool> written_;  // -> also read
   std::set<const clang::DeclRefExpr*> indexed_;  // d_/s_ references that are subscripted
   std::set<const clang::DeclRefExpr*> callees_;  // function references that are called

@@ -14,7 +14,9 @@
 //   - the body reads `s_hoisted0[s_idx]` where it had the expression.
 //
 // Destination-only subexpressions (BodyFacts::destinationOnly, e.g. `d_p[d_idx] / (rhoi *
-// rhoi)`) of properties that no pair loop of the plan writes likewise: a function
+// rhoi)`) of properties that no neighbour pass of the phases calling the body writes
+// (pairLoopWrites; until stop 37 no pair loop of the whole plan, which left out, e.g., every
+// value of rho in the momentum group after a summation density) likewise: a function
 // `PressureGradient_loop_dhoisted0(d_idx, d_p, d_rho)`, called in the destination loop before
 // the neighbours into a local `dhoisted_eq5_0`, read by the body as `d_hoisted0`. GCC does not
 // do this itself: the bodies' stores to d_ arrays may alias the d_ arrays they read.
@@ -114,14 +116,42 @@ std::string passHoisted(const std::string& eqStruct, size_t k) {
 
 }  // namespace
 
-const std::set<std::string>& ScenePrinter::pairLoopWrites() const {
+const std::set<std::string>& ScenePrinter::pairLoopWrites(const PlanBody& b) const {
   if (!pairLoopWrites_) {
     pairLoopWrites_ = std::make_unique<std::set<std::string>>();
     for (const PlanBody& other : plan_.bodies)
       if (other.source.kind == BodyKind::Loop || other.source.kind == BodyKind::LoopAll)
         for (const PropAccess& w : other.facts.dWrites) pairLoopWrites_->insert(w.prop);
+    // Per loop body: the d_ properties the neighbour passes of the phases that call it write
+    // (their loop, loop_all and initialize_pair bodies, every destination of the phase). A
+    // value hoisted per destination or shared by a pair is computed within such a pass (before
+    // the destination's neighbours, before the pass, or at the pair) and read at its pairs:
+    // only what runs between, the pass's own bodies, can change what it read. Another phase
+    // (e.g. the summation density writing rho before the momentum group reads it) runs
+    // wholly before or after.
+    pairLoopWritesByBody_ = std::make_unique<std::map<const PlanBody*, std::set<std::string>>>();
+    walkPhases(sched_.equations, [&](const Phase& ph) {
+      std::set<std::string> written;
+      std::set<const PlanBody*> loops;
+      for (const DestinationWork& w : ph.destinations)
+        for (const NeighbourPass& pass : w.passes) {
+          auto add = [&](const std::vector<const PlanEquation*>& eqs, ast::Method::Kind kind) {
+            for (const PlanEquation* eq : eqs)
+              for (const PropAccess& a : methodBody(*eq, kind).facts.dWrites)
+                written.insert(a.prop);
+          };
+          add(pass.equations, ast::Method::Loop);
+          add(pass.loopAll, ast::Method::LoopAll);
+          add(pass.initializePair, ast::Method::InitializePair);
+          for (const PlanEquation* eq : pass.equations)
+            loops.insert(&methodBody(*eq, ast::Method::Loop));
+        }
+      for (const PlanBody* l : loops) (*pairLoopWritesByBody_)[l].insert(written.begin(), written.end());
+    });
   }
-  return *pairLoopWrites_;
+  // A body in no pass (printed, never called in a pair loop): every pair loop's writes.
+  auto it = pairLoopWritesByBody_->find(&b);
+  return it == pairLoopWritesByBody_->end() ? *pairLoopWrites_ : it->second;
 }
 
 std::vector<SourceOnlySite> ScenePrinter::hoistedDestinationSites(const PlanBody& b,
@@ -130,8 +160,9 @@ std::vector<SourceOnlySite> ScenePrinter::hoistedDestinationSites(const PlanBody
       b.source.text.find("d_hoisted") != std::string::npos)  // the names would clash
     return {};
   // A property some pair loop writes (an accumulator such as au) changes during the
-  // neighbour loop of its destination: not hoisted. Checked over every loop of the plan.
-  const std::set<std::string>& written = pairLoopWrites();
+  // neighbour loop of its destination: not hoisted. Checked over the neighbour passes of
+  // every phase that calls the body (pairLoopWrites).
+  const std::set<std::string>& written = pairLoopWrites(b);
   std::vector<SourceOnlySite> kept;
   for (const SourceOnlySite& s : b.facts.destinationOnly) {
     bool ok = true;

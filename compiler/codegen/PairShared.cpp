@@ -20,7 +20,8 @@
 // The values are the same bit for bit: the analysis allows only exact IEEE identities (see
 // body/PairShared.cpp, also for the sign of a zero), the site's function computes the
 // expression with the body's own operations and fused multiply-adds (a site that would split
-// a multiply-add is not used), and the properties a site reads are written by no pair loop.
+// a multiply-add is not used), and the properties a site reads are written by no neighbour
+// pass of a phase that calls the body (pairLoopWrites).
 //
 // Single precision: as the hoisted values (codegen/Hoist.cpp), the functions are the float
 // text, return `auto` and are followed by their type (NAME_loop_pairsharedK_t), which the
@@ -68,7 +69,7 @@ std::vector<SourceOnlySite> ScenePrinter::pairSharedSites(const PlanBody& b, con
   if (!pairSharedBodies_)
     pairSharedBodies_ = std::make_unique<std::set<const PlanBody*>>(pairSharedBodies());
   if (!pairSharedBodies_->count(&b)) return {};  // no loop calls it both ways: as before
-  const std::set<std::string>& written = pairLoopWrites();  // by any pair loop of the plan
+  const std::set<std::string>& written = pairLoopWrites(b);  // by the passes of its phases
   std::vector<SourceOnlySite> kept;
   for (const SourceOnlySite& s : b.facts.pairShared) {
     bool ok = true;

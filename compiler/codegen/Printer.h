@@ -250,10 +250,12 @@ class ScenePrinter {
   // those computed once per destination particle (of properties no pair loop writes).
   std::vector<SourceOnlySite> hoistedSites(const PlanBody& b, const Dialect& d) const;
   std::vector<SourceOnlySite> hoistedDestinationSites(const PlanBody& b, const Dialect& d) const;
-  // The properties some pair loop of the plan writes (an accumulator such as au changes
-  // during the neighbour loop): neither hoisted per destination nor shared by a pair.
-  const std::set<std::string>& pairLoopWrites() const;
+  // The properties the neighbour passes of the phases that call loop body b write (an
+  // accumulator such as au changes during the neighbour loop): neither hoisted per
+  // destination nor shared by a pair in b. A body no pass calls: those of every pair loop.
+  const std::set<std::string>& pairLoopWrites(const PlanBody& b) const;
   mutable std::unique_ptr<std::set<std::string>> pairLoopWrites_;  // (once)
+  mutable std::unique_ptr<std::map<const PlanBody*, std::set<std::string>>> pairLoopWritesByBody_;
   // The body's text with each hoisted site replaced by `s_hoistedK[s_idx]` (and its facts
   // moved with it), its multiply-adds fused.
   // `extra`: further edits of the text (RegisterSums.cpp), none overlapping a hoisted site.
@@ -312,6 +314,10 @@ class ScenePrinter {
   // The call of eq's loop for destination s_idx and source d_idx, with the mirrored pair
   // quantities (XIJ_ji, ...); with `pointers`, its property arguments are pointers + d_NAME
   // and pointers + s_NAME (emitCrossPass: mirror_d_, mirror_s_).
+  // callBodyMirrored's arguments (the swapped indices, mirrored pair quantities, s_idx's
+  // destination-only values, the pair-shared locals): for callBody or pairCall's `first`.
+  std::function<std::string(const BodyParam&)> mirroredArgument(
+      const PlanEquation& eq, const std::string& pointers = "") const;
   std::string callBodyMirrored(const PlanEquation& eq, int dest,
                                const std::string& pointers = "") const;
   // Pair loops A <- B (A's last) and B <- A (B's first) of one phase that crossPairsRefusal()
@@ -352,6 +358,9 @@ class ScenePrinter {
   // Before the neighbour loop: the locals acc_NAME loaded (or, refused, a comment why);
   // after it: stored.
   void emitSumsLoad(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
+  // A sum's local (acc_NAME, accK_NAME) and its index in d_NAME for particle `idx`.
+  static std::string sumsLocalName(const std::string& prop, int stride, int comp);
+  static std::string sumsIndexText(int stride, int comp, const std::string& idx);
   void emitSumsStore(std::ostream& os, const std::string& indent, const RegisterSums& rs) const;
   // The call of eq's loop for destination d: with rs active, of its function on the locals
   // (named sumsPrefix + acc_NAME); `first`, where it returns an argument, overrides the others

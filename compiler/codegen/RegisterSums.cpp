@@ -116,6 +116,14 @@ std::string indexText(int stride, int comp) {
 
 }  // namespace
 
+std::string ScenePrinter::sumsLocalName(const std::string& prop, int stride, int comp) {
+  return localName(prop, stride, comp);
+}
+
+std::string ScenePrinter::sumsIndexText(int stride, int comp, const std::string& idx) {
+  return stride == 1 ? idx : std::to_string(stride) + " * " + idx + " + " + std::to_string(comp);
+}
+
 RegisterSums ScenePrinter::registerSums(const DestinationWork& w,
                                                       const NeighbourPass& pass,
                                                       const NeighbourPass* mirrored) const {

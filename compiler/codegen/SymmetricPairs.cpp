@@ -238,13 +238,12 @@ std::vector<std::string> symmetricPairsNotes(
 
 // ---- The printer ----
 
-std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest,
-                                           const std::string& pointers) const {
-  const PlanBody& b = methodBody(eq, ast::Method::Loop);
+std::function<std::string(const ScenePrinter::BodyParam&)> ScenePrinter::mirroredArgument(
+    const PlanEquation& eq, const std::string& pointers) const {
   const std::string eqValues = eqStruct(eq);
   // callBody's arguments but for the swapped indices, the mirrored pair quantities and the
   // destination-only values of particle s_idx.
-  auto argument = [&](const BodyParam& p) -> std::string {
+  return [this, eqValues, pointers](const BodyParam& p) -> std::string {
     switch (p.kind) {
       case BodyParam::Idx: return "s_idx";
       case BodyParam::SIdx: return "d_idx";
@@ -263,7 +262,13 @@ std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest,
       default: return "";
     }
   };
-  return callBody(bodyFunctionName(eq.name, "loop"), b, dest, eqValues, "t", ".", argument) +
+}
+
+std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest,
+                                           const std::string& pointers) const {
+  const PlanBody& b = methodBody(eq, ast::Method::Loop);
+  return callBody(bodyFunctionName(eq.name, "loop"), b, dest, eqStruct(eq), "t", ".",
+                  mirroredArgument(eq, pointers)) +
          ";  // " + eq.name + ", from " + loc(eq.loc) + ": destination s_idx, source d_idx\n";
 }
 
@@ -382,13 +387,36 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       emitPairQuantitiesOnce(q, bothSides, body);
       if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
       for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
+      // The mirrored calls: with the sums in locals, particle s_idx's too, for the pair's
+      // calls (loaded before them, stored after: the same operations on the same values, but
+      // the bodies' stores no longer alias what the next body reads, so the C++ compiler
+      // computes the values they share, e.g. m / rho of s_idx, once for the pair).
+      auto mirroredCalls = [&](const std::string& mb) {
+        if (!sums.active()) {
+          for (const PlanEquation* eq : pass.equations) scene_ << mb << callBodyMirrored(*eq, d);
+          return;
+        }
+        scene_ << mb << "// s_idx's sums in locals for its calls (codegen/SymmetricPairs.cpp)\n";
+        for (const auto& [p, sc] : sums.props)
+          for (int k : sc.second)
+            scene_ << mb << host_.real << " m_" << sumsLocalName(p, sc.first, k) << " = d_" << p
+                   << "[" << sumsIndexText(sc.first, k, "s_idx") << "];\n";
+        for (const PlanEquation* eq : pass.equations) {
+          std::string call = pairCall(*eq, d, sums, false, "m_", mirroredArgument(*eq));
+          call.insert(call.size() - 1, ": destination s_idx, source d_idx");
+          scene_ << mb << call;
+        }
+        for (const auto& [p, sc] : sums.props)
+          for (int k : sc.second)
+            scene_ << mb << "d_" << p << "[" << sumsIndexText(sc.first, k, "s_idx") << "] = m_"
+                   << sumsLocalName(p, sc.first, k) << ";\n";
+      };
       if (bothSides && sg.skipSelf) {  // s_idx > d_idx: the self pair is not in [k_first, ...)
         scene_ << body << "// the same pair for particle s_idx\n";
-        for (const PlanEquation* eq : pass.equations) scene_ << body << callBodyMirrored(*eq, d);
+        mirroredCalls(body);
       } else if (bothSides) {
         scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
-        for (const PlanEquation* eq : pass.equations)
-          scene_ << body << "  " << callBodyMirrored(*eq, d);
+        mirroredCalls(body + "  ");
         scene_ << body << "}\n";
       }
       endPairShared();

@@ -106,6 +106,14 @@ static cl::opt<bool> NoHoist(
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double and single precision; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoFoldZeroTerms(
+    "no-fold-zero-terms",
+    cl::desc("In a 1D or 2D scene, keep the terms of the bodies' multiply-adds whose product has "
+             "a factor the dimension leaves out (default: dropped, e.g. the z row and column of "
+             "a 3x3 tensor, the z term of a dot product: a * DWIJ[2] + c is c; the results are "
+             "the same bit for bit but where a factor is infinite or NaN or in the sign of a "
+             "zero sum, docs/performance.md)"),
+    cl::init(false), cl::cat(SphcCat));
 // --omp-min-particles (default): measured in docs/performance.md, "OpenMP on small scenes".
 static constexpr unsigned kDefaultOmpMinParticles = 10000;
 static cl::opt<unsigned> OmpMinParticles(
@@ -486,7 +494,7 @@ int main(int argc, char** argv) {
   if (diags.hasErrors()) return fail();
   if (dump(Pass::Bodies)) return 0;
 
-  if (!dropAbsentComponents(*plan, diags)) return fail();
+  if (!dropAbsentComponents(*plan, diags, !NoFoldZeroTerms)) return fail();
   if (!pruneEquations(*plan, diags)) return fail();
   if (dump(Pass::Prune)) return 0;
   if (!inferProperties(*plan, diags)) return fail();
