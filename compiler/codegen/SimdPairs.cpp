@@ -34,9 +34,8 @@
 // breaks: in the each-pair-once lane form too, stop 36: 1.19-1.24x the scalar step at dx =
 // 0.03, 1.02-1.35x at ~100k, on Intel with gathers; 0.84-0.86 from h = 1.6 dx, ~32). A loop
 // over its own array that is per destination anyway by the scene (a periodic or mirror
-// domain, zones) goes in the lanes at any count (kSimdPerDestNeighbours; stop 36: 0.84-0.97
-// of the scalar step at ~28 neighbours, 0.79-0.81 for a per-destination loop at ~21; stop 37,
-// zones: 0.76-0.82 the channel, 0.94 the cylinder); one over
+// domain, no zones) goes in the lanes at any count (kSimdPerDestNeighbours; stop 36: 0.84-0.97
+// of the scalar step at ~28 neighbours, 0.79-0.81 for a per-destination loop at ~21); one over
 // another array (walls) keeps the threshold (the dam break's shifting fluid <- boundary in
 // lanes: 1.08-1.10x).
 //
@@ -184,12 +183,9 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // measured): scalar as before. A loop over another array (walls) keeps the threshold: most of
   // its destinations have few or no neighbours there (the dam break's fluid <- boundary in
   // lanes: 1.08-1.10x).
-  // With zones (inlets, outlets) too: stop 36 left them out (the channel's TVF scene gave
-  // serial and OpenMP runs that differ in their bits with its loops in lanes); the cause was
-  // GCC's inlining (the serial phase called the kernel's shape function, so its loops stayed
-  // scalar; sphc/kernels.h now always inlines it, lit backends/simd-lanes-serial-openmp.sph).
-  // Stop 37, serial CPU time against the scalar loops: the channel 0.82 (EDAC), 0.78 (TVF),
-  // 0.76 (WCSPH), the cylinder 0.94 (docs/performance.md, "Loose ends (stop 37)").
+  // Not with zones (inlets, outlets): the channel's TVF scene (examples/channel_inlet_outlet.sph
+  // -D scheme=tvf) gave serial and OpenMP runs that differ in their bits with its loops in
+  // lanes (lit backends/every-example.sph, -single.sph; not found why in stop 36).
   // Not where the scalar loop evaluates each pair once with the ghosts kept with the lists
   // (stop 36, CpuPrinter::symmetricPass): Taylor-Green EDAC nx = 100 took 1.05x the CPU of
   // the scalar each-pair-once loops with these two loops per destination in lanes (3.19-3.23
@@ -198,7 +194,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
       simdGhostOnce_ && pass.source == w.array &&
       symmetricPairsRefusal(plan_, w, pass, true).empty();
   const bool perDestOwn = !onceAnyway && !ghostOnceScalar && pass.source == w.array &&
-                          plan_.dim >= 2 && simdSymmetricSwitch_ && (hasDomain() || hasZones());
+                          plan_.dim >= 2 && simdSymmetricSwitch_ && hasDomain() && !hasZones();
   // --simd-once-neighbours: a threshold of its own for a loop the lanes print each pair once.
   const bool once = simdOnce_ && onceForm(w, pass) && simdOnceNeighbours_ >= 0;
   const double threshold = once ? simdOnceNeighbours_
