@@ -18,7 +18,6 @@ namespace sphc {
 
 namespace {
 
-constexpr int C = kClusterSize;
 // The box tests keep squared distances up to radius^2 (1 + kBoxMargin) (sphc/cluster_pairs.h).
 constexpr double kBoxMargin = 1e-12;
 
@@ -59,14 +58,19 @@ inline double box_distance2(const double* a, const double* b) {
 
 }  // namespace
 
-double cluster_column_side(double spacing, int dim) {
-  return spacing * std::pow(static_cast<double>(C), 1.0 / dim);
+double cluster_column_side(double spacing, int dim, int width) {
+  return spacing * std::pow(static_cast<double>(width), 1.0 / dim);
 }
 
 void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, const double* z,
-                          std::size_t n, int dim, double column_side) {
+                          std::size_t n, int dim, double column_side, int width) {
   assert(dim == 2 || dim == 3);
+  assert(width >= 1 && width <= kMaxClusterSize);
+  if (width < 1) width = 1;
+  if (width > kMaxClusterSize) width = kMaxClusterSize;
+  const std::size_t C = static_cast<std::size_t>(width);
   L.dim = dim;
+  L.width = width;
   L.n = n;
   const int ncol_axes = dim - 1;  // 3D: x, y; 2D: x
   const double* col_axis[2] = {x, y};
@@ -88,7 +92,7 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
     int k = 0;
     for (int a = 0; a < dim; ++a)
       if (hi[a] > lo[a]) volume *= hi[a] - lo[a], ++k;
-    side = n > 0 && k > 0 ? std::pow(C * volume / static_cast<double>(n), 1.0 / k) : 1.0;
+    side = n > 0 && k > 0 ? std::pow(static_cast<double>(C) * volume / static_cast<double>(n), 1.0 / k) : 1.0;
     if (!(side > 0) || !std::isfinite(side)) side = 1.0;
   }
   // At most 4 n + 16 columns: wider columns where the extent would need more.
@@ -161,21 +165,33 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
 
 namespace {
 
-template <class T>
-void gather_slots_of(const ClusterLayout& L, const T* src, T* dst) {
+// W: the layout's width, a constant for the default 8 (the loops unrolled), 0 for another
+// (read from the layout).
+template <int W, class T>
+void gather_slots_w(const ClusterLayout& L, const T* src, T* dst) {
+  const int C = W > 0 ? W : L.width;
+  const std::uint8_t full = L.full_mask();
   const std::uint32_t* slot = L.slot.data();
   const std::size_t nc = L.n_clusters;
 #pragma omp parallel for schedule(static)
   for (std::size_t c = 0; c < nc; ++c) {
     const std::uint32_t* sl = slot + c * C;
     T* d = dst + c * C;
-    if (L.real_mask[c] == 0xff) {
+    if (L.real_mask[c] == full) {
       for (int k = 0; k < C; ++k) d[k] = src[sl[k]];
     } else {
       const T first = src[sl[0]];
       for (int k = 0; k < C; ++k) d[k] = sl[k] == kPadSlot ? first : src[sl[k]];
     }
   }
+}
+
+template <class T>
+void gather_slots_of(const ClusterLayout& L, const T* src, T* dst) {
+  if (L.width == kClusterSize)
+    gather_slots_w<kClusterSize>(L, src, dst);
+  else
+    gather_slots_w<0>(L, src, dst);
 }
 
 template <class T>
@@ -210,16 +226,23 @@ void gather_positions(const ClusterLayout& L, const double* x, const double* y, 
   if (L.slots() == L.n) return;  // no padding
   double xmax = -HUGE_VAL;
   for (std::size_t p = 0; p < L.n; ++p) xmax = std::max(xmax, x[p]);
+  const int C = L.width;
+  const unsigned full = L.full_mask();
   double k = 0;  // the padding slots numbered 1, 2, ... in slot order
   for (std::size_t c = 0; c < L.n_clusters; ++c) {
     const unsigned m = L.real_mask[c];
-    if (m == 0xff) continue;
+    if (m == full) continue;
     for (int lane = 0; lane < C; ++lane)
       if (!(m >> lane & 1u)) xs[c * C + lane] = xmax + (k += 1) * pad_offset;
   }
 }
 
-void update_boxes(ClusterLayout& L, const double* xs, const double* ys, const double* zs) {
+namespace {
+
+template <int W>
+void update_boxes_w(ClusterLayout& L, const double* xs, const double* ys, const double* zs) {
+  const int C = W > 0 ? W : L.width;
+  const std::uint8_t full = L.full_mask();
   const bool three = L.dim == 3;
   const std::size_t nc = L.n_clusters;
   double* box = L.box.data();
@@ -227,7 +250,7 @@ void update_boxes(ClusterLayout& L, const double* xs, const double* ys, const do
   for (std::size_t c = 0; c < nc; ++c) {
     const std::size_t s0 = c * C;
     double* b = box + 6 * c;
-    if (L.real_mask[c] == 0xff) {
+    if (L.real_mask[c] == full) {
       double lx = xs[s0], hx = xs[s0], ly = ys[s0], hy = ys[s0];
       for (int k = 1; k < C; ++k) {
         lx = std::min(lx, xs[s0 + k]), hx = std::max(hx, xs[s0 + k]);
@@ -251,6 +274,15 @@ void update_boxes(ClusterLayout& L, const double* xs, const double* ys, const do
       b[0] = lx, b[1] = ly, b[2] = lz, b[3] = hx, b[4] = hy, b[5] = hz;
     }
   }
+}
+
+}  // namespace
+
+void update_boxes(ClusterLayout& L, const double* xs, const double* ys, const double* zs) {
+  if (L.width == kClusterSize)
+    update_boxes_w<kClusterSize>(L, xs, ys, zs);
+  else
+    update_boxes_w<0>(L, xs, ys, zs);
 }
 
 namespace {

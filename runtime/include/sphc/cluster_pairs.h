@@ -5,10 +5,11 @@
 // A pair loop in tiles sees one particle array in *cluster order*: the particles sorted into
 // columns (3D: squares of side `column_side` in the x-y plane, each column sorted by z; 2D:
 // strips of width `column_side` in x, each sorted by y), each column cut into clusters of
-// kClusterSize consecutive particles, the last cluster of a column padded. Slot s = 8 c + k is
-// lane k of cluster c (ClusterLayout). Per evaluation the loop copies the properties it reads
+// `width` consecutive particles (kClusterSize = 8 by default; 1..8, e.g. 4 for 2D tiles:
+// docs/performance.md, "SIMD tiles in 2D, measured by hand (stop 38)"), the last cluster of a
+// column padded. Slot s = width c + k is lane k of cluster c (ClusterLayout). Per evaluation the loop copies the properties it reads
 // into slot order (gather_slots, gather_positions: contiguous vector loads of a cluster), runs
-// its tiles (one i of an i-cluster broadcast x the 8 lanes of a j-cluster, the cut-off a mask)
+// its tiles (one i of an i-cluster broadcast x the lanes of a j-cluster, the cut-off a mask)
 // over a ClusterPairList, and adds its sums, accumulated in slot order, back (add_slots).
 //
 // Lists. The *outer* list (build_cluster_pairs) holds, per i-cluster, the j-clusters whose
@@ -58,8 +59,10 @@
 
 namespace sphc {
 
-// The width of a cluster: one AVX-512 register of doubles (the j-cluster of a tile).
+// The default width of a cluster: one AVX-512 register of doubles (the j-cluster of a tile).
+// A layout may have another width (ClusterLayout::width, 1..kMaxClusterSize).
 constexpr int kClusterSize = 8;
+constexpr int kMaxClusterSize = 8;  // real_mask holds a cluster's slots in 8 bits
 // ClusterLayout::slot of a padding slot.
 constexpr std::uint32_t kPadSlot = 0xffffffffu;
 
@@ -67,11 +70,13 @@ constexpr std::uint32_t kPadSlot = 0xffffffffu;
 struct ClusterLayout {
   int dim = 3;                         // 2 or 3
   std::size_t n = 0;                   // real particles
-  std::size_t n_clusters = 0;          // slots = n_clusters * kClusterSize
+  int width = kClusterSize;            // slots per cluster (1..kMaxClusterSize)
+  std::size_t n_clusters = 0;          // slots = n_clusters * width
   std::vector<std::uint32_t> slot;     // slot -> particle index, kPadSlot for padding
   std::vector<std::uint32_t> slot_of;  // particle -> its slot
-  // Per cluster: bit k set where slot 8 c + k holds a real particle (its real slots come
-  // first: 0xff, or 2^m - 1 for the last cluster of a column with m real particles).
+  // Per cluster: bit k set where slot width c + k holds a real particle (its real slots come
+  // first: full_mask() (0xff for width 8), or 2^m - 1 for the last cluster of a column with m
+  // real particles).
   std::vector<std::uint8_t> real_mask;
   // Per cluster: lo x, lo y, lo z, hi x, hi y, hi z of its real particles (2D: z 0, 0), from
   // the positions given to build_cluster_layout or, since, to update_boxes.
@@ -85,21 +90,24 @@ struct ClusterLayout {
   std::size_t columns[2] = {0, 0};
   std::vector<std::uint32_t> column_begin;  // columns[0] * columns[1] + 1
 
-  std::size_t slots() const { return n_clusters * kClusterSize; }
+  std::size_t slots() const { return n_clusters * static_cast<std::size_t>(width); }
+  // real_mask of a cluster without padding.
+  std::uint8_t full_mask() const { return static_cast<std::uint8_t>((1u << width) - 1u); }
 };
 
-// A column side giving clusters about as wide as tall: spacing * kClusterSize^(1/dim) (2
-// spacings in 3D, 2.83 in 2D), spacing the particles' typical distance (dx).
-double cluster_column_side(double spacing, int dim);
+// A column side giving clusters about as wide as tall: spacing * width^(1/dim) (width 8: 2
+// spacings in 3D, 2.83 in 2D; width 4 in 2D: 2), spacing the particles' typical distance (dx).
+double cluster_column_side(double spacing, int dim, int width = kClusterSize);
 
 // At a list rebuild: the layout of n particles at (x, y, z) (z unused, may be null, in 2D).
-// column_side <= 0: (kClusterSize * V / n)^(1/k), V the volume (2D: area) of the particles'
+// column_side <= 0: (width * V / n)^(1/k), V the volume (2D: area) of the particles'
 // bounding box over the k axes along which they extend (2 dx for a filled box on a lattice of
 // spacing dx; a flat wall of a 3D scene: its area, 2.83 dx). Where the bounding box
 // would need more than 4 n + 16 columns (a stray particle), the columns are made wider.
-// Boxes from these positions.
+// Boxes from these positions. width: the slots per cluster (1..kMaxClusterSize).
 void build_cluster_layout(ClusterLayout& layout, const double* x, const double* y,
-                          const double* z, std::size_t n, int dim, double column_side);
+                          const double* z, std::size_t n, int dim, double column_side,
+                          int width = kClusterSize);
 
 // Per evaluation: dst[s] = src[slot[s]] for every slot (dst: layout.slots() values); a
 // padding slot takes the value of the first slot of its cluster (a real particle).
@@ -107,7 +115,7 @@ void gather_slots(const ClusterLayout& layout, const double* src, double* dst);
 void gather_slots(const ClusterLayout& layout, const float* src, float* dst);
 
 // Per evaluation: the positions in slot order (z, zs unused in 2D, may be null). The k-th
-// padding slot of the layout (k = 1, 2, ... in slot order; at most 7 per column) sits at
+// padding slot of the layout (k = 1, 2, ... in slot order; at most width - 1 per column) sits at
 // x = (largest x of the real particles) + k pad_offset, its y and z those of its cluster's
 // first particle: at least pad_offset from every real particle of the layout and from every
 // other padding slot (so with pad_offset beyond the cut-off no padding lane is within it of

@@ -25,7 +25,7 @@ struct Lists {
   std::vector<double> gathered, added;
 };
 
-Lists lists_with(int threads, int dim) {
+Lists lists_with(int threads, int dim, int width) {
   omp_set_num_threads(threads);
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -34,7 +34,7 @@ Lists lists_with(int threads, int dim) {
   for (std::size_t i = 0; i < n; ++i) x[i] = u(rng), y[i] = u(rng), z[i] = dim == 3 ? u(rng) : 0.0, v[i] = u(rng);
   const double radius = dim == 3 ? 0.12 : 0.045;
   Lists l;
-  sphc::build_cluster_layout(l.layout, x.data(), y.data(), z.data(), n, dim, 0.0);
+  sphc::build_cluster_layout(l.layout, x.data(), y.data(), z.data(), n, dim, 0.0, width);
   sphc::build_cluster_pairs(l.layout, l.layout, radius, true, l.outer);
   for (std::size_t i = 0; i < n; ++i) x[i] += 0.02 * radius * std::sin(3.0 * i), y[i] += 0.02 * radius * std::cos(5.0 * i);
   const std::size_t S = l.layout.slots();
@@ -51,14 +51,16 @@ Lists lists_with(int threads, int dim) {
 }
 
 TEST_F(ClusterPairsOmp, ListsOfAnyThreadCountEqualOneThreads) {
+  for (int width : {sphc::kClusterSize, 4})
   for (int dim : {2, 3}) {
     SCOPED_TRACE(dim);
-    const Lists one = lists_with(1, dim);
+    SCOPED_TRACE(width);
+    const Lists one = lists_with(1, dim, width);
     EXPECT_GT(one.pruned.j.size(), 0u);
     EXPECT_LT(one.pruned.j.size(), one.outer.j.size());
     for (int t = 2; t <= 4; ++t) {
       SCOPED_TRACE(t);
-      const Lists l = lists_with(t, dim);
+      const Lists l = lists_with(t, dim, width);
       EXPECT_EQ(l.layout.slot, one.layout.slot);
       EXPECT_EQ(l.layout.box, one.layout.box);
       EXPECT_EQ(l.outer.begin, one.outer.begin);
