@@ -1,0 +1,901 @@
+// The 2D dam break's fluid <- fluid pass with PySPH's effects (examples/dambreak.sph -D
+// density_diffusion=off -D shifting=off: continuity, momentum with Monaghan's artificial
+// viscosity, XSPH; WendlandQuintic 2D, h = 1.3 dx, support 2 h, ~19 neighbours), timed by
+// hand in SIMD tiles against the scalar each-pair-once loop sphc prints today
+// (docs/performance.md, "SIMD tiles in 2D, measured by hand (stop 38)"; issue 16). Not a test
+// of the solver: a prototype that prints figures, self-checking (exit 1 if a form's sums
+// disagree with form (a) beyond the tolerance, or a list misses a pair).
+//
+//   (a) today's scalar form (sphc's default in 2D: --simd-pairs=auto leaves 2D scalar): per
+//       destination i its kept list (candidates within 1.1 x 2 h, index order), the pairs
+//       j > i, the cut-off a branch, each pair once: i's sums in locals, j's in memory. The
+//       loop and the bodies are the generated C++ of `sphc examples/dambreak.sph -D
+//       density_diffusion=off -D shifting=off --emit=cpp` (main 9996b02), copied verbatim
+//       (#line directives removed; the kernel is the runtime's, sphc/kernels.h).
+//   (t) cluster-pair tiles in AVX-512 intrinsics on the runtime's layout and lists
+//       (sphc/cluster_pairs.h), shape CI x CJ: i-clusters of CI, j-clusters of CJ, a zmm
+//       register of 8 lanes holding RI = 8 / CJ i's x CJ j's:
+//         t4x4  GROMACS' "2xMM" (layout of width 4; one zmm = 2 i's x the 4 j's, the j's
+//               loaded once per tile into both halves, two registers per tile),
+//         t4x8  i-clusters the halves of 8-clusters (layout of width 8) x j-clusters of 8,
+//               one zmm per i (a row),
+//         t8x8  stop 36-37's tile (layout of width 8), one zmm per i.
+//       The pruned list (the outer list at 1.1 x 2 h pruned to 2 h with the boxes now; t4x8:
+//       an 8x8 list with each half's own box tested), a register skipped where its mask is
+//       empty; the cut-off (and j > i on the diagonal tile) the mask; i's sums in registers
+//       across its list, reduced once per i-cluster; j's summed over the tile's registers and
+//       added to memory once per tile (t4x4: the two halves folded first). No gathers.
+//       Arithmetic: "exact" = the operations of (a) in the same order (correctly rounded
+//       vdivpd and vsqrtpd, the same fma's; the mirrored terms with the negated vectors,
+//       DWIJ_ji = -DWIJ and VIJ_ji = -VIJ exactly as (a)'s); "rcp" = the divisions and the
+//       square root by vrcp14pd / vrsqrt14pd and two Newton steps (not (a)'s roundings).
+//
+// Results: (a) adds i's terms in list order into one scalar, j's in increasing i; (t) i's in 8
+// lane partial sums, j's per tile. The check: per sum, max |X - a| / max |a| <= 1e-12 (the
+// sums start from 0, so the pairs' terms are compared; the reassociation of ~19 terms of both
+// signs gives ~1e-15; a pair missed or counted twice gives > 1e-3).
+//
+// Particles: --positions FILE (x y u v rho p per line: a snapshot of the scene, dx = 0.03),
+// or the dam break's water column (--nx 33 --ny 66 at dx = 0.03, each coordinate moved by up
+// to --pert dx; velocities random up to 1 m/s, the hydrostatic pressure) in the solver's
+// order (cells of side 2 h). cs = c0 (rho / rho0)^3 as the scene's equation of state.
+//
+// Build (the flags of a solver: buildinfo cxxflags): c++ -std=c++17 -O3 -march=native
+//   -fno-math-errno -ffp-contract=off -I runtime/include bench/cluster_pairs_2d.cpp
+//   runtime/src/cluster_pairs.cpp -o cluster_pairs_2d   (tests/CMakeLists.txt:
+//   cluster_pairs_2d_check, ctest bench.cluster_pairs_2d)
+// Run: ./cluster_pairs_2d [--positions FILE] [--nx 33 --ny 66] [--pert 0.1] [--reps 7]
+//   [--sweeps N] [--forms a,t4x4,t4x4rcp,...] [--dx 0.03] [--hdx 1.3] [--skin 0.1]
+// Needs AVX-512F (exits 77 without it).
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <time.h>
+
+#include "sphc/cluster_pairs.h"
+#include "sphc/kernels.h"
+
+namespace {
+
+double cpu_now() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+constexpr int DIM = 2;
+using Kernel = sphc::WendlandQuintic<DIM>;
+constexpr double RADIUS2 = Kernel::radius_scale * Kernel::radius_scale;
+
+// ---- The loop bodies: the generated C++ of examples/dambreak.sph with PySPH's effects, verbatim ----
+// equation ContinuityEquation, method loop, from wcsph.sph:73: a value the pair shares, the same for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+static inline double ContinuityEquation_loop_pairshared0(int d_idx, int s_idx, double t, double dt, const double* VIJ, const double* DWIJ, const double* s_m) {
+  return std::fma(VIJ[0], DWIJ[0], VIJ[1] * DWIJ[1]);
+}
+
+// equation ContinuityEquation, method loop, from wcsph.sph:73: the destination's sums in locals (acc_NAME, accK_NAME: component K;
+// codegen/RegisterSums.cpp)
+static inline void ContinuityEquation_loop_sums(int d_idx, int s_idx, double t, double dt, const double* VIJ, const double* DWIJ, double& acc_arho, const double* s_m, double pair_shared0) {
+    double vijdotdwij = pair_shared0;
+    acc_arho = std::fma(s_m[s_idx], vijdotdwij, acc_arho);
+  
+}
+
+// equation PressureGradient, method loop, from wcsph.sph:158: once per source particle (hoisted out of the pair loop; --no-hoist: per pair)
+//   s_p[s_idx] / (rhoj * rhoj)
+static inline double PressureGradient_loop_hoisted0(int s_idx, const double* s_p, const double* s_rho) {
+  const double rhoj = s_rho[s_idx];
+  return s_p[s_idx] / (rhoj * rhoj);
+}
+
+// equation PressureGradient, method loop, from wcsph.sph:158: once per destination particle (hoisted out of the pair loop; --no-hoist: per pair)
+//   d_p[d_idx] / (rhoi * rhoi)
+static inline double PressureGradient_loop_dhoisted0(int d_idx, const double* d_p, const double* d_rho) {
+  const double rhoi = d_rho[d_idx];
+  return d_p[d_idx] / (rhoi * rhoi);
+}
+
+// equation PressureGradient, method loop, from wcsph.sph:158: a value the pair shares, the same for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+//   d_hoisted0 + s_hoisted0[s_idx]
+static inline double PressureGradient_loop_pairshared0(int d_idx, int s_idx, double t, double dt, const double* DWIJ, const double* d_p, const double* d_rho, const double* s_m, const double* s_p, const double* s_rho, const double* s_hoisted0, double d_hoisted0) {
+  const double rhoi = d_rho[d_idx];
+  const double rhoj = s_rho[s_idx];
+  return d_hoisted0 + s_hoisted0[s_idx];
+}
+
+// equation PressureGradient, method loop, from wcsph.sph:158: the destination's sums in locals (acc_NAME, accK_NAME: component K;
+// codegen/RegisterSums.cpp)
+static inline void PressureGradient_loop_sums(int d_idx, int s_idx, double t, double dt, const double* DWIJ, double& acc_au, double& acc_av, const double* d_p, const double* d_rho, const double* s_m, const double* s_p, const double* s_rho, const double* s_hoisted0, double d_hoisted0, double pair_shared0) { double sphc_sink = 0.0; (void)sphc_sink;
+    double rhoi = d_rho[d_idx];
+    double rhoj = s_rho[s_idx];
+    double tmp = pair_shared0;
+
+    double f = -s_m[s_idx] * tmp;
+    acc_au = std::fma(f, DWIJ[0], acc_au);
+    acc_av = std::fma(f, DWIJ[1], acc_av);
+    (void)0;
+  
+}
+
+static inline double MonaghanArtificialViscosity_loop_pairshared0(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* VIJ, const double* DWIJ, double R2IJ, double HIJ, double RHOIJ1, double EPS, double alpha, double beta, const double* d_cs, const double* s_cs, const double* s_m) {
+  return std::fma(VIJ[0], XIJ[0], VIJ[1] * XIJ[1]);
+}
+
+// equation MonaghanArtificialViscosity, method loop, from wcsph.sph:173: a value the pair shares, the same for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+//   piij after if (vijdotxij < 0.0) { double cij = 0.5 * (d_cs[d_idx] + s_cs[s_idx]); double muij = HI...
+static inline double MonaghanArtificialViscosity_loop_pairshared1(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* VIJ, const double* DWIJ, double R2IJ, double HIJ, double RHOIJ1, double EPS, double alpha, double beta, const double* d_cs, const double* s_cs, const double* s_m) {
+  const double vijdotxij = std::fma(VIJ[0], XIJ[0], VIJ[1] * XIJ[1]);
+  double piij = 0.0;
+  if (vijdotxij < 0.0) {
+      double cij = 0.5 * (d_cs[d_idx] + s_cs[s_idx]);
+      double muij = HIJ * vijdotxij / (R2IJ + EPS);
+      piij = std::fma(-alpha * cij, muij, beta * muij * muij) * RHOIJ1;
+    }
+  return piij;
+}
+
+// equation MonaghanArtificialViscosity, method loop, from wcsph.sph:173: the destination's sums in locals (acc_NAME, accK_NAME: component K;
+// codegen/RegisterSums.cpp)
+static inline void MonaghanArtificialViscosity_loop_sums(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* VIJ, const double* DWIJ, double R2IJ, double HIJ, double RHOIJ1, double EPS, double alpha, double beta, double& acc_au, double& acc_av, const double* d_cs, const double* s_cs, const double* s_m, double pair_shared0, double pair_shared1) { double sphc_sink = 0.0; (void)sphc_sink;
+    double vijdotxij = pair_shared0;
+    double piij = 0.0;
+    piij = pair_shared1;
+
+
+
+
+
+    double f = -s_m[s_idx] * piij;
+    acc_au = std::fma(f, DWIJ[0], acc_au);
+    acc_av = std::fma(f, DWIJ[1], acc_av);
+    (void)0;
+  
+}
+
+static inline void XSPHCorrection_loop_sums(int d_idx, int s_idx, double t, double dt, const double* VIJ, double WIJ, double RHOIJ1, double eps, double& acc_ax, double& acc_ay, const double* s_m) { double sphc_sink = 0.0; (void)sphc_sink;
+    // VIJ = v_a - v_b, hence the minus sign.
+    double f = -eps * s_m[s_idx] * RHOIJ1 * WIJ;
+    acc_ax = std::fma(f, VIJ[0], acc_ax);
+    acc_ay = std::fma(f, VIJ[1], acc_ay);
+    (void)0;
+  
+}
+// ---- end of the generated bodies ----
+
+struct Eq6 {
+  double alpha = 0.1;
+  static constexpr double beta = (0.0);
+};
+struct Eq7 {
+  static constexpr double eps = (0.5);
+};
+
+// The water in particle order: positions, the properties the pass reads, its 5 sums.
+struct Fluid {
+  int n = 0;
+  std::vector<double> x, y, u, v, h, rho, m, p, cs, hoisted;
+  std::vector<double> arho, au, av, ax, ay;
+  void zero_sums() {
+    for (auto* s : {&arho, &au, &av, &ax, &ay}) s->assign(n, 0.0);
+  }
+};
+
+// The kept lists as the solver keeps them (sphc/verlet.h): per destination its candidates
+// within VERLET_RADIUS2 hmax^2, in index order; upper: where s_idx >= d_idx starts.
+struct Kept {
+  std::vector<std::vector<std::uint32_t>> lists;
+  std::vector<std::uint32_t> upper;
+};
+
+Kept build_kept(const Fluid& f, double skin) {
+  const double VERLET_RADIUS2 = RADIUS2 * (1.0 + skin) * (1.0 + skin);
+  Kept k;
+  k.lists.resize(f.n);
+  k.upper.resize(f.n);
+  double hmax = 0, lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  for (int i = 0; i < f.n; ++i) {
+    hmax = std::max(hmax, f.h[i]);
+    lo[0] = std::min(lo[0], f.x[i]), hi[0] = std::max(hi[0], f.x[i]);
+    lo[1] = std::min(lo[1], f.y[i]), hi[1] = std::max(hi[1], f.y[i]);
+  }
+  const double cell = std::sqrt(VERLET_RADIUS2) * hmax;
+  const int nc[2] = {static_cast<int>((hi[0] - lo[0]) / cell) + 1, static_cast<int>((hi[1] - lo[1]) / cell) + 1};
+  std::vector<std::vector<int>> cells(static_cast<std::size_t>(nc[0]) * nc[1]);
+  auto cx = [&](int i) { return std::min(nc[0] - 1, static_cast<int>((f.x[i] - lo[0]) / cell)); };
+  auto cy = [&](int i) { return std::min(nc[1] - 1, static_cast<int>((f.y[i] - lo[1]) / cell)); };
+  for (int i = 0; i < f.n; ++i) cells[cy(i) * nc[0] + cx(i)].push_back(i);
+  for (int i = 0; i < f.n; ++i) {
+    std::vector<std::uint32_t>& l = k.lists[i];
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int qx = cx(i) + dx, qy = cy(i) + dy;
+        if (qx < 0 || qy < 0 || qx >= nc[0] || qy >= nc[1]) continue;
+        for (int j : cells[qy * nc[0] + qx]) {
+          const double XIJ[2] = {f.x[i] - f.x[j], f.y[i] - f.y[j]};
+          const double R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1];
+          const double hm = std::max(f.h[i], f.h[j]);
+          if (R2IJ >= VERLET_RADIUS2 * hm * hm) continue;
+          l.push_back(static_cast<std::uint32_t>(j));
+        }
+      }
+    std::sort(l.begin(), l.end());
+    k.upper[i] = static_cast<std::uint32_t>(std::lower_bound(l.begin(), l.end(), static_cast<std::uint32_t>(i)) - l.begin());
+  }
+  return k;
+}
+
+// ---- Form (a): the generated each-pair-once loop, verbatim (the pass's fluid <- fluid loop) ----
+__attribute__((noinline)) void form_a(Fluid& fluid, const Kept& verlet_fluid_fluid, const Eq6& eq6, const Eq7& eq7,
+                                      std::vector<double>& dhoist_eq4_0) {
+  const double t = 0.0, dt = 0.0;
+  const int n = fluid.n;
+  const double* di_x = fluid.x.data();
+  const double* di_y = fluid.y.data();
+  const double* di_h = fluid.h.data();
+  const double* di_u = fluid.u.data();
+  const double* di_v = fluid.v.data();
+  const double* di_rho = fluid.rho.data();
+  const double* sj_x = di_x;
+  const double* sj_y = di_y;
+  const double* sj_h = di_h;
+  const double* sj_u = di_u;
+  const double* sj_v = di_v;
+  const double* sj_rho = di_rho;
+  const double* d_cs = fluid.cs.data();
+  const double* d_p = fluid.p.data();
+  const double* d_rho = di_rho;
+  const double* s_cs = d_cs;
+  const double* s_m = fluid.m.data();
+  const double* s_p = d_p;
+  const double* s_rho = di_rho;
+  double* d_arho = fluid.arho.data();
+  double* d_au = fluid.au.data();
+  double* d_av = fluid.av.data();
+  double* d_ax = fluid.ax.data();
+  double* d_ay = fluid.ay.data();
+  const double* hoisted_eq4_0 = fluid.hoisted.data();
+        dhoist_eq4_0.resize(n);
+        double* const dhoisted_all_eq4_0 = dhoist_eq4_0.data();
+        for (int d_idx = 0; d_idx < n; ++d_idx) {
+          const double dhoisted_eq4_0 = PressureGradient_loop_dhoisted0(d_idx, d_p, d_rho);  // PressureGradient: d_p[d_idx] / (rhoi * rhoi)
+          dhoisted_all_eq4_0[d_idx] = dhoisted_eq4_0;
+        }
+        for (int d_idx = 0; d_idx < n; ++d_idx) {  // pairs (d_idx, s_idx > d_idx)
+          const double xi = di_x[d_idx];
+          const double yi = di_y[d_idx];
+          const double zi = 0.0;
+          const double hi = di_h[d_idx];
+          const double ui = di_u[d_idx];
+          const double vi = di_v[d_idx];
+          const double dhoisted_eq4_0 = dhoisted_all_eq4_0[d_idx];
+          const std::vector<std::uint32_t>& kept = verlet_fluid_fluid.lists[d_idx];
+          const std::uint32_t* const k_end = kept.data() + kept.size();
+          const std::uint32_t* k_first = kept.data() + verlet_fluid_fluid.upper[d_idx];
+          if (k_first != k_end && *k_first == static_cast<std::uint32_t>(d_idx)) ++k_first;  // the self pair: every body adds zeros there (sphc
+          // --no-self-pair-skip: evaluated; body/SelfPair.cpp)
+          // The destination's sums in locals across its neighbours (codegen/RegisterSums.cpp;
+          // sphc --no-register-sums: in memory at every pair): arho, au, av, ax, ay.
+          double acc_arho = d_arho[d_idx];
+          double acc_au = d_au[d_idx];
+          double acc_av = d_av[d_idx];
+          double acc_ax = d_ax[d_idx];
+          double acc_ay = d_ay[d_idx];
+          for (const std::uint32_t* k = k_first; k != k_end; ++k) {
+            const int s_idx = static_cast<int>(*k);
+            const double hj = sj_h[s_idx];
+            const double XIJ[3] = {xi - sj_x[s_idx], yi - sj_y[s_idx], 0.0};
+            const double R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1];
+            const double hmax = hi > hj ? hi : hj;
+            if (R2IJ >= RADIUS2 * hmax * hmax) continue;  // not a neighbour
+            const double XIJ_ji[3] = {sj_x[s_idx] - xi, sj_y[s_idx] - yi, 0.0};
+            const double HIJ = 0.5 * (hi + hj);
+            const double RIJ = std::sqrt(R2IJ);
+            const double VIJ[3] = {ui - sj_u[s_idx], vi - sj_v[s_idx], 0.0};
+            const double VIJ_ji[3] = {sj_u[s_idx] - ui, sj_v[s_idx] - vi, 0.0};
+            const double WIJ = Kernel::w(RIJ, HIJ);
+            double DWIJ[3], DWIJ_ji[3];
+            Kernel::gradient_pair(XIJ, XIJ_ji, RIJ, HIJ, DWIJ, DWIJ_ji);
+            const double RHOIJ = 0.5 * (di_rho[d_idx] + sj_rho[s_idx]);
+            const double RHOIJ1 = 1.0 / RHOIJ;
+            const double EPS = 0.01 * HIJ * HIJ;
+            const double pshared_eq2_0 = ContinuityEquation_loop_pairshared0(d_idx, s_idx, t, dt, VIJ, DWIJ, s_m);  // ContinuityEquation: the same for (s_idx, d_idx)
+            const double pshared_eq4_0 = PressureGradient_loop_pairshared0(d_idx, s_idx, t, dt, DWIJ, d_p, d_rho, s_m, s_p, s_rho, hoisted_eq4_0, dhoisted_eq4_0);  // PressureGradient: the same for (s_idx, d_idx)
+            const double pshared_eq6_0 = MonaghanArtificialViscosity_loop_pairshared0(d_idx, s_idx, t, dt, XIJ, VIJ, DWIJ, R2IJ, HIJ, RHOIJ1, EPS, eq6.alpha, eq6.beta, d_cs, s_cs, s_m);  // MonaghanArtificialViscosity: the same for (s_idx, d_idx)
+            const double pshared_eq6_1 = MonaghanArtificialViscosity_loop_pairshared1(d_idx, s_idx, t, dt, XIJ, VIJ, DWIJ, R2IJ, HIJ, RHOIJ1, EPS, eq6.alpha, eq6.beta, d_cs, s_cs, s_m);  // MonaghanArtificialViscosity: the same for (s_idx, d_idx)
+            ContinuityEquation_loop_sums(d_idx, s_idx, t, dt, VIJ, DWIJ, acc_arho, s_m, pshared_eq2_0);  // ContinuityEquation, from wcsph_scheme.sph:140
+            PressureGradient_loop_sums(d_idx, s_idx, t, dt, DWIJ, acc_au, acc_av, d_p, d_rho, s_m, s_p, s_rho, hoisted_eq4_0, dhoisted_eq4_0, pshared_eq4_0);  // PressureGradient, from wcsph_scheme.sph:142
+            MonaghanArtificialViscosity_loop_sums(d_idx, s_idx, t, dt, XIJ, VIJ, DWIJ, R2IJ, HIJ, RHOIJ1, EPS, eq6.alpha, eq6.beta, acc_au, acc_av, d_cs, s_cs, s_m, pshared_eq6_0, pshared_eq6_1);  // MonaghanArtificialViscosity, from wcsph_scheme.sph:147
+            XSPHCorrection_loop_sums(d_idx, s_idx, t, dt, VIJ, WIJ, RHOIJ1, eq7.eps, acc_ax, acc_ay, s_m);  // XSPHCorrection, from wcsph_scheme.sph:160
+            // the same pair for particle s_idx
+            // s_idx's sums in locals for its calls (codegen/SymmetricPairs.cpp)
+            double m_acc_arho = d_arho[s_idx];
+            double m_acc_au = d_au[s_idx];
+            double m_acc_av = d_av[s_idx];
+            double m_acc_ax = d_ax[s_idx];
+            double m_acc_ay = d_ay[s_idx];
+            ContinuityEquation_loop_sums(s_idx, d_idx, t, dt, VIJ_ji, DWIJ_ji, m_acc_arho, s_m, pshared_eq2_0);  // ContinuityEquation, from wcsph_scheme.sph:140: destination s_idx, source d_idx
+            PressureGradient_loop_sums(s_idx, d_idx, t, dt, DWIJ_ji, m_acc_au, m_acc_av, d_p, d_rho, s_m, s_p, s_rho, hoisted_eq4_0, dhoisted_all_eq4_0[s_idx], pshared_eq4_0);  // PressureGradient, from wcsph_scheme.sph:142: destination s_idx, source d_idx
+            MonaghanArtificialViscosity_loop_sums(s_idx, d_idx, t, dt, XIJ_ji, VIJ_ji, DWIJ_ji, R2IJ, HIJ, RHOIJ1, EPS, eq6.alpha, eq6.beta, m_acc_au, m_acc_av, d_cs, s_cs, s_m, pshared_eq6_0, pshared_eq6_1);  // MonaghanArtificialViscosity, from wcsph_scheme.sph:147: destination s_idx, source d_idx
+            XSPHCorrection_loop_sums(s_idx, d_idx, t, dt, VIJ_ji, WIJ, RHOIJ1, eq7.eps, m_acc_ax, m_acc_ay, s_m);  // XSPHCorrection, from wcsph_scheme.sph:160: destination s_idx, source d_idx
+            d_arho[s_idx] = m_acc_arho;
+            d_au[s_idx] = m_acc_au;
+            d_av[s_idx] = m_acc_av;
+            d_ax[s_idx] = m_acc_ax;
+            d_ay[s_idx] = m_acc_ay;
+          }
+          d_arho[d_idx] = acc_arho;
+          d_au[d_idx] = acc_au;
+          d_av[d_idx] = acc_av;
+          d_ax[d_idx] = acc_ax;
+          d_ay[d_idx] = acc_ay;
+        }
+}
+
+#ifdef __AVX512F__
+// ---- The tiles ----
+using V = __m512d;
+using M = __mmask8;
+inline V bc(double a) { return _mm512_set1_pd(a); }
+inline V add(V a, V b) { return _mm512_add_pd(a, b); }
+inline V sub(V a, V b) { return _mm512_sub_pd(a, b); }
+inline V mul(V a, V b) { return _mm512_mul_pd(a, b); }
+inline V div(V a, V b) { return _mm512_div_pd(a, b); }
+inline V fma(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
+inline V sel(M m, V yes, V no) { return _mm512_mask_blend_pd(m, no, yes); }
+// 1 / x from vrcp14pd (relative error < 2^-14) and two Newton steps.
+inline V rcp(V x) {
+  V r = _mm512_rcp14_pd(x);
+  r = fma(r, _mm512_fnmadd_pd(x, r, bc(1.0)), r);
+  r = fma(r, _mm512_fnmadd_pd(x, r, bc(1.0)), r);
+  return r;
+}
+// 1 / sqrt(x) from vrsqrt14pd and two Newton steps.
+inline V rsqrt(V x) {
+  V y = _mm512_rsqrt14_pd(x);
+  for (int it = 0; it < 2; ++it) {
+    const V e = _mm512_fnmadd_pd(mul(x, y), y, bc(1.0));
+    y = fma(mul(y, bc(0.5)), e, y);
+  }
+  return y;
+}
+
+enum Arith { EXACT = 0, RCP = 1 };
+constexpr int NF = 9;    // the fields a tile reads: x y u v h rho m cs hoisted
+constexpr int NS = 5;    // its sums: arho au av ax ay
+
+// One layout's slot-order copies (the per-evaluation gathers) and slot sums.
+struct Slots {
+  sphc::ClusterLayout L;
+  sphc::ClusterPairList outer, pruned;
+  std::vector<double, std::allocator<double>> f[NF], s[NS];
+};
+
+// i values of one register: RI = 1: particle i in every lane; RI = 2: i0 in lanes 0-3, i1 in 4-7.
+template <int RI>
+inline V ival(const double* F, int i) {
+  if (RI == 1) return bc(F[i]);
+  return _mm512_insertf64x4(bc(F[i]), _mm256_set1_pd(F[i + 1]), 1);
+}
+// j values: CJ = 8: the cluster; CJ = 4: the 4 j's in both halves.
+template <int CJ>
+inline V jval(const double* F, int j0) {
+  if (CJ == 8) return _mm512_loadu_pd(F + j0);
+  return _mm512_broadcast_f64x4(_mm256_loadu_pd(F + j0));
+}
+
+// The tile loop: i-clusters of CI slots (CI = 8 / the layout's width, or half of it: t4x8),
+// j-clusters of CJ = the layout's width, registers of RI = 8 / CJ i's. `list`: per i-cluster
+// (of CI slots: for CI < CJ, cluster ci of the list's own numbering, ci * CI its first slot)
+// its j-clusters.
+template <int CI, int CJ, int ARITH>
+__attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>& begin, const std::vector<std::uint32_t>& jl,
+                                      const Eq6& eq6, const Eq7& eq7) {
+  constexpr int RI = 8 / CJ;
+  const double sigma = Kernel::sigma;
+  const V one = bc(1.0), half = bc(0.5), two = bc(2.0), zero = _mm512_setzero_pd();
+  const V neg_eps = bc(-eq7.eps), neg_alpha = bc(-eq6.alpha), beta = bc(eq6.beta);
+  const V radius2 = bc(RADIUS2), tiny = bc(1e-12), m5 = bc(-5.0), c001 = bc(0.01);
+  const double *X = S.f[0].data(), *Y = S.f[1].data(), *U = S.f[2].data(), *VV = S.f[3].data();
+  const double *H = S.f[4].data(), *RHO = S.f[5].data(), *MS = S.f[6].data(), *CS = S.f[7].data();
+  const double* HO = S.f[8].data();
+  double* SUM[NS];
+  for (int k = 0; k < NS; ++k) SUM[k] = S.s[k].data();
+  // Lane l of a register: its i is the register's first i + l / CJ, its j the j-cluster's
+  // first + l % CJ.
+  const __m512i lane_i = RI == 1 ? _mm512_setzero_si512() : _mm512_set_epi64(1, 1, 1, 1, 0, 0, 0, 0);
+  const __m512i lane_j = CJ == 8 ? _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0) : _mm512_set_epi64(3, 2, 1, 0, 3, 2, 1, 0);
+  const int nci = static_cast<int>(begin.size()) - 1;
+  for (int ci = 0; ci < nci; ++ci) {
+    const int i0 = ci * CI;
+    if (begin[ci] == begin[ci + 1]) continue;
+    V iacc[CI / RI][NS];
+    for (int r = 0; r < CI / RI; ++r)
+      for (int k = 0; k < NS; ++k) iacc[r][k] = zero;
+    for (std::uint32_t e = begin[ci]; e < begin[ci + 1]; ++e) {
+      const int j0 = static_cast<int>(jl[e]) * CJ;
+      const V xj = jval<CJ>(X, j0), yj = jval<CJ>(Y, j0), uj = jval<CJ>(U, j0), vj = jval<CJ>(VV, j0);
+      const V hj = jval<CJ>(H, j0), rhoj = jval<CJ>(RHO, j0), mj = jval<CJ>(MS, j0), csj = jval<CJ>(CS, j0);
+      const V hoj = jval<CJ>(HO, j0);
+      const V neg_mj = sub(zero, mj);  // -s_m[s_idx]
+      const V neg_eps_mj = mul(neg_eps, mj);  // -eps * s_m[s_idx]
+      V jacc[NS];
+      for (int k = 0; k < NS; ++k) jacc[k] = zero;
+      const bool diagonal = j0 < i0 + CI && i0 < j0 + CJ;  // the j-cluster holds the i's: j > i only
+      for (int r = 0; r < CI / RI; ++r) {
+        const int i = i0 + r * RI;
+        const V xi = ival<RI>(X, i), yi = ival<RI>(Y, i);
+        const V XIJ_0 = sub(xi, xj), XIJ_1 = sub(yi, yj);
+        const V R2IJ = add(mul(XIJ_0, XIJ_0), mul(XIJ_1, XIJ_1));
+        const V hi = ival<RI>(H, i);
+        const V hmax = _mm512_max_pd(hi, hj);
+        // the cut-off: !(R2IJ >= RADIUS2 * hmax * hmax)
+        M in = _mm512_cmp_pd_mask(R2IJ, mul(mul(radius2, hmax), hmax), _CMP_NGE_UQ);
+        if (diagonal)
+          in &= _mm512_cmpgt_epi64_mask(_mm512_add_epi64(lane_j, _mm512_set1_epi64(j0)),
+                                        _mm512_add_epi64(lane_i, _mm512_set1_epi64(i)));
+        if (!in) continue;  // no pair of this register within the support
+        const V HIJ = mul(half, add(hi, hj));
+        const V VIJ_0 = sub(ival<RI>(U, i), uj), VIJ_1 = sub(ival<RI>(VV, i), vj);
+        // Kernel::w and gradient_pair (sphc/kernels.h: WendlandQuintic 2D, sigma / h^2 f(q))
+        V RIJ, ih, q, s_den_inv = zero;
+        if (ARITH == EXACT) {
+          RIJ = _mm512_sqrt_pd(R2IJ);
+          ih = div(one, HIJ);
+          q = div(RIJ, HIJ);
+        } else {
+          const V rinv = rsqrt(R2IJ);
+          RIJ = sel(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), mul(R2IJ, rinv), zero);
+          ih = rcp(HIJ);
+          q = mul(RIJ, ih);
+          s_den_inv = mul(ih, rinv);  // 1 / (h rij)
+        }
+        const V sk = mul(bc(sigma), mul(ih, ih));
+        const M inside = _mm512_cmp_pd_mask(q, two, _CMP_LT_OQ);  // f, df: 0 where q >= 2
+        const V t = sub(one, mul(half, q));
+        const V t2 = mul(t, t);
+        const V fq = mul(mul(t2, t2), add(mul(two, q), one));
+        const V dfq = mul(mul(mul(mul(m5, q), t), t), t);
+        const V WIJ = mul(sk, sel(inside, fq, zero));
+        const V dwdq = mul(sk, sel(inside, dfq, zero));
+        const M apart = _mm512_cmp_pd_mask(RIJ, tiny, _CMP_GT_OQ);
+        const V s = ARITH == EXACT ? div(dwdq, mul(HIJ, sel(apart, RIJ, one))) : mul(dwdq, s_den_inv);
+        const V DWIJ_f = sel(apart, s, zero);
+        const V DWIJ_0 = mul(DWIJ_f, XIJ_0), DWIJ_1 = mul(DWIJ_f, XIJ_1);
+        const V RHOIJ = mul(half, add(ival<RI>(RHO, i), rhoj));
+        const V RHOIJ1 = ARITH == EXACT ? div(one, RHOIJ) : rcp(RHOIJ);
+        const V EPS = mul(mul(c001, HIJ), HIJ);
+        // the values the pair shares
+        const V vdw = fma(VIJ_0, DWIJ_0, mul(VIJ_1, DWIJ_1));
+        const V tmp = add(ival<RI>(HO, i), hoj);
+        const V vdx = fma(VIJ_0, XIJ_0, mul(VIJ_1, XIJ_1));
+        const V cij = mul(half, add(ival<RI>(CS, i), csj));
+        const V muij = ARITH == EXACT ? div(mul(HIJ, vdx), add(R2IJ, EPS)) : mul(mul(HIJ, vdx), rcp(add(R2IJ, EPS)));
+        const V pi_f = fma(mul(neg_alpha, cij), muij, mul(mul(beta, muij), muij));
+        const M visc = _mm512_cmp_pd_mask(vdx, zero, _CMP_LT_OQ);
+        const V piij = sel(visc, mul(pi_f, RHOIJ1), zero);
+        // i's terms (destination i, source j) in (a)'s order, under the mask
+        const V fp = mul(neg_mj, tmp), fv = mul(neg_mj, piij);
+        const V fx = mul(mul(neg_eps_mj, RHOIJ1), WIJ);
+        V* ia = iacc[r];
+        ia[0] = _mm512_mask3_fmadd_pd(mj, vdw, ia[0], in);
+        ia[1] = _mm512_mask3_fmadd_pd(fv, DWIJ_0, _mm512_mask3_fmadd_pd(fp, DWIJ_0, ia[1], in), in);
+        ia[2] = _mm512_mask3_fmadd_pd(fv, DWIJ_1, _mm512_mask3_fmadd_pd(fp, DWIJ_1, ia[2], in), in);
+        ia[3] = _mm512_mask3_fmadd_pd(fx, VIJ_0, ia[3], in);
+        ia[4] = _mm512_mask3_fmadd_pd(fx, VIJ_1, ia[4], in);
+        // j's terms (destination j, source i): DWIJ_ji = -DWIJ, VIJ_ji = -VIJ exactly
+        const V mi = ival<RI>(MS, i);
+        const V neg_mi = sub(zero, mi);
+        const V gp = mul(neg_mi, tmp), gv = mul(neg_mi, piij);
+        const V gx = mul(mul(mul(neg_eps, mi), RHOIJ1), WIJ);
+        jacc[0] = _mm512_mask3_fmadd_pd(mi, vdw, jacc[0], in);
+        jacc[1] = _mm512_mask3_fnmadd_pd(gv, DWIJ_0, _mm512_mask3_fnmadd_pd(gp, DWIJ_0, jacc[1], in), in);
+        jacc[2] = _mm512_mask3_fnmadd_pd(gv, DWIJ_1, _mm512_mask3_fnmadd_pd(gp, DWIJ_1, jacc[2], in), in);
+        jacc[3] = _mm512_mask3_fnmadd_pd(gx, VIJ_0, jacc[3], in);
+        jacc[4] = _mm512_mask3_fnmadd_pd(gx, VIJ_1, jacc[4], in);
+      }
+      if (CJ == 8) {
+        for (int k = 0; k < NS; ++k) _mm512_storeu_pd(SUM[k] + j0, add(_mm512_loadu_pd(SUM[k] + j0), jacc[k]));
+      } else {  // the two halves (i's of the register) folded, then added to the 4 j's
+        for (int k = 0; k < NS; ++k) {
+          const __m256d lo = _mm512_castpd512_pd256(jacc[k]), hi = _mm512_extractf64x4_pd(jacc[k], 1);
+          _mm256_storeu_pd(SUM[k] + j0, _mm256_add_pd(_mm256_loadu_pd(SUM[k] + j0), _mm256_add_pd(lo, hi)));
+        }
+      }
+    }
+    for (int r = 0; r < CI / RI; ++r)
+      for (int k = 0; k < NS; ++k) {
+        if (RI == 1) {
+          SUM[k][i0 + r] += _mm512_reduce_add_pd(iacc[r][k]);
+        } else {
+          SUM[k][i0 + 2 * r] += _mm512_mask_reduce_add_pd(0x0f, iacc[r][k]);
+          SUM[k][i0 + 2 * r + 1] += _mm512_mask_reduce_add_pd(0xf0, iacc[r][k]);
+        }
+      }
+  }
+}
+
+// The core's clock while it runs 512-bit FMAs (a chain of dependent vfmadd, 4 cycles each).
+double clock_estimate() {
+  const long n = 20000000;
+  __m512d x = _mm512_set1_pd(1.0);
+  const __m512d b = _mm512_set1_pd(0.999999), c = _mm512_set1_pd(1e-9);
+  double best = 1e30;
+  for (int r = 0; r < 3; ++r) {
+    const double t0 = cpu_now();
+    for (long i = 0; i < n; ++i) {
+      x = _mm512_fmadd_pd(x, b, c);
+      __asm__ volatile("" : "+v"(x));
+    }
+    best = std::min(best, cpu_now() - t0);
+  }
+  return _mm512_reduce_add_pd(x) > 0 ? 4.0 * n / best : 0.0;
+}
+#endif  // __AVX512F__
+
+// The water column of the dam break (a lattice, jittered) or a snapshot from a file.
+Fluid make_fluid(const std::string& path, int nx, int ny, double dx, double hdx, double pert, unsigned seed) {
+  Fluid f;
+  const double ro = 1000.0, g = 9.81, H = 2.0;
+  std::vector<double> x, y, u, v, rho, p;
+  if (!path.empty()) {
+    FILE* in = std::fopen(path.c_str(), "r");
+    if (!in) return f;
+    char line[1024];
+    while (std::fgets(line, sizeof line, in)) {
+      if (line[0] == '#') continue;
+      double r[6];
+      if (std::sscanf(line, "%lf %lf %lf %lf %lf %lf", &r[0], &r[1], &r[2], &r[3], &r[4], &r[5]) != 6) continue;
+      x.push_back(r[0]), y.push_back(r[1]), u.push_back(r[2]), v.push_back(r[3]), rho.push_back(r[4]), p.push_back(r[5]);
+    }
+    std::fclose(in);
+  } else {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> uni(-1.0, 1.0);
+    const double co = 10.0 * std::sqrt(2.0 * g * H), B = co * co * ro / 7.0;
+    for (int iy = 0; iy < ny; ++iy)
+      for (int ix = 0; ix < nx; ++ix) {
+        x.push_back((ix + 0.5) * dx + pert * dx * uni(rng));
+        y.push_back((iy + 0.5) * dx + pert * dx * uni(rng));
+        u.push_back(uni(rng)), v.push_back(uni(rng));
+        const double ph = ro * g * (ny * dx - y.back());  // hydrostatic
+        const double r = ro * std::pow(1.0 + ph / B, 1.0 / 7.0);
+        rho.push_back(r), p.push_back(B * (std::pow(r / ro, 7.0) - 1.0));
+      }
+  }
+  // The solver's order: cells of side 2 h (y then x).
+  const double h = hdx * dx, cell = 2.0 * h;
+  double lo[2] = {1e300, 1e300};
+  for (std::size_t i = 0; i < x.size(); ++i) lo[0] = std::min(lo[0], x[i]), lo[1] = std::min(lo[1], y[i]);
+  auto key = [&](std::size_t i) {
+    return std::make_pair(static_cast<long>(std::floor((y[i] - lo[1]) / cell)), static_cast<long>(std::floor((x[i] - lo[0]) / cell)));
+  };
+  std::vector<std::size_t> order(x.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key(a) < key(b); });
+  const double co = 10.0 * std::sqrt(2.0 * g * H);
+  f.n = static_cast<int>(x.size());
+  for (std::size_t o : order) {
+    f.x.push_back(x[o]), f.y.push_back(y[o]), f.u.push_back(u[o]), f.v.push_back(v[o]);
+    f.rho.push_back(rho[o]), f.p.push_back(p[o]);
+    f.h.push_back(h), f.m.push_back(ro * dx * dx);
+    f.cs.push_back(co * std::pow(rho[o] / ro, 3.0));  // the scene's equation of state (gamma 7)
+  }
+  f.hoisted.resize(f.n);
+  for (int i = 0; i < f.n; ++i) f.hoisted[i] = PressureGradient_loop_hoisted0(i, f.p.data(), f.rho.data());
+  f.zero_sums();
+  return f;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string positions, forms_arg = "a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp";
+  int nx = 33, ny = 66, reps = 7, sweeps = 0;
+  double dx = 0.03, hdx = 1.3, pert = 0.1, skin = 0.1;
+  for (int k = 1; k < argc; ++k) {
+    const std::string a = argv[k];
+    auto next = [&]() -> const char* {
+      if (k + 1 >= argc) std::exit(2);
+      return argv[++k];
+    };
+    if (a == "--positions") positions = next();
+    else if (a == "--nx") nx = std::atoi(next());
+    else if (a == "--ny") ny = std::atoi(next());
+    else if (a == "--dx") dx = std::atof(next());
+    else if (a == "--hdx") hdx = std::atof(next());
+    else if (a == "--pert") pert = std::atof(next());
+    else if (a == "--skin") skin = std::atof(next());
+    else if (a == "--reps") reps = std::atoi(next());
+    else if (a == "--sweeps") sweeps = std::atoi(next());
+    else if (a == "--forms") forms_arg = next();
+    else {
+      std::fprintf(stderr, "usage: %s [--positions FILE] [--nx 33 --ny 66] [--dx 0.03] [--hdx 1.3] [--pert 0.1]"
+                           " [--skin 0.1] [--reps 7] [--sweeps N] [--forms a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp]\n",
+                   argv[0]);
+      return 2;
+    }
+  }
+#ifndef __AVX512F__
+  std::printf("built without AVX-512F: the tiles need it (skipped)\n");
+  return 77;
+#else
+  if (!__builtin_cpu_supports("avx512f")) {
+    std::printf("this CPU has no AVX-512F (skipped)\n");
+    return 77;
+  }
+  Fluid fa = make_fluid(positions, nx, ny, dx, hdx, pert, 12345);
+  if (fa.n == 0) {
+    std::fprintf(stderr, "no particles\n");
+    return 2;
+  }
+  const Eq6 eq6;
+  const Eq7 eq7;
+  double hmax = 0;
+  for (double h : fa.h) hmax = std::max(hmax, h);
+  const double support = Kernel::radius_scale * hmax, rlist = (1.0 + skin) * support;
+  const Kept kept = build_kept(fa, skin);
+  std::vector<double> dhoist;
+  long pairs = 0, entries = 0, visc = 0;
+  for (int i = 0; i < fa.n; ++i)
+    for (std::size_t e = kept.upper[i]; e < kept.lists[i].size(); ++e) {
+      const int j = static_cast<int>(kept.lists[i][e]);
+      if (j == i) continue;
+      ++entries;
+      const double ex = fa.x[i] - fa.x[j], ey = fa.y[i] - fa.y[j];
+      if (ex * ex + ey * ey < support * support) {
+        ++pairs;
+        visc += (fa.u[i] - fa.u[j]) * ex + (fa.v[i] - fa.v[j]) * ey < 0;
+      }
+    }
+  std::printf("%s: %d particles, dx = %g, h = %.3g dx; %ld pairs within 2 h (%.1f ordered neighbours per particle; the "
+              "viscosity's branch in %.0f%%), %.1f kept-list entries above i per particle\n",
+              positions.empty() ? "the dam break's water column (lattice, jittered)" : positions.c_str(), fa.n, dx, hdx,
+              pairs, 2.0 * pairs / fa.n, 100.0 * visc / pairs, double(entries) / fa.n);
+
+  // The layouts (width 4 and 8; the columns 2 and 2.83 dx: clusters about square) and their
+  // lists, built once (a rebuild); the per-evaluation pieces timed below.
+  Slots s4, s8;
+  const double* P[NF] = {fa.x.data(), fa.y.data(), fa.u.data(), fa.v.data(), fa.h.data(),
+                         fa.rho.data(), fa.m.data(), fa.cs.data(), fa.hoisted.data()};
+  for (Slots* s : {&s4, &s8}) {
+    const int w = s == &s4 ? 4 : 8;
+    sphc::build_cluster_layout(s->L, fa.x.data(), fa.y.data(), nullptr, fa.n, 2, sphc::cluster_column_side(dx, 2, w), w);
+    sphc::build_cluster_pairs(s->L, s->L, rlist, true, s->outer);
+    for (auto& v : s->f) v.assign(s->L.slots(), 0.0);
+    for (auto& v : s->s) v.assign(s->L.slots(), 0.0);
+  }
+  // t4x8's list: the halves of the 8-clusters, each against the j-clusters of its 8-cluster's
+  // pruned list whose boxes lie within the support of the half's own box.
+  std::vector<std::uint32_t> half_begin, half_j;
+  auto evaluate_pieces = [&](Slots& s, bool halves) {
+    sphc::gather_positions(s.L, fa.x.data(), fa.y.data(), nullptr, s.f[0].data(), s.f[1].data(), nullptr, 4 * rlist);
+    for (int k = 2; k < NF; ++k) sphc::gather_slots(s.L, P[k], s.f[k].data());
+    sphc::update_boxes(s.L, s.f[0].data(), s.f[1].data(), nullptr);
+    sphc::prune_cluster_pairs(s.L, s.L, s.outer, support, s.pruned);
+    for (auto& v : s.s) std::fill(v.begin(), v.end(), 0.0);
+    if (halves) {
+      const std::size_t nc = s.L.n_clusters;
+      half_begin.assign(2 * nc + 1, 0);
+      half_j.clear();
+      const double r2 = support * support * (1 + 1e-12);
+      for (std::size_t ci = 0; ci < nc; ++ci)
+        for (int hf = 0; hf < 2; ++hf) {
+          double lo[2] = {HUGE_VAL, HUGE_VAL}, hi[2] = {-HUGE_VAL, -HUGE_VAL};
+          bool any = false;
+          for (std::size_t sl = ci * 8 + 4 * hf; sl < ci * 8 + 4 * hf + 4; ++sl) {
+            if (s.L.slot[sl] == sphc::kPadSlot) continue;
+            any = true;
+            lo[0] = std::min(lo[0], s.f[0][sl]), hi[0] = std::max(hi[0], s.f[0][sl]);
+            lo[1] = std::min(lo[1], s.f[1][sl]), hi[1] = std::max(hi[1], s.f[1][sl]);
+          }
+          if (any)
+            for (std::uint32_t e = s.pruned.begin[ci]; e < s.pruned.begin[ci + 1]; ++e) {
+              const double* jb = &s.L.box[6 * s.pruned.j[e]];
+              const double gx = std::max({0.0, jb[0] - hi[0], lo[0] - jb[3]});
+              const double gy = std::max({0.0, jb[1] - hi[1], lo[1] - jb[4]});
+              if (gx * gx + gy * gy <= r2) half_j.push_back(s.pruned.j[e]);
+            }
+          half_begin[2 * ci + hf + 1] = static_cast<std::uint32_t>(half_j.size());
+        }
+    }
+  };
+  auto add_back = [&](Slots& s, Fluid& out) {
+    std::vector<double>* dst[NS] = {&out.arho, &out.au, &out.av, &out.ax, &out.ay};
+    for (int k = 0; k < NS; ++k) sphc::add_slots(s.L, s.s[k].data(), dst[k]->data());
+  };
+  evaluate_pieces(s4, false);
+  evaluate_pieces(s8, true);
+  // Lanes: pairs within the support in each form's registers.
+  auto count_regs = [&](const sphc::ClusterLayout& L, const std::vector<std::uint32_t>& b, const std::vector<std::uint32_t>& jl,
+                        int CI, int CJ, long& regs, long& regs_pair, long& in) {
+    const int RI = 8 / CJ;
+    const double* X = L.width == 4 ? s4.f[0].data() : s8.f[0].data();
+    const double* Y = L.width == 4 ? s4.f[1].data() : s8.f[1].data();
+    regs = regs_pair = in = 0;
+    for (std::size_t ci = 0; ci + 1 < b.size(); ++ci)
+      for (std::uint32_t e = b[ci]; e < b[ci + 1]; ++e)
+        for (int r = 0; r < CI / RI; ++r) {
+          long c = 0;
+          for (int i = static_cast<int>(ci) * CI + r * RI; i < static_cast<int>(ci) * CI + r * RI + RI; ++i)
+            for (int j = static_cast<int>(jl[e]) * CJ; j < static_cast<int>(jl[e]) * CJ + CJ; ++j) {
+              if (L.slot[i] == sphc::kPadSlot || L.slot[j] == sphc::kPadSlot || j <= i) continue;
+              const double ex = X[i] - X[j], ey = Y[i] - Y[j];
+              c += ex * ex + ey * ey < support * support;
+            }
+          ++regs;
+          regs_pair += c > 0;
+          in += c;
+        }
+  };
+
+  struct Form {
+    std::string name;
+    std::function<void()> run;  // one sweep from zeroed sums
+    std::function<void(Fluid&)> result;
+    long regs = 0, regs_pair = 0, in = 0;
+    std::vector<double> times;
+  };
+  std::vector<Form> forms;
+  Fluid fref = fa;
+  auto add_form = [&](const std::string& name) {
+    Form F;
+    F.name = name;
+    if (name == "a") {
+      F.run = [&] {
+        fa.zero_sums();
+        form_a(fa, kept, eq6, eq7, dhoist);
+      };
+      F.result = [&](Fluid& out) { out = fa; };
+    } else {
+      const bool rcp = name.size() > 4 && name.substr(4) == "rcp";
+      const std::string shape = name.substr(0, 4);
+      Slots* s = shape == "t4x4" ? &s4 : &s8;
+      auto zero = [s] {
+        for (auto& v : s->s) std::fill(v.begin(), v.end(), 0.0);
+      };
+      if (shape == "t4x4") {
+        F.run = rcp ? std::function<void()>([=, &eq6, &eq7] { zero(); form_t<4, 4, RCP>(*s, s->pruned.begin, s->pruned.j, eq6, eq7); })
+                    : std::function<void()>([=, &eq6, &eq7] { zero(); form_t<4, 4, EXACT>(*s, s->pruned.begin, s->pruned.j, eq6, eq7); });
+        count_regs(s->L, s->pruned.begin, s->pruned.j, 4, 4, F.regs, F.regs_pair, F.in);
+      } else if (shape == "t4x8") {
+        F.run = rcp ? std::function<void()>([=, &eq6, &eq7, &half_begin, &half_j] { zero(); form_t<4, 8, RCP>(*s, half_begin, half_j, eq6, eq7); })
+                    : std::function<void()>([=, &eq6, &eq7, &half_begin, &half_j] { zero(); form_t<4, 8, EXACT>(*s, half_begin, half_j, eq6, eq7); });
+        count_regs(s->L, half_begin, half_j, 4, 8, F.regs, F.regs_pair, F.in);
+      } else if (shape == "t8x8") {
+        F.run = rcp ? std::function<void()>([=, &eq6, &eq7] { zero(); form_t<8, 8, RCP>(*s, s->pruned.begin, s->pruned.j, eq6, eq7); })
+                    : std::function<void()>([=, &eq6, &eq7] { zero(); form_t<8, 8, EXACT>(*s, s->pruned.begin, s->pruned.j, eq6, eq7); });
+        count_regs(s->L, s->pruned.begin, s->pruned.j, 8, 8, F.regs, F.regs_pair, F.in);
+      } else {
+        std::fprintf(stderr, "unknown form %s\n", name.c_str());
+        std::exit(2);
+      }
+      F.result = [s, &add_back, &fa](Fluid& out) {
+        out = fa;
+        out.zero_sums();
+        add_back(*s, out);
+      };
+    }
+    forms.push_back(std::move(F));
+  };
+  {
+    std::size_t at = 0;
+    while (at <= forms_arg.size()) {
+      const std::size_t comma = std::min(forms_arg.find(',', at), forms_arg.size());
+      if (comma > at) add_form(forms_arg.substr(at, comma - at));
+      at = comma + 1;
+    }
+  }
+  // The reference: form (a) once.
+  fref.zero_sums();
+  form_a(fref, kept, eq6, eq7, dhoist);
+
+  // Sweeps per timed rep: ~20 ms of form (a).
+  if (sweeps <= 0) {
+    const double t0 = cpu_now();
+    int k = 0;
+    do form_a(fref, kept, eq6, eq7, dhoist), ++k;
+    while (cpu_now() - t0 < 0.02);
+    sweeps = std::max(1, k);
+    fref.zero_sums();
+    form_a(fref, kept, eq6, eq7, dhoist);
+  }
+  // Correctness of every form, then the timing rounds (interleaved).
+  int bad = 0;
+  const std::vector<double> Fluid::*sums[NS] = {&Fluid::arho, &Fluid::au, &Fluid::av, &Fluid::ax, &Fluid::ay};
+  const char* sum_names[NS] = {"arho", "au", "av", "ax", "ay"};
+  std::vector<double> worst(forms.size(), 0.0);
+  for (std::size_t k = 0; k < forms.size(); ++k) {
+    Form& F = forms[k];
+    F.run();
+    Fluid out;
+    F.result(out);
+    for (int q = 0; q < NS; ++q) {
+      const std::vector<double>& want = fref.*sums[q];
+      const std::vector<double>& got = out.*sums[q];
+      double scale = 0, diff = 0;
+      for (int i = 0; i < fa.n; ++i) scale = std::max(scale, std::fabs(want[i])), diff = std::max(diff, std::fabs(got[i] - want[i]));
+      const double rel = scale > 0 ? diff / scale : diff;
+      worst[k] = std::max(worst[k], rel);
+      if (!(rel <= 1e-12)) {
+        std::printf("FAILED: form %s, sum %s: max |X - a| / max |a| = %.3g > 1e-12\n", F.name.c_str(), sum_names[q], rel);
+        bad = 1;
+      }
+    }
+    if (F.name != "a" && F.in != pairs) {
+      std::printf("FAILED: form %s's registers hold %ld of the %ld pairs within the support\n", F.name.c_str(), F.in, pairs);
+      bad = 1;
+    }
+  }
+  // The per-evaluation pieces of the tiles (gathers of the 9 fields, boxes, pruning, adds).
+  double t_pieces4 = 1e30, t_pieces8 = 1e30, t_add4 = 1e30, t_add8 = 1e30;
+  Fluid scratch = fa;
+  for (int r = 0; r < reps; ++r) {
+    for (std::size_t k = 0; k < forms.size(); ++k) {
+      Form& F = forms[k];
+      const double t0 = cpu_now();
+      for (int w = 0; w < sweeps; ++w) F.run();
+      F.times.push_back((cpu_now() - t0) / sweeps);
+    }
+    double t0 = cpu_now();
+    for (int w = 0; w < sweeps; ++w) evaluate_pieces(s4, false);
+    t_pieces4 = std::min(t_pieces4, (cpu_now() - t0) / sweeps);
+    t0 = cpu_now();
+    for (int w = 0; w < sweeps; ++w) evaluate_pieces(s8, true);
+    t_pieces8 = std::min(t_pieces8, (cpu_now() - t0) / sweeps);
+    t0 = cpu_now();
+    for (int w = 0; w < sweeps; ++w) add_back(s4, scratch);
+    t_add4 = std::min(t_add4, (cpu_now() - t0) / sweeps);
+    t0 = cpu_now();
+    for (int w = 0; w < sweeps; ++w) add_back(s8, scratch);
+    t_add8 = std::min(t_add8, (cpu_now() - t0) / sweeps);
+  }
+  const double clock = clock_estimate();
+  std::printf("per evaluation besides the tiles: width 4 layout %.2f us (positions, 7 fields, boxes, pruning, sums zeroed) + %.2f us"
+              " (5 sums added back); width 8 %.2f + %.2f us (with t4x8's half list)\n",
+              1e6 * t_pieces4, 1e6 * t_add4, 1e6 * t_pieces8, 1e6 * t_add8);
+  std::printf("clock while running 512-bit FMAs: %.2f GHz; %d sweeps per rep, %d reps interleaved, thread CPU time\n\n",
+              clock * 1e-9, sweeps, reps);
+  std::printf("%-10s %11s %11s %9s %12s %12s %10s %10s %10s %12s\n", "form", "us/sweep", "median", "of (a)", "M pairs/s",
+              "ns/pair", "regs/part", "lanes in", "cyc/reg", "max rel diff");
+  double ta = 0;
+  for (Form& F : forms)
+    if (F.name == "a") ta = *std::min_element(F.times.begin(), F.times.end());
+  for (std::size_t k = 0; k < forms.size(); ++k) {
+    const Form& F = forms[k];
+    const double tmin = *std::min_element(F.times.begin(), F.times.end());
+    char regs[32] = "-", lanes[32] = "-", cyc[32] = "-";
+    if (F.name != "a") {
+      std::snprintf(regs, sizeof regs, "%.2f", double(F.regs_pair) / fa.n);
+      std::snprintf(lanes, sizeof lanes, "%.1f%%", 100.0 * F.in / (8.0 * F.regs_pair));
+      std::snprintf(cyc, sizeof cyc, "%.1f", tmin * clock / F.regs_pair);
+    }
+    std::printf("%-10s %11.2f %11.2f %9.3f %12.1f %12.2f %10s %10s %10s %12.2e\n", F.name.c_str(), 1e6 * tmin,
+                1e6 * median(F.times), ta > 0 ? tmin / ta : 0.0, 2.0 * pairs / tmin * 1e-6, 1e9 * tmin / pairs, regs, lanes,
+                cyc, worst[k]);
+  }
+  std::printf("(M pairs/s: ordered pairs within the support; ns/pair: per pair evaluated once; regs/part: registers with a"
+              " pair computed per particle; cyc/reg: real cycles per register computed)\n");
+  if (bad) return 1;
+  std::printf("OK: every form within 1e-12 of form (a), every pair within the support in the tiles\n");
+  return 0;
+#endif
+}
