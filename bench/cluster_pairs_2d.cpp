@@ -174,6 +174,103 @@ static inline void XSPHCorrection_loop_sums(int d_idx, int s_idx, double t, doub
     (void)0;
   
 }
+
+// ---- The shifting pass's bodies: the generated C++ of examples/dambreak.sph (its own effects:
+// `sphc examples/dambreak.sph --emit=cpp`, main 9996b02), verbatim ----
+static inline double KERNEL_W(double r, double h) { return Kernel::w(r, h); }
+
+// equation DeltaPlusShiftingSums, method loop, from shifting_sun2017.sph:191: once per source particle (hoisted out of the pair loop; --no-hoist: per pair)
+//   s_m[s_idx] / s_rho[s_idx]
+static inline double DeltaPlusShiftingSums_loop_hoisted0(int s_idx, const double* s_m, const double* s_rho) {
+  return s_m[s_idx] / s_rho[s_idx];
+}
+
+// equation DeltaPlusShiftingSums, method loop, from shifting_sun2017.sph:191: once per destination particle (hoisted out of the pair loop; --no-hoist: per pair)
+//   (1.0 / KERNEL_W(1.0 / hdx, 1.0))
+static inline double DeltaPlusShiftingSums_loop_dhoisted0(int d_idx, double hdx) {
+  (void)d_idx;  // scalars only
+  return (1.0 / KERNEL_W(1.0 / hdx, 1.0));
+}
+
+// equation DeltaPlusShiftingSums, method loop, from shifting_sun2017.sph:191: a value the pair shares, the same for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+//   dim == 1 ? HIJ : (dim == 2 ? HIJ * HIJ : HIJ * HIJ * HIJ)
+static inline double DeltaPlusShiftingSums_loop_pairshared0(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* DWIJ, double HIJ, double WIJ, double R, double hdx, double dim, const double* s_m, const double* s_rho, const double* s_hoisted0, double d_hoisted0) {
+  return dim == 1 ? HIJ : (dim == 2 ? HIJ * HIJ : HIJ * HIJ * HIJ);
+}
+
+// equation DeltaPlusShiftingSums, method loop, from shifting_sun2017.sph:191: a value the pair shares, the same for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+//   WIJ * hd * d_hoisted0
+static inline double DeltaPlusShiftingSums_loop_pairshared1(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* DWIJ, double HIJ, double WIJ, double R, double hdx, double dim, const double* s_m, const double* s_rho, const double* s_hoisted0, double d_hoisted0) {
+  const double hd = dim == 1 ? HIJ : (dim == 2 ? HIJ * HIJ : HIJ * HIJ * HIJ);
+  return WIJ * hd * d_hoisted0;
+}
+
+// equation DeltaPlusShiftingSums, method loop, from shifting_sun2017.sph:191: a value the pair shares, the same for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+//   (1.0 + R * wr * wr * wr * wr)
+static inline double DeltaPlusShiftingSums_loop_pairshared2(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* DWIJ, double HIJ, double WIJ, double R, double hdx, double dim, const double* s_m, const double* s_rho, const double* s_hoisted0, double d_hoisted0) {
+  const double hd = dim == 1 ? HIJ : (dim == 2 ? HIJ * HIJ : HIJ * HIJ * HIJ);
+  const double wr = WIJ * hd * d_hoisted0;
+  return std::fma(R * wr * wr * wr, wr, 1.0);
+}
+
+// equation DeltaPlusShiftingSums, method loop, from shifting_sun2017.sph:191: the destination's sums in locals (acc_NAME, accK_NAME: component K;
+// codegen/RegisterSums.cpp)
+static inline void DeltaPlusShiftingSums_loop_sums(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* DWIJ, double HIJ, double WIJ, double R, double hdx, double dim, double& acc0_binv, double& acc1_binv, double& acc2_binv, double& acc3_binv, double& acc0_gradc, double& acc1_gradc, double& acc0_gradcw, double& acc1_gradcw, const double* s_m, const double* s_rho, const double* s_hoisted0, double d_hoisted0, double pair_shared0, double pair_shared1, double pair_shared2) { double sphc_sink = 0.0; (void)sphc_sink;
+    double vb = s_hoisted0[s_idx];
+    // W_ab / W(h_ab / hdx, h_ab) = W_ab h_ab^dim / W(1 / hdx, 1), as W(r, h) = sigma h^-dim
+    // f(r / h): the divisor a constant of the equation (hoisted out of the pair loop).
+    double hd = pair_shared0;
+    double wr = pair_shared1;
+    double f = vb * pair_shared2;
+    acc0_gradcw = std::fma(f, DWIJ[0], acc0_gradcw);
+    acc1_gradcw = std::fma(f, DWIJ[1], acc1_gradcw);
+    (void)0;
+    acc0_gradc = std::fma(vb, DWIJ[0], acc0_gradc);
+    acc1_gradc = std::fma(vb, DWIJ[1], acc1_gradc);
+    (void)0;
+    // x_b - x_a = -XIJ
+    acc0_binv = std::fma(-(vb * XIJ[0]), DWIJ[0], acc0_binv);
+    acc1_binv = std::fma(-(vb * XIJ[0]), DWIJ[1], acc1_binv);
+    (void)0;
+    acc2_binv = std::fma(-(vb * XIJ[1]), DWIJ[0], acc2_binv);
+    acc3_binv = std::fma(-(vb * XIJ[1]), DWIJ[1], acc3_binv);
+    (void)0;
+    (void)0;
+    (void)0;
+    (void)0;
+  
+}
+
+// equation ShiftingCorrectionGradients, method loop, from shifting.sph:224: a value the pair shares, negated for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+//   s_rho[s_idx] - d_rho[d_idx]
+static inline double ShiftingCorrectionGradients_loop_pairshared0(int d_idx, int s_idx, double t, double dt, const double* VIJ, const double* DWIJ, const double* d_rho, const double* s_m, const double* s_rho, const double* s_hoisted0) {
+  return s_rho[s_idx] - d_rho[d_idx];
+}
+
+// equation ShiftingCorrectionGradients, method loop, from shifting.sph:224: the destination's sums in locals (acc_NAME, accK_NAME: component K;
+// codegen/RegisterSums.cpp)
+static inline void ShiftingCorrectionGradients_loop_sums(int d_idx, int s_idx, double t, double dt, const double* VIJ, const double* DWIJ, double& acc0_gradrhos, double& acc1_gradrhos, double& acc0_gradu, double& acc1_gradu, double& acc2_gradu, double& acc3_gradu, const double* d_rho, const double* s_m, const double* s_rho, const double* s_hoisted0, double pair_shared0) { double sphc_sink = 0.0; (void)sphc_sink;
+    double vb = s_hoisted0[s_idx];
+    double rhoba = pair_shared0;
+    acc0_gradrhos = std::fma(vb * rhoba, DWIJ[0], acc0_gradrhos);
+    acc1_gradrhos = std::fma(vb * rhoba, DWIJ[1], acc1_gradrhos);
+    (void)0;
+    // VIJ = u_a - u_b
+    acc0_gradu = std::fma(-(vb * VIJ[0]), DWIJ[0], acc0_gradu);
+    acc1_gradu = std::fma(-(vb * VIJ[0]), DWIJ[1], acc1_gradu);
+    (void)0;
+    acc2_gradu = std::fma(-(vb * VIJ[1]), DWIJ[0], acc2_gradu);
+    acc3_gradu = std::fma(-(vb * VIJ[1]), DWIJ[1], acc3_gradu);
+    (void)0;
+    (void)0;
+    (void)0;
+    (void)0;
+  
+}
 // ---- end of the generated bodies ----
 
 struct Eq6 {
@@ -183,14 +280,26 @@ struct Eq6 {
 struct Eq7 {
   static constexpr double eps = (0.5);
 };
+struct Eq11 {  // DeltaPlusShiftingSums(dest = fluid): the scene's values
+  static constexpr double R = (0.2);
+  double hdx = 1.3;
+  static constexpr double dim = (2.0);
+};
 
 // The water in particle order: positions, the properties the pass reads, its 5 sums.
 struct Fluid {
   int n = 0;
   std::vector<double> x, y, u, v, h, rho, m, p, cs, hoisted;
   std::vector<double> arho, au, av, ax, ay;
+  // The shifting pass: m / rho (hoisted), the destination-only value per particle, its sums
+  // (components interleaved as the solver stores them: binv 4, gradc 2, gradcw 2, gradrhos 2,
+  // gradu 4 per particle).
+  std::vector<double> vb, dh;
+  std::vector<double> binv, gradc, gradcw, gradrhos, gradu;
   void zero_sums() {
     for (auto* s : {&arho, &au, &av, &ax, &ay}) s->assign(n, 0.0);
+    binv.assign(4 * n, 0.0), gradc.assign(2 * n, 0.0), gradcw.assign(2 * n, 0.0);
+    gradrhos.assign(2 * n, 0.0), gradu.assign(4 * n, 0.0);
   }
 };
 
@@ -345,6 +454,138 @@ __attribute__((noinline)) void form_a(Fluid& fluid, const Kept& verlet_fluid_flu
         }
 }
 
+// ---- Form (a) of the shifting pass: the generated each-pair-once loop, verbatim ----
+__attribute__((noinline)) void form_a_shift(Fluid& fluid, const Kept& verlet_fluid_fluid, const Eq11& eq11,
+                                            std::vector<double>& dhoist_eq11_0) {
+  const double t = 0.0, dt = 0.0;
+  const int n = fluid.n;
+  const double* di_x = fluid.x.data();
+  const double* di_y = fluid.y.data();
+  const double* di_h = fluid.h.data();
+  const double* di_u = fluid.u.data();
+  const double* di_v = fluid.v.data();
+  const double* sj_x = di_x;
+  const double* sj_y = di_y;
+  const double* sj_h = di_h;
+  const double* sj_u = di_u;
+  const double* sj_v = di_v;
+  const double* d_rho = fluid.rho.data();
+  const double* s_m = fluid.m.data();
+  const double* s_rho = d_rho;
+  double* d_binv = fluid.binv.data();
+  double* d_gradc = fluid.gradc.data();
+  double* d_gradcw = fluid.gradcw.data();
+  double* d_gradrhos = fluid.gradrhos.data();
+  double* d_gradu = fluid.gradu.data();
+  const double* hoisted_eq11_0 = fluid.vb.data();
+  const double* hoisted_eq12_0 = hoisted_eq11_0;  // ShiftingCorrectionGradients: s_m[s_idx] / s_rho[s_idx], computed above
+        const double pass_dhoisted_eq11_0 = DeltaPlusShiftingSums_loop_dhoisted0(0, eq11.hdx);  // DeltaPlusShiftingSums: (1.0 / KERNEL_W(1.0 / hdx, 1.0)), of the parameters only: once per pass
+        dhoist_eq11_0.resize(n);
+        double* const dhoisted_all_eq11_0 = dhoist_eq11_0.data();
+        for (int d_idx = 0; d_idx < n; ++d_idx) {
+          const double dhoisted_eq11_0 = pass_dhoisted_eq11_0;  // DeltaPlusShiftingSums: once per pass
+          dhoisted_all_eq11_0[d_idx] = dhoisted_eq11_0;
+        }
+        for (int d_idx = 0; d_idx < n; ++d_idx) {  // pairs (d_idx, s_idx > d_idx)
+          const double xi = di_x[d_idx];
+          const double yi = di_y[d_idx];
+          const double zi = 0.0;
+          const double hi = di_h[d_idx];
+          const double ui = di_u[d_idx];
+          const double vi = di_v[d_idx];
+          const double dhoisted_eq11_0 = dhoisted_all_eq11_0[d_idx];
+          const std::vector<std::uint32_t>& kept = verlet_fluid_fluid.lists[d_idx];
+          const std::uint32_t* const k_end = kept.data() + kept.size();
+          const std::uint32_t* k_first = kept.data() + verlet_fluid_fluid.upper[d_idx];
+          if (k_first != k_end && *k_first == static_cast<std::uint32_t>(d_idx)) ++k_first;  // the self pair: every body adds zeros there (sphc
+          // --no-self-pair-skip: evaluated; body/SelfPair.cpp)
+          // The destination's sums in locals across its neighbours (codegen/RegisterSums.cpp;
+          // sphc --no-register-sums: in memory at every pair): binv, gradc, gradcw, gradrhos, gradu.
+          double acc0_binv = d_binv[4 * d_idx + 0];
+          double acc1_binv = d_binv[4 * d_idx + 1];
+          double acc2_binv = d_binv[4 * d_idx + 2];
+          double acc3_binv = d_binv[4 * d_idx + 3];
+          double acc0_gradc = d_gradc[2 * d_idx + 0];
+          double acc1_gradc = d_gradc[2 * d_idx + 1];
+          double acc0_gradcw = d_gradcw[2 * d_idx + 0];
+          double acc1_gradcw = d_gradcw[2 * d_idx + 1];
+          double acc0_gradrhos = d_gradrhos[2 * d_idx + 0];
+          double acc1_gradrhos = d_gradrhos[2 * d_idx + 1];
+          double acc0_gradu = d_gradu[4 * d_idx + 0];
+          double acc1_gradu = d_gradu[4 * d_idx + 1];
+          double acc2_gradu = d_gradu[4 * d_idx + 2];
+          double acc3_gradu = d_gradu[4 * d_idx + 3];
+          for (const std::uint32_t* k = k_first; k != k_end; ++k) {
+            const int s_idx = static_cast<int>(*k);
+            const double hj = sj_h[s_idx];
+            const double XIJ[3] = {xi - sj_x[s_idx], yi - sj_y[s_idx], 0.0};
+            const double R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1];
+            const double hmax = hi > hj ? hi : hj;
+            if (R2IJ >= RADIUS2 * hmax * hmax) continue;  // not a neighbour
+            const double XIJ_ji[3] = {sj_x[s_idx] - xi, sj_y[s_idx] - yi, 0.0};
+            const double HIJ = 0.5 * (hi + hj);
+            const double RIJ = std::sqrt(R2IJ);
+            const double VIJ[3] = {ui - sj_u[s_idx], vi - sj_v[s_idx], 0.0};
+            const double VIJ_ji[3] = {sj_u[s_idx] - ui, sj_v[s_idx] - vi, 0.0};
+            const double WIJ = Kernel::w(RIJ, HIJ);
+            double DWIJ[3], DWIJ_ji[3];
+            Kernel::gradient_pair(XIJ, XIJ_ji, RIJ, HIJ, DWIJ, DWIJ_ji);
+            const double pshared_eq11_0 = DeltaPlusShiftingSums_loop_pairshared0(d_idx, s_idx, t, dt, XIJ, DWIJ, HIJ, WIJ, eq11.R, eq11.hdx, eq11.dim, s_m, s_rho, hoisted_eq11_0, dhoisted_eq11_0);  // DeltaPlusShiftingSums: the same for (s_idx, d_idx)
+            const double pshared_eq11_1 = DeltaPlusShiftingSums_loop_pairshared1(d_idx, s_idx, t, dt, XIJ, DWIJ, HIJ, WIJ, eq11.R, eq11.hdx, eq11.dim, s_m, s_rho, hoisted_eq11_0, dhoisted_eq11_0);  // DeltaPlusShiftingSums: the same for (s_idx, d_idx)
+            const double pshared_eq11_2 = DeltaPlusShiftingSums_loop_pairshared2(d_idx, s_idx, t, dt, XIJ, DWIJ, HIJ, WIJ, eq11.R, eq11.hdx, eq11.dim, s_m, s_rho, hoisted_eq11_0, dhoisted_eq11_0);  // DeltaPlusShiftingSums: the same for (s_idx, d_idx)
+            const double pshared_eq12_0 = ShiftingCorrectionGradients_loop_pairshared0(d_idx, s_idx, t, dt, VIJ, DWIJ, d_rho, s_m, s_rho, hoisted_eq12_0);  // ShiftingCorrectionGradients: minus this for (s_idx, d_idx)
+            DeltaPlusShiftingSums_loop_sums(d_idx, s_idx, t, dt, XIJ, DWIJ, HIJ, WIJ, eq11.R, eq11.hdx, eq11.dim, acc0_binv, acc1_binv, acc2_binv, acc3_binv, acc0_gradc, acc1_gradc, acc0_gradcw, acc1_gradcw, s_m, s_rho, hoisted_eq11_0, dhoisted_eq11_0, pshared_eq11_0, pshared_eq11_1, pshared_eq11_2);  // DeltaPlusShiftingSums, from wcsph_scheme.sph:211
+            ShiftingCorrectionGradients_loop_sums(d_idx, s_idx, t, dt, VIJ, DWIJ, acc0_gradrhos, acc1_gradrhos, acc0_gradu, acc1_gradu, acc2_gradu, acc3_gradu, d_rho, s_m, s_rho, hoisted_eq12_0, pshared_eq12_0);  // ShiftingCorrectionGradients, from wcsph_scheme.sph:214
+            // the same pair for particle s_idx
+            // s_idx's sums in locals for its calls (codegen/SymmetricPairs.cpp)
+            double m_acc0_binv = d_binv[4 * s_idx + 0];
+            double m_acc1_binv = d_binv[4 * s_idx + 1];
+            double m_acc2_binv = d_binv[4 * s_idx + 2];
+            double m_acc3_binv = d_binv[4 * s_idx + 3];
+            double m_acc0_gradc = d_gradc[2 * s_idx + 0];
+            double m_acc1_gradc = d_gradc[2 * s_idx + 1];
+            double m_acc0_gradcw = d_gradcw[2 * s_idx + 0];
+            double m_acc1_gradcw = d_gradcw[2 * s_idx + 1];
+            double m_acc0_gradrhos = d_gradrhos[2 * s_idx + 0];
+            double m_acc1_gradrhos = d_gradrhos[2 * s_idx + 1];
+            double m_acc0_gradu = d_gradu[4 * s_idx + 0];
+            double m_acc1_gradu = d_gradu[4 * s_idx + 1];
+            double m_acc2_gradu = d_gradu[4 * s_idx + 2];
+            double m_acc3_gradu = d_gradu[4 * s_idx + 3];
+            DeltaPlusShiftingSums_loop_sums(s_idx, d_idx, t, dt, XIJ_ji, DWIJ_ji, HIJ, WIJ, eq11.R, eq11.hdx, eq11.dim, m_acc0_binv, m_acc1_binv, m_acc2_binv, m_acc3_binv, m_acc0_gradc, m_acc1_gradc, m_acc0_gradcw, m_acc1_gradcw, s_m, s_rho, hoisted_eq11_0, dhoisted_all_eq11_0[s_idx], pshared_eq11_0, pshared_eq11_1, pshared_eq11_2);  // DeltaPlusShiftingSums, from wcsph_scheme.sph:211: destination s_idx, source d_idx
+            ShiftingCorrectionGradients_loop_sums(s_idx, d_idx, t, dt, VIJ_ji, DWIJ_ji, m_acc0_gradrhos, m_acc1_gradrhos, m_acc0_gradu, m_acc1_gradu, m_acc2_gradu, m_acc3_gradu, d_rho, s_m, s_rho, hoisted_eq12_0, -pshared_eq12_0);  // ShiftingCorrectionGradients, from wcsph_scheme.sph:214: destination s_idx, source d_idx
+            d_binv[4 * s_idx + 0] = m_acc0_binv;
+            d_binv[4 * s_idx + 1] = m_acc1_binv;
+            d_binv[4 * s_idx + 2] = m_acc2_binv;
+            d_binv[4 * s_idx + 3] = m_acc3_binv;
+            d_gradc[2 * s_idx + 0] = m_acc0_gradc;
+            d_gradc[2 * s_idx + 1] = m_acc1_gradc;
+            d_gradcw[2 * s_idx + 0] = m_acc0_gradcw;
+            d_gradcw[2 * s_idx + 1] = m_acc1_gradcw;
+            d_gradrhos[2 * s_idx + 0] = m_acc0_gradrhos;
+            d_gradrhos[2 * s_idx + 1] = m_acc1_gradrhos;
+            d_gradu[4 * s_idx + 0] = m_acc0_gradu;
+            d_gradu[4 * s_idx + 1] = m_acc1_gradu;
+            d_gradu[4 * s_idx + 2] = m_acc2_gradu;
+            d_gradu[4 * s_idx + 3] = m_acc3_gradu;
+          }
+          d_binv[4 * d_idx + 0] = acc0_binv;
+          d_binv[4 * d_idx + 1] = acc1_binv;
+          d_binv[4 * d_idx + 2] = acc2_binv;
+          d_binv[4 * d_idx + 3] = acc3_binv;
+          d_gradc[2 * d_idx + 0] = acc0_gradc;
+          d_gradc[2 * d_idx + 1] = acc1_gradc;
+          d_gradcw[2 * d_idx + 0] = acc0_gradcw;
+          d_gradcw[2 * d_idx + 1] = acc1_gradcw;
+          d_gradrhos[2 * d_idx + 0] = acc0_gradrhos;
+          d_gradrhos[2 * d_idx + 1] = acc1_gradrhos;
+          d_gradu[4 * d_idx + 0] = acc0_gradu;
+          d_gradu[4 * d_idx + 1] = acc1_gradu;
+          d_gradu[4 * d_idx + 2] = acc2_gradu;
+          d_gradu[4 * d_idx + 3] = acc3_gradu;
+        }
+}
+
 #ifdef __AVX512F__
 // ---- The tiles ----
 using V = __m512d;
@@ -356,6 +597,8 @@ inline V mul(V a, V b) { return _mm512_mul_pd(a, b); }
 inline V div(V a, V b) { return _mm512_div_pd(a, b); }
 inline V fma(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
 inline V sel(M m, V yes, V no) { return _mm512_mask_blend_pd(m, no, yes); }
+// -x (the sign flipped, as the scalar code's unary minus; 0 - x would give +0 for +0)
+inline V neg(V x) { return _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(x), _mm512_set1_epi64(INT64_MIN))); }
 // 1 / x from vrcp14pd (relative error < 2^-14) and two Newton steps.
 inline V rcp(V x) {
   V r = _mm512_rcp14_pd(x);
@@ -374,14 +617,19 @@ inline V rsqrt(V x) {
 }
 
 enum Arith { EXACT = 0, RCP = 1 };
-constexpr int NF = 9;    // the fields a tile reads: x y u v h rho m cs hoisted
-constexpr int NS = 5;    // its sums: arho au av ax ay
+// The fields the tiles read: x y u v h rho m cs hoisted (p / rho^2) for the rates; x y u v h
+// rho vb (m / rho) dh for the shifting pass.
+enum Field { FX, FY, FU, FV, FH, FRHO, FM, FCS, FHO, FVB, FDH, NF };
+constexpr int RATES_FIELDS[] = {FX, FY, FU, FV, FH, FRHO, FM, FCS, FHO};
+constexpr int SHIFT_FIELDS[] = {FX, FY, FU, FV, FH, FRHO, FVB, FDH};
+constexpr int NS = 5;    // the rates' sums: arho au av ax ay
+constexpr int NSS = 14;  // the shifting's: binv 0-3, gradc 4-5, gradcw 6-7, gradrhos 8-9, gradu 10-13
 
 // One layout's slot-order copies (the per-evaluation gathers) and slot sums.
 struct Slots {
   sphc::ClusterLayout L;
   sphc::ClusterPairList outer, pruned;
-  std::vector<double, std::allocator<double>> f[NF], s[NS];
+  std::vector<double> f[NF], s[NS], ss[NSS];
 };
 
 // i values of one register: RI = 1: particle i in every lane; RI = 2: i0 in lanes 0-3, i1 in 4-7.
@@ -528,6 +776,142 @@ __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>
   }
 }
 
+// The shifting pass (DeltaPlusShiftingSums + ShiftingCorrectionGradients) in the same tiles.
+template <int CI, int CJ, int ARITH>
+__attribute__((noinline)) void form_t_shift(Slots& S, const std::vector<std::uint32_t>& begin,
+                                            const std::vector<std::uint32_t>& jl, const Eq11& eq11) {
+  constexpr int RI = 8 / CJ;
+  const double sigma = Kernel::sigma;
+  const V one = bc(1.0), half = bc(0.5), two = bc(2.0), zero = _mm512_setzero_pd();
+  const V radius2 = bc(RADIUS2), tiny = bc(1e-12), m5 = bc(-5.0), R = bc(eq11.R);
+  const double *X = S.f[FX].data(), *Y = S.f[FY].data(), *U = S.f[FU].data(), *VV = S.f[FV].data();
+  const double *H = S.f[FH].data(), *RHO = S.f[FRHO].data(), *VB = S.f[FVB].data(), *DH = S.f[FDH].data();
+  double* SUM[NSS];
+  for (int k = 0; k < NSS; ++k) SUM[k] = S.ss[k].data();
+  const __m512i lane_i = RI == 1 ? _mm512_setzero_si512() : _mm512_set_epi64(1, 1, 1, 1, 0, 0, 0, 0);
+  const __m512i lane_j = CJ == 8 ? _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0) : _mm512_set_epi64(3, 2, 1, 0, 3, 2, 1, 0);
+  const int nci = static_cast<int>(begin.size()) - 1;
+  for (int ci = 0; ci < nci; ++ci) {
+    const int i0 = ci * CI;
+    if (begin[ci] == begin[ci + 1]) continue;
+    V iacc[CI / RI][NSS];
+    for (int r = 0; r < CI / RI; ++r)
+      for (int k = 0; k < NSS; ++k) iacc[r][k] = zero;
+    for (std::uint32_t e = begin[ci]; e < begin[ci + 1]; ++e) {
+      const int j0 = static_cast<int>(jl[e]) * CJ;
+      const V xj = jval<CJ>(X, j0), yj = jval<CJ>(Y, j0), uj = jval<CJ>(U, j0), vj = jval<CJ>(VV, j0);
+      const V hj = jval<CJ>(H, j0), rhoj = jval<CJ>(RHO, j0), vbj = jval<CJ>(VB, j0);
+      V jacc[NSS];
+      for (int k = 0; k < NSS; ++k) jacc[k] = zero;
+      const bool diagonal = j0 < i0 + CI && i0 < j0 + CJ;
+      for (int r = 0; r < CI / RI; ++r) {
+        const int i = i0 + r * RI;
+        const V XIJ_0 = sub(ival<RI>(X, i), xj), XIJ_1 = sub(ival<RI>(Y, i), yj);
+        const V R2IJ = add(mul(XIJ_0, XIJ_0), mul(XIJ_1, XIJ_1));
+        const V hi = ival<RI>(H, i);
+        const V hmax = _mm512_max_pd(hi, hj);
+        M in = _mm512_cmp_pd_mask(R2IJ, mul(mul(radius2, hmax), hmax), _CMP_NGE_UQ);
+        if (diagonal)
+          in &= _mm512_cmpgt_epi64_mask(_mm512_add_epi64(lane_j, _mm512_set1_epi64(j0)),
+                                        _mm512_add_epi64(lane_i, _mm512_set1_epi64(i)));
+        if (!in) continue;
+        const V HIJ = mul(half, add(hi, hj));
+        const V VIJ_0 = sub(ival<RI>(U, i), uj), VIJ_1 = sub(ival<RI>(VV, i), vj);
+        V RIJ, ih, q, s_den_inv = zero;
+        if (ARITH == EXACT) {
+          RIJ = _mm512_sqrt_pd(R2IJ);
+          ih = div(one, HIJ);
+          q = div(RIJ, HIJ);
+        } else {
+          const V rinv = rsqrt(R2IJ);
+          RIJ = sel(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), mul(R2IJ, rinv), zero);
+          ih = rcp(HIJ);
+          q = mul(RIJ, ih);
+          s_den_inv = mul(ih, rinv);
+        }
+        const V sk = mul(bc(sigma), mul(ih, ih));
+        const M inside = _mm512_cmp_pd_mask(q, two, _CMP_LT_OQ);
+        const V t = sub(one, mul(half, q));
+        const V t2 = mul(t, t);
+        const V fq = mul(mul(t2, t2), add(mul(two, q), one));
+        const V dfq = mul(mul(mul(mul(m5, q), t), t), t);
+        const V WIJ = mul(sk, sel(inside, fq, zero));
+        const V dwdq = mul(sk, sel(inside, dfq, zero));
+        const M apart = _mm512_cmp_pd_mask(RIJ, tiny, _CMP_GT_OQ);
+        const V s = ARITH == EXACT ? div(dwdq, mul(HIJ, sel(apart, RIJ, one))) : mul(dwdq, s_den_inv);
+        const V DWIJ_f = sel(apart, s, zero);
+        const V D0 = mul(DWIJ_f, XIJ_0), D1 = mul(DWIJ_f, XIJ_1);
+        // the values the pair shares (eq11: hd, wr, 1 + R wr^4; eq12: rho_j - rho_i, negated for j)
+        const V hd = mul(HIJ, HIJ);  // dim == 2
+        const V wr = mul(mul(WIJ, hd), ival<RI>(DH, i));
+        const V ps2 = fma(mul(mul(mul(R, wr), wr), wr), wr, one);
+        const V rhoba = sub(rhoj, ival<RI>(RHO, i));
+        // i's terms (source j: vb = vb_j), in (a)'s order
+        {
+          const V vb = vbj, f = mul(vb, ps2);
+          const V nx0 = neg(mul(vb, XIJ_0)), nx1 = neg(mul(vb, XIJ_1));
+          const V g = mul(vb, rhoba);
+          const V nv0 = neg(mul(vb, VIJ_0)), nv1 = neg(mul(vb, VIJ_1));
+          V* a = iacc[r];
+          a[6] = _mm512_mask3_fmadd_pd(f, D0, a[6], in);
+          a[7] = _mm512_mask3_fmadd_pd(f, D1, a[7], in);
+          a[4] = _mm512_mask3_fmadd_pd(vb, D0, a[4], in);
+          a[5] = _mm512_mask3_fmadd_pd(vb, D1, a[5], in);
+          a[0] = _mm512_mask3_fmadd_pd(nx0, D0, a[0], in);
+          a[1] = _mm512_mask3_fmadd_pd(nx0, D1, a[1], in);
+          a[2] = _mm512_mask3_fmadd_pd(nx1, D0, a[2], in);
+          a[3] = _mm512_mask3_fmadd_pd(nx1, D1, a[3], in);
+          a[8] = _mm512_mask3_fmadd_pd(g, D0, a[8], in);
+          a[9] = _mm512_mask3_fmadd_pd(g, D1, a[9], in);
+          a[10] = _mm512_mask3_fmadd_pd(nv0, D0, a[10], in);
+          a[11] = _mm512_mask3_fmadd_pd(nv0, D1, a[11], in);
+          a[12] = _mm512_mask3_fmadd_pd(nv1, D0, a[12], in);
+          a[13] = _mm512_mask3_fmadd_pd(nv1, D1, a[13], in);
+        }
+        // j's terms (source i: vb = vb_i; XIJ_ji = -XIJ, DWIJ_ji = -DWIJ, VIJ_ji = -VIJ, rhoba
+        // negated, all exactly): fma(a, -D, c) = fnmadd(a, D, c); -(vb (-x)) = vb x.
+        {
+          const V vb = ival<RI>(VB, i), f = mul(vb, ps2);
+          const V px0 = mul(vb, XIJ_0), px1 = mul(vb, XIJ_1);
+          const V g = mul(vb, rhoba);  // vb (-rhoba) times -D: g D
+          const V pv0 = mul(vb, VIJ_0), pv1 = mul(vb, VIJ_1);
+          jacc[6] = _mm512_mask3_fnmadd_pd(f, D0, jacc[6], in);
+          jacc[7] = _mm512_mask3_fnmadd_pd(f, D1, jacc[7], in);
+          jacc[4] = _mm512_mask3_fnmadd_pd(vb, D0, jacc[4], in);
+          jacc[5] = _mm512_mask3_fnmadd_pd(vb, D1, jacc[5], in);
+          jacc[0] = _mm512_mask3_fnmadd_pd(px0, D0, jacc[0], in);
+          jacc[1] = _mm512_mask3_fnmadd_pd(px0, D1, jacc[1], in);
+          jacc[2] = _mm512_mask3_fnmadd_pd(px1, D0, jacc[2], in);
+          jacc[3] = _mm512_mask3_fnmadd_pd(px1, D1, jacc[3], in);
+          jacc[8] = _mm512_mask3_fmadd_pd(g, D0, jacc[8], in);
+          jacc[9] = _mm512_mask3_fmadd_pd(g, D1, jacc[9], in);
+          jacc[10] = _mm512_mask3_fnmadd_pd(pv0, D0, jacc[10], in);
+          jacc[11] = _mm512_mask3_fnmadd_pd(pv0, D1, jacc[11], in);
+          jacc[12] = _mm512_mask3_fnmadd_pd(pv1, D0, jacc[12], in);
+          jacc[13] = _mm512_mask3_fnmadd_pd(pv1, D1, jacc[13], in);
+        }
+      }
+      if (CJ == 8) {
+        for (int k = 0; k < NSS; ++k) _mm512_storeu_pd(SUM[k] + j0, add(_mm512_loadu_pd(SUM[k] + j0), jacc[k]));
+      } else {
+        for (int k = 0; k < NSS; ++k) {
+          const __m256d lo = _mm512_castpd512_pd256(jacc[k]), hi = _mm512_extractf64x4_pd(jacc[k], 1);
+          _mm256_storeu_pd(SUM[k] + j0, _mm256_add_pd(_mm256_loadu_pd(SUM[k] + j0), _mm256_add_pd(lo, hi)));
+        }
+      }
+    }
+    for (int r = 0; r < CI / RI; ++r)
+      for (int k = 0; k < NSS; ++k) {
+        if (RI == 1) {
+          SUM[k][i0 + r] += _mm512_reduce_add_pd(iacc[r][k]);
+        } else {
+          SUM[k][i0 + 2 * r] += _mm512_mask_reduce_add_pd(0x0f, iacc[r][k]);
+          SUM[k][i0 + 2 * r + 1] += _mm512_mask_reduce_add_pd(0xf0, iacc[r][k]);
+        }
+      }
+  }
+}
+
 // The core's clock while it runs 512-bit FMAs (a chain of dependent vfmadd, 4 cycles each).
 double clock_estimate() {
   const long n = 20000000;
@@ -596,6 +980,9 @@ Fluid make_fluid(const std::string& path, int nx, int ny, double dx, double hdx,
   }
   f.hoisted.resize(f.n);
   for (int i = 0; i < f.n; ++i) f.hoisted[i] = PressureGradient_loop_hoisted0(i, f.p.data(), f.rho.data());
+  f.vb.resize(f.n);
+  for (int i = 0; i < f.n; ++i) f.vb[i] = DeltaPlusShiftingSums_loop_hoisted0(i, f.m.data(), f.rho.data());
+  f.dh.assign(f.n, DeltaPlusShiftingSums_loop_dhoisted0(0, hdx));
   f.zero_sums();
   return f;
 }
@@ -608,7 +995,7 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string positions, forms_arg = "a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp";
+  std::string positions, forms_arg = "a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp,sa,st4x4,st4x8,st8x8,st4x4rcp,st8x8rcp";
   int nx = 33, ny = 66, reps = 7, sweeps = 0;
   double dx = 0.03, hdx = 1.3, pert = 0.1, skin = 0.1;
   for (int k = 1; k < argc; ++k) {
@@ -629,7 +1016,7 @@ int main(int argc, char** argv) {
     else if (a == "--forms") forms_arg = next();
     else {
       std::fprintf(stderr, "usage: %s [--positions FILE] [--nx 33 --ny 66] [--dx 0.03] [--hdx 1.3] [--pert 0.1]"
-                           " [--skin 0.1] [--reps 7] [--sweeps N] [--forms a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp]\n",
+                           " [--skin 0.1] [--reps 7] [--sweeps N] [--forms a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp,sa,st4x4,...]\n",
                    argv[0]);
       return 2;
     }
@@ -673,25 +1060,39 @@ int main(int argc, char** argv) {
 
   // The layouts (width 4 and 8; the columns 2 and 2.83 dx: clusters about square) and their
   // lists, built once (a rebuild); the per-evaluation pieces timed below.
+  const Eq11 eq11{hdx};
   Slots s4, s8;
-  const double* P[NF] = {fa.x.data(), fa.y.data(), fa.u.data(), fa.v.data(), fa.h.data(),
-                         fa.rho.data(), fa.m.data(), fa.cs.data(), fa.hoisted.data()};
+  const double* P[NF] = {fa.x.data(), fa.y.data(), fa.u.data(),       fa.v.data(),  fa.h.data(), fa.rho.data(),
+                         fa.m.data(), fa.cs.data(), fa.hoisted.data(), fa.vb.data(), fa.dh.data()};
   for (Slots* s : {&s4, &s8}) {
     const int w = s == &s4 ? 4 : 8;
     sphc::build_cluster_layout(s->L, fa.x.data(), fa.y.data(), nullptr, fa.n, 2, sphc::cluster_column_side(dx, 2, w), w);
     sphc::build_cluster_pairs(s->L, s->L, rlist, true, s->outer);
     for (auto& v : s->f) v.assign(s->L.slots(), 0.0);
     for (auto& v : s->s) v.assign(s->L.slots(), 0.0);
+    for (auto& v : s->ss) v.assign(s->L.slots(), 0.0);
   }
   // t4x8's list: the halves of the 8-clusters, each against the j-clusters of its 8-cluster's
   // pruned list whose boxes lie within the support of the half's own box.
   std::vector<std::uint32_t> half_begin, half_j;
-  auto evaluate_pieces = [&](Slots& s, bool halves) {
-    sphc::gather_positions(s.L, fa.x.data(), fa.y.data(), nullptr, s.f[0].data(), s.f[1].data(), nullptr, 4 * rlist);
-    for (int k = 2; k < NF; ++k) sphc::gather_slots(s.L, P[k], s.f[k].data());
-    sphc::update_boxes(s.L, s.f[0].data(), s.f[1].data(), nullptr);
+  // Per evaluation (pass 0: the rates, 1: the shifting): the positions and the pass's fields
+  // into slot order, the boxes, the pruned list (t4x8: its half list), the slot sums zeroed.
+  auto evaluate_pieces = [&](Slots& s, bool halves, int pass) {
+    sphc::gather_positions(s.L, fa.x.data(), fa.y.data(), nullptr, s.f[FX].data(), s.f[FY].data(), nullptr, 4 * rlist);
+    if (pass == 0)
+      for (int k : RATES_FIELDS) {
+        if (k != FX && k != FY) sphc::gather_slots(s.L, P[k], s.f[k].data());
+      }
+    else
+      for (int k : SHIFT_FIELDS) {
+        if (k != FX && k != FY) sphc::gather_slots(s.L, P[k], s.f[k].data());
+      }
+    sphc::update_boxes(s.L, s.f[FX].data(), s.f[FY].data(), nullptr);
     sphc::prune_cluster_pairs(s.L, s.L, s.outer, support, s.pruned);
-    for (auto& v : s.s) std::fill(v.begin(), v.end(), 0.0);
+    if (pass == 0)
+      for (auto& v : s.s) std::fill(v.begin(), v.end(), 0.0);
+    else
+      for (auto& v : s.ss) std::fill(v.begin(), v.end(), 0.0);
     if (halves) {
       const std::size_t nc = s.L.n_clusters;
       half_begin.assign(2 * nc + 1, 0);
@@ -704,8 +1105,8 @@ int main(int argc, char** argv) {
           for (std::size_t sl = ci * 8 + 4 * hf; sl < ci * 8 + 4 * hf + 4; ++sl) {
             if (s.L.slot[sl] == sphc::kPadSlot) continue;
             any = true;
-            lo[0] = std::min(lo[0], s.f[0][sl]), hi[0] = std::max(hi[0], s.f[0][sl]);
-            lo[1] = std::min(lo[1], s.f[1][sl]), hi[1] = std::max(hi[1], s.f[1][sl]);
+            lo[0] = std::min(lo[0], s.f[FX][sl]), hi[0] = std::max(hi[0], s.f[FX][sl]);
+            lo[1] = std::min(lo[1], s.f[FY][sl]), hi[1] = std::max(hi[1], s.f[FY][sl]);
           }
           if (any)
             for (std::uint32_t e = s.pruned.begin[ci]; e < s.pruned.begin[ci + 1]; ++e) {
@@ -718,18 +1119,31 @@ int main(int argc, char** argv) {
         }
     }
   };
-  auto add_back = [&](Slots& s, Fluid& out) {
-    std::vector<double>* dst[NS] = {&out.arho, &out.au, &out.av, &out.ax, &out.ay};
-    for (int k = 0; k < NS; ++k) sphc::add_slots(s.L, s.s[k].data(), dst[k]->data());
+  // The slot sums added back onto the particles' sums (the shifting's components interleaved).
+  auto add_back = [&](Slots& s, Fluid& out, int pass) {
+    if (pass == 0) {
+      std::vector<double>* dst[NS] = {&out.arho, &out.au, &out.av, &out.ax, &out.ay};
+      for (int k = 0; k < NS; ++k) sphc::add_slots(s.L, s.s[k].data(), dst[k]->data());
+      return;
+    }
+    const std::uint32_t* slot_of = s.L.slot_of.data();
+    double *binv = out.binv.data(), *gradc = out.gradc.data(), *gradcw = out.gradcw.data();
+    double *gradrhos = out.gradrhos.data(), *gradu = out.gradu.data();
+    for (int p = 0; p < out.n; ++p) {
+      const std::uint32_t q = slot_of[p];
+      for (int c = 0; c < 4; ++c) binv[4 * p + c] += s.ss[c][q], gradu[4 * p + c] += s.ss[10 + c][q];
+      for (int c = 0; c < 2; ++c)
+        gradc[2 * p + c] += s.ss[4 + c][q], gradcw[2 * p + c] += s.ss[6 + c][q], gradrhos[2 * p + c] += s.ss[8 + c][q];
+    }
   };
-  evaluate_pieces(s4, false);
-  evaluate_pieces(s8, true);
+  evaluate_pieces(s4, false, 0);
+  evaluate_pieces(s8, true, 0);
   // Lanes: pairs within the support in each form's registers.
   auto count_regs = [&](const sphc::ClusterLayout& L, const std::vector<std::uint32_t>& b, const std::vector<std::uint32_t>& jl,
                         int CI, int CJ, long& regs, long& regs_pair, long& in) {
     const int RI = 8 / CJ;
-    const double* X = L.width == 4 ? s4.f[0].data() : s8.f[0].data();
-    const double* Y = L.width == 4 ? s4.f[1].data() : s8.f[1].data();
+    const double* X = L.width == 4 ? s4.f[FX].data() : s8.f[FX].data();
+    const double* Y = L.width == 4 ? s4.f[FY].data() : s8.f[FY].data();
     regs = regs_pair = in = 0;
     for (std::size_t ci = 0; ci + 1 < b.size(); ++ci)
       for (std::uint32_t e = b[ci]; e < b[ci + 1]; ++e)
@@ -749,51 +1163,62 @@ int main(int argc, char** argv) {
 
   struct Form {
     std::string name;
+    int pass = 0;
+    Slots* slots = nullptr;
+    bool halves = false;
     std::function<void()> run;  // one sweep from zeroed sums
-    std::function<void(Fluid&)> result;
     long regs = 0, regs_pair = 0, in = 0;
     std::vector<double> times;
   };
   std::vector<Form> forms;
-  Fluid fref = fa;
-  auto add_form = [&](const std::string& name) {
+  std::vector<double> dhoist11;
+  auto add_form = [&](const std::string& full) {
     Form F;
-    F.name = name;
+    F.name = full;
+    F.pass = full[0] == 's' ? 1 : 0;
+    const std::string name = F.pass ? full.substr(1) : full;
     if (name == "a") {
-      F.run = [&] {
-        fa.zero_sums();
-        form_a(fa, kept, eq6, eq7, dhoist);
-      };
-      F.result = [&](Fluid& out) { out = fa; };
-    } else {
-      const bool rcp = name.size() > 4 && name.substr(4) == "rcp";
-      const std::string shape = name.substr(0, 4);
-      Slots* s = shape == "t4x4" ? &s4 : &s8;
-      auto zero = [s] {
-        for (auto& v : s->s) std::fill(v.begin(), v.end(), 0.0);
-      };
-      if (shape == "t4x4") {
-        F.run = rcp ? std::function<void()>([=, &eq6, &eq7] { zero(); form_t<4, 4, RCP>(*s, s->pruned.begin, s->pruned.j, eq6, eq7); })
-                    : std::function<void()>([=, &eq6, &eq7] { zero(); form_t<4, 4, EXACT>(*s, s->pruned.begin, s->pruned.j, eq6, eq7); });
-        count_regs(s->L, s->pruned.begin, s->pruned.j, 4, 4, F.regs, F.regs_pair, F.in);
-      } else if (shape == "t4x8") {
-        F.run = rcp ? std::function<void()>([=, &eq6, &eq7, &half_begin, &half_j] { zero(); form_t<4, 8, RCP>(*s, half_begin, half_j, eq6, eq7); })
-                    : std::function<void()>([=, &eq6, &eq7, &half_begin, &half_j] { zero(); form_t<4, 8, EXACT>(*s, half_begin, half_j, eq6, eq7); });
-        count_regs(s->L, half_begin, half_j, 4, 8, F.regs, F.regs_pair, F.in);
-      } else if (shape == "t8x8") {
-        F.run = rcp ? std::function<void()>([=, &eq6, &eq7] { zero(); form_t<8, 8, RCP>(*s, s->pruned.begin, s->pruned.j, eq6, eq7); })
-                    : std::function<void()>([=, &eq6, &eq7] { zero(); form_t<8, 8, EXACT>(*s, s->pruned.begin, s->pruned.j, eq6, eq7); });
-        count_regs(s->L, s->pruned.begin, s->pruned.j, 8, 8, F.regs, F.regs_pair, F.in);
-      } else {
-        std::fprintf(stderr, "unknown form %s\n", name.c_str());
-        std::exit(2);
-      }
-      F.result = [s, &add_back, &fa](Fluid& out) {
-        out = fa;
-        out.zero_sums();
-        add_back(*s, out);
-      };
+      if (F.pass == 0)
+        F.run = [&] {
+          fa.zero_sums();
+          form_a(fa, kept, eq6, eq7, dhoist);
+        };
+      else
+        F.run = [&] {
+          fa.zero_sums();
+          form_a_shift(fa, kept, eq11, dhoist11);
+        };
+      forms.push_back(std::move(F));
+      return;
     }
+    const bool rcp = name.size() > 4 && name.substr(4) == "rcp";
+    const std::string shape = name.substr(0, 4);
+    if ((name.size() > 4 && !rcp) || (shape != "t4x4" && shape != "t4x8" && shape != "t8x8")) {
+      std::fprintf(stderr, "unknown form %s\n", full.c_str());
+      std::exit(2);
+    }
+    Slots* s = shape == "t4x4" ? &s4 : &s8;
+    F.slots = s;
+    F.halves = shape == "t4x8";
+    const int pass = F.pass;
+    auto zero = [s, pass] {
+      if (pass)
+        for (auto& v : s->ss) std::fill(v.begin(), v.end(), 0.0);
+      else
+        for (auto& v : s->s) std::fill(v.begin(), v.end(), 0.0);
+    };
+    const std::vector<std::uint32_t>& b = shape == "t4x8" ? half_begin : s->pruned.begin;
+    const std::vector<std::uint32_t>& j = shape == "t4x8" ? half_j : s->pruned.j;
+#define SPHC_FORM(CI, CJ)                                                                   \
+  if (pass == 0 && rcp) F.run = [=, &b, &j, &eq6, &eq7] { zero(); form_t<CI, CJ, RCP>(*s, b, j, eq6, eq7); };      \
+  if (pass == 0 && !rcp) F.run = [=, &b, &j, &eq6, &eq7] { zero(); form_t<CI, CJ, EXACT>(*s, b, j, eq6, eq7); };   \
+  if (pass == 1 && rcp) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, RCP>(*s, b, j, eq11); };         \
+  if (pass == 1 && !rcp) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, EXACT>(*s, b, j, eq11); };      \
+  count_regs(s->L, b, j, CI, CJ, F.regs, F.regs_pair, F.in);
+    if (shape == "t4x4") { SPHC_FORM(4, 4) }
+    if (shape == "t4x8") { SPHC_FORM(4, 8) }
+    if (shape == "t8x8") { SPHC_FORM(8, 8) }
+#undef SPHC_FORM
     forms.push_back(std::move(F));
   };
   {
@@ -804,96 +1229,122 @@ int main(int argc, char** argv) {
       at = comma + 1;
     }
   }
-  // The reference: form (a) once.
+  // The references: form (a) of each pass once.
+  Fluid fref = fa;
   fref.zero_sums();
   form_a(fref, kept, eq6, eq7, dhoist);
+  form_a_shift(fref, kept, eq11, dhoist11);
 
-  // Sweeps per timed rep: ~20 ms of form (a).
+  // Sweeps per timed rep: ~20 ms of form (a) of the rates.
   if (sweeps <= 0) {
+    Fluid tmp = fa;
     const double t0 = cpu_now();
     int k = 0;
-    do form_a(fref, kept, eq6, eq7, dhoist), ++k;
+    do form_a(tmp, kept, eq6, eq7, dhoist), ++k;
     while (cpu_now() - t0 < 0.02);
     sweeps = std::max(1, k);
-    fref.zero_sums();
-    form_a(fref, kept, eq6, eq7, dhoist);
   }
   // Correctness of every form, then the timing rounds (interleaved).
   int bad = 0;
-  const std::vector<double> Fluid::*sums[NS] = {&Fluid::arho, &Fluid::au, &Fluid::av, &Fluid::ax, &Fluid::ay};
-  const char* sum_names[NS] = {"arho", "au", "av", "ax", "ay"};
+  struct Sum {
+    const char* name;
+    std::vector<double> Fluid::*v;
+    int pass;
+  };
+  const Sum sums[] = {{"arho", &Fluid::arho, 0},        {"au", &Fluid::au, 0},         {"av", &Fluid::av, 0},
+                      {"ax", &Fluid::ax, 0},            {"ay", &Fluid::ay, 0},         {"binv", &Fluid::binv, 1},
+                      {"gradc", &Fluid::gradc, 1},      {"gradcw", &Fluid::gradcw, 1}, {"gradrhos", &Fluid::gradrhos, 1},
+                      {"gradu", &Fluid::gradu, 1}};
   std::vector<double> worst(forms.size(), 0.0);
   for (std::size_t k = 0; k < forms.size(); ++k) {
     Form& F = forms[k];
+    if (F.slots) evaluate_pieces(*F.slots, F.halves, F.pass);
     F.run();
-    Fluid out;
-    F.result(out);
-    for (int q = 0; q < NS; ++q) {
-      const std::vector<double>& want = fref.*sums[q];
-      const std::vector<double>& got = out.*sums[q];
-      double scale = 0, diff = 0;
-      for (int i = 0; i < fa.n; ++i) scale = std::max(scale, std::fabs(want[i])), diff = std::max(diff, std::fabs(got[i] - want[i]));
-      const double rel = scale > 0 ? diff / scale : diff;
-      worst[k] = std::max(worst[k], rel);
-      if (!(rel <= 1e-12)) {
-        std::printf("FAILED: form %s, sum %s: max |X - a| / max |a| = %.3g > 1e-12\n", F.name.c_str(), sum_names[q], rel);
-        bad = 1;
+    Fluid out = fa;
+    if (F.slots) {
+      out.zero_sums();
+      add_back(*F.slots, out, F.pass);
+    }
+    for (const Sum& q : sums) {
+      if (q.pass != F.pass) continue;
+      const std::vector<double>& want = fref.*q.v;
+      const std::vector<double>& got = out.*q.v;
+      // per component (the shifting's sums interleave 2 or 4 components)
+      const int nc = static_cast<int>(want.size()) / fa.n;
+      for (int c = 0; c < nc; ++c) {
+        double scale = 0, diff = 0;
+        for (int i = 0; i < fa.n; ++i)
+          scale = std::max(scale, std::fabs(want[nc * i + c])), diff = std::max(diff, std::fabs(got[nc * i + c] - want[nc * i + c]));
+        const double rel = scale > 0 ? diff / scale : diff;
+        worst[k] = std::max(worst[k], rel);
+        if (!(rel <= 1e-12)) {
+          std::printf("FAILED: form %s, sum %s[%d]: max |X - a| / max |a| = %.3g > 1e-12\n", F.name.c_str(), q.name, c, rel);
+          bad = 1;
+        }
       }
     }
-    if (F.name != "a" && F.in != pairs) {
+    if (F.slots && F.in != pairs) {
       std::printf("FAILED: form %s's registers hold %ld of the %ld pairs within the support\n", F.name.c_str(), F.in, pairs);
       bad = 1;
     }
   }
-  // The per-evaluation pieces of the tiles (gathers of the 9 fields, boxes, pruning, adds).
-  double t_pieces4 = 1e30, t_pieces8 = 1e30, t_add4 = 1e30, t_add8 = 1e30;
+  // Timing: per round every form (its tiles only: the pieces are timed apart), interleaved.
+  double t_pieces[2][2], t_add[2][2];  // [layout 4, 8][pass]
+  for (auto& a : t_pieces) a[0] = a[1] = 1e30;
+  for (auto& a : t_add) a[0] = a[1] = 1e30;
+  bool pass_used[2] = {false, false};
+  for (const Form& F : forms) pass_used[F.pass] = true;
   Fluid scratch = fa;
   for (int r = 0; r < reps; ++r) {
     for (std::size_t k = 0; k < forms.size(); ++k) {
       Form& F = forms[k];
+      if (F.slots) evaluate_pieces(*F.slots, F.halves, F.pass);
       const double t0 = cpu_now();
       for (int w = 0; w < sweeps; ++w) F.run();
       F.times.push_back((cpu_now() - t0) / sweeps);
     }
-    double t0 = cpu_now();
-    for (int w = 0; w < sweeps; ++w) evaluate_pieces(s4, false);
-    t_pieces4 = std::min(t_pieces4, (cpu_now() - t0) / sweeps);
-    t0 = cpu_now();
-    for (int w = 0; w < sweeps; ++w) evaluate_pieces(s8, true);
-    t_pieces8 = std::min(t_pieces8, (cpu_now() - t0) / sweeps);
-    t0 = cpu_now();
-    for (int w = 0; w < sweeps; ++w) add_back(s4, scratch);
-    t_add4 = std::min(t_add4, (cpu_now() - t0) / sweeps);
-    t0 = cpu_now();
-    for (int w = 0; w < sweeps; ++w) add_back(s8, scratch);
-    t_add8 = std::min(t_add8, (cpu_now() - t0) / sweeps);
+    for (int pass = 0; pass < 2; ++pass) {
+      if (!pass_used[pass]) continue;
+      for (int l = 0; l < 2; ++l) {
+        Slots& s = l ? s8 : s4;
+        double t0 = cpu_now();
+        for (int w = 0; w < sweeps; ++w) evaluate_pieces(s, l == 1, pass);
+        t_pieces[l][pass] = std::min(t_pieces[l][pass], (cpu_now() - t0) / sweeps);
+        t0 = cpu_now();
+        for (int w = 0; w < sweeps; ++w) add_back(s, scratch, pass);
+        t_add[l][pass] = std::min(t_add[l][pass], (cpu_now() - t0) / sweeps);
+      }
+    }
   }
   const double clock = clock_estimate();
-  std::printf("per evaluation besides the tiles: width 4 layout %.2f us (positions, 7 fields, boxes, pruning, sums zeroed) + %.2f us"
-              " (5 sums added back); width 8 %.2f + %.2f us (with t4x8's half list)\n",
-              1e6 * t_pieces4, 1e6 * t_add4, 1e6 * t_pieces8, 1e6 * t_add8);
+  for (int pass = 0; pass < 2; ++pass)
+    if (pass_used[pass])
+      std::printf("per evaluation besides the tiles, %s: width 4 layout %.2f us (positions, %d fields, boxes, pruning, slot sums"
+                  " zeroed) + %.2f us (%d sums added back); width 8 %.2f + %.2f us (with t4x8's half list)\n",
+                  pass ? "the shifting pass" : "the rates", 1e6 * t_pieces[0][pass], pass ? 6 : 7, 1e6 * t_add[0][pass],
+                  pass ? NSS : NS, 1e6 * t_pieces[1][pass], 1e6 * t_add[1][pass]);
   std::printf("clock while running 512-bit FMAs: %.2f GHz; %d sweeps per rep, %d reps interleaved, thread CPU time\n\n",
               clock * 1e-9, sweeps, reps);
   std::printf("%-10s %11s %11s %9s %12s %12s %10s %10s %10s %12s\n", "form", "us/sweep", "median", "of (a)", "M pairs/s",
               "ns/pair", "regs/part", "lanes in", "cyc/reg", "max rel diff");
-  double ta = 0;
+  double ta[2] = {0, 0};
   for (Form& F : forms)
-    if (F.name == "a") ta = *std::min_element(F.times.begin(), F.times.end());
+    if (!F.slots) ta[F.pass] = *std::min_element(F.times.begin(), F.times.end());
   for (std::size_t k = 0; k < forms.size(); ++k) {
     const Form& F = forms[k];
     const double tmin = *std::min_element(F.times.begin(), F.times.end());
     char regs[32] = "-", lanes[32] = "-", cyc[32] = "-";
-    if (F.name != "a") {
+    if (F.slots) {
       std::snprintf(regs, sizeof regs, "%.2f", double(F.regs_pair) / fa.n);
       std::snprintf(lanes, sizeof lanes, "%.1f%%", 100.0 * F.in / (8.0 * F.regs_pair));
       std::snprintf(cyc, sizeof cyc, "%.1f", tmin * clock / F.regs_pair);
     }
     std::printf("%-10s %11.2f %11.2f %9.3f %12.1f %12.2f %10s %10s %10s %12.2e\n", F.name.c_str(), 1e6 * tmin,
-                1e6 * median(F.times), ta > 0 ? tmin / ta : 0.0, 2.0 * pairs / tmin * 1e-6, 1e9 * tmin / pairs, regs, lanes,
-                cyc, worst[k]);
+                1e6 * median(F.times), ta[F.pass] > 0 ? tmin / ta[F.pass] : 0.0, 2.0 * pairs / tmin * 1e-6,
+                1e9 * tmin / pairs, regs, lanes, cyc, worst[k]);
   }
-  std::printf("(M pairs/s: ordered pairs within the support; ns/pair: per pair evaluated once; regs/part: registers with a"
-              " pair computed per particle; cyc/reg: real cycles per register computed)\n");
+  std::printf("(forms s...: the shifting pass; M pairs/s: ordered pairs within the support; ns/pair: per pair evaluated once;"
+              " regs/part: registers with a pair computed per particle; cyc/reg: real cycles per register computed)\n");
   if (bad) return 1;
   std::printf("OK: every form within 1e-12 of form (a), every pair within the support in the tiles\n");
   return 0;
