@@ -175,6 +175,67 @@ static inline void XSPHCorrection_loop_sums(int d_idx, int s_idx, double t, doub
   
 }
 
+// ---- The own effects' rates add FourtakasDensityDiffusion (`sphc examples/dambreak.sph
+// --emit=cpp`, main 9996b02; the other bodies of that loop are the ones above, the same text) ----
+static inline void FourtakasDensityDiffusion_initialize(int d_idx, double t, double dt, double B, double* d_bpinv, const double* d_p, const double* d_rho, double* d_rhoeos) {
+    double base = 1.0 + d_p[d_idx] / B;
+    d_rhoeos[d_idx] = base > 0.0 ? d_rho[d_idx] : 0.0;
+    d_bpinv[d_idx] = base > 0.0 ? 1.0 / (B * base) : 0.0;
+  
+}
+
+static inline double FourtakasDensityDiffusion_loop_hoisted0(int s_idx, const double* s_m, const double* s_rho) {
+  return s_m[s_idx] / s_rho[s_idx];
+}
+
+// equation FourtakasDensityDiffusion, method loop, from delta_sph.sph:146: a value the pair shares, negated for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+//   -rho0 * (gx * XIJ[0] + gy * XIJ[1])
+static inline double FourtakasDensityDiffusion_loop_pairshared0(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* DWIJ, double R2IJ, double HIJ, double delta, double c0, double rho0, double gx, double gy, double gz, double B, double invgamma, double s2, const double* d_bpinv, const double* d_p, const double* d_rhoeos, const double* s_m, const double* s_rho, const double* s_hoisted0) {
+  return -rho0 * std::fma(gx, XIJ[0], gy * XIJ[1]);
+}
+
+// equation FourtakasDensityDiffusion, method loop, from delta_sph.sph:146: a value the pair shares, the same for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+//   -(XIJ[0] * DWIJ[0] + XIJ[1] * DWIJ[1])
+static inline double FourtakasDensityDiffusion_loop_pairshared1(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* DWIJ, double R2IJ, double HIJ, double delta, double c0, double rho0, double gx, double gy, double gz, double B, double invgamma, double s2, const double* d_bpinv, const double* d_p, const double* d_rhoeos, const double* s_m, const double* s_rho, const double* s_hoisted0) {
+  return -std::fma(XIJ[0], DWIJ[0], XIJ[1] * DWIJ[1]);
+}
+
+// equation FourtakasDensityDiffusion, method loop, from delta_sph.sph:146: a value the pair shares, the same for the mirrored pair (once per pair
+// where each pair is evaluated once; codegen/PairShared.cpp; --pair-shared-values=off: in each call)
+//   delta * HIJ * c0 * 2.0
+static inline double FourtakasDensityDiffusion_loop_pairshared2(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* DWIJ, double R2IJ, double HIJ, double delta, double c0, double rho0, double gx, double gy, double gz, double B, double invgamma, double s2, const double* d_bpinv, const double* d_p, const double* d_rhoeos, const double* s_m, const double* s_rho, const double* s_hoisted0) {
+  return delta * HIJ * c0 * 2.0;
+}
+
+// equation FourtakasDensityDiffusion, method loop, from delta_sph.sph:146: the destination's sums in locals (acc_NAME, accK_NAME: component K;
+// codegen/RegisterSums.cpp)
+static inline void FourtakasDensityDiffusion_loop_sums(int d_idx, int s_idx, double t, double dt, const double* XIJ, const double* DWIJ, double R2IJ, double HIJ, double delta, double c0, double rho0, double gx, double gy, double gz, double B, double invgamma, double s2, double& acc_arho, const double* d_bpinv, const double* d_p, const double* d_rhoeos, const double* s_m, const double* s_rho, const double* s_hoisted0, double pair_shared0, double pair_shared1, double pair_shared2) {
+    if (R2IJ > 0.0) {
+      double vb = s_hoisted0[s_idx];
+      // x_b - x_a = -XIJ
+      double dph = pair_shared0;
+      // rho^H_b|a = rho0 (1 + (p_a + dph) / B)^(1/gamma) = rho^EOS_a (1 + x)^(1/gamma),
+      // x = dph / (B + p_a): |x| <= rho0 |g| 2h / B, 1.4e-3 in the dam break at dx = 0.03.
+      // Below |x| = 0.01 the series to x^2 (error below 0.038 |x|^3 / (1 - |x|)^3 relative:
+      // 4e-8 at 0.01, 1e-10 in the dam break); beyond it (never in a weakly compressible
+      // run: it needs dph above 1% of B) the power itself.
+      double x = dph * d_bpinv[d_idx];
+      double rhoh = 0.0;
+      if (fabs(x) < 0.01) {
+        rhoh = d_rhoeos[d_idx] * std::fma(x, std::fma(s2, x, invgamma), 1.0);
+      } else {
+        double base = 1.0 + (d_p[d_idx] + dph) / B;
+        rhoh = base > 0.0 ? rho0 * pow(base, invgamma) : 0.0;
+      }
+      double rhoba = s_rho[s_idx] - rhoh;
+      double xdotdw = pair_shared1;
+      acc_arho = std::fma(pair_shared2 * rhoba * xdotdw / R2IJ, vb, acc_arho);
+    }
+  
+}
+
 // ---- The shifting pass's bodies: the generated C++ of examples/dambreak.sph (its own effects:
 // `sphc examples/dambreak.sph --emit=cpp`, main 9996b02), verbatim ----
 static inline double KERNEL_W(double r, double h) { return Kernel::w(r, h); }
@@ -280,6 +341,14 @@ struct Eq6 {
 struct Eq7 {
   static constexpr double eps = (0.5);
 };
+struct Eq8 {  // FourtakasDensityDiffusion(dest = fluid): the scene's values (dambreak.sph)
+  double delta = 0.1, c0 = 10.0 * std::sqrt(2.0 * 9.81 * 2.0), rho0 = 1000.0;
+  static constexpr double gamma = (7.0);
+  static constexpr double gx = (0.0);
+  double gy = -9.81;
+  static constexpr double gz = (0.0);
+  double B = rho0 * c0 * c0 / gamma, invgamma = 1.0 / gamma, s2 = (0.5 / gamma) * ((1.0 / gamma) - 1.0);
+};
 struct Eq11 {  // DeltaPlusShiftingSums(dest = fluid): the scene's values
   static constexpr double R = (0.2);
   double hdx = 1.3;
@@ -295,6 +364,8 @@ struct Fluid {
   // (components interleaved as the solver stores them: binv 4, gradc 2, gradcw 2, gradrhos 2,
   // gradu 4 per particle).
   std::vector<double> vb, dh;
+  // The own effects' rates: FourtakasDensityDiffusion's per-particle values (its initialize).
+  std::vector<double> rhoeos, bpinv;
   std::vector<double> binv, gradc, gradcw, gradrhos, gradu;
   void zero_sums() {
     for (auto* s : {&arho, &au, &av, &ax, &ay}) s->assign(n, 0.0);
@@ -347,9 +418,11 @@ Kept build_kept(const Fluid& f, double skin) {
   return k;
 }
 
-// ---- Form (a): the generated each-pair-once loop, verbatim (the pass's fluid <- fluid loop) ----
+// ---- Form (a): the generated each-pair-once loop, verbatim (the pass's fluid <- fluid loop);
+// OWN: the own effects' loop, the same with FourtakasDensityDiffusion's lines (`if constexpr`) ----
+template <bool OWN = false>
 __attribute__((noinline)) void form_a(Fluid& fluid, const Kept& verlet_fluid_fluid, const Eq6& eq6, const Eq7& eq7,
-                                      std::vector<double>& dhoist_eq4_0) {
+                                      std::vector<double>& dhoist_eq4_0, const Eq8& eq8 = Eq8()) {
   const double t = 0.0, dt = 0.0;
   const int n = fluid.n;
   const double* di_x = fluid.x.data();
@@ -377,6 +450,9 @@ __attribute__((noinline)) void form_a(Fluid& fluid, const Kept& verlet_fluid_flu
   double* d_ax = fluid.ax.data();
   double* d_ay = fluid.ay.data();
   const double* hoisted_eq4_0 = fluid.hoisted.data();
+  const double* hoisted_eq8_0 = fluid.vb.data();  // FourtakasDensityDiffusion: s_m[s_idx] / s_rho[s_idx]
+  const double* d_bpinv = fluid.bpinv.data();
+  const double* d_rhoeos = fluid.rhoeos.data();
         dhoist_eq4_0.resize(n);
         double* const dhoisted_all_eq4_0 = dhoist_eq4_0.data();
         for (int d_idx = 0; d_idx < n; ++d_idx) {
@@ -425,10 +501,18 @@ __attribute__((noinline)) void form_a(Fluid& fluid, const Kept& verlet_fluid_flu
             const double pshared_eq4_0 = PressureGradient_loop_pairshared0(d_idx, s_idx, t, dt, DWIJ, d_p, d_rho, s_m, s_p, s_rho, hoisted_eq4_0, dhoisted_eq4_0);  // PressureGradient: the same for (s_idx, d_idx)
             const double pshared_eq6_0 = MonaghanArtificialViscosity_loop_pairshared0(d_idx, s_idx, t, dt, XIJ, VIJ, DWIJ, R2IJ, HIJ, RHOIJ1, EPS, eq6.alpha, eq6.beta, d_cs, s_cs, s_m);  // MonaghanArtificialViscosity: the same for (s_idx, d_idx)
             const double pshared_eq6_1 = MonaghanArtificialViscosity_loop_pairshared1(d_idx, s_idx, t, dt, XIJ, VIJ, DWIJ, R2IJ, HIJ, RHOIJ1, EPS, eq6.alpha, eq6.beta, d_cs, s_cs, s_m);  // MonaghanArtificialViscosity: the same for (s_idx, d_idx)
+            double pshared_eq8_0 = 0, pshared_eq8_1 = 0, pshared_eq8_2 = 0;
+            if constexpr (OWN) {
+            pshared_eq8_0 = FourtakasDensityDiffusion_loop_pairshared0(d_idx, s_idx, t, dt, XIJ, DWIJ, R2IJ, HIJ, eq8.delta, eq8.c0, eq8.rho0, eq8.gx, eq8.gy, eq8.gz, eq8.B, eq8.invgamma, eq8.s2, d_bpinv, d_p, d_rhoeos, s_m, s_rho, hoisted_eq8_0);  // FourtakasDensityDiffusion: minus this for (s_idx, d_idx)
+            pshared_eq8_1 = FourtakasDensityDiffusion_loop_pairshared1(d_idx, s_idx, t, dt, XIJ, DWIJ, R2IJ, HIJ, eq8.delta, eq8.c0, eq8.rho0, eq8.gx, eq8.gy, eq8.gz, eq8.B, eq8.invgamma, eq8.s2, d_bpinv, d_p, d_rhoeos, s_m, s_rho, hoisted_eq8_0);  // FourtakasDensityDiffusion: the same for (s_idx, d_idx)
+            pshared_eq8_2 = FourtakasDensityDiffusion_loop_pairshared2(d_idx, s_idx, t, dt, XIJ, DWIJ, R2IJ, HIJ, eq8.delta, eq8.c0, eq8.rho0, eq8.gx, eq8.gy, eq8.gz, eq8.B, eq8.invgamma, eq8.s2, d_bpinv, d_p, d_rhoeos, s_m, s_rho, hoisted_eq8_0);  // FourtakasDensityDiffusion: the same for (s_idx, d_idx)
+            }
             ContinuityEquation_loop_sums(d_idx, s_idx, t, dt, VIJ, DWIJ, acc_arho, s_m, pshared_eq2_0);  // ContinuityEquation, from wcsph_scheme.sph:140
             PressureGradient_loop_sums(d_idx, s_idx, t, dt, DWIJ, acc_au, acc_av, d_p, d_rho, s_m, s_p, s_rho, hoisted_eq4_0, dhoisted_eq4_0, pshared_eq4_0);  // PressureGradient, from wcsph_scheme.sph:142
             MonaghanArtificialViscosity_loop_sums(d_idx, s_idx, t, dt, XIJ, VIJ, DWIJ, R2IJ, HIJ, RHOIJ1, EPS, eq6.alpha, eq6.beta, acc_au, acc_av, d_cs, s_cs, s_m, pshared_eq6_0, pshared_eq6_1);  // MonaghanArtificialViscosity, from wcsph_scheme.sph:147
             XSPHCorrection_loop_sums(d_idx, s_idx, t, dt, VIJ, WIJ, RHOIJ1, eq7.eps, acc_ax, acc_ay, s_m);  // XSPHCorrection, from wcsph_scheme.sph:160
+            if constexpr (OWN)
+            FourtakasDensityDiffusion_loop_sums(d_idx, s_idx, t, dt, XIJ, DWIJ, R2IJ, HIJ, eq8.delta, eq8.c0, eq8.rho0, eq8.gx, eq8.gy, eq8.gz, eq8.B, eq8.invgamma, eq8.s2, acc_arho, d_bpinv, d_p, d_rhoeos, s_m, s_rho, hoisted_eq8_0, pshared_eq8_0, pshared_eq8_1, pshared_eq8_2);  // FourtakasDensityDiffusion, from wcsph_scheme.sph:176
             // the same pair for particle s_idx
             // s_idx's sums in locals for its calls (codegen/SymmetricPairs.cpp)
             double m_acc_arho = d_arho[s_idx];
@@ -440,6 +524,8 @@ __attribute__((noinline)) void form_a(Fluid& fluid, const Kept& verlet_fluid_flu
             PressureGradient_loop_sums(s_idx, d_idx, t, dt, DWIJ_ji, m_acc_au, m_acc_av, d_p, d_rho, s_m, s_p, s_rho, hoisted_eq4_0, dhoisted_all_eq4_0[s_idx], pshared_eq4_0);  // PressureGradient, from wcsph_scheme.sph:142: destination s_idx, source d_idx
             MonaghanArtificialViscosity_loop_sums(s_idx, d_idx, t, dt, XIJ_ji, VIJ_ji, DWIJ_ji, R2IJ, HIJ, RHOIJ1, EPS, eq6.alpha, eq6.beta, m_acc_au, m_acc_av, d_cs, s_cs, s_m, pshared_eq6_0, pshared_eq6_1);  // MonaghanArtificialViscosity, from wcsph_scheme.sph:147: destination s_idx, source d_idx
             XSPHCorrection_loop_sums(s_idx, d_idx, t, dt, VIJ_ji, WIJ, RHOIJ1, eq7.eps, m_acc_ax, m_acc_ay, s_m);  // XSPHCorrection, from wcsph_scheme.sph:160: destination s_idx, source d_idx
+            if constexpr (OWN)
+            FourtakasDensityDiffusion_loop_sums(s_idx, d_idx, t, dt, XIJ_ji, DWIJ_ji, R2IJ, HIJ, eq8.delta, eq8.c0, eq8.rho0, eq8.gx, eq8.gy, eq8.gz, eq8.B, eq8.invgamma, eq8.s2, m_acc_arho, d_bpinv, d_p, d_rhoeos, s_m, s_rho, hoisted_eq8_0, -pshared_eq8_0, pshared_eq8_1, pshared_eq8_2);  // FourtakasDensityDiffusion, from wcsph_scheme.sph:176: destination s_idx, source d_idx
             d_arho[s_idx] = m_acc_arho;
             d_au[s_idx] = m_acc_au;
             d_av[s_idx] = m_acc_av;
@@ -619,9 +705,11 @@ inline V rsqrt(V x) {
 enum Arith { EXACT = 0, RCP = 1 };
 // The fields the tiles read: x y u v h rho m cs hoisted (p / rho^2) for the rates; x y u v h
 // rho vb (m / rho) dh for the shifting pass.
-enum Field { FX, FY, FU, FV, FH, FRHO, FM, FCS, FHO, FVB, FDH, NF };
+// The own effects' rates add vb (m / rho), rhoeos, bpinv and p (the density diffusion's).
+enum Field { FX, FY, FU, FV, FH, FRHO, FM, FCS, FHO, FVB, FDH, FREOS, FBPI, FP, NF };
 constexpr int RATES_FIELDS[] = {FX, FY, FU, FV, FH, FRHO, FM, FCS, FHO};
 constexpr int SHIFT_FIELDS[] = {FX, FY, FU, FV, FH, FRHO, FVB, FDH};
+constexpr int OWN_FIELDS[] = {FX, FY, FU, FV, FH, FRHO, FM, FCS, FHO, FVB, FREOS, FBPI, FP};
 constexpr int NS = 5;    // the rates' sums: arho au av ax ay
 constexpr int NSS = 14;  // the shifting's: binv 0-3, gradc 4-5, gradcw 6-7, gradrhos 8-9, gradu 10-13
 
@@ -649,9 +737,11 @@ inline V jval(const double* F, int j0) {
 // j-clusters of CJ = the layout's width, registers of RI = 8 / CJ i's. `list`: per i-cluster
 // (of CI slots: for CI < CJ, cluster ci of the list's own numbering, ci * CI its first slot)
 // its j-clusters.
-template <int CI, int CJ, int ARITH>
+// OWN: the own effects' rates (+ FourtakasDensityDiffusion: its series in the lanes; a lane
+// whose |x| >= 0.01, never in a weakly compressible run, takes the power in a scalar fallback).
+template <int CI, int CJ, int ARITH, bool OWN = false>
 __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>& begin, const std::vector<std::uint32_t>& jl,
-                                      const Eq6& eq6, const Eq7& eq7) {
+                                      const Eq6& eq6, const Eq7& eq7, const Eq8& eq8 = Eq8()) {
   constexpr int RI = 8 / CJ;
   const double sigma = Kernel::sigma;
   const V one = bc(1.0), half = bc(0.5), two = bc(2.0), zero = _mm512_setzero_pd();
@@ -660,6 +750,21 @@ __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>
   const double *X = S.f[0].data(), *Y = S.f[1].data(), *U = S.f[2].data(), *VV = S.f[3].data();
   const double *H = S.f[4].data(), *RHO = S.f[5].data(), *MS = S.f[6].data(), *CS = S.f[7].data();
   const double* HO = S.f[8].data();
+  const double *VB = S.f[FVB].data(), *REOS = S.f[FREOS].data(), *BPI = S.f[FBPI].data(), *PP = S.f[FP].data();
+  const V neg_rho0 = bc(-eq8.rho0), gxv = bc(eq8.gx), gyv = bc(eq8.gy), deltav = bc(eq8.delta), c0v = bc(eq8.c0);
+  const V s2v = bc(eq8.s2), invgv = bc(eq8.invgamma), lim = bc(0.01);
+  // rhoh of the lanes in `big` by the power (the body's else branch), scalar.
+  auto fallback = [&](M big, V rhoh, V dph, const double* p_of_lane) -> V {
+    alignas(64) double r[8], d[8];
+    _mm512_store_pd(r, rhoh);
+    _mm512_store_pd(d, dph);
+    for (int l = 0; l < 8; ++l)
+      if (big >> l & 1) {
+        const double base = 1.0 + (p_of_lane[l] + d[l]) / eq8.B;
+        r[l] = base > 0.0 ? eq8.rho0 * pow(base, eq8.invgamma) : 0.0;
+      }
+    return _mm512_load_pd(r);
+  };
   double* SUM[NS];
   for (int k = 0; k < NS; ++k) SUM[k] = S.s[k].data();
   // Lane l of a register: its i is the register's first i + l / CJ, its j the j-cluster's
@@ -678,6 +783,8 @@ __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>
       const V xj = jval<CJ>(X, j0), yj = jval<CJ>(Y, j0), uj = jval<CJ>(U, j0), vj = jval<CJ>(VV, j0);
       const V hj = jval<CJ>(H, j0), rhoj = jval<CJ>(RHO, j0), mj = jval<CJ>(MS, j0), csj = jval<CJ>(CS, j0);
       const V hoj = jval<CJ>(HO, j0);
+      V vbj = zero, reosj = zero, bpij = zero;
+      if (OWN) vbj = jval<CJ>(VB, j0), reosj = jval<CJ>(REOS, j0), bpij = jval<CJ>(BPI, j0);
       const V neg_mj = sub(zero, mj);  // -s_m[s_idx]
       const V neg_eps_mj = mul(neg_eps, mj);  // -eps * s_m[s_idx]
       V jacc[NS];
@@ -754,6 +861,36 @@ __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>
         jacc[2] = _mm512_mask3_fnmadd_pd(gv, DWIJ_1, _mm512_mask3_fnmadd_pd(gp, DWIJ_1, jacc[2], in), in);
         jacc[3] = _mm512_mask3_fnmadd_pd(gx, VIJ_0, jacc[3], in);
         jacc[4] = _mm512_mask3_fnmadd_pd(gx, VIJ_1, jacc[4], in);
+        if (OWN) {  // FourtakasDensityDiffusion, after the continuity's term on arho (as (a))
+          const M pos = in & _mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ);
+          const V dph = mul(neg_rho0, fma(gxv, XIJ_0, mul(gyv, XIJ_1)));
+          const V xdw = neg(fma(XIJ_0, DWIJ_0, mul(XIJ_1, DWIJ_1)));
+          const V ps2f = mul(mul(mul(deltav, HIJ), c0v), two);
+          const V r2inv = ARITH == EXACT ? zero : rcp(R2IJ);
+          // i's term: dph, i's bpinv and rhoeos, source j
+          const V xi_ = mul(dph, ival<RI>(BPI, i));
+          V rhoh_i = mul(ival<RI>(REOS, i), fma(xi_, fma(s2v, xi_, invgv), one));
+          const M big_i = pos & _mm512_cmp_pd_mask(_mm512_abs_pd(xi_), lim, _CMP_NLT_UQ);
+          if (big_i) {
+            alignas(64) double pl[8];
+            _mm512_store_pd(pl, ival<RI>(PP, i));
+            rhoh_i = fallback(big_i, rhoh_i, dph, pl);
+          }
+          const V ti = mul(mul(ps2f, sub(rhoj, rhoh_i)), xdw);
+          ia[0] = _mm512_mask3_fmadd_pd(ARITH == EXACT ? div(ti, R2IJ) : mul(ti, r2inv), vbj, ia[0], pos);
+          // j's term: -dph, j's bpinv and rhoeos, source i
+          const V ndph = neg(dph);
+          const V xj_ = mul(ndph, bpij);
+          V rhoh_j = mul(reosj, fma(xj_, fma(s2v, xj_, invgv), one));
+          const M big_j = pos & _mm512_cmp_pd_mask(_mm512_abs_pd(xj_), lim, _CMP_NLT_UQ);
+          if (big_j) {
+            alignas(64) double pl[8];
+            _mm512_store_pd(pl, jval<CJ>(PP, j0));
+            rhoh_j = fallback(big_j, rhoh_j, ndph, pl);
+          }
+          const V tj = mul(mul(ps2f, sub(ival<RI>(RHO, i), rhoh_j)), xdw);
+          jacc[0] = _mm512_mask3_fmadd_pd(ARITH == EXACT ? div(tj, R2IJ) : mul(tj, r2inv), ival<RI>(VB, i), jacc[0], pos);
+        }
       }
       if (CJ == 8) {
         for (int k = 0; k < NS; ++k) _mm512_storeu_pd(SUM[k] + j0, add(_mm512_loadu_pd(SUM[k] + j0), jacc[k]));
@@ -983,6 +1120,10 @@ Fluid make_fluid(const std::string& path, int nx, int ny, double dx, double hdx,
   f.vb.resize(f.n);
   for (int i = 0; i < f.n; ++i) f.vb[i] = DeltaPlusShiftingSums_loop_hoisted0(i, f.m.data(), f.rho.data());
   f.dh.assign(f.n, DeltaPlusShiftingSums_loop_dhoisted0(0, hdx));
+  const Eq8 eq8;
+  f.rhoeos.resize(f.n), f.bpinv.resize(f.n);
+  for (int i = 0; i < f.n; ++i)
+    FourtakasDensityDiffusion_initialize(i, 0.0, 0.0, eq8.B, f.bpinv.data(), f.p.data(), f.rho.data(), f.rhoeos.data());
   f.zero_sums();
   return f;
 }
@@ -995,7 +1136,7 @@ double median(std::vector<double> v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string positions, forms_arg = "a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp,sa,st4x4,st4x8,st8x8,st4x4rcp,st8x8rcp";
+  std::string positions, forms_arg = "a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp,sa,st4x4,st4x8,st8x8,st4x4rcp,st8x8rcp,oa,ot4x4,ot8x8,ot4x4rcp,ot8x8rcp";
   int nx = 33, ny = 66, reps = 7, sweeps = 0;
   double dx = 0.03, hdx = 1.3, pert = 0.1, skin = 0.1;
   for (int k = 1; k < argc; ++k) {
@@ -1062,8 +1203,10 @@ int main(int argc, char** argv) {
   // lists, built once (a rebuild); the per-evaluation pieces timed below.
   const Eq11 eq11{hdx};
   Slots s4, s8;
-  const double* P[NF] = {fa.x.data(), fa.y.data(), fa.u.data(),       fa.v.data(),  fa.h.data(), fa.rho.data(),
-                         fa.m.data(), fa.cs.data(), fa.hoisted.data(), fa.vb.data(), fa.dh.data()};
+  const Eq8 eq8;
+  const double* P[NF] = {fa.x.data(),  fa.y.data(),       fa.u.data(),  fa.v.data(),  fa.h.data(),
+                         fa.rho.data(), fa.m.data(),      fa.cs.data(), fa.hoisted.data(), fa.vb.data(),
+                         fa.dh.data(), fa.rhoeos.data(), fa.bpinv.data(), fa.p.data()};
   for (Slots* s : {&s4, &s8}) {
     const int w = s == &s4 ? 4 : 8;
     sphc::build_cluster_layout(s->L, fa.x.data(), fa.y.data(), nullptr, fa.n, 2, sphc::cluster_column_side(dx, 2, w), w);
@@ -1075,7 +1218,7 @@ int main(int argc, char** argv) {
   // t4x8's list: the halves of the 8-clusters, each against the j-clusters of its 8-cluster's
   // pruned list whose boxes lie within the support of the half's own box.
   std::vector<std::uint32_t> half_begin, half_j;
-  // Per evaluation (pass 0: the rates, 1: the shifting): the positions and the pass's fields
+  // Per evaluation (pass 0: the rates, 1: the shifting, 2: the own rates): the positions and the pass's fields
   // into slot order, the boxes, the pruned list (t4x8: its half list), the slot sums zeroed.
   auto evaluate_pieces = [&](Slots& s, bool halves, int pass) {
     sphc::gather_positions(s.L, fa.x.data(), fa.y.data(), nullptr, s.f[FX].data(), s.f[FY].data(), nullptr, 4 * rlist);
@@ -1083,13 +1226,17 @@ int main(int argc, char** argv) {
       for (int k : RATES_FIELDS) {
         if (k != FX && k != FY) sphc::gather_slots(s.L, P[k], s.f[k].data());
       }
-    else
+    else if (pass == 1)
       for (int k : SHIFT_FIELDS) {
+        if (k != FX && k != FY) sphc::gather_slots(s.L, P[k], s.f[k].data());
+      }
+    else
+      for (int k : OWN_FIELDS) {
         if (k != FX && k != FY) sphc::gather_slots(s.L, P[k], s.f[k].data());
       }
     sphc::update_boxes(s.L, s.f[FX].data(), s.f[FY].data(), nullptr);
     sphc::prune_cluster_pairs(s.L, s.L, s.outer, support, s.pruned);
-    if (pass == 0)
+    if (pass != 1)
       for (auto& v : s.s) std::fill(v.begin(), v.end(), 0.0);
     else
       for (auto& v : s.ss) std::fill(v.begin(), v.end(), 0.0);
@@ -1121,7 +1268,7 @@ int main(int argc, char** argv) {
   };
   // The slot sums added back onto the particles' sums (the shifting's components interleaved).
   auto add_back = [&](Slots& s, Fluid& out, int pass) {
-    if (pass == 0) {
+    if (pass != 1) {
       std::vector<double>* dst[NS] = {&out.arho, &out.au, &out.av, &out.ax, &out.ay};
       for (int k = 0; k < NS; ++k) sphc::add_slots(s.L, s.s[k].data(), dst[k]->data());
       return;
@@ -1175,13 +1322,18 @@ int main(int argc, char** argv) {
   auto add_form = [&](const std::string& full) {
     Form F;
     F.name = full;
-    F.pass = full[0] == 's' ? 1 : 0;
+    F.pass = full[0] == 's' ? 1 : full[0] == 'o' ? 2 : 0;
     const std::string name = F.pass ? full.substr(1) : full;
     if (name == "a") {
       if (F.pass == 0)
         F.run = [&] {
           fa.zero_sums();
           form_a(fa, kept, eq6, eq7, dhoist);
+        };
+      else if (F.pass == 2)
+        F.run = [&] {
+          fa.zero_sums();
+          form_a<true>(fa, kept, eq6, eq7, dhoist, eq8);
         };
       else
         F.run = [&] {
@@ -1202,7 +1354,7 @@ int main(int argc, char** argv) {
     F.halves = shape == "t4x8";
     const int pass = F.pass;
     auto zero = [s, pass] {
-      if (pass)
+      if (pass == 1)
         for (auto& v : s->ss) std::fill(v.begin(), v.end(), 0.0);
       else
         for (auto& v : s->s) std::fill(v.begin(), v.end(), 0.0);
@@ -1214,6 +1366,8 @@ int main(int argc, char** argv) {
   if (pass == 0 && !rcp) F.run = [=, &b, &j, &eq6, &eq7] { zero(); form_t<CI, CJ, EXACT>(*s, b, j, eq6, eq7); };   \
   if (pass == 1 && rcp) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, RCP>(*s, b, j, eq11); };         \
   if (pass == 1 && !rcp) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, EXACT>(*s, b, j, eq11); };      \
+  if (pass == 2 && rcp) F.run = [=, &b, &j, &eq6, &eq7, &eq8] { zero(); form_t<CI, CJ, RCP, true>(*s, b, j, eq6, eq7, eq8); }; \
+  if (pass == 2 && !rcp) F.run = [=, &b, &j, &eq6, &eq7, &eq8] { zero(); form_t<CI, CJ, EXACT, true>(*s, b, j, eq6, eq7, eq8); }; \
   count_regs(s->L, b, j, CI, CJ, F.regs, F.regs_pair, F.in);
     if (shape == "t4x4") { SPHC_FORM(4, 4) }
     if (shape == "t4x8") { SPHC_FORM(4, 8) }
@@ -1229,11 +1383,14 @@ int main(int argc, char** argv) {
       at = comma + 1;
     }
   }
-  // The references: form (a) of each pass once.
-  Fluid fref = fa;
+  // The references: form (a) of each pass once (fref: the rates and the shifting; fown: the
+  // own effects' rates).
+  Fluid fref = fa, fown = fa;
   fref.zero_sums();
   form_a(fref, kept, eq6, eq7, dhoist);
   form_a_shift(fref, kept, eq11, dhoist11);
+  fown.zero_sums();
+  form_a<true>(fown, kept, eq6, eq7, dhoist, eq8);
 
   // Sweeps per timed rep: ~20 ms of form (a) of the rates.
   if (sweeps <= 0) {
@@ -1266,8 +1423,8 @@ int main(int argc, char** argv) {
       add_back(*F.slots, out, F.pass);
     }
     for (const Sum& q : sums) {
-      if (q.pass != F.pass) continue;
-      const std::vector<double>& want = fref.*q.v;
+      if (q.pass != (F.pass == 2 ? 0 : F.pass)) continue;
+      const std::vector<double>& want = (F.pass == 2 ? fown : fref).*q.v;
       const std::vector<double>& got = out.*q.v;
       // per component (the shifting's sums interleave 2 or 4 components)
       const int nc = static_cast<int>(want.size()) / fa.n;
@@ -1289,10 +1446,10 @@ int main(int argc, char** argv) {
     }
   }
   // Timing: per round every form (its tiles only: the pieces are timed apart), interleaved.
-  double t_pieces[2][2], t_add[2][2];  // [layout 4, 8][pass]
-  for (auto& a : t_pieces) a[0] = a[1] = 1e30;
-  for (auto& a : t_add) a[0] = a[1] = 1e30;
-  bool pass_used[2] = {false, false};
+  double t_pieces[2][3], t_add[2][3];  // [layout 4, 8][pass]
+  for (auto& a : t_pieces) a[0] = a[1] = a[2] = 1e30;
+  for (auto& a : t_add) a[0] = a[1] = a[2] = 1e30;
+  bool pass_used[3] = {false, false, false};
   for (const Form& F : forms) pass_used[F.pass] = true;
   Fluid scratch = fa;
   for (int r = 0; r < reps; ++r) {
@@ -1303,7 +1460,7 @@ int main(int argc, char** argv) {
       for (int w = 0; w < sweeps; ++w) F.run();
       F.times.push_back((cpu_now() - t0) / sweeps);
     }
-    for (int pass = 0; pass < 2; ++pass) {
+    for (int pass = 0; pass < 3; ++pass) {
       if (!pass_used[pass]) continue;
       for (int l = 0; l < 2; ++l) {
         Slots& s = l ? s8 : s4;
@@ -1317,17 +1474,18 @@ int main(int argc, char** argv) {
     }
   }
   const double clock = clock_estimate();
-  for (int pass = 0; pass < 2; ++pass)
+  for (int pass = 0; pass < 3; ++pass)
     if (pass_used[pass])
       std::printf("per evaluation besides the tiles, %s: width 4 layout %.2f us (positions, %d fields, boxes, pruning, slot sums"
                   " zeroed) + %.2f us (%d sums added back); width 8 %.2f + %.2f us (with t4x8's half list)\n",
-                  pass ? "the shifting pass" : "the rates", 1e6 * t_pieces[0][pass], pass ? 6 : 7, 1e6 * t_add[0][pass],
-                  pass ? NSS : NS, 1e6 * t_pieces[1][pass], 1e6 * t_add[1][pass]);
+                  pass == 1 ? "the shifting pass" : pass == 2 ? "the own effects' rates" : "the rates (PySPH's effects)",
+                  1e6 * t_pieces[0][pass], pass == 1 ? 6 : pass == 2 ? 11 : 7, 1e6 * t_add[0][pass], pass == 1 ? NSS : NS,
+                  1e6 * t_pieces[1][pass], 1e6 * t_add[1][pass]);
   std::printf("clock while running 512-bit FMAs: %.2f GHz; %d sweeps per rep, %d reps interleaved, thread CPU time\n\n",
               clock * 1e-9, sweeps, reps);
   std::printf("%-10s %11s %11s %9s %12s %12s %10s %10s %10s %12s\n", "form", "us/sweep", "median", "of (a)", "M pairs/s",
               "ns/pair", "regs/part", "lanes in", "cyc/reg", "max rel diff");
-  double ta[2] = {0, 0};
+  double ta[3] = {0, 0, 0};
   for (Form& F : forms)
     if (!F.slots) ta[F.pass] = *std::min_element(F.times.begin(), F.times.end());
   for (std::size_t k = 0; k < forms.size(); ++k) {
@@ -1343,7 +1501,7 @@ int main(int argc, char** argv) {
                 1e6 * median(F.times), ta[F.pass] > 0 ? tmin / ta[F.pass] : 0.0, 2.0 * pairs / tmin * 1e-6,
                 1e9 * tmin / pairs, regs, lanes, cyc, worst[k]);
   }
-  std::printf("(forms s...: the shifting pass; M pairs/s: ordered pairs within the support; ns/pair: per pair evaluated once;"
+  std::printf("(forms s...: the shifting pass, o...: the own effects' rates; M pairs/s: ordered pairs within the support; ns/pair: per pair evaluated once;"
               " regs/part: registers with a pair computed per particle; cyc/reg: real cycles per register computed)\n");
   if (bad) return 1;
   std::printf("OK: every form within 1e-12 of form (a), every pair within the support in the tiles\n");
