@@ -802,7 +802,9 @@ __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>
         if (diagonal)
           in &= _mm512_cmpgt_epi64_mask(_mm512_add_epi64(lane_j, _mm512_set1_epi64(j0)),
                                         _mm512_add_epi64(lane_i, _mm512_set1_epi64(i)));
-        if (!in) continue;  // no pair of this register within the support
+#ifndef NO_REGSKIP
+        if (!in) continue;  // no pair of this register within the support (-DNO_REGSKIP: every register computed)
+#endif
         const V HIJ = mul(half, add(hi, hj));
         const V VIJ_0 = sub(ival<RI>(U, i), uj), VIJ_1 = sub(ival<RI>(VV, i), vj);
         // Kernel::w and gradient_pair (sphc/kernels.h: WendlandQuintic 2D, sigma / h^2 f(q))
@@ -951,7 +953,9 @@ __attribute__((noinline)) void form_t_shift(Slots& S, const std::vector<std::uin
         if (diagonal)
           in &= _mm512_cmpgt_epi64_mask(_mm512_add_epi64(lane_j, _mm512_set1_epi64(j0)),
                                         _mm512_add_epi64(lane_i, _mm512_set1_epi64(i)));
+#ifndef NO_REGSKIP
         if (!in) continue;
+#endif
         const V HIJ = mul(half, add(hi, hj));
         const V VIJ_0 = sub(ival<RI>(U, i), uj), VIJ_1 = sub(ival<RI>(VV, i), vj);
         V RIJ, ih, q, s_den_inv = zero;
