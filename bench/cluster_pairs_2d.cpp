@@ -1053,6 +1053,147 @@ __attribute__((noinline)) void form_t_shift(Slots& S, const std::vector<std::uin
   }
 }
 
+// The same, register-major: per i-cluster, per register (RI i's) its whole list, so that only one
+// register's 14 i sums are live (tile-major: all of the i-cluster's, 28 for 2xMM); the j sums
+// added to memory per register and tile (2xMM: the halves folded first).
+template <int CI, int CJ, int ARITH>
+__attribute__((noinline)) void form_t_shift_r(Slots& S, const std::vector<std::uint32_t>& begin,
+                                            const std::vector<std::uint32_t>& jl, const Eq11& eq11) {
+  constexpr int RI = 8 / CJ;
+  const double sigma = Kernel::sigma;
+  const V one = bc(1.0), half = bc(0.5), two = bc(2.0), zero = _mm512_setzero_pd();
+  const V radius2 = bc(RADIUS2), tiny = bc(1e-12), m5 = bc(-5.0), R = bc(eq11.R);
+  const double *X = S.f[FX].data(), *Y = S.f[FY].data(), *U = S.f[FU].data(), *VV = S.f[FV].data();
+  const double *H = S.f[FH].data(), *RHO = S.f[FRHO].data(), *VB = S.f[FVB].data(), *DH = S.f[FDH].data();
+  double* SUM[NSS];
+  for (int k = 0; k < NSS; ++k) SUM[k] = S.ss[k].data();
+  const __m512i lane_i = RI == 1 ? _mm512_setzero_si512() : _mm512_set_epi64(1, 1, 1, 1, 0, 0, 0, 0);
+  const __m512i lane_j = CJ == 8 ? _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0) : _mm512_set_epi64(3, 2, 1, 0, 3, 2, 1, 0);
+  const int nci = static_cast<int>(begin.size()) - 1;
+  for (int ci = 0; ci < nci; ++ci) {
+    const int i0 = ci * CI;
+    if (begin[ci] == begin[ci + 1]) continue;
+    for (int rr = 0; rr < CI / RI; ++rr) {
+    V iacc1[NSS];
+    for (int k = 0; k < NSS; ++k) iacc1[k] = zero;
+    for (std::uint32_t e = begin[ci]; e < begin[ci + 1]; ++e) {
+      const int j0 = static_cast<int>(jl[e]) * CJ;
+      const V xj = jval<CJ>(X, j0), yj = jval<CJ>(Y, j0), uj = jval<CJ>(U, j0), vj = jval<CJ>(VV, j0);
+      const V hj = jval<CJ>(H, j0), rhoj = jval<CJ>(RHO, j0), vbj = jval<CJ>(VB, j0);
+      V jacc[NSS];
+      for (int k = 0; k < NSS; ++k) jacc[k] = zero;
+      const bool diagonal = j0 < i0 + CI && i0 < j0 + CJ;
+      {
+        const int r = rr;
+        const int i = i0 + r * RI;
+        const V XIJ_0 = sub(ival<RI>(X, i), xj), XIJ_1 = sub(ival<RI>(Y, i), yj);
+        const V R2IJ = add(mul(XIJ_0, XIJ_0), mul(XIJ_1, XIJ_1));
+        const V hi = ival<RI>(H, i);
+        const V hmax = _mm512_max_pd(hi, hj);
+        M in = _mm512_cmp_pd_mask(R2IJ, mul(mul(radius2, hmax), hmax), _CMP_NGE_UQ);
+        if (diagonal)
+          in &= _mm512_cmpgt_epi64_mask(_mm512_add_epi64(lane_j, _mm512_set1_epi64(j0)),
+                                        _mm512_add_epi64(lane_i, _mm512_set1_epi64(i)));
+#ifndef NO_REGSKIP
+        if (!in) continue;
+#endif
+        const V HIJ = mul(half, add(hi, hj));
+        const V VIJ_0 = sub(ival<RI>(U, i), uj), VIJ_1 = sub(ival<RI>(VV, i), vj);
+        V RIJ, ih, q, s_den_inv = zero;
+        if (ARITH == EXACT) {
+          RIJ = _mm512_sqrt_pd(R2IJ);
+          ih = div(one, HIJ);
+          q = div(RIJ, HIJ);
+        } else {
+          const V rinv = rsqrt(R2IJ);
+          RIJ = sel(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), mul(R2IJ, rinv), zero);
+          ih = rcp(HIJ);
+          q = mul(RIJ, ih);
+          s_den_inv = mul(ih, rinv);
+        }
+        const V sk = mul(bc(sigma), mul(ih, ih));
+        const M inside = _mm512_cmp_pd_mask(q, two, _CMP_LT_OQ);
+        const V t = sub(one, mul(half, q));
+        const V t2 = mul(t, t);
+        const V fq = mul(mul(t2, t2), add(mul(two, q), one));
+        const V dfq = mul(mul(mul(mul(m5, q), t), t), t);
+        const V WIJ = mul(sk, sel(inside, fq, zero));
+        const V dwdq = mul(sk, sel(inside, dfq, zero));
+        const M apart = _mm512_cmp_pd_mask(RIJ, tiny, _CMP_GT_OQ);
+        const V s = ARITH == EXACT ? div(dwdq, mul(HIJ, sel(apart, RIJ, one))) : mul(dwdq, s_den_inv);
+        const V DWIJ_f = sel(apart, s, zero);
+        const V D0 = mul(DWIJ_f, XIJ_0), D1 = mul(DWIJ_f, XIJ_1);
+        // the values the pair shares (eq11: hd, wr, 1 + R wr^4; eq12: rho_j - rho_i, negated for j)
+        const V hd = mul(HIJ, HIJ);  // dim == 2
+        const V wr = mul(mul(WIJ, hd), ival<RI>(DH, i));
+        const V ps2 = fma(mul(mul(mul(R, wr), wr), wr), wr, one);
+        const V rhoba = sub(rhoj, ival<RI>(RHO, i));
+        // i's terms (source j: vb = vb_j), in (a)'s order
+        {
+          const V vb = vbj, f = mul(vb, ps2);
+          const V nx0 = neg(mul(vb, XIJ_0)), nx1 = neg(mul(vb, XIJ_1));
+          const V g = mul(vb, rhoba);
+          const V nv0 = neg(mul(vb, VIJ_0)), nv1 = neg(mul(vb, VIJ_1));
+          V* a = iacc1;
+          a[6] = _mm512_mask3_fmadd_pd(f, D0, a[6], in);
+          a[7] = _mm512_mask3_fmadd_pd(f, D1, a[7], in);
+          a[4] = _mm512_mask3_fmadd_pd(vb, D0, a[4], in);
+          a[5] = _mm512_mask3_fmadd_pd(vb, D1, a[5], in);
+          a[0] = _mm512_mask3_fmadd_pd(nx0, D0, a[0], in);
+          a[1] = _mm512_mask3_fmadd_pd(nx0, D1, a[1], in);
+          a[2] = _mm512_mask3_fmadd_pd(nx1, D0, a[2], in);
+          a[3] = _mm512_mask3_fmadd_pd(nx1, D1, a[3], in);
+          a[8] = _mm512_mask3_fmadd_pd(g, D0, a[8], in);
+          a[9] = _mm512_mask3_fmadd_pd(g, D1, a[9], in);
+          a[10] = _mm512_mask3_fmadd_pd(nv0, D0, a[10], in);
+          a[11] = _mm512_mask3_fmadd_pd(nv0, D1, a[11], in);
+          a[12] = _mm512_mask3_fmadd_pd(nv1, D0, a[12], in);
+          a[13] = _mm512_mask3_fmadd_pd(nv1, D1, a[13], in);
+        }
+        // j's terms (source i: vb = vb_i; XIJ_ji = -XIJ, DWIJ_ji = -DWIJ, VIJ_ji = -VIJ, rhoba
+        // negated, all exactly): fma(a, -D, c) = fnmadd(a, D, c); -(vb (-x)) = vb x.
+        {
+          const V vb = ival<RI>(VB, i), f = mul(vb, ps2);
+          const V px0 = mul(vb, XIJ_0), px1 = mul(vb, XIJ_1);
+          const V g = mul(vb, rhoba);  // vb (-rhoba) times -D: g D
+          const V pv0 = mul(vb, VIJ_0), pv1 = mul(vb, VIJ_1);
+          jacc[6] = _mm512_mask3_fnmadd_pd(f, D0, jacc[6], in);
+          jacc[7] = _mm512_mask3_fnmadd_pd(f, D1, jacc[7], in);
+          jacc[4] = _mm512_mask3_fnmadd_pd(vb, D0, jacc[4], in);
+          jacc[5] = _mm512_mask3_fnmadd_pd(vb, D1, jacc[5], in);
+          jacc[0] = _mm512_mask3_fnmadd_pd(px0, D0, jacc[0], in);
+          jacc[1] = _mm512_mask3_fnmadd_pd(px0, D1, jacc[1], in);
+          jacc[2] = _mm512_mask3_fnmadd_pd(px1, D0, jacc[2], in);
+          jacc[3] = _mm512_mask3_fnmadd_pd(px1, D1, jacc[3], in);
+          jacc[8] = _mm512_mask3_fmadd_pd(g, D0, jacc[8], in);
+          jacc[9] = _mm512_mask3_fmadd_pd(g, D1, jacc[9], in);
+          jacc[10] = _mm512_mask3_fnmadd_pd(pv0, D0, jacc[10], in);
+          jacc[11] = _mm512_mask3_fnmadd_pd(pv0, D1, jacc[11], in);
+          jacc[12] = _mm512_mask3_fnmadd_pd(pv1, D0, jacc[12], in);
+          jacc[13] = _mm512_mask3_fnmadd_pd(pv1, D1, jacc[13], in);
+        }
+      }
+      if (CJ == 8) {
+        for (int k = 0; k < NSS; ++k) _mm512_storeu_pd(SUM[k] + j0, add(_mm512_loadu_pd(SUM[k] + j0), jacc[k]));
+      } else {
+        for (int k = 0; k < NSS; ++k) {
+          const __m256d lo = _mm512_castpd512_pd256(jacc[k]), hi = _mm512_extractf64x4_pd(jacc[k], 1);
+          _mm256_storeu_pd(SUM[k] + j0, _mm256_add_pd(_mm256_loadu_pd(SUM[k] + j0), _mm256_add_pd(lo, hi)));
+        }
+      }
+    }
+    for (int k = 0; k < NSS; ++k) {
+      if (RI == 1) {
+        SUM[k][i0 + rr] += _mm512_reduce_add_pd(iacc1[k]);
+      } else {
+        SUM[k][i0 + 2 * rr] += _mm512_mask_reduce_add_pd(0x0f, iacc1[k]);
+        SUM[k][i0 + 2 * rr + 1] += _mm512_mask_reduce_add_pd(0xf0, iacc1[k]);
+      }
+    }
+    }  // rr
+  }
+}
+
 // The core's clock while it runs 512-bit FMAs (a chain of dependent vfmadd, 4 cycles each).
 double clock_estimate() {
   const long n = 20000000;
@@ -1347,9 +1488,10 @@ int main(int argc, char** argv) {
       forms.push_back(std::move(F));
       return;
     }
+    const bool rmajor = F.pass == 1 && name.size() > 4 && name.substr(4) == "r";
     const bool rcp = name.size() > 4 && name.substr(4) == "rcp";
     const std::string shape = name.substr(0, 4);
-    if ((name.size() > 4 && !rcp) || (shape != "t4x4" && shape != "t4x8" && shape != "t8x8")) {
+    if ((name.size() > 4 && !rcp && !rmajor) || (shape != "t4x4" && shape != "t4x8" && shape != "t8x8")) {
       std::fprintf(stderr, "unknown form %s\n", full.c_str());
       std::exit(2);
     }
@@ -1369,7 +1511,8 @@ int main(int argc, char** argv) {
   if (pass == 0 && rcp) F.run = [=, &b, &j, &eq6, &eq7] { zero(); form_t<CI, CJ, RCP>(*s, b, j, eq6, eq7); };      \
   if (pass == 0 && !rcp) F.run = [=, &b, &j, &eq6, &eq7] { zero(); form_t<CI, CJ, EXACT>(*s, b, j, eq6, eq7); };   \
   if (pass == 1 && rcp) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, RCP>(*s, b, j, eq11); };         \
-  if (pass == 1 && !rcp) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, EXACT>(*s, b, j, eq11); };      \
+  if (pass == 1 && !rcp && !rmajor) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, EXACT>(*s, b, j, eq11); }; \
+  if (pass == 1 && rmajor) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift_r<CI, CJ, EXACT>(*s, b, j, eq11); }; \
   if (pass == 2 && rcp) F.run = [=, &b, &j, &eq6, &eq7, &eq8] { zero(); form_t<CI, CJ, RCP, true>(*s, b, j, eq6, eq7, eq8); }; \
   if (pass == 2 && !rcp) F.run = [=, &b, &j, &eq6, &eq7, &eq8] { zero(); form_t<CI, CJ, EXACT, true>(*s, b, j, eq6, eq7, eq8); }; \
   count_regs(s->L, b, j, CI, CJ, F.regs, F.regs_pair, F.in);
