@@ -443,10 +443,12 @@ class ScenePrinter {
   // The pass as cluster-pair tiles (in emitSymmetricPass's place, after the kept lists'
   // rebuild check: verlet_build): the cluster layout and list at a rebuild, the slot-order
   // copies, the pruned list, the tiles, the sums added back. `state`: the prefix of its
-  // members (clusterTilesMembers).
+  // members (clusterTilesMembers). `openmp`: blocks of i-clusters in parallel, bitwise the
+  // serial tiles' sums (the tiles across two blocks computed in both, each side in one).
   void emitClusterTiles(const DestinationWork& w, const NeighbourPass& pass,
                         const std::string& state, const std::string& listRadius2,
-                        const std::set<std::string>& q, const RegisterSums& sums);
+                        const std::set<std::string>& q, const RegisterSums& sums,
+                        bool openmp = false);
   // The members of struct Scene a pass in tiles keeps (state: its kept lists' member name).
   static void clusterTilesMembers(std::ostream& os, const std::string& state,
                                   const std::string& what);
