@@ -436,8 +436,7 @@ class ScenePrinter {
   // ---- Each pair once in cluster-pair tiles (ClusterPairs.cpp; sphc --simd-pairs=cluster) ----
   // Why the pass (destination w) that onceLanes() prints each pair once in lanes is not
   // printed as cluster-pair tiles, "" if it is ("off" without the switch). The CPU printer
-  // adds its own conditions (the OpenMP build, kept lists shared with another pass, the
-  // tuned skin).
+  // adds its own conditions (kept lists shared with another pass, the tuned skin).
   virtual std::string clusterTilesRefusal(const DestinationWork& w,
                                           const NeighbourPass& pass) const;
   // The pass as cluster-pair tiles (in emitSymmetricPass's place, after the kept lists'
