@@ -31,8 +31,16 @@
 // Results: the sums reassociated (per i: 8 lane partial sums across its cluster pairs, summed
 // in lane order; per j: the tile's i's first, then tile by tile; added to the value each sum
 // had before the pass), so not bitwise the lanes' or the scalar loops' (tests: lit
-// codegen/simd-pairs-cluster*.sph, stability.cluster_compare_*). Serial only: the OpenMP
-// build prints the pass as --simd-pairs=once does.
+// codegen/simd-pairs-cluster*.sph, stability.cluster_compare_*).
+//
+// OpenMP (stop 38): contiguous blocks of i-clusters, one per thread (balanced by the pruned
+// list's pairs), each writing only its own slots' sums, in the serial order whatever the
+// blocks: (1) the j sides of the tiles of earlier i-clusters whose j-cluster is in the block
+// (half tiles, i-clusters in increasing order), (2) the block's i-clusters, their tiles with
+// j-clusters in the block whole, those with j-clusters in later blocks for the i side only.
+// A tile across two blocks is computed twice, each side once (the scalar loops' OpenMP
+// scheme, SymmetricPairs.cpp, in tiles), so the OpenMP build's sums are the serial tiles'
+// bit for bit for any thread count (test: stability.cluster_omp_*).
 #include "analysis/PairQuantityTable.h"
 #include "codegen/CppText.h"
 #include "codegen/Printer.h"
@@ -90,6 +98,7 @@ std::string withArguments(const std::string& call, const std::map<std::string, s
 std::string ScenePrinter::clusterTilesRefusal(const DestinationWork& w,
                                               const NeighbourPass& pass) const {
   if (!simdCluster_) return "off";
+  if (simdClusterAuto_ && plan_.dim != 3) return "off";  // auto: the 3D loops (measured there)
   if (!onceLanes(w, pass)) return "not each pair once in SIMD lanes";
   if (plan_.dim < 2) return "a 1D scene";
   const int d = w.array;
@@ -139,7 +148,8 @@ void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& stat
 
 void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPass& pass,
                                     const std::string& state, const std::string& listRadius2,
-                                    const std::set<std::string>& q, const RegisterSums& sums) {
+                                    const std::set<std::string>& q, const RegisterSums& sums,
+                                    bool openmp) {
   const int d = w.array;
   const std::string R = "double";
   const bool selfPair = !skipsSelfPair(pass);
@@ -184,10 +194,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
             "        // themselves are not built), pruned at the support per evaluation; the sums\n"
             "        // reassociated (lane sums per i across its list, per j across a tile).\n";
   // The destination-only values of every particle, for the mirrored calls (gathered below).
-  emitDestinationHoistedAll(pass, "");
+  emitDestinationHoistedAll(pass, openmp ? "        #pragma omp parallel for schedule(static)\n" : "");
   scene_ << "        {\n";
   scene_ << in << "sphc::ClusterLayout& cl_layout = " << state << "_layout;\n";
   scene_ << in << "double cl_hmax = 0.0;  // the largest h now\n";
+  if (openmp) scene_ << in << "#pragma omp parallel for schedule(static) reduction(max: cl_hmax)\n";
   scene_ << in << "for (int i = 0; i < n; ++i) cl_hmax = std::max(cl_hmax, di_h[i]);\n";
   const std::string zIn = plan_.dim == 3 ? "di_z" : "nullptr";
   scene_ << in << "if (verlet_build) sphc::build_cluster_layout(cl_layout, di_x, di_y, " << zIn
@@ -214,16 +225,28 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   for (const auto& c : copies)
     if (!c.second.empty())
       scene_ << in << "sphc::gather_slots(cl_layout, " << c.second << ", cl_" << c.first << ");\n";
-  if (!accs.empty())
-    scene_ << in << "std::fill(cl_acc_" << accs.front() << ", cl_acc_" << accs.front() << " + "
-           << accs.size() << " * n_slots, 0.0);\n";
-  // The tiles, in a lambda without jump threading (see above).
+  // The tiles, in a lambda without jump threading (see above), over the i-clusters [cb, ce)
+  // of one block: serial, one block of them all; OpenMP, blocks in parallel, the same sums.
   scene_ << "#if defined(__GNUC__) && !defined(__clang__)\n"
             "#define SPHC_TILES_OPTIMIZE __attribute__((optimize(\"no-thread-jumps\")))\n"
             "#else\n"
             "#define SPHC_TILES_OPTIMIZE\n"
             "#endif\n";
-  scene_ << in << "auto tiles = [&]() SPHC_TILES_OPTIMIZE {\n";
+  scene_ << in << "static_assert(sphc::kClusterSize == 8, \"codegen/ClusterPairs.cpp prints tiles of 8 x 8: "
+                  "the runtime's cluster width must be 8\");\n";
+  if (openmp)
+    scene_ << in << "// OpenMP: contiguous blocks of i-clusters, one per thread, balanced by the pruned\n"
+           << in << "// list's pairs; a block writes only its own slots' sums, each sum in the serial\n"
+           << in << "// order whatever the blocks (so the serial tiles' bits for any thread count):\n"
+           << in << "// (1) the j sides of the tiles of EARLIER i-clusters whose j-cluster is in the\n"
+           << in << "//     block (j-side half tiles, i-clusters in increasing order: the serial order\n"
+           << in << "//     of those tiles' sums, which come before the block's own),\n"
+           << in << "// (2) the block's i-clusters: their tiles with j-clusters in the block for both\n"
+           << in << "//     sides, those with j-clusters in LATER blocks for the i side only (i-side\n"
+           << in << "//     half tiles: the later block computes their j sides in its (1)).\n"
+           << in << "// A tile across two blocks is computed twice, each side once; a half tile does\n"
+           << in << "// the same operations on the same values as its side of the whole tile.\n";
+  scene_ << in << "auto tiles = [&](const int cb, const int ce) SPHC_TILES_OPTIMIZE {\n";
   const std::string t = in + "  ";
   scene_ << t << "static constexpr double cl_lane[8] = {0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0};\n";
   // The copies' pointers again, locals of the lambda (captured by reference, GCC reloads them
@@ -239,110 +262,168 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   scene_ << t << "// The destination side: the copies at d_idx, the slot of particle i.\n";
   for (const std::string& p : pass.shared)
     scene_ << t << "const double* const di_" << p << " = cl_" << p << ";\n";
-  scene_ << t << "const int n_ci = static_cast<int>(cl_layout.n_clusters);\n";
-  scene_ << t << "for (int ci = 0; ci < n_ci; ++ci) {\n";
+  scene_ << t << "// the block's slot sums (only this block writes them)\n";
+  for (const std::string& p : accs)
+    scene_ << t << "std::fill(cl_acc_" << p << " + 8 * static_cast<std::size_t>(cb), cl_acc_" << p
+           << " + 8 * static_cast<std::size_t>(ce), 0.0);\n";
+  // One tile (j-cluster cl_j[e] of i-cluster ci): both sides, or one side's half tile.
+  enum class Side { Both, I, J };
+  auto tile = [&](Side side, const std::string& c2) {
+    const bool iSide = side != Side::J, jSide = side != Side::I;
+    scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * 8;\n";
+    if (side == Side::Both)
+      scene_ << c2 << "const bool diagonal = cl_j[e] == static_cast<std::uint32_t>(ci);\n";
+    scene_ << c2 << "// The source side: the j-cluster's 8 slots, s_idx the lane.\n";
+    for (const std::string& p : pass.shared)
+      scene_ << c2 << "const double* const sj_" << p << " = cl_" << p << " + j0;\n";
+    for (const std::string& p : pass.sourceProps)
+      scene_ << c2 << "const double* const s_" << p << " = cl_" << p << " + j0;\n";
+    for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = cl_" << h << " + j0;\n";
+    // (the mirrored calls read particle s_idx's destination values through d_NAME)
+    for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = cl_" << p << " + j0;\n";
+    for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = cl_" << h << " + j0;\n";
+    if (jSide) {
+      scene_ << c2 << "// j's sums over the tile's i's\n";
+      for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[8] = {};\n";
+    }
+    scene_ << c2 << "for (int ii = 0; ii < 8 && (real_i >> ii & 1u); ++ii) {  // the real i's (first)\n";
+    const std::string c3 = c2 + "  ";
+    scene_ << c3 << "const int d_idx = ci * 8 + ii;\n";
+    emitDestLocals(scene_, c3, q, host_);
+    for (const PlanEquation* eq : pass.equations) {
+      const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+      for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
+        const std::string K = std::to_string(k);
+        scene_ << c3 << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = cl_"
+               << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+      }
+    }
+    for (const std::string& p : dvals)  // the destination's values (the d_NAME above are offset)
+      scene_ << c3 << "const double " << destinationValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
+    {  // the mirrored calls' source values: particle d_idx's
+      std::set<std::string> loads;
+      for (const PlanEquation* eq : pass.equations)
+        for (const auto& [p, sc] : sourceValues(methodBody(*eq, ast::Method::Loop)))
+          if (loads.insert(sourceValueName(p, 1, 0)).second)
+            scene_ << c3 << "const double " << sourceValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
+    }
+    if (side == Side::Both) {
+      scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
+      scene_ << c3 << "const double lane_s = diagonal ? static_cast<double>(ii) : -1.0;\n";
+      scene_ << c3 << "const double lane_d = diagonal ? static_cast<double>(ii" << (selfPair ? " - 1" : "") << ") : -1.0;\n";
+    } else {
+      scene_ << c3 << "// (a half tile is never on the diagonal: every lane within the cut-off counts)\n";
+    }
+    // The row's cut-off alone first: a row with no pair within it is skipped.
+    // (a double sum of 0 or 1: an int reduction makes GCC 12 take 8 int lanes, so this loop in
+    // 256-bit vectors, 10-12% more per sweep in bench/cluster_pairs.cpp)
+    scene_ << c3 << "double any = 0.0;\n";
+    scene_ << c3 << "#pragma omp simd reduction(+: any)\n";
+    scene_ << c3 << "for (int s_idx = 0; s_idx < 8; ++s_idx) {\n";
+    {
+      const std::string b = c3 + "  ";
+      scene_ << b << "const double hj = sj_h[s_idx];\n";
+      std::string r2;
+      for (int k = 0; k < plan_.dim; ++k) {
+        scene_ << b << "const double XIJ_" << k << " = " << axes[k] << "i - sj_" << axes[k] << "[s_idx];\n";
+        r2 += (k ? " + " : "") + std::string("XIJ_") + std::to_string(k) + " * XIJ_" + std::to_string(k);
+      }
+      scene_ << b << "const double R2IJ = " << r2 << ";\n";
+      scene_ << b << "const double hmax = hi > hj ? hi : hj;\n";
+      if (side == Side::Both)
+        scene_ << b << "any += !(R2IJ >= RADIUS2 * hmax * hmax) & (cl_lane[s_idx] > lane_d) ? 1.0 : 0.0;\n";
+      else
+        scene_ << b << "any += !(R2IJ >= RADIUS2 * hmax * hmax) ? 1.0 : 0.0;\n";
+    }
+    scene_ << c3 << "}\n";
+    scene_ << c3 << "if (!(any > 0.0)) continue;  // no pair of the row within the support\n";
+    if (iSide)
+      for (const std::string& p : accs) scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[ii];\n";
+    scene_ << c3 << "#pragma omp simd\n";
+    scene_ << c3 << "for (int s_idx = 0; s_idx < 8; ++s_idx) {\n";
+    const std::string body = c3 + "  ";
+    emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
+    scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
+    scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
+    if (side == Side::Both) {
+      scene_ << body << "const bool in_d = in_cut & (cl_lane[s_idx] > lane_d);  // for d_idx\n";
+      scene_ << body << "const bool in_s = in_cut & (cl_lane[s_idx] > lane_s);  // for the lane's particle\n";
+    }
+    const std::string inD = side == Side::Both ? "in_d" : "in_cut";
+    const std::string inS = side == Side::Both ? "in_s" : "in_cut";
+    emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
+    for (const std::string& p : accs) {
+      if (iSide) scene_ << body << "double pd_acc_" << p << " = ti_" << p << "_i[s_idx];\n";
+      if (jSide) scene_ << body << "double ps_acc_" << p << " = tj_" << p << "[s_idx];\n";
+    }
+    if (iSide)
+      for (const PlanEquation* eq : pass.equations)
+        scene_ << body << pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_");
+    // The mirrored calls index the source's arrays they are given as pointers (a source
+    // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
+    // not offset to the j-cluster.
+    if (jSide) {
+      std::map<std::string, std::string> absolute;
+      for (const std::string& p : pass.sourceProps) absolute["s_" + p] = "cl_" + p;
+      for (const std::string& h : hoisted) absolute[h] = "cl_" + h;
+      for (const PlanEquation* eq : pass.equations)
+        scene_ << body << withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute);
+    }
+    endPairShared();
+    for (const std::string& p : accs) {
+      if (iSide)
+        scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_acc_" << p << " : ti_" << p << "_i[s_idx];\n";
+      if (jSide)
+        scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_acc_" << p << " : tj_" << p << "[s_idx];\n";
+    }
+    scene_ << c3 << "}\n";
+    scene_ << c2 << "}\n";
+    if (jSide) {
+      scene_ << c2 << "#pragma omp simd  // (a vector: unrolled, the tj_ arrays would be scalars)\n";
+      scene_ << c2 << "for (int l = 0; l < 8; ++l) {\n";
+      for (const std::string& p : accs)
+        scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l];\n";
+      scene_ << c2 << "}\n";
+    }
+  };
+  if (openmp) {
+    scene_ << t << "// (1) the j sides of earlier i-clusters' tiles with j-clusters in [cb, ce)\n";
+    scene_ << t << "for (int ci = 0; ci < cb; ++ci) {\n";
+    const std::string c1 = t + "  ";
+    scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
+    scene_ << c1 << "if (cl_begin[ci] == e_end || cl_j[e_end - 1] < static_cast<std::uint32_t>(cb)) continue;\n";
+    scene_ << c1 << "std::uint32_t e = static_cast<std::uint32_t>(std::lower_bound(cl_j + cl_begin[ci], cl_j + e_end, "
+                    "static_cast<std::uint32_t>(cb)) - cl_j);\n";
+    scene_ << c1 << "const unsigned real_i = cl_real[ci];\n";
+    scene_ << c1 << "for (; e < e_end && cl_j[e] < static_cast<std::uint32_t>(ce); ++e) {\n";
+    tile(Side::J, c1 + "  ");
+    scene_ << c1 << "}\n";
+    scene_ << t << "}\n";
+    scene_ << t << "// (2) the block's i-clusters\n";
+  }
+  scene_ << t << "for (int ci = cb; ci < ce; ++ci) {\n";
   const std::string c1 = t + "  ";
   scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
   scene_ << c1 << "if (cl_begin[ci] == e_end) continue;\n";
   scene_ << c1 << "const unsigned real_i = cl_real[ci];\n";
   scene_ << c1 << "// i's sums: 8 lane partial sums per i across its cluster pairs\n";
   for (const std::string& p : accs) scene_ << c1 << "alignas(64) double ti_" << p << "[8][8] = {};\n";
-  scene_ << c1 << "for (std::uint32_t e = cl_begin[ci]; e < e_end; ++e) {\n";
-  const std::string c2 = c1 + "  ";
-  scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * 8;\n";
-  scene_ << c2 << "const bool diagonal = cl_j[e] == static_cast<std::uint32_t>(ci);\n";
-  scene_ << c2 << "// The source side: the j-cluster's 8 slots, s_idx the lane.\n";
-  for (const std::string& p : pass.shared)
-    scene_ << c2 << "const double* const sj_" << p << " = cl_" << p << " + j0;\n";
-  for (const std::string& p : pass.sourceProps)
-    scene_ << c2 << "const double* const s_" << p << " = cl_" << p << " + j0;\n";
-  for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = cl_" << h << " + j0;\n";
-  // (the mirrored calls read particle s_idx's destination values through d_NAME)
-  for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = cl_" << p << " + j0;\n";
-  for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = cl_" << h << " + j0;\n";
-  scene_ << c2 << "// j's sums over the tile's i's\n";
-  for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[8] = {};\n";
-  scene_ << c2 << "for (int ii = 0; ii < 8 && (real_i >> ii & 1u); ++ii) {  // the real i's (first)\n";
-  const std::string c3 = c2 + "  ";
-  scene_ << c3 << "const int d_idx = ci * 8 + ii;\n";
-  emitDestLocals(scene_, c3, q, host_);
-  for (const PlanEquation* eq : pass.equations) {
-    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
-    for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
-      const std::string K = std::to_string(k);
-      scene_ << c3 << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = cl_"
-             << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
-    }
+  if (openmp) {
+    scene_ << c1 << "// the tiles with j-clusters in the block (both sides), then those in later blocks\n";
+    scene_ << c1 << "const std::uint32_t e_mid = static_cast<std::uint32_t>(std::lower_bound(cl_j + cl_begin[ci], "
+                    "cl_j + e_end, static_cast<std::uint32_t>(ce)) - cl_j);\n";
+    scene_ << c1 << "std::uint32_t e = cl_begin[ci];\n";
+    scene_ << c1 << "for (; e < e_mid; ++e) {\n";
+  } else {
+    scene_ << c1 << "for (std::uint32_t e = cl_begin[ci]; e < e_end; ++e) {\n";
   }
-  for (const std::string& p : dvals)  // the destination's values (the d_NAME above are offset)
-    scene_ << c3 << "const double " << destinationValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
-  {  // the mirrored calls' source values: particle d_idx's
-    std::set<std::string> loads;
-    for (const PlanEquation* eq : pass.equations)
-      for (const auto& [p, sc] : sourceValues(methodBody(*eq, ast::Method::Loop)))
-        if (loads.insert(sourceValueName(p, 1, 0)).second)
-          scene_ << c3 << "const double " << sourceValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
-  }
-  scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
-  scene_ << c3 << "const double lane_s = diagonal ? static_cast<double>(ii) : -1.0;\n";
-  scene_ << c3 << "const double lane_d = diagonal ? static_cast<double>(ii" << (selfPair ? " - 1" : "") << ") : -1.0;\n";
-  // The row's cut-off alone first: a row with no pair within it is skipped.
-  // (a double sum of 0 or 1: an int reduction makes GCC 12 take 8 int lanes, so this loop in
-  // 256-bit vectors, 10-12% more per sweep in bench/cluster_pairs.cpp)
-  scene_ << c3 << "double any = 0.0;\n";
-  scene_ << c3 << "#pragma omp simd reduction(+: any)\n";
-  scene_ << c3 << "for (int s_idx = 0; s_idx < 8; ++s_idx) {\n";
-  {
-    const std::string b = c3 + "  ";
-    scene_ << b << "const double hj = sj_h[s_idx];\n";
-    std::string r2;
-    for (int k = 0; k < plan_.dim; ++k) {
-      scene_ << b << "const double XIJ_" << k << " = " << axes[k] << "i - sj_" << axes[k] << "[s_idx];\n";
-      r2 += (k ? " + " : "") + std::string("XIJ_") + std::to_string(k) + " * XIJ_" + std::to_string(k);
-    }
-    scene_ << b << "const double R2IJ = " << r2 << ";\n";
-    scene_ << b << "const double hmax = hi > hj ? hi : hj;\n";
-    scene_ << b << "any += !(R2IJ >= RADIUS2 * hmax * hmax) & (cl_lane[s_idx] > lane_d) ? 1.0 : 0.0;\n";
-  }
-  scene_ << c3 << "}\n";
-  scene_ << c3 << "if (!(any > 0.0)) continue;  // no pair of the row within the support\n";
-  for (const std::string& p : accs) scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[ii];\n";
-  scene_ << c3 << "#pragma omp simd\n";
-  scene_ << c3 << "for (int s_idx = 0; s_idx < 8; ++s_idx) {\n";
-  const std::string body = c3 + "  ";
-  emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
-  scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
-  scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
-  scene_ << body << "const bool in_d = in_cut & (cl_lane[s_idx] > lane_d);  // for d_idx\n";
-  scene_ << body << "const bool in_s = in_cut & (cl_lane[s_idx] > lane_s);  // for the lane's particle\n";
-  emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
-  for (const std::string& p : accs) {
-    scene_ << body << "double pd_acc_" << p << " = ti_" << p << "_i[s_idx];\n";
-    scene_ << body << "double ps_acc_" << p << " = tj_" << p << "[s_idx];\n";
-  }
-  for (const PlanEquation* eq : pass.equations)
-    scene_ << body << pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_");
-  // The mirrored calls index the source's arrays they are given as pointers (a source
-  // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
-  // not offset to the j-cluster.
-  std::map<std::string, std::string> absolute;
-  for (const std::string& p : pass.sourceProps) absolute["s_" + p] = "cl_" + p;
-  for (const std::string& h : hoisted) absolute[h] = "cl_" + h;
-  for (const PlanEquation* eq : pass.equations)
-    scene_ << body << withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute);
-  endPairShared();
-  for (const std::string& p : accs) {
-    scene_ << body << "ti_" << p << "_i[s_idx] = in_d ? pd_acc_" << p << " : ti_" << p << "_i[s_idx];\n";
-    scene_ << body << "tj_" << p << "[s_idx] = in_s ? ps_acc_" << p << " : tj_" << p << "[s_idx];\n";
-  }
-  scene_ << c3 << "}\n";
-  scene_ << c2 << "}\n";
-  scene_ << c2 << "#pragma omp simd  // (a vector: unrolled, the tj_ arrays would be scalars)\n";
-  scene_ << c2 << "for (int l = 0; l < 8; ++l) {\n";
-  for (const std::string& p : accs)
-    scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l];\n";
-  scene_ << c2 << "}\n";
+  tile(Side::Both, c1 + "  ");
   scene_ << c1 << "}\n";
+  if (openmp) {
+    scene_ << c1 << "for (; e < e_end; ++e) {  // the i side only: the later block adds the j side\n";
+    tile(Side::I, c1 + "  ");
+    scene_ << c1 << "}\n";
+  }
   scene_ << c1 << "for (int ii = 0; ii < 8; ++ii) {\n";
   for (const std::string& p : accs) {
     scene_ << c1 << "  double s_" << p << " = 0.0;\n";
@@ -352,7 +433,22 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   scene_ << c1 << "}\n";
   scene_ << t << "}\n";
   scene_ << in << "};\n";
-  scene_ << in << "tiles();\n";
+  if (!openmp) {
+    scene_ << in << "tiles(0, static_cast<int>(cl_layout.n_clusters));\n";
+  } else {
+    scene_ << in << "{  // the blocks: balanced by the pruned list's pairs (the sums do not depend on them)\n";
+    scene_ << in << "  const int n_ci = static_cast<int>(cl_layout.n_clusters);\n";
+    scene_ << in << "  const int n_blocks = std::max(1, std::min(n_ci, omp_get_max_threads()));\n";
+    scene_ << in << "  const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
+    scene_ << in << "  std::vector<int> cl_cb(n_blocks + 1, n_ci);\n";
+    scene_ << in << "  cl_cb[0] = 0;\n";
+    scene_ << in << "  for (int blk = 1; blk < n_blocks; ++blk)\n";
+    scene_ << in << "    cl_cb[blk] = static_cast<int>(std::lower_bound(cl_begin, cl_begin + n_ci, static_cast<std::uint32_t>(\n";
+    scene_ << in << "        static_cast<std::uint64_t>(cl_begin[n_ci]) * blk / n_blocks)) - cl_begin);\n";
+    scene_ << in << "  #pragma omp parallel for schedule(static, 1)\n";
+    scene_ << in << "  for (int blk = 0; blk < n_blocks; ++blk) tiles(cl_cb[blk], cl_cb[blk + 1]);\n";
+    scene_ << in << "}\n";
+  }
   scene_ << in << "// The slot sums onto the particles' sums (padding slots never read).\n";
   for (const std::string& p : accs)
     scene_ << in << "sphc::add_slots(cl_layout, cl_acc_" << p << ", d_" << p << ");\n";

@@ -644,7 +644,6 @@ std::string CpuPrinter::clusterTilesRefusal(const DestinationWork& w,
                                             const NeighbourPass& pass) const {
   std::string why = ScenePrinter::clusterTilesRefusal(w, pass);
   if (!why.empty()) return why;
-  if (openmp_) return "the OpenMP build (the tiles are serial in this version)";
   if (tuned()) return "--verlet-skin=auto (the tiles take the fixed skin's radius)";
   if (!verlet()) return "no kept lists";
   // The tiles build no kept lists: none may be shared with another pass (verletLists).

@@ -436,21 +436,24 @@ class ScenePrinter {
   // ---- Each pair once in cluster-pair tiles (ClusterPairs.cpp; sphc --simd-pairs=cluster) ----
   // Why the pass (destination w) that onceLanes() prints each pair once in lanes is not
   // printed as cluster-pair tiles, "" if it is ("off" without the switch). The CPU printer
-  // adds its own conditions (the OpenMP build, kept lists shared with another pass, the
-  // tuned skin).
+  // adds its own conditions (kept lists shared with another pass, the tuned skin).
   virtual std::string clusterTilesRefusal(const DestinationWork& w,
                                           const NeighbourPass& pass) const;
   // The pass as cluster-pair tiles (in emitSymmetricPass's place, after the kept lists'
   // rebuild check: verlet_build): the cluster layout and list at a rebuild, the slot-order
   // copies, the pruned list, the tiles, the sums added back. `state`: the prefix of its
-  // members (clusterTilesMembers).
+  // members (clusterTilesMembers). `openmp`: blocks of i-clusters in parallel, bitwise the
+  // serial tiles' sums (the tiles across two blocks computed in both, each side in one).
   void emitClusterTiles(const DestinationWork& w, const NeighbourPass& pass,
                         const std::string& state, const std::string& listRadius2,
-                        const std::set<std::string>& q, const RegisterSums& sums);
+                        const std::set<std::string>& q, const RegisterSums& sums,
+                        bool openmp = false);
   // The members of struct Scene a pass in tiles keeps (state: its kept lists' member name).
   static void clusterTilesMembers(std::ostream& os, const std::string& state,
                                   const std::string& what);
   bool simdCluster_ = false;  // EmitOptions::simdPairsCluster (with simdOnce_)
+  bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops only
+  std::string simdClusterWhy_;    // the report's reason (--simd-pairs=cluster, or auto's)
   // --precision=single: the float local a SIMD loop passes for a body's double argument (t,
   // dt, an equation's scalar: f_t, f_eq2_alpha), converted once before the loop; "" for
   // other parameters.

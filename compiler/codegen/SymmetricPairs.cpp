@@ -299,7 +299,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   // --simd-pairs=cluster: in cluster-pair tiles where they can (ClusterPairs.cpp).
   const std::string clusterWhy = simd ? clusterTilesRefusal(w, pass) : "off";
   if (clusterWhy.empty())
-    return emitClusterTiles(w, pass, lists, listRadius2, q, registerSums(w, pass));
+    return emitClusterTiles(w, pass, lists, listRadius2, q, registerSums(w, pass), openmp);
   if (clusterWhy != "off")
     scene_ << "        // Not in cluster-pair tiles (codegen/ClusterPairs.cpp): " << clusterWhy << ".\n";
   if (simd)
