@@ -463,6 +463,9 @@ class ScenePrinter {
     std::string why;
   };
   SimdAutoChoice simdPairsAutoChoice(const DestinationWork& w, const NeighbourPass& pass) const;
+  // With zones (inlets, outlets): why the per-destination lanes are not taken ("" where they
+  // are: every pair-loop body of the scene adds what vanishes at the support; SimdPairs.cpp).
+  std::string zonesLanesRefusal() const;
   // Whether the CPU printer would evaluate pass (destination w) once per pair without SIMD.
   bool eachPairOncePossible(const DestinationWork& w, const NeighbourPass& pass) const;
   // --report: per pair loop, whether it is in SIMD lanes and why (nothing with the switch off).
