@@ -206,9 +206,9 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // measured): scalar as before. A loop over another array (walls) keeps the threshold: most of
   // its destinations have few or no neighbours there (the dam break's fluid <- boundary in
   // lanes: 1.08-1.10x).
-  // With zones (inlets, outlets; no domain: the lists are gathered at every evaluation, so
-  // the loops are per destination anyway) where every pair-loop body of the scene adds what
-  // vanishes at the support (zonesLanesRefusal). Stop 36 left zones out (the channel's TVF
+  // With zones (inlets, outlets: the lists are gathered at every evaluation, so the loops
+  // are per destination anyway), with or without a domain, where every pair-loop body of the
+  // scene adds what vanishes at the support (zonesLanesRefusal). Stop 36 left zones out (the channel's TVF
   // scene's serial and OpenMP bits: GCC's inlining of the kernel, fixed in stop 37); stop 37
   // found the cylinder in lanes 2.3e-10 of u from OpenCL and the scalar loops after one step
   // at two particles: its lattice start (h = dx, support 3 h) puts pairs at r = 3 h exactly,
@@ -227,7 +227,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
       symmetricPairsRefusal(plan_, w, pass, true).empty();
   const bool perDestOwn = !onceAnyway && !ghostOnceScalar && pass.source == w.array &&
                           plan_.dim >= 2 && simdSymmetricSwitch_ &&
-                          (hasDomain() || (hasZones() && zonesLanesRefusal().empty()));
+                          (hasZones() ? zonesLanesRefusal().empty() : hasDomain());
   // --simd-once-neighbours: a threshold of its own for a loop the lanes print each pair once.
   const bool once = simdOnce_ && onceForm(w, pass) && simdOnceNeighbours_ >= 0;
   const double threshold = once ? simdOnceNeighbours_
@@ -249,7 +249,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
                   how.c_str(), perDestOwn ? " and the loop (over its own array, per destination anyway)" : "");
   std::string why = buf;
   if (!perDestOwn && !onceAnyway && !ghostOnceScalar && pass.source == w.array &&
-      plan_.dim >= 2 && simdSymmetricSwitch_ && !hasDomain() && hasZones() && !lanes)
+      plan_.dim >= 2 && simdSymmetricSwitch_ && hasZones() && !lanes)
     why.insert(why.size() - 2, " (zones: not at any count, " + zonesLanesRefusal() + ")");
   // The CPU the solver is built for (SimdCpu.cpp): where the lanes lose, the scalar loops.
   if (lanes && !simdCpu_.lanes) {
