@@ -154,6 +154,10 @@ struct BodyFacts {
   // properties (body/SelfPair.cpp), so an each-pair-once loop of bodies that all do may skip
   // that pair (codegen/SymmetricPairs.cpp).
   bool vanishesOnSelfPair = false;
+  // Loop bodies: at the edge of the support (a pair at r = support h_max, where the kernel
+  // and its gradient vanish) the body only adds zeros to properties (body/SelfPair.cpp): what
+  // it adds is continuous as a pair enters or leaves the neighbours.
+  bool vanishesAtSupport = false;
 };
 
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given

@@ -266,5 +266,8 @@ void findZeroFactors(clang::FunctionDecl* fn, const std::vector<ProductFactors>&
 // Whether a loop body adds only zeros to properties at the self pair (BodyFacts::
 // vanishesOnSelfPair; SelfPair.cpp).
 bool vanishesOnSelfPair(const BodySource& body, clang::FunctionDecl* fn);
+// Whether it adds only zeros at the edge of the support, where the kernel and its gradient
+// vanish (BodyFacts::vanishesAtSupport; SelfPair.cpp).
+bool vanishesAtSupport(const BodySource& body, clang::FunctionDecl* fn);
 
 }  // namespace sphc::body_detail

@@ -42,6 +42,7 @@ class BodyChecker : public clang::RecursiveASTVisitor<BodyChecker> {
       facts_.pairShared = findPairSharedSites(body_, fn, range);
       for (size_t k = 0; k < facts_.pairShared.size(); ++k) facts_.pairShared[k].id = static_cast<int>(k);
       facts_.vanishesOnSelfPair = vanishesOnSelfPair(body_, fn);
+      facts_.vanishesAtSupport = vanishesAtSupport(body_, fn);
     }
   }
 

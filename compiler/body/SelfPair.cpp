@@ -27,6 +27,18 @@
 // self pair comes (it starts as -0, e.g. set to a -0 velocity, and everything added before is
 // -0), and unless a factor of the product was not finite (inf * 0 = NaN: a sum the run's
 // checks would have stopped on). docs/performance.md, "The self pair" (stop 35).
+//
+// The same check at the edge of the support (BodyFacts::vanishesAtSupport, stop 38): a pair
+// is a neighbour while r < support h_max (the cut-off test), and at r = support h_max the
+// kernel values WIJ, WI, WJ and gradients DWIJ, DWI, DWJ are zeros (q >= support for each
+// smoothing length; of a kernel that vanishes there, with its derivative: not the truncated
+// Gaussians). Where every write adds such a zero, what a pair adds goes to zero as it
+// reaches the cut-off, and a pair that comes in or leaves by a rounding of the positions
+// changes the sums by as little (a continuous function of the positions); a body that adds
+// a count (`d_nnbr[d_idx] += 1.0`) or a source's value unweighted (`d_pavg[d_idx] +=
+// s_p[s_idx]`, EDACAveragePressure) jumps by a whole term there. The zeros at the support:
+// WIJ, WI, WJ, DWIJ[k], DWI[k], DWJ[k], a literal 0, and products, quotients, sums, ... of
+// them as above; no branch is taken as known (both sides of an `if` must add zeros).
 #include "body/AssignedLocals.h"
 #include "body/BodyBatch.h"
 
@@ -38,9 +50,13 @@ namespace sphc::body_detail {
 
 namespace {
 
+// Where the body is checked: at the self pair (r = 0), or at the edge of the support (a pair
+// at r = support h_max: the top of the file and vanishesAtSupport below).
+enum class At { SelfPair, Support };
+
 class SelfPairCheck : public AssignedLocalsVisitor<SelfPairCheck> {
  public:
-  explicit SelfPairCheck(const BodySource& body) : body_(body) {}
+  SelfPairCheck(const BodySource& body, At at) : body_(body), at_(at) {}
 
   bool check(clang::FunctionDecl* fn) {
     TraverseStmt(fn->getBody());  // the locals that are assigned after their declaration
@@ -106,14 +122,17 @@ class SelfPairCheck : public AssignedLocalsVisitor<SelfPairCheck> {
         return var->isLocalVarDecl() && !assigned(var) && var->getInit() &&
                var->getType()->isArithmeticType() && zero(var->getInit());
       const std::string name = d->getName().str();
-      return llvm::isa<clang::ParmVarDecl>(d) && nameRole(body_, name) == NameRole::PairQuantity &&
-             (name == "R2IJ" || name == "RIJ");
+      if (!llvm::isa<clang::ParmVarDecl>(d) || nameRole(body_, name) != NameRole::PairQuantity)
+        return false;
+      return at_ == At::SelfPair ? name == "R2IJ" || name == "RIJ"
+                                 : name == "WIJ" || name == "WI" || name == "WJ";
     }
     if (auto* a = llvm::dyn_cast<clang::ArraySubscriptExpr>(e)) {
       auto* base = llvm::dyn_cast<clang::DeclRefExpr>(a->getBase()->IgnoreParenImpCasts());
       if (!base || !llvm::isa<clang::ParmVarDecl>(base->getDecl())) return false;
-      static const std::set<std::string> vectors = {"XIJ", "VIJ", "DWIJ", "DWI", "DWJ"};
-      return vectors.count(base->getDecl()->getName().str()) > 0;
+      static const std::set<std::string> atSelf = {"XIJ", "VIJ", "DWIJ", "DWI", "DWJ"};
+      static const std::set<std::string> atSupport = {"DWIJ", "DWI", "DWJ"};
+      return (at_ == At::SelfPair ? atSelf : atSupport).count(base->getDecl()->getName().str()) > 0;
     }
     if (auto* u = llvm::dyn_cast<clang::UnaryOperator>(e))
       return (u->getOpcode() == clang::UO_Minus || u->getOpcode() == clang::UO_Plus) &&
@@ -125,6 +144,7 @@ class SelfPairCheck : public AssignedLocalsVisitor<SelfPairCheck> {
         case clang::BO_Add: return zero(b->getLHS()) && zero(b->getRHS());
         case clang::BO_Sub: {
           if (zero(b->getLHS()) && zero(b->getRHS())) return true;
+          if (at_ == At::Support) return false;
           // One property of one particle: d_X[d_idx] - s_X[s_idx] (either way round).
           for (bool dl : {true, false}) {
             const std::string l = particleValue(b->getLHS(), dl);
@@ -150,6 +170,7 @@ class SelfPairCheck : public AssignedLocalsVisitor<SelfPairCheck> {
 
   // Whether the self pair does not take a branch under condition e.
   bool falseAtSelf(const clang::Expr* e) {
+    if (at_ == At::Support) return false;  // at the support: no branch known not taken
     e = e->IgnoreParenImpCasts();
     if (auto* b = llvm::dyn_cast<clang::BinaryOperator>(e)) {
       const clang::Expr* l = b->getLHS();
@@ -209,13 +230,19 @@ class SelfPairCheck : public AssignedLocalsVisitor<SelfPairCheck> {
   }
 
   const BodySource& body_;
+  const At at_;
 };
 
 }  // namespace
 
 bool vanishesOnSelfPair(const BodySource& body, clang::FunctionDecl* fn) {
   if (body.kind != BodyKind::Loop || !fn->getBody()) return false;
-  return SelfPairCheck(body).check(fn);
+  return SelfPairCheck(body, At::SelfPair).check(fn);
+}
+
+bool vanishesAtSupport(const BodySource& body, clang::FunctionDecl* fn) {
+  if (body.kind != BodyKind::Loop || !fn->getBody()) return false;
+  return SelfPairCheck(body, At::Support).check(fn);
 }
 
 }  // namespace sphc::body_detail

@@ -136,7 +136,7 @@ struct EmitOptions {
   double simdAutoNeighbours = -1;  // < 0: kSimdAutoNeighbours
   // --simd-once-neighbours=N: the threshold of a loop the lanes print each pair once (< 0:
   // simdAutoNeighbours); --simd-perdest-neighbours=N: of a loop over its own array that is per
-  // destination anyway (no each pair once: a periodic or mirror domain without zones; < 0:
+  // destination anyway (no each pair once: a periodic or mirror domain, zones; < 0:
   // kSimdPerDestNeighbours). Measurement knobs.
   double simdOnceNeighbours = -1;
   double simdPerDestNeighbours = -1;
@@ -149,10 +149,11 @@ struct EmitOptions {
 // of 2 h, 74 and 21 neighbours).
 inline constexpr double kSimdAutoNeighbours = 30.0;
 // --simd-pairs=auto: a loop over its own array that is per destination anyway (no each pair
-// once to lose: a periodic or mirror domain, without zones) goes in the lanes at any
+// once to lose: a periodic or mirror domain; zones where every pair body vanishes at the
+// support, ScenePrinter::zonesLanesRefusal) goes in the lanes at any
 // expected count in 2D and 3D (stop 36, Intel with gathers: 0.84-0.97 of the scalar step at
 // ~28 neighbours, 0.79-0.81 for a per-destination loop at ~21; stop 33, AMD Zen 5: 0.89 at
-// ~28).
+// ~28; stop 37, zones: 0.76-0.82 the channel).
 inline constexpr double kSimdPerDestNeighbours = 0.0;
 
 // The lines around the out-of-class phases of a split solver (EmitOptions::splitUnits).

@@ -279,6 +279,25 @@ static std::string hoistArguments(const SourceOnlySite& s, const BodyFacts& f, b
   return args;
 }
 
+std::pair<std::string, std::string> ScenePrinter::sameDestinationHoisted(
+    const NeighbourPass& pass, const PlanEquation& eq, size_t k) const {
+  std::map<std::string, std::pair<std::string, std::string>> first;  // key -> (eq struct, k)
+  for (const PlanEquation* e : pass.equations) {
+    const PlanBody& b = methodBody(*e, ast::Method::Loop);
+    const auto sites = hoistedDestinationSites(b, host_);
+    for (size_t j = 0; j < sites.size(); ++j) {
+      std::string key;
+      if (!particleFree(b.source.text, b.facts, sites[j]))
+        key = hoistedSiteKey(b, sites[j], hoistedValueType(b, host_, false, j), false);
+      auto it = key.empty() ? first.end() : first.find(key);
+      if (e == &eq && j == k)
+        return it == first.end() ? std::make_pair(std::string(), std::string()) : it->second;
+      if (!key.empty() && it == first.end()) first.emplace(key, std::make_pair(eqStruct(*e), std::to_string(j)));
+    }
+  }
+  return {"", ""};
+}
+
 void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass& pass,
                                           const std::string& indent) const {
   for (const PlanEquation* eq : pass.equations) {
@@ -290,6 +309,16 @@ void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass&
       if (particleFree(b.source.text, b.facts, sites[k])) {  // emitHoistedValues computed it
         os << indent << "const " << type << " " << local << " = " << passHoisted(eqStruct(*eq), k)
            << ";  // " << eq->name << ": once per pass\n";
+        continue;
+      }
+      // The same value as an earlier equation's of the pass (e.g. the EDAC momentum bodies'
+      // m_a / rho_a): its local, the same double.
+      const auto same = sameDestinationHoisted(pass, *eq, k);
+      if (!same.first.empty()) {
+        os << indent << "const " << type << " " << local << " = "
+           << hoistDestinationArgument(same.first, same.second) << ";  // " << eq->name << ": "
+           << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
+           << ", computed above\n";
         continue;
       }
       os << indent << "const " << type << " " << local
@@ -363,14 +392,16 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
 }
 
 std::string ScenePrinter::hoistedSiteKey(const PlanBody& b, const SourceOnlySite& s,
-                                         const std::string& type) const {
+                                         const std::string& type, bool source) const {
   // The equation's scalars are its own (eqN.k): not compared, such a value is not shared.
   if (!s.scalars.empty()) return "";
   const std::string& text = b.source.text;
   // Single precision: the type is the function's decltype alias, named per equation; the same
   // float text gives the same type.
-  std::string key = (host_.floatBodies ? std::string("float text") : type) + "|" + (s.usesT ? "t" : "") + (s.usesDt ? "dt" : "") + "|";
-  for (const auto& p : sideReads(b.facts, s, true)) key += p + ",";
+  std::string key = std::string(source ? "s|" : "d|") +
+                    (host_.floatBodies ? std::string("float text") : type) + "|" +
+                    (s.usesT ? "t" : "") + (s.usesDt ? "dt" : "") + "|";
+  for (const auto& p : sideReads(b.facts, s, source)) key += p + ",";
   for (const auto& l : s.locals)
     key += "|" + l.type + " " + l.name + " = " +
            fusedRange(text, b.facts, l.initBegin, l.initEnd, host_.fma);

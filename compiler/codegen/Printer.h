@@ -295,8 +295,16 @@ class ScenePrinter {
   // What identifies a source-hoisted value across the equations of a pass (Hoist.cpp): its
   // type, t/dt, the properties it reads, its locals and its expression as printed; "" where
   // it reads an equation's scalars (not shared).
+  // source = false: of a destination-only value (the destination's properties it reads).
   std::string hoistedSiteKey(const PlanBody& b, const SourceOnlySite& s,
-                             const std::string& type) const;
+                             const std::string& type, bool source = true) const;
+  // A destination-only value of equation eq's loop (its site k, hoistedDestinationSites) that
+  // an earlier equation of the pass hoists too (the same hoistedSiteKey, not a value of the
+  // parameters alone): that equation's struct name and site index, whose local and per-
+  // particle array it reads; {"", ""} where it is the first (Hoist.cpp, stop 38).
+  std::pair<std::string, std::string> sameDestinationHoisted(const NeighbourPass& pass,
+                                                             const PlanEquation& eq,
+                                                             size_t k) const;
   std::string hoistArgument(const std::string& eqValues, const std::string& k) const {
     return "hoisted_" + eqValues + "_" + k;
   }
@@ -466,6 +474,9 @@ class ScenePrinter {
     std::string why;
   };
   SimdAutoChoice simdPairsAutoChoice(const DestinationWork& w, const NeighbourPass& pass) const;
+  // With zones (inlets, outlets): why the per-destination lanes are not taken ("" where they
+  // are: every pair-loop body of the scene adds what vanishes at the support; SimdPairs.cpp).
+  std::string zonesLanesRefusal() const;
   // Whether the CPU printer would evaluate pass (destination w) once per pair without SIMD.
   bool eachPairOncePossible(const DestinationWork& w, const NeighbourPass& pass) const;
   // --report: per pair loop, whether it is in SIMD lanes and why (nothing with the switch off).

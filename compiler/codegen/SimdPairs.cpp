@@ -34,8 +34,9 @@
 // breaks: in the each-pair-once lane form too, stop 36: 1.19-1.24x the scalar step at dx =
 // 0.03, 1.02-1.35x at ~100k, on Intel with gathers; 0.84-0.86 from h = 1.6 dx, ~32). A loop
 // over its own array that is per destination anyway by the scene (a periodic or mirror
-// domain, no zones) goes in the lanes at any count (kSimdPerDestNeighbours; stop 36: 0.84-0.97
-// of the scalar step at ~28 neighbours, 0.79-0.81 for a per-destination loop at ~21); one over
+// domain; zones where every pair body vanishes at the support, stop 38) goes in the lanes at
+// any count (kSimdPerDestNeighbours; stop 36: 0.84-0.97 of the scalar step at ~28 neighbours,
+// 0.79-0.81 for a per-destination loop at ~21; the zones' channel 0.76-0.82); one over
 // another array (walls) keeps the threshold (the dam break's shifting fluid <- boundary in
 // lanes: 1.08-1.10x).
 //
@@ -169,6 +170,28 @@ bool ScenePrinter::eachPairOncePossible(const DestinationWork& w,
   return found;
 }
 
+std::string ScenePrinter::zonesLanesRefusal() const {
+  // The lanes sum a destination's neighbours in another order than the scalar loop, so the
+  // positions differ in their last bits after a step; a pair at the cut-off may then be a
+  // neighbour in one build and not in the other. Harmless (a change of the order of the
+  // round-off) where what a pair adds vanishes at the cut-off (body/SelfPair.cpp,
+  // vanishesAtSupport): not with a kernel that does not vanish there, a loop_all body (it
+  // sees the list), or a loop body that adds a count or an unweighted value.
+  if (plan_.kernel == "Gaussian" || plan_.kernel == "SuperGaussian")
+    return "the kernel " + plan_.kernel + " does not vanish at its support";
+  for (const PlanEquation& eq : plan_.equations) {
+    if (!eq.live || eq.sources.empty()) continue;
+    const auto& methods = plan_.equationDecls[eq.declIndex].methods;
+    if (methods.count(ast::Method::LoopAll))
+      return eq.name + " has a loop_all body (it sees the neighbour list)";
+    auto loop = methods.find(ast::Method::Loop);
+    if (loop != methods.end() && !plan_.bodies[loop->second].facts.vanishesAtSupport)
+      return eq.name + " adds what does not vanish at the support (a pair at the cut-off, in "
+                       "or out by a rounding of the positions, changes its sums by a whole term)";
+  }
+  return "";
+}
+
 ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const DestinationWork& w,
                                                                const NeighbourPass& pass) const {
   std::string how;
@@ -183,9 +206,18 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // measured): scalar as before. A loop over another array (walls) keeps the threshold: most of
   // its destinations have few or no neighbours there (the dam break's fluid <- boundary in
   // lanes: 1.08-1.10x).
-  // Not with zones (inlets, outlets): the channel's TVF scene (examples/channel_inlet_outlet.sph
-  // -D scheme=tvf) gave serial and OpenMP runs that differ in their bits with its loops in
-  // lanes (lit backends/every-example.sph, -single.sph; not found why in stop 36).
+  // With zones (inlets, outlets: the lists are gathered at every evaluation, so the loops
+  // are per destination anyway), with or without a domain, where every pair-loop body of the
+  // scene adds what vanishes at the support (zonesLanesRefusal). Stop 36 left zones out (the channel's TVF
+  // scene's serial and OpenMP bits: GCC's inlining of the kernel, fixed in stop 37); stop 37
+  // found the cylinder in lanes 2.3e-10 of u from OpenCL and the scalar loops after one step
+  // at two particles: its lattice start (h = dx, support 3 h) puts pairs at r = 3 h exactly,
+  // the lanes' sums round the first evaluation's transport acceleration (a near-cancelling
+  // sum) otherwise, one particle moves 1 ulp otherwise, and the pair at the cut-off is in one
+  // build and out in the other: EDACAveragePressure's count and sum of p jump there (p_avg
+  // by 1/26), not the kernel-weighted sums. Stop 38: the channel 0.76-0.82 of the scalar CPU
+  // time, the cylinder (EDACAveragePressure) scalar (docs/performance.md, "Loose ends (stop
+  // 38)").
   // Not where the scalar loop evaluates each pair once with the ghosts kept with the lists
   // (stop 36, CpuPrinter::symmetricPass): Taylor-Green EDAC nx = 100 took 1.05x the CPU of
   // the scalar each-pair-once loops with these two loops per destination in lanes (3.19-3.23
@@ -194,7 +226,8 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
       simdGhostOnce_ && pass.source == w.array &&
       symmetricPairsRefusal(plan_, w, pass, true).empty();
   const bool perDestOwn = !onceAnyway && !ghostOnceScalar && pass.source == w.array &&
-                          plan_.dim >= 2 && simdSymmetricSwitch_ && hasDomain() && !hasZones();
+                          plan_.dim >= 2 && simdSymmetricSwitch_ &&
+                          (hasZones() ? zonesLanesRefusal().empty() : hasDomain());
   // --simd-once-neighbours: a threshold of its own for a loop the lanes print each pair once.
   const bool once = simdOnce_ && onceForm(w, pass) && simdOnceNeighbours_ >= 0;
   const double threshold = once ? simdOnceNeighbours_
@@ -215,6 +248,9 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
     std::snprintf(buf, sizeof buf, "h/dx not known before the run, by the dimension (%s)%s: ",
                   how.c_str(), perDestOwn ? " and the loop (over its own array, per destination anyway)" : "");
   std::string why = buf;
+  if (!perDestOwn && !onceAnyway && !ghostOnceScalar && pass.source == w.array &&
+      plan_.dim >= 2 && simdSymmetricSwitch_ && hasZones() && !lanes)
+    why.insert(why.size() - 2, " (zones: not at any count, " + zonesLanesRefusal() + ")");
   // The CPU the solver is built for (SimdCpu.cpp): where the lanes lose, the scalar loops.
   if (lanes && !simdCpu_.lanes) {
     lanes = false;

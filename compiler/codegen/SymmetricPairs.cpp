@@ -520,6 +520,14 @@ void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const st
     for (size_t k = 0; k < sites.size(); ++k) {
       const std::string K = std::to_string(k), E = eqStruct(*eq);
       const std::string ptr = symmetricDestinationHoisted(E, K);
+      // The same value as an earlier equation's of the pass: its array (Hoist.cpp).
+      const auto same = sameDestinationHoisted(pass, *eq, k);
+      if (!same.first.empty()) {
+        scene_ << "        " << hoistedValueType(b, host_, false, k) << "* const " << ptr
+               << " = " << symmetricDestinationHoisted(same.first, same.second) << ";  // "
+               << eq->name << ": the same value, computed above\n";
+        continue;
+      }
       scene_ << "        dhoist_" << E << "_" << K << ".resize(n);\n";
       scene_ << "        " << hoistedValueType(b, host_, false, k) << "* const " << ptr
              << " = dhoist_" << E << "_" << K << ".data();\n";
@@ -534,6 +542,7 @@ void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const st
       const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
       for (size_t k = 0; k < sites.size(); ++k) {
         const std::string K = std::to_string(k);
+        if (!sameDestinationHoisted(pass, *eq, k).first.empty()) continue;  // filled above
         scene_ << "          " << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx] = "
                << hoistDestinationArgument(eqStruct(*eq), K) << ";\n";
       }
