@@ -26,6 +26,7 @@ the serial backend; --max-particles caps its sizes. --scaling-only: that alone.
 Usage:
   python3 bench/pair_rate.py [--steps 10] [--scenes dambreak2d,cube,...] [--scaling]
                              [--max-particles 1100000] [--sphc build/bin/sphc] [--keep]
+                             [--sphc-opt=--simd-pairs=cluster ...]
 """
 
 import argparse
@@ -71,12 +72,13 @@ def run(cmd, env=None):
     return p.stdout, wall, children_cpu() - c0
 
 
-def build(sphc, scene, tmp, backend="serial"):
+def build(sphc, scene, tmp, backend="serial", sphc_opts=()):
     src, defines = SCENES[scene][0], SCENES[scene][1]
     exe = os.path.join(tmp, scene + "_" + backend)
     env = dict(os.environ)
     env.setdefault("SPHC_CACHE_DIR", os.path.join(tmp, "cache"))
-    run([sphc, os.path.join(ROOT, src), "-o", exe, "--backend=" + backend] + defines, env=env)
+    run([sphc, os.path.join(ROOT, src), "-o", exe, "--backend=" + backend] + defines +
+        list(sphc_opts), env=env)
     return exe
 
 
@@ -147,7 +149,7 @@ def pair_rates(args, tmp):
     rows = []
     for scene in args.scenes.split(","):
         print("%s: compiling ..." % scene, flush=True)
-        exe = build(args.sphc, scene, tmp)
+        exe = build(args.sphc, scene, tmp, sphc_opts=args.sphc_opt)
         out = os.path.join(tmp, scene + "-out")
         extra = ["--tf", "100"]   # the step count decides, not the scene's tf (cube: 5 steps)
         one = solve(exe, 1, extra)
@@ -189,6 +191,9 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--sphc", default=os.path.join(ROOT, "build", "bin", "sphc"))
     ap.add_argument("--steps", type=int, default=10)
+    ap.add_argument("--sphc-opt", action="append", default=[],
+                    help="an sphc option for the pair-rate builds (repeatable), e.g. "
+                         "--sphc-opt=--simd-pairs=cluster")
     ap.add_argument("--scenes", default="dambreak2d,cube,dambreak3d_dualsphysics")
     ap.add_argument("--scaling", action="store_true", help="cost from 10k to 1M particles")
     ap.add_argument("--scaling-only", action="store_true")
