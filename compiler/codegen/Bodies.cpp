@@ -56,6 +56,9 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   // SimdPairs.cpp: each pair once in the lanes (double precision: the pair-shared values).
   simdOnce_ = opts.simdPairsOnce && simdPairs_ && simdSymmetric_ && !singlePrecision_;
   simdCluster_ = opts.simdPairsCluster && simdOnce_;  // ClusterPairs.cpp
+  simdClusterAuto_ = opts.simdPairsClusterAuto;
+  simdClusterWhy_ = opts.simdPairsClusterAuto ? "--simd-pairs=auto: " + opts.simdCpu.tilesWhy
+                                              : std::string("--simd-pairs=cluster");
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in
   // lanes); --simd-pairs=on prints every loop that allows it per destination.
   pairShared_ = opts.pairShared && host_.hoist && (!simdPairs_ || simdAuto_);

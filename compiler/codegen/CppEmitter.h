@@ -127,6 +127,9 @@ struct EmitOptions {
   // precision, 2D and 3D; sphc/cluster_pairs.h),
   // else as simdPairsOnce prints it, the generated code saying why.
   bool simdPairsCluster = false;
+  // --simd-pairs=auto (stop 38): simdPairsCluster set by auto's rule (the CPU's verdict,
+  // SimdCpuVerdict::tiles), for the 3D loops only; a 2D loop stays in the lanes silently.
+  bool simdPairsClusterAuto = false;
   // --simd-neighbours=N: auto's threshold on a loop's expected neighbour count
   // (kSimdAutoNeighbours by default; a measurement knob: 0 puts every loop that allows it in
   // lanes under auto's rule, e.g. with --simd-pairs=once the 2D scenes' loops).

@@ -452,6 +452,8 @@ class ScenePrinter {
   static void clusterTilesMembers(std::ostream& os, const std::string& state,
                                   const std::string& what);
   bool simdCluster_ = false;  // EmitOptions::simdPairsCluster (with simdOnce_)
+  bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops only
+  std::string simdClusterWhy_;    // the report's reason (--simd-pairs=cluster, or auto's)
   // --precision=single: the float local a SIMD loop passes for a body's double argument (t,
   // dt, an equation's scalar: f_t, f_eq2_alpha), converted once before the loop; "" for
   // other parameters.

@@ -18,6 +18,10 @@
 // Rapids, measured) and 143 (Sapphire Rapids, the same cores), with AVX-512F; the scalar
 // loops on other Intel CPUs, without AVX-512F, and on every CPU not measured (the scalar loops
 // were the default before stop 33 on every machine).
+// The cluster-pair tiles (codegen/ClusterPairs.cpp; docs/performance.md, "Cluster-pair tiles
+// under OpenMP (stop 38)") for auto's 3D loops each pair once in lanes: on the Intel models of
+// the lanes (measured on Emerald Rapids: the cube, the 3D dam break and the DualSPHysics
+// scene, serial and OpenMP); not on AMD (not measured: the lanes).
 #include "codegen/SimdCpu.h"
 
 #include <cstdio>
@@ -105,6 +109,9 @@ SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu) {
     v.lanes = true;
     v.why = "on " + cpu.describe() +
             " (Intel Sapphire/Emerald Rapids) the lanes pay with gathers allowed";
+    v.tiles = true;
+    v.tilesWhy = "on " + cpu.describe() +
+                 " the cluster-pair tiles pay in 3D (serial and OpenMP; stop 38)";
   } else if (cpu.vendor == "GenuineIntel") {
     v.lanes = false;
     v.why = "on " + cpu.describe() + " (Intel) the lanes were not measured to pay: the scalar loops";

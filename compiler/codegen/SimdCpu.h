@@ -36,6 +36,10 @@ bool parseSimdCpu(const std::string& text, SimdCpu& cpu, std::string& why);
 struct SimdCpuVerdict {
   bool lanes = true;
   std::string why;
+  // Whether auto prints the 3D loops it puts each pair once in lanes as cluster-pair tiles
+  // (codegen/ClusterPairs.cpp) on `cpu`, and why: where the tiles were measured to pay.
+  bool tiles = false;
+  std::string tilesWhy;
 };
 SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu);
 

@@ -328,14 +328,14 @@ std::vector<std::string> ScenePrinter::simdPairsNotes() const {
     if (!why.empty())
       notes.push_back("pair loop not in SIMD lanes: " + loop + ": " + why);
     else if (onceLanes(w, pass) && clusterTilesRefusal(w, pass).empty())  // ClusterPairs.cpp
-      notes.push_back("pair loop in cluster-pair tiles, each pair once: " + loop +
-                      ": --simd-pairs=cluster");
+      notes.push_back("pair loop in cluster-pair tiles, each pair once: " + loop + ": " +
+                      simdClusterWhy_);
     else if (onceLanes(w, pass))
       notes.push_back("pair loop in SIMD lanes, each pair once: " + loop +
                       ": --simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why +
-                      (simdCluster_ ? " (not in cluster-pair tiles: " +
-                                          clusterTilesRefusal(w, pass) + ")"
-                                    : std::string()));
+                      (clusterTilesRefusal(w, pass) != "off" ? " (not in cluster-pair tiles: " +
+                                                                   clusterTilesRefusal(w, pass) + ")"
+                                                             : std::string()));
     else
       notes.push_back("pair loop in SIMD lanes: " + loop + ": " +
                       (simdAuto_ ? "--simd-pairs=auto: " + simdPairsAutoChoice(w, pass).why

@@ -200,7 +200,9 @@ static cl::opt<std::string> SimdPairs(
              "or mirror domain, zones) at any count; on (or --simd-pairs alone): every loop that allows it; off: the "
              "scalar loops. Under auto a loop in lanes over its own array (kept lists, double "
              "precision) evaluates each pair once in them, the values the pair shares once, "
-             "the source side gathered and scattered (once: the same; perdest: auto's loops "
+             "the source side gathered and scattered; on Intel Sapphire/Emerald Rapids a 3D "
+             "such loop in cluster-pair tiles of 8 x 8 particles instead (stop 38) (once: the "
+             "lanes; perdest: auto's loops "
              "per destination, the default before stop 35; docs/performance.md). --report says "
              "per loop which and why. The sums are reassociated "
              "in the lanes, so results differ from the scalar loop's in the last bits "
@@ -601,9 +603,10 @@ int main(int argc, char** argv) {
   emitOpts.simdPairs = simdMode != "off";
   // auto (= once since stop 35): the loops that pay in lanes, each pair once in them where
   // they may; perdest: the same loops per destination (stops 33-34's auto).
-  // cluster (opt-in, not in the option's help while it is measured; stop 37): auto's loops,
-  // those each pair once in lanes as cluster-pair tiles where they can
-  // (codegen/ClusterPairs.cpp).
+  // cluster (stop 37; not in the option's help): auto's loops, those each pair once in
+  // lanes as cluster-pair tiles where they can (codegen/ClusterPairs.cpp), 2D too and on
+  // any CPU; since stop 38 auto takes the tiles for its 3D loops where the CPU's verdict says
+  // (SimdCpuVerdict::tiles), once keeps the lanes.
   emitOpts.simdPairsAuto = simdMode == "auto" || simdMode == "once" || simdMode == "perdest" ||
                            simdMode == "cluster";
   emitOpts.simdPairsOnce = simdMode == "auto" || simdMode == "once" || simdMode == "cluster";
@@ -631,6 +634,13 @@ int main(int argc, char** argv) {
       emitOpts.simdCpu.lanes = false;
       emitOpts.simdCpu.why = "--cxxflags without -march=native build for a CPU sphc does not "
                              "know (--simd-cpu names it): the scalar loops";
+    }
+    // auto (stop 38): its 3D loops each pair once in lanes as cluster-pair tiles
+    // (codegen/ClusterPairs.cpp, where they can) on a CPU where the tiles were measured to pay
+    // (codegen/SimdCpu.cpp); --simd-pairs=once keeps the lanes.
+    if (simdMode == "auto" && emitOpts.simdCpu.lanes && emitOpts.simdCpu.tiles) {
+      emitOpts.simdPairsCluster = true;
+      emitOpts.simdPairsClusterAuto = true;
     }
     if (Verbose && emitOpts.simdPairsAuto && emitOpts.simdPairs &&
         Backend != sphc::Backend::OpenCL && !Mpi)  // the CPU backends' lanes

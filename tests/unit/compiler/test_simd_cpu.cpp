@@ -55,6 +55,28 @@ TEST(SimdCpu, LanesWhereMeasuredToPay) {
   EXPECT_FALSE(lanes("AuthenticAMD:26:2:noavx512"));
 }
 
+// auto's cluster-pair tiles for its 3D loops (stop 38): where they were measured to pay, the
+// Intel models of the lanes; not on AMD (not measured), nor where the lanes are refused.
+TEST(SimdCpu, TilesWhereMeasuredToPay) {
+  auto tiles = [](const char* text) {
+    SimdCpu cpu;
+    std::string why;
+    EXPECT_TRUE(parseSimdCpu(text, cpu, why)) << text;
+    const SimdCpuVerdict v = simdLanesOnCpu(cpu);
+    if (v.tiles) {
+      EXPECT_TRUE(v.lanes) << text;
+      EXPECT_NE(v.tilesWhy.find(cpu.describe()), std::string::npos) << v.tilesWhy;
+    }
+    return v.tiles;
+  };
+  EXPECT_TRUE(tiles("GenuineIntel:6:207"));    // Emerald Rapids (stop 38: measured)
+  EXPECT_TRUE(tiles("GenuineIntel:6:143"));    // Sapphire Rapids: the same cores
+  EXPECT_FALSE(tiles("AuthenticAMD:26:2"));    // Zen 5: the lanes (tiles not measured)
+  EXPECT_FALSE(tiles("GenuineIntel:6:85"));
+  EXPECT_FALSE(tiles("GenuineIntel:6:207:noavx512"));
+  EXPECT_FALSE(tiles("HygonGenuine:24:0"));
+}
+
 TEST(SimdCpu, HostIsReadOnX86) {
   const SimdCpu cpu = hostSimdCpu();
   EXPECT_EQ(cpu.origin, "this machine");
