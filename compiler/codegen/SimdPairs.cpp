@@ -224,7 +224,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // the threshold goes to the lanes where the tiles take it (clusterTilesFormRefusal), to be
   // printed as tiles, never as lanes (the lanes lose in 2D; a loop the tiles refuse keeps the
   // scalar loop). Not auto's rule: the tiles took 0.76x of the default's CPU on the dam break
-  // with PySPH's effects at dx = 0.03 but 1.06-1.11x at ~100k particles (docs/performance.md,
+  // with PySPH's effects at dx = 0.03 but 1.04-1.11x at ~100k particles (docs/performance.md,
   // "Cluster-pair tiles for the 2D scenes (stop 38)").
   if (!lanes && simdCluster_ && !simdClusterAuto_ && plan_.dim == 2 && simdCpu_.lanes &&
       onceForm(w, pass) && clusterTilesFormRefusal(w, pass).empty())
