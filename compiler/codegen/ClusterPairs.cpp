@@ -100,6 +100,13 @@ std::string ScenePrinter::clusterTilesRefusal(const DestinationWork& w,
   if (!simdCluster_) return "off";
   if (simdClusterAuto_ && plan_.dim != 3) return "off";  // auto: the 3D loops (measured there)
   if (!onceLanes(w, pass)) return "not each pair once in SIMD lanes";
+  return clusterTilesFormRefusal(w, pass);
+}
+
+// Everything but the switch and the lanes (onceLanes): --simd-pairs=cluster's choice of the
+// 2D loops asks it before they are in the lanes (SimdPairs.cpp, simdPairsAutoChoice; stop 38).
+std::string ScenePrinter::clusterTilesFormRefusal(const DestinationWork& w,
+                                                  const NeighbourPass& pass) const {
   if (plan_.dim < 2) return "a 1D scene";
   const int d = w.array;
   auto oneDouble = [&](const std::string& p) -> std::string {

@@ -47,8 +47,8 @@ class CpuPrinter : public ScenePrinter {
   }
   // --simd-pairs=cluster (codegen/ClusterPairs.cpp): the base's conditions, then the CPU
   // printer's: serial, the fixed skin, kept lists of the pass's own.
-  std::string clusterTilesRefusal(const DestinationWork& w,
-                                  const NeighbourPass& pass) const override;
+  std::string clusterTilesFormRefusal(const DestinationWork& w,
+                                      const NeighbourPass& pass) const override;
   bool anyClusterTiles() const {
     bool any = false;
     walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
@@ -640,9 +640,9 @@ std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(
   return found;
 }
 
-std::string CpuPrinter::clusterTilesRefusal(const DestinationWork& w,
-                                            const NeighbourPass& pass) const {
-  std::string why = ScenePrinter::clusterTilesRefusal(w, pass);
+std::string CpuPrinter::clusterTilesFormRefusal(const DestinationWork& w,
+                                                const NeighbourPass& pass) const {
+  std::string why = ScenePrinter::clusterTilesFormRefusal(w, pass);
   if (!why.empty()) return why;
   if (tuned()) return "--verlet-skin=auto (the tiles take the fixed skin's radius)";
   if (!verlet()) return "no kept lists";

@@ -445,8 +445,12 @@ class ScenePrinter {
   // Why the pass (destination w) that onceLanes() prints each pair once in lanes is not
   // printed as cluster-pair tiles, "" if it is ("off" without the switch). The CPU printer
   // adds its own conditions (kept lists shared with another pass, the tuned skin).
-  virtual std::string clusterTilesRefusal(const DestinationWork& w,
-                                          const NeighbourPass& pass) const;
+  std::string clusterTilesRefusal(const DestinationWork& w, const NeighbourPass& pass) const;
+  // The same without the switch and the lanes (the bodies, the properties; the CPU printer's
+  // conditions): for --simd-pairs=cluster's choice of the 2D loops (simdPairsAutoChoice),
+  // which puts a loop in the lanes only where the tiles take it.
+  virtual std::string clusterTilesFormRefusal(const DestinationWork& w,
+                                              const NeighbourPass& pass) const;
   // The pass as cluster-pair tiles (in emitSymmetricPass's place, after the kept lists'
   // rebuild check: verlet_build): the cluster layout and list at a rebuild, the slot-order
   // copies, the pruned list, the tiles, the sums added back. `state`: the prefix of its

@@ -256,6 +256,15 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
     lanes = false;
     why.replace(why.size() - 2, 2, ", but " + simdCpu_.why + ": ");
   }
+  // --simd-pairs=cluster (opt-in; stop 38): a 2D loop each pair once over its own array below
+  // the threshold goes to the lanes where the tiles take it (clusterTilesFormRefusal), to be
+  // printed as tiles, never as lanes (the lanes lose in 2D; a loop the tiles refuse keeps the
+  // scalar loop). Not auto's rule: the tiles took 0.76x of the default's CPU on the dam break
+  // with PySPH's effects at dx = 0.03 but 1.04-1.11x at ~100k particles (docs/performance.md,
+  // "Cluster-pair tiles for the 2D scenes (stop 38)").
+  if (!lanes && simdCluster_ && !simdClusterAuto_ && plan_.dim == 2 && simdCpu_.lanes &&
+      onceForm(w, pass) && clusterTilesFormRefusal(w, pass).empty())
+    return {true, why + "in cluster-pair tiles at any count (--simd-pairs=cluster)"};
   if (onceAnyway || ghostOnceScalar)
     why += lanes ? (simdOnce_ && pass.source == w.array ? "the lanes pay, each pair once in them"
                                                          : "the lanes pay more than each pair once")

@@ -604,8 +604,9 @@ int main(int argc, char** argv) {
   // auto (= once since stop 35): the loops that pay in lanes, each pair once in them where
   // they may; perdest: the same loops per destination (stops 33-34's auto).
   // cluster (stop 37; not in the option's help): auto's loops, those each pair once in
-  // lanes as cluster-pair tiles where they can (codegen/ClusterPairs.cpp), 2D too and on
-  // any CPU; since stop 38 auto takes the tiles for its 3D loops where the CPU's verdict says
+  // lanes as cluster-pair tiles where they can (codegen/ClusterPairs.cpp), 2D too (there,
+  // since stop 38, every loop each pair once the tiles take, at any neighbour count:
+  // SimdPairs.cpp) and on any CPU; since stop 38 auto takes the tiles for its 3D loops where the CPU's verdict says
   // (SimdCpuVerdict::tiles), once keeps the lanes.
   emitOpts.simdPairsAuto = simdMode == "auto" || simdMode == "once" || simdMode == "perdest" ||
                            simdMode == "cluster";
