@@ -414,46 +414,89 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
   // The reductions' per-particle values: in the post_loop kernel where the schedule says so
   // (DestinationWork::reduceInPostLoop), else a kernel each.
   auto reduceSlot = [&](size_t i) { return std::to_string(kReduceSlot + i); };
-  auto perParticle = [&](ast::Method::Kind kind, const char* what) {
+  // A per-particle method's kernel (initialize with the work fused into it, post_loop with
+  // the reductions' values): its arguments and its calls, in its own kernel or in a pass's.
+  auto particleWork = [&](ast::Method::Kind kind) -> const std::vector<const PlanEquation*>& {
+    static const std::vector<const PlanEquation*> none;
     const bool init = kind == ast::Method::Initialize;
-    const std::vector<const PlanEquation*>& with = init ? w.initialize : w.postLoop;
-    if (with.empty()) return;
     // Moved by the schedule into a later phase's initialize kernel on the same array.
-    if (init ? w.initializeMoved : w.postLoopMoved) {
-      scene_ << "      // " << what << ": fused into the next initialize kernel on " << D << "\n";
-      return;
-    }
-    const std::vector<MovedWork> none;
-    const std::vector<MovedWork>& first = init ? w.initializeFirst : none;
-    const bool reduce = !init && w.reduceInPostLoop;
-    KernelArgs ka;
-    for (const MovedWork& mw : first) addBodyArgs(ka, methodBody(*mw.equation, mw.method), d, -1, eqStruct(*mw.equation));
-    for (const auto* eq : with) addBodyArgs(ka, methodBody(*eq, kind), d, -1, eqStruct(*eq));
-    if (reduce)
+    if (init ? w.initializeMoved : w.postLoopMoved) return none;
+    return init ? w.initialize : w.postLoop;
+  };
+  auto particleArgs = [&](ast::Method::Kind kind, KernelArgs& ka) {
+    const bool init = kind == ast::Method::Initialize;
+    if (init)
+      for (const MovedWork& mw : w.initializeFirst)
+        addBodyArgs(ka, methodBody(*mw.equation, mw.method), d, -1, eqStruct(*mw.equation));
+    for (const auto* eq : particleWork(kind)) addBodyArgs(ka, methodBody(*eq, kind), d, -1, eqStruct(*eq));
+    if (!init && w.reduceInPostLoop)
       for (size_t i = 0; i < w.reductions.size(); ++i) {
         const PlanEquation* eq = w.reductions[i].equation;
         addBodyArgs(ka, methodBody(*eq, ast::Method::Reduce), d, -1, eqStruct(*eq));
         ka.add("__global real* reduce_values_" + std::to_string(i), "ocl.scratch(n, " + reduceSlot(i) + ")",
                "reduce_values_" + std::to_string(i));
       }
-    std::string k = name + "_" + D + "_" + what;
-    rangeArg(w, ka);
-    // Provenance of the fused work: the phases it comes from.
-    for (const MovedWork& mw : first)
-      cl_ << "// fused: " << mw.equation->name << "." << (mw.method == ast::Method::Initialize ? "initialize" : "post_loop")
-          << " of " << mw.phase << " (nothing between reads or writes " << D << ")\n";
-    if (reduce) cl_ << "// fused: the reductions' values of this phase\n";
-    beginKernel(k, ka);
-    rangeGuard(w);
-    for (const MovedWork& mw : first) cl_ << "  " << equationCall(*mw.equation, mw.method, d, "_");
-    for (const auto* eq : with) cl_ << "  " << equationCall(*eq, kind, d, "_");
-    if (reduce)
+  };
+  auto particleComments = [&](ast::Method::Kind kind) {
+    if (kind == ast::Method::Initialize) {
+      // Provenance of the fused work: the phases it comes from.
+      for (const MovedWork& mw : w.initializeFirst)
+        cl_ << "// fused: " << mw.equation->name << "." << (mw.method == ast::Method::Initialize ? "initialize" : "post_loop")
+            << " of " << mw.phase << " (nothing between reads or writes " << D << ")\n";
+    } else if (w.reduceInPostLoop) {
+      cl_ << "// fused: the reductions' values of this phase\n";
+    }
+  };
+  auto particleCalls = [&](ast::Method::Kind kind) {
+    if (kind == ast::Method::Initialize)
+      for (const MovedWork& mw : w.initializeFirst) cl_ << "  " << equationCall(*mw.equation, mw.method, d, "_");
+    for (const auto* eq : particleWork(kind)) cl_ << "  " << equationCall(*eq, kind, d, "_");
+    if (kind != ast::Method::Initialize && w.reduceInPostLoop)
       for (size_t i = 0; i < w.reductions.size(); ++i)
         cl_ << "  reduce_values_" << i << "[d_idx] = "
             << equationCall(*w.reductions[i].equation, ast::Method::Reduce, d, "_");
+  };
+  // The initialize kernel joins the first neighbour pass, and the post_loop kernel the last,
+  // when that pass's source is another array: its kernel then reads and writes the
+  // destination at d_idx only (the source's data are not written), so the per-particle work
+  // of a work item before (after) its own neighbour loop is the separate kernel's, bit for
+  // bit; both run over the same particles (rangeEnd, the same start_idx guard).
+  auto ownKernelPass = [&](const NeighbourPass* p) {
+    return p && p->searches() && p->source != d;
+  };
+  const NeighbourPass* prologuePass =
+      !w.passes.empty() && w.passes.front().initializePair.empty() && !particleWork(ast::Method::Initialize).empty()
+          ? &w.passes.front() : nullptr;
+  if (!ownKernelPass(prologuePass)) prologuePass = nullptr;
+  const NeighbourPass* epiloguePass =
+      !w.passes.empty() && !particleWork(ast::Method::PostLoop).empty() ? &w.passes.back() : nullptr;
+  if (!ownKernelPass(epiloguePass)) epiloguePass = nullptr;
+  auto perParticle = [&](ast::Method::Kind kind, const char* what) {
+    const bool init = kind == ast::Method::Initialize;
+    const std::vector<const PlanEquation*>& with = init ? w.initialize : w.postLoop;
+    if (with.empty()) return;
+    if (init ? w.initializeMoved : w.postLoopMoved) {
+      scene_ << "      // " << what << ": fused into the next initialize kernel on " << D << "\n";
+      return;
+    }
+    if (init ? prologuePass != nullptr : epiloguePass != nullptr) {
+      scene_ << "      // " << what << ": in the kernel of the neighbour pass " << D << " <- "
+             << arr((init ? prologuePass : epiloguePass)->source).name << "\n";
+      return;
+    }
+    const bool reduce = !init && w.reduceInPostLoop;
+    const bool fusedFirst = init && !w.initializeFirst.empty();
+    KernelArgs ka;
+    particleArgs(kind, ka);
+    std::string k = name + "_" + D + "_" + what;
+    rangeArg(w, ka);
+    particleComments(kind);
+    beginKernel(k, ka);
+    rangeGuard(w);
+    particleCalls(kind);
     cl_ << "}\n\n";
     scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // " << what
-           << (first.empty() ? "" : " (with fused work of earlier phases)")
+           << (fusedFirst ? " (with fused work of earlier phases)" : "")
            << (reduce ? " (with the reductions' values)" : "") << "\n";
   };
   perParticle(ast::Method::Initialize, "initialize");
@@ -494,10 +537,23 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
       ka.add("__global const real* di_" + p, devBuffer(d, p), "di_" + p);
       ka.add("__global const real* sj_" + p, devBuffer(s, p), "sj_" + p);
     }
+    const bool prologue = &pass == prologuePass, epilogue = &pass == epiloguePass;
+    if (prologue) particleArgs(ast::Method::Initialize, ka);
+    if (epilogue) particleArgs(ast::Method::PostLoop, ka);
     ka.add("SPHC_CELLS_ARGS(cells)", "cells_" + S, "cells");
     ka.add("SPHC_GRID_ARGS", "grid", "grid");
     std::string k = name + "_" + D + "_from_" + S;
     cl_ << "// neighbours: " << D << " <- " << S << "\n";
+    if (prologue) {
+      particleComments(ast::Method::Initialize);
+      cl_ << "// fused: the initialize kernel of " << D << " (the pass reads " << D
+          << " at d_idx only)\n";
+    }
+    if (epilogue) {
+      particleComments(ast::Method::PostLoop);
+      cl_ << "// fused: the post_loop kernel of " << D << " (the pass reads " << D
+          << " at d_idx only)\n";
+    }
     rangeArg(w, ka);
     if (all)
       cl_ << "#define SPHC_MAX_NBRS " << kMaxNbrs << "  // loop_all's neighbour list\n";
@@ -506,6 +562,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
       cl_ << "  if (d_idx < d_begin) { nbrs_count[d_idx] = 0; return; }  // start_idx\n";
     else
       rangeGuard(w);
+    if (prologue) particleCalls(ast::Method::Initialize);
     emitDestLocals(cl_, "  ", q, device_);
     // The 3^dim cells around the particle's cell, by z, y, x (the CPU candidate order).
     const char* axes[3] = {"x", "y", "z"};
@@ -538,10 +595,12 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
       emitCandidate(cl_, q, pass.equations, d, device_);
       cl_ << "    }\n  }\n";
     }
+    if (epilogue) particleCalls(ast::Method::PostLoop);
     cl_ << "}\n";
     if (all) cl_ << "#undef SPHC_MAX_NBRS\n";
     cl_ << "\n";
     scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // neighbours: " << D << " <- " << S
+           << (prologue ? ", after initialize" : "") << (epilogue ? ", then post_loop" : "")
            << "\n";
     if (all)
       scene_ << "      sphc::ocl::check_neighbour_lists(ocl, ocl.scratch(" << rangeEnd(w)
