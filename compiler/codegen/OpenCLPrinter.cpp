@@ -159,6 +159,12 @@ class OpenCLPrinter : public ScenePrinter {
   std::string extentSources() const;
   // The extents of the arrays in neighbour loops, for ocl.search_domain / ocl.make_grid.
   std::string deviceExtents(const std::string& indent) const;
+  // Whether stepper run `r`'s kernels compute the search domain's extents for the neighbour
+  // update that follows it (foldsExtents), and whether any run does.
+  bool foldsExtents(int r) const;
+  bool anyFoldsExtents() const;
+  // The scratch slot of those extents' partial results (Context::scratch).
+  static constexpr int kExtentSlot = -4;
 };
 
 void OpenCLPrinter::deviceKernelFunctions() {
@@ -219,6 +225,10 @@ void OpenCLPrinter::searchMembers() {
   out_ << "  sphc::ocl::Context ocl;\n";
   for (const auto& a : plan_.arrays) out_ << "  sphc::ocl::DeviceArray dev_" << a.name << ";\n";
   out_ << "  sphc::ocl::Grid grid;\n";
+  if (anyFoldsExtents())
+    out_ << "  // > 0: the rows of extents that the last stepper run's kernels computed, for the\n"
+            "  // next neighbour update (0: it computes them itself).\n"
+            "  std::size_t extent_rows = 0;\n";
   for (const auto& S : sourceArrays_) out_ << "  sphc::ocl::CellTable cells_" << S << ";\n";
   if (keptCells_ && !sourceArrays_.empty() && !hasDomain()) {
     char skin[64];
@@ -279,9 +289,19 @@ std::string OpenCLPrinter::cellTablesBuild(
 // start/end). Positions never leave the device.
 void OpenCLPrinter::updateNeighbours() {
   if (keptCells_ && !sourceArrays_.empty()) return updateNeighboursKept();
-  if (!loopArrays_.empty())
+  if (!loopArrays_.empty() && anyFoldsExtents()) {
+    scene_ << "    if (extent_rows > 0) {  // from the stepper run's kernels\n"
+           << "      grid = ocl.grid_of_extents(ocl.scratch(7 * extent_rows, " << kExtentSlot
+           << "), extent_rows, DIM, Kernel::radius_scale);\n"
+           << "      extent_rows = 0;\n"
+           << "    } else {\n"
+           << "      grid = ocl.make_grid(" << deviceExtents("                            ")
+           << ", DIM, Kernel::radius_scale);\n"
+           << "    }\n";
+  } else if (!loopArrays_.empty()) {
     scene_ << "    grid = ocl.make_grid(" << deviceExtents("                          ")
            << ", DIM, Kernel::radius_scale);\n";
+  }
   // Every REORDER_EVERY builds the particles are sorted in cell order on the device, as
   // on the CPU (same grid, same order), so outputs list particles in the same order.
   if (anyReorders())
@@ -353,6 +373,48 @@ void OpenCLPrinter::updateNeighboursKept() {
   scene_ << cellTablesBuild(all, "    ");
   scene_ << "    kept.built(ocl, " << deviceExtents(std::string(20, ' ')) << ",\n"
          << std::string(20, ' ') << extentSources() << ");\n";
+}
+
+// A stepper run folds the extents when every statement that calls it is followed by a
+// neighbour update with nothing between that could move particles: the next statement (past
+// update_domain, which does nothing without a periodic or mirror domain) is
+// compute_accelerations, or it is the step's last and post_step runs its update at every step
+// (no `every` group). Only without a domain (the ghosts' update has its own extents), without
+// inlet/outlet (arrays change size), without --kept-cells (its kernel tests displacements),
+// and when the run has a kernel for every array in a neighbour loop. Every other run sets
+// extent_rows to 0, so an update never uses extents older than the last positions.
+bool OpenCLPrinter::foldsExtents(int r) const {
+  if (hasDomain() || keptCells_ || loopArrays_.empty()) return false;
+  const StepperRun& run = sched_.stepperRuns[r];
+  for (const std::string& A : loopArrays_) {
+    bool has = false;
+    for (const StepperRun::Part& part : run.parts) has |= arr(part.array).name == A;
+    if (!has) return false;
+  }
+  const std::vector<StepStatement>& st = sched_.step;
+  bool called = false;
+  for (size_t i = 0; i < st.size(); ++i) {
+    if (st[i].kind == StepStatement::InletOutlet) return false;
+    if (st[i].kind != StepStatement::Stepper || st[i].run != r) continue;
+    called = true;
+    size_t j = i + 1;
+    while (j < st.size() && st[j].kind == StepStatement::UpdateDomain) ++j;
+    if (j < st.size()) {
+      if (st[j].kind != StepStatement::ComputeAccelerations) return false;
+      continue;
+    }
+    // The step's last statement: post_step's update follows, when it runs at every step.
+    if (sched_.postStep.empty() || !sched_.postStepNeighbours) return false;
+    for (const auto& ps : sched_.postStep)
+      if (ps.group->every) return false;
+  }
+  return called;
+}
+
+bool OpenCLPrinter::anyFoldsExtents() const {
+  for (size_t r = 0; r < sched_.stepperRuns.size(); ++r)
+    if (!sched_.stepperRuns[r].parts.empty() && foldsExtents(static_cast<int>(r))) return true;
+  return false;
 }
 
 // A run of stepper statements: its function, with each statement's time.
@@ -651,12 +713,36 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
 // A run of stepper statements (the schedule's StepperRun): per array one kernel doing the
 // run's methods in turn on each particle, each at its statement's time t_<k> (steppers read
 // and write their own particle only, so this equals a kernel per method, bit for bit).
+// Where the run is followed by a neighbour update (foldsExtents), each array's kernel also
+// computes the search domain's extents of its particles after its stepper bodies
+// (sphc_extent_group, in work groups of Context::kGroup items), which saves the update's
+// extents kernel: the update reads the rows of partial results (Context::grid_of_extents).
 void OpenCLPrinter::steppers() {
-  for (const StepperRun& run : sched_.stepperRuns) {
+  for (size_t ri = 0; ri < sched_.stepperRuns.size(); ++ri) {
+    const StepperRun& run = sched_.stepperRuns[ri];
     if (run.parts.empty()) continue;
+    const bool fold = foldsExtents(static_cast<int>(ri));
     scene_ << "  void " << run.name << "(";
     for (size_t k = 0; k < run.methods.size(); ++k) scene_ << "double t_" << k << ", ";
     scene_ << "double dt) {\n";
+    std::string rows;  // the rows of every array's groups, as an expression
+    if (fold) {
+      scene_ << "    // The search domain's extents, computed by these kernels for the neighbour update\n"
+             << "    // that follows (a row of partial results per work group).\n";
+      for (const StepperRun::Part& part : run.parts) {
+        if (!loopArrays_.count(arr(part.array).name)) continue;
+        const std::string& A = arr(part.array).name;
+        scene_ << "    const std::size_t rows_" << A << " = sphc::ocl::Context::groups(" << A
+               << ".n);\n";
+      }
+      for (const StepperRun::Part& part : run.parts)
+        if (loopArrays_.count(arr(part.array).name))
+          rows += (rows.empty() ? "" : " + ") + std::string("rows_") + arr(part.array).name;
+      scene_ << "    cl_mem extents = ocl.scratch(7 * (" << rows << "), " << kExtentSlot << ");\n";
+    } else if (anyFoldsExtents()) {
+      scene_ << "    extent_rows = 0;  // positions may change: the update computes its extents\n";
+    }
+    std::string rowBefore = "0";  // the rows of the arrays before this one
     // A statement's time is unused when no array's stepper has its method.
     for (size_t k = 1; k < run.methods.size(); ++k) {
       bool used = false;
@@ -678,18 +764,58 @@ void OpenCLPrinter::steppers() {
         if (k > 0) ka.add("const real " + tk, tk, tk);  // t_0 is the kernel's t
         addBodyArgs(ka, *b, part.array, -1, "");
       }
+      const bool extents = fold && loopArrays_.count(A.name);
+      const char* axes[3] = {"x", "y", "z"};
+      if (extents) {
+        for (int a = 0; a < plan_.dim; ++a)
+          ka.add(std::string("__global const real* ext_") + axes[a], devBuffer(part.array, axes[a]),
+                 std::string("d_") + axes[a]);
+        ka.add("__global const real* ext_h", devBuffer(part.array, "h"), "d_h");
+        ka.add("__global real* extent_partial", "extents", "extent_partial");
+        ka.add("const uint extent_row", "static_cast<unsigned>(" + rowBefore + ")", "extent_row");
+      }
       std::string kn = run.name + "_" + A.name;
-      cl_ << "// " << A.name << ": " << stepper << methods << " (a run of the step)\n";
-      beginKernel(kn, ka);
+      cl_ << "// " << A.name << ": " << stepper << methods << " (a run of the step)"
+          << (extents ? ", then the extents of its particles" : "") << "\n";
+      if (extents) {
+        cl_ << "__attribute__((reqd_work_group_size(SPHC_GROUP, 1, 1)))\n";
+        beginKernel(kn, ka, /*guard=*/false);
+        cl_ << "  __local real extent_local[7 * SPHC_GROUP];\n"
+               "  const int d_idx = get_global_id(0);\n"
+               "  if (d_idx < n) {\n";
+      } else {
+        beginKernel(kn, ka);
+      }
+      const std::string in = extents ? "    " : "  ";
       for (const auto& [k, b] : part.bodies)
-        cl_ << "  "
+        cl_ << in
             << callBody(bodyFunctionName(stepper, run.methods[k]), *b, part.array, "",
                         k == 0 ? std::string("t") : "t_" + std::to_string(k), "_")
             << ";\n";
+      if (extents) {
+        // The kernel's own buffer of an axis, else the argument added above.
+        auto buf = [&](const std::string& p) {
+          const std::string& decl = ka.decls[ka.at.at("d_" + p)];
+          const std::string own = " d_" + p;
+          return decl.size() >= own.size() && decl.compare(decl.size() - own.size(), own.size(), own) == 0
+                     ? "d_" + p : "ext_" + p;
+        };
+        cl_ << "  }\n  sphc_extent_group(d_idx < n, " << plan_.dim << ", d_idx, " << buf("x") << ", "
+            << (plan_.dim > 1 ? buf("y") : buf("x")) << ", " << (plan_.dim > 2 ? buf("z") : buf("x"))
+            << ", " << buf("h") << ", extent_local, extent_partial + 7 * extent_row);\n";
+      }
       cl_ << "}\n\n";
       // The kernel's t is the run's first statement's time.
-      scene_ << "      " << launch(kn, "n", ka, "t_0") << "\n    }\n";
+      if (extents) {
+        std::string l = launch(kn, "n", ka, "t_0");
+        l.replace(0, std::string("ocl.run(").size(), "ocl.run_grouped(");
+        scene_ << "      " << l << "\n    }\n";
+        rowBefore = rowBefore == "0" ? "rows_" + A.name : rowBefore + " + rows_" + A.name;
+      } else {
+        scene_ << "      " << launch(kn, "n", ka, "t_0") << "\n    }\n";
+      }
     }
+    if (fold) scene_ << "    extent_rows = " << rows << ";\n";
     scene_ << "  }\n\n";
   }
 }

@@ -341,6 +341,44 @@ __kernel void sphc_extent_moved(const int dim, const uint na, __global const rea
   partial[7] = moved;
 }
 
+// The search domain's extents computed by a scene kernel that visits the particles anyway
+// (sphc --backend=opencl: a stepper run's kernel before a neighbour update), in work groups
+// of SPHC_GROUP items (the kernel's reqd_work_group_size; every item of a group calls this,
+// past its own particle's work: it holds barriers): item i (valid: i < n) gives its finite
+// coordinates and h, the group's minima and maxima go to partial[7 * group + 0..6] (lo, hi
+// per axis, max h: the layout of sphc_extent's partial results), the host takes those of all
+// groups (Context::grid_of_extents). Minima and maxima are exact, so the grid is the one of
+// sphc_extent, bit for bit.
+#define SPHC_GROUP 64
+inline void sphc_extent_group(const int valid, const int dim, const int i,
+                              __global const real* x, __global const real* y,
+                              __global const real* z, __global const real* h,
+                              __local real* s, __global real* partial) {
+  const int l = get_local_id(0);
+  real v[7] = {INFINITY, -INFINITY, INFINITY, -INFINITY, INFINITY, -INFINITY, -INFINITY};
+  if (valid) {
+    const real c[3] = {x[i], dim > 1 ? y[i] : (real)0, dim > 2 ? z[i] : (real)0};
+    for (int a = 0; a < dim; ++a)
+      if (isfinite(c[a])) {
+        v[2 * a] = c[a];
+        v[2 * a + 1] = c[a];
+      }
+    if (isfinite(h[i])) v[6] = h[i];
+  }
+  for (int k = 0; k < 7; ++k) s[k * SPHC_GROUP + l] = v[k];
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (int w = SPHC_GROUP / 2; w > 0; w >>= 1) {
+    if (l < w)
+      for (int k = 0; k < 7; ++k) {
+        const real a = s[k * SPHC_GROUP + l], b = s[k * SPHC_GROUP + l + w];
+        s[k * SPHC_GROUP + l] = k == 0 || k == 2 || k == 4 ? fmin(a, b) : fmax(a, b);
+      }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (l == 0)
+    for (int k = 0; k < 7; ++k) partial[7 * get_group_id(0) + k] = s[k * SPHC_GROUP];
+}
+
 // Partial reductions: work item g combines v[g], v[g + G], ... (G work items).
 __kernel void sphc_reduce(__global const real* v, const uint n, const int op,
                           const int finite_only, const uint offset, __global real* partial) {
@@ -784,6 +822,19 @@ SearchDomain Context::search_domain(const std::vector<Extent>& arrays, int dim,
   // As sphc::make_search_domain, so that in double precision the grid, hence the cell order
   // and the particle order after a reorder, is the CPU one.
   return search_domain_of_box(lo, hi, hmax, dim, radius_scale);
+}
+
+void Context::launch_group(cl_kernel k, std::size_t n, const std::string& name) {
+  std::size_t local = kGroup;
+  enqueue(k, groups(n) * kGroup, &local, name);
+}
+
+Grid Context::grid_of_extents(cl_mem partial, std::size_t rows, int dim, double radius_scale) {
+  std::vector<double> values(7 * rows);
+  read_reals(partial, values.data(), values.size());
+  double lo[3], hi[3], hmax;
+  combine_extents(values, 7, dim, lo, hi, hmax);
+  return grid_of(search_domain_of_box(lo, hi, hmax, dim, radius_scale));
 }
 
 Grid Context::grid_of(const SearchDomain& dom) const {

@@ -179,6 +179,23 @@ class Context {
   Grid make_grid(const std::vector<Extent>& arrays, int dim, double radius_scale) {
     return grid_of(search_domain(arrays, dim, radius_scale));
   }
+  // Kernels that reduce within work groups (sphc_extent_group) run in groups of kGroup work
+  // items (their reqd_work_group_size, SPHC_GROUP in the runtime's OpenCL C): groups(n) of
+  // them for n particles, one row of partial results each.
+  static constexpr std::size_t kGroup = 64;
+  static std::size_t groups(std::size_t n) { return (n + kGroup - 1) / kGroup; }
+  // As run, in work groups of exactly kGroup work items.
+  template <class... A>
+  void run_grouped(const std::string& name, std::size_t n, const A&... args) {
+    if (n == 0) return;
+    cl_kernel k = kernel(name);
+    cl_uint i = 0;
+    (set_arg(k, i, args), ...);
+    launch_group(k, n, name);
+  }
+  // make_grid from extents that scene kernels computed (sphc_extent_group): `rows` rows of 7
+  // partial results in `partial`; the same grid as make_grid's over the same particles.
+  Grid grid_of_extents(cl_mem partial, std::size_t rows, int dim, double radius_scale);
   void finish();
   // Copies n reals from the device into doubles (blocking).
   void read_reals(cl_mem m, double* out, std::size_t n);
@@ -195,6 +212,8 @@ class Context {
   // As launch, in work groups of `local` work items (fewer where the device allows fewer
   // for k).
   void launch_local(cl_kernel k, std::size_t n, std::size_t local, const std::string& name);
+  // As launch, in work groups of exactly kGroup work items.
+  void launch_group(cl_kernel k, std::size_t n, const std::string& name);
   bool profiling() const { return profile_; }
   // Kernel launches so far (every launch through `launch`: the scene's kernels, the neighbour
   // search's, reductions), for --timing's launches_per_step.
