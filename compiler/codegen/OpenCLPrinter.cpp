@@ -114,6 +114,8 @@ class OpenCLPrinter : public ScenePrinter {
   // The scratch slots of a destination's reductions' per-particle values (one each: the
   // post_loop kernel may compute them all).
   static constexpr int kReduceSlot = 8;
+  // ... and of their work groups' results, where the kernel reduces within its groups.
+  static constexpr int kGroupReduceSlot = 32;
 
   // Kernel arguments: declarations in the kernel, expressions on the host.
   struct KernelArgs {
@@ -478,6 +480,39 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
   auto reduceSlot = [&](size_t i) { return std::to_string(kReduceSlot + i); };
   // A per-particle method's kernel (initialize with the work fused into it, post_loop with
   // the reductions' values): its arguments and its calls, in its own kernel or in a pass's.
+  // Min and max reductions whose values the post_loop kernel computes are reduced within its
+  // work groups (sphc_group_reduce, groups of Context::kGroup items), the host combines the
+  // groups' results: no reduction kernel. Minima and maxima are exact: the same values.
+  bool groupReduce = w.reduceInPostLoop && !w.ranged() && !w.reductions.empty();
+  for (const Reduction& r : w.reductions) {
+    const std::string& op = plan_.equationDecls[r.equation->declIndex].reduceOp;
+    if (op != "max" && op != "min") groupReduce = false;
+  }
+  auto reduceIsMax = [&](size_t i) {
+    return plan_.equationDecls[w.reductions[i].equation->declIndex].reduceOp == "max";
+  };
+  auto groupSlot = [&](size_t i) { return std::to_string(kGroupReduceSlot + i); };
+  auto groupPartial = [&](size_t i) {
+    return "ocl.scratch(sphc::ocl::Context::groups(n), " + groupSlot(i) + ")";
+  };
+  // The kernel that computes them: in groups, every work item past its particle's work.
+  auto groupBegin = [&]() {
+    cl_ << "  __local real reduce_local[SPHC_GROUP];\n";
+    for (size_t i = 0; i < w.reductions.size(); ++i)
+      cl_ << "  real reduce_value_" << i << " = " << (reduceIsMax(i) ? "-INFINITY" : "INFINITY")
+          << ";\n";
+    cl_ << "  const int d_idx = get_global_id(0);\n  if (d_idx < n) {\n";
+  };
+  auto groupEnd = [&]() {
+    cl_ << "  }\n";
+    for (size_t i = 0; i < w.reductions.size(); ++i)
+      cl_ << "  sphc_group_reduce(reduce_local, reduce_value_" << i << ", "
+          << (reduceIsMax(i) ? 1 : 0) << ", reduce_partial_" << i << ");\n";
+  };
+  auto groupLaunch = [&](std::string l) {
+    if (groupReduce) l.replace(0, std::string("ocl.run(").size(), "ocl.run_grouped(");
+    return l;
+  };
   auto particleWork = [&](ast::Method::Kind kind) -> const std::vector<const PlanEquation*>& {
     static const std::vector<const PlanEquation*> none;
     const bool init = kind == ast::Method::Initialize;
@@ -495,8 +530,12 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
       for (size_t i = 0; i < w.reductions.size(); ++i) {
         const PlanEquation* eq = w.reductions[i].equation;
         addBodyArgs(ka, methodBody(*eq, ast::Method::Reduce), d, -1, eqStruct(*eq));
-        ka.add("__global real* reduce_values_" + std::to_string(i), "ocl.scratch(n, " + reduceSlot(i) + ")",
-               "reduce_values_" + std::to_string(i));
+        if (groupReduce)
+          ka.add("__global real* reduce_partial_" + std::to_string(i), groupPartial(i),
+                 "reduce_partial_" + std::to_string(i));
+        else
+          ka.add("__global real* reduce_values_" + std::to_string(i), "ocl.scratch(n, " + reduceSlot(i) + ")",
+                 "reduce_values_" + std::to_string(i));
       }
   };
   auto particleComments = [&](ast::Method::Kind kind) {
@@ -515,7 +554,8 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     for (const auto* eq : particleWork(kind)) cl_ << "  " << equationCall(*eq, kind, d, "_");
     if (kind != ast::Method::Initialize && w.reduceInPostLoop)
       for (size_t i = 0; i < w.reductions.size(); ++i)
-        cl_ << "  reduce_values_" << i << "[d_idx] = "
+        cl_ << (groupReduce ? "  reduce_value_" + std::to_string(i) + " = "
+                            : "  reduce_values_" + std::to_string(i) + "[d_idx] = ")
             << equationCall(*w.reductions[i].equation, ast::Method::Reduce, d, "_");
   };
   // The initialize kernel joins the first neighbour pass, and the post_loop kernel the last,
@@ -553,11 +593,16 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     std::string k = name + "_" + D + "_" + what;
     rangeArg(w, ka);
     particleComments(kind);
-    beginKernel(k, ka);
+    const bool grouped = reduce && groupReduce;
+    if (grouped) cl_ << "__attribute__((reqd_work_group_size(SPHC_GROUP, 1, 1)))\n";
+    beginKernel(k, ka, /*guard=*/!grouped);
+    if (grouped) groupBegin();
     rangeGuard(w);
     particleCalls(kind);
+    if (grouped) groupEnd();
     cl_ << "}\n\n";
-    scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // " << what
+    const std::string l = launch(k, rangeEnd(w), ka);
+    scene_ << "      " << (grouped ? groupLaunch(l) : l) << "  // " << what
            << (fusedFirst ? " (with fused work of earlier phases)" : "")
            << (reduce ? " (with the reductions' values)" : "") << "\n";
   };
@@ -619,7 +664,10 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     rangeArg(w, ka);
     if (all)
       cl_ << "#define SPHC_MAX_NBRS " << kMaxNbrs << "  // loop_all's neighbour list\n";
-    beginKernel(k, ka);
+    const bool grouped = epilogue && groupReduce;
+    if (grouped) cl_ << "__attribute__((reqd_work_group_size(SPHC_GROUP, 1, 1)))\n";
+    beginKernel(k, ka, /*guard=*/!grouped);
+    if (grouped) groupBegin();
     if (all && w.ranged())
       cl_ << "  if (d_idx < d_begin) { nbrs_count[d_idx] = 0; return; }  // start_idx\n";
     else
@@ -658,10 +706,12 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
       cl_ << "    }\n  }\n";
     }
     if (epilogue) particleCalls(ast::Method::PostLoop);
+    if (grouped) groupEnd();
     cl_ << "}\n";
     if (all) cl_ << "#undef SPHC_MAX_NBRS\n";
     cl_ << "\n";
-    scene_ << "      " << launch(k, rangeEnd(w), ka) << "  // neighbours: " << D << " <- " << S
+    const std::string l = launch(k, rangeEnd(w), ka);
+    scene_ << "      " << (grouped ? groupLaunch(l) : l) << "  // neighbours: " << D << " <- " << S
            << (prologue ? ", after initialize" : "") << (epilogue ? ", then post_loop" : "")
            << "\n";
     if (all)
@@ -696,6 +746,14 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
           << "}\n\n";
       scene_ << "        " << launch(k, nReal, ka) << (onGhosts ? "  // real particles only" : "")
              << "\n";
+    } else if (groupReduce) {
+      scene_ << "        // the work groups' results: from the post_loop's kernel\n";
+      scene_ << "        " << D << ".constant(" << constSlot(d, c) << ")[0] = ocl.reduce_groups("
+             << groupPartial(ri) << ", sphc::ocl::Context::groups(n), sphc::ocl::Op::" << op
+             << ");\n";
+      scene_ << "        dev_" << D << ".upload_constant(ocl, " << D << ", " << constSlot(d, c) << ");\n";
+      scene_ << "      }\n";
+      continue;
     } else {
       scene_ << "        // the values: from the post_loop kernel\n";
     }

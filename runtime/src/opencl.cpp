@@ -379,6 +379,22 @@ inline void sphc_extent_group(const int valid, const int dim, const int i,
     for (int k = 0; k < 7; ++k) partial[7 * get_group_id(0) + k] = s[k * SPHC_GROUP];
 }
 
+// A min (op 0) or max (op 1) of v over a work group of SPHC_GROUP items (every item of the
+// group calls it; s: SPHC_GROUP reals of local memory, free again when it returns), into
+// partial[group] (Context::reduce_groups combines the groups').
+inline void sphc_group_reduce(__local real* s, const real v, const int op,
+                              __global real* partial) {
+  const int l = get_local_id(0);
+  barrier(CLK_LOCAL_MEM_FENCE);  // s may still be read by an earlier call
+  s[l] = v;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (int w = SPHC_GROUP / 2; w > 0; w >>= 1) {
+    if (l < w) s[l] = op ? fmax(s[l], s[l + w]) : fmin(s[l], s[l + w]);
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (l == 0) partial[get_group_id(0)] = s[0];
+}
+
 // Partial reductions: work item g combines v[g], v[g + G], ... (G work items).
 __kernel void sphc_reduce(__global const real* v, const uint n, const int op,
                           const int finite_only, const uint offset, __global real* partial) {
@@ -827,6 +843,15 @@ SearchDomain Context::search_domain(const std::vector<Extent>& arrays, int dim,
 void Context::launch_group(cl_kernel k, std::size_t n, const std::string& name) {
   std::size_t local = kGroup;
   enqueue(k, groups(n) * kGroup, &local, name);
+}
+
+double Context::reduce_groups(cl_mem partial, std::size_t rows, Op op) {
+  host_partial_.resize(rows);
+  if (rows) read_reals(partial, host_partial_.data(), rows);
+  double acc = op == Op::Min ? HUGE_VAL : -HUGE_VAL;
+  for (std::size_t j = 0; j < rows; ++j)
+    acc = op == Op::Min ? std::fmin(acc, host_partial_[j]) : std::fmax(acc, host_partial_[j]);
+  return acc;
 }
 
 Grid Context::grid_of_extents(cl_mem partial, std::size_t rows, int dim, double radius_scale) {

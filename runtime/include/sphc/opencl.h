@@ -196,6 +196,9 @@ class Context {
   // make_grid from extents that scene kernels computed (sphc_extent_group): `rows` rows of 7
   // partial results in `partial`; the same grid as make_grid's over the same particles.
   Grid grid_of_extents(cl_mem partial, std::size_t rows, int dim, double radius_scale);
+  // The min or max (Op::Min, Op::Max; fmin/fmax: NaN ignored) of `rows` results of work
+  // groups that a scene kernel reduced (sphc_group_reduce), on the host.
+  double reduce_groups(cl_mem partial, std::size_t rows, Op op);
   void finish();
   // Copies n reals from the device into doubles (blocking).
   void read_reals(cl_mem m, double* out, std::size_t n);
