@@ -5,7 +5,9 @@
 // Particle data stays on the device; `converged` tests run on the host.
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 
+#include "analysis/Access.h"
 #include "codegen/Printer.h"
 
 namespace sphc {
@@ -167,6 +169,25 @@ class OpenCLPrinter : public ScenePrinter {
   bool anyFoldsExtents() const;
   // The scratch slot of those extents' partial results (Context::scratch).
   static constexpr int kExtentSlot = -4;
+  // The initialize kernels pulled into a stepper run's kernels (pulledOf): the first
+  // per-particle work on each array of the evaluation (sequence 0) or of the post_step groups
+  // (1), when the run before it ends in the neighbour update (runSequence: 1 + the sequence,
+  // or 0). The update reads positions and h only and permutes every property (which commutes
+  // with per-particle work), so the initialize, which writes neither, may run before it.
+  struct Pulled {
+    const DestinationWork* work = nullptr;
+    std::string phase;
+    int flag = 0;  // index into the scene's pulled_init[]
+  };
+  mutable std::map<int, Pulled> pulled_[2];  // by array
+  mutable int pulledCount_ = -1;             // -1: not computed yet
+  void computePulled() const;
+  int runSequence(int r) const;
+  const Pulled* pulledOf(const DestinationWork& w) const;
+  // The pulled initialize's arguments and calls (at time `time`) in a kernel on its array.
+  void initializeArgs(const DestinationWork& w, KernelArgs& ka) const;
+  std::string initializeCalls(const DestinationWork& w, const std::string& time,
+                              const std::string& indent) const;
 };
 
 void OpenCLPrinter::deviceKernelFunctions() {
@@ -231,6 +252,11 @@ void OpenCLPrinter::searchMembers() {
     out_ << "  // > 0: the rows of extents that the last stepper run's kernels computed, for the\n"
             "  // next neighbour update (0: it computes them itself).\n"
             "  std::size_t extent_rows = 0;\n";
+  computePulled();
+  if (pulledCount_ > 0)
+    out_ << "  // true: the initialize kernel k was done in the stepper run's kernels before the\n"
+            "  // neighbour update (its own launch is skipped once).\n"
+            "  bool pulled_init[" << pulledCount_ << "] = {};\n";
   for (const auto& S : sourceArrays_) out_ << "  sphc::ocl::CellTable cells_" << S << ";\n";
   if (keptCells_ && !sourceArrays_.empty() && !hasDomain()) {
     char skin[64];
@@ -419,13 +445,143 @@ bool OpenCLPrinter::anyFoldsExtents() const {
   return false;
 }
 
+// 1 + the sequence that follows every call of run r (0: the evaluation, 1: post_step), 0 when
+// the run does not end in a neighbour update (foldsExtents) or is followed by both.
+int OpenCLPrinter::runSequence(int r) const {
+  if (!foldsExtents(r)) return 0;
+  const std::vector<StepStatement>& st = sched_.step;
+  int seq = 0;
+  for (size_t i = 0; i < st.size(); ++i) {
+    if (st[i].kind != StepStatement::Stepper || st[i].run != r) continue;
+    size_t j = i + 1;
+    while (j < st.size() && st[j].kind == StepStatement::UpdateDomain) ++j;
+    const int s = j < st.size() ? 1 : 2;
+    if (seq && seq != s) return 0;
+    seq = s;
+  }
+  return seq;
+}
+
+// The first per-particle work on each array in a sequence of calls with no test between
+// them, as the schedule's fusion walks it (ScheduleFusion.cpp): an initialize kernel is
+// pulled when nothing before it in the sequence reads or writes its array (no pass with the
+// array as destination or source, no earlier work on it), it is the array's own kernel (not
+// moved into a later phase's, not ranged, not on ghosts, parallel), and it writes no position
+// and not h. The walk stops at a group that tests, repeats or skips, and at host reductions.
+void OpenCLPrinter::computePulled() const {
+  if (pulledCount_ >= 0) return;
+  pulledCount_ = 0;
+  bool runs[2] = {false, false};
+  for (size_t r = 0; r < sched_.stepperRuns.size(); ++r)
+    if (!sched_.stepperRuns[r].parts.empty())
+      if (int q = runSequence(static_cast<int>(r))) runs[q - 1] = true;
+  const std::vector<std::string> moving = [&] {
+    std::vector<std::string> m = positionProps(plan_.dim);
+    m.push_back("h");
+    return m;
+  }();
+  for (int q = 0; q < 2; ++q) {
+    if (!runs[q]) continue;
+    std::set<int> touched;
+    bool stop = false;
+    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+      for (const auto& m : g.members) {
+        if (stop) return;
+        if (!m.isPhase) {
+          const ScheduleGroup& sub = *g.subgroups[m.index];
+          if (q == 0 && sub.group->postStep) continue;
+          const PlanGroup& pg = *sub.group;
+          if (pg.iterate || pg.every || pg.condition || sub.rebuildNeighbours) {
+            stop = true;
+            return;
+          }
+          walk(sub);
+          continue;
+        }
+        const Phase& ph = g.phases[m.index];
+        for (const DestinationWork& w : ph.destinations) {
+          const int a = w.array;
+          // Work moved whole into a later kernel on the array does nothing here.
+          if (w.initializeMoved && w.passes.empty() && w.postLoop.empty() &&
+              w.reductions.empty() && w.ghostRefresh.empty() && w.hostReduce.empty())
+            continue;
+          bool ok = !touched.count(a) && !w.initialize.empty() && !w.initializeMoved &&
+                    !w.ranged() && !w.onGhosts && w.perParticle == LoopOrder::Parallel;
+          if (ok) {
+            std::vector<std::pair<const PlanEquation*, ast::Method::Kind>> work;
+            for (const MovedWork& mw : w.initializeFirst) work.push_back({mw.equation, mw.method});
+            for (const auto* eq : w.initialize) work.push_back({eq, ast::Method::Initialize});
+            for (const auto& [eq, kind] : work)
+              for (const Access& x : equationAccesses(plan_, *eq))
+                if (x.method == kind && x.write && x.array == a &&
+                    std::find(moving.begin(), moving.end(), x.prop) != moving.end())
+                  ok = false;
+          }
+          if (ok) pulled_[q][a] = {&w, ph.name, pulledCount_++};
+          touched.insert(a);
+          for (const NeighbourPass& pass : w.passes) touched.insert(pass.source);
+          if (!w.hostReduce.empty()) stop = true;
+        }
+      }
+    };
+    if (q == 0) {
+      walk(sched_.equations);
+    } else {
+      for (const auto& sub : sched_.equations.subgroups)
+        if (sub->group->postStep && !stop) {
+          const PlanGroup& pg = *sub->group;
+          if (pg.iterate || pg.every || pg.condition || sub->rebuildNeighbours) break;
+          walk(*sub);
+        }
+    }
+  }
+}
+
+const OpenCLPrinter::Pulled* OpenCLPrinter::pulledOf(const DestinationWork& w) const {
+  computePulled();
+  for (const auto& seq : pulled_)
+    if (auto it = seq.find(w.array); it != seq.end() && it->second.work == &w) return &it->second;
+  return nullptr;
+}
+
+void OpenCLPrinter::initializeArgs(const DestinationWork& w, KernelArgs& ka) const {
+  for (const MovedWork& mw : w.initializeFirst)
+    addBodyArgs(ka, methodBody(*mw.equation, mw.method), w.array, -1, eqStruct(*mw.equation));
+  for (const auto* eq : w.initialize)
+    addBodyArgs(ka, methodBody(*eq, ast::Method::Initialize), w.array, -1, eqStruct(*eq));
+}
+
+std::string OpenCLPrinter::initializeCalls(const DestinationWork& w, const std::string& time,
+                                           const std::string& indent) const {
+  std::string r;
+  auto call = [&](const PlanEquation& eq, ast::Method::Kind kind) {
+    r += indent + callBody(bodyFunctionName(eq.name, ast::methodKeyword(kind)), methodBody(eq, kind),
+                           w.array, eqStruct(eq), time, "_") +
+         ";  // " + eq.name + ", from " + loc(eq.loc) + "\n";
+  };
+  for (const MovedWork& mw : w.initializeFirst) call(*mw.equation, mw.method);
+  for (const auto* eq : w.initialize) call(*eq, ast::Method::Initialize);
+  return r;
+}
+
 // A run of stepper statements: its function, with each statement's time.
 void OpenCLPrinter::stepperCall(const StepStatement& st,
                                 const std::function<std::string(int)>& timeAfter) {
   const StepperRun& run = sched_.stepperRuns[st.run];
   if (run.parts.empty()) return;
+  computePulled();
   std::string args;
   for (int d : st.stagesDone) args += timeAfter(d) + ", ";
+  // The time of the evaluation (or post_step) that the run's pulled initialize kernels are for.
+  const int seq = runSequence(st.run);
+  bool pulls = false;
+  for (const StepperRun::Part& part : run.parts) pulls |= seq > 0 && pulled_[seq - 1].count(part.array);
+  if (pulls) {
+    const std::vector<StepStatement>& all = sched_.step;
+    size_t i = static_cast<size_t>(&st - all.data()) + 1;
+    while (i < all.size() && all[i].kind == StepStatement::UpdateDomain) ++i;
+    args += i < all.size() ? timeAfter(all[i].stagesDone[0]) + ", " : std::string("t + dt, ");
+  }
   scene_ << "    " << run.name << "(" << args << "dt);\n";
 }
 
@@ -569,7 +725,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
   const NeighbourPass* prologuePass =
       !w.passes.empty() && w.passes.front().initializePair.empty() && !particleWork(ast::Method::Initialize).empty()
           ? &w.passes.front() : nullptr;
-  if (!ownKernelPass(prologuePass)) prologuePass = nullptr;
+  if (!ownKernelPass(prologuePass) || pulledOf(w)) prologuePass = nullptr;
   const NeighbourPass* epiloguePass =
       !w.passes.empty() && !particleWork(ast::Method::PostLoop).empty() ? &w.passes.back() : nullptr;
   if (!ownKernelPass(epiloguePass)) epiloguePass = nullptr;
@@ -602,6 +758,11 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     if (grouped) groupEnd();
     cl_ << "}\n\n";
     const std::string l = launch(k, rangeEnd(w), ka);
+    if (const Pulled* pl = init ? pulledOf(w) : nullptr) {
+      const std::string f = "pulled_init[" + std::to_string(pl->flag) + "]";
+      scene_ << "      if (" << f << ")  // done by the stepper run's kernel\n        " << f
+             << " = false;\n      else\n  ";
+    }
     scene_ << "      " << (grouped ? groupLaunch(l) : l) << "  // " << what
            << (fusedFirst ? " (with fused work of earlier phases)" : "")
            << (reduce ? " (with the reductions' values)" : "") << "\n";
@@ -776,12 +937,17 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
 // (sphc_extent_group, in work groups of Context::kGroup items), which saves the update's
 // extents kernel: the update reads the rows of partial results (Context::grid_of_extents).
 void OpenCLPrinter::steppers() {
+  computePulled();
   for (size_t ri = 0; ri < sched_.stepperRuns.size(); ++ri) {
     const StepperRun& run = sched_.stepperRuns[ri];
     if (run.parts.empty()) continue;
     const bool fold = foldsExtents(static_cast<int>(ri));
+    const int seq = runSequence(static_cast<int>(ri));
+    bool pulls = false;
+    for (const StepperRun::Part& part : run.parts) pulls |= seq > 0 && pulled_[seq - 1].count(part.array);
     scene_ << "  void " << run.name << "(";
     for (size_t k = 0; k < run.methods.size(); ++k) scene_ << "double t_" << k << ", ";
+    if (pulls) scene_ << "double t_eval, ";
     scene_ << "double dt) {\n";
     std::string rows;  // the rows of every array's groups, as an expression
     if (fold) {
@@ -822,6 +988,11 @@ void OpenCLPrinter::steppers() {
         if (k > 0) ka.add("const real " + tk, tk, tk);  // t_0 is the kernel's t
         addBodyArgs(ka, *b, part.array, -1, "");
       }
+      const Pulled* pl = seq > 0 && pulled_[seq - 1].count(part.array) ? &pulled_[seq - 1].at(part.array) : nullptr;
+      if (pl) {
+        ka.add("const real t_eval", "t_eval", "t_eval");
+        initializeArgs(*pl->work, ka);
+      }
       const bool extents = fold && loopArrays_.count(A.name);
       const char* axes[3] = {"x", "y", "z"};
       if (extents) {
@@ -835,6 +1006,9 @@ void OpenCLPrinter::steppers() {
       std::string kn = run.name + "_" + A.name;
       cl_ << "// " << A.name << ": " << stepper << methods << " (a run of the step)"
           << (extents ? ", then the extents of its particles" : "") << "\n";
+      if (pl)
+        cl_ << "// fused: the initialize kernel of " << pl->phase << " on " << A.name
+            << " (after the neighbour update, which it does not read)\n";
       if (extents) {
         cl_ << "__attribute__((reqd_work_group_size(SPHC_GROUP, 1, 1)))\n";
         beginKernel(kn, ka, /*guard=*/false);
@@ -850,6 +1024,7 @@ void OpenCLPrinter::steppers() {
             << callBody(bodyFunctionName(stepper, run.methods[k]), *b, part.array, "",
                         k == 0 ? std::string("t") : "t_" + std::to_string(k), "_")
             << ";\n";
+      if (pl) cl_ << initializeCalls(*pl->work, "t_eval", in);
       if (extents) {
         // The kernel's own buffer of an axis, else the argument added above.
         auto buf = [&](const std::string& p) {
@@ -867,11 +1042,15 @@ void OpenCLPrinter::steppers() {
       if (extents) {
         std::string l = launch(kn, "n", ka, "t_0");
         l.replace(0, std::string("ocl.run(").size(), "ocl.run_grouped(");
-        scene_ << "      " << l << "\n    }\n";
+        scene_ << "      " << l << "\n";
         rowBefore = rowBefore == "0" ? "rows_" + A.name : rowBefore + " + rows_" + A.name;
       } else {
-        scene_ << "      " << launch(kn, "n", ka, "t_0") << "\n    }\n";
+        scene_ << "      " << launch(kn, "n", ka, "t_0") << "\n";
       }
+      if (pl)
+        scene_ << "      pulled_init[" << pl->flag << "] = true;  // " << pl->phase
+               << "'s initialize on " << A.name << "\n";
+      scene_ << "    }\n";
     }
     if (fold) scene_ << "    extent_rows = " << rows << ";\n";
     scene_ << "  }\n\n";
