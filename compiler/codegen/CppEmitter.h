@@ -52,6 +52,10 @@ struct EmitOptions {
   // of launches (sphc::ocl::build_tables); false (--no-batched-tables): CellTable::build per
   // source. The same tables, the same results bit for bit.
   bool batchedTables = true;
+  // --backend=opencl: fewer kernel launches per step (docs/performance.md, "OpenCL: fewer
+  // launches per step (stop 39)"); false (--no-fused-launches): a kernel each. The same
+  // results bit for bit.
+  bool fusedLaunches = true;
   // --backend=opencl: the cell tables kept across neighbour updates on cells of (1 + skin)
   // times the support while no source particle moved farther than the skin
   // (sphc::ocl::KeptTables, --kept-cells=F); 0 (the default): built at every update.

@@ -19,7 +19,7 @@ class OpenCLPrinter : public ScenePrinter {
   OpenCLPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
       : ScenePrinter(sched, diags, opts), batchedTables_(opts.batchedTables),
         keptCells_(opts.keptCellsSkin > 0.0 && opts.batchedTables),
-        keptSkin_(opts.keptCellsSkin) {
+        keptSkin_(opts.keptCellsSkin), fused_(opts.fusedLaunches) {
     // Line 1 of the kernel source is this directive, so lines are the source's own.
     cl_ << "#line 2 \"" << plan_.sceneName << ".cl\"\n";
   }
@@ -157,6 +157,7 @@ class OpenCLPrinter : public ScenePrinter {
   bool batchedTables_ = true;
   bool keptCells_ = false;  // EmitOptions::keptCellsSkin > 0 (with batchedTables_)
   double keptSkin_ = 0.0;
+  bool fused_ = true;  // EmitOptions::fusedLaunches
   // update_neighbours with the cell tables kept across updates (keptCells_).
   void updateNeighboursKept();
   // The arrays of deviceExtents: whether each is a source ("{true, false}").
@@ -412,7 +413,7 @@ void OpenCLPrinter::updateNeighboursKept() {
 // and when the run has a kernel for every array in a neighbour loop. Every other run sets
 // extent_rows to 0, so an update never uses extents older than the last positions.
 bool OpenCLPrinter::foldsExtents(int r) const {
-  if (hasDomain() || keptCells_ || loopArrays_.empty()) return false;
+  if (!fused_ || hasDomain() || keptCells_ || loopArrays_.empty()) return false;
   const StepperRun& run = sched_.stepperRuns[r];
   for (const std::string& A : loopArrays_) {
     bool has = false;
@@ -639,7 +640,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
   // Min and max reductions whose values the post_loop kernel computes are reduced within its
   // work groups (sphc_group_reduce, groups of Context::kGroup items), the host combines the
   // groups' results: no reduction kernel. Minima and maxima are exact: the same values.
-  bool groupReduce = w.reduceInPostLoop && !w.ranged() && !w.reductions.empty();
+  bool groupReduce = fused_ && w.reduceInPostLoop && !w.ranged() && !w.reductions.empty();
   for (const Reduction& r : w.reductions) {
     const std::string& op = plan_.equationDecls[r.equation->declIndex].reduceOp;
     if (op != "max" && op != "min") groupReduce = false;
@@ -720,7 +721,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
   // of a work item before (after) its own neighbour loop is the separate kernel's, bit for
   // bit; both run over the same particles (rangeEnd, the same start_idx guard).
   auto ownKernelPass = [&](const NeighbourPass* p) {
-    return p && p->searches() && p->source != d;
+    return fused_ && p && p->searches() && p->source != d;
   };
   const NeighbourPass* prologuePass =
       !w.passes.empty() && w.passes.front().initializePair.empty() && !particleWork(ast::Method::Initialize).empty()

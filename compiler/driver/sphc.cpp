@@ -130,6 +130,15 @@ static cl::opt<bool> NoBatchedTables(
              "(default: the tables of all sources of an update in four launches per two "
              "sources; the same tables, the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoFusedLaunches(
+    "no-fused-launches",
+    cl::desc("--backend=opencl: a kernel per initialize and post_loop, per stepper run and "
+             "array, for the search domain's extents and per min/max reduction (default: "
+             "the initialize and post_loop of a destination in its neighbour pass's kernel "
+             "where the pass's source is another array, the first initialize of each array "
+             "after a neighbour update and the extents in the stepper run's kernels, min/max "
+             "reductions within the kernel's work groups; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<std::string> KeptCells(
     "kept-cells",
     cl::desc("--backend=opencl without periodic or mirror sides: keep the device's cell tables "
@@ -576,6 +585,7 @@ int main(int argc, char** argv) {
   emitOpts.ompMinParticles = OmpMinParticles;
   emitOpts.verletAuto = verletTuned;  // --verlet-skin=tuned: the skin and re-sort chosen at run time
   emitOpts.batchedTables = !NoBatchedTables;
+  emitOpts.fusedLaunches = !NoFusedLaunches;
   emitOpts.keptCellsSkin = keptCellsSkin;
   emitOpts.splitUnits = !SingleUnit && Emit == EmitKind::Exe;
   emitOpts.symmetricPairs = !NoSymmetricPairs;
