@@ -185,6 +185,20 @@ class OpenCLPrinter : public ScenePrinter {
   void computePulled() const;
   int runSequence(int r) const;
   const Pulled* pulledOf(const DestinationWork& w) const;
+  // The adaptive time step's limits computed by the last kernel of the step on an array
+  // (dtWorkOf: an initialize-only phase of the post_step groups after which nothing in the
+  // step touches the array), within its work groups: adaptive_dt reads them, no kernel.
+  mutable std::map<int, const DestinationWork*> dtWork_;
+  mutable bool dtComputed_ = false;
+  void computeDtWork() const;
+  bool dtWorkOf(const DestinationWork& w) const;
+  static constexpr int kDtSlot = -5;
+  mutable std::string dtAmag_;  // dtLimits' |a| of particle i, where the force limit is used
+  // The limits over array a (name, per-particle value of particle i), the properties they
+  // read, each named by `name`.
+  std::vector<std::pair<std::string, std::string>> dtLimits(
+      int a, std::vector<std::string>& props,
+      const std::function<std::string(const std::string&)>& name) const;
   // The pulled initialize's arguments and calls (at time `time`) in a kernel on its array.
   void initializeArgs(const DestinationWork& w, KernelArgs& ka) const;
   std::string initializeCalls(const DestinationWork& w, const std::string& time,
@@ -254,6 +268,11 @@ void OpenCLPrinter::searchMembers() {
             "  // next neighbour update (0: it computes them itself).\n"
             "  std::size_t extent_rows = 0;\n";
   computePulled();
+  computeDtWork();
+  for (const auto& [a, w] : dtWork_)
+    out_ << "  // > 0: the rows of the adaptive step's limits over " << arr(a).name
+         << " that the step's last kernel on it computed\n  std::size_t dt_rows_" << arr(a).name
+         << " = 0;\n";
   if (pulledCount_ > 0)
     out_ << "  // true: the initialize kernel k was done in the stepper run's kernels before the\n"
             "  // neighbour update (its own launch is skipped once).\n"
@@ -565,6 +584,101 @@ std::string OpenCLPrinter::initializeCalls(const DestinationWork& w, const std::
   return r;
 }
 
+std::vector<std::pair<std::string, std::string>> OpenCLPrinter::dtLimits(
+    int a, std::vector<std::string>& props,
+    const std::function<std::string(const std::string&)>& name) const {
+  (void)a;
+  const AdaptiveDt& ad = sched_.adaptiveDt;
+  const bool useCfl = ad.cfl;
+  const std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
+  props = {"h"};
+  if (useCfl) props.push_back("cs");
+  for (int k = 0; k < plan_.dim; ++k) {
+    if (useCfl) props.push_back(vel[k]);
+    if (ad.force) props.push_back(acc[k]);
+  }
+  auto at = [&](const std::string& p) { return name(p) + "[i]"; };
+  auto mag = [&](const std::vector<std::string>& c) {
+    std::string m = "sqrt(";
+    for (int k = 0; k < plan_.dim; ++k) m += (k ? " + " : "") + at(c[k]) + " * " + at(c[k]);
+    return m + ")";
+  };
+  dtAmag_ = ad.force ? mag(acc) : std::string();
+  std::vector<std::pair<std::string, std::string>> limits;
+  if (useCfl) limits.push_back({"dt_cfl", at("h") + " / (" + at("cs") + " + " + mag(vel) + ")"});
+  if (ad.force) limits.push_back({"dt_force", "amag > 0 ? sqrt(" + at("h") + " / amag) : INFINITY"});
+  if (ad.viscous) limits.push_back({"h2min", at("h") + " * " + at("h")});
+  return limits;
+}
+
+// The last work of the step on each array with adaptive-dt limits, where it is a kernel of
+// its own: the post_step groups run at every step (no `every`; none tests, repeats or
+// rebuilds), and, walking them in call order, the array's last destination work is an
+// initialize only (no pass, post_loop, reduction, ghost refresh or host reduce; not moved,
+// not pulled into a stepper, not ranged, not on ghosts, parallel), after which no pass reads
+// the array as its source. Nothing else runs on the device before adaptive_dt (the run loop
+// only reads the arrays back for outputs and checks), so the limits computed at the end of
+// that kernel are those of the adaptive_dt kernel, and their minima the same values.
+void OpenCLPrinter::computeDtWork() const {
+  if (dtComputed_) return;
+  dtComputed_ = true;
+  const AdaptiveDt& ad = sched_.adaptiveDt;
+  if (!fused_ || !ad.enabled || hasDomain() || sched_.postStep.empty()) return;
+  for (const StepStatement& st : sched_.step)
+    if (st.kind == StepStatement::InletOutlet) return;
+  for (const auto& ps : sched_.postStep) {
+    const PlanGroup& pg = *ps.group;
+    if (pg.every || pg.iterate || pg.condition) return;
+  }
+  std::map<int, const DestinationWork*> last;
+  bool stop = false;
+  std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
+    for (const auto& m : g.members) {
+      if (stop) return;
+      if (!m.isPhase) {
+        const ScheduleGroup& sub = *g.subgroups[m.index];
+        const PlanGroup& pg = *sub.group;
+        if (pg.iterate || pg.every || pg.condition || sub.rebuildNeighbours) {
+          stop = true;
+          return;
+        }
+        walk(sub);
+        continue;
+      }
+      for (const DestinationWork& w : g.phases[m.index].destinations) {
+        const int a = w.array;
+        if (w.initializeMoved && w.passes.empty() && w.postLoop.empty() &&
+            w.reductions.empty() && w.ghostRefresh.empty() && w.hostReduce.empty())
+          continue;  // moved whole into a later kernel on the array
+        const bool own = !w.initialize.empty() && !w.initializeMoved && w.passes.empty() &&
+                         w.postLoop.empty() && w.reductions.empty() && w.ghostRefresh.empty() &&
+                         w.hostReduce.empty() && !w.ranged() && !w.onGhosts &&
+                         w.perParticle == LoopOrder::Parallel && !pulledOf(w);
+        if (own)
+          last[a] = &w;
+        else
+          last.erase(a);
+        for (const NeighbourPass& pass : w.passes) last.erase(pass.source);
+        if (!w.hostReduce.empty()) stop = true;
+      }
+    }
+  };
+  for (const auto& sub : sched_.equations.subgroups)
+    if (sub->group->postStep) {
+      if (sub->rebuildNeighbours) return;
+      walk(*sub);
+    }
+  if (stop) return;
+  for (int a : ad.arrays)
+    if (last.count(a)) dtWork_[a] = last[a];
+}
+
+bool OpenCLPrinter::dtWorkOf(const DestinationWork& w) const {
+  computeDtWork();
+  auto it = dtWork_.find(w.array);
+  return it != dtWork_.end() && it->second == &w;
+}
+
 // A run of stepper statements: its function, with each statement's time.
 void OpenCLPrinter::stepperCall(const StepStatement& st,
                                 const std::function<std::string(int)>& timeAfter) {
@@ -751,14 +865,52 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     rangeArg(w, ka);
     particleComments(kind);
     const bool grouped = reduce && groupReduce;
-    if (grouped) cl_ << "__attribute__((reqd_work_group_size(SPHC_GROUP, 1, 1)))\n";
-    beginKernel(k, ka, /*guard=*/!grouped);
+    const bool dtLims = init && dtWorkOf(w);
+    std::vector<std::pair<std::string, std::string>> lims;
+    if (dtLims) {
+      std::vector<std::string> props;
+      KernelArgs probe = ka;  // the kernel's own buffers, by key
+      auto own = [&](const std::string& p) {
+        auto it = probe.at.find("d_" + p);
+        if (it == probe.at.end()) return "dtl_" + p;
+        const std::string& decl = probe.decls[it->second];
+        const std::string o = " d_" + p;
+        return decl.size() >= o.size() && decl.compare(decl.size() - o.size(), o.size(), o) == 0
+                   ? "d_" + p : "dtl_" + p;
+      };
+      lims = dtLimits(d, props, own);
+      for (const auto& p : props)
+        if (own(p) != "d_" + p) ka.add("__global const real* dtl_" + p, devBuffer(d, p), "d_" + p);
+      ka.add("__global real* dt_partial",
+             "ocl.scratch(" + std::to_string(lims.size()) + " * sphc::ocl::Context::groups(n), " +
+                 std::to_string(kDtSlot) + ")",
+             "dt_partial");
+      cl_ << "// fused: the adaptive time step's limits over " << D
+          << " (nothing after this kernel in the step touches " << D << ")\n";
+    }
+    if (grouped || dtLims) cl_ << "__attribute__((reqd_work_group_size(SPHC_GROUP, 1, 1)))\n";
+    beginKernel(k, ka, /*guard=*/!(grouped || dtLims));
     if (grouped) groupBegin();
+    if (dtLims) {
+      cl_ << "  __local real dt_local[SPHC_GROUP];\n";
+      for (const auto& [lname, v] : lims) cl_ << "  real " << lname << " = INFINITY;\n";
+      cl_ << "  const int d_idx = get_global_id(0);\n  if (d_idx < n) {\n";
+    }
     rangeGuard(w);
     particleCalls(kind);
     if (grouped) groupEnd();
+    if (dtLims) {
+      cl_ << "  {  // the limits of adaptive_dt, after this kernel's work\n    const int i = d_idx;\n";
+      if (sched_.adaptiveDt.force) cl_ << "    const real amag = " << dtAmag_ << ";\n";
+      for (const auto& [lname, v] : lims) cl_ << "    " << lname << " = fmin(" << lname << ", " << v << ");\n";
+      cl_ << "  }\n  }\n";
+      for (size_t m = 0; m < lims.size(); ++m)
+        cl_ << "  sphc_group_reduce(dt_local, " << lims[m].first << ", 0, dt_partial + " << m
+            << " * get_num_groups(0));\n";
+    }
     cl_ << "}\n\n";
-    const std::string l = launch(k, rangeEnd(w), ka);
+    std::string l = launch(k, rangeEnd(w), ka);
+    if (dtLims) l.replace(0, std::string("ocl.run(").size(), "ocl.run_grouped(");
     if (const Pulled* pl = init ? pulledOf(w) : nullptr) {
       const std::string f = "pulled_init[" + std::to_string(pl->flag) + "]";
       scene_ << "      if (" << f << ")  // done by the stepper run's kernel\n        " << f
@@ -767,6 +919,8 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
     scene_ << "      " << (grouped ? groupLaunch(l) : l) << "  // " << what
            << (fusedFirst ? " (with fused work of earlier phases)" : "")
            << (reduce ? " (with the reductions' values)" : "") << "\n";
+    if (dtLims)
+      scene_ << "      dt_rows_" << D << " = sphc::ocl::Context::groups(n);  // for adaptive_dt\n";
   };
   perParticle(ast::Method::Initialize, "initialize");
   for (const NeighbourPass& pass : w.passes) {
@@ -1124,27 +1278,14 @@ void OpenCLPrinter::ghostRefresh(const DestinationWork& w) {
 // g + G, ...), the host the minima of those (fmin, as sphc_reduce: the same values).
 void OpenCLPrinter::adaptiveDtArray(int a) {
   const AdaptiveDt& ad = sched_.adaptiveDt;
-  const bool useCfl = ad.cfl;
   const std::string& A = arr(a).name;
-  const std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
   KernelArgs ka;
-  std::vector<std::string> props = {"h"};
-  if (useCfl) props.push_back("cs");
-  for (int k = 0; k < plan_.dim; ++k) {
-    if (useCfl) props.push_back(vel[k]);
-    if (ad.force) props.push_back(acc[k]);
-  }
-  for (const auto& p : props) ka.add("__global const real* " + p, devBuffer(a, p), p);
+  std::vector<std::string> props;
   // The limits the scene uses, in order: (name, per-particle value).
-  auto mag = [&](const std::vector<std::string>& c) {
-    std::string m = "sqrt(";
-    for (int k = 0; k < plan_.dim; ++k) m += (k ? " + " : "") + c[k] + "[i] * " + c[k] + "[i]";
-    return m + ")";
-  };
-  std::vector<std::pair<std::string, std::string>> limits;
-  if (useCfl) limits.push_back({"dt_cfl", "h[i] / (cs[i] + " + mag(vel) + ")"});
-  if (ad.force) limits.push_back({"dt_force", "amag > 0 ? sqrt(h[i] / amag) : INFINITY"});
-  if (ad.viscous) limits.push_back({"h2min", "h[i] * h[i]"});
+  const std::vector<std::pair<std::string, std::string>> limits =
+      dtLimits(a, props, [](const std::string& p) { return p; });
+  const std::string amag = dtAmag_;
+  for (const auto& p : props) ka.add("__global const real* " + p, devBuffer(a, p), p);
   if (limits.empty()) {
     scene_ << "    }\n";
     return;
@@ -1158,19 +1299,34 @@ void OpenCLPrinter::adaptiveDtArray(int a) {
   cl_ << "  const int g = get_global_id(0), G = get_global_size(0);\n";
   for (const auto& [name, v] : limits) cl_ << "  real " << name << " = INFINITY;\n";
   cl_ << "  for (int i = g; i < n; i += G) {\n";
-  if (ad.force) cl_ << "    const real amag = " << mag(acc) << ";\n";
+  if (ad.force) cl_ << "    const real amag = " << amag << ";\n";
   for (const auto& [name, v] : limits) cl_ << "    " << name << " = fmin(" << name << ", " << v << ");\n";
   cl_ << "  }\n";
   for (size_t m = 0; m < limits.size(); ++m)
     cl_ << "  partial[" << limits.size() << " * g + " << m << "] = " << limits[m].first << ";\n";
   cl_ << "}\n\n";
   scene_ << "      const int n = static_cast<int>(" << A << ".n);\n";
-  scene_ << "      const double t = 0.0, dt = 0.0;  // (kernel arguments, unused)\n";
+  std::string in = "      ";
+  computeDtWork();
+  const bool fused = dtWork_.count(a) > 0;
+  if (fused) {
+    const std::string L = std::to_string(limits.size());
+    scene_ << "      std::vector<double> mins;\n";
+    scene_ << "      if (dt_rows_" << A << " > 0) {  // from the step's last kernel on " << A << "\n";
+    scene_ << "        mins = ocl.minima_rows(ocl.scratch(" << L << " * dt_rows_" << A << ", "
+           << kDtSlot << "), dt_rows_" << A << ", " << L << ");\n";
+    scene_ << "        dt_rows_" << A << " = 0;\n      } else {\n";
+    in = "        ";
+  }
+  scene_ << in << "const double t = 0.0, dt = 0.0;  // (kernel arguments, unused)\n";
   std::string l = "ocl.run(\"" + k + "\", sphc::ocl::Context::kPartials, n, t, dt";
   for (const auto& h : ka.host) l += ", " + h;
-  scene_ << "      " << l << ");\n";
-  scene_ << "      const std::vector<double> mins = ocl.minima(" << partial << ", "
-         << limits.size() << ");\n";
+  scene_ << in << l << ");\n";
+  if (fused)
+    scene_ << in << "mins = ocl.minima(" << partial << ", " << limits.size() << ");\n      }\n";
+  else
+    scene_ << "      const std::vector<double> mins = ocl.minima(" << partial << ", "
+           << limits.size() << ");\n";
   for (size_t m = 0; m < limits.size(); ++m)
     scene_ << "      " << limits[m].first << " = std::fmin(" << limits[m].first << ", mins[" << m
            << "]);\n";

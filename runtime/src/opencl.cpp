@@ -792,6 +792,16 @@ std::vector<double> Context::minima(cl_mem partial, int columns) {
   return out;
 }
 
+std::vector<double> Context::minima_rows(cl_mem partial, std::size_t rows, int columns) {
+  const std::size_t c = static_cast<std::size_t>(columns);
+  host_partial_.resize(rows * c);
+  if (rows) read_reals(partial, host_partial_.data(), host_partial_.size());
+  std::vector<double> out(c, HUGE_VAL);
+  for (std::size_t k = 0; k < c; ++k)
+    for (std::size_t g = 0; g < rows; ++g) out[k] = std::fmin(out[k], host_partial_[k * rows + g]);
+  return out;
+}
+
 double Context::reduce(cl_mem v, std::size_t n, Op op, bool finite_only) {
   return reduce_all({{v, n, op, finite_only}})[0];
 }

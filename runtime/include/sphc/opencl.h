@@ -169,6 +169,9 @@ class Context {
   // item g writing partial[columns * g + c]): their minima per column (fmin: NaN ignored).
   static constexpr std::size_t kPartials = 256;
   std::vector<double> minima(cl_mem partial, int columns);
+  // The same of `rows` work groups' minima that a scene kernel computed (sphc_group_reduce),
+  // column c at partial[c * rows + group].
+  std::vector<double> minima_rows(cl_mem partial, std::size_t rows, int columns);
   // The search domain over every array in a neighbour loop (as sphc::make_search_domain:
   // bounding box of finite coordinates, padded, cell_size = radius_scale * max h), from
   // device data.
