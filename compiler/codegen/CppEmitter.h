@@ -56,6 +56,11 @@ struct EmitOptions {
   // launches per step (stop 39)"); false (--no-fused-launches): a kernel each. The same
   // results bit for bit.
   bool fusedLaunches = true;
+  // With fusedLaunches, --fused-reductions: the search domain's extents, min/max reductions
+  // and the adaptive step's limits within the work groups of kernels that visit the
+  // particles anyway (barriers in local memory), which saves their kernels. Off by default:
+  // on PoCL's CPU device those kernels cost more than the launches they save.
+  bool fusedReductions = false;
   // --backend=opencl: the cell tables kept across neighbour updates on cells of (1 + skin)
   // times the support while no source particle moved farther than the skin
   // (sphc::ocl::KeptTables, --kept-cells=F); 0 (the default): built at every update.

@@ -19,7 +19,8 @@ class OpenCLPrinter : public ScenePrinter {
   OpenCLPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
       : ScenePrinter(sched, diags, opts), batchedTables_(opts.batchedTables),
         keptCells_(opts.keptCellsSkin > 0.0 && opts.batchedTables),
-        keptSkin_(opts.keptCellsSkin), fused_(opts.fusedLaunches) {
+        keptSkin_(opts.keptCellsSkin), fused_(opts.fusedLaunches),
+        groupReductions_(opts.fusedLaunches && opts.fusedReductions) {
     // Line 1 of the kernel source is this directive, so lines are the source's own.
     cl_ << "#line 2 \"" << plan_.sceneName << ".cl\"\n";
   }
@@ -158,6 +159,7 @@ class OpenCLPrinter : public ScenePrinter {
   bool keptCells_ = false;  // EmitOptions::keptCellsSkin > 0 (with batchedTables_)
   double keptSkin_ = 0.0;
   bool fused_ = true;  // EmitOptions::fusedLaunches
+  bool groupReductions_ = false;  // EmitOptions::fusedReductions (with fused_)
   // update_neighbours with the cell tables kept across updates (keptCells_).
   void updateNeighboursKept();
   // The arrays of deviceExtents: whether each is a source ("{true, false}").
@@ -167,6 +169,7 @@ class OpenCLPrinter : public ScenePrinter {
   // Whether stepper run `r`'s kernels compute the search domain's extents for the neighbour
   // update that follows it (foldsExtents), and whether any run does.
   bool foldsExtents(int r) const;
+  bool endsInUpdate(int r) const;
   bool anyFoldsExtents() const;
   // The scratch slot of those extents' partial results (Context::scratch).
   static constexpr int kExtentSlot = -4;
@@ -423,15 +426,18 @@ void OpenCLPrinter::updateNeighboursKept() {
          << std::string(20, ' ') << extentSources() << ");\n";
 }
 
-// A stepper run folds the extents when every statement that calls it is followed by a
-// neighbour update with nothing between that could move particles: the next statement (past
+// A stepper run ends in the neighbour update (endsInUpdate) when every statement that calls
+// it is followed by a neighbour update with nothing between that could move particles: the next statement (past
 // update_domain, which does nothing without a periodic or mirror domain) is
 // compute_accelerations, or it is the step's last and post_step runs its update at every step
 // (no `every` group). Only without a domain (the ghosts' update has its own extents), without
 // inlet/outlet (arrays change size), without --kept-cells (its kernel tests displacements),
 // and when the run has a kernel for every array in a neighbour loop. Every other run sets
-// extent_rows to 0, so an update never uses extents older than the last positions.
-bool OpenCLPrinter::foldsExtents(int r) const {
+// extent_rows to 0, so an update never uses extents older than the last positions. It folds
+// the extents (foldsExtents) with --fused-reductions.
+bool OpenCLPrinter::foldsExtents(int r) const { return groupReductions_ && endsInUpdate(r); }
+
+bool OpenCLPrinter::endsInUpdate(int r) const {
   if (!fused_ || hasDomain() || keptCells_ || loopArrays_.empty()) return false;
   const StepperRun& run = sched_.stepperRuns[r];
   for (const std::string& A : loopArrays_) {
@@ -466,9 +472,9 @@ bool OpenCLPrinter::anyFoldsExtents() const {
 }
 
 // 1 + the sequence that follows every call of run r (0: the evaluation, 1: post_step), 0 when
-// the run does not end in a neighbour update (foldsExtents) or is followed by both.
+// the run does not end in a neighbour update (endsInUpdate) or is followed by both.
 int OpenCLPrinter::runSequence(int r) const {
-  if (!foldsExtents(r)) return 0;
+  if (!endsInUpdate(r)) return 0;
   const std::vector<StepStatement>& st = sched_.step;
   int seq = 0;
   for (size_t i = 0; i < st.size(); ++i) {
@@ -623,7 +629,7 @@ void OpenCLPrinter::computeDtWork() const {
   if (dtComputed_) return;
   dtComputed_ = true;
   const AdaptiveDt& ad = sched_.adaptiveDt;
-  if (!fused_ || !ad.enabled || hasDomain() || sched_.postStep.empty()) return;
+  if (!fused_ || !groupReductions_ || !ad.enabled || hasDomain() || sched_.postStep.empty()) return;
   for (const StepStatement& st : sched_.step)
     if (st.kind == StepStatement::InletOutlet) return;
   for (const auto& ps : sched_.postStep) {
@@ -754,7 +760,7 @@ void OpenCLPrinter::destination(const DestinationWork& w, const std::string& nam
   // Min and max reductions whose values the post_loop kernel computes are reduced within its
   // work groups (sphc_group_reduce, groups of Context::kGroup items), the host combines the
   // groups' results: no reduction kernel. Minima and maxima are exact: the same values.
-  bool groupReduce = fused_ && w.reduceInPostLoop && !w.ranged() && !w.reductions.empty();
+  bool groupReduce = fused_ && groupReductions_ && w.reduceInPostLoop && !w.ranged() && !w.reductions.empty();
   for (const Reduction& r : w.reductions) {
     const std::string& op = plan_.equationDecls[r.equation->declIndex].reduceOp;
     if (op != "max" && op != "min") groupReduce = false;

@@ -136,8 +136,18 @@ static cl::opt<bool> NoFusedLaunches(
              "array, for the search domain's extents and per min/max reduction (default: "
              "the initialize and post_loop of a destination in its neighbour pass's kernel "
              "where the pass's source is another array, the first initialize of each array "
-             "after a neighbour update and the extents in the stepper run's kernels, min/max "
-             "reductions within the kernel's work groups; the results are the same bit for bit)"),
+             "after a neighbour update in the stepper run's kernel before it, and with "
+             "--fused-reductions more; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> FusedReductions(
+    "fused-reductions",
+    cl::desc("--backend=opencl: also compute the search domain's extents (in the stepper "
+             "runs before a neighbour update), min/max reductions (in the post_loop's kernel) "
+             "and the adaptive step's limits (in the step's last kernel on the array) within "
+             "those kernels' work groups, saving their kernels (the dam break: 16 launches "
+             "per step instead of 20). Off by default: on PoCL's CPU device the kernels with "
+             "work-group barriers cost more than the launches they save. The results are the "
+             "same bit for bit"),
     cl::init(false), cl::cat(SphcCat));
 static cl::opt<std::string> KeptCells(
     "kept-cells",
@@ -586,6 +596,7 @@ int main(int argc, char** argv) {
   emitOpts.verletAuto = verletTuned;  // --verlet-skin=tuned: the skin and re-sort chosen at run time
   emitOpts.batchedTables = !NoBatchedTables;
   emitOpts.fusedLaunches = !NoFusedLaunches;
+  emitOpts.fusedReductions = FusedReductions;
   emitOpts.keptCellsSkin = keptCellsSkin;
   emitOpts.splitUnits = !SingleUnit && Emit == EmitKind::Exe;
   emitOpts.symmetricPairs = !NoSymmetricPairs;
