@@ -59,7 +59,7 @@ struct EmitOptions {
   // With fusedLaunches, --fused-reductions: the search domain's extents, min/max reductions
   // and the adaptive step's limits within the work groups of kernels that visit the
   // particles anyway (barriers in local memory), which saves their kernels. Off by default:
-  // on PoCL's CPU device those kernels cost more than the launches they save.
+  // no gain measured on PoCL's CPU device, where those kernels profile slower.
   bool fusedReductions = false;
   // --backend=opencl: the cell tables kept across neighbour updates on cells of (1 + skin)
   // times the support while no source particle moved farther than the skin
