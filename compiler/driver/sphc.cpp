@@ -146,8 +146,8 @@ static cl::opt<bool> FusedReductions(
              "and the adaptive step's limits (in the step's last kernel on the array) within "
              "those kernels' work groups, saving their kernels (the dam break: 16 launches "
              "per step instead of 20). Off by default: no gain measured on PoCL's CPU device, "
-             "where the kernels with work-group barriers profile slower than the launches they "
-             "save (docs/performance.md); meant for GPUs. The results are the same bit for bit"),
+             "where the kernels with work-group barriers profile slower than the kernels they "
+             "replace (docs/performance.md); meant for GPUs. The results are the same bit for bit"),
     cl::init(false), cl::cat(SphcCat));
 static cl::opt<std::string> KeptCells(
     "kept-cells",
