@@ -131,6 +131,9 @@ class ScenePrinter {
   virtual void timedNeighbourUpdate() = 0;
   virtual void adaptiveDtArray(int a) = 0;          // the limits of one moving array
   virtual void mainPrologue() {}                    // before `static Scene scene;`
+  // --omp-min-particles: the `if (COUNT >= OMP_MIN_PARTICLES)` clause of a loop without
+  // neighbours ("" where there is none: serial, or the option 0).
+  virtual std::string ompMinIf(const std::string& count) const { return ""; }
   virtual void mainBackendOptions() {}              // prog.set_threads, device selection
   virtual std::string afterSetup() const { return ""; }  // "    if (!sphc::counting_particles()) scene.to_device();\n"
   virtual bool hasToHost() const { return false; }
