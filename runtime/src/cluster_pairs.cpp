@@ -20,6 +20,9 @@ namespace {
 
 // The box tests keep squared distances up to radius^2 (1 + kBoxMargin) (sphc/cluster_pairs.h).
 constexpr double kBoxMargin = 1e-12;
+// build_cluster_layout's parallel parts under OpenMP from this many particles (as
+// --omp-min-particles' default: fewer cost more in waking the threads than they save).
+constexpr std::size_t kLayoutParallelMin = 10000;
 
 // A coordinate as a sort or column key: NaN as +inf (a total order for the sort; a NaN
 // position lands in the last column and cluster, and must_rebuild rebuilds at every step).
@@ -129,11 +132,18 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
     for (std::size_t p = 0; p < n; ++p)
       order[at[col[p]]++] = {key(sort_axis[p]), static_cast<std::uint32_t>(p)};
   }
-  // Each column by its sort key (ties by particle index), then cut into clusters.
+  // Each column by its sort key (ties by particle index: a total order, so the same layout
+  // whatever the threads), then cut into clusters. Under OpenMP the columns' sorts and their
+  // slots in parallel (stop 39) where there are at least kLayoutParallelMin particles.
+  const bool parallel = n >= kLayoutParallelMin;
+  (void)parallel;
+  const long ncols = static_cast<long>(ncol);
+#pragma omp parallel for schedule(dynamic, 16) if (parallel)
+  for (long c = 0; c < ncols; ++c)
+    std::sort(order.begin() + count[c], order.begin() + count[c + 1]);
   L.column_begin.assign(ncol + 1, 0);
   std::size_t clusters = 0;
   for (std::size_t c = 0; c < ncol; ++c) {
-    std::sort(order.begin() + count[c], order.begin() + count[c + 1]);
     L.column_begin[c] = static_cast<std::uint32_t>(clusters);
     clusters += (count[c + 1] - count[c] + C - 1) / C;
   }
@@ -142,7 +152,8 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
   L.slot.assign(clusters * C, kPadSlot);
   L.slot_of.assign(n, 0);
   L.real_mask.assign(clusters, 0);
-  for (std::size_t c = 0; c < ncol; ++c) {
+#pragma omp parallel for schedule(dynamic, 16) if (parallel)
+  for (long c = 0; c < ncols; ++c) {  // a column's clusters are its own
     std::size_t s = static_cast<std::size_t>(L.column_begin[c]) * C;
     for (std::size_t k = count[c]; k < count[c + 1]; ++k, ++s) {
       const std::uint32_t p = order[k].second;
@@ -151,17 +162,11 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
       L.real_mask[s / C] |= static_cast<std::uint8_t>(1u << (s % C));
     }
   }
-  // Boxes from these positions.
+  // Boxes from these positions (of the real slots: the positions' gather with the boxes).
   L.box.assign(clusters * 6, 0.0);
   std::vector<double> xs(L.slots()), ys(L.slots()), zs(dim == 3 ? L.slots() : 0);
-  for (std::size_t s = 0; s < L.slots(); ++s) {
-    const std::uint32_t p = L.slot[s];
-    if (p == kPadSlot) continue;
-    xs[s] = x[p];
-    ys[s] = y[p];
-    if (dim == 3) zs[s] = z[p];
-  }
-  update_boxes(L, xs.data(), ys.data(), dim == 3 ? zs.data() : nullptr);
+  gather_positions_boxes(L, x, y, z, xs.data(), ys.data(), dim == 3 ? zs.data() : nullptr, 0.0,
+                         parallel);
 }
 
 namespace {

@@ -115,4 +115,33 @@ TEST_F(ClusterPairsOmp, ListsOfAnyThreadCountEqualOneThreads) {
   }
 }
 
+// Stop 39: the layout's columns sorted and cut into slots in parallel (from 10,000
+// particles): the same layout as one thread's, boxes included.
+TEST_F(ClusterPairsOmp, LargeLayoutsOfAnyThreadCountEqualOneThreads) {
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const std::size_t n = 30000;
+    std::vector<double> x(n), y(n), z(n);
+    for (std::size_t i = 0; i < n; ++i) x[i] = u(rng), y[i] = u(rng), z[i] = dim == 3 ? u(rng) : 0.0;
+    // ties in the sort key: a few particles at one height
+    for (std::size_t i = 0; i < n; i += 97) (dim == 3 ? z : y)[i] = 0.5;
+    omp_set_num_threads(1);
+    sphc::ClusterLayout one;
+    sphc::build_cluster_layout(one, x.data(), y.data(), z.data(), n, dim, 0.0);
+    for (int t = 2; t <= 4; ++t) {
+      SCOPED_TRACE(t);
+      omp_set_num_threads(t);
+      sphc::ClusterLayout l;
+      sphc::build_cluster_layout(l, x.data(), y.data(), z.data(), n, dim, 0.0);
+      EXPECT_EQ(l.slot, one.slot);
+      EXPECT_EQ(l.slot_of, one.slot_of);
+      EXPECT_EQ(l.real_mask, one.real_mask);
+      EXPECT_EQ(l.column_begin, one.column_begin);
+      EXPECT_EQ(l.box, one.box);
+    }
+  }
+}
+
 }  // namespace
