@@ -193,6 +193,28 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       copy(ptr, ptr);
     }
   }
+  // The hoisted values computed in slot order from the copies of what they read (the same
+  // function of the same doubles, so the values a gather would give, padding included: a
+  // padding slot holds its cluster's first particle's values; stop 39), where every property
+  // they read is a copy (not the positions, whose padding lies far away): name -> the call.
+  std::map<std::string, std::string> rename;
+  for (const auto& c : copies)
+    if (c.second.rfind("di_", 0) == 0 || c.second.rfind("s_", 0) == 0 || c.second.rfind("d_", 0) == 0)
+      rename[c.first] = "cl_" + c.first;
+  std::map<std::string, std::string> inSlots;
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    for (size_t k = 0; k < hoistedSites(b, host_).size(); ++k) {
+      const std::string call = hoistedCall(*eq, k, true, "s_idx", rename);
+      if (!call.empty()) inSlots[hoistArgument(eqStruct(*eq), std::to_string(k))] = call;
+    }
+    for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
+      const std::string call = hoistedCall(*eq, k, false, "s_idx", rename);
+      if (!call.empty()) inSlots[symmetricDestinationHoisted(eqStruct(*eq), std::to_string(k))] = call;
+    }
+  }
+  bool allDestinationInSlots = true;
+  for (const std::string& h : dhoisted) allDestinationInSlots &= inSlots.count(h) > 0;
   std::vector<std::string> accs;  // the sums: acc_NAME
   for (const auto& [p, sc] : sums.props) accs.push_back(p);
   const std::string in = "          ";
@@ -204,8 +226,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // The destination-only values of every particle, for the mirrored calls (gathered below;
   // a loop without neighbours: --omp-min-particles' `if`, stop 39).
   const std::string ompIfN = openmp ? ompMinIf("n") : "";  // "" or if (n >= OMP_MIN_PARTICLES)
-  emitDestinationHoistedAll(pass, openmp ? "        #pragma omp parallel for schedule(static)" +
-                                               (ompIfN.empty() ? "" : " " + ompIfN) + "\n" : "");
+  if (!allDestinationInSlots)
+    emitDestinationHoistedAll(pass, openmp ? "        #pragma omp parallel for schedule(static)" +
+                                                 (ompIfN.empty() ? "" : " " + ompIfN) + "\n" : "");
   // The properties nothing writes between two builds (no live equation or stepper writes
   // them: PlanProperty::written; a sort of the particles rebuilds the layout) are copied at
   // the build only; the largest h too where nothing writes h (stop 39).
@@ -260,6 +283,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     if (c.second.empty()) continue;  // the positions
     const bool prop = c.second.rfind("di_", 0) == 0 || c.second.rfind("s_", 0) == 0 || c.second.rfind("d_", 0) == 0;
     const std::string name = prop ? c.second.substr(c.second.find('_') + 1) : "";
+    if (inSlots.count(c.first)) continue;  // computed from the copies below
     (prop && unchanged(name) ? fixedCopies : evalCopies).push_back(c);
   }
   auto gathers = [&](const std::vector<std::pair<std::string, std::string>>& cs, const std::string& ind) {
@@ -279,6 +303,17 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   if (!evalCopies.empty()) {
     scene_ << in << "{  // the copies of what changes between builds\n";
     gathers(evalCopies, in + "  ");
+    scene_ << in << "}\n";
+  }
+  if (!inSlots.empty()) {
+    scene_ << in << "// the hoisted values in slot order from the copies (the same function of the same\n"
+           << in << "// doubles as in the particles' order: the values a gather would copy)\n";
+    if (openmp)
+      scene_ << in << "#pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "for (int s_idx = 0; s_idx < static_cast<int>(n_slots); ++s_idx) {\n";
+    for (const auto& c : copies)
+      if (auto it = inSlots.find(c.first); it != inSlots.end())
+        scene_ << in << "  cl_" << c.first << "[s_idx] = " << it->second << ";\n";
     scene_ << in << "}\n";
   }
   // The tiles, in a lambda without jump threading (see above), over the i-clusters [cb, ce)

@@ -308,6 +308,12 @@ class ScenePrinter {
   std::pair<std::string, std::string> sameDestinationHoisted(const NeighbourPass& pass,
                                                              const PlanEquation& eq,
                                                              size_t k) const;
+  // The call of eq's loop's hoisted site k's function (source: per source particle, else
+  // per destination) for `index`, each property it reads as the array `rename` names for it
+  // (stop 39: the tiles' slot-order copies); "" where one is not in `rename`, or a
+  // destination value of the parameters alone.
+  std::string hoistedCall(const PlanEquation& eq, size_t k, bool source, const std::string& index,
+                          const std::map<std::string, std::string>& rename) const;
   std::string hoistArgument(const std::string& eqValues, const std::string& k) const {
     return "hoisted_" + eqValues + "_" + k;
   }
