@@ -4,8 +4,8 @@ pieces (stop 39)").
 
 Prints the scene's C++ (`sphc SCENE --emit=cpp ...`), puts timers between the pieces of every
 tile pass (the destination-only values, the largest h, the layout at a rebuild, the positions'
-gather (with the boxes since stop 39), the boxes, the outer list at a rebuild, the pruning, the other gathers, the tiles, the
-sums added back), builds it with the flags and libraries sphc builds the scene with (`sphc -v`),
+gather (with the boxes since stop 39), the boxes, the outer list at a rebuild, the pruning, the other gathers
+(and the hoisted values computed in slot order since stop 39), the tiles, the sums added back), builds it with the flags and libraries sphc builds the scene with (`sphc -v`),
 runs it and prints per piece the wall and process CPU time (all threads), per evaluation and in
 all, and their shares of the tile passes.
 
@@ -104,9 +104,10 @@ def instrument(src):
             out.append(line)
             out.append(lap("prune"))
             continue
-        if in_pass and s.startswith("sphc::gather_slots(") and not lines[i + 1].strip().startswith("sphc::gather_slots("):
+        if in_pass and s.startswith("#if defined(__GNUC__) && !defined(__clang__)"):
+            # the copies (and, since stop 39, the hoisted values in slot order) end here
+            out.append("sphc_tp::acc.lap(%d);  // tile_pieces: gathers" % idx["gathers"])
             out.append(line)
-            out.append(lap("gathers"))
             continue
         if in_pass and s.startswith("// The slot sums onto the particles' sums"):
             out.append(lap("tiles"))
