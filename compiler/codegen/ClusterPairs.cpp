@@ -231,7 +231,10 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
                                                  (ompIfN.empty() ? "" : " " + ompIfN) + "\n" : "");
   // The properties nothing writes between two builds (no live equation or stepper writes
   // them: PlanProperty::written; a sort of the particles rebuilds the layout) are copied at
-  // the build only; the largest h too where nothing writes h (stop 39).
+  // the build only; the largest h too where nothing writes h (stop 39). The slot buffer is
+  // this pass's own: the tiles take no pass whose kept lists another pass shares
+  // (CpuPrinter.cpp, "its kept lists are shared with another pass"); were that allowed, a
+  // pass would have to copy again where another one filled the buffer since.
   auto unchanged = [&](const std::string& p) {
     const PlanProperty* prop = arr(d).find(p);
     return prop && !prop->written;
