@@ -122,7 +122,6 @@ def instrument(src):
     text = "\n".join(out)
     # after the includes: the first line that is not an #include or a comment
     pre = PRELUDE % {"names": ", ".join('"%s"' % p for p in PIECES), "n": len(PIECES)}
-    m = re.search(r"^#include[^\n]*\n(?!#include)", text, re.M)
     last = [mm.end() for mm in re.finditer(r"^#include[^\n]*\n", text, re.M)][-1]
     text = text[:last] + pre + text[last:]
     return text, n_passes
