@@ -26,7 +26,10 @@
 // particle's list entries above it, in chunks of 8). --ny NY: a rectangle of nx x ny in 2D
 // (the dam break's water column at dx = 0.03: --nx 33 --ny 66). --positions FILE: the
 // particles from a text file (x y [z] per line; --dx its spacing, h = hdx dx), e.g. a
-// snapshot of a run; --dx also scales the lattice (default 1 / nx).
+// snapshot of a run; --dx also scales the lattice (default 1 / nx). --flush MB: a buffer of
+// MB written before each per-evaluation piece (cold caches, as in a solver); the pieces of
+// stop 39 in one call each (gather_positions_boxes, gather_slots and add_slots of several
+// arrays) are timed after the others.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -329,7 +332,7 @@ int fill_report(const Cube& built, const Cube& moved, int dim, double side, doub
 int main(int argc, char** argv) {
   int nx = 47, ny = 0, reps = 7, fields = 8, sums = 7, dim = 3, width = sphc::kClusterSize;
   bool cluster_order = false, fill = false;
-  double hdx = 1.5, pert = 0.05, skin = 0.1, column = 0, move = 0.5, dx_arg = 0;
+  double hdx = 1.5, pert = 0.05, skin = 0.1, column = 0, move = 0.5, dx_arg = 0, flush_mb = 0;
   std::string positions;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
@@ -353,10 +356,11 @@ int main(int argc, char** argv) {
     else if (a == "--ny") ny = std::atoi(next());
     else if (a == "--dx") dx_arg = std::atof(next());
     else if (a == "--positions") positions = next();
+    else if (a == "--flush") flush_mb = std::atof(next());
     else {
       std::fprintf(stderr, "usage: %s [--nx 47] [--hdx 1.5] [--pert 0.05] [--skin 0.1] [--reps 7] [--column DX]"
                            " [--fields 8] [--sums 7] [--move 0.5] [--dim 3] [--cluster-order]"
-                           " [--width 8] [--fill] [--ny NY] [--dx DX] [--positions FILE]\n", argv[0]);
+                           " [--width 8] [--fill] [--ny NY] [--dx DX] [--positions FILE] [--flush MB]\n", argv[0]);
       return 2;
     }
   }
@@ -411,10 +415,17 @@ int main(int argc, char** argv) {
   std::vector<double> xs, ys, zs;
   std::vector<std::vector<double>> src(fields, std::vector<double>(n, 1.0)), dst(fields);
   std::vector<std::vector<double>> acc(sums), back(sums, std::vector<double>(n, 0.0));
-  enum { LAYOUT, PAIRS, POSITIONS, FIELDS, BOXES, PRUNE, ADD, NPIECES };
+  enum { LAYOUT, PAIRS, POSITIONS, FIELDS, BOXES, PRUNE, ADD, POS_BOXES, FIELDS_1, ADD_1, NPIECES };
   const char* names[NPIECES] = {"layout (sort into columns, clusters)", "outer list at (1 + skin) 2 h",
                                 "gather positions (x, y, z in 3D)", "gather other fields", "update boxes", "prune to 2 h",
-                                "add sums back"};
+                                "add sums back", "(stop 39) positions + boxes, one pass", "(stop 39) other fields, one call",
+                                "(stop 39) sums back, one call"};
+  // --flush MB: a buffer written before each piece, so that each starts with cold caches (as
+  // in a solver, whose tiles evict the copies between the pieces).
+  std::vector<double> flush_buf(static_cast<std::size_t>(flush_mb * (1 << 20) / 8), 0.0);
+  auto flush = [&]() {
+    for (std::size_t k = 0; k < flush_buf.size(); k += 8) flush_buf[k] += 1.0;
+  };
   std::vector<double> best(NPIECES, 1e30);
   for (int r = 0; r < reps; ++r) {
     double t = cpu_now(), t1;
@@ -430,21 +441,47 @@ int main(int argc, char** argv) {
     xs.resize(L.slots()), ys.resize(L.slots()), zs.resize(L.slots());
     for (auto& d : dst) d.resize(L.slots());
     for (auto& s : acc) s.assign(L.slots(), 1.0);
+    std::vector<const double*> from(fields), sums_from(sums);
+    std::vector<double*> to(fields), into(sums);
+    for (int f = 0; f < fields; ++f) from[f] = src[f].data(), to[f] = dst[f].data();
+    for (int s = 0; s < sums; ++s) sums_from[s] = acc[s].data(), into[s] = back[s].data();
+    flush();
     t = cpu_now();
     sphc::gather_positions(L, moved.x.data(), moved.y.data(), moved.z.data(), xs.data(), ys.data(), zs.data(),
                            4 * support);
     lap(POSITIONS);
+    flush();
+    t = cpu_now();
     for (int f = 0; f < fields; ++f) sphc::gather_slots(L, src[f].data(), dst[f].data());
     lap(FIELDS);
+    flush();
+    t = cpu_now();
     sphc::update_boxes(L, xs.data(), ys.data(), zs.data());
     lap(BOXES);
+    flush();
+    t = cpu_now();
     sphc::prune_cluster_pairs(L, L, outer, support, pruned);
     lap(PRUNE);
+    flush();
+    t = cpu_now();
     for (int s = 0; s < sums; ++s) sphc::add_slots(L, acc[s].data(), back[s].data());
     lap(ADD);
+    flush();
+    t = cpu_now();
+    sphc::gather_positions_boxes(L, moved.x.data(), moved.y.data(), moved.z.data(), xs.data(), ys.data(),
+                                 zs.data(), 4 * support);
+    lap(POS_BOXES);
+    flush();
+    t = cpu_now();
+    sphc::gather_slots(L, from.data(), to.data(), fields);
+    lap(FIELDS_1);
+    flush();
+    t = cpu_now();
+    sphc::add_slots(L, sums_from.data(), into.data(), sums);
+    lap(ADD_1);
   }
   double per_eval = 0, rebuild = best[LAYOUT] + best[PAIRS];
-  for (int p = POSITIONS; p < NPIECES; ++p) per_eval += best[p];
+  for (int p = POSITIONS; p <= ADD; ++p) per_eval += best[p];
   std::printf("clusters: %zu (%zu slots, %.1f%% padding), columns %zu x %zu of side %.2f dx\n", L.n_clusters,
               L.slots(), 100.0 * (L.slots() - n) / n, L.columns[0], L.columns[1], L.column_side / dx);
   std::printf("\n%-40s %10s\n", "piece (thread CPU time, best of reps)", "ms");

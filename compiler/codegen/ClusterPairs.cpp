@@ -151,6 +151,7 @@ void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& stat
   os << "  sphc::ClusterLayout " << state << "_layout;\n";
   os << "  sphc::ClusterPairList " << state << "_outer, " << state << "_pruned;\n";
   os << "  std::vector<double> " << state << "_slots;\n";
+  os << "  double " << state << "_hmax = 0.0;  // the largest h at the build (where nothing writes h)\n";
 }
 
 void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPass& pass,
@@ -192,6 +193,28 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       copy(ptr, ptr);
     }
   }
+  // The hoisted values computed in slot order from the copies of what they read (the same
+  // function of the same doubles, so the values a gather would give, padding included: a
+  // padding slot holds its cluster's first particle's values; stop 39), where every property
+  // they read is a copy (not the positions, whose padding lies far away): name -> the call.
+  std::map<std::string, std::string> rename;
+  for (const auto& c : copies)
+    if (c.second.rfind("di_", 0) == 0 || c.second.rfind("s_", 0) == 0 || c.second.rfind("d_", 0) == 0)
+      rename[c.first] = "cl_" + c.first;
+  std::map<std::string, std::string> inSlots;
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    for (size_t k = 0; k < hoistedSites(b, host_).size(); ++k) {
+      const std::string call = hoistedCall(*eq, k, true, "s_idx", rename);
+      if (!call.empty()) inSlots[hoistArgument(eqStruct(*eq), std::to_string(k))] = call;
+    }
+    for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
+      const std::string call = hoistedCall(*eq, k, false, "s_idx", rename);
+      if (!call.empty()) inSlots[symmetricDestinationHoisted(eqStruct(*eq), std::to_string(k))] = call;
+    }
+  }
+  bool allDestinationInSlots = true;
+  for (const std::string& h : dhoisted) allDestinationInSlots &= inSlots.count(h) > 0;
   std::vector<std::string> accs;  // the sums: acc_NAME
   for (const auto& [p, sc] : sums.props) accs.push_back(p);
   const std::string in = "          ";
@@ -200,38 +223,102 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
             "        // (sphc/cluster_pairs.h), rebuilt with the kept lists (verlet_build; the lists\n"
             "        // themselves are not built), pruned at the support per evaluation; the sums\n"
             "        // reassociated (lane sums per i across its list, per j across a tile).\n";
-  // The destination-only values of every particle, for the mirrored calls (gathered below).
-  emitDestinationHoistedAll(pass, openmp ? "        #pragma omp parallel for schedule(static)\n" : "");
+  // The destination-only values of every particle, for the mirrored calls (gathered below;
+  // a loop without neighbours: --omp-min-particles' `if`, stop 39).
+  const std::string ompIfN = openmp ? ompMinIf("n") : "";  // "" or if (n >= OMP_MIN_PARTICLES)
+  if (!allDestinationInSlots)
+    emitDestinationHoistedAll(pass, openmp ? "        #pragma omp parallel for schedule(static)" +
+                                                 (ompIfN.empty() ? "" : " " + ompIfN) + "\n" : "");
+  // The properties nothing writes between two builds (no live equation or stepper writes
+  // them: PlanProperty::written; a sort of the particles rebuilds the layout) are copied at
+  // the build only; the largest h too where nothing writes h (stop 39). The slot buffer is
+  // this pass's own: the tiles take no pass whose kept lists another pass shares
+  // (CpuPrinter.cpp, "its kept lists are shared with another pass"); were that allowed, a
+  // pass would have to copy again where another one filled the buffer since.
+  auto unchanged = [&](const std::string& p) {
+    const PlanProperty* prop = arr(d).find(p);
+    return prop && !prop->written;
+  };
+  const bool hFixed = unchanged("h");
+  // Under OpenMP the pieces without neighbours honour --omp-min-particles (their `if`).
+  const std::string par = ompIfN.empty() ? "" : ", n >= OMP_MIN_PARTICLES";
   scene_ << "        {\n";
   scene_ << in << "sphc::ClusterLayout& cl_layout = " << state << "_layout;\n";
-  scene_ << in << "double cl_hmax = 0.0;  // the largest h now\n";
-  if (openmp) scene_ << in << "#pragma omp parallel for schedule(static) reduction(max: cl_hmax)\n";
-  scene_ << in << "for (int i = 0; i < n; ++i) cl_hmax = std::max(cl_hmax, di_h[i]);\n";
   const std::string zIn = plan_.dim == 3 ? "di_z" : "nullptr";
+  if (hFixed) {
+    scene_ << in << "// the largest h: at the build (nothing writes h)\n";
+    scene_ << in << "if (verlet_build) {\n";
+    scene_ << in << "  double cl_hmax_build = 0.0;\n";
+    scene_ << in << "  for (int i = 0; i < n; ++i) cl_hmax_build = std::max(cl_hmax_build, di_h[i]);\n";
+    scene_ << in << "  " << state << "_hmax = cl_hmax_build;\n";
+    scene_ << in << "}\n";
+    scene_ << in << "const double cl_hmax = " << state << "_hmax;  // the largest h now\n";
+  } else {
+    scene_ << in << "double cl_hmax = 0.0;  // the largest h now\n";
+    if (openmp)
+      scene_ << in << "#pragma omp parallel for schedule(static) reduction(max: cl_hmax)"
+             << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "for (int i = 0; i < n; ++i) cl_hmax = std::max(cl_hmax, di_h[i]);\n";
+  }
   scene_ << in << "if (verlet_build) sphc::build_cluster_layout(cl_layout, di_x, di_y, " << zIn
          << ", static_cast<std::size_t>(n), DIM, 0.0);\n";
   scene_ << in << "const std::size_t n_slots = cl_layout.slots();\n";
   scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots;\n";
-  scene_ << in << "cl_buf.resize(" << copies.size() + accs.size() << " * n_slots);\n";
+  scene_ << in << "cl_buf.resize(" << copies.size() + accs.size() << " * n_slots);  // (kept: the copies made at the build)\n";
   size_t at = 0;
   for (const auto& c : copies)
     scene_ << in << "double* const cl_" << c.first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   for (const std::string& p : accs)
     scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
-  scene_ << in << "// The positions in slot order (padding slots 4 supports away from every particle),\n"
-         << in << "// the boxes, the outer list at a rebuild, the list pruned at the support now.\n";
-  scene_ << in << "sphc::gather_positions(cl_layout, di_x, di_y, " << zIn << ", cl_x, cl_y, "
-         << (plan_.dim == 3 ? "cl_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax);\n";
-  scene_ << in << "sphc::update_boxes(cl_layout, cl_x, cl_y, " << (plan_.dim == 3 ? "cl_z" : "nullptr")
-         << ");\n";
+  scene_ << in << "// The positions in slot order (padding slots 4 supports away from every particle)\n"
+         << in << "// and the boxes in one pass, the outer list at a rebuild, the list pruned at the\n"
+         << in << "// support now.\n";
+  scene_ << in << "sphc::gather_positions_boxes(cl_layout, di_x, di_y, " << zIn << ", cl_x, cl_y, "
+         << (plan_.dim == 3 ? "cl_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax" << par << ");\n";
   scene_ << in << "if (verlet_build) sphc::build_cluster_pairs(cl_layout, cl_layout, std::sqrt("
-         << listRadius2 << ") * cl_hmax, true, " << state << "_outer);\n";
+         << listRadius2 << ") * cl_hmax, true, " << state << "_outer" << par << ");\n";
   scene_ << in << "sphc::prune_cluster_pairs(cl_layout, cl_layout, " << state
-         << "_outer, Kernel::radius_scale * cl_hmax, " << state << "_pruned);\n";
+         << "_outer, Kernel::radius_scale * cl_hmax, " << state << "_pruned" << par << ");\n";
   scene_ << in << "const sphc::ClusterPairList& cl_pruned = " << state << "_pruned;\n";
-  for (const auto& c : copies)
-    if (!c.second.empty())
-      scene_ << in << "sphc::gather_slots(cl_layout, " << c.second << ", cl_" << c.first << ");\n";
+  // The other copies in one pass each: those nothing writes at the build, the rest now.
+  std::vector<std::pair<std::string, std::string>> fixedCopies, evalCopies;
+  for (const auto& c : copies) {
+    if (c.second.empty()) continue;  // the positions
+    const bool prop = c.second.rfind("di_", 0) == 0 || c.second.rfind("s_", 0) == 0 || c.second.rfind("d_", 0) == 0;
+    const std::string name = prop ? c.second.substr(c.second.find('_') + 1) : "";
+    if (inSlots.count(c.first)) continue;  // computed from the copies below
+    (prop && unchanged(name) ? fixedCopies : evalCopies).push_back(c);
+  }
+  auto gathers = [&](const std::vector<std::pair<std::string, std::string>>& cs, const std::string& ind) {
+    scene_ << ind << "const double* const cl_from[] = {";
+    for (size_t k = 0; k < cs.size(); ++k) scene_ << (k ? ", " : "") << cs[k].second;
+    scene_ << "};\n";
+    scene_ << ind << "double* const cl_to[] = {";
+    for (size_t k = 0; k < cs.size(); ++k) scene_ << (k ? ", " : "") << "cl_" << cs[k].first;
+    scene_ << "};\n";
+    scene_ << ind << "sphc::gather_slots(cl_layout, cl_from, cl_to, " << cs.size() << par << ");\n";
+  };
+  if (!fixedCopies.empty()) {
+    scene_ << in << "if (verlet_build) {  // the copies of what nothing writes: at the build only\n";
+    gathers(fixedCopies, in + "  ");
+    scene_ << in << "}\n";
+  }
+  if (!evalCopies.empty()) {
+    scene_ << in << "{  // the copies of what changes between builds\n";
+    gathers(evalCopies, in + "  ");
+    scene_ << in << "}\n";
+  }
+  if (!inSlots.empty()) {
+    scene_ << in << "// the hoisted values in slot order from the copies (the same function of the same\n"
+           << in << "// doubles as in the particles' order: the values a gather would copy)\n";
+    if (openmp)
+      scene_ << in << "#pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "for (int s_idx = 0; s_idx < static_cast<int>(n_slots); ++s_idx) {\n";
+    for (const auto& c : copies)
+      if (auto it = inSlots.find(c.first); it != inSlots.end())
+        scene_ << in << "  cl_" << c.first << "[s_idx] = " << it->second << ";\n";
+    scene_ << in << "}\n";
+  }
   // The tiles, in a lambda without jump threading (see above), over the i-clusters [cb, ce)
   // of one block: serial, one block of them all; OpenMP, blocks in parallel, the same sums.
   scene_ << "#if defined(__GNUC__) && !defined(__clang__)\n"
@@ -456,9 +543,18 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "  for (int blk = 0; blk < n_blocks; ++blk) tiles(cl_cb[blk], cl_cb[blk + 1]);\n";
     scene_ << in << "}\n";
   }
-  scene_ << in << "// The slot sums onto the particles' sums (padding slots never read).\n";
-  for (const std::string& p : accs)
-    scene_ << in << "sphc::add_slots(cl_layout, cl_acc_" << p << ", d_" << p << ");\n";
+  scene_ << in << "// The slot sums onto the particles' sums (padding slots never read), in one pass.\n";
+  if (!accs.empty()) {
+    scene_ << in << "{\n";
+    scene_ << in << "  const double* const cl_sums[] = {";
+    for (size_t k = 0; k < accs.size(); ++k) scene_ << (k ? ", " : "") << "cl_acc_" << accs[k];
+    scene_ << "};\n";
+    scene_ << in << "  double* const cl_into[] = {";
+    for (size_t k = 0; k < accs.size(); ++k) scene_ << (k ? ", " : "") << "d_" << accs[k];
+    scene_ << "};\n";
+    scene_ << in << "  sphc::add_slots(cl_layout, cl_sums, cl_into, " << accs.size() << par << ");\n";
+    scene_ << in << "}\n";
+  }
   scene_ << "        }\n";
 }
 

@@ -245,6 +245,7 @@ class CpuPrinter : public ScenePrinter {
   std::string ompIf(const std::string& count) const {
     return ompMinParticles_ > 0 ? "if (" + count + " >= OMP_MIN_PARTICLES)" : "";
   }
+  std::string ompMinIf(const std::string& count) const override { return openmp_ ? ompIf(count) : ""; }
   // ompIf after `clauses`.
   static std::string withIf(const std::string& clauses, const std::string& cond) {
     return clauses.empty() ? cond : cond.empty() ? clauses : clauses + " " + cond;

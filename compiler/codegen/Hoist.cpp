@@ -279,6 +279,27 @@ static std::string hoistArguments(const SourceOnlySite& s, const BodyFacts& f, b
   return args;
 }
 
+std::string ScenePrinter::hoistedCall(const PlanEquation& eq, size_t k, bool source,
+                                      const std::string& index,
+                                      const std::map<std::string, std::string>& rename) const {
+  const PlanBody& b = methodBody(eq, ast::Method::Loop);
+  const auto sites = source ? hoistedSites(b, host_) : hoistedDestinationSites(b, host_);
+  if (k >= sites.size()) return "";
+  const SourceOnlySite& s = sites[k];
+  if (!source && particleFree(b.source.text, b.facts, s)) return "";
+  std::string args;
+  if (s.usesT) args += ", t";
+  if (s.usesDt) args += ", dt";
+  for (const auto& sc : s.scalars) args += ", " + eqStruct(eq) + "." + sc;
+  for (const auto& p : sideReads(b.facts, s, source)) {
+    auto it = rename.find(p);
+    if (it == rename.end()) return "";
+    args += ", " + it->second;
+  }
+  return bodyFunctionName(eq.name, "loop") + (source ? "_hoisted" : "_dhoisted") +
+         std::to_string(k) + "(" + index + args + ")";
+}
+
 std::pair<std::string, std::string> ScenePrinter::sameDestinationHoisted(
     const NeighbourPass& pass, const PlanEquation& eq, size_t k) const {
   std::map<std::string, std::pair<std::string, std::string>> first;  // key -> (eq struct, k)

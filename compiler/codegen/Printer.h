@@ -131,6 +131,9 @@ class ScenePrinter {
   virtual void timedNeighbourUpdate() = 0;
   virtual void adaptiveDtArray(int a) = 0;          // the limits of one moving array
   virtual void mainPrologue() {}                    // before `static Scene scene;`
+  // --omp-min-particles: the `if (COUNT >= OMP_MIN_PARTICLES)` clause of a loop without
+  // neighbours ("" where there is none: serial, or the option 0).
+  virtual std::string ompMinIf(const std::string& count) const { return ""; }
   virtual void mainBackendOptions() {}              // prog.set_threads, device selection
   virtual std::string afterSetup() const { return ""; }  // "    if (!sphc::counting_particles()) scene.to_device();\n"
   virtual bool hasToHost() const { return false; }
@@ -305,6 +308,12 @@ class ScenePrinter {
   std::pair<std::string, std::string> sameDestinationHoisted(const NeighbourPass& pass,
                                                              const PlanEquation& eq,
                                                              size_t k) const;
+  // The call of eq's loop's hoisted site k's function (source: per source particle, else
+  // per destination) for `index`, each property it reads as the array `rename` names for it
+  // (stop 39: the tiles' slot-order copies); "" where one is not in `rename`, or a
+  // destination value of the parameters alone.
+  std::string hoistedCall(const PlanEquation& eq, size_t k, bool source, const std::string& index,
+                          const std::map<std::string, std::string>& rename) const;
   std::string hoistArgument(const std::string& eqValues, const std::string& k) const {
     return "hoisted_" + eqValues + "_" + k;
   }

@@ -20,6 +20,9 @@ namespace {
 
 // The box tests keep squared distances up to radius^2 (1 + kBoxMargin) (sphc/cluster_pairs.h).
 constexpr double kBoxMargin = 1e-12;
+// build_cluster_layout's parallel parts under OpenMP from this many particles (as
+// --omp-min-particles' default: fewer cost more in waking the threads than they save).
+constexpr std::size_t kLayoutParallelMin = 10000;
 
 // A coordinate as a sort or column key: NaN as +inf (a total order for the sort; a NaN
 // position lands in the last column and cluster, and must_rebuild rebuilds at every step).
@@ -35,10 +38,11 @@ inline std::size_t column_of(double v, double origin, double side, std::size_t c
 
 // Blocks of i-clusters for the build and the prune: one per OpenMP thread (1 without OpenMP),
 // at most one per 64 clusters.
-inline int block_count(std::size_t clusters) {
+inline int block_count(std::size_t clusters, bool parallel = true) {
 #ifdef _OPENMP
-  const std::size_t threads = static_cast<std::size_t>(omp_get_max_threads());
+  const std::size_t threads = parallel ? static_cast<std::size_t>(omp_get_max_threads()) : 1;
 #else
+  (void)parallel;
   const std::size_t threads = 1;
 #endif
   return static_cast<int>(std::max<std::size_t>(1, std::min(threads, clusters / 64)));
@@ -128,11 +132,18 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
     for (std::size_t p = 0; p < n; ++p)
       order[at[col[p]]++] = {key(sort_axis[p]), static_cast<std::uint32_t>(p)};
   }
-  // Each column by its sort key (ties by particle index), then cut into clusters.
+  // Each column by its sort key (ties by particle index: a total order, so the same layout
+  // whatever the threads), then cut into clusters. Under OpenMP the columns' sorts and their
+  // slots in parallel (stop 39) where there are at least kLayoutParallelMin particles.
+  const bool parallel = n >= kLayoutParallelMin;
+  (void)parallel;
+  const long ncols = static_cast<long>(ncol);
+#pragma omp parallel for schedule(dynamic, 16) if (parallel)
+  for (long c = 0; c < ncols; ++c)
+    std::sort(order.begin() + count[c], order.begin() + count[c + 1]);
   L.column_begin.assign(ncol + 1, 0);
   std::size_t clusters = 0;
   for (std::size_t c = 0; c < ncol; ++c) {
-    std::sort(order.begin() + count[c], order.begin() + count[c + 1]);
     L.column_begin[c] = static_cast<std::uint32_t>(clusters);
     clusters += (count[c + 1] - count[c] + C - 1) / C;
   }
@@ -141,7 +152,8 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
   L.slot.assign(clusters * C, kPadSlot);
   L.slot_of.assign(n, 0);
   L.real_mask.assign(clusters, 0);
-  for (std::size_t c = 0; c < ncol; ++c) {
+#pragma omp parallel for schedule(dynamic, 16) if (parallel)
+  for (long c = 0; c < ncols; ++c) {  // a column's clusters are its own
     std::size_t s = static_cast<std::size_t>(L.column_begin[c]) * C;
     for (std::size_t k = count[c]; k < count[c + 1]; ++k, ++s) {
       const std::uint32_t p = order[k].second;
@@ -150,17 +162,11 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
       L.real_mask[s / C] |= static_cast<std::uint8_t>(1u << (s % C));
     }
   }
-  // Boxes from these positions.
+  // Boxes from these positions (of the real slots: the positions' gather with the boxes).
   L.box.assign(clusters * 6, 0.0);
   std::vector<double> xs(L.slots()), ys(L.slots()), zs(dim == 3 ? L.slots() : 0);
-  for (std::size_t s = 0; s < L.slots(); ++s) {
-    const std::uint32_t p = L.slot[s];
-    if (p == kPadSlot) continue;
-    xs[s] = x[p];
-    ys[s] = y[p];
-    if (dim == 3) zs[s] = z[p];
-  }
-  update_boxes(L, xs.data(), ys.data(), dim == 3 ? zs.data() : nullptr);
+  gather_positions_boxes(L, x, y, z, xs.data(), ys.data(), dim == 3 ? zs.data() : nullptr, 0.0,
+                         parallel);
 }
 
 namespace {
@@ -287,6 +293,164 @@ void update_boxes(ClusterLayout& L, const double* xs, const double* ys, const do
 
 namespace {
 
+// The arrays one after another (a pass over the slots each: long streams, measured faster
+// than all the arrays per cluster, bench/cluster_lists.cpp `--flush`), under OpenMP in one
+// parallel region (each thread the same clusters of every array: no barrier between them).
+template <int W>
+void gather_slots_n_w(const ClusterLayout& L, const double* const* src, double* const* dst,
+                      int count, bool parallel) {
+  const int C = W > 0 ? W : L.width;
+  const std::uint8_t full = L.full_mask();
+  const std::uint32_t* slot = L.slot.data();
+  const std::uint8_t* real = L.real_mask.data();
+  const std::size_t nc = L.n_clusters;
+  (void)parallel;
+#pragma omp parallel if (parallel)
+  for (int a = 0; a < count; ++a) {
+    const double* s = src[a];
+    double* const da = dst[a];
+#pragma omp for schedule(static) nowait
+    for (std::size_t c = 0; c < nc; ++c) {
+      const std::uint32_t* sl = slot + c * C;
+      double* d = da + c * C;
+      if (real[c] == full) {
+        for (int k = 0; k < C; ++k) d[k] = s[sl[k]];
+      } else {  // padding: its cluster's first value
+        const double first = s[sl[0]];
+        for (int k = 0; k < C; ++k) d[k] = sl[k] == kPadSlot ? first : s[sl[k]];
+      }
+    }
+  }
+}
+
+// One cluster's box from its gathered positions (update_boxes_w's arithmetic).
+template <int W>
+inline void cluster_box(int C, unsigned mask, unsigned full, bool three, const double* xs,
+                        const double* ys, const double* zs, double* b) {
+  if (mask == full) {
+    double lx = xs[0], hx = xs[0], ly = ys[0], hy = ys[0];
+    for (int k = 1; k < C; ++k) {
+      lx = std::min(lx, xs[k]), hx = std::max(hx, xs[k]);
+      ly = std::min(ly, ys[k]), hy = std::max(hy, ys[k]);
+    }
+    double lz = 0, hz = 0;
+    if (three) {
+      lz = hz = zs[0];
+      for (int k = 1; k < C; ++k) lz = std::min(lz, zs[k]), hz = std::max(hz, zs[k]);
+    }
+    b[0] = lx, b[1] = ly, b[2] = lz, b[3] = hx, b[4] = hy, b[5] = hz;
+  } else {
+    const int m = __builtin_popcount(mask);  // the real slots come first
+    double lx = xs[0], hx = xs[0], ly = ys[0], hy = ys[0];
+    double lz = three ? zs[0] : 0, hz = lz;
+    for (int k = 1; k < m; ++k) {
+      lx = std::min(lx, xs[k]), hx = std::max(hx, xs[k]);
+      ly = std::min(ly, ys[k]), hy = std::max(hy, ys[k]);
+      if (three) lz = std::min(lz, zs[k]), hz = std::max(hz, zs[k]);
+    }
+    b[0] = lx, b[1] = ly, b[2] = lz, b[3] = hx, b[4] = hy, b[5] = hz;
+  }
+}
+
+template <int W>
+void gather_positions_boxes_w(ClusterLayout& L, const double* x, const double* y,
+                              const double* z, double* xs, double* ys, double* zs,
+                              double pad_offset, bool parallel) {
+  const int C = W > 0 ? W : L.width;
+  const unsigned full = L.full_mask();
+  const bool three = L.dim == 3;
+  const std::uint32_t* slot = L.slot.data();
+  const std::uint8_t* real = L.real_mask.data();
+  double* box = L.box.data();
+  const std::size_t nc = L.n_clusters;
+  // The largest x of the real particles: per thread, then over the threads (max is exact and
+  // std::max skips a NaN second argument, so the value of gather_positions' scan in particle
+  // order, whatever the order; a +-0 makes no difference to the padding's x).
+  double xmax = -HUGE_VAL;
+  (void)parallel;
+#pragma omp parallel if (parallel)
+  {
+    double xm = -HUGE_VAL;
+#pragma omp for schedule(static) nowait
+    for (std::size_t c = 0; c < nc; ++c) {
+      const std::uint32_t* sl = slot + c * C;
+      const unsigned mask = real[c];
+      double* dx = xs + c * C;
+      double* dy = ys + c * C;
+      double* dz = three ? zs + c * C : nullptr;
+      if (mask == full) {
+        for (int k = 0; k < C; ++k) dx[k] = x[sl[k]], dy[k] = y[sl[k]];
+        if (three)
+          for (int k = 0; k < C; ++k) dz[k] = z[sl[k]];
+        for (int k = 0; k < C; ++k) xm = std::max(xm, dx[k]);
+      } else {
+        const std::uint32_t p0 = sl[0];
+        for (int k = 0; k < C; ++k) {
+          const std::uint32_t p = sl[k] == kPadSlot ? p0 : sl[k];
+          dx[k] = x[p], dy[k] = y[p];
+          if (three) dz[k] = z[p];
+        }
+        const int m = __builtin_popcount(mask);
+        for (int k = 0; k < m; ++k) xm = std::max(xm, dx[k]);
+      }
+      cluster_box<W>(C, mask, full, three, dx, dy, dz, box + 6 * c);
+    }
+#pragma omp critical(sphc_cluster_xmax)
+    xmax = std::max(xmax, xm);
+  }
+  if (L.slots() == L.n) return;  // no padding
+  double k = 0;  // the padding slots numbered 1, 2, ... in slot order
+  for (std::size_t c = 0; c < nc; ++c) {
+    const unsigned m = real[c];
+    if (m == full) continue;
+    for (int lane = 0; lane < C; ++lane)
+      if (!(m >> lane & 1u)) xs[c * C + lane] = xmax + (k += 1) * pad_offset;
+  }
+}
+
+// As gather_slots_n_w: a pass per array, one parallel region.
+void add_slots_n(const ClusterLayout& L, const double* const* sums, double* const* dst,
+                 int count, bool parallel) {
+  const std::uint32_t* slot_of = L.slot_of.data();
+  const std::size_t n = L.n;
+  (void)parallel;
+#pragma omp parallel if (parallel)
+  for (int a = 0; a < count; ++a) {
+    const double* s = sums[a];
+    double* const d = dst[a];
+#pragma omp for schedule(static) nowait
+    for (std::size_t p = 0; p < n; ++p) d[p] += s[slot_of[p]];
+  }
+}
+
+}  // namespace
+
+void gather_slots(const ClusterLayout& L, const double* const* src, double* const* dst,
+                  int count, bool parallel) {
+  if (count <= 0) return;
+  if (L.width == kClusterSize)
+    gather_slots_n_w<kClusterSize>(L, src, dst, count, parallel);
+  else
+    gather_slots_n_w<0>(L, src, dst, count, parallel);
+}
+
+void add_slots(const ClusterLayout& L, const double* const* sums, double* const* dst, int count,
+               bool parallel) {
+  if (count <= 0) return;
+  add_slots_n(L, sums, dst, count, parallel);
+}
+
+void gather_positions_boxes(ClusterLayout& L, const double* x, const double* y, const double* z,
+                            double* xs, double* ys, double* zs, double pad_offset,
+                            bool parallel) {
+  if (L.width == kClusterSize)
+    gather_positions_boxes_w<kClusterSize>(L, x, y, z, xs, ys, zs, pad_offset, parallel);
+  else
+    gather_positions_boxes_w<0>(L, x, y, z, xs, ys, zs, pad_offset, parallel);
+}
+
+namespace {
+
 // Per column of b, running bounds along the sort axis: lo_up[k] = max of the clusters'
 // high sort coordinate up to k (from the column's first), lo_down[k] = min of their low sort
 // coordinate from k to the column's last. Both increase with k, so the j-clusters within
@@ -393,7 +557,7 @@ void find_pairs(const ClusterLayout& b, const ColumnBounds& cb, const double* ib
 }  // namespace
 
 void build_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b, double radius,
-                         bool once, ClusterPairList& out) {
+                         bool once, ClusterPairList& out, bool parallel) {
   assert(!once || &a == &b);
   assert(a.dim == b.dim);
   const ColumnBounds cb = column_bounds(b);
@@ -403,11 +567,11 @@ void build_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b, double 
   out.j.clear();
   if (b.n_clusters == 0) return;
   // Blocks of i-clusters (one per thread under OpenMP), concatenated in order.
-  const int nblocks = block_count(nci);
+  const int nblocks = block_count(nci, parallel);
   std::vector<std::vector<std::uint32_t>> part(nblocks);
   part[0].swap(out.j);  // the first block writes into out.j's storage (kept across rebuilds)
   part[0].clear();
-#pragma omp parallel for schedule(static, 1)
+#pragma omp parallel for schedule(static, 1) if (nblocks > 1)
   for (int blk = 0; blk < nblocks; ++blk) {
     const std::size_t c0 = nci * blk / nblocks, c1 = nci * (blk + 1) / nblocks;
     std::vector<std::uint32_t>& o = part[blk];
@@ -432,7 +596,8 @@ void build_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b, double 
 }
 
 void prune_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b,
-                         const ClusterPairList& outer, double radius, ClusterPairList& out) {
+                         const ClusterPairList& outer, double radius, ClusterPairList& out,
+                         bool parallel) {
   assert(&out != &outer);
   const double r2 = radius * radius * (1 + kBoxMargin);
   const std::size_t nci = a.n_clusters;
@@ -443,9 +608,9 @@ void prune_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b,
   // Blocks of i-clusters (one per thread under OpenMP): each compacts its kept pairs within
   // its own part of out.j (the outer list's range), then the parts are moved together in
   // order: the serial result.
-  const int nblocks = block_count(nci);
+  const int nblocks = block_count(nci, parallel);
   std::vector<std::size_t> kept(nblocks, 0);
-#pragma omp parallel for schedule(static, 1)
+#pragma omp parallel for schedule(static, 1) if (nblocks > 1)
   for (int blk = 0; blk < nblocks; ++blk) {
     const std::size_t c0 = nci * blk / nblocks, c1 = nci * (blk + 1) / nblocks;
     const std::size_t first = outer.begin[c0];

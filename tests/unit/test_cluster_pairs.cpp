@@ -369,6 +369,66 @@ TEST(ClusterPairs, GatherAndAddRoundTripExactly) {
   }
 }
 
+// Stop 39: the per-evaluation pieces in one call each give exactly the values of the calls
+// they replace: gather_positions_boxes = gather_positions then update_boxes (positions,
+// padding and boxes bit for bit), gather_slots and add_slots of several arrays = one call per
+// array; with parallel = false too.
+TEST(ClusterPairs, OnePassPiecesEqualTheCallsTheyReplace) {
+  for (int width : kWidths)
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    SCOPED_TRACE(width);
+    const ClusterLayout built = layout_of(c.p, c.side, width);
+    // Moved since the build (boxes change).
+    std::vector<double> x = c.p.x, y = c.p.y, z = c.p.dim == 3 ? c.p.z : std::vector<double>();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      x[i] += 0.03 * c.radius * std::sin(1.0 + i), y[i] += 0.03 * c.radius * std::cos(2.0 * i);
+      if (c.p.dim == 3) z[i] -= 0.02 * c.radius * std::sin(3.0 * i);
+    }
+    const double* zp = c.p.dim == 3 ? z.data() : nullptr;
+    const double pad = 3.0 * c.radius;
+    const std::size_t S = built.slots();
+    for (bool parallel : {true, false}) {
+      SCOPED_TRACE(parallel);
+      ClusterLayout a = built, b = built;
+      std::vector<double> xa(S, -1.0), ya(S, -1.0), za(S, -1.0), xb(S, -2.0), yb(S, -2.0), zb(S, -2.0);
+      sphc::gather_positions(a, x.data(), y.data(), zp, xa.data(), ya.data(), c.p.dim == 3 ? za.data() : nullptr, pad);
+      sphc::update_boxes(a, xa.data(), ya.data(), c.p.dim == 3 ? za.data() : nullptr);
+      sphc::gather_positions_boxes(b, x.data(), y.data(), zp, xb.data(), yb.data(),
+                                   c.p.dim == 3 ? zb.data() : nullptr, pad, parallel);
+      EXPECT_EQ(xa, xb);
+      EXPECT_EQ(ya, yb);
+      if (c.p.dim == 3) EXPECT_EQ(za, zb);
+      EXPECT_EQ(a.box, b.box);
+      if (x.size() > 0) EXPECT_NE(a.box, built.box);
+      // Three arrays gathered and added back.
+      std::mt19937_64 rng(11);
+      std::uniform_real_distribution<double> u(-1.0, 1.0);
+      std::vector<std::vector<double>> v(3, std::vector<double>(x.size()));
+      for (auto& w : v)
+        for (double& q : w) q = u(rng);
+      std::vector<std::vector<double>> one(3, std::vector<double>(S, 5.0)), all(3, std::vector<double>(S, 6.0));
+      for (int k = 0; k < 3; ++k) sphc::gather_slots(a, v[k].data(), one[k].data());
+      const double* from[3] = {v[0].data(), v[1].data(), v[2].data()};
+      double* to[3] = {all[0].data(), all[1].data(), all[2].data()};
+      sphc::gather_slots(a, from, to, 3, parallel);
+      EXPECT_EQ(one, all);
+      std::vector<std::vector<double>> back1(3, std::vector<double>(x.size(), 0.5)), back3 = back1;
+      for (int k = 0; k < 3; ++k)
+        for (std::size_t s2 = 0; s2 < S; ++s2) one[k][s2] = u(rng);
+      for (int k = 0; k < 3; ++k) sphc::add_slots(a, one[k].data(), back1[k].data());
+      const double* sums[3] = {one[0].data(), one[1].data(), one[2].data()};
+      double* into[3] = {back3[0].data(), back3[1].data(), back3[2].data()};
+      sphc::add_slots(a, sums, into, 3, parallel);
+      EXPECT_EQ(back1, back3);
+      // None: nothing written.
+      sphc::gather_slots(a, from, to, 0, parallel);
+      sphc::add_slots(a, sums, into, 0, parallel);
+      EXPECT_EQ(back1, back3);
+    }
+  }
+}
+
 TEST(ClusterPairs, PaddingPositionsLieFarFromEveryRealParticle) {
   for (int width : kWidths)
   for (const Case& c : cases()) {

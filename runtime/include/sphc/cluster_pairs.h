@@ -133,6 +133,24 @@ void add_slots(const ClusterLayout& layout, const float* sums, float* dst);
 // unused in 2D).
 void update_boxes(ClusterLayout& layout, const double* xs, const double* ys, const double* zs);
 
+// The per-evaluation pieces in fewer passes (docs/performance.md, "The tiles' per-evaluation
+// pieces (stop 39)"); each gives exactly the values of the calls it replaces. `parallel`:
+// under OpenMP (libsphc_runtime_omp) the pass is one parallel region when true (the
+// generated code passes n >= OMP_MIN_PARTICLES), on the calling thread when false; without
+// OpenMP it is ignored.
+//
+// gather_slots for `count` arrays in one pass over the slots: dst[k][s] = src[k][slot[s]].
+void gather_slots(const ClusterLayout& layout, const double* const* src, double* const* dst,
+                  int count, bool parallel = true);
+// add_slots for `count` arrays in one pass over the particles: dst[k][p] += sums[k][slot_of[p]].
+void add_slots(const ClusterLayout& layout, const double* const* sums, double* const* dst,
+               int count, bool parallel = true);
+// gather_positions and then update_boxes, in one pass over the clusters (each cluster's box
+// from the positions as they are gathered; the largest x in the same pass).
+void gather_positions_boxes(ClusterLayout& layout, const double* x, const double* y,
+                            const double* z, double* xs, double* ys, double* zs,
+                            double pad_offset, bool parallel = true);
+
 // A list of cluster pairs: CSR over the i-clusters.
 struct ClusterPairList {
   std::vector<std::uint32_t> begin;  // n_clusters of the i layout + 1
@@ -144,11 +162,14 @@ struct ClusterPairList {
 // lie within `radius` (box-to-box distance). once = true: a and b the same layout (&a == &b),
 // only j >= i. From the grid of b's columns (the columns within reach of each i box),
 // correct for boxes moved since the layout was built too.
+// parallel = false: one block on the calling thread (the same list).
 void build_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b, double radius,
-                         bool once, ClusterPairList& out);
+                         bool once, ClusterPairList& out, bool parallel = true);
 
 // Per evaluation: the pairs of `outer` whose boxes (as updated now) lie within `radius`.
+// parallel = false: one block on the calling thread (the same list).
 void prune_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b,
-                         const ClusterPairList& outer, double radius, ClusterPairList& out);
+                         const ClusterPairList& outer, double radius, ClusterPairList& out,
+                         bool parallel = true);
 
 }  // namespace sphc

@@ -23,6 +23,10 @@ struct Lists {
   sphc::ClusterLayout layout;
   sphc::ClusterPairList outer, pruned, cross;
   std::vector<double> gathered, added;
+  // Stop 39: the one-call pieces (parallel and not).
+  std::vector<double> xs1, gathered3, added3;
+  std::vector<double> box1;
+  sphc::ClusterPairList pruned_serial;
 };
 
 Lists lists_with(int threads, int dim, int width) {
@@ -47,6 +51,36 @@ Lists lists_with(int threads, int dim, int width) {
   sphc::gather_slots(l.layout, v.data(), l.gathered.data());
   l.added.assign(n, 1.0);
   sphc::add_slots(l.layout, l.gathered.data(), l.added.data());
+  // The one-call pieces: positions and boxes in one pass, three arrays gathered and added.
+  sphc::ClusterLayout L2 = l.layout;
+  std::vector<double> xs2(S), ys2(S), zs2(S);
+  sphc::gather_positions_boxes(L2, x.data(), y.data(), z.data(), xs2.data(), ys2.data(), zs2.data(), 10.0);
+  l.xs1 = xs2;
+  l.xs1.insert(l.xs1.end(), ys2.begin(), ys2.end());
+  if (dim == 3) l.xs1.insert(l.xs1.end(), zs2.begin(), zs2.end());
+  l.box1 = L2.box;
+  std::vector<double> v2(n), v3(n);
+  for (std::size_t i = 0; i < n; ++i) v2[i] = std::sin(1.0 * i), v3[i] = std::cos(1.0 * i);
+  std::vector<double> g1(S), g2(S), g3(S);
+  const double* from[3] = {v.data(), v2.data(), v3.data()};
+  double* to[3] = {g1.data(), g2.data(), g3.data()};
+  sphc::gather_slots(l.layout, from, to, 3);
+  l.gathered3 = g1;
+  l.gathered3.insert(l.gathered3.end(), g2.begin(), g2.end());
+  l.gathered3.insert(l.gathered3.end(), g3.begin(), g3.end());
+  std::vector<double> b1(n, 1.0), b2(n, 2.0), b3(n, 3.0);
+  const double* sums[3] = {g1.data(), g2.data(), g3.data()};
+  double* into[3] = {b1.data(), b2.data(), b3.data()};
+  sphc::add_slots(l.layout, sums, into, 3);
+  l.added3 = b1;
+  l.added3.insert(l.added3.end(), b2.begin(), b2.end());
+  l.added3.insert(l.added3.end(), b3.begin(), b3.end());
+  sphc::prune_cluster_pairs(l.layout, l.layout, l.outer, radius / 1.1, l.pruned_serial, /*parallel=*/false);
+  // The serial calls' values: positions then boxes as gather_positions and update_boxes gave.
+  EXPECT_EQ(L2.box, l.layout.box);
+  for (std::size_t s2 = 0; s2 < S; ++s2) EXPECT_EQ(xs2[s2], xs[s2]);
+  EXPECT_EQ(g1, l.gathered);
+  EXPECT_EQ(b1, l.added);
   return l;
 }
 
@@ -71,6 +105,41 @@ TEST_F(ClusterPairsOmp, ListsOfAnyThreadCountEqualOneThreads) {
       EXPECT_EQ(l.cross.j, one.cross.j);
       EXPECT_EQ(l.gathered, one.gathered);
       EXPECT_EQ(l.added, one.added);
+      EXPECT_EQ(l.xs1, one.xs1);
+      EXPECT_EQ(l.box1, one.box1);
+      EXPECT_EQ(l.gathered3, one.gathered3);
+      EXPECT_EQ(l.added3, one.added3);
+      EXPECT_EQ(l.pruned_serial.begin, one.pruned.begin);
+      EXPECT_EQ(l.pruned_serial.j, one.pruned.j);
+    }
+  }
+}
+
+// Stop 39: the layout's columns sorted and cut into slots in parallel (from 10,000
+// particles): the same layout as one thread's, boxes included.
+TEST_F(ClusterPairsOmp, LargeLayoutsOfAnyThreadCountEqualOneThreads) {
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const std::size_t n = 30000;
+    std::vector<double> x(n), y(n), z(n);
+    for (std::size_t i = 0; i < n; ++i) x[i] = u(rng), y[i] = u(rng), z[i] = dim == 3 ? u(rng) : 0.0;
+    // ties in the sort key: a few particles at one height
+    for (std::size_t i = 0; i < n; i += 97) (dim == 3 ? z : y)[i] = 0.5;
+    omp_set_num_threads(1);
+    sphc::ClusterLayout one;
+    sphc::build_cluster_layout(one, x.data(), y.data(), z.data(), n, dim, 0.0);
+    for (int t = 2; t <= 4; ++t) {
+      SCOPED_TRACE(t);
+      omp_set_num_threads(t);
+      sphc::ClusterLayout l;
+      sphc::build_cluster_layout(l, x.data(), y.data(), z.data(), n, dim, 0.0);
+      EXPECT_EQ(l.slot, one.slot);
+      EXPECT_EQ(l.slot_of, one.slot_of);
+      EXPECT_EQ(l.real_mask, one.real_mask);
+      EXPECT_EQ(l.column_begin, one.column_begin);
+      EXPECT_EQ(l.box, one.box);
     }
   }
 }
