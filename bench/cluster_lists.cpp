@@ -42,6 +42,7 @@
 
 #include <time.h>
 
+#include "bench_options.h"
 #include "sphc/cluster_pairs.h"
 
 namespace {
@@ -334,36 +335,18 @@ int main(int argc, char** argv) {
   bool cluster_order = false, fill = false;
   double hdx = 1.5, pert = 0.05, skin = 0.1, column = 0, move = 0.5, dx_arg = 0, flush_mb = 0;
   std::string positions;
-  for (int k = 1; k < argc; ++k) {
-    const std::string a = argv[k];
-    auto next = [&]() -> const char* {
-      if (k + 1 >= argc) std::exit(2);
-      return argv[++k];
-    };
-    if (a == "--nx") nx = std::atoi(next());
-    else if (a == "--reps") reps = std::atoi(next());
-    else if (a == "--hdx") hdx = std::atof(next());
-    else if (a == "--pert") pert = std::atof(next());
-    else if (a == "--skin") skin = std::atof(next());
-    else if (a == "--column") column = std::atof(next());
-    else if (a == "--fields") fields = std::atoi(next());
-    else if (a == "--sums") sums = std::atoi(next());
-    else if (a == "--move") move = std::atof(next());
-    else if (a == "--dim") dim = std::atoi(next());
-    else if (a == "--cluster-order") cluster_order = true;
-    else if (a == "--width") width = std::atoi(next());
-    else if (a == "--fill") fill = true;
-    else if (a == "--ny") ny = std::atoi(next());
-    else if (a == "--dx") dx_arg = std::atof(next());
-    else if (a == "--positions") positions = next();
-    else if (a == "--flush") flush_mb = std::atof(next());
-    else {
-      std::fprintf(stderr, "usage: %s [--nx 47] [--hdx 1.5] [--pert 0.05] [--skin 0.1] [--reps 7] [--column DX]"
-                           " [--fields 8] [--sums 7] [--move 0.5] [--dim 3] [--cluster-order]"
-                           " [--width 8] [--fill] [--ny NY] [--dx DX] [--positions FILE] [--flush MB]\n", argv[0]);
-      return 2;
-    }
-  }
+  bench::Options opts;
+  opts.value("--nx", nx).value("--reps", reps).value("--hdx", hdx).value("--pert", pert);
+  opts.value("--skin", skin).value("--column", column).value("--fields", fields);
+  opts.value("--sums", sums).value("--move", move).value("--dim", dim);
+  opts.flag("--cluster-order", cluster_order).value("--width", width).flag("--fill", fill);
+  opts.value("--ny", ny).value("--dx", dx_arg).value("--positions", positions);
+  opts.value("--flush", flush_mb);
+  if (!opts.parse(argc, argv,
+                  "[--nx 47] [--hdx 1.5] [--pert 0.05] [--skin 0.1] [--reps 7] [--column DX]"
+                  " [--fields 8] [--sums 7] [--move 0.5] [--dim 3] [--cluster-order]"
+                  " [--width 8] [--fill] [--ny NY] [--dx DX] [--positions FILE] [--flush MB]"))
+    return 2;
   const double dx = dx_arg > 0 ? dx_arg : 1.0 / nx, h = hdx * dx, support = 2.0 * h,
                rlist = (1.0 + skin) * support;
   if (dim != 2 && dim != 3) return 2;

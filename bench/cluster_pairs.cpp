@@ -67,6 +67,7 @@
 
 #include <time.h>
 
+#include "bench_options.h"
 #include "sphc/cluster_pairs.h"
 #include "sphc/kernels.h"
 
@@ -1495,33 +1496,18 @@ int main(int argc, char** argv) {
   bool uniform = false;  // column side in dx (0: (8 / density)^(1/3))
   std::string forms = "a,b,c1x8,c1x8rcp,c1x8cut,c1x8rcpcut,c2x8cut,c2x8rcpcut,c4x8,c8x8,c4x8rcp,c8x8rcp,c4x8cut,c8x8cut,c4x8rcpcut,c8x8rcpcut,c4x8rcpdivcut,c8x8rcpdivcut,c4x8ompcut";
   double tol = 1e-12;
-  for (int k = 1; k < argc; ++k) {
-    const std::string a = argv[k];
-    auto next = [&]() -> const char* {
-      if (k + 1 >= argc) std::exit(2);
-      return argv[++k];
-    };
-    if (a == "--nx") nx = std::atoi(next());
-    else if (a == "--reps") reps = std::atoi(next());
-    else if (a == "--pert") pert = std::atof(next());
-    else if (a == "--hdx") hdx = std::atof(next());
-    else if (a == "--uniform-velocity") uniform = true;
-    else if (a == "--skin") skin = std::atof(next());
-    else if (a == "--column") column = std::atof(next());
-    else if (a == "--forms") forms = next();
-    else if (a == "--tol") tol = std::atof(next());
-    else {
-      std::fprintf(stderr,
-                   "usage: %s [--nx 47] [--hdx 1.5] [--uniform-velocity] [--reps 7] [--pert 0.05] [--skin 0.1] [--column DX] [--tol 1e-12]\n"
-                   "          [--forms a,b,c4x8,c8x8,c4x8rcp,c8x8rcp,c4x8cut,...]\n"
-                   "  c<CI>x8[rcp|rcpdiv|lean][cut], CI = 1, 2, 4, 8: cluster-pair tiles, CI i's x 8 j's; rcp:\n"
-                   "  reciprocal approximations (rcpdiv: for the divisions only; lean: rcp, fewer operations);\n"
-                   "  cut: the cluster-pair list pruned at the support (no skin); omp: the tile as `omp simd`\n"
-                   "  over the 8 j's with the generated lane body (no intrinsics)\n",
-                   argv[0]);
-      return 2;
-    }
-  }
+  bench::Options opts;
+  opts.value("--nx", nx).value("--reps", reps).value("--pert", pert).value("--hdx", hdx);
+  opts.flag("--uniform-velocity", uniform).value("--skin", skin).value("--column", column);
+  opts.value("--forms", forms).value("--tol", tol);
+  if (!opts.parse(argc, argv,
+                  "[--nx 47] [--hdx 1.5] [--uniform-velocity] [--reps 7] [--pert 0.05] [--skin 0.1] [--column DX] [--tol 1e-12]\n"
+                  "          [--forms a,b,c4x8,c8x8,c4x8rcp,c8x8rcp,c4x8cut,...]\n"
+                  "  c<CI>x8[rcp|rcpdiv|lean][cut], CI = 1, 2, 4, 8: cluster-pair tiles, CI i's x 8 j's; rcp:\n"
+                  "  reciprocal approximations (rcpdiv: for the divisions only; lean: rcp, fewer operations);\n"
+                  "  cut: the cluster-pair list pruned at the support (no skin); omp: the tile as `omp simd`\n"
+                  "  over the 8 j's with the generated lane body (no intrinsics)"))
+    return 2;
 #ifdef __AVX512F__
   if (!__builtin_cpu_supports("avx512f")) {
     std::printf("no AVX-512F on this CPU: skipped\n");

@@ -63,6 +63,7 @@
 
 #include <time.h>
 
+#include "bench_options.h"
 #include "sphc/cluster_pairs.h"
 #include "sphc/kernels.h"
 
@@ -1284,29 +1285,14 @@ int main(int argc, char** argv) {
   std::string positions, forms_arg = "a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp,sa,st4x4,st4x8,st8x8,st4x4rcp,st8x8rcp,oa,ot4x4,ot8x8,ot4x4rcp,ot8x8rcp";
   int nx = 33, ny = 66, reps = 7, sweeps = 0;
   double dx = 0.03, hdx = 1.3, pert = 0.1, skin = 0.1;
-  for (int k = 1; k < argc; ++k) {
-    const std::string a = argv[k];
-    auto next = [&]() -> const char* {
-      if (k + 1 >= argc) std::exit(2);
-      return argv[++k];
-    };
-    if (a == "--positions") positions = next();
-    else if (a == "--nx") nx = std::atoi(next());
-    else if (a == "--ny") ny = std::atoi(next());
-    else if (a == "--dx") dx = std::atof(next());
-    else if (a == "--hdx") hdx = std::atof(next());
-    else if (a == "--pert") pert = std::atof(next());
-    else if (a == "--skin") skin = std::atof(next());
-    else if (a == "--reps") reps = std::atoi(next());
-    else if (a == "--sweeps") sweeps = std::atoi(next());
-    else if (a == "--forms") forms_arg = next();
-    else {
-      std::fprintf(stderr, "usage: %s [--positions FILE] [--nx 33 --ny 66] [--dx 0.03] [--hdx 1.3] [--pert 0.1]"
-                           " [--skin 0.1] [--reps 7] [--sweeps N] [--forms a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp,sa,st4x4,...]\n",
-                   argv[0]);
-      return 2;
-    }
-  }
+  bench::Options opts;
+  opts.value("--positions", positions).value("--nx", nx).value("--ny", ny).value("--dx", dx);
+  opts.value("--hdx", hdx).value("--pert", pert).value("--skin", skin).value("--reps", reps);
+  opts.value("--sweeps", sweeps).value("--forms", forms_arg);
+  if (!opts.parse(argc, argv,
+                  "[--positions FILE] [--nx 33 --ny 66] [--dx 0.03] [--hdx 1.3] [--pert 0.1]"
+                  " [--skin 0.1] [--reps 7] [--sweeps N] [--forms a,t4x4,t4x8,t8x8,t4x4rcp,t4x8rcp,t8x8rcp,sa,st4x4,...]"))
+    return 2;
 #ifndef __AVX512F__
   std::printf("built without AVX-512F: the tiles need it (skipped)\n");
   return 77;

@@ -281,7 +281,7 @@ def main():
         base_med = statistics.median(per["sym"])
         snap = "%s_%06d.h5" % ("dambreak" if scene == "dambreak" else "cube", long_)
         for form, exe in exes.items():
-            fn = "group_139" if scene == "dambreak" else "group_31"
+            fn = "group_2_ContinuityEquation"  # the rates' phase of both scenes
             print("  %-9s min %.4f (%.2f)  median %.4f (%.2f)  | %s | vs sym after %d steps: %s" % (
                 form, min(per[form]), min(per[form]) / base, statistics.median(per[form]),
                 statistics.median(per[form]) / base_med, vector_counts(exe, fn), long_,

@@ -152,6 +152,9 @@ class CpuPrinter : public ScenePrinter {
   }
   // --verlet-skin with a periodic or mirror domain (the lists and ghosts kept together).
   void updateNeighboursKeptGhosts();
+  // sphc::add_ghosts of every source array within `cutoff` (a local of the generated code),
+  // carrying its ghost properties.
+  void addGhosts(const std::string& indent);
   // The member holding the kept lists of the pass of destination work w over source s in a
   // phase. The pair loops of every phase with the same destination and source share one set
   // of lists (the support radius is the scene's), rebuilt by whichever loop finds them stale;
@@ -898,17 +901,21 @@ void CpuPrinter::updateNeighboursWithGhosts() {
   } else {
     scene_ << "    // Ghosts within the largest interaction radius of a periodic or mirror side.\n";
     scene_ << "    const double cutoff = domain.cell_size;\n";
-    for (const auto& S : sourceArrays_) {
-      int s = plan_.arrayIndex(S);
-      scene_ << "    sphc::add_ghosts(box, " << hostData(s) << ", cutoff, ghosts_" << S << ", "
-             << propIndexList(s, arr(s).ghostProps) << ");  //";
-      for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
-      scene_ << "\n";
-    }
+    addGhosts("    ");
     scene_ << "    sphc::extend_for_ghosts(domain, box, cutoff);\n";
   }
   for (const auto& S : sourceArrays_)
     scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
+}
+
+void CpuPrinter::addGhosts(const std::string& indent) {
+  for (const auto& S : sourceArrays_) {
+    int s = plan_.arrayIndex(S);
+    scene_ << indent << "sphc::add_ghosts(box, " << hostData(s) << ", cutoff, ghosts_" << S
+           << ", " << propIndexList(s, arr(s).ghostProps) << ");  //";
+    for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
+    scene_ << "\n";
+  }
 }
 
 std::string CpuPrinter::removeGhosts() const {
@@ -965,13 +972,7 @@ void CpuPrinter::updateNeighboursKeptGhosts() {
             "need (1 + VERLET_SKIN + WRAP_MARGIN) supports along a periodic or mirrored axis; "
             "a solver built with sphc --verlet-skin=off needs one support\");\n";
   scene_ << "    if (new_ghosts) {\n";
-  for (const auto& S : sourceArrays_) {
-    int s = plan_.arrayIndex(S);
-    scene_ << "      sphc::add_ghosts(box, " << hostData(s) << ", cutoff, ghosts_" << S << ", "
-           << propIndexList(s, arr(s).ghostProps) << ");  //";
-    for (const auto& p : arr(s).ghostProps) scene_ << " " << p;
-    scene_ << "\n";
-  }
+  addGhosts("      ");
   scene_ << "      ghost_skin.mark(" << all << ");\n";
   forEachVerletLists([&](const std::string& lists, const Phase&, const DestinationWork&,
                          const NeighbourPass&) {

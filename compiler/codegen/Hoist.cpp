@@ -300,27 +300,27 @@ std::string ScenePrinter::hoistedCall(const PlanEquation& eq, size_t k, bool sou
          std::to_string(k) + "(" + index + args + ")";
 }
 
-std::pair<std::string, std::string> ScenePrinter::sameDestinationHoisted(
-    const NeighbourPass& pass, const PlanEquation& eq, size_t k) const {
+ScenePrinter::SameHoisted ScenePrinter::sameDestinationHoisted(const NeighbourPass& pass) const {
+  SameHoisted same;
   std::map<std::string, std::pair<std::string, std::string>> first;  // key -> (eq struct, k)
   for (const PlanEquation* e : pass.equations) {
     const PlanBody& b = methodBody(*e, ast::Method::Loop);
     const auto sites = hoistedDestinationSites(b, host_);
     for (size_t j = 0; j < sites.size(); ++j) {
-      std::string key;
-      if (!particleFree(b.source.text, b.facts, sites[j]))
-        key = hoistedSiteKey(b, sites[j], hoistedValueType(b, host_, false, j), false);
-      auto it = key.empty() ? first.end() : first.find(key);
-      if (e == &eq && j == k)
-        return it == first.end() ? std::make_pair(std::string(), std::string()) : it->second;
-      if (!key.empty() && it == first.end()) first.emplace(key, std::make_pair(eqStruct(*e), std::to_string(j)));
+      if (particleFree(b.source.text, b.facts, sites[j])) continue;
+      const std::string key =
+          hoistedSiteKey(b, sites[j], hoistedValueType(b, host_, false, j), false);
+      if (key.empty()) continue;
+      const auto found = first.emplace(key, std::make_pair(eqStruct(*e), std::to_string(j)));
+      if (!found.second) same.emplace(std::make_pair(e, j), found.first->second);
     }
   }
-  return {"", ""};
+  return same;
 }
 
 void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass& pass,
                                           const std::string& indent) const {
+  const SameHoisted sameAs = sameDestinationHoisted(pass);
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     const auto sites = hoistedDestinationSites(b, host_);
@@ -334,10 +334,11 @@ void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass&
       }
       // The same value as an earlier equation's of the pass (e.g. the EDAC momentum bodies'
       // m_a / rho_a): its local, the same double.
-      const auto same = sameDestinationHoisted(pass, *eq, k);
-      if (!same.first.empty()) {
+      const auto same = sameAs.find({eq, k});
+      if (same != sameAs.end()) {
         os << indent << "const " << type << " " << local << " = "
-           << hoistDestinationArgument(same.first, same.second) << ";  // " << eq->name << ": "
+           << hoistDestinationArgument(same->second.first, same->second.second) << ";  // "
+           << eq->name << ": "
            << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
            << ", computed above\n";
         continue;

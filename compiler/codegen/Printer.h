@@ -301,13 +301,14 @@ class ScenePrinter {
   // source = false: of a destination-only value (the destination's properties it reads).
   std::string hoistedSiteKey(const PlanBody& b, const SourceOnlySite& s,
                              const std::string& type, bool source = true) const;
-  // A destination-only value of equation eq's loop (its site k, hoistedDestinationSites) that
-  // an earlier equation of the pass hoists too (the same hoistedSiteKey, not a value of the
-  // parameters alone): that equation's struct name and site index, whose local and per-
-  // particle array it reads; {"", ""} where it is the first (Hoist.cpp, stop 38).
-  std::pair<std::string, std::string> sameDestinationHoisted(const NeighbourPass& pass,
-                                                             const PlanEquation& eq,
-                                                             size_t k) const;
+  // The destination-only values of a pass's loops (an equation's site k,
+  // hoistedDestinationSites) that an earlier equation of the pass hoists too (the same
+  // hoistedSiteKey, not a value of the parameters alone), each mapped to that equation's
+  // struct name and site index, whose local and per-particle array it reads; the first of
+  // each value is not in the map (Hoist.cpp, stop 38). One scan of the pass.
+  using SameHoisted =
+      std::map<std::pair<const PlanEquation*, size_t>, std::pair<std::string, std::string>>;
+  SameHoisted sameDestinationHoisted(const NeighbourPass& pass) const;
   // The call of eq's loop's hoisted site k's function (source: per source particle, else
   // per destination) for `index`, each property it reads as the array `rename` names for it
   // (stop 39: the tiles' slot-order copies); "" where one is not in `rename`, or a

@@ -17,8 +17,7 @@ namespace {
 
 class ScheduleBuilder {
  public:
-  ScheduleBuilder(const Plan& plan, const DiagnosticEngine& diags, bool fuseGroups)
-      : plan_(plan), diags_(diags), fuseGroups_(fuseGroups) {}
+  ScheduleBuilder(const Plan& plan, bool fuseGroups) : plan_(plan), fuseGroups_(fuseGroups) {}
   std::unique_ptr<Schedule> run();
   void postStepNeighbours();
 
@@ -66,16 +65,11 @@ class ScheduleBuilder {
     for (int k = 2;; ++k)
       if (used_.insert(base + "_" + std::to_string(k)).second) return base + "_" + std::to_string(k);
   }
-  std::string lineOf(llvm::SMLoc l) const {
-    std::string info = diags_.lineInfo(l);  // file.sph:line
-    size_t colon = info.rfind(':');
-    return colon == std::string::npos ? "0" : info.substr(colon + 1);
-  }
 
   const Plan& plan_;
-  const DiagnosticEngine& diags_;
   bool fuseGroups_ = true;
   std::set<std::string> used_;
+  int groupsNamed_ = 0;  // the groups numbered so far (ScheduleBuilder::group)
   std::unique_ptr<Schedule> s_;
   std::set<std::string> sourceNames_, loopNames_;
 };
@@ -151,9 +145,13 @@ void ScheduleBuilder::postStepNeighbours() {
 }
 
 // Runs of direct equations become fused phases; subgroups run in place, in order. A group's
-// function is named by its line (group_114), a phase's by its group and first equation
-// (group_114_TaitEOS), so that names say where the code comes from (and OpenCL profiles,
-// which list kernels named after phases, say what ran).
+// function is named by its position (docs/design.md): group_K for the K-th group of the
+// scene's equations { } as the schemes and effects expand it, counted from 1 in source order
+// with the groups inside groups and the post_step groups (group_1 ... group_5, group_3
+// holding group_4 and group_5); a phase's by its group and first equation (group_1_TaitEOS),
+// so that names say what the code computes (and OpenCL profiles, which list kernels named
+// after phases, say what ran). No name depends on a source line, so reformatting a file
+// moves none; the comments before the functions give the lines.
 void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, ScheduleGroup& out) {
   out.name = name;
   out.group = &g;
@@ -179,7 +177,10 @@ void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, Schedul
       flush();
       std::vector<const PlanGroup*> fused;
       for (int k : groupRun) fused.push_back(g.subgroups[-g.order[k] - 1].get());
-      std::string fn = unique("group_" + lineOf(fused.front()->loc));
+      // The first group's number; the others' are not reused (the names of the groups
+      // after them are those of --no-group-fusion).
+      std::string fn = unique("group_" + std::to_string(groupsNamed_ + 1));
+      groupsNamed_ += static_cast<int>(fused.size());
       out.members.push_back({false, static_cast<int>(out.subgroups.size())});
       out.subgroups.push_back(std::make_unique<ScheduleGroup>());
       fusedGroup(fused, fn, *out.subgroups.back());
@@ -197,7 +198,7 @@ void ScheduleBuilder::group(const PlanGroup& g, const std::string& name, Schedul
     }
     flush();
     const PlanGroup& sub = *g.subgroups[-entry - 1];
-    std::string fn = unique("group_" + lineOf(sub.loc));
+    std::string fn = unique("group_" + std::to_string(++groupsNamed_));
     out.members.push_back({false, static_cast<int>(out.subgroups.size())});
     out.subgroups.push_back(std::make_unique<ScheduleGroup>());
     group(sub, fn, *out.subgroups.back());
@@ -436,9 +437,8 @@ void ScheduleBuilder::adaptiveDt() {
 
 }  // namespace
 
-std::unique_ptr<Schedule> buildSchedule(const Plan& plan, const DiagnosticEngine& diags,
-                                        bool fuseGroups) {
-  return ScheduleBuilder(plan, diags, fuseGroups).run();
+std::unique_ptr<Schedule> buildSchedule(const Plan& plan, bool fuseGroups) {
+  return ScheduleBuilder(plan, fuseGroups).run();
 }
 
 // ---- --dump-after=schedule ------------------------------------------------------------------

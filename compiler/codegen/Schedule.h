@@ -103,7 +103,7 @@ struct DestinationWork {
 // destination, every initialize, the neighbour passes, then post_loop and reduce.
 struct Phase {
   // The generated function: its group's name and its first equation's, e.g.
-  // group_114_TaitEOS (equations_TaitEOS for direct members of the scene's equations { }).
+  // group_1_TaitEOS (equations_TaitEOS for direct members of the scene's equations { }).
   std::string name;
   const PlanGroup* group = nullptr;
   std::vector<int> equations;  // equation ids, live or not, in group order
@@ -112,8 +112,9 @@ struct Phase {
 
 // A group of the scene's equations { }: its phases and subgroups run in order.
 struct ScheduleGroup {
-  // The generated function: `equations` for the scene's equations { }, group_<line> for a
-  // group (its line in the scene file).
+  // The generated function: `equations` for the scene's equations { }, group_K for its K-th
+  // group (from 1, in source order, groups inside groups and post_step groups counted); a
+  // run of fused groups is named after its first (ScheduleBuilder::group).
   std::string name;
   const PlanGroup* group = nullptr;
   struct Member {
@@ -262,11 +263,9 @@ void fusePerParticleWork(Schedule& s);
 bool fusibleGroup(const Plan& plan, const PlanGroup& g);
 std::vector<std::vector<int>> groupFusionRuns(const Plan& plan, const PlanGroup& parent);
 
-// The schedule of an analysed plan (after the ghost pass). Pure: reads the plan only (and
-// the source lines of its groups, which name their functions). fuseGroups = false
-// (--no-group-fusion): every group on its own.
-std::unique_ptr<Schedule> buildSchedule(const Plan& plan, const DiagnosticEngine& diags,
-                                        bool fuseGroups = true);
+// The schedule of an analysed plan (after the ghost pass). Pure: reads the plan only.
+// fuseGroups = false (--no-group-fusion): every group on its own.
+std::unique_ptr<Schedule> buildSchedule(const Plan& plan, bool fuseGroups = true);
 
 // --dump-after=schedule.
 void printSchedule(const Schedule& s, const DiagnosticEngine& diags, llvm::raw_ostream& os);

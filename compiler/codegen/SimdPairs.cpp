@@ -406,13 +406,7 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
                    (sc.first == 1 ? "acc_" + p : "acc" + std::to_string(k) + "_" + p);
   os << in << "// The neighbours in SIMD lanes, the sums reduced across them (codegen/SimdPairs.cpp;\n"
      << in << "// sphc --simd-pairs; the list holds neighbours only: no cut-off test).\n";
-  // The destination's other properties the bodies read, loaded once.
-  std::set<std::string> loads;
-  for (const PlanEquation* eq : pass.equations)
-    for (const auto& [p, sc] : destinationValues(methodBody(*eq, ast::Method::Loop), w.array))
-      for (int k : sc.second)
-        if (loads.insert(destinationValueName(p, sc.first, k)).second)
-          os << in << destinationValueLoad(p, sc.first, k) << "\n";
+  emitDestinationValueLoads(os, w, pass, in);
   // Single precision: the double arguments (t, dt, the equations' scalars) as float locals;
   // converted in the loop, GCC would not if-convert a conversion under an `if` (it may trap).
   if (host_.floatBodies) {

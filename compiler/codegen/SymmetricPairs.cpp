@@ -514,18 +514,19 @@ void ScenePrinter::emitKeptListsBuild(const std::string& lists, bool openmp,
 
 void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma) {
   std::vector<std::string> fills;
+  // The same value as an earlier equation's of the pass: its array (Hoist.cpp).
+  const SameHoisted sameAs = sameDestinationHoisted(pass);
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     const auto sites = hoistedDestinationSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k) {
       const std::string K = std::to_string(k), E = eqStruct(*eq);
       const std::string ptr = symmetricDestinationHoisted(E, K);
-      // The same value as an earlier equation's of the pass: its array (Hoist.cpp).
-      const auto same = sameDestinationHoisted(pass, *eq, k);
-      if (!same.first.empty()) {
+      const auto same = sameAs.find({eq, k});
+      if (same != sameAs.end()) {
         scene_ << "        " << hoistedValueType(b, host_, false, k) << "* const " << ptr
-               << " = " << symmetricDestinationHoisted(same.first, same.second) << ";  // "
-               << eq->name << ": the same value, computed above\n";
+               << " = " << symmetricDestinationHoisted(same->second.first, same->second.second)
+               << ";  // " << eq->name << ": the same value, computed above\n";
         continue;
       }
       scene_ << "        dhoist_" << E << "_" << K << ".resize(n);\n";
@@ -542,7 +543,7 @@ void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const st
       const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
       for (size_t k = 0; k < sites.size(); ++k) {
         const std::string K = std::to_string(k);
-        if (!sameDestinationHoisted(pass, *eq, k).first.empty()) continue;  // filled above
+        if (sameAs.count({eq, k})) continue;  // filled above
         scene_ << "          " << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx] = "
                << hoistDestinationArgument(eqStruct(*eq), K) << ";\n";
       }

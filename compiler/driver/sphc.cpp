@@ -575,7 +575,7 @@ int main(int argc, char** argv) {
   }
 
   // --- the back half: schedule, code generation and build ----------------------------
-  auto schedule = buildSchedule(*plan, diags, !NoGroupFusion);
+  auto schedule = buildSchedule(*plan, !NoGroupFusion);
   log("schedule");
   if (DumpAfter == Pass::Schedule) {
     printSchedule(*schedule, diags, llvm::outs());

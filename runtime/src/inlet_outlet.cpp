@@ -117,18 +117,8 @@ void append_particle(ParticleArray& to, const ParticleArray& from, std::size_t i
                      const CopyMap& map) {
   const std::size_t j = to.n;
   to.resize(j + 1);  // every property grows; new values 0 (std::vector: amortised growth)
-  for (std::size_t k = 0; k < map.to.size(); ++k) {
-    Property& p = to.props[map.to[k]];
-    const Property& q = from.props[map.from[k]];
-    const std::size_t s = static_cast<std::size_t>(p.stride);
-    for (std::size_t c = 0; c < s; ++c) {
-      switch (p.type) {
-        case PropType::F64: p.f64[j * s + c] = q.f64[i * s + c]; break;
-        case PropType::I32: p.i32[j * s + c] = q.i32[i * s + c]; break;
-        case PropType::U32: p.u32[j * s + c] = q.u32[i * s + c]; break;
-      }
-    }
-  }
+  for (std::size_t k = 0; k < map.to.size(); ++k)
+    copy_particle_values(to.props[map.to[k]], j, from.props[map.from[k]], i);
 }
 
 void set_inlet_velocity(InletZone& in, double t) {

@@ -28,6 +28,17 @@ void resize_prop(Property& p, std::size_t n) {
 
 }  // namespace
 
+void copy_particle_values(Property& to, std::size_t j, const Property& from, std::size_t i) {
+  const std::size_t s = static_cast<std::size_t>(to.stride);
+  for (std::size_t c = 0; c < s; ++c) {
+    switch (to.type) {
+      case PropType::F64: to.f64[j * s + c] = from.f64[i * s + c]; break;
+      case PropType::I32: to.i32[j * s + c] = from.i32[i * s + c]; break;
+      case PropType::U32: to.u32[j * s + c] = from.u32[i * s + c]; break;
+    }
+  }
+}
+
 const char* prop_type_name(PropType t) {
   switch (t) {
     case PropType::F64: return "double";
@@ -143,16 +154,7 @@ void ParticleArray::append_from(const ParticleArray& src, std::size_t i) {
   for (std::size_t k = 0; k < props.size(); ++k) {
     Property& p = props[k];
     resize_prop(p, n + 1);
-    if (src_idx[k] < 0) continue;
-    const Property& q = src.props[src_idx[k]];
-    const std::size_t s = static_cast<std::size_t>(p.stride);
-    for (std::size_t c = 0; c < s; ++c) {
-      switch (p.type) {
-        case PropType::F64: p.f64[n * s + c] = q.f64[i * s + c]; break;
-        case PropType::I32: p.i32[n * s + c] = q.i32[i * s + c]; break;
-        case PropType::U32: p.u32[n * s + c] = q.u32[i * s + c]; break;
-      }
-    }
+    if (src_idx[k] >= 0) copy_particle_values(p, n, src.props[src_idx[k]], i);
   }
   ++n;
 }

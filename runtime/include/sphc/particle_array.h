@@ -28,6 +28,10 @@ struct Property {
   std::vector<std::uint32_t> u32;
 };
 
+// Particle j of `to` takes the values of particle i of `from` (a property of the same type
+// and stride; `to` holds j already).
+void copy_particle_values(Property& to, std::size_t j, const Property& from, std::size_t i);
+
 struct Constant {
   std::string name;
   std::vector<double> values;

@@ -33,48 +33,39 @@ TEST(SimdCpu, ParsesVendorFamilyModel) {
   }
 }
 
-TEST(SimdCpu, LanesWhereMeasuredToPay) {
-  auto lanes = [](const char* text) {
+// auto's verdict per CPU: the lanes where they were measured to pay, and for its 3D loops the
+// cluster-pair tiles (stop 38) on the Intel models of the lanes only (not on AMD: not
+// measured; never where the lanes are refused). Each reason names the CPU.
+TEST(SimdCpu, VerdictsWhereMeasuredToPay) {
+  struct Case {
+    const char* cpu;
+    bool lanes, tiles;
+  };
+  const Case cases[] = {
+      {"AuthenticAMD:26:2", true, false},    // Zen 5 (stop 33: 0.82-0.86 of a cube step)
+      {"AuthenticAMD:27:0", true, false},    // later AMD families
+      {"GenuineIntel:6:207", true, true},    // Emerald Rapids (stop 35, gathers: 0.80-0.82;
+                                             // tiles: stop 38, measured)
+      {"GenuineIntel:6:143", true, true},    // Sapphire Rapids: the same cores
+      {"GenuineIntel:6:85", false, false},   // Skylake-SP / Cascade Lake: not measured
+      {"GenuineIntel:6:106", false, false},  // Ice Lake-SP: not measured
+      {"GenuineIntel:6:207:noavx512", false, false},
+      {"AuthenticAMD:25:17", false, false},  // Zen 4: not measured
+      {"HygonGenuine:24:0", false, false},   // not measured
+      // Without AVX-512F GCC 12 does not if-convert the bodies' divisions: no lanes anywhere.
+      {"AuthenticAMD:26:2:noavx512", false, false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.cpu);
     SimdCpu cpu;
     std::string why;
-    EXPECT_TRUE(parseSimdCpu(text, cpu, why)) << text;
+    ASSERT_TRUE(parseSimdCpu(c.cpu, cpu, why));
     const SimdCpuVerdict v = simdLanesOnCpu(cpu);
+    EXPECT_EQ(v.lanes, c.lanes);
+    EXPECT_EQ(v.tiles, c.tiles);
     EXPECT_NE(v.why.find(cpu.describe()), std::string::npos) << v.why;
-    return v.lanes;
-  };
-  EXPECT_TRUE(lanes("AuthenticAMD:26:2"));     // Zen 5 (stop 33: 0.82-0.86 of a cube step)
-  EXPECT_TRUE(lanes("AuthenticAMD:27:0"));     // later AMD families
-  EXPECT_TRUE(lanes("GenuineIntel:6:207"));    // Emerald Rapids (stop 35, gathers: 0.80-0.82)
-  EXPECT_TRUE(lanes("GenuineIntel:6:143"));    // Sapphire Rapids: the same cores
-  EXPECT_FALSE(lanes("GenuineIntel:6:85"));    // Skylake-SP / Cascade Lake: not measured
-  EXPECT_FALSE(lanes("GenuineIntel:6:106"));   // Ice Lake-SP: not measured
-  EXPECT_FALSE(lanes("GenuineIntel:6:207:noavx512"));
-  EXPECT_FALSE(lanes("AuthenticAMD:25:17"));   // Zen 4: not measured
-  EXPECT_FALSE(lanes("HygonGenuine:24:0"));    // not measured
-  // Without AVX-512F GCC 12 does not if-convert the bodies' divisions: no lanes anywhere.
-  EXPECT_FALSE(lanes("AuthenticAMD:26:2:noavx512"));
-}
-
-// auto's cluster-pair tiles for its 3D loops (stop 38): where they were measured to pay, the
-// Intel models of the lanes; not on AMD (not measured), nor where the lanes are refused.
-TEST(SimdCpu, TilesWhereMeasuredToPay) {
-  auto tiles = [](const char* text) {
-    SimdCpu cpu;
-    std::string why;
-    EXPECT_TRUE(parseSimdCpu(text, cpu, why)) << text;
-    const SimdCpuVerdict v = simdLanesOnCpu(cpu);
-    if (v.tiles) {
-      EXPECT_TRUE(v.lanes) << text;
-      EXPECT_NE(v.tilesWhy.find(cpu.describe()), std::string::npos) << v.tilesWhy;
-    }
-    return v.tiles;
-  };
-  EXPECT_TRUE(tiles("GenuineIntel:6:207"));    // Emerald Rapids (stop 38: measured)
-  EXPECT_TRUE(tiles("GenuineIntel:6:143"));    // Sapphire Rapids: the same cores
-  EXPECT_FALSE(tiles("AuthenticAMD:26:2"));    // Zen 5: the lanes (tiles not measured)
-  EXPECT_FALSE(tiles("GenuineIntel:6:85"));
-  EXPECT_FALSE(tiles("GenuineIntel:6:207:noavx512"));
-  EXPECT_FALSE(tiles("HygonGenuine:24:0"));
+    if (v.tiles) EXPECT_NE(v.tilesWhy.find(cpu.describe()), std::string::npos) << v.tilesWhy;
+  }
 }
 
 TEST(SimdCpu, HostIsReadOnX86) {
