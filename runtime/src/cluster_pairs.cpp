@@ -217,6 +217,28 @@ void add_slots(const ClusterLayout& L, const float* sums, float* dst) {
   add_slots_of(L, sums, dst);
 }
 
+void gather_slots_doubled(const ClusterLayout& L, const double* src, double* dst) {
+  const int C = L.width;
+  const std::uint8_t full = L.full_mask();
+  const std::uint32_t* slot = L.slot.data();
+  const std::size_t nc = L.n_clusters;
+#pragma omp parallel for schedule(static)
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::uint32_t* sl = slot + c * C;
+    double* d = dst + 2 * c * C;
+    if (C == 4 && L.real_mask[c] == full) {  // the 2xMM width: unrolled
+      const double v0 = src[sl[0]], v1 = src[sl[1]], v2 = src[sl[2]], v3 = src[sl[3]];
+      d[0] = d[4] = v0;
+      d[1] = d[5] = v1;
+      d[2] = d[6] = v2;
+      d[3] = d[7] = v3;
+    } else {
+      const double first = src[sl[0]];
+      for (int k = 0; k < C; ++k) d[k] = d[C + k] = sl[k] == kPadSlot ? first : src[sl[k]];
+    }
+  }
+}
+
 void gather_positions(const ClusterLayout& L, const double* x, const double* y, const double* z,
                       double* xs, double* ys, double* zs, double pad_offset) {
   const bool three = L.dim == 3;
