@@ -31,9 +31,10 @@
 // the array has m and rho), a tile = a 4-cluster of i's x a 4-cluster of j's in two
 // registers of CL_LANES = 8 lanes, lane l of register r holding i = 2 r + l / 4 and j = l % 4:
 //   - the j side from copies doubled per cluster (cl2_NAME: a cluster's 4 values twice, one
-//     contiguous load of 8 lanes), made once per evaluation after the gathers;
+//     contiguous load of 8 lanes), gathered so once per evaluation (gather_slots_doubled;
+//     the positions, gathered in slot order for the boxes, doubled by a printed loop);
 //   - the i side from the i-cluster's registers (ri_NAME[r][lane], built once per i-cluster
-//     from the copies), read in the lanes with d_idx = the lane (so the bodies' [d_idx] and
+//     from the doubled copies), read in the lanes with d_idx = the lane (so the bodies' [d_idx] and
 //     the mirrored calls' source arrays index them: no gathers, no int arithmetic but the
 //     lane);
 //   - the register's cut-off alone first (skipped when no lane is within it), the diagonal
