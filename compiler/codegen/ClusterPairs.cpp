@@ -31,8 +31,11 @@
 // the array has m and rho), a tile = a 4-cluster of i's x a 4-cluster of j's in two
 // registers of CL_LANES = 8 lanes, lane l of register r holding i = 2 r + l / 4 and j = l % 4:
 //   - the j side from copies doubled per cluster (cl2_NAME: a cluster's 4 values twice, one
-//     contiguous load of 8 lanes), gathered so once per evaluation (gather_slots_doubled;
-//     the positions, gathered in slot order for the boxes, doubled by a printed loop);
+//     contiguous load of 8 lanes), gathered so in one call (gather_slots_doubled with
+//     arrays of pointers; what nothing writes at the build only, the rest per evaluation:
+//     tileover's pieces, merged), the hoisted values computed from the doubled copies (at
+//     the first half, written to both), the positions gathered in slot order with the
+//     boxes (gather_positions_boxes) and doubled by a printed loop;
 //   - the i side from the i-cluster's registers (ri_NAME[r][lane], built once per i-cluster
 //     from the doubled copies), read in the lanes with d_idx = the lane (so the bodies' [d_idx] and
 //     the mirrored calls' source arrays index them: no gathers, no int arithmetic but the
