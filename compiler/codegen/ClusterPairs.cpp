@@ -25,6 +25,27 @@
 //     for d_idx where the self pair is evaluated);
 //   - the tile's j sums added to the slot sums once per tile, i's lane sums once per
 //     i-cluster; the slot sums added to the particles' sums (add_slots).
+// 2D (stop 39; docs/performance.md "2D tiles in the 2xMM form (stop 39)"): GROMACS' AVX-512
+// double "2xMM" form instead (--cluster-2d-8x8 keeps the 8 x 8 one, a measurement knob): the
+// layout of width CL_W = 4 (the column side 2 spacings, the spacing sqrt(mean m / rho) where
+// the array has m and rho), a tile = a 4-cluster of i's x a 4-cluster of j's in two
+// registers of CL_LANES = 8 lanes, lane l of register r holding i = 2 r + l / 4 and j = l % 4:
+//   - the j side from copies doubled per cluster (cl2_NAME: a cluster's 4 values twice, one
+//     contiguous load of 8 lanes), gathered so in one call (gather_slots_doubled with
+//     arrays of pointers; what nothing writes at the build only, the rest per evaluation:
+//     tileover's pieces, merged), the hoisted values computed from the doubled copies (at
+//     the first half, written to both), the positions gathered in slot order with the
+//     boxes (gather_positions_boxes) and doubled by a printed loop;
+//   - the i side from the i-cluster's registers (ri_NAME[r][lane], built once per i-cluster
+//     from the doubled copies), read in the lanes with d_idx = the lane (so the bodies' [d_idx] and
+//     the mirrored calls' source arrays index them: no gathers, no int arithmetic but the
+//     lane);
+//   - the register's cut-off alone first (skipped when no lane is within it), the diagonal
+//     tile's j > i from lane tables (cl_ilane, cl_jlane);
+//   - i's sums per register in 8 lane partial sums across the i-cluster's list, reduced per
+//     i (4 lanes each) once per i-cluster; j's per tile, the two halves folded (lanes l and
+//     l + 4: j l) onto the slot sums.
+// The same OpenMP blocks and half tiles as the 8 x 8 form (bitwise the serial tiles).
 // The tiles are a lambda compiled without jump threading (GCC 12 threads the kernel's
 // branches before if-conversion, "control flow in loop": the lanes stay scalar).
 //
@@ -161,6 +182,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   const int d = w.array;
   const std::string R = "double";
   const bool selfPair = !skipsSelfPair(pass);
+  // 2D (stop 39): GROMACS' 2xMM form, layouts of width 4, a register = 2 i's x the 4 j's
+  // (see the top of this file); 3D (and 2D with --cluster-2d-8x8): 8 x 8 tiles.
+  const bool mm = plan_.dim == 2 && !cluster2d8x8_;
   // The copies in slot order: positions first, then every property the lanes read (by name:
   // di_NAME, sj_NAME, s_NAME and d_NAME of one array are one array), the hoisted values, the
   // sums. name -> the array it is gathered from.
@@ -200,16 +224,18 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   std::map<std::string, std::string> rename;
   for (const auto& c : copies)
     if (c.second.rfind("di_", 0) == 0 || c.second.rfind("s_", 0) == 0 || c.second.rfind("d_", 0) == 0)
-      rename[c.first] = "cl_" + c.first;
+      rename[c.first] = (mm ? "cl2_" : "cl_") + c.first;  // 2xMM: the doubled copies
+  // (2xMM: computed into the doubled arrays, at cl_s2 = CL_LANES c + l for slot CL_W c + l.)
+  const std::string slotIndex = mm ? "cl_s2" : "s_idx";
   std::map<std::string, std::string> inSlots;
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     for (size_t k = 0; k < hoistedSites(b, host_).size(); ++k) {
-      const std::string call = hoistedCall(*eq, k, true, "s_idx", rename);
+      const std::string call = hoistedCall(*eq, k, true, slotIndex, rename);
       if (!call.empty()) inSlots[hoistArgument(eqStruct(*eq), std::to_string(k))] = call;
     }
     for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
-      const std::string call = hoistedCall(*eq, k, false, "s_idx", rename);
+      const std::string call = hoistedCall(*eq, k, false, slotIndex, rename);
       if (!call.empty()) inSlots[symmetricDestinationHoisted(eqStruct(*eq), std::to_string(k))] = call;
     }
   }
@@ -218,11 +244,20 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   std::vector<std::string> accs;  // the sums: acc_NAME
   for (const auto& [p, sc] : sums.props) accs.push_back(p);
   const std::string in = "          ";
-  scene_ << "        // Each pair once for both particles in cluster-pair tiles (codegen/ClusterPairs.cpp;\n"
-            "        // sphc --simd-pairs=cluster): 8 i's x 8 j's of the runtime's cluster-pair lists\n"
-            "        // (sphc/cluster_pairs.h), rebuilt with the kept lists (verlet_build; the lists\n"
-            "        // themselves are not built), pruned at the support per evaluation; the sums\n"
-            "        // reassociated (lane sums per i across its list, per j across a tile).\n";
+  if (mm)
+    scene_ << "        // Each pair once for both particles in cluster-pair tiles (codegen/ClusterPairs.cpp;\n"
+              "        // sphc --simd-pairs=cluster), GROMACS' 2xMM form: 4-clusters of i's x 4-clusters\n"
+              "        // of j's of the runtime's cluster-pair lists (sphc/cluster_pairs.h, a layout of\n"
+              "        // width 4), a tile in two registers of 8 lanes (lane l: i 2 r + l / 4, j l % 4),\n"
+              "        // rebuilt with the kept lists (verlet_build; the lists themselves are not built),\n"
+              "        // pruned at the support per evaluation; the sums reassociated (lane sums per i\n"
+              "        // across its list, per j across a tile).\n";
+  else
+    scene_ << "        // Each pair once for both particles in cluster-pair tiles (codegen/ClusterPairs.cpp;\n"
+              "        // sphc --simd-pairs=cluster): 8 i's x 8 j's of the runtime's cluster-pair lists\n"
+              "        // (sphc/cluster_pairs.h), rebuilt with the kept lists (verlet_build; the lists\n"
+              "        // themselves are not built), pruned at the support per evaluation; the sums\n"
+              "        // reassociated (lane sums per i across its list, per j across a tile).\n";
   // The destination-only values of every particle, for the mirrored calls (gathered below;
   // a loop without neighbours: --omp-min-particles' `if`, stop 39).
   const std::string ompIfN = openmp ? ompMinIf("n") : "";  // "" or if (n >= OMP_MIN_PARTICLES)
@@ -243,6 +278,15 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // Under OpenMP the pieces without neighbours honour --omp-min-particles (their `if`).
   const std::string par = ompIfN.empty() ? "" : ", n >= OMP_MIN_PARTICLES";
   scene_ << "        {\n";
+  // The tiles' shape: CL_LANES lanes per register (one zmm of doubles: the runtime's
+  // kClusterSize), CL_W slots per cluster (the layout's width).
+  scene_ << in << "constexpr int CL_LANES = sphc::kClusterSize;  // the lanes of a register: one zmm of doubles\n";
+  if (mm)
+    scene_ << in << "constexpr int CL_W = CL_LANES / 2;  // 2xMM: the layout's width; a register holds 2 i's x CL_W j's\n";
+  else
+    scene_ << in << "constexpr int CL_W = CL_LANES;  // the layout's width; a register holds one i x CL_W j's\n";
+  scene_ << in << "static_assert(CL_LANES == 8 && CL_W <= sphc::kMaxClusterSize, \"codegen/ClusterPairs.cpp prints "
+                  "its lane tables for registers of 8 doubles (sphc::kClusterSize)\");\n";
   scene_ << in << "sphc::ClusterLayout& cl_layout = " << state << "_layout;\n";
   const std::string zIn = plan_.dim == 3 ? "di_z" : "nullptr";
   if (hFixed) {
@@ -260,16 +304,46 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
              << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
     scene_ << in << "for (int i = 0; i < n; ++i) cl_hmax = std::max(cl_hmax, di_h[i]);\n";
   }
+  // The column side: from the particle spacing where the array has m and rho (2xMM: columns
+  // of 2 spacings, clusters about square; the bounding box's rule grows with the flow's empty
+  // space: docs/performance.md, stop 38), else the layout's rule from the bounding box (0).
+  std::string side = "0.0";
+  auto plainDouble = [&](const std::string& p) {
+    const PlanProperty* prop = arr(d).find(p);
+    return prop && prop->stride == 1 && propIndex(d, p) >= 0 && hostType(d, p) == "double";
+  };
+  if (mm && plainDouble("m") && plainDouble("rho")) {
+    side = "cl_side";
+    scene_ << in << "double cl_side = 0.0;  // the column side: the spacing sqrt(mean m / rho) x 2 (2xMM)\n";
+    scene_ << in << "if (verlet_build && n > 0) {\n";
+    scene_ << in << "  const double* const cl_vm = " << hostPtr(d, "m") << ";\n";
+    scene_ << in << "  const double* const cl_vrho = " << hostPtr(d, "rho") << ";\n";
+    scene_ << in << "  double cl_vol = 0.0;\n";
+    scene_ << in << "  for (int i = 0; i < n; ++i) cl_vol += cl_vm[i] / cl_vrho[i];\n";
+    scene_ << in << "  cl_vol /= n;\n";
+    scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::sqrt(cl_vol), DIM, CL_W);\n";
+    scene_ << in << "}\n";
+  }
   scene_ << in << "if (verlet_build) sphc::build_cluster_layout(cl_layout, di_x, di_y, " << zIn
-         << ", static_cast<std::size_t>(n), DIM, 0.0);\n";
+         << ", static_cast<std::size_t>(n), DIM, " << side << ", CL_W);\n";
   scene_ << in << "const std::size_t n_slots = cl_layout.slots();\n";
   scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots;\n";
-  scene_ << in << "cl_buf.resize(" << copies.size() + accs.size() << " * n_slots);  // (kept: the copies made at the build)\n";
+  // 2xMM: after the copies and the sums, each copy doubled per cluster (cl2_NAME: cluster c's
+  // CL_W values twice, the j side of a register in one contiguous load).
+  // (2xMM: the positions alone in slot order, for the boxes; every copy doubled)
+  const size_t nSlotCopies = mm ? static_cast<size_t>(plan_.dim) : copies.size();
+  const size_t nBuf = nSlotCopies + accs.size() + (mm ? 2 * copies.size() : 0);
+  scene_ << in << "cl_buf.resize(" << nBuf << " * n_slots);  // (kept: the copies made at the build)\n";
   size_t at = 0;
-  for (const auto& c : copies)
-    scene_ << in << "double* const cl_" << c.first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  for (size_t k = 0; k < nSlotCopies; ++k)
+    scene_ << in << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   for (const std::string& p : accs)
     scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  if (mm)
+    for (const auto& c : copies) {
+      scene_ << in << "double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
+      at += 2;
+    }
   scene_ << in << "// The positions in slot order (padding slots 4 supports away from every particle)\n"
          << in << "// and the boxes in one pass, the outer list at a rebuild, the list pruned at the\n"
          << in << "// support now.\n";
@@ -294,9 +368,10 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (size_t k = 0; k < cs.size(); ++k) scene_ << (k ? ", " : "") << cs[k].second;
     scene_ << "};\n";
     scene_ << ind << "double* const cl_to[] = {";
-    for (size_t k = 0; k < cs.size(); ++k) scene_ << (k ? ", " : "") << "cl_" << cs[k].first;
+    for (size_t k = 0; k < cs.size(); ++k) scene_ << (k ? ", " : "") << (mm ? "cl2_" : "cl_") << cs[k].first;
     scene_ << "};\n";
-    scene_ << ind << "sphc::gather_slots(cl_layout, cl_from, cl_to, " << cs.size() << par << ");\n";
+    scene_ << ind << (mm ? "sphc::gather_slots_doubled" : "sphc::gather_slots") << "(cl_layout, cl_from, cl_to, "
+           << cs.size() << par << ");\n";
   };
   if (!fixedCopies.empty()) {
     scene_ << in << "if (verlet_build) {  // the copies of what nothing writes: at the build only\n";
@@ -308,7 +383,36 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     gathers(evalCopies, in + "  ");
     scene_ << in << "}\n";
   }
-  if (!inSlots.empty()) {
+  if (mm) {  // the positions doubled (the copies above are doubled as they are gathered)
+    scene_ << in << "// The positions doubled: cluster c's CL_W values twice (the j side of a register in\n"
+           << in << "// one load of 8 lanes; the i-cluster's registers from its first half).\n";
+    if (openmp)
+      scene_ << in << "#pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "for (std::size_t c = 0; c < cl_layout.n_clusters; ++c) {\n";
+    scene_ << in << "  #pragma omp simd  // (one vector of CL_W per copy: without it GCC 12 stores every value alone)\n";
+    scene_ << in << "  for (int l = 0; l < CL_W; ++l) {\n";
+    for (int k = 0; k < plan_.dim; ++k) {
+      const auto& c = copies[k];
+      scene_ << in << "    const double v_" << c.first << " = cl_" << c.first << "[CL_W * c + l];\n";
+      scene_ << in << "    cl2_" << c.first << "[CL_LANES * c + l] = v_" << c.first << ";\n";
+      scene_ << in << "    cl2_" << c.first << "[CL_LANES * c + CL_W + l] = v_" << c.first << ";\n";
+    }
+    scene_ << in << "  }\n";
+    scene_ << in << "}\n";
+  }
+  if (mm && !inSlots.empty()) {
+    scene_ << in << "// the hoisted values in slot order from the doubled copies (the same function of the\n"
+           << in << "// same doubles as in the particles' order: the values a gather would copy), doubled\n";
+    if (openmp)
+      scene_ << in << "#pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "for (std::size_t c = 0; c < cl_layout.n_clusters; ++c)\n";
+    scene_ << in << "  for (int l = 0; l < CL_W; ++l) {\n";
+    scene_ << in << "    const int cl_s2 = static_cast<int>(CL_LANES * c) + l;  // slot CL_W c + l, first half\n";
+    for (const auto& c : copies)
+      if (auto it = inSlots.find(c.first); it != inSlots.end())
+        scene_ << in << "    cl2_" << c.first << "[cl_s2] = cl2_" << c.first << "[cl_s2 + CL_W] = " << it->second << ";\n";
+    scene_ << in << "  }\n";
+  } else if (!inSlots.empty()) {
     scene_ << in << "// the hoisted values in slot order from the copies (the same function of the same\n"
            << in << "// doubles as in the particles' order: the values a gather would copy)\n";
     if (openmp)
@@ -326,8 +430,6 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
             "#else\n"
             "#define SPHC_TILES_OPTIMIZE\n"
             "#endif\n";
-  scene_ << in << "static_assert(sphc::kClusterSize == 8, \"codegen/ClusterPairs.cpp prints tiles of 8 x 8: "
-                  "the runtime's cluster width must be 8\");\n";
   if (openmp)
     scene_ << in << "// OpenMP: contiguous blocks of i-clusters, one per thread, balanced by the pruned\n"
            << in << "// list's pairs; a block writes only its own slots' sums, each sum in the serial\n"
@@ -342,80 +444,161 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
            << in << "// the same operations on the same values as its side of the whole tile.\n";
   scene_ << in << "auto tiles = [&](const int cb, const int ce) SPHC_TILES_OPTIMIZE {\n";
   const std::string t = in + "  ";
-  scene_ << t << "static constexpr double cl_lane[8] = {0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0};\n";
+  if (mm) {
+    scene_ << t << "// lane l of a register: its i the register's first + l / CL_W, its j l % CL_W\n";
+    scene_ << t << "static constexpr double cl_ilane[8] = {0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0};\n";
+    scene_ << t << "static constexpr double cl_jlane[8] = {0.0, 1.0, 2.0, 3.0, 0.0, 1.0, 2.0, 3.0};\n";
+  } else {
+    scene_ << t << "static constexpr double cl_lane[8] = {0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0};\n";
+  }
   // The copies' pointers again, locals of the lambda (captured by reference, GCC reloads them
   // in the loops), and the lists' arrays.
   at = 0;
-  for (const auto& c : copies)
-    scene_ << t << "double* const cl_" << c.first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  for (size_t k = 0; k < nSlotCopies; ++k)
+    if (!mm) scene_ << t << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+    else ++at;  // (2xMM: the tiles read the doubled copies only)
   for (const std::string& p : accs)
     scene_ << t << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  if (mm)
+    for (const auto& c : copies) {
+      scene_ << t << "const double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
+      at += 2;
+    }
   scene_ << t << "const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
   scene_ << t << "const std::uint32_t* const cl_j = cl_pruned.j.data();\n";
   scene_ << t << "const std::uint8_t* const cl_real = cl_layout.real_mask.data();\n";
-  scene_ << t << "// The destination side: the copies at d_idx, the slot of particle i.\n";
-  for (const std::string& p : pass.shared)
-    scene_ << t << "const double* const di_" << p << " = cl_" << p << ";\n";
+  if (!mm) {
+    scene_ << t << "// The destination side: the copies at d_idx, the slot of particle i.\n";
+    for (const std::string& p : pass.shared)
+      scene_ << t << "const double* const di_" << p << " = cl_" << p << ";\n";
+  }
   scene_ << t << "// the block's slot sums (only this block writes them)\n";
   for (const std::string& p : accs)
-    scene_ << t << "std::fill(cl_acc_" << p << " + 8 * static_cast<std::size_t>(cb), cl_acc_" << p
-           << " + 8 * static_cast<std::size_t>(ce), 0.0);\n";
+    scene_ << t << "std::fill(cl_acc_" << p << " + CL_W * static_cast<std::size_t>(cb), cl_acc_" << p
+           << " + CL_W * static_cast<std::size_t>(ce), 0.0);\n";
+  // 2xMM: the i-cluster's two registers' values (ri_NAME[r][lane], i = 2 r + lane / CL_W),
+  // once per i-cluster.
+  auto iRegisters = [&](const std::string& c1) {
+    scene_ << c1 << "// its two registers' i's: lane l of register r holds slot ci CL_W + 2 r + l / CL_W\n";
+    for (const auto& c : copies) scene_ << c1 << "alignas(64) double ri_" << c.first << "[2][CL_LANES];\n";
+    scene_ << c1 << "for (int l = 0; l < CL_W; ++l) {\n";
+    for (const auto& c : copies) {
+      const std::string src = "cl2_" + c.first + "[CL_LANES * ci + ";
+      scene_ << c1 << "  ri_" << c.first << "[0][l] = " << src << "0]; ri_" << c.first << "[0][CL_W + l] = "
+             << src << "1]; ri_" << c.first << "[1][l] = " << src << "2]; ri_" << c.first
+             << "[1][CL_W + l] = " << src << "3];\n";
+    }
+    scene_ << c1 << "}\n";
+  };
   // One tile (j-cluster cl_j[e] of i-cluster ci): both sides, or one side's half tile.
   enum class Side { Both, I, J };
   auto tile = [&](Side side, const std::string& c2) {
     const bool iSide = side != Side::J, jSide = side != Side::I;
-    scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * 8;\n";
+    const std::string L = "CL_LANES";  // the lanes of a register
+    if (mm) {
+      scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;  // its first slot\n";
+      scene_ << c2 << "const int j2 = static_cast<int>(cl_j[e]) * CL_LANES;  // in the doubled copies\n";
+    } else {
+      scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;\n";
+    }
+    const std::string jOff = mm ? "cl2_" : "cl_";
+    const std::string jAt = mm ? " + j2" : " + j0";
     if (side == Side::Both)
       scene_ << c2 << "const bool diagonal = cl_j[e] == static_cast<std::uint32_t>(ci);\n";
-    scene_ << c2 << "// The source side: the j-cluster's 8 slots, s_idx the lane.\n";
+    if (mm)
+      scene_ << c2 << "// The source side: the j-cluster's CL_W slots twice (the doubled copies), s_idx the lane.\n";
+    else
+      scene_ << c2 << "// The source side: the j-cluster's 8 slots, s_idx the lane.\n";
     for (const std::string& p : pass.shared)
-      scene_ << c2 << "const double* const sj_" << p << " = cl_" << p << " + j0;\n";
+      scene_ << c2 << "const double* const sj_" << p << " = " << jOff << p << jAt << ";\n";
     for (const std::string& p : pass.sourceProps)
-      scene_ << c2 << "const double* const s_" << p << " = cl_" << p << " + j0;\n";
-    for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = cl_" << h << " + j0;\n";
+      scene_ << c2 << "const double* const s_" << p << " = " << jOff << p << jAt << ";\n";
+    for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = " << jOff << h << jAt << ";\n";
     // (the mirrored calls read particle s_idx's destination values through d_NAME)
-    for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = cl_" << p << " + j0;\n";
-    for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = cl_" << h << " + j0;\n";
+    for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = " << jOff << p << jAt << ";\n";
+    for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = " << jOff << h << jAt << ";\n";
     if (jSide) {
-      scene_ << c2 << "// j's sums over the tile's i's\n";
-      for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[8] = {};\n";
+      scene_ << c2 << "// j's sums over the tile's i's" << (mm ? " (lanes l and l + CL_W: j l)" : "") << "\n";
+      for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[" << L << "] = {};\n";
     }
-    scene_ << c2 << "for (int ii = 0; ii < 8 && (real_i >> ii & 1u); ++ii) {  // the real i's (first)\n";
-    const std::string c3 = c2 + "  ";
-    scene_ << c3 << "const int d_idx = ci * 8 + ii;\n";
-    emitDestLocals(scene_, c3, q, host_);
-    for (const PlanEquation* eq : pass.equations) {
-      const PlanBody& b = methodBody(*eq, ast::Method::Loop);
-      for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
-        const std::string K = std::to_string(k);
-        scene_ << c3 << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = cl_"
-               << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+    std::string c3 = c2 + "  ";
+    if (mm) {
+      scene_ << c2 << "for (int r = 0; r < 2 && (real_i >> (2 * r) & 1u); ++r) {  // the registers with a real i (first)\n";
+      scene_ << c3 << "// the register's i's: d_idx is the lane too (ir_NAME: the i of lane d_idx)\n";
+      for (const auto& c : copies) scene_ << c3 << "const double* const ir_" << c.first << " = ri_" << c.first << "[r];\n";
+      for (const std::string& p : pass.shared) scene_ << c3 << "const double* const di_" << p << " = ir_" << p << ";\n";
+      if (side == Side::Both) {
+        scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
+        scene_ << c3 << "const double lane_s = diagonal ? 2.0 * r : -8.0;  // + cl_ilane: the lane's i in the cluster\n";
+        scene_ << c3 << "const double lane_d = lane_s" << (selfPair ? " - 1.0" : "") << ";\n";
+      } else {
+        scene_ << c3 << "// (a half tile is never on the diagonal: every lane within the cut-off counts)\n";
+      }
+    } else {
+      scene_ << c2 << "for (int ii = 0; ii < CL_W && (real_i >> ii & 1u); ++ii) {  // the real i's (first)\n";
+      scene_ << c3 << "const int d_idx = ci * CL_W + ii;\n";
+      emitDestLocals(scene_, c3, q, host_);
+      for (const PlanEquation* eq : pass.equations) {
+        const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+        for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
+          const std::string K = std::to_string(k);
+          scene_ << c3 << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = cl_"
+                 << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+        }
+      }
+      for (const std::string& p : dvals)  // the destination's values (the d_NAME above are offset)
+        scene_ << c3 << "const double " << destinationValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
+      {  // the mirrored calls' source values: particle d_idx's
+        std::set<std::string> loads;
+        for (const PlanEquation* eq : pass.equations)
+          for (const auto& [p, sc] : sourceValues(methodBody(*eq, ast::Method::Loop)))
+            if (loads.insert(sourceValueName(p, 1, 0)).second)
+              scene_ << c3 << "const double " << sourceValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
+      }
+      if (side == Side::Both) {
+        scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
+        scene_ << c3 << "const double lane_s = diagonal ? static_cast<double>(ii) : -1.0;\n";
+        scene_ << c3 << "const double lane_d = diagonal ? static_cast<double>(ii" << (selfPair ? " - 1" : "") << ") : -1.0;\n";
+      } else {
+        scene_ << c3 << "// (a half tile is never on the diagonal: every lane within the cut-off counts)\n";
       }
     }
-    for (const std::string& p : dvals)  // the destination's values (the d_NAME above are offset)
-      scene_ << c3 << "const double " << destinationValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
-    {  // the mirrored calls' source values: particle d_idx's
+    // 2xMM: the i's values of a lane (d_idx = the lane), at the top of a lane loop's body.
+    auto laneDest = [&](const std::string& b) {
+      scene_ << b << "const int d_idx = s_idx;  // the lane's i: its values ir_NAME[d_idx]\n";
+      emitDestLocals(scene_, b, q, host_);
+      for (const PlanEquation* eq : pass.equations) {
+        const PlanBody& pb = methodBody(*eq, ast::Method::Loop);
+        for (size_t k = 0; k < hoistedDestinationSites(pb, host_).size(); ++k) {
+          const std::string K = std::to_string(k);
+          scene_ << b << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = ir_"
+                 << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+        }
+      }
+      for (const std::string& p : dvals)
+        scene_ << b << "const double " << destinationValueName(p, 1, 0) << " = ir_" << p << "[d_idx];\n";
       std::set<std::string> loads;
       for (const PlanEquation* eq : pass.equations)
         for (const auto& [p, sc] : sourceValues(methodBody(*eq, ast::Method::Loop)))
           if (loads.insert(sourceValueName(p, 1, 0)).second)
-            scene_ << c3 << "const double " << sourceValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
-    }
-    if (side == Side::Both) {
-      scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
-      scene_ << c3 << "const double lane_s = diagonal ? static_cast<double>(ii) : -1.0;\n";
-      scene_ << c3 << "const double lane_d = diagonal ? static_cast<double>(ii" << (selfPair ? " - 1" : "") << ") : -1.0;\n";
-    } else {
-      scene_ << c3 << "// (a half tile is never on the diagonal: every lane within the cut-off counts)\n";
-    }
-    // The row's cut-off alone first: a row with no pair within it is skipped.
+            scene_ << b << "const double " << sourceValueName(p, 1, 0) << " = ir_" << p << "[d_idx];\n";
+    };
+    // The lane's position in the diagonal tile's comparisons.
+    const std::string jl = mm ? "cl_jlane[s_idx]" : "cl_lane[s_idx]";
+    const std::string il = mm ? "cl_ilane[s_idx] + " : "";
+    // The row's (register's) cut-off alone first: a row with no pair within it is skipped.
     // (a double sum of 0 or 1: an int reduction makes GCC 12 take 8 int lanes, so this loop in
     // 256-bit vectors, 10-12% more per sweep in bench/cluster_pairs.cpp)
     scene_ << c3 << "double any = 0.0;\n";
     scene_ << c3 << "#pragma omp simd reduction(+: any)\n";
-    scene_ << c3 << "for (int s_idx = 0; s_idx < 8; ++s_idx) {\n";
+    scene_ << c3 << "for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
     {
       const std::string b = c3 + "  ";
+      if (mm) {
+        scene_ << b << "const double hi = ir_h[s_idx];\n";
+        for (int k = 0; k < plan_.dim; ++k)
+          scene_ << b << "const double " << axes[k] << "i = ir_" << axes[k] << "[s_idx];\n";
+      }
       scene_ << b << "const double hj = sj_h[s_idx];\n";
       std::string r2;
       for (int k = 0; k < plan_.dim; ++k) {
@@ -425,23 +608,25 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << b << "const double R2IJ = " << r2 << ";\n";
       scene_ << b << "const double hmax = hi > hj ? hi : hj;\n";
       if (side == Side::Both)
-        scene_ << b << "any += !(R2IJ >= RADIUS2 * hmax * hmax) & (cl_lane[s_idx] > lane_d) ? 1.0 : 0.0;\n";
+        scene_ << b << "any += !(R2IJ >= RADIUS2 * hmax * hmax) & (" << jl << " > " << il << "lane_d) ? 1.0 : 0.0;\n";
       else
         scene_ << b << "any += !(R2IJ >= RADIUS2 * hmax * hmax) ? 1.0 : 0.0;\n";
     }
     scene_ << c3 << "}\n";
-    scene_ << c3 << "if (!(any > 0.0)) continue;  // no pair of the row within the support\n";
+    scene_ << c3 << "if (!(any > 0.0)) continue;  // no pair of the " << (mm ? "register" : "row") << " within the support\n";
     if (iSide)
-      for (const std::string& p : accs) scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[ii];\n";
+      for (const std::string& p : accs)
+        scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[" << (mm ? "r" : "ii") << "];\n";
     scene_ << c3 << "#pragma omp simd\n";
-    scene_ << c3 << "for (int s_idx = 0; s_idx < 8; ++s_idx) {\n";
+    scene_ << c3 << "for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
     const std::string body = c3 + "  ";
+    if (mm) laneDest(body);
     emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
     scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
     scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
     if (side == Side::Both) {
-      scene_ << body << "const bool in_d = in_cut & (cl_lane[s_idx] > lane_d);  // for d_idx\n";
-      scene_ << body << "const bool in_s = in_cut & (cl_lane[s_idx] > lane_s);  // for the lane's particle\n";
+      scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
+      scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
     }
     const std::string inD = side == Side::Both ? "in_d" : "in_cut";
     const std::string inS = side == Side::Both ? "in_s" : "in_cut";
@@ -455,11 +640,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
         scene_ << body << pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_");
     // The mirrored calls index the source's arrays they are given as pointers (a source
     // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
-    // not offset to the j-cluster.
+    // not offset to the j-cluster (2xMM: the register's i's, d_idx the lane).
     if (jSide) {
       std::map<std::string, std::string> absolute;
-      for (const std::string& p : pass.sourceProps) absolute["s_" + p] = "cl_" + p;
-      for (const std::string& h : hoisted) absolute[h] = "cl_" + h;
+      const std::string pre = mm ? "ir_" : "cl_";
+      for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
+      for (const std::string& h : hoisted) absolute[h] = pre + h;
       for (const PlanEquation* eq : pass.equations)
         scene_ << body << withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute);
     }
@@ -473,10 +659,17 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << c3 << "}\n";
     scene_ << c2 << "}\n";
     if (jSide) {
-      scene_ << c2 << "#pragma omp simd  // (a vector: unrolled, the tj_ arrays would be scalars)\n";
-      scene_ << c2 << "for (int l = 0; l < 8; ++l) {\n";
-      for (const std::string& p : accs)
-        scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l];\n";
+      if (mm) {
+        scene_ << c2 << "#pragma omp simd  // the two halves folded (j l: lanes l, l + CL_W), onto the slot sums\n";
+        scene_ << c2 << "for (int l = 0; l < CL_W; ++l) {\n";
+        for (const std::string& p : accs)
+          scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l] + tj_" << p << "[CL_W + l];\n";
+      } else {
+        scene_ << c2 << "#pragma omp simd  // (a vector: unrolled, the tj_ arrays would be scalars)\n";
+        scene_ << c2 << "for (int l = 0; l < CL_LANES; ++l) {\n";
+        for (const std::string& p : accs)
+          scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l];\n";
+      }
       scene_ << c2 << "}\n";
     }
   };
@@ -488,7 +681,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << c1 << "if (cl_begin[ci] == e_end || cl_j[e_end - 1] < static_cast<std::uint32_t>(cb)) continue;\n";
     scene_ << c1 << "std::uint32_t e = static_cast<std::uint32_t>(std::lower_bound(cl_j + cl_begin[ci], cl_j + e_end, "
                     "static_cast<std::uint32_t>(cb)) - cl_j);\n";
+    if (mm) scene_ << c1 << "if (e == e_end || cl_j[e] >= static_cast<std::uint32_t>(ce)) continue;\n";
     scene_ << c1 << "const unsigned real_i = cl_real[ci];\n";
+    if (mm) iRegisters(c1);
     scene_ << c1 << "for (; e < e_end && cl_j[e] < static_cast<std::uint32_t>(ce); ++e) {\n";
     tile(Side::J, c1 + "  ");
     scene_ << c1 << "}\n";
@@ -500,8 +695,14 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
   scene_ << c1 << "if (cl_begin[ci] == e_end) continue;\n";
   scene_ << c1 << "const unsigned real_i = cl_real[ci];\n";
-  scene_ << c1 << "// i's sums: 8 lane partial sums per i across its cluster pairs\n";
-  for (const std::string& p : accs) scene_ << c1 << "alignas(64) double ti_" << p << "[8][8] = {};\n";
+  if (mm) {
+    iRegisters(c1);
+    scene_ << c1 << "// i's sums: per register 8 lane partial sums across its cluster pairs (i 2 r + l / CL_W)\n";
+    for (const std::string& p : accs) scene_ << c1 << "alignas(64) double ti_" << p << "[2][CL_LANES] = {};\n";
+  } else {
+    scene_ << c1 << "// i's sums: 8 lane partial sums per i across its cluster pairs\n";
+    for (const std::string& p : accs) scene_ << c1 << "alignas(64) double ti_" << p << "[CL_W][CL_LANES] = {};\n";
+  }
   if (openmp) {
     scene_ << c1 << "// the tiles with j-clusters in the block (both sides), then those in later blocks\n";
     scene_ << c1 << "const std::uint32_t e_mid = static_cast<std::uint32_t>(std::lower_bound(cl_j + cl_begin[ci], "
@@ -518,11 +719,20 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     tile(Side::I, c1 + "  ");
     scene_ << c1 << "}\n";
   }
-  scene_ << c1 << "for (int ii = 0; ii < 8; ++ii) {\n";
-  for (const std::string& p : accs) {
-    scene_ << c1 << "  double s_" << p << " = 0.0;\n";
-    scene_ << c1 << "  for (int l = 0; l < 8; ++l) s_" << p << " += ti_" << p << "[ii][l];\n";
-    scene_ << c1 << "  cl_acc_" << p << "[ci * 8 + ii] += s_" << p << ";\n";
+  if (mm) {
+    scene_ << c1 << "for (int k = 0; k < CL_W; ++k) {  // slot k: register k / 2, lanes (k % 2) CL_W ...\n";
+    for (const std::string& p : accs) {
+      scene_ << c1 << "  double s_" << p << " = 0.0;\n";
+      scene_ << c1 << "  for (int l = 0; l < CL_W; ++l) s_" << p << " += ti_" << p << "[k / 2][(k % 2) * CL_W + l];\n";
+      scene_ << c1 << "  cl_acc_" << p << "[ci * CL_W + k] += s_" << p << ";\n";
+    }
+  } else {
+    scene_ << c1 << "for (int ii = 0; ii < CL_W; ++ii) {\n";
+    for (const std::string& p : accs) {
+      scene_ << c1 << "  double s_" << p << " = 0.0;\n";
+      scene_ << c1 << "  for (int l = 0; l < CL_LANES; ++l) s_" << p << " += ti_" << p << "[ii][l];\n";
+      scene_ << c1 << "  cl_acc_" << p << "[ci * CL_W + ii] += s_" << p << ";\n";
+    }
   }
   scene_ << c1 << "}\n";
   scene_ << t << "}\n";

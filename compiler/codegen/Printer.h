@@ -475,6 +475,7 @@ class ScenePrinter {
                                   const std::string& what);
   bool simdCluster_ = false;  // EmitOptions::simdPairsCluster (with simdOnce_)
   bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops only
+  bool cluster2d8x8_ = false;     // EmitOptions::cluster2d8x8: 2D tiles 8 x 8, not 2xMM
   std::string simdClusterWhy_;    // the report's reason (--simd-pairs=cluster, or auto's)
   // --precision=single: the float local a SIMD loop passes for a body's double argument (t,
   // dt, an equation's scalar: f_t, f_eq2_alpha), converted once before the loop; "" for

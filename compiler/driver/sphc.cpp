@@ -182,6 +182,12 @@ static cl::opt<bool> NoRegisterSums(
              "bodies allow it; serial and openmp, double and single precision (float locals "
              "in single); the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> Cluster2d8x8(
+    "cluster-2d-8x8",
+    cl::desc("The 2D cluster-pair tiles (--simd-pairs=cluster) as 8 x 8 tiles of one i x 8 j's "
+             "per register (stops 37-38), not GROMACS' 2xMM form of 4 x 4 cluster pairs in "
+             "registers of 2 i's x 4 j's (stop 39; a measurement knob)"),
+    cl::init(false), cl::Hidden, cl::cat(SphcCat));
 static cl::opt<bool> NoSelfPairSkip(
     "no-self-pair-skip",
     cl::desc("Evaluate the self pair (a particle with itself, r = 0) in the each-pair-once "
@@ -633,6 +639,7 @@ int main(int argc, char** argv) {
                            simdMode == "cluster";
   emitOpts.simdPairsOnce = simdMode == "auto" || simdMode == "once" || simdMode == "cluster";
   emitOpts.simdPairsCluster = simdMode == "cluster";
+  emitOpts.cluster2d8x8 = Cluster2d8x8;
   emitOpts.simdAutoNeighbours = SimdNeighbours;
   emitOpts.simdOnceNeighbours = SimdOnceNeighbours;
   emitOpts.simdPerDestNeighbours = SimdPerDestNeighbours;

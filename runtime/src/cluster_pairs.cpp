@@ -223,6 +223,28 @@ void add_slots(const ClusterLayout& L, const float* sums, float* dst) {
   add_slots_of(L, sums, dst);
 }
 
+void gather_slots_doubled(const ClusterLayout& L, const double* src, double* dst) {
+  const int C = L.width;
+  const std::uint8_t full = L.full_mask();
+  const std::uint32_t* slot = L.slot.data();
+  const std::size_t nc = L.n_clusters;
+#pragma omp parallel for schedule(static)
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::uint32_t* sl = slot + c * C;
+    double* d = dst + 2 * c * C;
+    if (C == 4 && L.real_mask[c] == full) {  // the 2xMM width: unrolled
+      const double v0 = src[sl[0]], v1 = src[sl[1]], v2 = src[sl[2]], v3 = src[sl[3]];
+      d[0] = d[4] = v0;
+      d[1] = d[5] = v1;
+      d[2] = d[6] = v2;
+      d[3] = d[7] = v3;
+    } else {
+      const double first = src[sl[0]];
+      for (int k = 0; k < C; ++k) d[k] = d[C + k] = sl[k] == kPadSlot ? first : src[sl[k]];
+    }
+  }
+}
+
 void gather_positions(const ClusterLayout& L, const double* x, const double* y, const double* z,
                       double* xs, double* ys, double* zs, double pad_offset) {
   const bool three = L.dim == 3;
@@ -408,6 +430,37 @@ void gather_positions_boxes_w(ClusterLayout& L, const double* x, const double* y
   }
 }
 
+// gather_slots_doubled's values for `count` arrays, as gather_slots_n_w: one parallel region.
+void gather_slots_doubled_n(const ClusterLayout& L, const double* const* src,
+                            double* const* dst, int count, bool parallel) {
+  const int C = L.width;
+  const std::uint8_t full = L.full_mask();
+  const std::uint32_t* slot = L.slot.data();
+  const std::uint8_t* real = L.real_mask.data();
+  const std::size_t nc = L.n_clusters;
+  (void)parallel;
+#pragma omp parallel if (parallel)
+  for (int a = 0; a < count; ++a) {
+    const double* s = src[a];
+    double* const da = dst[a];
+#pragma omp for schedule(static) nowait
+    for (std::size_t c = 0; c < nc; ++c) {
+      const std::uint32_t* sl = slot + c * C;
+      double* d = da + 2 * c * C;
+      if (C == 4 && real[c] == full) {  // the 2xMM width: unrolled
+        const double v0 = s[sl[0]], v1 = s[sl[1]], v2 = s[sl[2]], v3 = s[sl[3]];
+        d[0] = d[4] = v0;
+        d[1] = d[5] = v1;
+        d[2] = d[6] = v2;
+        d[3] = d[7] = v3;
+      } else {
+        const double first = s[sl[0]];
+        for (int k = 0; k < C; ++k) d[k] = d[C + k] = sl[k] == kPadSlot ? first : s[sl[k]];
+      }
+    }
+  }
+}
+
 // As gather_slots_n_w: a pass per array, one parallel region.
 void add_slots_n(const ClusterLayout& L, const double* const* sums, double* const* dst,
                  int count, bool parallel) {
@@ -424,6 +477,11 @@ void add_slots_n(const ClusterLayout& L, const double* const* sums, double* cons
 }
 
 }  // namespace
+
+void gather_slots_doubled(const ClusterLayout& L, const double* const* src,
+                          double* const* dst, int count, bool parallel) {
+  if (count > 0) gather_slots_doubled_n(L, src, dst, count, parallel);
+}
 
 void gather_slots(const ClusterLayout& L, const double* const* src, double* const* dst,
                   int count, bool parallel) {

@@ -354,6 +354,24 @@ TEST(ClusterPairs, GatherAndAddRoundTripExactly) {
       const std::size_t first = k / L.width * L.width;
       EXPECT_EQ(s[k], v[L.slot[k] == kPadSlot ? L.slot[first] : L.slot[k]]);
     }
+    // gather_slots_doubled (the 2xMM tiles' copies, stop 39): each cluster's values twice.
+    std::vector<double> s2(2 * L.slots(), -7.0);
+    sphc::gather_slots_doubled(L, v.data(), s2.data());
+    for (std::size_t k = 0; k < L.slots(); ++k) {
+      const std::size_t c = k / L.width, at = 2 * c * L.width + k % L.width;
+      EXPECT_EQ(s2[at], s[k]);
+      EXPECT_EQ(s2[at + L.width], s[k]);
+    }
+    {  // the arrays' form (one call for several copies, tilemerge): the same values
+      std::vector<double> w(v.size());
+      for (std::size_t i = 0; i < v.size(); ++i) w[i] = -v[i];
+      std::vector<double> a2(2 * L.slots(), -5.0), b2(2 * L.slots(), -5.0);
+      const double* from[] = {v.data(), w.data()};
+      double* to[] = {a2.data(), b2.data()};
+      sphc::gather_slots_doubled(L, from, to, 2);
+      EXPECT_EQ(a2, s2);
+      for (std::size_t k = 0; k < s2.size(); ++k) EXPECT_EQ(b2[k], -s2[k]);
+    }
     sphc::add_slots(L, s.data(), back.data());
     EXPECT_EQ(back, v);
     // add_slots adds to what is there; padding slots are never read.

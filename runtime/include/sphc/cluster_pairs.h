@@ -114,6 +114,11 @@ void build_cluster_layout(ClusterLayout& layout, const double* x, const double* 
 void gather_slots(const ClusterLayout& layout, const double* src, double* dst);
 void gather_slots(const ClusterLayout& layout, const float* src, float* dst);
 
+// Per evaluation, for tiles of 2 i's x a cluster's j's per register (codegen/ClusterPairs.cpp's
+// 2xMM form, stop 39): gather_slots with each cluster's values twice, dst[2 w c + k] =
+// dst[2 w c + w + k] = the value of slot w c + k (dst: 2 layout.slots() values).
+void gather_slots_doubled(const ClusterLayout& layout, const double* src, double* dst);
+
 // Per evaluation: the positions in slot order (z, zs unused in 2D, may be null). The k-th
 // padding slot of the layout (k = 1, 2, ... in slot order; at most width - 1 per column) sits at
 // x = (largest x of the real particles) + k pad_offset, its y and z those of its cluster's
@@ -142,6 +147,9 @@ void update_boxes(ClusterLayout& layout, const double* xs, const double* ys, con
 // gather_slots for `count` arrays in one pass over the slots: dst[k][s] = src[k][slot[s]].
 void gather_slots(const ClusterLayout& layout, const double* const* src, double* const* dst,
                   int count, bool parallel = true);
+// gather_slots_doubled for `count` arrays in one parallel region (the 2xMM form's copies).
+void gather_slots_doubled(const ClusterLayout& layout, const double* const* src,
+                          double* const* dst, int count, bool parallel = true);
 // add_slots for `count` arrays in one pass over the particles: dst[k][p] += sums[k][slot_of[p]].
 void add_slots(const ClusterLayout& layout, const double* const* sums, double* const* dst,
                int count, bool parallel = true);
