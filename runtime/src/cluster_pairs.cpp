@@ -318,13 +318,13 @@ namespace {
 // The arrays one after another (a pass over the slots each: long streams, measured faster
 // than all the arrays per cluster, bench/cluster_lists.cpp `--flush`), under OpenMP in one
 // parallel region (each thread the same clusters of every array: no barrier between them).
-template <int W>
-void gather_slots_n_w(const ClusterLayout& L, const double* const* src, double* const* dst,
-                      int count, bool parallel) {
-  const int C = W > 0 ? W : L.width;
-  const std::uint8_t full = L.full_mask();
+// The frame of the one-call gathers: `count` arrays one after another, under OpenMP in one
+// parallel region, each thread the same clusters of every array (`omp for nowait`);
+// `cluster(s, sl, c, da)` writes cluster c of array da from source s, its slots sl.
+template <typename PerCluster>
+void gather_each_array(const ClusterLayout& L, int C, const double* const* src,
+                       double* const* dst, int count, bool parallel, PerCluster cluster) {
   const std::uint32_t* slot = L.slot.data();
-  const std::uint8_t* real = L.real_mask.data();
   const std::size_t nc = L.n_clusters;
   (void)parallel;
 #pragma omp parallel if (parallel)
@@ -332,17 +332,26 @@ void gather_slots_n_w(const ClusterLayout& L, const double* const* src, double* 
     const double* s = src[a];
     double* const da = dst[a];
 #pragma omp for schedule(static) nowait
-    for (std::size_t c = 0; c < nc; ++c) {
-      const std::uint32_t* sl = slot + c * C;
-      double* d = da + c * C;
-      if (real[c] == full) {
-        for (int k = 0; k < C; ++k) d[k] = s[sl[k]];
-      } else {  // padding: its cluster's first value
-        const double first = s[sl[0]];
-        for (int k = 0; k < C; ++k) d[k] = sl[k] == kPadSlot ? first : s[sl[k]];
-      }
-    }
+    for (std::size_t c = 0; c < nc; ++c) cluster(s, slot + c * C, c, da);
   }
+}
+
+template <int W>
+void gather_slots_n_w(const ClusterLayout& L, const double* const* src, double* const* dst,
+                      int count, bool parallel) {
+  const int C = W > 0 ? W : L.width;
+  const std::uint8_t full = L.full_mask();
+  const std::uint8_t* real = L.real_mask.data();
+  gather_each_array(L, C, src, dst, count, parallel,
+                    [=](const double* s, const std::uint32_t* sl, std::size_t c, double* da) {
+                      double* d = da + c * C;
+                      if (real[c] == full) {
+                        for (int k = 0; k < C; ++k) d[k] = s[sl[k]];
+                      } else {  // padding: its cluster's first value
+                        const double first = s[sl[0]];
+                        for (int k = 0; k < C; ++k) d[k] = sl[k] == kPadSlot ? first : s[sl[k]];
+                      }
+                    });
 }
 
 // One cluster's box from its gathered positions (update_boxes_w's arithmetic).
@@ -435,30 +444,21 @@ void gather_slots_doubled_n(const ClusterLayout& L, const double* const* src,
                             double* const* dst, int count, bool parallel) {
   const int C = L.width;
   const std::uint8_t full = L.full_mask();
-  const std::uint32_t* slot = L.slot.data();
   const std::uint8_t* real = L.real_mask.data();
-  const std::size_t nc = L.n_clusters;
-  (void)parallel;
-#pragma omp parallel if (parallel)
-  for (int a = 0; a < count; ++a) {
-    const double* s = src[a];
-    double* const da = dst[a];
-#pragma omp for schedule(static) nowait
-    for (std::size_t c = 0; c < nc; ++c) {
-      const std::uint32_t* sl = slot + c * C;
-      double* d = da + 2 * c * C;
-      if (C == 4 && real[c] == full) {  // the 2xMM width: unrolled
-        const double v0 = s[sl[0]], v1 = s[sl[1]], v2 = s[sl[2]], v3 = s[sl[3]];
-        d[0] = d[4] = v0;
-        d[1] = d[5] = v1;
-        d[2] = d[6] = v2;
-        d[3] = d[7] = v3;
-      } else {
-        const double first = s[sl[0]];
-        for (int k = 0; k < C; ++k) d[k] = d[C + k] = sl[k] == kPadSlot ? first : s[sl[k]];
-      }
-    }
-  }
+  gather_each_array(L, C, src, dst, count, parallel,
+                    [=](const double* s, const std::uint32_t* sl, std::size_t c, double* da) {
+                      double* d = da + 2 * c * C;
+                      if (C == 4 && real[c] == full) {  // the 2xMM width: unrolled
+                        const double v0 = s[sl[0]], v1 = s[sl[1]], v2 = s[sl[2]], v3 = s[sl[3]];
+                        d[0] = d[4] = v0;
+                        d[1] = d[5] = v1;
+                        d[2] = d[6] = v2;
+                        d[3] = d[7] = v3;
+                      } else {
+                        const double first = s[sl[0]];
+                        for (int k = 0; k < C; ++k) d[k] = d[C + k] = sl[k] == kPadSlot ? first : s[sl[k]];
+                      }
+                    });
 }
 
 // As gather_slots_n_w: a pass per array, one parallel region.
