@@ -43,15 +43,12 @@
 #include <time.h>
 
 #include "bench_options.h"
+#include "bench_tiles.h"
 #include "sphc/cluster_pairs.h"
 
 namespace {
 
-double cpu_now() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
+using bench::tiles::cpu_now;
 
 struct Cube {
   std::vector<double> x, y, z;

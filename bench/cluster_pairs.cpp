@@ -68,17 +68,13 @@
 #include <time.h>
 
 #include "bench_options.h"
+#include "bench_tiles.h"
 #include "sphc/cluster_pairs.h"
 #include "sphc/kernels.h"
 
 namespace {
 
-// CPU time of this thread (the machine is shared: wall time would be the load's).
-double cpu_now() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
+using namespace bench::tiles;  // cpu_now, median, the vector operations, clock_estimate
 
 constexpr int DIM = 3;
 using Kernel = sphc::CubicSpline<DIM>;
@@ -856,32 +852,6 @@ PairList build_pair_list(const Clusters& cl, int CI, double rlist, int cjs = CJ)
 // The intrinsics need AVX-512F (a build for another CPU, e.g. -march=x86-64-v3 to count
 // instructions under valgrind, has forms (a), (b) and the `omp` tiles only).
 #ifdef __AVX512F__
-using V = __m512d;
-using M = __mmask8;
-inline V bc(double a) { return _mm512_set1_pd(a); }
-inline V add(V a, V b) { return _mm512_add_pd(a, b); }
-inline V sub(V a, V b) { return _mm512_sub_pd(a, b); }
-inline V mul(V a, V b) { return _mm512_mul_pd(a, b); }
-inline V div(V a, V b) { return _mm512_div_pd(a, b); }
-inline V fma(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
-inline V sel(M m, V yes, V no) { return _mm512_mask_blend_pd(m, no, yes); }
-// 1 / x from vrcp14pd (relative error < 2^-14) and two Newton steps (~2^-28, then ~1 ulp).
-inline V rcp(V x) {
-  V r = _mm512_rcp14_pd(x);
-  r = fma(r, _mm512_fnmadd_pd(x, r, bc(1.0)), r);
-  r = fma(r, _mm512_fnmadd_pd(x, r, bc(1.0)), r);
-  return r;
-}
-// 1 / sqrt(x) from vrsqrt14pd and two Newton steps: y += y (1 - x y^2) / 2.
-inline V rsqrt(V x) {
-  V y = _mm512_rsqrt14_pd(x);
-  for (int it = 0; it < 2; ++it) {
-    const V e = _mm512_fnmadd_pd(mul(x, y), y, bc(1.0));
-    y = fma(mul(y, bc(0.5)), e, y);
-  }
-  return y;
-}
-
 // One sweep of form (c): tiles of CI i's x 8 j's. Arithmetic: EXACT, the divisions and the
 // square root of (a); RCP, rcp / rsqrt with Newton steps for all of them; RCP_DIV, the
 // divisions by rcp, the square root exact (which of the two limits); LEAN, RCP with fewer
@@ -1028,23 +998,6 @@ __attribute__((noinline)) void form_c(Clusters& cl, const PairList& pl, const Co
   }
 }
 
-// The core's clock while it runs 512-bit FMAs: a chain of dependent vfmadd (4 cycles each on
-// this core) timed by the thread's CPU time. The table's cycles are at the nominal clock.
-double clock_estimate() {
-  const long n = 30000000;
-  __m512d x = _mm512_set1_pd(1.0);
-  const __m512d b = _mm512_set1_pd(0.999999), c = _mm512_set1_pd(1e-9);
-  double best = 1e30;
-  for (int r = 0; r < 3; ++r) {
-    const double t0 = cpu_now();
-    for (long i = 0; i < n; ++i) {
-      x = _mm512_fmadd_pd(x, b, c);
-      __asm__ volatile("" : "+v"(x));
-    }
-    best = std::min(best, cpu_now() - t0);
-  }
-  return _mm512_reduce_add_pd(x) > 0 ? 4.0 * n / best : 0.0;
-}
 #endif  // __AVX512F__
 
 // Dynamic pruning (GROMACS): the list kept with a skin, pruned every step to the cluster
@@ -1483,11 +1436,6 @@ struct Result {
   long lanes = 0;
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -1699,7 +1647,7 @@ int main(int argc, char** argv) {
   }
 #ifdef __AVX512F__
   std::printf("clock while running 512-bit FMAs (a chain of dependent vfmadd, 4 cycles each): %.2f GHz\n",
-              clock_estimate() * 1e-9);
+              clock_estimate(30000000) * 1e-9);
 #endif
   std::printf("(peak %.1f GFLOP/s at %.1f GHz; useful = pairs within the support x %.2f flops of form (a); thread CPU\n"
               " time, best of %d interleaved rounds; cycles at the nominal clock, per ordered pair within the support\n"

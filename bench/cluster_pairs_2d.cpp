@@ -64,16 +64,13 @@
 #include <time.h>
 
 #include "bench_options.h"
+#include "bench_tiles.h"
 #include "sphc/cluster_pairs.h"
 #include "sphc/kernels.h"
 
 namespace {
 
-double cpu_now() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
+using namespace bench::tiles;  // cpu_now, median, the vector operations, clock_estimate
 
 constexpr int DIM = 2;
 using Kernel = sphc::WendlandQuintic<DIM>;
@@ -675,34 +672,6 @@ __attribute__((noinline)) void form_a_shift(Fluid& fluid, const Kept& verlet_flu
 
 #ifdef __AVX512F__
 // ---- The tiles ----
-using V = __m512d;
-using M = __mmask8;
-inline V bc(double a) { return _mm512_set1_pd(a); }
-inline V add(V a, V b) { return _mm512_add_pd(a, b); }
-inline V sub(V a, V b) { return _mm512_sub_pd(a, b); }
-inline V mul(V a, V b) { return _mm512_mul_pd(a, b); }
-inline V div(V a, V b) { return _mm512_div_pd(a, b); }
-inline V fma(V a, V b, V c) { return _mm512_fmadd_pd(a, b, c); }
-inline V sel(M m, V yes, V no) { return _mm512_mask_blend_pd(m, no, yes); }
-// -x (the sign flipped, as the scalar code's unary minus; 0 - x would give +0 for +0)
-inline V neg(V x) { return _mm512_castsi512_pd(_mm512_xor_si512(_mm512_castpd_si512(x), _mm512_set1_epi64(INT64_MIN))); }
-// 1 / x from vrcp14pd (relative error < 2^-14) and two Newton steps.
-inline V rcp(V x) {
-  V r = _mm512_rcp14_pd(x);
-  r = fma(r, _mm512_fnmadd_pd(x, r, bc(1.0)), r);
-  r = fma(r, _mm512_fnmadd_pd(x, r, bc(1.0)), r);
-  return r;
-}
-// 1 / sqrt(x) from vrsqrt14pd and two Newton steps.
-inline V rsqrt(V x) {
-  V y = _mm512_rsqrt14_pd(x);
-  for (int it = 0; it < 2; ++it) {
-    const V e = _mm512_fnmadd_pd(mul(x, y), y, bc(1.0));
-    y = fma(mul(y, bc(0.5)), e, y);
-  }
-  return y;
-}
-
 enum Arith { EXACT = 0, RCP = 1 };
 // The fields the tiles read: x y u v h rho m cs hoisted (p / rho^2) for the rates; x y u v h
 // rho vb (m / rho) dh for the shifting pass.
@@ -734,6 +703,79 @@ inline V jval(const double* F, int j0) {
   return _mm512_broadcast_f64x4(_mm256_loadu_pd(F + j0));
 }
 
+// The cut-off of a register (RI i's from slot i x the j-cluster at j0): !(R2IJ >= RADIUS2 *
+// hmax^2), and j > i on a diagonal tile (lane l: i = i + l / CJ, j = j0 + l % CJ).
+template <int RI, int CJ>
+__attribute__((always_inline)) inline M register_mask(V R2IJ, V hi, V hj, bool diagonal, int i, int j0) {
+  const __m512i lane_i = RI == 1 ? _mm512_setzero_si512() : _mm512_set_epi64(1, 1, 1, 1, 0, 0, 0, 0);
+  const __m512i lane_j = CJ == 8 ? _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0) : _mm512_set_epi64(3, 2, 1, 0, 3, 2, 1, 0);
+  const V hmax = _mm512_max_pd(hi, hj);
+  M in = _mm512_cmp_pd_mask(R2IJ, mul(mul(bc(RADIUS2), hmax), hmax), _CMP_NGE_UQ);
+  if (diagonal)
+    in &= _mm512_cmpgt_epi64_mask(_mm512_add_epi64(lane_j, _mm512_set1_epi64(j0)),
+                                  _mm512_add_epi64(lane_i, _mm512_set1_epi64(i)));
+  return in;
+}
+
+// Kernel::w and gradient_pair (sphc/kernels.h: WendlandQuintic 2D, sigma / h^2 f(q)) of a
+// register: WIJ and the gradient's factor DWIJ_f (DWIJ = DWIJ_f XIJ; 0 for coincident
+// particles). EXACT: (a)'s correctly rounded divisions and square root; RCP: rcp / rsqrt.
+template <int ARITH>
+__attribute__((always_inline)) inline void wendland_register(V R2IJ, V HIJ, V& WIJ, V& DWIJ_f) {
+  const V one = bc(1.0), half = bc(0.5), two = bc(2.0), zero = _mm512_setzero_pd();
+  V RIJ, ih, q, s_den_inv = zero;
+  if (ARITH == EXACT) {
+    RIJ = _mm512_sqrt_pd(R2IJ);
+    ih = div(one, HIJ);
+    q = div(RIJ, HIJ);
+  } else {
+    const V rinv = rsqrt(R2IJ);
+    RIJ = sel(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), mul(R2IJ, rinv), zero);
+    ih = rcp(HIJ);
+    q = mul(RIJ, ih);
+    s_den_inv = mul(ih, rinv);  // 1 / (h rij)
+  }
+  const V sk = mul(bc(Kernel::sigma), mul(ih, ih));
+  const M inside = _mm512_cmp_pd_mask(q, two, _CMP_LT_OQ);  // f, df: 0 where q >= 2
+  const V t = sub(one, mul(half, q));
+  const V t2 = mul(t, t);
+  const V fq = mul(mul(t2, t2), add(mul(two, q), one));
+  const V dfq = mul(mul(mul(mul(bc(-5.0), q), t), t), t);
+  WIJ = mul(sk, sel(inside, fq, zero));
+  const V dwdq = mul(sk, sel(inside, dfq, zero));
+  const M apart = _mm512_cmp_pd_mask(RIJ, bc(1e-12), _CMP_GT_OQ);
+  const V s = ARITH == EXACT ? div(dwdq, mul(HIJ, sel(apart, RIJ, one))) : mul(dwdq, s_den_inv);
+  DWIJ_f = sel(apart, s, zero);
+}
+
+// A tile's j sums added to memory once: CJ = 8, a load-add-store per sum; CJ = 4, the two
+// halves (i's of the register) folded, then added to the 4 j's.
+template <int CJ>
+__attribute__((always_inline)) inline void add_j_sums(double* const* SUM, int nsums, const V* jacc, int j0) {
+  if (CJ == 8) {
+    for (int k = 0; k < nsums; ++k) _mm512_storeu_pd(SUM[k] + j0, add(_mm512_loadu_pd(SUM[k] + j0), jacc[k]));
+  } else {
+    for (int k = 0; k < nsums; ++k) {
+      const __m256d lo = _mm512_castpd512_pd256(jacc[k]), hi = _mm512_extractf64x4_pd(jacc[k], 1);
+      _mm256_storeu_pd(SUM[k] + j0, _mm256_add_pd(_mm256_loadu_pd(SUM[k] + j0), _mm256_add_pd(lo, hi)));
+    }
+  }
+}
+
+// A register's i sums (lane partial sums across its list) reduced and added to slot i (RI = 2:
+// lanes 0-3 to i, 4-7 to i + 1).
+template <int RI>
+__attribute__((always_inline)) inline void add_i_sums(double* const* SUM, int nsums, const V* iacc, int i) {
+  for (int k = 0; k < nsums; ++k) {
+    if (RI == 1) {
+      SUM[k][i] += _mm512_reduce_add_pd(iacc[k]);
+    } else {
+      SUM[k][i] += _mm512_mask_reduce_add_pd(0x0f, iacc[k]);
+      SUM[k][i + 1] += _mm512_mask_reduce_add_pd(0xf0, iacc[k]);
+    }
+  }
+}
+
 // The tile loop: i-clusters of CI slots (CI = 8 / the layout's width, or half of it: t4x8),
 // j-clusters of CJ = the layout's width, registers of RI = 8 / CJ i's. `list`: per i-cluster
 // (of CI slots: for CI < CJ, cluster ci of the list's own numbering, ci * CI its first slot)
@@ -744,10 +786,9 @@ template <int CI, int CJ, int ARITH, bool OWN = false>
 __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>& begin, const std::vector<std::uint32_t>& jl,
                                       const Eq6& eq6, const Eq7& eq7, const Eq8& eq8 = Eq8()) {
   constexpr int RI = 8 / CJ;
-  const double sigma = Kernel::sigma;
   const V one = bc(1.0), half = bc(0.5), two = bc(2.0), zero = _mm512_setzero_pd();
   const V neg_eps = bc(-eq7.eps), neg_alpha = bc(-eq6.alpha), beta = bc(eq6.beta);
-  const V radius2 = bc(RADIUS2), tiny = bc(1e-12), m5 = bc(-5.0), c001 = bc(0.01);
+  const V c001 = bc(0.01);
   const double *X = S.f[0].data(), *Y = S.f[1].data(), *U = S.f[2].data(), *VV = S.f[3].data();
   const double *H = S.f[4].data(), *RHO = S.f[5].data(), *MS = S.f[6].data(), *CS = S.f[7].data();
   const double* HO = S.f[8].data();
@@ -768,10 +809,6 @@ __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>
   };
   double* SUM[NS];
   for (int k = 0; k < NS; ++k) SUM[k] = S.s[k].data();
-  // Lane l of a register: its i is the register's first i + l / CJ, its j the j-cluster's
-  // first + l % CJ.
-  const __m512i lane_i = RI == 1 ? _mm512_setzero_si512() : _mm512_set_epi64(1, 1, 1, 1, 0, 0, 0, 0);
-  const __m512i lane_j = CJ == 8 ? _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0) : _mm512_set_epi64(3, 2, 1, 0, 3, 2, 1, 0);
   const int nci = static_cast<int>(begin.size()) - 1;
   for (int ci = 0; ci < nci; ++ci) {
     const int i0 = ci * CI;
@@ -797,41 +834,14 @@ __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>
         const V XIJ_0 = sub(xi, xj), XIJ_1 = sub(yi, yj);
         const V R2IJ = add(mul(XIJ_0, XIJ_0), mul(XIJ_1, XIJ_1));
         const V hi = ival<RI>(H, i);
-        const V hmax = _mm512_max_pd(hi, hj);
-        // the cut-off: !(R2IJ >= RADIUS2 * hmax * hmax)
-        M in = _mm512_cmp_pd_mask(R2IJ, mul(mul(radius2, hmax), hmax), _CMP_NGE_UQ);
-        if (diagonal)
-          in &= _mm512_cmpgt_epi64_mask(_mm512_add_epi64(lane_j, _mm512_set1_epi64(j0)),
-                                        _mm512_add_epi64(lane_i, _mm512_set1_epi64(i)));
+        const M in = register_mask<RI, CJ>(R2IJ, hi, hj, diagonal, i, j0);
 #ifndef NO_REGSKIP
         if (!in) continue;  // no pair of this register within the support (-DNO_REGSKIP: every register computed)
 #endif
         const V HIJ = mul(half, add(hi, hj));
         const V VIJ_0 = sub(ival<RI>(U, i), uj), VIJ_1 = sub(ival<RI>(VV, i), vj);
-        // Kernel::w and gradient_pair (sphc/kernels.h: WendlandQuintic 2D, sigma / h^2 f(q))
-        V RIJ, ih, q, s_den_inv = zero;
-        if (ARITH == EXACT) {
-          RIJ = _mm512_sqrt_pd(R2IJ);
-          ih = div(one, HIJ);
-          q = div(RIJ, HIJ);
-        } else {
-          const V rinv = rsqrt(R2IJ);
-          RIJ = sel(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), mul(R2IJ, rinv), zero);
-          ih = rcp(HIJ);
-          q = mul(RIJ, ih);
-          s_den_inv = mul(ih, rinv);  // 1 / (h rij)
-        }
-        const V sk = mul(bc(sigma), mul(ih, ih));
-        const M inside = _mm512_cmp_pd_mask(q, two, _CMP_LT_OQ);  // f, df: 0 where q >= 2
-        const V t = sub(one, mul(half, q));
-        const V t2 = mul(t, t);
-        const V fq = mul(mul(t2, t2), add(mul(two, q), one));
-        const V dfq = mul(mul(mul(mul(m5, q), t), t), t);
-        const V WIJ = mul(sk, sel(inside, fq, zero));
-        const V dwdq = mul(sk, sel(inside, dfq, zero));
-        const M apart = _mm512_cmp_pd_mask(RIJ, tiny, _CMP_GT_OQ);
-        const V s = ARITH == EXACT ? div(dwdq, mul(HIJ, sel(apart, RIJ, one))) : mul(dwdq, s_den_inv);
-        const V DWIJ_f = sel(apart, s, zero);
+        V WIJ, DWIJ_f;
+        wendland_register<ARITH>(R2IJ, HIJ, WIJ, DWIJ_f);
         const V DWIJ_0 = mul(DWIJ_f, XIJ_0), DWIJ_1 = mul(DWIJ_f, XIJ_1);
         const V RHOIJ = mul(half, add(ival<RI>(RHO, i), rhoj));
         const V RHOIJ1 = ARITH == EXACT ? div(one, RHOIJ) : rcp(RHOIJ);
@@ -895,41 +905,102 @@ __attribute__((noinline)) void form_t(Slots& S, const std::vector<std::uint32_t>
           jacc[0] = _mm512_mask3_fmadd_pd(ARITH == EXACT ? div(tj, R2IJ) : mul(tj, r2inv), ival<RI>(VB, i), jacc[0], pos);
         }
       }
-      if (CJ == 8) {
-        for (int k = 0; k < NS; ++k) _mm512_storeu_pd(SUM[k] + j0, add(_mm512_loadu_pd(SUM[k] + j0), jacc[k]));
-      } else {  // the two halves (i's of the register) folded, then added to the 4 j's
-        for (int k = 0; k < NS; ++k) {
-          const __m256d lo = _mm512_castpd512_pd256(jacc[k]), hi = _mm512_extractf64x4_pd(jacc[k], 1);
-          _mm256_storeu_pd(SUM[k] + j0, _mm256_add_pd(_mm256_loadu_pd(SUM[k] + j0), _mm256_add_pd(lo, hi)));
-        }
-      }
+      add_j_sums<CJ>(SUM, NS, jacc, j0);
     }
-    for (int r = 0; r < CI / RI; ++r)
-      for (int k = 0; k < NS; ++k) {
-        if (RI == 1) {
-          SUM[k][i0 + r] += _mm512_reduce_add_pd(iacc[r][k]);
-        } else {
-          SUM[k][i0 + 2 * r] += _mm512_mask_reduce_add_pd(0x0f, iacc[r][k]);
-          SUM[k][i0 + 2 * r + 1] += _mm512_mask_reduce_add_pd(0xf0, iacc[r][k]);
-        }
-      }
+    for (int r = 0; r < CI / RI; ++r) add_i_sums<RI>(SUM, NS, iacc[r], i0 + r * RI);
   }
 }
 
 // The shifting pass (DeltaPlusShiftingSums + ShiftingCorrectionGradients) in the same tiles.
+// One register: RI i's from slot i against the j-cluster at j0 (its values J), i's NSS terms
+// into `a`, j's into `jacc`, under the cut-off's mask; false where no lane is within it (then
+// nothing is computed).
+struct ShiftJ {
+  V x, y, u, v, h, rho, vb;
+};
+template <int RI, int CJ, int ARITH>
+__attribute__((always_inline)) inline bool shift_register(const Slots& S, const ShiftJ& J, V R, int i, int j0, bool diagonal, V* a, V* jacc) {
+  const double *X = S.f[FX].data(), *Y = S.f[FY].data(), *U = S.f[FU].data(), *VV = S.f[FV].data();
+  const double *H = S.f[FH].data(), *RHO = S.f[FRHO].data(), *VB = S.f[FVB].data(), *DH = S.f[FDH].data();
+  const V XIJ_0 = sub(ival<RI>(X, i), J.x), XIJ_1 = sub(ival<RI>(Y, i), J.y);
+  const V R2IJ = add(mul(XIJ_0, XIJ_0), mul(XIJ_1, XIJ_1));
+  const V hi = ival<RI>(H, i);
+  const M in = register_mask<RI, CJ>(R2IJ, hi, J.h, diagonal, i, j0);
+#ifndef NO_REGSKIP
+  if (!in) return false;
+#endif
+  const V HIJ = mul(bc(0.5), add(hi, J.h));
+  const V VIJ_0 = sub(ival<RI>(U, i), J.u), VIJ_1 = sub(ival<RI>(VV, i), J.v);
+  V WIJ, DWIJ_f;
+  wendland_register<ARITH>(R2IJ, HIJ, WIJ, DWIJ_f);
+  const V D0 = mul(DWIJ_f, XIJ_0), D1 = mul(DWIJ_f, XIJ_1);
+  // the values the pair shares (eq11: hd, wr, 1 + R wr^4; eq12: rho_j - rho_i, negated for j)
+  const V hd = mul(HIJ, HIJ);  // dim == 2
+  const V wr = mul(mul(WIJ, hd), ival<RI>(DH, i));
+  const V ps2 = fma(mul(mul(mul(R, wr), wr), wr), wr, bc(1.0));
+  const V rhoba = sub(J.rho, ival<RI>(RHO, i));
+  // i's terms (source j: vb = vb_j), in (a)'s order
+  {
+    const V vb = J.vb, f = mul(vb, ps2);
+    const V nx0 = neg(mul(vb, XIJ_0)), nx1 = neg(mul(vb, XIJ_1));
+    const V g = mul(vb, rhoba);
+    const V nv0 = neg(mul(vb, VIJ_0)), nv1 = neg(mul(vb, VIJ_1));
+    a[6] = _mm512_mask3_fmadd_pd(f, D0, a[6], in);
+    a[7] = _mm512_mask3_fmadd_pd(f, D1, a[7], in);
+    a[4] = _mm512_mask3_fmadd_pd(vb, D0, a[4], in);
+    a[5] = _mm512_mask3_fmadd_pd(vb, D1, a[5], in);
+    a[0] = _mm512_mask3_fmadd_pd(nx0, D0, a[0], in);
+    a[1] = _mm512_mask3_fmadd_pd(nx0, D1, a[1], in);
+    a[2] = _mm512_mask3_fmadd_pd(nx1, D0, a[2], in);
+    a[3] = _mm512_mask3_fmadd_pd(nx1, D1, a[3], in);
+    a[8] = _mm512_mask3_fmadd_pd(g, D0, a[8], in);
+    a[9] = _mm512_mask3_fmadd_pd(g, D1, a[9], in);
+    a[10] = _mm512_mask3_fmadd_pd(nv0, D0, a[10], in);
+    a[11] = _mm512_mask3_fmadd_pd(nv0, D1, a[11], in);
+    a[12] = _mm512_mask3_fmadd_pd(nv1, D0, a[12], in);
+    a[13] = _mm512_mask3_fmadd_pd(nv1, D1, a[13], in);
+  }
+  // j's terms (source i: vb = vb_i; XIJ_ji = -XIJ, DWIJ_ji = -DWIJ, VIJ_ji = -VIJ, rhoba
+  // negated, all exactly): fma(a, -D, c) = fnmadd(a, D, c); -(vb (-x)) = vb x.
+  {
+    const V vb = ival<RI>(VB, i), f = mul(vb, ps2);
+    const V px0 = mul(vb, XIJ_0), px1 = mul(vb, XIJ_1);
+    const V g = mul(vb, rhoba);  // vb (-rhoba) times -D: g D
+    const V pv0 = mul(vb, VIJ_0), pv1 = mul(vb, VIJ_1);
+    jacc[6] = _mm512_mask3_fnmadd_pd(f, D0, jacc[6], in);
+    jacc[7] = _mm512_mask3_fnmadd_pd(f, D1, jacc[7], in);
+    jacc[4] = _mm512_mask3_fnmadd_pd(vb, D0, jacc[4], in);
+    jacc[5] = _mm512_mask3_fnmadd_pd(vb, D1, jacc[5], in);
+    jacc[0] = _mm512_mask3_fnmadd_pd(px0, D0, jacc[0], in);
+    jacc[1] = _mm512_mask3_fnmadd_pd(px0, D1, jacc[1], in);
+    jacc[2] = _mm512_mask3_fnmadd_pd(px1, D0, jacc[2], in);
+    jacc[3] = _mm512_mask3_fnmadd_pd(px1, D1, jacc[3], in);
+    jacc[8] = _mm512_mask3_fmadd_pd(g, D0, jacc[8], in);
+    jacc[9] = _mm512_mask3_fmadd_pd(g, D1, jacc[9], in);
+    jacc[10] = _mm512_mask3_fnmadd_pd(pv0, D0, jacc[10], in);
+    jacc[11] = _mm512_mask3_fnmadd_pd(pv0, D1, jacc[11], in);
+    jacc[12] = _mm512_mask3_fnmadd_pd(pv1, D0, jacc[12], in);
+    jacc[13] = _mm512_mask3_fnmadd_pd(pv1, D1, jacc[13], in);
+  }
+  return true;
+}
+
+template <int CJ>
+__attribute__((always_inline)) inline ShiftJ shift_j(const Slots& S, int j0) {
+  return {jval<CJ>(S.f[FX].data(), j0), jval<CJ>(S.f[FY].data(), j0), jval<CJ>(S.f[FU].data(), j0),
+          jval<CJ>(S.f[FV].data(), j0), jval<CJ>(S.f[FH].data(), j0), jval<CJ>(S.f[FRHO].data(), j0),
+          jval<CJ>(S.f[FVB].data(), j0)};
+}
+
+// Tile-major: per i-cluster its list, per tile every register of the i-cluster (all their i
+// sums live: 14 per register).
 template <int CI, int CJ, int ARITH>
 __attribute__((noinline)) void form_t_shift(Slots& S, const std::vector<std::uint32_t>& begin,
                                             const std::vector<std::uint32_t>& jl, const Eq11& eq11) {
   constexpr int RI = 8 / CJ;
-  const double sigma = Kernel::sigma;
-  const V one = bc(1.0), half = bc(0.5), two = bc(2.0), zero = _mm512_setzero_pd();
-  const V radius2 = bc(RADIUS2), tiny = bc(1e-12), m5 = bc(-5.0), R = bc(eq11.R);
-  const double *X = S.f[FX].data(), *Y = S.f[FY].data(), *U = S.f[FU].data(), *VV = S.f[FV].data();
-  const double *H = S.f[FH].data(), *RHO = S.f[FRHO].data(), *VB = S.f[FVB].data(), *DH = S.f[FDH].data();
+  const V zero = _mm512_setzero_pd(), R = bc(eq11.R);
   double* SUM[NSS];
   for (int k = 0; k < NSS; ++k) SUM[k] = S.ss[k].data();
-  const __m512i lane_i = RI == 1 ? _mm512_setzero_si512() : _mm512_set_epi64(1, 1, 1, 1, 0, 0, 0, 0);
-  const __m512i lane_j = CJ == 8 ? _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0) : _mm512_set_epi64(3, 2, 1, 0, 3, 2, 1, 0);
   const int nci = static_cast<int>(begin.size()) - 1;
   for (int ci = 0; ci < nci; ++ci) {
     const int i0 = ci * CI;
@@ -939,118 +1010,14 @@ __attribute__((noinline)) void form_t_shift(Slots& S, const std::vector<std::uin
       for (int k = 0; k < NSS; ++k) iacc[r][k] = zero;
     for (std::uint32_t e = begin[ci]; e < begin[ci + 1]; ++e) {
       const int j0 = static_cast<int>(jl[e]) * CJ;
-      const V xj = jval<CJ>(X, j0), yj = jval<CJ>(Y, j0), uj = jval<CJ>(U, j0), vj = jval<CJ>(VV, j0);
-      const V hj = jval<CJ>(H, j0), rhoj = jval<CJ>(RHO, j0), vbj = jval<CJ>(VB, j0);
+      const ShiftJ J = shift_j<CJ>(S, j0);
       V jacc[NSS];
       for (int k = 0; k < NSS; ++k) jacc[k] = zero;
       const bool diagonal = j0 < i0 + CI && i0 < j0 + CJ;
-      for (int r = 0; r < CI / RI; ++r) {
-        const int i = i0 + r * RI;
-        const V XIJ_0 = sub(ival<RI>(X, i), xj), XIJ_1 = sub(ival<RI>(Y, i), yj);
-        const V R2IJ = add(mul(XIJ_0, XIJ_0), mul(XIJ_1, XIJ_1));
-        const V hi = ival<RI>(H, i);
-        const V hmax = _mm512_max_pd(hi, hj);
-        M in = _mm512_cmp_pd_mask(R2IJ, mul(mul(radius2, hmax), hmax), _CMP_NGE_UQ);
-        if (diagonal)
-          in &= _mm512_cmpgt_epi64_mask(_mm512_add_epi64(lane_j, _mm512_set1_epi64(j0)),
-                                        _mm512_add_epi64(lane_i, _mm512_set1_epi64(i)));
-#ifndef NO_REGSKIP
-        if (!in) continue;
-#endif
-        const V HIJ = mul(half, add(hi, hj));
-        const V VIJ_0 = sub(ival<RI>(U, i), uj), VIJ_1 = sub(ival<RI>(VV, i), vj);
-        V RIJ, ih, q, s_den_inv = zero;
-        if (ARITH == EXACT) {
-          RIJ = _mm512_sqrt_pd(R2IJ);
-          ih = div(one, HIJ);
-          q = div(RIJ, HIJ);
-        } else {
-          const V rinv = rsqrt(R2IJ);
-          RIJ = sel(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), mul(R2IJ, rinv), zero);
-          ih = rcp(HIJ);
-          q = mul(RIJ, ih);
-          s_den_inv = mul(ih, rinv);
-        }
-        const V sk = mul(bc(sigma), mul(ih, ih));
-        const M inside = _mm512_cmp_pd_mask(q, two, _CMP_LT_OQ);
-        const V t = sub(one, mul(half, q));
-        const V t2 = mul(t, t);
-        const V fq = mul(mul(t2, t2), add(mul(two, q), one));
-        const V dfq = mul(mul(mul(mul(m5, q), t), t), t);
-        const V WIJ = mul(sk, sel(inside, fq, zero));
-        const V dwdq = mul(sk, sel(inside, dfq, zero));
-        const M apart = _mm512_cmp_pd_mask(RIJ, tiny, _CMP_GT_OQ);
-        const V s = ARITH == EXACT ? div(dwdq, mul(HIJ, sel(apart, RIJ, one))) : mul(dwdq, s_den_inv);
-        const V DWIJ_f = sel(apart, s, zero);
-        const V D0 = mul(DWIJ_f, XIJ_0), D1 = mul(DWIJ_f, XIJ_1);
-        // the values the pair shares (eq11: hd, wr, 1 + R wr^4; eq12: rho_j - rho_i, negated for j)
-        const V hd = mul(HIJ, HIJ);  // dim == 2
-        const V wr = mul(mul(WIJ, hd), ival<RI>(DH, i));
-        const V ps2 = fma(mul(mul(mul(R, wr), wr), wr), wr, one);
-        const V rhoba = sub(rhoj, ival<RI>(RHO, i));
-        // i's terms (source j: vb = vb_j), in (a)'s order
-        {
-          const V vb = vbj, f = mul(vb, ps2);
-          const V nx0 = neg(mul(vb, XIJ_0)), nx1 = neg(mul(vb, XIJ_1));
-          const V g = mul(vb, rhoba);
-          const V nv0 = neg(mul(vb, VIJ_0)), nv1 = neg(mul(vb, VIJ_1));
-          V* a = iacc[r];
-          a[6] = _mm512_mask3_fmadd_pd(f, D0, a[6], in);
-          a[7] = _mm512_mask3_fmadd_pd(f, D1, a[7], in);
-          a[4] = _mm512_mask3_fmadd_pd(vb, D0, a[4], in);
-          a[5] = _mm512_mask3_fmadd_pd(vb, D1, a[5], in);
-          a[0] = _mm512_mask3_fmadd_pd(nx0, D0, a[0], in);
-          a[1] = _mm512_mask3_fmadd_pd(nx0, D1, a[1], in);
-          a[2] = _mm512_mask3_fmadd_pd(nx1, D0, a[2], in);
-          a[3] = _mm512_mask3_fmadd_pd(nx1, D1, a[3], in);
-          a[8] = _mm512_mask3_fmadd_pd(g, D0, a[8], in);
-          a[9] = _mm512_mask3_fmadd_pd(g, D1, a[9], in);
-          a[10] = _mm512_mask3_fmadd_pd(nv0, D0, a[10], in);
-          a[11] = _mm512_mask3_fmadd_pd(nv0, D1, a[11], in);
-          a[12] = _mm512_mask3_fmadd_pd(nv1, D0, a[12], in);
-          a[13] = _mm512_mask3_fmadd_pd(nv1, D1, a[13], in);
-        }
-        // j's terms (source i: vb = vb_i; XIJ_ji = -XIJ, DWIJ_ji = -DWIJ, VIJ_ji = -VIJ, rhoba
-        // negated, all exactly): fma(a, -D, c) = fnmadd(a, D, c); -(vb (-x)) = vb x.
-        {
-          const V vb = ival<RI>(VB, i), f = mul(vb, ps2);
-          const V px0 = mul(vb, XIJ_0), px1 = mul(vb, XIJ_1);
-          const V g = mul(vb, rhoba);  // vb (-rhoba) times -D: g D
-          const V pv0 = mul(vb, VIJ_0), pv1 = mul(vb, VIJ_1);
-          jacc[6] = _mm512_mask3_fnmadd_pd(f, D0, jacc[6], in);
-          jacc[7] = _mm512_mask3_fnmadd_pd(f, D1, jacc[7], in);
-          jacc[4] = _mm512_mask3_fnmadd_pd(vb, D0, jacc[4], in);
-          jacc[5] = _mm512_mask3_fnmadd_pd(vb, D1, jacc[5], in);
-          jacc[0] = _mm512_mask3_fnmadd_pd(px0, D0, jacc[0], in);
-          jacc[1] = _mm512_mask3_fnmadd_pd(px0, D1, jacc[1], in);
-          jacc[2] = _mm512_mask3_fnmadd_pd(px1, D0, jacc[2], in);
-          jacc[3] = _mm512_mask3_fnmadd_pd(px1, D1, jacc[3], in);
-          jacc[8] = _mm512_mask3_fmadd_pd(g, D0, jacc[8], in);
-          jacc[9] = _mm512_mask3_fmadd_pd(g, D1, jacc[9], in);
-          jacc[10] = _mm512_mask3_fnmadd_pd(pv0, D0, jacc[10], in);
-          jacc[11] = _mm512_mask3_fnmadd_pd(pv0, D1, jacc[11], in);
-          jacc[12] = _mm512_mask3_fnmadd_pd(pv1, D0, jacc[12], in);
-          jacc[13] = _mm512_mask3_fnmadd_pd(pv1, D1, jacc[13], in);
-        }
-      }
-      if (CJ == 8) {
-        for (int k = 0; k < NSS; ++k) _mm512_storeu_pd(SUM[k] + j0, add(_mm512_loadu_pd(SUM[k] + j0), jacc[k]));
-      } else {
-        for (int k = 0; k < NSS; ++k) {
-          const __m256d lo = _mm512_castpd512_pd256(jacc[k]), hi = _mm512_extractf64x4_pd(jacc[k], 1);
-          _mm256_storeu_pd(SUM[k] + j0, _mm256_add_pd(_mm256_loadu_pd(SUM[k] + j0), _mm256_add_pd(lo, hi)));
-        }
-      }
+      for (int r = 0; r < CI / RI; ++r) shift_register<RI, CJ, ARITH>(S, J, R, i0 + r * RI, j0, diagonal, iacc[r], jacc);
+      add_j_sums<CJ>(SUM, NSS, jacc, j0);
     }
-    for (int r = 0; r < CI / RI; ++r)
-      for (int k = 0; k < NSS; ++k) {
-        if (RI == 1) {
-          SUM[k][i0 + r] += _mm512_reduce_add_pd(iacc[r][k]);
-        } else {
-          SUM[k][i0 + 2 * r] += _mm512_mask_reduce_add_pd(0x0f, iacc[r][k]);
-          SUM[k][i0 + 2 * r + 1] += _mm512_mask_reduce_add_pd(0xf0, iacc[r][k]);
-        }
-      }
+    for (int r = 0; r < CI / RI; ++r) add_i_sums<RI>(SUM, NSS, iacc[r], i0 + r * RI);
   }
 }
 
@@ -1061,156 +1028,29 @@ template <int CI, int CJ, int ARITH>
 __attribute__((noinline)) void form_t_shift_r(Slots& S, const std::vector<std::uint32_t>& begin,
                                             const std::vector<std::uint32_t>& jl, const Eq11& eq11) {
   constexpr int RI = 8 / CJ;
-  const double sigma = Kernel::sigma;
-  const V one = bc(1.0), half = bc(0.5), two = bc(2.0), zero = _mm512_setzero_pd();
-  const V radius2 = bc(RADIUS2), tiny = bc(1e-12), m5 = bc(-5.0), R = bc(eq11.R);
-  const double *X = S.f[FX].data(), *Y = S.f[FY].data(), *U = S.f[FU].data(), *VV = S.f[FV].data();
-  const double *H = S.f[FH].data(), *RHO = S.f[FRHO].data(), *VB = S.f[FVB].data(), *DH = S.f[FDH].data();
+  const V zero = _mm512_setzero_pd(), R = bc(eq11.R);
   double* SUM[NSS];
   for (int k = 0; k < NSS; ++k) SUM[k] = S.ss[k].data();
-  const __m512i lane_i = RI == 1 ? _mm512_setzero_si512() : _mm512_set_epi64(1, 1, 1, 1, 0, 0, 0, 0);
-  const __m512i lane_j = CJ == 8 ? _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0) : _mm512_set_epi64(3, 2, 1, 0, 3, 2, 1, 0);
   const int nci = static_cast<int>(begin.size()) - 1;
   for (int ci = 0; ci < nci; ++ci) {
     const int i0 = ci * CI;
     if (begin[ci] == begin[ci + 1]) continue;
-    for (int rr = 0; rr < CI / RI; ++rr) {
-    V iacc1[NSS];
-    for (int k = 0; k < NSS; ++k) iacc1[k] = zero;
-    for (std::uint32_t e = begin[ci]; e < begin[ci + 1]; ++e) {
-      const int j0 = static_cast<int>(jl[e]) * CJ;
-      const V xj = jval<CJ>(X, j0), yj = jval<CJ>(Y, j0), uj = jval<CJ>(U, j0), vj = jval<CJ>(VV, j0);
-      const V hj = jval<CJ>(H, j0), rhoj = jval<CJ>(RHO, j0), vbj = jval<CJ>(VB, j0);
-      V jacc[NSS];
-      for (int k = 0; k < NSS; ++k) jacc[k] = zero;
-      const bool diagonal = j0 < i0 + CI && i0 < j0 + CJ;
-      {
-        const int r = rr;
-        const int i = i0 + r * RI;
-        const V XIJ_0 = sub(ival<RI>(X, i), xj), XIJ_1 = sub(ival<RI>(Y, i), yj);
-        const V R2IJ = add(mul(XIJ_0, XIJ_0), mul(XIJ_1, XIJ_1));
-        const V hi = ival<RI>(H, i);
-        const V hmax = _mm512_max_pd(hi, hj);
-        M in = _mm512_cmp_pd_mask(R2IJ, mul(mul(radius2, hmax), hmax), _CMP_NGE_UQ);
-        if (diagonal)
-          in &= _mm512_cmpgt_epi64_mask(_mm512_add_epi64(lane_j, _mm512_set1_epi64(j0)),
-                                        _mm512_add_epi64(lane_i, _mm512_set1_epi64(i)));
-#ifndef NO_REGSKIP
-        if (!in) continue;
-#endif
-        const V HIJ = mul(half, add(hi, hj));
-        const V VIJ_0 = sub(ival<RI>(U, i), uj), VIJ_1 = sub(ival<RI>(VV, i), vj);
-        V RIJ, ih, q, s_den_inv = zero;
-        if (ARITH == EXACT) {
-          RIJ = _mm512_sqrt_pd(R2IJ);
-          ih = div(one, HIJ);
-          q = div(RIJ, HIJ);
-        } else {
-          const V rinv = rsqrt(R2IJ);
-          RIJ = sel(_mm512_cmp_pd_mask(R2IJ, zero, _CMP_GT_OQ), mul(R2IJ, rinv), zero);
-          ih = rcp(HIJ);
-          q = mul(RIJ, ih);
-          s_den_inv = mul(ih, rinv);
-        }
-        const V sk = mul(bc(sigma), mul(ih, ih));
-        const M inside = _mm512_cmp_pd_mask(q, two, _CMP_LT_OQ);
-        const V t = sub(one, mul(half, q));
-        const V t2 = mul(t, t);
-        const V fq = mul(mul(t2, t2), add(mul(two, q), one));
-        const V dfq = mul(mul(mul(mul(m5, q), t), t), t);
-        const V WIJ = mul(sk, sel(inside, fq, zero));
-        const V dwdq = mul(sk, sel(inside, dfq, zero));
-        const M apart = _mm512_cmp_pd_mask(RIJ, tiny, _CMP_GT_OQ);
-        const V s = ARITH == EXACT ? div(dwdq, mul(HIJ, sel(apart, RIJ, one))) : mul(dwdq, s_den_inv);
-        const V DWIJ_f = sel(apart, s, zero);
-        const V D0 = mul(DWIJ_f, XIJ_0), D1 = mul(DWIJ_f, XIJ_1);
-        // the values the pair shares (eq11: hd, wr, 1 + R wr^4; eq12: rho_j - rho_i, negated for j)
-        const V hd = mul(HIJ, HIJ);  // dim == 2
-        const V wr = mul(mul(WIJ, hd), ival<RI>(DH, i));
-        const V ps2 = fma(mul(mul(mul(R, wr), wr), wr), wr, one);
-        const V rhoba = sub(rhoj, ival<RI>(RHO, i));
-        // i's terms (source j: vb = vb_j), in (a)'s order
-        {
-          const V vb = vbj, f = mul(vb, ps2);
-          const V nx0 = neg(mul(vb, XIJ_0)), nx1 = neg(mul(vb, XIJ_1));
-          const V g = mul(vb, rhoba);
-          const V nv0 = neg(mul(vb, VIJ_0)), nv1 = neg(mul(vb, VIJ_1));
-          V* a = iacc1;
-          a[6] = _mm512_mask3_fmadd_pd(f, D0, a[6], in);
-          a[7] = _mm512_mask3_fmadd_pd(f, D1, a[7], in);
-          a[4] = _mm512_mask3_fmadd_pd(vb, D0, a[4], in);
-          a[5] = _mm512_mask3_fmadd_pd(vb, D1, a[5], in);
-          a[0] = _mm512_mask3_fmadd_pd(nx0, D0, a[0], in);
-          a[1] = _mm512_mask3_fmadd_pd(nx0, D1, a[1], in);
-          a[2] = _mm512_mask3_fmadd_pd(nx1, D0, a[2], in);
-          a[3] = _mm512_mask3_fmadd_pd(nx1, D1, a[3], in);
-          a[8] = _mm512_mask3_fmadd_pd(g, D0, a[8], in);
-          a[9] = _mm512_mask3_fmadd_pd(g, D1, a[9], in);
-          a[10] = _mm512_mask3_fmadd_pd(nv0, D0, a[10], in);
-          a[11] = _mm512_mask3_fmadd_pd(nv0, D1, a[11], in);
-          a[12] = _mm512_mask3_fmadd_pd(nv1, D0, a[12], in);
-          a[13] = _mm512_mask3_fmadd_pd(nv1, D1, a[13], in);
-        }
-        // j's terms (source i: vb = vb_i; XIJ_ji = -XIJ, DWIJ_ji = -DWIJ, VIJ_ji = -VIJ, rhoba
-        // negated, all exactly): fma(a, -D, c) = fnmadd(a, D, c); -(vb (-x)) = vb x.
-        {
-          const V vb = ival<RI>(VB, i), f = mul(vb, ps2);
-          const V px0 = mul(vb, XIJ_0), px1 = mul(vb, XIJ_1);
-          const V g = mul(vb, rhoba);  // vb (-rhoba) times -D: g D
-          const V pv0 = mul(vb, VIJ_0), pv1 = mul(vb, VIJ_1);
-          jacc[6] = _mm512_mask3_fnmadd_pd(f, D0, jacc[6], in);
-          jacc[7] = _mm512_mask3_fnmadd_pd(f, D1, jacc[7], in);
-          jacc[4] = _mm512_mask3_fnmadd_pd(vb, D0, jacc[4], in);
-          jacc[5] = _mm512_mask3_fnmadd_pd(vb, D1, jacc[5], in);
-          jacc[0] = _mm512_mask3_fnmadd_pd(px0, D0, jacc[0], in);
-          jacc[1] = _mm512_mask3_fnmadd_pd(px0, D1, jacc[1], in);
-          jacc[2] = _mm512_mask3_fnmadd_pd(px1, D0, jacc[2], in);
-          jacc[3] = _mm512_mask3_fnmadd_pd(px1, D1, jacc[3], in);
-          jacc[8] = _mm512_mask3_fmadd_pd(g, D0, jacc[8], in);
-          jacc[9] = _mm512_mask3_fmadd_pd(g, D1, jacc[9], in);
-          jacc[10] = _mm512_mask3_fnmadd_pd(pv0, D0, jacc[10], in);
-          jacc[11] = _mm512_mask3_fnmadd_pd(pv0, D1, jacc[11], in);
-          jacc[12] = _mm512_mask3_fnmadd_pd(pv1, D0, jacc[12], in);
-          jacc[13] = _mm512_mask3_fnmadd_pd(pv1, D1, jacc[13], in);
-        }
+    for (int r = 0; r < CI / RI; ++r) {
+      V iacc[NSS];
+      for (int k = 0; k < NSS; ++k) iacc[k] = zero;
+      for (std::uint32_t e = begin[ci]; e < begin[ci + 1]; ++e) {
+        const int j0 = static_cast<int>(jl[e]) * CJ;
+        V jacc[NSS];
+        for (int k = 0; k < NSS; ++k) jacc[k] = zero;
+        const bool diagonal = j0 < i0 + CI && i0 < j0 + CJ;
+        if (shift_register<RI, CJ, ARITH>(S, shift_j<CJ>(S, j0), R, i0 + r * RI, j0, diagonal, iacc, jacc))
+          add_j_sums<CJ>(SUM, NSS, jacc, j0);
       }
-      if (CJ == 8) {
-        for (int k = 0; k < NSS; ++k) _mm512_storeu_pd(SUM[k] + j0, add(_mm512_loadu_pd(SUM[k] + j0), jacc[k]));
-      } else {
-        for (int k = 0; k < NSS; ++k) {
-          const __m256d lo = _mm512_castpd512_pd256(jacc[k]), hi = _mm512_extractf64x4_pd(jacc[k], 1);
-          _mm256_storeu_pd(SUM[k] + j0, _mm256_add_pd(_mm256_loadu_pd(SUM[k] + j0), _mm256_add_pd(lo, hi)));
-        }
-      }
+      add_i_sums<RI>(SUM, NSS, iacc, i0 + r * RI);
     }
-    for (int k = 0; k < NSS; ++k) {
-      if (RI == 1) {
-        SUM[k][i0 + rr] += _mm512_reduce_add_pd(iacc1[k]);
-      } else {
-        SUM[k][i0 + 2 * rr] += _mm512_mask_reduce_add_pd(0x0f, iacc1[k]);
-        SUM[k][i0 + 2 * rr + 1] += _mm512_mask_reduce_add_pd(0xf0, iacc1[k]);
-      }
-    }
-    }  // rr
   }
 }
 
-// The core's clock while it runs 512-bit FMAs (a chain of dependent vfmadd, 4 cycles each).
-double clock_estimate() {
-  const long n = 20000000;
-  __m512d x = _mm512_set1_pd(1.0);
-  const __m512d b = _mm512_set1_pd(0.999999), c = _mm512_set1_pd(1e-9);
-  double best = 1e30;
-  for (int r = 0; r < 3; ++r) {
-    const double t0 = cpu_now();
-    for (long i = 0; i < n; ++i) {
-      x = _mm512_fmadd_pd(x, b, c);
-      __asm__ volatile("" : "+v"(x));
-    }
-    best = std::min(best, cpu_now() - t0);
-  }
-  return _mm512_reduce_add_pd(x) > 0 ? 4.0 * n / best : 0.0;
-}
 #endif  // __AVX512F__
 
 // The water column of the dam break (a lattice, jittered) or a snapshot from a file.
@@ -1272,11 +1112,6 @@ Fluid make_fluid(const std::string& path, int nx, int ny, double dx, double hdx,
     FourtakasDensityDiffusion_initialize(i, 0.0, 0.0, eq8.B, f.bpinv.data(), f.p.data(), f.rho.data(), f.rhoeos.data());
   f.zero_sums();
   return f;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
 }  // namespace
@@ -1606,7 +1441,7 @@ int main(int argc, char** argv) {
       }
     }
   }
-  const double clock = clock_estimate();
+  const double clock = clock_estimate(20000000);
   for (int pass = 0; pass < 3; ++pass)
     if (pass_used[pass])
       std::printf("per evaluation besides the tiles, %s: width 4 layout %.2f us (positions, %d fields, boxes, pruning, slot sums"
