@@ -78,7 +78,7 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
 
 import plots  # noqa: E402  (tests/validation/plots.py)
 from metrics_csv import metrics_file, read_metrics, row_at  # noqa: E402
-from snapshots import (argument_parser, read_fluid, report_failures,  # noqa: E402
+from snapshots import (FluidCount, argument_parser, read_fluid, report_failures,  # noqa: E402
                        snapshots)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -150,7 +150,7 @@ def main():
     failures = []
     snaps = []   # (t, x, y, u, v)
     hist = []    # (t, kinetic energy, max speed)
-    n0 = mass0 = None
+    count = FluidCount()
     for path in files:
         name = os.path.basename(path)
         with h5py.File(path, "r") as f:
@@ -158,11 +158,7 @@ def main():
             if got is None:
                 return 2
             t, (x, y, u, v, m) = got
-        if n0 is None:
-            n0, mass0 = len(x), float(np.sum(m))
-        if len(x) != n0 or float(np.sum(m)) != mass0:
-            failures.append("%s: %d fluid particles of mass %.17g, initially %d of %.17g"
-                            % (name, len(x), float(np.sum(m)), n0, mass0))
+        count.check(name, m, failures)
         out = (x < 0) | (x > L) | (y < 0) | (y > L)
         if np.any(out):
             failures.append("t = %.3f: %d fluid particles outside the cavity"
@@ -171,6 +167,7 @@ def main():
                      float(np.max(np.hypot(u, v))) if len(u) else 0.0))
         snaps.append((t, x, y, u, v))
 
+    n0 = count.n0
     nx = int(round(np.sqrt(n0)))
     dx = L / nx
     h = dx          # examples/cavity.sph: h = hdx dx, hdx = 1

@@ -101,7 +101,7 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
 
 import plots  # noqa: E402  (tests/validation/plots.py)
 from metrics_csv import metrics_file, read_metrics, row_at  # noqa: E402  (metrics_csv.py)
-from snapshots import (argument_parser, read_fluid, report_failures,  # noqa: E402
+from snapshots import (FluidCount, argument_parser, read_fluid, report_failures,  # noqa: E402
                        snapshots)
 
 # In units of d^2 / nu (= 1 s in Morris's set-up).
@@ -227,7 +227,7 @@ def main():
             return 2
 
     snaps = []  # (t, y, u)
-    n0 = mass0 = None
+    count = FluidCount()
     ny = None
     for path in files:
         name = os.path.basename(path)
@@ -236,12 +236,9 @@ def main():
             if got is None:
                 return 2
             t, (_, y, u, v, m) = got
-        if n0 is None:
-            n0, mass0 = len(y), float(np.sum(m))
+        if ny is None:
             ny = len(np.unique(np.round(y / d * 1e6)))
-        if len(y) != n0 or float(np.sum(m)) != mass0:
-            failures.append("%s: %d fluid particles of mass %.17g, initially %d of %.17g"
-                            % (name, len(y), float(np.sum(m)), n0, mass0))
+        count.check(name, m, failures)
         out = (y <= 0) | (y >= d)
         if np.any(out):
             failures.append("t = %.4f: %d fluid particles outside the channel"
@@ -273,7 +270,7 @@ def main():
         chosen.append(len(snaps) - 1)
 
     print("%s flow: %d snapshots in %s, %d fluid particles (ny = %d rows), t = %.4g s"
-          % (flow, len(files), args.outdir, n0, ny, tf))
+          % (flow, len(files), args.outdir, count.n0, ny, tf))
     print("u_ref = %.4g m/s (%s); Re = %.4g" % (uref, "u_max" if flow == "poiseuille" else "U",
                                                  uref * d / nu))
     print("series self-test: |u(t = 0)| <= %.1e u_ref, |u(t -> inf) - u_s| <= %.1e u_ref, "

@@ -68,7 +68,7 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
 
 import plots  # noqa: E402  (tests/validation/plots.py)
 from metrics_csv import read_metrics, row_at  # noqa: E402  (metrics_csv.py)
-from snapshots import (argument_parser, read_fluid, report_failures,  # noqa: E402
+from snapshots import (FluidCount, argument_parser, read_fluid, report_failures,  # noqa: E402
                        snapshots)
 
 
@@ -122,7 +122,8 @@ def main():
 
     failures = []
     rows = []
-    n0 = mass0 = y20 = None
+    count = FluidCount()
+    mass0 = y20 = None
     first = last = None
     for path in files:
         name = os.path.basename(path)
@@ -135,15 +136,11 @@ def main():
         if k is None:
             sys.stderr.write("elliptical_drop.py: no row of the metric file at t = %.17g\n" % t)
             return 2
-        if n0 is None:
-            n0, mass0, y20 = len(x), float(np.sum(m)), metrics["y2"][k]
+        if first is None:
+            y20 = metrics["y2"][k]
             first = (t, x, y)
-        if len(x) != n0:
-            failures.append("%s: %d particles, the first snapshot has %d" % (name, len(x), n0))
-        mass = float(np.sum(m))
-        if mass != mass0:
-            failures.append("%s: total mass %.17g, initially %.17g (not conserved)"
-                            % (name, mass, mass0))
+        mass = count.check(name, m, failures)
+        mass0 = count.mass0
         drho = metrics["drho"][k]
         if not drho <= args.rho_tol:
             failures.append("%s: density deviates by %.2f%% from rho0 (tolerance %.0f%%)"
@@ -165,7 +162,7 @@ def main():
                             "computed from the snapshot, %.17g" % (t, what, ours, theirs))
 
     print("elliptical drop vs exact solution (Monaghan 1994): %d snapshots in %s, %d particles"
-          % (len(files), args.outdir, n0))
+          % (len(files), args.outdir, count.n0))
     print("b = semi-major axis: exact (RK4 of the ODEs), tip = max |y|, moment = "
           "sqrt(<y^2>/<y^2>_0)")
     print()

@@ -84,7 +84,7 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.exit(2)
 
 import plots  # noqa: E402  (tests/validation/plots.py)
-from snapshots import (argument_parser, lattice_spacing, read_fluid,  # noqa: E402
+from snapshots import (FluidCount, argument_parser, lattice_spacing, read_fluid,  # noqa: E402
                        report_failures, snapshots)
 from metrics_csv import read_metrics, row_at  # noqa: E402  (metrics_csv.py)
 
@@ -130,7 +130,8 @@ def main():
     vref = np.sqrt(g * H)
     failures = []
     hist = []
-    n0 = mass0 = dx = None
+    count = FluidCount()
+    dx = None
     last = None
     settled = []  # (t, max speed / sqrt(gH), centre-line pressure error) for t >= settle
 
@@ -162,15 +163,9 @@ def main():
                     return 2
                 dens = (np.asarray(fl["rho"][()], dtype=float), float(consts["rho_rest"][0]),
                         float(consts["rhoerr"][0]) if "rhoerr" in consts else float("nan"))
-        if n0 is None:
-            n0, mass0 = len(x), float(np.sum(m))
+        if dx is None:
             dx = lattice_spacing((x, y))
-        if len(x) != n0:
-            failures.append("%s: %d fluid particles, the first snapshot has %d"
-                            % (name, len(x), n0))
-        if float(np.sum(m)) != mass0:
-            failures.append("%s: fluid mass %.17g, initially %.17g (not conserved)"
-                            % (name, float(np.sum(m)), mass0))
+        count.check(name, m, failures)
         out = (y < 0) | (x < 0) | (x > W)
         if np.any(out):
             failures.append("t = %.3f: %d fluid particles in or beyond the walls"
@@ -196,7 +191,7 @@ def main():
                             "computed from the snapshot, %.17g" % (t, what, ours, theirs))
 
     print("hydrostatic tank: %d snapshots in %s, %d fluid particles, dx = %.4g"
-          % (len(files), args.outdir, n0, dx))
+          % (len(files), args.outdir, count.n0, dx))
     print("H = %g m, g = %g m/s^2, rho0 g H = %.6g Pa, sqrt(g H) = %.4g m/s"
           % (H, g, pref, vref))
     print()

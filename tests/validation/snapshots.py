@@ -4,6 +4,7 @@ particle arrays and the fluid group of one snapshot, the checks every script mak
 (required datasets present, no non-finite values), and the report of the failures."""
 import argparse
 import glob
+import math
 import os
 import re
 import sys
@@ -149,6 +150,29 @@ def read_series(directory, keys, who, at_least=2):
             return None
         series.append((name, got[0], got[1]))
     return series, failures
+
+
+class FluidCount:
+    """The fluid's particle count and total mass at the first snapshot checked, and the check
+    of each snapshot against them: the same count, and the same mass to the bit (summed with
+    math.fsum, which is exact, so independent of the particles' order)."""
+
+    def __init__(self):
+        self.n0 = self.mass0 = None
+
+    def check(self, name, m, failures):
+        """Appends to `failures` a line where snapshot `name` (the fluid's masses m) has another
+        particle count or total mass than the first; returns its total mass."""
+        mass = math.fsum(m)
+        if self.n0 is None:
+            self.n0, self.mass0 = len(m), mass
+        if len(m) != self.n0:
+            failures.append("%s: %d fluid particles, the first snapshot has %d"
+                            % (name, len(m), self.n0))
+        if mass != self.mass0:
+            failures.append("%s: fluid mass %.17g, initially %.17g (not conserved)"
+                            % (name, mass, self.mass0))
+        return mass
 
 
 def check_conserved(what, t, value, start, tol, failures):

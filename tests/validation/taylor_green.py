@@ -66,7 +66,6 @@ Usage: taylor_green.py OUTPUT_DIR [--re 100] [--decay-tol 0.01] [--l1-tol 0.01] 
                        [--plot out.png]
 """
 
-import math
 import os
 import sys
 
@@ -78,7 +77,7 @@ except ImportError as exc:  # pragma: no cover - environment problem, not a test
     sys.exit(2)
 
 import plots  # noqa: E402  (tests/validation/plots.py)
-from snapshots import argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
+from snapshots import FluidCount, argument_parser, read_fluid, snapshots  # noqa: E402  (snapshots.py)
 from metrics_csv import read_metrics, row_at  # noqa: E402  (metrics_csv.py)
 
 
@@ -130,7 +129,7 @@ def main():
 
     failures = []
     rows = []
-    n0 = mass0 = None
+    count = FluidCount()
     last = None
     for path in files:
         name = os.path.basename(path)
@@ -139,13 +138,7 @@ def main():
             if got is None:
                 return 2
             t, (x, y, u, v, m) = got
-        if n0 is None:
-            n0, mass0 = len(x), math.fsum(m)
-        if len(x) != n0:
-            failures.append("%s: %d particles, the first snapshot has %d" % (name, len(x), n0))
-        # math.fsum is exact, so the sum does not depend on the particle order.
-        if math.fsum(m) != mass0:
-            failures.append("%s: total mass %.17g, initially %.17g" % (name, math.fsum(m), mass0))
+        count.check(name, m, failures)
         outside = int(np.count_nonzero((x < 0) | (x >= args.L) | (y < 0) | (y >= args.L)))
         if outside:
             failures.append("%s: %d particles outside the periodic box [0, %g)^2"
@@ -177,7 +170,7 @@ def main():
         return 1
 
     print("Taylor-Green vortex, Re = %g, vs the exact solution: %d snapshots in %s, "
-          "%d particles" % (args.re, len(files), args.outdir, n0))
+          "%d particles" % (args.re, len(files), args.outdir, count.n0))
     print("decay error = max|v| / (U exp(-8 pi^2 t / Re)) - 1;  L1 = sum| |v| - |v_e| | / "
           "sum |v_e|")
     print()
