@@ -31,7 +31,7 @@ import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from common import (ROOT, DEFAULT_DX, cpu_model, remove_tmp, run,  # noqa: E402
-                    serial_env)
+                    serial_env, timing_line)
 
 TIMING_RE = re.compile(r"timing: steps=(\d+) particles=(\d+) wall_s=([0-9.eE+-]+) "
                        r"us_per_particle_step=([0-9.eE+-]+) backend=(\w+) threads=(\d+) "
@@ -76,10 +76,7 @@ def timing(exe, backend, dx, steps, repeat, threads, device):
     best = None
     for _ in range(repeat):
         _, out = run(cmd, env=env)
-        m = TIMING_RE.search(out)
-        if not m:
-            sys.stderr.write("no 'timing:' line in the output of %s:\n%s\n" % (cmd, out[-2000:]))
-            raise SystemExit(1)
+        m = timing_line(out, cmd, TIMING_RE)
         r = dict(particles=int(m.group(2)), steps=int(m.group(1)), us=float(m.group(4)),
                  precision=m.group(7), nnps=float(m.group(9)) if m.group(9) else None)
         # (nnps: the share of the time loop in the neighbour search)

@@ -67,6 +67,57 @@ def run(cmd, env=None, cwd=None):
     return wall, p.stdout
 
 
+# The solver's `--timing` line: steps (1), particles (2), the time loop's wall seconds (3);
+# us_per_particle_step and the rest follow (a script's own pattern reads them).
+TIMING_RE = re.compile(r"timing: steps=(\d+) particles=(\d+) wall_s=([0-9.eE+-]+)")
+
+
+def timing_line(out, what, pattern=TIMING_RE):
+    """The match of the solver's `--timing` line in its output `out`; exits (naming `what`, the
+    command) where there is none."""
+    m = pattern.search(out)
+    if not m:
+        sys.stderr.write("no 'timing:' line in the output of %s:\n%s\n" % (what, out[-2000:]))
+        raise SystemExit(1)
+    return m
+
+
+def require_sphc(sphc, hint="pass --sphc, or --skip-sphc"):
+    """False (and a line on stderr) where `sphc` is not an executable."""
+    if os.access(sphc, os.X_OK):
+        return True
+    sys.stderr.write("no sphc at %s (build it, or %s)\n" % (sphc, hint))
+    return False
+
+
+def pysph_seconds(out, what):
+    """PySPH's "Setup took" (what = "Setup") or "Run took" ("Run") seconds in its output, or
+    None."""
+    m = re.search(r"%s took: ([0-9.eE+-]+) secs" % what, out)
+    return float(m.group(1)) if m else None
+
+
+def pysph_timing(out, outdir):
+    """PySPH's figures of a run: set-up and run seconds (its output), steps (the calls of
+    Integrator.stage1 in outdir's profile_info.csv), particles ("Total: N", else "nfluid = N";
+    None where neither). Exits where set-up, run or steps is missing."""
+    setup, runt = pysph_seconds(out, "Setup"), pysph_seconds(out, "Run")
+    total = re.search(r"Total: (\d+)", out) or re.search(r"nfluid = (\d+)", out)
+    steps = None
+    prof = os.path.join(outdir, "profile_info.csv")
+    if os.path.exists(prof):
+        with open(prof) as f:
+            for line in f:
+                cells = line.strip().split(",")
+                if len(cells) == 5 and cells[2] == "Integrator.stage1":
+                    steps = int(cells[3])
+    if setup is None or runt is None or not steps:
+        sys.stderr.write("could not read PySPH's timing from its output:\n%s\n" % out[-3000:])
+        raise SystemExit(1)
+    return dict(setup=setup, run=runt, steps=steps,
+                particles=int(total.group(1)) if total else None)
+
+
 def serial_env(extra=None):
     env = dict(os.environ)
     env["OMP_NUM_THREADS"] = "1"

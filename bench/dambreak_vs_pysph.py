@@ -38,8 +38,8 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import (ROOT, DEFAULT_DX, argument_parser, cpu_model, fmt, run,  # noqa: E402,F401
-                    remove_tmp, scale_dambreak, serial_env)
+from common import (ROOT, DEFAULT_DX, argument_parser, cpu_model, fmt, pysph_timing,  # noqa: E402,F401
+                    remove_tmp, require_sphc, run, scale_dambreak, serial_env, timing_line)
 
 
 def pysph_driver(argv):
@@ -82,10 +82,7 @@ def sphc_timing(exe, dx, steps, repeat, threads=None):
             cmd += ["--threads", str(threads)]
             env["OMP_NUM_THREADS"] = str(threads)
         _, out = run(cmd, env=env)
-        m = TIMING_RE.search(out)
-        if not m:
-            sys.stderr.write("no 'timing:' line in the output of %s:\n%s\n" % (cmd, out[-2000:]))
-            raise SystemExit(1)
+        m = timing_line(out, cmd, TIMING_RE)
         r = dict(steps=int(m.group(1)), particles=int(m.group(2)), wall=float(m.group(3)),
                  us=float(m.group(4)))
         if best is None or r["us"] < best["us"]:
@@ -106,22 +103,11 @@ def pysph_run(python, dx, steps, outdir, home=None, threads=None):
         cmd.append("--openmp")
         env["OMP_NUM_THREADS"] = str(threads)
     wall, out = run(cmd, env=env)
-    setup = re.search(r"Setup took: ([0-9.eE+-]+) secs", out)
-    runt = re.search(r"Run took: ([0-9.eE+-]+) secs", out)
-    total = re.search(r"Total: (\d+)", out)
-    nsteps = None
-    prof = os.path.join(outdir, "profile_info.csv")
-    if os.path.exists(prof):
-        with open(prof) as f:
-            for line in f:
-                cells = line.strip().split(",")
-                if len(cells) == 5 and cells[2] == "Integrator.stage1":
-                    nsteps = int(cells[3])
-    if not (setup and runt and total and nsteps):
-        sys.stderr.write("could not read PySPH's timing from its output:\n%s\n" % out[-3000:])
+    r = pysph_timing(out, outdir)
+    if r["particles"] is None:
+        sys.stderr.write("no particle count in PySPH's output:\n%s\n" % out[-3000:])
         raise SystemExit(1)
-    r = dict(setup=float(setup.group(1)), run=float(runt.group(1)), steps=nsteps,
-             particles=int(total.group(1)), wall=wall)
+    r["wall"] = wall
     r["us"] = r["run"] / (r["steps"] * r["particles"]) * 1e6
     return r
 
@@ -181,9 +167,7 @@ def main():
     p = {}
     try:
         if not args.skip_sphc:
-            if not os.access(args.sphc, os.X_OK):
-                sys.stderr.write("no sphc at %s (build it, or pass --sphc, or --skip-sphc)\n"
-                                 % args.sphc)
+            if not require_sphc(args.sphc):
                 return 1
             print("sphc: compiling examples/dambreak.sph (cold, then cached) ...", flush=True)
             exe, s["cold"], s["cached"] = sphc_compile(args.sphc, tmp)

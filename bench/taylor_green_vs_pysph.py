@@ -46,8 +46,8 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "validation"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import (argument_parser, cpu_model, fmt, load_average, remove_tmp,  # noqa: E402
-                    run, serial_env)
+from common import (argument_parser, cpu_model, fmt, load_average, pysph_seconds,  # noqa: E402
+                    remove_tmp, require_sphc, run, serial_env, timing_line)
 
 
 def pysph_driver(argv):
@@ -79,7 +79,6 @@ def errors(x, y, u, v, t):
 
 # ---- sphc ---------------------------------------------------------------------------------
 
-TIMING_RE = re.compile(r"timing: steps=(\d+) particles=(\d+) wall_s=([0-9.eE+-]+)")
 
 
 def sphc_all(sphc, tmp, nx, tf):
@@ -93,10 +92,7 @@ def sphc_all(sphc, tmp, nx, tf):
     wall, text = run([exe, "--set", "nx=%d" % nx, "--tf", repr(tf), "--output-every", repr(tf),
                       "--timing", "--quiet", "-d", out], env=env)
     cpu = run.cpu
-    m = TIMING_RE.search(text)
-    if not m:
-        sys.stderr.write("no 'timing:' line in the solver's output:\n%s\n" % text[-2000:])
-        raise SystemExit(1)
+    m = timing_line(text, "the solver")
     with h5py.File(last_file(out, "*.h5"), "r") as f:
         t = float(f.attrs["t"])
         g = f["fluid"]
@@ -119,13 +115,13 @@ def pysph_all(python, tmp, nx, tf):
 
     # One step with the empty cache: the set-up time (Cython generation and compilation).
     _, text = run(cmd(os.path.join(tmp, "pysph-cold"), ["--max-steps", "1"]), env=env)
-    setup = re.search(r"Setup took: ([0-9.eE+-]+) secs", text)
+    setup = pysph_seconds(text, "Setup")
     # The run, with the cache now warm (its CPU time is then nearly all the time loop's).
     out = os.path.join(tmp, "pysph-out")
     wall, text = run(cmd(out, ["--tf", repr(tf)]), env=env)
     cpu = run.cpu
-    runt = re.search(r"Run took: ([0-9.eE+-]+) secs", text)
-    if not (setup and runt):
+    runt = pysph_seconds(text, "Run")
+    if setup is None or runt is None:
         sys.stderr.write("could not read PySPH's timing from its output:\n%s\n" % text[-3000:])
         raise SystemExit(1)
     # Read PySPH's last state with PySPH's own loader, in its Python.
@@ -140,7 +136,7 @@ def pysph_all(python, tmp, nx, tf):
     import numpy as np
     d = np.load(npz)
     decay, l1 = errors(d["x"], d["y"], d["u"], d["v"], float(d["t"]))
-    return dict(setup=float(setup.group(1)), run=float(runt.group(1)), wall=wall, cpu=cpu,
+    return dict(setup=setup, run=runt, wall=wall, cpu=cpu,
                 steps=int(d["count"]), particles=len(d["x"]), t=float(d["t"]), decay=decay,
                 l1=l1)
 
@@ -161,9 +157,7 @@ def main():
     s = p = None
     try:
         if not args.skip_sphc:
-            if not os.access(args.sphc, os.X_OK):
-                sys.stderr.write("no sphc at %s (build it, or pass --sphc, or --skip-sphc)\n"
-                                 % args.sphc)
+            if not require_sphc(args.sphc):
                 return 1
             print("sphc: compiling examples/taylor_green.sph -D scheme=edac, running nx = %d "
                   "to t = %g ..." % (args.nx, args.tf), flush=True)

@@ -48,7 +48,6 @@ stops after N steps; accuracy then not judged).
 """
 
 import os
-import re
 import sys
 import tempfile
 
@@ -56,12 +55,11 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "tests", "validation"))
 sys.path.insert(0, HERE)
-from common import (argument_parser, cpu_model, fmt, load_average, remove_tmp,  # noqa: E402
-                    run)
+from common import (argument_parser, cpu_model, fmt, load_average, pysph_timing,  # noqa: E402
+                    remove_tmp, require_sphc, run, timing_line)
 import dambreak_vs_pysph  # noqa: E402
 import taylor_green_vs_pysph  # noqa: E402
 
-TIMING_RE = re.compile(r"timing: steps=(\d+) particles=(\d+) wall_s=([0-9.eE+-]+)")
 
 
 def pysph_driver(argv):
@@ -235,10 +233,7 @@ def sphc_run(args, case, exe, threads, outdir, max_steps=None):
             cmd += ["--max-steps", str(args.max_steps)]
     wall, out = run(cmd, env=env)
     cpu = run.cpu
-    m = TIMING_RE.search(out)
-    if not m:
-        sys.stderr.write("no 'timing:' line in the output of %s:\n%s\n" % (cmd, out[-2000:]))
-        raise SystemExit(1)
+    m = timing_line(out, cmd)
     return dict(loop=float(m.group(3)), steps=int(m.group(1)), particles=int(m.group(2)),
                 wall=wall, cpu=cpu)
 
@@ -258,22 +253,9 @@ def pysph_run(args, case, threads, outdir, home, max_steps=None):
             cmd += ["--max-steps", str(args.max_steps)]
     wall, out = run(cmd, env=env)
     cpu = run.cpu
-    setup = re.search(r"Setup took: ([0-9.eE+-]+) secs", out)
-    runt = re.search(r"Run took: ([0-9.eE+-]+) secs", out)
-    total = re.search(r"Total: (\d+)", out) or re.search(r"nfluid = (\d+)", out)
-    steps = None
-    prof = os.path.join(outdir, "profile_info.csv")
-    if os.path.exists(prof):
-        with open(prof) as f:
-            for line in f:
-                cells = line.strip().split(",")
-                if len(cells) == 5 and cells[2] == "Integrator.stage1":
-                    steps = int(cells[3])
-    if not (setup and runt and steps):
-        sys.stderr.write("could not read PySPH's timing from its output:\n%s\n" % out[-3000:])
-        raise SystemExit(1)
-    return dict(setup=float(setup.group(1)), loop=float(runt.group(1)), steps=steps,
-                particles=int(total.group(1)) if total else None, wall=wall, cpu=cpu)
+    r = pysph_timing(out, outdir)
+    return dict(setup=r["setup"], loop=r["run"], steps=r["steps"], particles=r["particles"],
+                wall=wall, cpu=cpu)
 
 
 def run_case(args, case, tmp, home):
@@ -432,8 +414,7 @@ def main():
             cases.append(tg_case(nx_tg, tf_tg))
         else:
             ap.error("unknown case %s (dambreak, dambreak-pysph-numerics, cube, tg)" % c)
-    if not args.skip_sphc and not os.access(args.sphc, os.X_OK):
-        sys.stderr.write("no sphc at %s (build it, or pass --sphc)\n" % args.sphc)
+    if not args.skip_sphc and not require_sphc(args.sphc, "pass --sphc"):
         return 1
 
     load0 = load_average()
