@@ -25,6 +25,24 @@ import tempfile
 
 PIECES = ["dvalues", "hmax", "layout", "gpos", "boxes", "outer", "prune", "gathers", "tiles", "add"]
 
+# The lines of a tile pass that end a piece: the piece's timer stops after such a line (ENDS_AFTER)
+# or before it (ENDS_BEFORE). The layout (its rebuilds counted) and the sums added back (after the
+# last add_slots) are instrumented in instrument() itself.
+ENDS_AFTER = [
+    ("sphc::ClusterLayout& cl_layout =", "dvalues"),
+    ("for (int i = 0; i < n; ++i) cl_hmax", "hmax"),
+    ("sphc::gather_positions(", "gpos"),
+    ("sphc::gather_positions_boxes(", "gpos"),
+    ("sphc::update_boxes(", "boxes"),
+    ("if (verlet_build) sphc::build_cluster_pairs(", "outer"),
+    ("sphc::prune_cluster_pairs(", "prune"),
+]
+ENDS_BEFORE = [
+    # the copies (and, since stop 39, the hoisted values in slot order) end here
+    ("#if defined(__GNUC__) && !defined(__clang__)", "gathers"),
+    ("// The slot sums onto the particles' sums", "tiles"),
+]
+
 PRELUDE = r"""
 #include <time.h>
 #include <cstdio>
@@ -75,42 +93,19 @@ def instrument(src):
             in_pass = True
             n_passes += 1
             continue
-        if in_pass and s.startswith("sphc::ClusterLayout& cl_layout ="):
-            out.append(line)
-            out.append(lap("dvalues"))
-            continue
-        if in_pass and s.startswith("for (int i = 0; i < n; ++i) cl_hmax"):
-            out.append(line)
-            out.append(lap("hmax"))
-            continue
         if in_pass and s.startswith("if (verlet_build) sphc::build_cluster_layout("):
             out.append(ind + "if (verlet_build) ++sphc_tp::acc.builds;")
             out.append(line)
             out.append(lap("layout"))
             continue
-        if in_pass and (s.startswith("sphc::gather_positions(") or s.startswith("sphc::gather_positions_boxes(")):
+        ends = in_pass and [p for start, p in ENDS_AFTER if s.startswith(start)]
+        if ends:
             out.append(line)
-            out.append(lap("gpos"))
+            out.append(lap(ends[0]))
             continue
-        if in_pass and s.startswith("sphc::update_boxes("):
-            out.append(line)
-            out.append(lap("boxes"))
-            continue
-        if in_pass and s.startswith("if (verlet_build) sphc::build_cluster_pairs("):
-            out.append(line)
-            out.append(lap("outer"))
-            continue
-        if in_pass and s.startswith("sphc::prune_cluster_pairs("):
-            out.append(line)
-            out.append(lap("prune"))
-            continue
-        if in_pass and s.startswith("#if defined(__GNUC__) && !defined(__clang__)"):
-            # the copies (and, since stop 39, the hoisted values in slot order) end here
-            out.append("sphc_tp::acc.lap(%d);  // tile_pieces: gathers" % idx["gathers"])
-            out.append(line)
-            continue
-        if in_pass and s.startswith("// The slot sums onto the particles' sums"):
-            out.append(lap("tiles"))
+        ends = in_pass and [p for start, p in ENDS_BEFORE if s.startswith(start)]
+        if ends:
+            out.append(lap(ends[0]))
             out.append(line)
             continue
         if in_pass and s.startswith("sphc::add_slots(") and not lines[i + 1].strip().startswith("sphc::add_slots("):
