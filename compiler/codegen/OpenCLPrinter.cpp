@@ -14,6 +14,13 @@ namespace sphc {
 
 namespace {
 
+// Whether destination work w has per-particle methods only (no neighbour pass, post_loop,
+// reduction, ghost refresh or host reduction): at most its initialize.
+bool initializeOnly(const DestinationWork& w) {
+  return w.passes.empty() && w.postLoop.empty() && w.reductions.empty() &&
+         w.ghostRefresh.empty() && w.hostReduce.empty();
+}
+
 class OpenCLPrinter : public ScenePrinter {
  public:
   OpenCLPrinter(const Schedule& sched, const DiagnosticEngine& diags, const EmitOptions& opts)
@@ -183,6 +190,14 @@ class OpenCLPrinter : public ScenePrinter {
     std::string phase;
     int flag = 0;  // index into the scene's pulled_init[]
   };
+  // The walk computePulled and computeDtWork share: the destination work of group g's phases
+  // in call order (its subgroups' within them) to `visit`, but work that the schedule moved
+  // whole into a later kernel on its array; it stops (stop = true) at a subgroup that tests,
+  // repeats, skips or rebuilds the neighbours, and after work with host reductions. The
+  // subgroups `skip` names are passed over.
+  void walkStraight(const ScheduleGroup& g, bool& stop,
+                    const std::function<bool(const ScheduleGroup&)>& skip,
+                    const std::function<void(const DestinationWork&, const Phase&)>& visit) const;
   mutable std::map<int, Pulled> pulled_[2];  // by array
   mutable int pulledCount_ = -1;             // -1: not computed yet
   void computePulled() const;
@@ -488,6 +503,31 @@ int OpenCLPrinter::runSequence(int r) const {
   return seq;
 }
 
+void OpenCLPrinter::walkStraight(
+    const ScheduleGroup& g, bool& stop, const std::function<bool(const ScheduleGroup&)>& skip,
+    const std::function<void(const DestinationWork&, const Phase&)>& visit) const {
+  for (const auto& m : g.members) {
+    if (stop) return;
+    if (!m.isPhase) {
+      const ScheduleGroup& sub = *g.subgroups[m.index];
+      if (skip && skip(sub)) continue;
+      const PlanGroup& pg = *sub.group;
+      if (pg.iterate || pg.every || pg.condition || sub.rebuildNeighbours) {
+        stop = true;
+        return;
+      }
+      walkStraight(sub, stop, skip, visit);
+      continue;
+    }
+    const Phase& ph = g.phases[m.index];
+    for (const DestinationWork& w : ph.destinations) {
+      if (w.initializeMoved && initializeOnly(w)) continue;  // moved whole into a later kernel
+      visit(w, ph);
+      if (!w.hostReduce.empty()) stop = true;
+    }
+  }
+}
+
 // The first per-particle work on each array in a sequence of calls with no test between
 // them, as the schedule's fusion walks it (ScheduleFusion.cpp): an initialize kernel is
 // pulled when nothing before it in the sequence reads or writes its array (no pass with the
@@ -510,54 +550,34 @@ void OpenCLPrinter::computePulled() const {
     if (!runs[q]) continue;
     std::set<int> touched;
     bool stop = false;
-    std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-      for (const auto& m : g.members) {
-        if (stop) return;
-        if (!m.isPhase) {
-          const ScheduleGroup& sub = *g.subgroups[m.index];
-          if (q == 0 && sub.group->postStep) continue;
-          const PlanGroup& pg = *sub.group;
-          if (pg.iterate || pg.every || pg.condition || sub.rebuildNeighbours) {
-            stop = true;
-            return;
-          }
-          walk(sub);
-          continue;
-        }
-        const Phase& ph = g.phases[m.index];
-        for (const DestinationWork& w : ph.destinations) {
-          const int a = w.array;
-          // Work moved whole into a later kernel on the array does nothing here.
-          if (w.initializeMoved && w.passes.empty() && w.postLoop.empty() &&
-              w.reductions.empty() && w.ghostRefresh.empty() && w.hostReduce.empty())
-            continue;
-          bool ok = !touched.count(a) && !w.initialize.empty() && !w.initializeMoved &&
-                    !w.ranged() && !w.onGhosts && w.perParticle == LoopOrder::Parallel;
-          if (ok) {
-            std::vector<std::pair<const PlanEquation*, ast::Method::Kind>> work;
-            for (const MovedWork& mw : w.initializeFirst) work.push_back({mw.equation, mw.method});
-            for (const auto* eq : w.initialize) work.push_back({eq, ast::Method::Initialize});
-            for (const auto& [eq, kind] : work)
-              for (const Access& x : equationAccesses(plan_, *eq))
-                if (x.method == kind && x.write && x.array == a &&
-                    std::find(moving.begin(), moving.end(), x.prop) != moving.end())
-                  ok = false;
-          }
-          if (ok) pulled_[q][a] = {&w, ph.name, pulledCount_++};
-          touched.insert(a);
-          for (const NeighbourPass& pass : w.passes) touched.insert(pass.source);
-          if (!w.hostReduce.empty()) stop = true;
-        }
+    // Post_step's groups are not part of the evaluation.
+    auto skip = [q](const ScheduleGroup& sub) { return q == 0 && sub.group->postStep; };
+    auto visit = [&](const DestinationWork& w, const Phase& ph) {
+      const int a = w.array;
+      bool ok = !touched.count(a) && !w.initialize.empty() && !w.initializeMoved &&
+                !w.ranged() && !w.onGhosts && w.perParticle == LoopOrder::Parallel;
+      if (ok) {
+        std::vector<std::pair<const PlanEquation*, ast::Method::Kind>> work;
+        for (const MovedWork& mw : w.initializeFirst) work.push_back({mw.equation, mw.method});
+        for (const auto* eq : w.initialize) work.push_back({eq, ast::Method::Initialize});
+        for (const auto& [eq, kind] : work)
+          for (const Access& x : equationAccesses(plan_, *eq))
+            if (x.method == kind && x.write && x.array == a &&
+                std::find(moving.begin(), moving.end(), x.prop) != moving.end())
+              ok = false;
       }
+      if (ok) pulled_[q][a] = {&w, ph.name, pulledCount_++};
+      touched.insert(a);
+      for (const NeighbourPass& pass : w.passes) touched.insert(pass.source);
     };
     if (q == 0) {
-      walk(sched_.equations);
+      walkStraight(sched_.equations, stop, skip, visit);
     } else {
       for (const auto& sub : sched_.equations.subgroups)
         if (sub->group->postStep && !stop) {
           const PlanGroup& pg = *sub->group;
           if (pg.iterate || pg.every || pg.condition || sub->rebuildNeighbours) break;
-          walk(*sub);
+          walkStraight(*sub, stop, skip, visit);
         }
     }
   }
@@ -638,41 +658,21 @@ void OpenCLPrinter::computeDtWork() const {
   }
   std::map<int, const DestinationWork*> last;
   bool stop = false;
-  std::function<void(const ScheduleGroup&)> walk = [&](const ScheduleGroup& g) {
-    for (const auto& m : g.members) {
-      if (stop) return;
-      if (!m.isPhase) {
-        const ScheduleGroup& sub = *g.subgroups[m.index];
-        const PlanGroup& pg = *sub.group;
-        if (pg.iterate || pg.every || pg.condition || sub.rebuildNeighbours) {
-          stop = true;
-          return;
-        }
-        walk(sub);
-        continue;
-      }
-      for (const DestinationWork& w : g.phases[m.index].destinations) {
-        const int a = w.array;
-        if (w.initializeMoved && w.passes.empty() && w.postLoop.empty() &&
-            w.reductions.empty() && w.ghostRefresh.empty() && w.hostReduce.empty())
-          continue;  // moved whole into a later kernel on the array
-        const bool own = !w.initialize.empty() && !w.initializeMoved && w.passes.empty() &&
-                         w.postLoop.empty() && w.reductions.empty() && w.ghostRefresh.empty() &&
-                         w.hostReduce.empty() && !w.ranged() && !w.onGhosts &&
-                         w.perParticle == LoopOrder::Parallel && !pulledOf(w);
-        if (own)
-          last[a] = &w;
-        else
-          last.erase(a);
-        for (const NeighbourPass& pass : w.passes) last.erase(pass.source);
-        if (!w.hostReduce.empty()) stop = true;
-      }
-    }
+  auto visit = [&](const DestinationWork& w, const Phase&) {
+    const int a = w.array;
+    const bool own = !w.initialize.empty() && !w.initializeMoved && initializeOnly(w) &&
+                     !w.ranged() && !w.onGhosts && w.perParticle == LoopOrder::Parallel &&
+                     !pulledOf(w);
+    if (own)
+      last[a] = &w;
+    else
+      last.erase(a);
+    for (const NeighbourPass& pass : w.passes) last.erase(pass.source);
   };
   for (const auto& sub : sched_.equations.subgroups)
     if (sub->group->postStep) {
       if (sub->rebuildNeighbours) return;
-      walk(*sub);
+      walkStraight(*sub, stop, nullptr, visit);
     }
   if (stop) return;
   for (int a : ad.arrays)
