@@ -749,12 +749,10 @@ void CpuPrinter::reduction(const DestinationWork& w, const Reduction& r) {
 
 // Ghosts copy the values a phase computed on the real particles, where they carry them.
 void CpuPrinter::ghostRefresh(const DestinationWork& w) {
+  if (!ghostsFollow(w)) return;
   const int d = w.array;
   const std::string& D = arr(d).name;
   const std::vector<std::string>& refresh = w.ghostRefresh;
-  if (refresh.empty()) return;
-  scene_ << "      // ghosts follow:";
-  for (const auto& p : refresh) scene_ << " " << p;
   scene_ << (mpi_ ? "\n      sphc::mpi::refresh_halo(box, " : "\n      sphc::refresh_ghosts(box, ")
          << hostData(d) << ", ghosts_" << D << ", "
            << propIndexList(d, refresh) << ");\n";

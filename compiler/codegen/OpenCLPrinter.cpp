@@ -1269,12 +1269,10 @@ void OpenCLPrinter::updateNeighboursWithGhosts() {
 
 // Ghosts copy the values a phase computed on the real particles, where they carry them.
 void OpenCLPrinter::ghostRefresh(const DestinationWork& w) {
+  if (!ghostsFollow(w)) return;
   const int d = w.array;
   const std::string& D = arr(d).name;
   const std::vector<std::string>& refresh = w.ghostRefresh;
-  if (refresh.empty()) return;
-  scene_ << "      // ghosts follow:";
-  for (const auto& p : refresh) scene_ << " " << p;
   scene_ << "\n      ghosts_" << D << ".refresh(ocl, box, " << D << ", dev_" << D << ", "
          << propIndexList(d, refresh) << ");\n";
 }

@@ -609,6 +609,14 @@ class ScenePrinter {
     return false;
   }
   std::string propIndexList(int a, const std::vector<std::string>& props) const;
+  // The comment before a ghost refresh, "// ghosts follow: p q ...", in scene_; false (nothing
+  // printed) where the destination work refreshes no property.
+  bool ghostsFollow(const DestinationWork& w) {
+    if (w.ghostRefresh.empty()) return false;
+    scene_ << "      // ghosts follow:";
+    for (const auto& p : w.ghostRefresh) scene_ << " " << p;
+    return true;
+  }
   // The name of property slot i / constant slot c of array a in the generated code
   // (`fluid_props::rho`, `fluid_consts::dim`), declared by emitSlots().
   std::string propSlot(int a, int i) const;
