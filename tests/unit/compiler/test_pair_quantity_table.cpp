@@ -67,32 +67,34 @@ TEST(PairQuantityTable, PropertiesReadOfBothParticles) {
 }
 
 TEST(PairQuantityTable, StatementsInEachDialect) {
-  PairDialect host{"double", "std::sqrt", "Kernel::w", "Kernel::gradient", ""};
-  PairDialect hostFloat{"float", "std::sqrt", "Kernel::w", "Kernel::gradient", "f"};
-  PairDialect device{"real", "sqrt", "kernel_w", "kernel_gradient", ""};
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("XIJ"), 2, host, "  "),
-            "  const double XIJ[3] = {xi - sj_x[s_idx], yi - sj_y[s_idx], 0.0};\n");
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("VIJ"), 2, hostFloat, ""),
-            "const float VIJ[3] = {ui - sj_u[s_idx], vi - sj_v[s_idx], 0.0f};\n");
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("RIJ"), 3, host, ""),
-            "const double RIJ = std::sqrt(R2IJ);\n");
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("RIJ"), 3, device, ""),
-            "const real RIJ = sqrt(R2IJ);\n");
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("EPS"), 3, hostFloat, ""),
-            "const float EPS = 0.01f * HIJ * HIJ;\n");
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("R2IJ"), 3, hostFloat, ""),
-            "const float R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * XIJ[2];\n");
-  // The scene's axes only: the others' literal 0 squared adds +0 (exact).
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("R2IJ"), 2, host, ""),
-            "const double R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1];\n");
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("R2IJ"), 1, host, ""),
-            "const double R2IJ = XIJ[0] * XIJ[0];\n");
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("WJ"), 2, device, ""),
-            "const real WJ = kernel_w(RIJ, hj);\n");
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("DWIJ"), 2, host, "  "),
-            "  double DWIJ[3];\n  Kernel::gradient(XIJ, RIJ, HIJ, DWIJ);\n");
-  EXPECT_EQ(pairQuantityStatement(*findPairQuantity("RHOIJ"), 2, hostFloat, ""),
-            "const float RHOIJ = 0.5f * (di_rho[d_idx] + sj_rho[s_idx]);\n");
+  const PairDialect host{"double", "std::sqrt", "Kernel::w", "Kernel::gradient", ""};
+  const PairDialect hostFloat{"float", "std::sqrt", "Kernel::w", "Kernel::gradient", "f"};
+  const PairDialect device{"real", "sqrt", "kernel_w", "kernel_gradient", ""};
+  struct Case {
+    const char* quantity;
+    int dim;
+    const PairDialect& dialect;
+    const char* indent;
+    const char* statement;
+  };
+  const Case cases[] = {
+      {"XIJ", 2, host, "  ", "  const double XIJ[3] = {xi - sj_x[s_idx], yi - sj_y[s_idx], 0.0};\n"},
+      {"VIJ", 2, hostFloat, "", "const float VIJ[3] = {ui - sj_u[s_idx], vi - sj_v[s_idx], 0.0f};\n"},
+      {"RIJ", 3, host, "", "const double RIJ = std::sqrt(R2IJ);\n"},
+      {"RIJ", 3, device, "", "const real RIJ = sqrt(R2IJ);\n"},
+      {"EPS", 3, hostFloat, "", "const float EPS = 0.01f * HIJ * HIJ;\n"},
+      {"R2IJ", 3, hostFloat, "", "const float R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1] + XIJ[2] * XIJ[2];\n"},
+      // The scene's axes only: the others' literal 0 squared adds +0 (exact).
+      {"R2IJ", 2, host, "", "const double R2IJ = XIJ[0] * XIJ[0] + XIJ[1] * XIJ[1];\n"},
+      {"R2IJ", 1, host, "", "const double R2IJ = XIJ[0] * XIJ[0];\n"},
+      {"WJ", 2, device, "", "const real WJ = kernel_w(RIJ, hj);\n"},
+      {"DWIJ", 2, host, "  ", "  double DWIJ[3];\n  Kernel::gradient(XIJ, RIJ, HIJ, DWIJ);\n"},
+      {"RHOIJ", 2, hostFloat, "", "const float RHOIJ = 0.5f * (di_rho[d_idx] + sj_rho[s_idx]);\n"},
+  };
+  for (const Case& c : cases)
+    EXPECT_EQ(pairQuantityStatement(*findPairQuantity(c.quantity), c.dim, c.dialect, c.indent),
+              c.statement)
+        << c.quantity << ", dim " << c.dim << ", " << c.dialect.real;
 }
 
 }  // namespace
