@@ -159,10 +159,7 @@ def main():
                 continue
             compare_fields(run["fields"][tf], ref["fields"][tf], dx, a.tol, "t = %.6f" % tf,
                            failures)
-    if S.report_failures(failures, limit=20):
-        return 1
-    print("OK: sphc's port agrees with PySPH within %.0e at every snapshot" % a.tol)
-    return 0
+    return S.port_result(failures, a.tol)
 
 
 if __name__ == "__main__":

@@ -194,6 +194,15 @@ def finish(args, draw, failures, limit=20, **plot_options):
     return 0
 
 
+def port_result(failures, tol):
+    """The end of a check of a port against PySPH's run: the failures (the first 20), or OK.
+    Returns the exit status: 1 with failures, else 0."""
+    if report_failures(failures, limit=20):
+        return 1
+    print("OK: sphc's port agrees with PySPH within %.0e at every snapshot" % tol)
+    return 0
+
+
 def pysph_comparison(description, load_run, read_reference, write_reference, extra=()):
     """The command line shared by the checks against a PySPH run (SPHC_OUT with --reference
     FILE or --pysph-dir DIR; --write-reference FILE --pysph-dir DIR stores PySPH's run), and
