@@ -992,9 +992,12 @@ __attribute__((always_inline)) inline ShiftJ shift_j(const Slots& S, int j0) {
           jval<CJ>(S.f[FVB].data(), j0)};
 }
 
-// Tile-major: per i-cluster its list, per tile every register of the i-cluster (all their i
-// sums live: 14 per register).
-template <int CI, int CJ, int ARITH>
+// RMAJOR false, tile-major: per i-cluster its list, per tile every register of the i-cluster
+// (all their i sums live: 14 per register). RMAJOR, register-major: per i-cluster, per register
+// (RI i's) its whole list, so that only one register's 14 i sums are live (tile-major: all of
+// the i-cluster's, 28 for 2xMM); the j sums added to memory per register and tile (2xMM: the
+// halves folded first).
+template <int CI, int CJ, int ARITH, bool RMAJOR = false>
 __attribute__((noinline)) void form_t_shift(Slots& S, const std::vector<std::uint32_t>& begin,
                                             const std::vector<std::uint32_t>& jl, const Eq11& eq11) {
   constexpr int RI = 8 / CJ;
@@ -1005,6 +1008,22 @@ __attribute__((noinline)) void form_t_shift(Slots& S, const std::vector<std::uin
   for (int ci = 0; ci < nci; ++ci) {
     const int i0 = ci * CI;
     if (begin[ci] == begin[ci + 1]) continue;
+    if (RMAJOR) {
+      for (int r = 0; r < CI / RI; ++r) {
+        V iacc[NSS];
+        for (int k = 0; k < NSS; ++k) iacc[k] = zero;
+        for (std::uint32_t e = begin[ci]; e < begin[ci + 1]; ++e) {
+          const int j0 = static_cast<int>(jl[e]) * CJ;
+          V jacc[NSS];
+          for (int k = 0; k < NSS; ++k) jacc[k] = zero;
+          const bool diagonal = j0 < i0 + CI && i0 < j0 + CJ;
+          if (shift_register<RI, CJ, ARITH>(S, shift_j<CJ>(S, j0), R, i0 + r * RI, j0, diagonal, iacc, jacc))
+            add_j_sums<CJ>(SUM, NSS, jacc, j0);
+        }
+        add_i_sums<RI>(SUM, NSS, iacc, i0 + r * RI);
+      }
+      continue;
+    }
     V iacc[CI / RI][NSS];
     for (int r = 0; r < CI / RI; ++r)
       for (int k = 0; k < NSS; ++k) iacc[r][k] = zero;
@@ -1018,36 +1037,6 @@ __attribute__((noinline)) void form_t_shift(Slots& S, const std::vector<std::uin
       add_j_sums<CJ>(SUM, NSS, jacc, j0);
     }
     for (int r = 0; r < CI / RI; ++r) add_i_sums<RI>(SUM, NSS, iacc[r], i0 + r * RI);
-  }
-}
-
-// The same, register-major: per i-cluster, per register (RI i's) its whole list, so that only one
-// register's 14 i sums are live (tile-major: all of the i-cluster's, 28 for 2xMM); the j sums
-// added to memory per register and tile (2xMM: the halves folded first).
-template <int CI, int CJ, int ARITH>
-__attribute__((noinline)) void form_t_shift_r(Slots& S, const std::vector<std::uint32_t>& begin,
-                                            const std::vector<std::uint32_t>& jl, const Eq11& eq11) {
-  constexpr int RI = 8 / CJ;
-  const V zero = _mm512_setzero_pd(), R = bc(eq11.R);
-  double* SUM[NSS];
-  for (int k = 0; k < NSS; ++k) SUM[k] = S.ss[k].data();
-  const int nci = static_cast<int>(begin.size()) - 1;
-  for (int ci = 0; ci < nci; ++ci) {
-    const int i0 = ci * CI;
-    if (begin[ci] == begin[ci + 1]) continue;
-    for (int r = 0; r < CI / RI; ++r) {
-      V iacc[NSS];
-      for (int k = 0; k < NSS; ++k) iacc[k] = zero;
-      for (std::uint32_t e = begin[ci]; e < begin[ci + 1]; ++e) {
-        const int j0 = static_cast<int>(jl[e]) * CJ;
-        V jacc[NSS];
-        for (int k = 0; k < NSS; ++k) jacc[k] = zero;
-        const bool diagonal = j0 < i0 + CI && i0 < j0 + CJ;
-        if (shift_register<RI, CJ, ARITH>(S, shift_j<CJ>(S, j0), R, i0 + r * RI, j0, diagonal, iacc, jacc))
-          add_j_sums<CJ>(SUM, NSS, jacc, j0);
-      }
-      add_i_sums<RI>(SUM, NSS, iacc, i0 + r * RI);
-    }
   }
 }
 
@@ -1333,7 +1322,7 @@ int main(int argc, char** argv) {
   if (pass == 0 && !rcp) F.run = [=, &b, &j, &eq6, &eq7] { zero(); form_t<CI, CJ, EXACT>(*s, b, j, eq6, eq7); };   \
   if (pass == 1 && rcp) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, RCP>(*s, b, j, eq11); };         \
   if (pass == 1 && !rcp && !rmajor) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, EXACT>(*s, b, j, eq11); }; \
-  if (pass == 1 && rmajor) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift_r<CI, CJ, EXACT>(*s, b, j, eq11); }; \
+  if (pass == 1 && rmajor) F.run = [=, &b, &j, &eq11] { zero(); form_t_shift<CI, CJ, EXACT, true>(*s, b, j, eq11); }; \
   if (pass == 2 && rcp) F.run = [=, &b, &j, &eq6, &eq7, &eq8] { zero(); form_t<CI, CJ, RCP, true>(*s, b, j, eq6, eq7, eq8); }; \
   if (pass == 2 && !rcp) F.run = [=, &b, &j, &eq6, &eq7, &eq8] { zero(); form_t<CI, CJ, EXACT, true>(*s, b, j, eq6, eq7, eq8); }; \
   count_regs(s->L, b, j, CI, CJ, F.regs, F.regs_pair, F.in);
