@@ -82,6 +82,9 @@ Case invariants (options):
                 the --ke-floor.
   --surface-drift-after T       the top of the fluid (the largest y; z in 3D) stays within
                 --surface-drift dx (default 1) of its value at the first snapshot at t >= T.
+  --max-removed N               removed: at most N particles of the fluid removed by the
+                scene's limits (a limit's `remove`, OUTPUT_DIR/<scene>_removed.csv) up to
+                each snapshot (water thrown out of an open tank over a wall's top).
   --expect-violation NAME       invert the verdict for the invariant NAME: the check passes
                 only if NAME is violated (and prints where); the other invariants must hold.
                 For the cases that must show a failure (the tensile instability without
@@ -298,6 +301,7 @@ def main():
     ap.add_argument("--ke-no-growth-after", type=float, default=None)
     ap.add_argument("--surface-drift-after", type=float, default=None)
     ap.add_argument("--surface-drift", type=float, default=1.0)
+    ap.add_argument("--max-removed", type=int, default=None)
     ap.add_argument("--expect-violation", default=None)
     ap.add_argument("--summary", default=None)
     ap.add_argument("--case", default="?")
@@ -322,6 +326,9 @@ def main():
 
     nan = add("no-nan", 0, "non-finite values (count)")
     count = add("count", 0, "particles gained or lost")
+    gone_fluid = add("removed", args.max_removed,
+                     "fluid particles removed by the scene's limits (out of the tank)") \
+        if args.max_removed is not None else None
     mass = add("mass", 1e-12, "relative change of the total mass")
     kej = add("ke-jump", args.ke_jump, "largest KE rise in one interval beyond its source, "
               "relative to KE at its start")
@@ -441,6 +448,12 @@ def main():
         # (the particles removed after the first snapshot and up to this one, per array)
         gone = [r for r in removed if step is not None and first.get("step") is not None
                 and first["step"] < r[0] <= step]
+        if gone_fluid is not None:
+            k = sum(1 for r in gone if r[2] == args.fluid)
+            gone_fluid.record(k, lambda a_, b: a_ > b)
+            if k > args.max_removed:
+                gone_fluid.fail(t, "%d fluid particles removed by the scene's limits so far "
+                                   "(limit %d)" % (k, args.max_removed))
         for a, n0 in first["n"].items():
             na = len(data[a]["x"]) if a in data and "x" in data[a] else 0
             na += sum(1 for r in gone if r[2] == a)
