@@ -225,6 +225,13 @@ class CpuPrinter : public ScenePrinter {
       r += "    scene.static_cells_built = false;  // the file's particles: their cells anew\n";
     return r;
   }
+  std::string afterRemoval(int a) const override {
+    const std::string& A = arr(a).name;
+    std::string r;
+    if (cpuSingle_) r += "      scene.f32_" + A + ".upload(scene." + A + ");  // its float copy\n";
+    if (isStatic(A)) r += "      scene.static_cells_built = false;  // its cells anew\n";
+    return r;
+  }
   // --precision=single: the manager works on the host doubles; the float copies follow.
   void arraysToHost(const std::vector<int>& arrays) override {
     if (!cpuSingle_) return;

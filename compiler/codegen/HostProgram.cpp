@@ -687,11 +687,32 @@ void ScenePrinter::emitLimits() {
   };
   out_ << "  prog.limits = [] {  // limits { }: warn once outside warn, stop outside stop\n"
           "    std::vector<sphc::Limit> l;\n";
-  for (const auto& l : plan_.limits)
+  for (const auto& l : plan_.limits) {
     out_ << "    l.push_back({\"" << arr(l.array).name << "\", \"" << l.quantity << "\", \""
          << loc(l.loc) << "\", " << bounds(l.hasWarn, l.warnLo, l.warnHi) << ", "
          << bounds(l.hasStop, l.stopLo, l.stopHi) << "});\n";
+    if (!l.hasRemove) continue;
+    // remove [lo, hi] where C in [lo, hi]: taken out of the run (the run loop, sphc/sanity.h)
+    out_ << "    l.back().remove = " << bounds(true, l.removeLo, l.removeHi) << ";\n";
+    if (!l.removeWhere.empty())
+      out_ << "    l.back().remove_where = \"" << l.removeWhere << "\";\n"
+           << "    l.back().where_bounds = " << bounds(true, l.whereLo, l.whereHi) << ";\n";
+  }
   out_ << "    return l;\n  };\n";
+  bool removes = false;
+  for (const auto& l : plan_.limits) removes |= l.hasRemove;
+  if (!removes) return;
+  // What follows the run loop's removal of particles from a host array (afterRemoval).
+  std::string after;
+  for (std::size_t a = 0; a < plan_.arrays.size(); ++a) {
+    bool removed = false;
+    for (const auto& l : plan_.limits) removed |= l.hasRemove && l.array == static_cast<int>(a);
+    const std::string s = removed ? afterRemoval(static_cast<int>(a)) : "";
+    if (!s.empty())
+      after += "    if (&a == &scene." + arr(static_cast<int>(a)).name + ") {\n" + s + "    }\n";
+  }
+  out_ << "  prog.after_removal = [](const sphc::ParticleArray& a) {  // limits' remove\n"
+       << (after.empty() ? "    (void)a;  // kept lists see the new count\n" : after) << "  };\n";
 }
 
 void ScenePrinter::emitMain() {

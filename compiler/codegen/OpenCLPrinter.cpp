@@ -88,6 +88,12 @@ class OpenCLPrinter : public ScenePrinter {
   std::string restoreData() const override {
     return "    scene.from_host();  // the restored arrays to the device\n";
   }
+  // A limit's remove compacted the host array: up again (the buffers keep their capacity;
+  // the cell tables, kept ones too, are built again for the new count).
+  std::string afterRemoval(int a) const override {
+    const std::string& A = arr(a).name;
+    return "      scene.dev_" + A + ".upload(scene.ocl, scene." + A + ");  // to the device\n";
+  }
   // The manager works on the host arrays: down before it, up after (DeviceArray::upload
   // grows the buffers' capacity by at least a quarter when an array outgrows it).
   void arraysToHost(const std::vector<int>& arrays) override {

@@ -140,6 +140,11 @@ class ScenePrinter {
   // --restart: the statements that move the restored host arrays to where the scene computes
   // on them (OpenCL: uploads; --precision=single: the float copies); "" where they are it.
   virtual std::string restoreData() const { return ""; }
+  // A limit's `remove` took particles out of the host array a (the run loop, sphc/sanity.h):
+  // the statements (in main, on `scene.`) that move it back where the scene computes and
+  // forget what depended on its particles; "" where nothing does (kept lists are rebuilt when
+  // a count changes).
+  virtual std::string afterRemoval(int a) const { return ""; }
   // The inlet/outlet step runs on the host: the arrays it resizes come to the host before
   // it and go back to where the scene computes after it (their new sizes included).
   virtual void arraysToHost(const std::vector<int>& arrays) {}

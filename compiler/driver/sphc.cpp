@@ -498,6 +498,24 @@ int main(int argc, char** argv) {
     }
   }
   plan->distributed = Mpi;
+  // A limit's `remove` takes particles out of the host arrays between steps (the run loop,
+  // sphc/sanity.h), which then go back where the scene computes (afterRemoval): written for
+  // one process without periodic or mirror sides (whose kept ghosts are made from the
+  // particles' places).
+  for (const auto& l : plan->limits) {
+    if (!l.hasRemove) continue;
+    const char* why = Mpi ? "by a distributed solver (--mpi)"
+                      : plan->domain.any() ? "with periodic or mirror sides (their ghosts, "
+                                             "kept with the neighbour lists)"
+                                           : nullptr;
+    if (why)
+      diags.error(l.removeLoc, llvm::Twine("'remove' in limit '") + plan->arrays[l.array].name +
+                                   "." + l.quantity + "' is not supported " + why +
+                                   ": the run loop takes particles out of the host arrays "
+                                   "between steps, in one process (serial, openmp, opencl), "
+                                   "without periodic or mirror sides");
+  }
+  if (diags.hasErrors()) return fail();
   // Inlets and outlets are distributed (sphc/mpi/zones.h), metrics too: their sums are
   // combined over the ranks (sphc/mpi/comm.h, all_reduce).
   auto dump = [&](Pass pass) {

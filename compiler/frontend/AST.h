@@ -291,6 +291,11 @@ struct LimitItem {
   Ident array;
   Ident quantity;               // a property of the array, or `speed` (|(u, v, w)|)
   std::optional<LimitBound> warn, stop;
+  // `remove [lo, hi] where y >= W`: the particles outside `remove` (where the condition on
+  // another coordinate holds) leave the run, counted (docs/language.md, Limits).
+  std::optional<LimitBound> remove;
+  Ident removeWhere;            // the condition's coordinate (empty name: no condition)
+  std::optional<LimitBound> removeWhereBound;
 };
 
 struct LimitsDecl {

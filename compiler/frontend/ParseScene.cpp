@@ -233,7 +233,8 @@ bool Parser::parseLimits(ast::SceneDecl& scene) {
   return parseSceneBlock("limits", scene.limits, &Parser::parseLimitItem);
 }
 
-// ARRAY.QUANTITY (warn BOUND)? (stop BOUND)?;  at least one of warn and stop.
+// ARRAY.QUANTITY (warn BOUND)? (stop BOUND)? (remove BOUND (where COORD COND)?)?;  at least
+// one of warn, stop and remove (in any order), COND: '>= lo', '<= hi' or 'in [lo, hi]'.
 bool Parser::parseLimitItem(ast::LimitsDecl& limits) {
   ast::LimitItem item;
   if (!parseIdent(item.array, "expected a limit, as in 'fluid.rho warn [990, 1010];', found " +
@@ -244,20 +245,45 @@ bool Parser::parseLimitItem(ast::LimitsDecl& limits) {
                                      ".' in a limit"))
     return false;
   const std::string head = "limit '" + item.array.name + "." + item.quantity.name + "'";
-  while (atWord("warn") || atWord("stop")) {
-    const bool warn = atWord("warn");
-    auto& slot = warn ? item.warn : item.stop;
-    if (slot)
-      return error(cur().loc, std::string("'") + (warn ? "warn" : "stop") + "' is given twice in " +
-                                  head);
+  while (atWord("warn") || atWord("stop") || atWord("remove")) {
+    const std::string kind = cur().text.str();
+    auto& slot = kind == "warn" ? item.warn : kind == "stop" ? item.stop : item.remove;
+    if (slot) return error(cur().loc, "'" + kind + "' is given twice in " + head);
     slot.emplace();
     slot->loc = cur().loc;
     advance();
-    if (!parseLimitBound(*slot, head + (warn ? " warn" : " stop"))) return false;
+    if (!parseLimitBound(*slot, head + " " + kind)) return false;
+    if (kind != "remove" || !atWord("where")) continue;
+    // where COORD (>= lo | <= hi | in [lo, hi]): the particles removed are those outside the
+    // bound where the condition holds.
+    advance();
+    const std::string cond = head + " remove where";
+    if (!parseIdent(item.removeWhere, "expected a coordinate after 'where' in " + head +
+                                          " (as in 'remove [0, 4] where y >= 4'), found " +
+                                          describe(cur())))
+      return false;
+    item.removeWhereBound.emplace();
+    item.removeWhereBound->loc = item.removeWhere.loc;
+    if (consumeIf(Token::LessEq)) {
+      if (!(item.removeWhereBound->hi = parseExpr())) return false;
+    } else if (consumeIf(Token::GreaterEq)) {
+      if (!(item.removeWhereBound->lo = parseExpr())) return false;
+    } else if (atWord("in")) {
+      advance();
+      if (!cur().is(Token::LBracket))
+        return error(cur().loc, "expected '[lo, hi]' after 'in' in " + cond + ", found " +
+                                    describe(cur()));
+      if (!parseLimitBound(*item.removeWhereBound, cond)) return false;
+      item.removeWhereBound->loc = item.removeWhere.loc;
+    } else {
+      return error(cur().loc, "expected '>= lo', '<= hi' or 'in [lo, hi]' after '" +
+                                  item.removeWhere.name + "' in " + cond + ", found " +
+                                  describe(cur()));
+    }
   }
-  if (!item.warn && !item.stop)
-    return error(cur().loc, "expected 'warn' or 'stop' and a bound after " + head + ", found " +
-                                describe(cur()));
+  if (!item.warn && !item.stop && !item.remove)
+    return error(cur().loc, "expected 'warn', 'stop' or 'remove' and a bound after " + head +
+                                ", found " + describe(cur()));
   limits.items.push_back(std::move(item));
   return expect(Token::Semi, "after " + head);
 }

@@ -156,6 +156,14 @@ struct PlanLimit {
   std::string quantity;                       // a property, or "speed"
   bool hasWarn = false, hasStop = false;
   ast::ExprPtr warnLo, warnHi, stopLo, stopHi;
+  // `remove [lo, hi] where C in [lo, hi]` (quantity x, y or z): the particles outside the
+  // remove bound where the coordinate C lies within its bound are taken out of the run,
+  // counted; C empty: no condition. Absent ends are unbounded.
+  bool hasRemove = false;
+  llvm::SMLoc removeLoc;                      // the `remove` keyword
+  ast::ExprPtr removeLo, removeHi;
+  std::string removeWhere;                    // "x", "y", "z" or empty
+  ast::ExprPtr whereLo, whereHi;
 };
 
 // One metric of the scene's `metrics { }` (docs/language.md, Metrics; sema/Metrics.cpp):

@@ -248,6 +248,55 @@ void SemaImpl::buildLimits(const ast::LimitsDecl& d) {
     };
     if (item.warn) checkBound(*item.warn, "warn");
     if (item.stop) checkBound(*item.stop, "stop");
+    if (item.remove) {
+      // Particles leave the run only by leaving a region of space: a position, and a
+      // condition on another coordinate of the scene's dimension.
+      static const char* kAxes[3] = {"x", "y", "z"};
+      auto axis = [&](const std::string& q) {
+        for (int k = 0; k < 3; ++k)
+          if (q == kAxes[k]) return k;
+        return -1;
+      };
+      const int qa = axis(item.quantity.name);
+      if (qa < 0) {
+        diags_.error(item.remove->loc,
+                     "'remove' in limit '" + name + "' takes out the particles that leave a "
+                     "region of space: its quantity is a position (x, y or z), not '" +
+                         item.quantity.name + "' (a bound on '" + item.quantity.name +
+                         "' is 'warn' or 'stop')");
+        ok = false;
+      } else if (qa >= plan_->dim) {
+        diags_.error(item.quantity.loc, "'" + item.quantity.name + "' is beyond the scene's " +
+                                            llvm::Twine(plan_->dim) + " dimension" +
+                                            (plan_->dim == 1 ? "" : "s") + " (dim = " +
+                                            llvm::Twine(plan_->dim) + ")");
+        ok = false;
+      }
+      checkBound(*item.remove, "remove");
+      if (!item.removeWhere.name.empty()) {
+        const int wa = axis(item.removeWhere.name);
+        if (wa < 0) {
+          diags_.error(item.removeWhere.loc,
+                       "the condition of 'remove' in limit '" + name + "' is on a coordinate "
+                       "(x, y or z), not '" + item.removeWhere.name + "'");
+          ok = false;
+        } else if (wa == qa) {
+          diags_.error(item.removeWhere.loc,
+                       "the condition of 'remove' in limit '" + name + "' is on '" +
+                           item.removeWhere.name + "' itself: give the bound of '" +
+                           item.removeWhere.name + "' in 'remove [lo, hi]', and the condition "
+                           "on another coordinate");
+          ok = false;
+        } else if (wa >= plan_->dim) {
+          diags_.error(item.removeWhere.loc,
+                       "'" + item.removeWhere.name + "' is beyond the scene's " +
+                           llvm::Twine(plan_->dim) + " dimension" + (plan_->dim == 1 ? "" : "s") +
+                           " (dim = " + llvm::Twine(plan_->dim) + ")");
+          ok = false;
+        }
+        checkBound(*item.removeWhereBound, "'where'");
+      }
+    }
     if (!ok) continue;
     if (item.warn && item.stop) {
       // A warn bound outside the stop bound would never warn: said when both are literals.
@@ -279,6 +328,18 @@ void SemaImpl::buildLimits(const ast::LimitsDecl& d) {
       l.stopHi = item.stop->hi;
     }
     auto& props = plan_->arrays[a].limitProps;
+    if (item.remove) {
+      l.hasRemove = true;
+      l.removeLoc = item.remove->loc;
+      l.removeLo = item.remove->lo;
+      l.removeHi = item.remove->hi;
+      l.removeWhere = item.removeWhere.name;
+      if (item.removeWhereBound) {
+        l.whereLo = item.removeWhereBound->lo;
+        l.whereHi = item.removeWhereBound->hi;
+        props.push_back(l.removeWhere);
+      }
+    }
     if (l.quantity == "speed") {
       static const char* kVel[3] = {"u", "v", "w"};
       for (int k = 0; k < plan_->dim; ++k) props.push_back(kVel[k]);

@@ -149,6 +149,36 @@ LimitCheck check_limit(const Limit& limit, const ParticleArray& a, int dim) {
   return c;
 }
 
+std::string Limit::remove_text() const {
+  if (!remove) return "";
+  std::string where;
+  if (!remove_where.empty()) {
+    const bool has_lo = std::isfinite(where_bounds.lo), has_hi = std::isfinite(where_bounds.hi);
+    where = " where " + remove_where + (has_lo && has_hi ? " in " : " ") + where_bounds.text();
+  }
+  return "outside " + remove->text() + where;
+}
+
+std::vector<std::uint8_t> removal_mask(const Limit& limit, const ParticleArray& a, int dim) {
+  std::vector<std::uint8_t> mask;
+  if (!limit.remove) return mask;
+  const Quantity q = quantity_of(limit, a, dim);
+  const double* c = nullptr;
+  if (!limit.remove_where.empty()) {
+    Limit cond = limit;
+    cond.quantity = limit.remove_where;
+    c = quantity_of(cond, a, dim).values;
+  }
+  for (std::size_t i = 0; i < a.n; ++i) {
+    const double v = q(i);
+    if (std::isnan(v) || limit.remove->contains(v)) continue;
+    if (c && !limit.where_bounds.contains(c[i])) continue;  // NaN: not contained
+    if (mask.empty()) mask.assign(a.n, 0);
+    mask[i] = 1;
+  }
+  return mask;
+}
+
 std::string describe_particle(const ParticleArray& a, std::size_t i, int dim,
                               const std::string& quantity, double value) {
   std::string pos;

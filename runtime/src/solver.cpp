@@ -639,6 +639,7 @@ class Simulation {
     check_fixed_dt(times);
     arrays_ = prog_.arrays ? prog_.arrays() : std::vector<ParticleArray*>{};
     set_up_limits();
+    set_up_removals();
     const std::string dir =
         opt_.directory.empty() ? scene_name(prog_) + "_output" : opt_.directory;
     // Distributed: rank 0 writes, or every rank with collective output (write_particles).
@@ -648,6 +649,7 @@ class Simulation {
     if (opt_.restartable) writer.write_all_properties();
     if (!opt_.restart.empty()) writer.continue_series(read_meta_hdf5(opt_.restart).step);
     open_metrics(dir);
+    open_removed(dir);
 
     const double tf = times.tf;
     const double slack = kTimeSlack * tf;
@@ -660,7 +662,7 @@ class Simulation {
       // holds computed quantities (pressures, summation densities) and not zeros.
       if (prog_.compute_initial) prog_.compute_initial(t_, dt_);
       if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
-      if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
+      if (auto bad = remove_and_check_limits()) return blow_up(kLeftLimits, *bad);
       write_output();
     }
 
@@ -693,17 +695,18 @@ class Simulation {
       const bool output_due = schedule.due(t_, planned.length);
       if (output_due || step_ % check_every == 0) {
         if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
-        if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
+        if (auto bad = remove_and_check_limits()) return blow_up(kLeftLimits, *bad);
       }
       if (output_due) write_output();
       progress_.update(t_, step_, dt_, particles());
     }
     if (last_output_step_ != step_) {
       if (auto bad = check_finite()) return blow_up("simulation blew up", *bad);
-      if (auto bad = check_limits()) return blow_up(kLeftLimits, *bad);
+      if (auto bad = remove_and_check_limits()) return blow_up(kLeftLimits, *bad);
       write_output();
     }
     report_limits();
+    report_removals();
     report(seconds_since(loop_start), particle_steps, tf);
     report_metrics();
     return kExitOk;
@@ -968,6 +971,172 @@ class Simulation {
       check_limit(l, **it, prog_.dim);  // throws if the quantity does not exist
       watched_.push_back(Watched{l, *it});
     }
+  }
+
+  // -------------------------------------------------------------------------------------------
+  // Removal (a limit's `remove`, sphc/sanity.h): at every check, before the bounds are
+  // checked, the particles outside a remove bound (where its condition holds) are taken out
+  // of the host arrays (ParticleArray::remove_particles: a stable compaction, so the others
+  // keep their order), counted, and written with their last state to DIR/SCENE_removed.csv
+  // (as DualSPHysics' excluded particles); prog.after_removal moves the array back where the
+  // scene computes. Serial and in particle order: every thread count removes the same.
+
+  struct Removing {
+    Limit limit;
+    ParticleArray* array = nullptr;
+    std::size_t removed = 0;      // particles so far
+    double mass = 0.0;            // their mass (NaN: the array has no m)
+    double mass_at_start = 0.0;   // the array's at the start
+    double first_t = 0.0, last_t = 0.0;
+    std::string last;             // the last particle removed: its position and t
+  };
+  std::vector<Removing> removing_;
+  std::ofstream removed_csv_;
+
+  static constexpr const char* kRemovedHeader =
+      "step,t,limit,array,index,gid,x,y,z,u,v,w,m,rho";
+
+  void set_up_removals() {
+    if (!prog_.limits) return;
+    for (const Limit& l : prog_.limits()) {
+      if (!l.remove) continue;
+      auto it = std::find_if(arrays_.begin(), arrays_.end(),
+                             [&](const ParticleArray* a) { return a->name == l.array; });
+      if (it == arrays_.end())
+        throw std::runtime_error(fmt::format("limit '{}' ({}): the scene has no array '{}'",
+                                             l.name(), l.where, l.array));
+      removal_mask(l, **it, prog_.dim);  // throws if a quantity does not exist
+      Removing r{l, *it};
+      const int m = (*it)->find("m");
+      r.mass = m >= 0 && (*it)->props[m].type == PropType::F64 ? 0.0 : std::nan("");
+      if (m >= 0 && (*it)->props[m].type == PropType::F64)
+        for (std::size_t i = 0; i < (*it)->n; ++i) r.mass_at_start += (*it)->f64(m)[i];
+      removing_.push_back(std::move(r));
+    }
+  }
+
+  // DIR/SCENE_removed.csv: one row per removed particle. A restart keeps the rows up to its
+  // step and counts them again.
+  void open_removed(const std::string& dir) {
+    if (removing_.empty() || opt_.no_output || prog_.rank > 0) return;
+    const std::string path =
+        (std::filesystem::path(dir) / (scene_name(prog_) + "_removed.csv")).string();
+    std::vector<std::string> kept;
+    if (!opt_.restart.empty()) {
+      const long step = read_meta_hdf5(opt_.restart).step;
+      std::ifstream in(path);
+      std::string line;
+      if (in && std::getline(in, line) && line == kRemovedHeader)
+        while (std::getline(in, line)) {
+          char* end = nullptr;
+          const long row_step = std::strtol(line.c_str(), &end, 10);
+          if (end == line.c_str() || *end != ',' || row_step > step) continue;
+          kept.push_back(line);
+          // step,t,limit,array,index,gid,x,y,z,u,v,w,m,rho: count it for its limit.
+          std::vector<std::string> f;
+          for (std::size_t a = 0, b; a <= line.size(); a = b + 1) {
+            b = line.find(',', a);
+            if (b == std::string::npos) b = line.size();
+            f.push_back(line.substr(a, b - a));
+          }
+          if (f.size() < 14) continue;
+          for (Removing& r : removing_)
+            if (r.limit.name() == f[2]) {
+              if (r.removed++ == 0) r.first_t = std::strtod(f[1].c_str(), nullptr);
+              r.last_t = std::strtod(f[1].c_str(), nullptr);
+              r.mass += std::strtod(f[12].c_str(), nullptr);
+            }
+        }
+    }
+    removed_csv_.open(path, std::ios::trunc);
+    if (!removed_csv_) throw std::runtime_error("cannot write the removed particles to '" + path + "'");
+    removed_csv_ << kRemovedHeader << "\n";
+    for (const std::string& row : kept) removed_csv_ << row << "\n";
+    removed_csv_ << std::flush;
+  }
+
+  void remove_particles() {
+    for (Removing& r : removing_) {
+      ParticleArray& a = *r.array;
+      const std::vector<std::uint8_t> mask = removal_mask(r.limit, a, prog_.dim);
+      if (mask.empty()) continue;
+      auto column = [&](const char* name) -> const double* {
+        const int k = a.find(name);
+        return k >= 0 && a.props[k].type == PropType::F64 && a.props[k].stride == 1 ? a.f64(k)
+                                                                                   : nullptr;
+      };
+      const char* const names[] = {"x", "y", "z", "u", "v", "w", "m", "rho"};
+      const double* col[8];
+      for (int k = 0; k < 8; ++k) col[k] = k % 3 < prog_.dim || k >= 6 ? column(names[k]) : nullptr;
+      const int gid = a.find("gid");
+      const std::uint32_t* ids =
+          gid >= 0 && a.props[gid].type == PropType::U32 ? a.u32(gid) : nullptr;
+      std::size_t count = 0;
+      double mass = 0.0;
+      std::string positions;
+      for (std::size_t i = 0; i < a.n; ++i) {
+        if (!mask[i]) continue;
+        std::string pos;
+        for (int k = 0; k < prog_.dim && k < 3; ++k)
+          pos += fmt::format("{}{:.6g}", k ? ", " : "", col[k] ? col[k][i] : 0.0);
+        if (count < 4) positions += fmt::format("{}({})", count ? ", " : "", pos);
+        ++count;
+        if (col[6]) mass += col[6][i];
+        r.last = fmt::format("({}) at t={}", pos, t_);
+        if (removed_csv_.is_open()) {
+          removed_csv_ << fmt::format("{},{:.17g},{},{},{},{}", step_, t_, r.limit.name(), a.name,
+                                      i, ids ? std::to_string(ids[i]) : std::string());
+          for (int k = 0; k < 8; ++k)
+            removed_csv_ << "," << (col[k] ? fmt::format("{:.17g}", col[k][i]) : std::string());
+          removed_csv_ << "\n";
+        }
+      }
+      if (removed_csv_.is_open()) removed_csv_ << std::flush;
+      if (r.removed == 0) r.first_t = t_;
+      r.last_t = t_;
+      r.removed += count;
+      r.mass += mass;
+      a.remove_particles(mask);
+      if (prog_.after_removal) prog_.after_removal(a);
+      if (prog_.rank > 0) continue;
+      progress_.break_line();
+      const std::string from = r.limit.where.empty() ? "" : " (" + r.limit.where + ")";
+      fmt::print(stderr,
+                 "removed at t={}, step {}: {} particle{} of array '{}' {} (limit '{}'{}){}: "
+                 "{}{}; {} removed so far{}\n",
+                 t_, step_, count, count == 1 ? "" : "s", a.name, r.limit.remove_text(),
+                 r.limit.name(), from,
+                 col[6] ? fmt::format(", mass {:.6g}", mass) : "", "at ",
+                 positions + (count > 4 ? ", ..." : ""), r.removed,
+                 col[6] ? fmt::format(" (mass {:.6g})", r.mass) : "");
+    }
+  }
+
+  // At the end of a run: what each remove bound took out.
+  void report_removals() {
+    if (prog_.rank > 0) return;
+    for (const Removing& r : removing_) {
+      if (r.removed == 0) continue;
+      progress_.break_line();
+      const std::string from = r.limit.where.empty() ? "" : " (" + r.limit.where + ")";
+      const std::string mass =
+          std::isnan(r.mass) ? ""
+                             : fmt::format(", mass {:.6g} ({:.3g}% of the array's at the start)",
+                                           r.mass, r.mass_at_start > 0
+                                                       ? 100.0 * r.mass / r.mass_at_start
+                                                       : 0.0);
+      fmt::print(stderr,
+                 "removed: {} particle{} of array '{}' {} (limit '{}'{}){}, from t={} to "
+                 "t={}; the last at {}\n",
+                 r.removed, r.removed == 1 ? "" : "s", r.array->name, r.limit.remove_text(),
+                 r.limit.name(), from, mass, r.first_t, r.last_t, r.last);
+    }
+  }
+
+  // The removals, then the limits (on host data: call after check_finite).
+  std::optional<std::string> remove_and_check_limits() {
+    remove_particles();
+    return check_limits();
   }
 
   // Checks the limits (on host data: call after check_finite) and the iterated groups.

@@ -16,9 +16,12 @@ mass, in J/kg, and every energy check is a ratio, so its verdict is the same).
 
 Blanket invariants (every case):
   no-nan        no NaN or Inf in any dataset of any array.
-  count         the number of particles of every array is that of the first snapshot.
+  count         the number of particles of every array is that of the first snapshot,
+                less the particles the scene's limits removed up to the snapshot's step (a
+                limit's `remove`: water thrown out of an open tank; the solver lists each in
+                OUTPUT_DIR/<scene>_removed.csv, read when it is there).
   mass          the total mass of every array that writes `m` is that of the first snapshot
-                (to 1e-12 relative: the masses are constants).
+                less the removed particles' (to 1e-12 relative: the masses are constants).
   ke-jump       the kinetic energy of the fluid, KE = sum m |v|^2 / 2, never rises in one
                 output interval by more than --ke-jump (default 10%) of its value at the
                 start of the interval plus the work its physical source can do in it:
@@ -79,6 +82,9 @@ Case invariants (options):
                 the --ke-floor.
   --surface-drift-after T       the top of the fluid (the largest y; z in 3D) stays within
                 --surface-drift dx (default 1) of its value at the first snapshot at t >= T.
+  --max-removed N               removed: at most N particles of the fluid removed by the
+                scene's limits (a limit's `remove`, OUTPUT_DIR/<scene>_removed.csv) up to
+                each snapshot (water thrown out of an open tank over a wall's top).
   --expect-violation NAME       invert the verdict for the invariant NAME: the check passes
                 only if NAME is violated (and prints where); the other invariants must hold.
                 For the cases that must show a failure (the tensile instability without
@@ -90,6 +96,7 @@ Exit 0 when every invariant holds (or the expected violation happens), 1 when on
 2 on bad input.
 """
 import argparse
+import glob
 import math
 import os
 import sys
@@ -240,6 +247,24 @@ class Invariant:
         self.violations.append("[%s] t = %.4f: %s" % (self.name, t, msg))
 
 
+def removed_particles(outdir):
+    """The particles the solver removed (a limit's `remove`), from OUTPUT_DIR/*_removed.csv:
+    (step, limit, array, mass) per particle (mass 0 where the array has no m)."""
+    rows = []
+    for path in sorted(glob.glob(os.path.join(outdir, "*_removed.csv"))):
+        with open(path) as f:
+            header = f.readline().strip().split(",")
+            col = {k: i for i, k in enumerate(header)}
+            for line in f:
+                v = line.rstrip("\n").split(",")
+                if len(v) != len(header):
+                    continue
+                m = v[col["m"]]
+                rows.append((int(v[col["step"]]), v[col["limit"]], v[col["array"]],
+                             float(m) if m else 0.0))
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("outdir")
@@ -276,6 +301,7 @@ def main():
     ap.add_argument("--ke-no-growth-after", type=float, default=None)
     ap.add_argument("--surface-drift-after", type=float, default=None)
     ap.add_argument("--surface-drift", type=float, default=1.0)
+    ap.add_argument("--max-removed", type=int, default=None)
     ap.add_argument("--expect-violation", default=None)
     ap.add_argument("--summary", default=None)
     ap.add_argument("--case", default="?")
@@ -300,6 +326,9 @@ def main():
 
     nan = add("no-nan", 0, "non-finite values (count)")
     count = add("count", 0, "particles gained or lost")
+    gone_fluid = add("removed", args.max_removed,
+                     "fluid particles removed by the scene's limits (out of the tank)") \
+        if args.max_removed is not None else None
     mass = add("mass", 1e-12, "relative change of the total mass")
     kej = add("ke-jump", args.ke_jump, "largest KE rise in one interval beyond its source, "
               "relative to KE at its start")
@@ -334,6 +363,11 @@ def main():
         if args.surface_drift_after is not None else None
     grow = add("ke-growth", 1.0, "max KE of the 2nd half / max KE of the 1st half after "
                "t = %g" % args.ke_no_growth_after) if args.ke_no_growth_after is not None else None
+
+    removed = removed_particles(args.outdir)
+    if removed:
+        print("%s: %d particles removed by the scene's limits (%s), accounted in count and mass"
+              % (WHO, len(removed), ", ".join(sorted({r[1] for r in removed}))))
 
     first = None
     prev = None
@@ -405,19 +439,33 @@ def main():
         if args.c0 is not None and rho is not None and args.rho0 is not None:
             eint = elastic_energy(m, rho, args.rho0, args.c0, gamma)
         if first is None:
-            first = {"t": t, "n": {a: len(p["x"]) for a, p in data.items() if "x" in p},
+            first = {"t": t, "step": step,
+                     "n": {a: len(p["x"]) for a, p in data.items() if "x" in p},
                      "m": {a: float(np.sum(p["m"])) for a, p in data.items() if "m" in p},
                      "M": msum,
                      "eref": args.g * float(np.sum(m * (fl[vert] - fl[vert].min())))}
         # count and mass
+        # (the particles removed after the first snapshot and up to this one, per array)
+        gone = [r for r in removed if step is not None and first.get("step") is not None
+                and first["step"] < r[0] <= step]
+        if gone_fluid is not None:
+            k = sum(1 for r in gone if r[2] == args.fluid)
+            gone_fluid.record(k, lambda a_, b: a_ > b)
+            if k > args.max_removed:
+                gone_fluid.fail(t, "%d fluid particles removed by the scene's limits so far "
+                                   "(limit %d)" % (k, args.max_removed))
         for a, n0 in first["n"].items():
             na = len(data[a]["x"]) if a in data and "x" in data[a] else 0
+            na += sum(1 for r in gone if r[2] == a)
             count.record(abs(na - n0), lambda a_, b: a_ > b)
             if na != n0:
-                count.fail(t, "array %s has %d particles, the first snapshot %d" % (a, na, n0))
+                count.fail(t, "array %s has %d particles and %d removed, the first snapshot %d"
+                           % (a, na - sum(1 for r in gone if r[2] == a),
+                              sum(1 for r in gone if r[2] == a), n0))
         for a, m0 in first["m"].items():
             if a in data and "m" in data[a]:
-                rel = abs(float(np.sum(data[a]["m"])) - m0) / abs(m0) if m0 else 0.0
+                ma = float(np.sum(data[a]["m"])) + sum(r[3] for r in gone if r[2] == a)
+                rel = abs(ma - m0) / abs(m0) if m0 else 0.0
                 mass.record(rel, lambda a_, b: a_ > b)
                 if rel > mass.limit:
                     mass.fail(t, "total mass of %s changed by %.3g (relative)" % (a, rel))

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "sphc/sanity.h"
 
@@ -58,6 +59,40 @@ TEST(Sanity, CheckCountsAndNamesTheWorstParticle) {
   EXPECT_EQ(w.outside_stop, 0u);
   EXPECT_EQ(w.worst, 3u);
   EXPECT_DOUBLE_EQ(w.excess, 1400);
+}
+
+// A limit's remove: the particles outside the remove bound where the condition on another
+// coordinate holds (x = 0, 1, 2, 3 at y = 0, 0.5, 1, 1.5).
+TEST(Sanity, RemovalMaskOutsideTheBoundWhereTheConditionHolds) {
+  ParticleArray a = make_fluid();
+  Limit x{"fluid", "x", "s.sph:4", std::nullopt, Bounds{-1, 2.5}};
+  EXPECT_TRUE(removal_mask(x, a, 2).empty());  // no remove bound: nothing
+  x.remove = Bounds{0.5, 2.5};
+  EXPECT_EQ(removal_mask(x, a, 2), (std::vector<std::uint8_t>{1, 0, 0, 1}));  // every height
+  EXPECT_EQ(x.remove_text(), "outside [0.5, 2.5]");
+  x.remove_where = "y";
+  x.where_bounds = Bounds{1.0, HUGE_VAL};  // above y = 1 only: x = 0 (y = 0) stays
+  EXPECT_EQ(removal_mask(x, a, 2), (std::vector<std::uint8_t>{0, 0, 0, 1}));
+  EXPECT_EQ(x.remove_text(), "outside [0.5, 2.5] where y >= 1");
+  x.where_bounds = Bounds{-1, 0.25};
+  EXPECT_EQ(x.remove_text(), "outside [0.5, 2.5] where y in [-1, 0.25]");
+  EXPECT_EQ(removal_mask(x, a, 2), (std::vector<std::uint8_t>{1, 0, 0, 0}));
+  // NaN in the quantity or the condition: not removed (the NaN check names it).
+  a.f64("x")[0] = NAN;
+  a.f64("y")[3] = NAN;
+  x.where_bounds = Bounds{};
+  EXPECT_TRUE(removal_mask(x, a, 2).empty());
+  // Removing keeps the others in order.
+  a.f64("x")[0] = -5;
+  const auto mask = removal_mask(x, a, 2);
+  EXPECT_EQ(mask, (std::vector<std::uint8_t>{1, 0, 0, 0}));
+  EXPECT_EQ(a.remove_particles(mask), 1u);
+  ASSERT_EQ(a.n, 3u);
+  EXPECT_DOUBLE_EQ(a.f64("x")[0], 1);
+  EXPECT_DOUBLE_EQ(a.f64("rho")[2], 2500);
+  // A condition on a coordinate the array lacks is an error naming the limit.
+  x.remove_where = "z";
+  EXPECT_THROW(removal_mask(x, a, 2), std::runtime_error);
 }
 
 TEST(Sanity, SpeedIsTheVelocityMagnitude) {

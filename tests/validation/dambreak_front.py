@@ -8,7 +8,9 @@ directory (files <scene>_NNNNNN.h5 with root attributes t, step, dt, dim and gro
 files <name>_NNNNN.hdf5 with /particles/fluid/arrays/x and the time in /solver_data) and checks
 
   1. finiteness: no NaN or infinity in any dataset of any snapshot;
-  2. containment: every fluid particle stays in the tank, i.e.
+  2. containment: every fluid particle stays in the tank (the particles the scene's limits
+     removed, listed by the solver in OUTPUT_DIR/<scene>_removed.csv, left it over a wall's
+     top: the count of each snapshot is the first's less them), i.e.
          -layers*dx - tol <= x <= W + layers*dx + tol   and   y >= -layers*dx - tol,
      with tol = 0.1 dx: a particle past the outer face of the wall layers has gone through
      the wall (there is no lid, so y is not bounded above); in 3D (below) the vertical is z,
@@ -82,6 +84,7 @@ Usage: dambreak_front.py OUTPUT_DIR [--tol 0.10] [--tol-ko 0.20] [--tol-mps 0.10
                          [--x0 0] [--dim 2|3] [--depth D] [--label sphc] [--plot out.png]
 """
 
+import glob
 import os
 import sys
 
@@ -197,15 +200,27 @@ def main():
         if metrics is None:
             return 2
 
+    # The water the scene's limits removed (a limit's `remove`: thrown over the walls' top,
+    # out of the open tank), from the solver's OUTPUT_DIR/<scene>_removed.csv: (step, array).
+    removed = []
+    for rpath in sorted(glob.glob(os.path.join(args.outdir, "*_removed.csv"))):
+        with open(rpath) as rf:
+            head = rf.readline().strip().split(",")
+            for line in rf:
+                v = line.rstrip("\n").split(",")
+                if len(v) == len(head):
+                    removed.append((int(v[head.index("step")]), v[head.index("array")]))
+
     failures = []
     dx = args.dx
     dim = args.dim
     channel = None  # 3D: (ymin, ymax) of the channel
-    times, fronts, filtered, nfluid = [], [], [], None
+    times, fronts, filtered, nfluid, first_step = [], [], [], None, None
     for path in files:
         name = os.path.basename(path)
         with h5py.File(path, "r") as f:
             t, fdim, arrays = particle_arrays(f)
+            step = int(f.attrs["step"]) if "step" in f.attrs else None
             if dim is None:
                 dim = fdim if fdim is not None else 2
             if dim not in (2, 3):
@@ -224,8 +239,12 @@ def main():
                 return 2
             pos = [np.asarray(arrays["fluid"][a][()], dtype=float) for a in axes]
             pos[0] = pos[0] - args.x0
+        gone = sum(1 for r_step, r_array in removed
+                   if r_array == "fluid" and step is not None and first_step is not None
+                   and first_step < r_step <= step)
         if nfluid is None:
             nfluid = len(pos[0])
+            first_step = step
             if dx is None:
                 dx = lattice_spacing(pos)
             if dim == 3:
@@ -233,9 +252,9 @@ def main():
                     channel = (0.0, args.depth)
                 else:
                     channel = (float(pos[1].min()) - 0.5 * dx, float(pos[1].max()) + 0.5 * dx)
-        elif len(pos[0]) != nfluid:
-            failures.append("%s: %d fluid particles, the first snapshot has %d"
-                            % (name, len(pos[0]), nfluid))
+        elif len(pos[0]) + gone != nfluid:
+            failures.append("%s: %d fluid particles and %d removed, the first snapshot has %d"
+                            % (name, len(pos[0]), gone, nfluid))
 
         ok = np.all([np.isfinite(c) for c in pos], axis=0)
         pos = tuple(c[ok] for c in pos)

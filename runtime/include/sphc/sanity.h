@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <string>
@@ -40,7 +41,16 @@ struct Limit {
   std::string where;     // source location of the scene's item ("dambreak.sph:151"); empty:
                          // set on the command line or a default
   std::optional<Bounds> warn, stop;
+  // `remove [lo, hi] where C in [lo, hi]` (a position only): the particles outside `remove`
+  // whose coordinate `remove_where` ("x", "y", "z"; empty: every particle) lies within
+  // `where_bounds` are taken out of the run before the bounds are checked (an open tank's
+  // splash over a wall). The scene's, kept under --limits warn and off.
+  std::optional<Bounds> remove;
+  std::string remove_where;
+  Bounds where_bounds;
   std::string name() const { return array + "." + quantity; }
+  // "outside [-0.06, 4.06] where y >= 4"
+  std::string remove_text() const;
 };
 
 // The default limits of a scene that declares none: for every array with positions, the
@@ -64,6 +74,12 @@ struct LimitCheck {
 // Checks `limit` on `a` (the array it names; a quantity it lacks: std::runtime_error naming
 // the limit and where it comes from).
 LimitCheck check_limit(const Limit& limit, const ParticleArray& a, int dim);
+
+// The particles of `a` that `limit`'s remove bound takes out now: mask[i] = 1 for each (the
+// size of the array; empty if none). A particle with a NaN in the quantity or the condition's
+// coordinate is not removed (the run's NaN check names it). std::runtime_error as check_limit
+// for a quantity the array lacks.
+std::vector<std::uint8_t> removal_mask(const Limit& limit, const ParticleArray& a, int dim);
 
 // "particle 37 of array 'fluid' at (0.015, -0.062) has rho = 607000"
 std::string describe_particle(const ParticleArray& a, std::size_t i, int dim,

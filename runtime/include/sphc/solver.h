@@ -190,6 +190,11 @@ struct SceneProgram {
   // The scene's limits { } (sphc/sanity.h), computed from the parameters after the set-up;
   // empty: none declared (the default bounding box applies).
   std::function<std::vector<Limit>()> limits;
+  // After the run loop took particles of array `a` out of the host arrays (a limit's
+  // `remove`): moves the array where the scene computes on it (--precision=single: its float
+  // copy) and forgets what depended on its particles (a static array's cells); empty: nothing
+  // to do (kept lists see the new count and are rebuilt).
+  std::function<void(const ParticleArray& a)> after_removal;
   // The scene's metrics { } (sphc/metrics.h): what they are, and their values at time t from
   // the host arrays (the run loop calls it where it writes output); empty: none declared.
   std::vector<MetricInfo> metrics;
