@@ -89,6 +89,13 @@ struct ClusterLayout {
   double origin[2] = {0, 0};
   std::size_t columns[2] = {0, 0};
   std::vector<std::uint32_t> column_begin;  // columns[0] * columns[1] + 1
+  // In order (build_cluster_layout_in_order, stop 40): slot s IS particle s (the last
+  // cluster padded), a cluster in the column of its box's centre; column_cluster[k] for k in
+  // [column_begin[col], column_begin[col + 1]) the clusters of column col by the low sort
+  // coordinate of their boxes (ties by index). Empty otherwise (the column's clusters are
+  // the indices themselves).
+  bool in_order = false;
+  std::vector<std::uint32_t> column_cluster;
 
   std::size_t slots() const { return n_clusters * static_cast<std::size_t>(width); }
   // real_mask of a cluster without padding.
@@ -108,6 +115,49 @@ double cluster_column_side(double spacing, int dim, int width = kClusterSize);
 void build_cluster_layout(ClusterLayout& layout, const double* x, const double* y,
                           const double* z, std::size_t n, int dim, double column_side,
                           int width = kClusterSize);
+
+// Particles kept in the tiles' slot order (stop 40; docs/performance.md "Particles in the
+// tiles' slot order (stop 40)"). The generated code permutes an array whose tiles' lists are
+// due into `cluster_order`'s order (ParticleArray::permute) and builds its layout in that
+// order (build_cluster_layout_in_order): slot s is particle s, the tiles read and write the
+// particles' arrays themselves; only the last cluster (n % width real particles, if any) is
+// padded, its slots copied per evaluation into `width`-value tails (gather_tail,
+// tail_positions).
+//
+// The order: build_cluster_layout's slots, the padding dropped, the columns in boustrophedon
+// order (3D: the rows of columns along x alternately forwards and backwards, 2D: the strips
+// along x) and each non-empty column along its sort axis alternately upwards and downwards,
+// so that runs of `width` consecutive particles are compact clusters, one that crosses from
+// one column to the next included (both ends at the same height).
+void cluster_order(std::vector<std::uint32_t>& order, const double* x, const double* y,
+                   const double* z, std::size_t n, int dim, double column_side,
+                   int width = kClusterSize);
+// The layout of the particles as they are: slot s = particle s, cluster c the particles
+// [width c, width c + width), the last padded (real slots first); boxes from x, y, z; the
+// grid of columns as build_cluster_layout's (column_side <= 0: the same rule).
+void build_cluster_layout_in_order(ClusterLayout& layout, const double* x, const double* y,
+                                   const double* z, std::size_t n, int dim, double column_side,
+                                   int width = kClusterSize);
+// The padded cluster of an in-order layout: its index, n_clusters if every cluster is full.
+inline std::size_t tail_cluster(const ClusterLayout& L) {
+  return L.n_clusters > 0 && L.slots() != L.n ? L.n_clusters - 1 : L.n_clusters;
+}
+// In order, per evaluation: the padded cluster's values, dst[k][l] = src[k][width t + l]
+// for its real lanes l, its first particle's value for the padding (dst: width values
+// each; nothing where every cluster is full).
+void gather_tail(const ClusterLayout& layout, const double* const* src, double* const* dst,
+                 int count);
+// In order, per evaluation, after the boxes: the padded cluster's positions (width values
+// each; tz unused in 2D), its padding lanes as gather_positions' (x = the largest x of the
+// boxes + k pad_offset, y and z the cluster's first particle's).
+void tail_positions(const ClusterLayout& layout, const double* x, const double* y,
+                    const double* z, double* tx, double* ty, double* tz, double pad_offset);
+// In order, per evaluation (the 2xMM tiles, width 4): the boxes from the particles'
+// positions and the positions doubled per cluster (x2[2 w c + k] = x2[2 w c + w + k] = x[w c
+// + k]), the padding lanes as tail_positions'; z, z2 unused in 2D.
+void positions_doubled_boxes(ClusterLayout& layout, const double* x, const double* y,
+                             const double* z, double* x2, double* y2, double* z2,
+                             double pad_offset, bool parallel = true);
 
 // Per evaluation: dst[s] = src[slot[s]] for every slot (dst: layout.slots() values); a
 // padding slot takes the value of the first slot of its cluster (a real particle).
