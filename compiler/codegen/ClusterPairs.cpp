@@ -173,6 +173,48 @@ void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& stat
   os << "  sphc::ClusterPairList " << state << "_outer, " << state << "_pruned;\n";
   os << "  std::vector<double> " << state << "_slots;\n";
   os << "  double " << state << "_hmax = 0.0;  // the largest h at the build (where nothing writes h)\n";
+  os << "  std::vector<std::uint32_t> " << state << "_order;  // the tiles' slot order (stop 40; update_neighbours)\n";
+}
+
+// Stop 40: the statements of update_neighbours that put the pass's array into its tiles'
+// slot order (sphc::cluster_order, the layout's column side and width as emitClusterTiles
+// builds it) where its lists are expected to be rebuilt at this evaluation
+// (VerletSkin::rebuild_expected), and make every kept list in `forget` rebuild.
+void ScenePrinter::emitClusterSlotOrder(const DestinationWork& w, const std::string& state,
+                                        const std::vector<std::string>& forget,
+                                        const std::string& ind) {
+  const int d = w.array;
+  const std::string A = arr(d).name;
+  const bool mm = plan_.dim == 2 && !cluster2d8x8_;
+  auto plainDouble = [&](const std::string& p) {
+    const PlanProperty* prop = arr(d).find(p);
+    return prop && prop->stride == 1 && propIndex(d, p) >= 0 && hostType(d, p) == "double";
+  };
+  scene_ << ind << "// --simd-pairs=cluster (stop 40): " << A << " in its tiles' slot order (sphc/cluster_pairs.h,\n"
+         << ind << "// cluster_order) where their lists are expected to be rebuilt now; every kept list\n"
+         << ind << "// of " << A << " then rebuilt (a permutation is no movement to measure).\n";
+  scene_ << ind << "if (" << state << ".skin.rebuild_expected(Kernel::radius_scale)) {\n";
+  const std::string in = ind + "  ";
+  std::string side = "0.0";
+  if (mm && plainDouble("m") && plainDouble("rho")) {  // emitClusterTiles' column side
+    side = "cl_side";
+    scene_ << in << "double cl_side = 0.0;\n";
+    scene_ << in << "if (" << A << ".n > 0) {\n";
+    scene_ << in << "  const double* const cl_vm = " << hostPtr(d, "m") << ";\n";
+    scene_ << in << "  const double* const cl_vrho = " << hostPtr(d, "rho") << ";\n";
+    scene_ << in << "  double cl_vol = 0.0;\n";
+    scene_ << in << "  for (std::size_t i = 0; i < " << A << ".n; ++i) cl_vol += cl_vm[i] / cl_vrho[i];\n";
+    scene_ << in << "  cl_vol /= static_cast<double>(" << A << ".n);\n";
+    scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::sqrt(cl_vol), DIM, "
+           << (mm ? "sphc::kClusterSize / 2" : "sphc::kClusterSize") << ");\n";
+    scene_ << in << "}\n";
+  }
+  scene_ << in << "sphc::cluster_order(" << state << "_order, " << hostPtr(d, "x") << ", " << hostPtr(d, "y") << ", "
+         << (plan_.dim == 3 ? hostPtr(d, "z") : std::string("nullptr")) << ", " << A << ".n, DIM, " << side << ", "
+         << (mm ? "sphc::kClusterSize / 2" : "sphc::kClusterSize") << ");\n";
+  scene_ << in << A << ".permute(" << state << "_order);\n";
+  for (const std::string& l : forget) scene_ << in << l << ".skin.forget();\n";
+  scene_ << ind << "}\n";
 }
 
 void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPass& pass,
@@ -185,6 +227,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // 2D (stop 39): GROMACS' 2xMM form, layouts of width 4, a register = 2 i's x the 4 j's
   // (see the top of this file); 3D (and 2D with --cluster-2d-8x8): 8 x 8 tiles.
   const bool mm = plan_.dim == 2 && !cluster2d8x8_;
+  // Stop 40: the array kept in the tiles' slot order (update_neighbours permutes it where the
+  // lists are due; the layout in that order: slot s = particle s, the last cluster padded):
+  // the tiles read and write the particles' arrays (2xMM: the doubled copies stay, now
+  // contiguous reads), the padded last cluster from W-value tails (cl_t_NAME, cl_tacc_NAME).
+  const bool inOrder = clusterSlotOrder(w, pass);
   // The copies in slot order: positions first, then every property the lanes read (by name:
   // di_NAME, sj_NAME, s_NAME and d_NAME of one array are one array), the hoisted values, the
   // sums. name -> the array it is gathered from.
@@ -239,6 +286,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       if (!call.empty()) inSlots[symmetricDestinationHoisted(eqStruct(*eq), std::to_string(k))] = call;
     }
   }
+  // In order: what a copy is read from (the pass's own pointers; the hoisted values' arrays
+  // in the particles' order).
+  auto origin = [&](const std::pair<std::string, std::string>& c) {
+    return c.second.empty() ? "di_" + c.first : c.second;
+  };
   bool allDestinationInSlots = true;
   for (const std::string& h : dhoisted) allDestinationInSlots &= inSlots.count(h) > 0;
   std::vector<std::string> accs;  // the sums: acc_NAME
@@ -261,7 +313,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // The destination-only values of every particle, for the mirrored calls (gathered below;
   // a loop without neighbours: --omp-min-particles' `if`, stop 39).
   const std::string ompIfN = openmp ? ompMinIf("n") : "";  // "" or if (n >= OMP_MIN_PARTICLES)
-  if (!allDestinationInSlots)
+  if (!allDestinationInSlots || (inOrder && !mm))
     emitDestinationHoistedAll(pass, openmp ? "        #pragma omp parallel for schedule(static)" +
                                                  (ompIfN.empty() ? "" : " " + ompIfN) + "\n" : "");
   // The properties nothing writes between two builds (no live equation or stepper writes
@@ -324,31 +376,59 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::sqrt(cl_vol), DIM, CL_W);\n";
     scene_ << in << "}\n";
   }
-  scene_ << in << "if (verlet_build) sphc::build_cluster_layout(cl_layout, di_x, di_y, " << zIn
-         << ", static_cast<std::size_t>(n), DIM, " << side << ", CL_W);\n";
+  scene_ << in << "if (verlet_build) sphc::" << (inOrder ? "build_cluster_layout_in_order" : "build_cluster_layout")
+         << "(cl_layout, di_x, di_y, " << zIn << ", static_cast<std::size_t>(n), DIM, " << side << ", CL_W);\n";
+  if (inOrder)
+    scene_ << in << "const std::uint32_t cl_tail = static_cast<std::uint32_t>(sphc::tail_cluster(cl_layout));  // the padded cluster (n_clusters: none)\n";
   scene_ << in << "const std::size_t n_slots = cl_layout.slots();\n";
   scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots;\n";
   // 2xMM: after the copies and the sums, each copy doubled per cluster (cl2_NAME: cluster c's
   // CL_W values twice, the j side of a register in one contiguous load).
   // (2xMM: the positions alone in slot order, for the boxes; every copy doubled)
-  const size_t nSlotCopies = mm ? static_cast<size_t>(plan_.dim) : copies.size();
-  const size_t nBuf = nSlotCopies + accs.size() + (mm ? 2 * copies.size() : 0);
-  scene_ << in << "cl_buf.resize(" << nBuf << " * n_slots);  // (kept: the copies made at the build)\n";
+  const size_t nSlotCopies = inOrder ? 0 : mm ? static_cast<size_t>(plan_.dim) : copies.size();
+  const size_t nAccs = inOrder ? 0 : accs.size();  // in order: the sums in the particles' arrays
+  const size_t nBuf = nSlotCopies + nAccs + (mm ? 2 * copies.size() : 0);
+  // In order: the tails (the padded cluster's values, CL_W each) after the slot buffers.
+  const size_t nTails = inOrder ? (mm ? 0 : copies.size()) + accs.size() : 0;
+  scene_ << in << "cl_buf.resize(" << nBuf << " * n_slots" << (nTails ? " + " + std::to_string(nTails) + " * CL_W" : "")
+         << ");  // (kept: the copies made at the build)\n";
   size_t at = 0;
   for (size_t k = 0; k < nSlotCopies; ++k)
     scene_ << in << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
-  for (const std::string& p : accs)
-    scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  if (!inOrder)
+    for (const std::string& p : accs)
+      scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   if (mm)
     for (const auto& c : copies) {
       scene_ << in << "double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
       at += 2;
     }
+  // In order: the tails' pointers (printed again in the tiles).
+  auto tailPointers = [&](const std::string& ind) {
+    size_t k = 0;
+    if (!mm)
+      for (const auto& c : copies)
+        scene_ << ind << "double* const cl_t_" << c.first << " = cl_buf.data() + " << at << " * n_slots + " << k++ << " * CL_W;\n";
+    for (const std::string& p : accs)
+      scene_ << ind << "double* const cl_tacc_" << p << " = cl_buf.data() + " << at << " * n_slots + " << k++ << " * CL_W;\n";
+  };
+  if (inOrder) tailPointers(in);
   scene_ << in << "// The positions in slot order (padding slots 4 supports away from every particle)\n"
          << in << "// and the boxes in one pass, the outer list at a rebuild, the list pruned at the\n"
          << in << "// support now.\n";
-  scene_ << in << "sphc::gather_positions_boxes(cl_layout, di_x, di_y, " << zIn << ", cl_x, cl_y, "
-         << (plan_.dim == 3 ? "cl_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax" << par << ");\n";
+  if (inOrder && mm) {
+    scene_ << in << "// (in order: the boxes and the doubled positions from the particles' own)\n";
+    scene_ << in << "sphc::positions_doubled_boxes(cl_layout, di_x, di_y, " << zIn << ", cl2_x, cl2_y, "
+           << (plan_.dim == 3 ? "cl2_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax" << par << ");\n";
+  } else if (inOrder) {
+    scene_ << in << "// (in order: the boxes from the particles' positions, the padded cluster's in its tail)\n";
+    scene_ << in << "sphc::update_boxes(cl_layout, di_x, di_y, " << zIn << ");\n";
+    scene_ << in << "sphc::tail_positions(cl_layout, di_x, di_y, " << zIn << ", cl_t_x, cl_t_y, "
+           << (plan_.dim == 3 ? "cl_t_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax);\n";
+  } else {
+    scene_ << in << "sphc::gather_positions_boxes(cl_layout, di_x, di_y, " << zIn << ", cl_x, cl_y, "
+           << (plan_.dim == 3 ? "cl_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax" << par << ");\n";
+  }
   scene_ << in << "if (verlet_build) sphc::build_cluster_pairs(cl_layout, cl_layout, std::sqrt("
          << listRadius2 << ") * cl_hmax, true, " << state << "_outer" << par << ");\n";
   scene_ << in << "sphc::prune_cluster_pairs(cl_layout, cl_layout, " << state
@@ -373,6 +453,23 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << ind << (mm ? "sphc::gather_slots_doubled" : "sphc::gather_slots") << "(cl_layout, cl_from, cl_to, "
            << cs.size() << par << ");\n";
   };
+  if (inOrder && !mm) {  // the tiles read the arrays themselves: the padded cluster's tails only
+    fixedCopies.clear();
+    evalCopies.clear();
+    std::vector<std::string> from, to;
+    for (size_t k = static_cast<size_t>(plan_.dim); k < copies.size(); ++k) {
+      from.push_back(origin(copies[k]));
+      to.push_back("cl_t_" + copies[k].first);
+    }
+    if (!from.empty()) {
+      scene_ << in << "{  // the padded cluster's values (its padding lanes: its first particle's)\n";
+      scene_ << in << "  const double* const cl_from[] = {";
+      for (size_t k = 0; k < from.size(); ++k) scene_ << (k ? ", " : "") << from[k];
+      scene_ << "};\n" << in << "  double* const cl_to[] = {";
+      for (size_t k = 0; k < to.size(); ++k) scene_ << (k ? ", " : "") << to[k];
+      scene_ << "};\n" << in << "  sphc::gather_tail(cl_layout, cl_from, cl_to, " << from.size() << ");\n" << in << "}\n";
+    }
+  }
   if (!fixedCopies.empty()) {
     scene_ << in << "if (verlet_build) {  // the copies of what nothing writes: at the build only\n";
     gathers(fixedCopies, in + "  ");
@@ -383,7 +480,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     gathers(evalCopies, in + "  ");
     scene_ << in << "}\n";
   }
-  if (mm) {  // the positions doubled (the copies above are doubled as they are gathered)
+  if (mm && !inOrder) {  // the positions doubled (the copies above are doubled as they are gathered)
     scene_ << in << "// The positions doubled: cluster c's CL_W values twice (the j side of a register in\n"
            << in << "// one load of 8 lanes; the i-cluster's registers from its first half).\n";
     if (openmp)
@@ -412,7 +509,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       if (auto it = inSlots.find(c.first); it != inSlots.end())
         scene_ << in << "    cl2_" << c.first << "[cl_s2] = cl2_" << c.first << "[cl_s2 + CL_W] = " << it->second << ";\n";
     scene_ << in << "  }\n";
-  } else if (!inSlots.empty()) {
+  } else if (!inSlots.empty() && !inOrder) {
     scene_ << in << "// the hoisted values in slot order from the copies (the same function of the same\n"
            << in << "// doubles as in the particles' order: the values a gather would copy)\n";
     if (openmp)
@@ -442,6 +539,10 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
            << in << "//     half tiles: the later block computes their j sides in its (1)).\n"
            << in << "// A tile across two blocks is computed twice, each side once; a half tile does\n"
            << in << "// the same operations on the same values as its side of the whole tile.\n";
+  if (inOrder && !accs.empty()) {
+    scene_ << in << "// the padded cluster's j-side sums (written by the block that holds it only)\n";
+    for (const std::string& p : accs) scene_ << in << "std::fill(cl_tacc_" << p << ", cl_tacc_" << p << " + CL_W, 0.0);\n";
+  }
   scene_ << in << "auto tiles = [&](const int cb, const int ce) SPHC_TILES_OPTIMIZE {\n";
   const std::string t = in + "  ";
   if (mm) {
@@ -454,16 +555,24 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // The copies' pointers again, locals of the lambda (captured by reference, GCC reloads them
   // in the loops), and the lists' arrays.
   at = 0;
+  if (inOrder && !mm) {
+    scene_ << t << "// in order: slot s is particle s (cl_NAME: the arrays), the padded cluster's tails\n";
+    for (const auto& c : copies) scene_ << t << "const double* const cl_" << c.first << " = " << origin(c) << ";\n";
+  }
   for (size_t k = 0; k < nSlotCopies; ++k)
     if (!mm) scene_ << t << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
     else ++at;  // (2xMM: the tiles read the doubled copies only)
   for (const std::string& p : accs)
-    scene_ << t << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+    if (inOrder)
+      scene_ << t << "double* const cl_acc_" << p << " = d_" << p << ";  // (in order: the particles' sums)\n";
+    else
+      scene_ << t << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   if (mm)
     for (const auto& c : copies) {
       scene_ << t << "const double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
       at += 2;
     }
+  if (inOrder) tailPointers(t);
   scene_ << t << "const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
   scene_ << t << "const std::uint32_t* const cl_j = cl_pruned.j.data();\n";
   scene_ << t << "const std::uint8_t* const cl_real = cl_layout.real_mask.data();\n";
@@ -472,7 +581,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (const std::string& p : pass.shared)
       scene_ << t << "const double* const di_" << p << " = cl_" << p << ";\n";
   }
-  scene_ << t << "// the block's slot sums (only this block writes them)\n";
+  if (!inOrder) scene_ << t << "// the block's slot sums (only this block writes them)\n";
+  if (!inOrder)
   for (const std::string& p : accs)
     scene_ << t << "std::fill(cl_acc_" << p << " + CL_W * static_cast<std::size_t>(cb), cl_acc_" << p
            << " + CL_W * static_cast<std::size_t>(ce), 0.0);\n";
@@ -490,19 +600,37 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     }
     scene_ << c1 << "}\n";
   };
+  // The j side's sums: in order the padded cluster's in its tails.
+  auto jAcc = [&](const std::string& p) {
+    return inOrder ? "(jt ? cl_tacc_" + p + " : cl_acc_" + p + ")" : "cl_acc_" + p;
+  };
   // One tile (j-cluster cl_j[e] of i-cluster ci): both sides, or one side's half tile.
   enum class Side { Both, I, J };
   auto tile = [&](Side side, const std::string& c2) {
     const bool iSide = side != Side::J, jSide = side != Side::I;
     const std::string L = "CL_LANES";  // the lanes of a register
     if (mm) {
-      scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;  // its first slot\n";
+      if (inOrder) {
+        scene_ << c2 << "const bool jt = cl_j[e] == cl_tail;  // the padded cluster: its sums in its tails\n";
+        scene_ << c2 << "const int j0 = jt ? 0 : static_cast<int>(cl_j[e]) * CL_W;  // its first slot\n";
+      } else {
+        scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;  // its first slot\n";
+      }
       scene_ << c2 << "const int j2 = static_cast<int>(cl_j[e]) * CL_LANES;  // in the doubled copies\n";
     } else {
-      scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;\n";
+      if (inOrder) {
+        scene_ << c2 << "const bool jt = cl_j[e] == cl_tail;  // the padded cluster: from its tails\n";
+        scene_ << c2 << "const int j0 = jt ? 0 : static_cast<int>(cl_j[e]) * CL_W;\n";
+      } else {
+        scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;\n";
+      }
     }
     const std::string jOff = mm ? "cl2_" : "cl_";
     const std::string jAt = mm ? " + j2" : " + j0";
+    // (in order, 8 x 8: the padded cluster's values from its tails)
+    auto jPtr = [&](const std::string& name) {
+      return !mm && inOrder ? "(jt ? cl_t_" + name + " : cl_" + name + ")" + jAt : jOff + name + jAt;
+    };
     if (side == Side::Both)
       scene_ << c2 << "const bool diagonal = cl_j[e] == static_cast<std::uint32_t>(ci);\n";
     if (mm)
@@ -510,13 +638,13 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     else
       scene_ << c2 << "// The source side: the j-cluster's 8 slots, s_idx the lane.\n";
     for (const std::string& p : pass.shared)
-      scene_ << c2 << "const double* const sj_" << p << " = " << jOff << p << jAt << ";\n";
+      scene_ << c2 << "const double* const sj_" << p << " = " << jPtr(p) << ";\n";
     for (const std::string& p : pass.sourceProps)
-      scene_ << c2 << "const double* const s_" << p << " = " << jOff << p << jAt << ";\n";
-    for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = " << jOff << h << jAt << ";\n";
+      scene_ << c2 << "const double* const s_" << p << " = " << jPtr(p) << ";\n";
+    for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = " << jPtr(h) << ";\n";
     // (the mirrored calls read particle s_idx's destination values through d_NAME)
-    for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = " << jOff << p << jAt << ";\n";
-    for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = " << jOff << h << jAt << ";\n";
+    for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = " << jPtr(p) << ";\n";
+    for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = " << jPtr(h) << ";\n";
     if (jSide) {
       scene_ << c2 << "// j's sums over the tile's i's" << (mm ? " (lanes l and l + CL_W: j l)" : "") << "\n";
       for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[" << L << "] = {};\n";
@@ -663,12 +791,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
         scene_ << c2 << "#pragma omp simd  // the two halves folded (j l: lanes l, l + CL_W), onto the slot sums\n";
         scene_ << c2 << "for (int l = 0; l < CL_W; ++l) {\n";
         for (const std::string& p : accs)
-          scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l] + tj_" << p << "[CL_W + l];\n";
+          scene_ << c2 << "  " << jAcc(p) << "[j0 + l] += tj_" << p << "[l] + tj_" << p << "[CL_W + l];\n";
       } else {
         scene_ << c2 << "#pragma omp simd  // (a vector: unrolled, the tj_ arrays would be scalars)\n";
         scene_ << c2 << "for (int l = 0; l < CL_LANES; ++l) {\n";
         for (const std::string& p : accs)
-          scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l];\n";
+          scene_ << c2 << "  " << jAcc(p) << "[j0 + l] += tj_" << p << "[l];\n";
       }
       scene_ << c2 << "}\n";
     }
@@ -720,14 +848,15 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << c1 << "}\n";
   }
   if (mm) {
-    scene_ << c1 << "for (int k = 0; k < CL_W; ++k) {  // slot k: register k / 2, lanes (k % 2) CL_W ...\n";
+    scene_ << c1 << "for (int k = 0; k < CL_W" << (inOrder ? " && (real_i >> k & 1u)" : "")
+           << "; ++k) {  // slot k: register k / 2, lanes (k % 2) CL_W ...\n";
     for (const std::string& p : accs) {
       scene_ << c1 << "  double s_" << p << " = 0.0;\n";
       scene_ << c1 << "  for (int l = 0; l < CL_W; ++l) s_" << p << " += ti_" << p << "[k / 2][(k % 2) * CL_W + l];\n";
       scene_ << c1 << "  cl_acc_" << p << "[ci * CL_W + k] += s_" << p << ";\n";
     }
   } else {
-    scene_ << c1 << "for (int ii = 0; ii < CL_W; ++ii) {\n";
+    scene_ << c1 << "for (int ii = 0; ii < CL_W" << (inOrder ? " && (real_i >> ii & 1u)" : "") << "; ++ii) {\n";
     for (const std::string& p : accs) {
       scene_ << c1 << "  double s_" << p << " = 0.0;\n";
       scene_ << c1 << "  for (int l = 0; l < CL_LANES; ++l) s_" << p << " += ti_" << p << "[ii][l];\n";
@@ -753,8 +882,16 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "  for (int blk = 0; blk < n_blocks; ++blk) tiles(cl_cb[blk], cl_cb[blk + 1]);\n";
     scene_ << in << "}\n";
   }
-  scene_ << in << "// The slot sums onto the particles' sums (padding slots never read), in one pass.\n";
-  if (!accs.empty()) {
+  if (inOrder && !accs.empty()) {
+    scene_ << in << "// In order the tiles summed onto the particles' sums, but for the padded cluster's\n"
+           << in << "// j sides, in its tails: added to its real particles.\n";
+    scene_ << in << "if (cl_tail < cl_layout.n_clusters)\n";
+    scene_ << in << "  for (std::size_t s = static_cast<std::size_t>(cl_tail) * CL_W, l = 0; s < cl_layout.n; ++s, ++l) {\n";
+    for (const std::string& p : accs) scene_ << in << "    d_" << p << "[s] += cl_tacc_" << p << "[l];\n";
+    scene_ << in << "  }\n";
+  }
+  if (!inOrder) scene_ << in << "// The slot sums onto the particles' sums (padding slots never read), in one pass.\n";
+  if (!accs.empty() && !inOrder) {
     scene_ << in << "{\n";
     scene_ << in << "  const double* const cl_sums[] = {";
     for (size_t k = 0; k < accs.size(); ++k) scene_ << (k ? ", " : "") << "cl_acc_" << accs[k];

@@ -49,6 +49,15 @@ class CpuPrinter : public ScenePrinter {
   // printer's: serial, the fixed skin, kept lists of the pass's own.
   std::string clusterTilesFormRefusal(const DestinationWork& w,
                                       const NeighbourPass& pass) const override;
+  // Slot order (stop 40): the pass over its own array, which is sorted (no ranged group
+  // names its particles by index), double, without ghosts or halos.
+  bool clusterSlotOrder(const DestinationWork& w, const NeighbourPass& pass) const override {
+    return clusterSlotOrder_ && !mpi_ && !cpuSingle_ && !hasDomain() && !hasZones() &&
+           w.array == pass.source && !w.ranged() && reorders(arr(w.array).name);
+  }
+  std::string slotOrderLists(const std::string& S) const;
+  bool slotOrdered(const std::string& S) const { return !slotOrderLists(S).empty(); }
+  void emitSlotOrder(const std::string& S);
   bool anyClusterTiles() const {
     bool any = false;
     walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
@@ -990,6 +999,31 @@ void CpuPrinter::updateNeighboursKeptGhosts() {
     scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
 }
 
+// The tiled pass over S's own particles kept in slot order (stop 40), if any: its lists'
+// name, "" if none.
+std::string CpuPrinter::slotOrderLists(const std::string& S) const {
+  std::string found;
+  forEachVerletLists([&](const std::string& lists, const Phase&, const DestinationWork& w,
+                         const NeighbourPass& pass) {
+    if (found.empty() && arr(w.array).name == S && clusterTilesRefusal(w, pass).empty() &&
+        clusterSlotOrder(w, pass))
+      found = lists;
+  });
+  return found;
+}
+
+void CpuPrinter::emitSlotOrder(const std::string& S) {
+  const std::string state = slotOrderLists(S);
+  std::vector<std::string> forget;
+  const DestinationWork* tiled = nullptr;
+  forEachVerletLists([&](const std::string& lists, const Phase&, const DestinationWork& w,
+                         const NeighbourPass& pass) {
+    if (arr(w.array).name == S || arr(pass.source).name == S) forget.push_back(lists);
+    if (lists == state) tiled = &w;
+  });
+  emitClusterSlotOrder(*tiled, state, forget, "    ");
+}
+
 bool CpuPrinter::isStatic(const std::string& S) const {
   if (hasDomain() || mpi_ || hasZones()) return false;  // ghosts, halos, inlets and outlets
   auto written = [&](int a, const char* p) {
@@ -1078,6 +1112,11 @@ void CpuPrinter::updateNeighbours() {
   for (const auto& S : sourceArrays_) {
     if (isStatic(S)) continue;  // build_static_cells
     const std::string build = cellListBuild(S, S + ".n");
+    if (slotOrdered(S)) {  // in its tiles' slot order, not in cell order (stop 40)
+      emitSlotOrder(S);
+      if (!lazyCells()) scene_ << "    " << build << "\n";
+      continue;
+    }
     if (lazyCells()) {
       if (reorders(S))
         scene_ << "    if (reorder) {\n      " << cellListBuild(S, S + ".n", "order_domain")

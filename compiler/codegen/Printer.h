@@ -470,12 +470,21 @@ class ScenePrinter {
                         const std::string& state, const std::string& listRadius2,
                         const std::set<std::string>& q, const RegisterSums& sums,
                         bool openmp = false);
+  // Stop 40: update_neighbours' statements that permute w's array into the tiles' slot
+  // order where the lists `state` are expected to be rebuilt, then forget the lists `forget`.
+  void emitClusterSlotOrder(const DestinationWork& w, const std::string& state,
+                            const std::vector<std::string>& forget, const std::string& ind);
   // The members of struct Scene a pass in tiles keeps (state: its kept lists' member name).
   static void clusterTilesMembers(std::ostream& os, const std::string& state,
                                   const std::string& what);
   bool simdCluster_ = false;  // EmitOptions::simdPairsCluster (with simdOnce_)
   bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops only
   bool cluster2d8x8_ = false;     // EmitOptions::cluster2d8x8: 2D tiles 8 x 8, not 2xMM
+  bool clusterSlotOrder_ = true;  // EmitOptions::clusterSlotOrder (--no-slot-order: false)
+  // Whether the pass's array is kept in its tiles' slot order (stop 40; ClusterPairs.cpp):
+  // permuted into it where its tiles' lists are due (update_neighbours) and read and written
+  // by the tiles in place. The CPU printer's answer (its own arrays, sorted, double).
+  virtual bool clusterSlotOrder(const DestinationWork&, const NeighbourPass&) const { return false; }
   std::string simdClusterWhy_;    // the report's reason (--simd-pairs=cluster, or auto's)
   // --precision=single: the float local a SIMD loop passes for a body's double argument (t,
   // dt, an equation's scalar: f_t, f_eq2_alpha), converted once before the loop; "" for
