@@ -74,6 +74,11 @@ namespace sphc {
 
 namespace {
 
+// Stop 40: the particles are put in the tiles' order again when the outer list, built in
+// their present order, holds this many times the cluster pairs per cluster that it held at
+// the first build after the last sort (the clusters loosened as the particles moved).
+constexpr const char* kSlotOrderLoosened = "1.05";
+
 // Whether `text` names d_idx or s_idx other than as a whole subscript `[d_idx]` (with the
 // slot indices of the tiles, an index used as a number would change meaning).
 bool indexUsedAsNumber(const std::string& text) {
@@ -174,6 +179,10 @@ void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& stat
   os << "  std::vector<double> " << state << "_slots;\n";
   os << "  double " << state << "_hmax = 0.0;  // the largest h at the build (where nothing writes h)\n";
   os << "  std::vector<std::uint32_t> " << state << "_order;  // the tiles' slot order (stop 40; update_neighbours)\n";
+  os << "  // (stop 40) whether the particles are to be put in the tiles' order at the next expected\n"
+        "  // rebuild; whether they were since the last build; the outer list's pairs per cluster then\n";
+  os << "  bool " << state << "_order_due = true, " << state << "_sorted = false;\n";
+  os << "  double " << state << "_pairs0 = 0.0;\n";
 }
 
 // Stop 40: the statements of update_neighbours that put the pass's array into its tiles'
@@ -193,7 +202,7 @@ void ScenePrinter::emitClusterSlotOrder(const DestinationWork& w, const std::str
   scene_ << ind << "// --simd-pairs=cluster (stop 40): " << A << " in its tiles' slot order (sphc/cluster_pairs.h,\n"
          << ind << "// cluster_order) where their lists are expected to be rebuilt now; every kept list\n"
          << ind << "// of " << A << " then rebuilt (a permutation is no movement to measure).\n";
-  scene_ << ind << "if (" << state << ".skin.rebuild_expected(Kernel::radius_scale)) {\n";
+  scene_ << ind << "if (" << state << "_order_due && " << state << ".skin.rebuild_expected(Kernel::radius_scale)) {\n";
   const std::string in = ind + "  ";
   std::string side = "0.0";
   if (mm && plainDouble("m") && plainDouble("rho")) {  // emitClusterTiles' column side
@@ -214,6 +223,8 @@ void ScenePrinter::emitClusterSlotOrder(const DestinationWork& w, const std::str
          << (mm ? "sphc::kClusterSize / 2" : "sphc::kClusterSize") << ");\n";
   scene_ << in << A << ".permute(" << state << "_order);\n";
   for (const std::string& l : forget) scene_ << in << l << ".skin.forget();\n";
+  scene_ << in << state << "_order_due = false;\n";
+  scene_ << in << state << "_sorted = true;\n";
   scene_ << ind << "}\n";
 }
 
@@ -431,6 +442,14 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   }
   scene_ << in << "if (verlet_build) sphc::build_cluster_pairs(cl_layout, cl_layout, std::sqrt("
          << listRadius2 << ") * cl_hmax, true, " << state << "_outer" << par << ");\n";
+  if (inOrder) {
+    scene_ << in << "if (verlet_build) {  // (stop 40) sorted again where the clusters loosened: 5% more cluster pairs\n"
+           << in << "  const double cl_pairs = static_cast<double>(" << state << "_outer.pairs()) / static_cast<double>(std::max<std::size_t>(1, cl_layout.n_clusters));\n"
+           << in << "  if (" << state << "_sorted) " << state << "_pairs0 = cl_pairs;  // the reference: just sorted\n"
+           << in << "  else if (cl_pairs > " << kSlotOrderLoosened << " * " << state << "_pairs0) " << state << "_order_due = true;\n"
+           << in << "  " << state << "_sorted = false;\n"
+           << in << "}\n";
+  }
   scene_ << in << "sphc::prune_cluster_pairs(cl_layout, cl_layout, " << state
          << "_outer, Kernel::radius_scale * cl_hmax, " << state << "_pruned" << par << ");\n";
   scene_ << in << "const sphc::ClusterPairList& cl_pruned = " << state << "_pruned;\n";

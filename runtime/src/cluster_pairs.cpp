@@ -187,22 +187,18 @@ void cluster_order(std::vector<std::uint32_t>& order, const double* x, const dou
   const std::size_t C = static_cast<std::size_t>(L.width);
   order.clear();
   order.reserve(n);
-  bool up = true;  // the next non-empty column along its sort axis upwards
+  std::vector<std::uint32_t> rest;  // the columns' last clusters' particles, if not full
   for (std::size_t cy = 0; cy < L.columns[1]; ++cy)
     for (std::size_t k = 0; k < L.columns[0]; ++k) {
       const std::size_t cx = cy % 2 == 0 ? k : L.columns[0] - 1 - k;
       const std::size_t col = cy * L.columns[0] + cx;
-      const std::size_t s0 = L.column_begin[col] * C, s1 = L.column_begin[col + 1] * C;
-      if (s0 == s1) continue;
-      if (up) {
-        for (std::size_t s = s0; s < s1; ++s)
-          if (L.slot[s] != kPadSlot) order.push_back(L.slot[s]);
-      } else {
-        for (std::size_t s = s1; s-- > s0;)
-          if (L.slot[s] != kPadSlot) order.push_back(L.slot[s]);
+      for (std::size_t c = L.column_begin[col]; c < L.column_begin[col + 1]; ++c) {
+        std::vector<std::uint32_t>& to = L.real_mask[c] == L.full_mask() ? order : rest;
+        for (std::size_t s = c * C; s < (c + 1) * C; ++s)
+          if (L.slot[s] != kPadSlot) to.push_back(L.slot[s]);
       }
-      up = !up;
     }
+  order.insert(order.end(), rest.begin(), rest.end());
 }
 
 void build_cluster_layout_in_order(ClusterLayout& L, const double* x, const double* y,
@@ -698,6 +694,10 @@ struct ColumnBounds {
   std::vector<double> up, down;
   double overhang = 0;  // the most a box sticks out of its column's x-y square (+ slack)
   double slack = 0;     // absolute slack of the reach along the sort axis
+  // In order (stop 40): per column the x and y bounds of its clusters' boxes (lo x, hi x, lo
+  // y, hi y; empty: inverted), which the search tests in place of the widened square (a
+  // cluster of the columns' tops may reach over several columns: the overhang is large).
+  std::vector<double> ext;
 };
 
 ColumnBounds column_bounds(const ClusterLayout& b) {
@@ -705,6 +705,7 @@ ColumnBounds column_bounds(const ClusterLayout& b) {
   const int sa = b.dim == 3 ? 2 : 1;
   cb.up.resize(b.n_clusters);
   cb.down.resize(b.n_clusters);
+  if (b.in_order) cb.ext.assign(4 * b.columns[0] * b.columns[1], 0.0);
   const std::size_t ncol = b.columns[0] * b.columns[1];
   double over = 0;
   for (std::size_t col = 0; col < ncol; ++col) {
@@ -717,6 +718,15 @@ ColumnBounds column_bounds(const ClusterLayout& b) {
     for (std::size_t c = c0; c < c1; ++c) run = std::max(run, b.box[6 * cl(c) + 3 + sa]), cb.up[c] = run;
     run = HUGE_VAL;
     for (std::size_t c = c1; c-- > c0;) run = std::min(run, b.box[6 * cl(c) + sa]), cb.down[c] = run;
+    if (cc) {
+      double e[4] = {HUGE_VAL, -HUGE_VAL, HUGE_VAL, -HUGE_VAL};
+      for (std::size_t c = c0; c < c1; ++c) {
+        const double* bx = &b.box[6 * cl(c)];
+        e[0] = std::min(e[0], bx[0]), e[1] = std::max(e[1], bx[3]);
+        e[2] = std::min(e[2], bx[1]), e[3] = std::max(e[3], bx[4]);
+      }
+      std::copy(e, e + 4, cb.ext.begin() + 4 * static_cast<std::ptrdiff_t>(col));
+    }
     const std::size_t cx = col % b.columns[0], cy = col / b.columns[0];
     const double x0 = b.origin[0] + static_cast<double>(cx) * b.column_side, x1 = x0 + b.column_side;
     const double y0 = b.origin[1] + static_cast<double>(cy) * b.column_side, y1 = y0 + b.column_side;
@@ -777,8 +787,19 @@ void find_pairs(const ClusterLayout& b, const ColumnBounds& cb, const double* ib
     }
     for (std::size_t cx = x0; cx <= x1; ++cx) {
       const double c0 = b.origin[0] + static_cast<double>(cx) * b.column_side - cb.overhang;
-      const double gx = gap(ib[0], ib[3], c0, c0 + b.column_side + 2 * cb.overhang);
-      const double gxy2 = gx * gx + gy2;
+      double gx = gap(ib[0], ib[3], c0, c0 + b.column_side + 2 * cb.overhang);
+      double gyc2 = gy2;
+      if (cc) {  // in order: the column's own bounds (a box's gaps are at least these)
+        const std::size_t col = cy * b.columns[0] + cx;
+        if (b.column_begin[col] == b.column_begin[col + 1]) continue;
+        const double* e = &cb.ext[4 * col];
+        gx = gap(ib[0], ib[3], e[0], e[1]);
+        if (b.dim == 3) {
+          const double gy = gap(ib[1], ib[4], e[2], e[3]);
+          gyc2 = gy * gy;
+        }
+      }
+      const double gxy2 = gx * gx + gyc2;
       if (gxy2 > r2) continue;
       // Along the sort axis a box of this column within r2 is within sqrt(r2 - gxy2).
       const double reach_z = std::sqrt(r2 - gxy2) * (1 + 1e-9) + cb.slack;

@@ -124,11 +124,11 @@ void build_cluster_layout(ClusterLayout& layout, const double* x, const double* 
 // padded, its slots copied per evaluation into `width`-value tails (gather_tail,
 // tail_positions).
 //
-// The order: build_cluster_layout's slots, the padding dropped, the columns in boustrophedon
-// order (3D: the rows of columns along x alternately forwards and backwards, 2D: the strips
-// along x) and each non-empty column along its sort axis alternately upwards and downwards,
-// so that runs of `width` consecutive particles are compact clusters, one that crosses from
-// one column to the next included (both ends at the same height).
+// The order: build_cluster_layout's full clusters as they are (a column's clusters aligned
+// from its bottom, as in the sorted layout), the columns in boustrophedon order (3D: the rows
+// of columns along x alternately forwards and backwards), then the particles of the columns'
+// last clusters that are not full, in the same column order (the tops of neighbouring
+// columns, cut into clusters of their own).
 void cluster_order(std::vector<std::uint32_t>& order, const double* x, const double* y,
                    const double* z, std::size_t n, int dim, double column_side,
                    int width = kClusterSize);
