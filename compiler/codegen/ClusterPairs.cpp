@@ -621,7 +621,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   };
   // The j side's sums: in order the padded cluster's in its tails.
   auto jAcc = [&](const std::string& p) {
-    return inOrder ? "(jt ? cl_tacc_" + p + " : cl_acc_" + p + ")" : "cl_acc_" + p;
+    return (inOrder ? "ja_" : "cl_acc_") + p;
   };
   // One tile (j-cluster cl_j[e] of i-cluster ci): both sides, or one side's half tile.
   enum class Side { Both, I, J };
@@ -806,6 +806,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << c3 << "}\n";
     scene_ << c2 << "}\n";
     if (jSide) {
+      if (inOrder)  // the fold's targets, chosen once per tile
+        for (const std::string& p : accs)
+          scene_ << c2 << "double* const ja_" << p << " = jt ? cl_tacc_" << p << " : cl_acc_" << p << ";\n";
       if (mm) {
         scene_ << c2 << "#pragma omp simd  // the two halves folded (j l: lanes l, l + CL_W), onto the slot sums\n";
         scene_ << c2 << "for (int l = 0; l < CL_W; ++l) {\n";
