@@ -67,6 +67,7 @@
 #include "codegen/Printer.h"
 
 #include <map>
+#include <regex>
 #include <set>
 #include <vector>
 
@@ -92,6 +93,21 @@ bool indexUsedAsNumber(const std::string& text) {
     }
   }
   return false;
+}
+
+// `text` with each site of a sum's component, `d_NAME[S * d_idx + K]` (NAME in `sums`), as
+// `d_NAME[d_idx]`: the bodies' _simd forms have their locals there (stop 40).
+std::string withoutSumComponents(const std::string& text, const std::set<std::string>& sums) {
+  static const std::regex site(R"(\bd_([A-Za-z_][A-Za-z0-9_]*)\s*\[\s*\d+\s*\*\s*d_idx\s*(\+\s*\d+\s*)?\])");
+  std::string out;
+  size_t last = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), site); it != std::sregex_iterator(); ++it) {
+    const std::smatch& m = *it;
+    if (!sums.count(m[1].str())) continue;
+    out += text.substr(last, m.position(0) - last) + "d_" + m[1].str() + "[d_idx]";
+    last = m.position(0) + m.length(0);
+  }
+  return out + text.substr(last);
 }
 
 // `call` (NAME(a, b, ...);  // comment) with each argument that is a whole key of `rename`
@@ -141,16 +157,16 @@ std::string ScenePrinter::clusterTilesFormRefusal(const DestinationWork& w,
     if (std::string why = oneDouble(p); !why.empty()) return why;
   for (const std::string& p : pass.sourceProps)
     if (std::string why = oneDouble(p); !why.empty()) return why;
-  const RegisterSums rs = registerSums(w, pass);
-  for (const auto& [p, sc] : rs.props)
-    if (sc.first != 1) return "the sum " + p + " has " + std::to_string(sc.first) + " components";
+  // (sums with components: a lane array per component, stop 40)
+  std::set<std::string> sums;
+  for (const auto& [p, sc] : registerSums(w, pass).props) sums.insert(p);
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     for (const auto& [p, sc] : destinationValues(b, d))
       if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
     for (const auto& [p, sc] : sourceValues(b))
       if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
-    if (indexUsedAsNumber(b.source.text))
+    if (indexUsedAsNumber(withoutSumComponents(b.source.text, sums)))
       return eq->name + " uses d_idx or s_idx otherwise than as a subscript";
     const auto sites = hoistedSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k)
@@ -165,13 +181,15 @@ std::string ScenePrinter::clusterTilesFormRefusal(const DestinationWork& w,
 }
 
 void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& state,
-                                       const std::string& what) {
+                                       const std::string& what, int users) {
   os << "  // " << what << " in cluster-pair tiles (--simd-pairs=cluster, sphc/cluster_pairs.h): the\n"
         "  // layout and outer list (built with the kept lists' skin), the pruned list, the\n"
         "  // slot-order copies and sums.\n";
   os << "  sphc::ClusterLayout " << state << "_layout;\n";
   os << "  sphc::ClusterPairList " << state << "_outer, " << state << "_pruned;\n";
-  os << "  std::vector<double> " << state << "_slots;\n";
+  for (int u = 0; u < users; ++u)
+    os << "  std::vector<double> " << state << "_slots" << (u ? std::to_string(u) : "")
+       << ";" << (users > 1 ? "  // the slot buffer of pass " + std::to_string(u) + " of these lists" : "") << "\n";
   os << "  double " << state << "_hmax = 0.0;  // the largest h at the build (where nothing writes h)\n";
 }
 
@@ -241,8 +259,19 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   }
   bool allDestinationInSlots = true;
   for (const std::string& h : dhoisted) allDestinationInSlots &= inSlots.count(h) > 0;
-  std::vector<std::string> accs;  // the sums: acc_NAME
-  for (const auto& [p, sc] : sums.props) accs.push_back(p);
+  // The sums, one lane array per component (stop 40): NAME (stride 1) or K_NAME (component K
+  // of a property of stride S, d_NAME[S * d_idx + K]); their locals in the lanes acc_NAME,
+  // accK_NAME (the bodies' _simd forms' names, RegisterSums.cpp).
+  std::vector<std::string> accs;
+  std::map<std::string, std::string> accLocal;           // lane name -> the bodies' local
+  std::map<std::string, std::pair<int, int>> accStride;  // lane name -> stride, component
+  for (const auto& [p, sc] : sums.props)
+    for (int k : sc.second) {
+      const std::string lane = sc.first == 1 ? p : std::to_string(k) + "_" + p;
+      accs.push_back(lane);
+      accLocal[lane] = sumsLocalName(p, sc.first, k);
+      accStride[lane] = {sc.first, k};
+    }
   const std::string in = "          ";
   if (mm)
     scene_ << "        // Each pair once for both particles in cluster-pair tiles (codegen/ClusterPairs.cpp;\n"
@@ -270,9 +299,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // this pass's own: the tiles take no pass whose kept lists another pass shares
   // (CpuPrinter.cpp, "its kept lists are shared with another pass"); were that allowed, a
   // pass would have to copy again where another one filled the buffer since.
+  // Kept lists shared with other passes in tiles (stop 40): the layout is rebuilt by
+  // whichever pass sees the rebuild first, so a pass copies everything at each evaluation.
+  const std::pair<int, int> share = clusterListsShare(w, pass);
   auto unchanged = [&](const std::string& p) {
     const PlanProperty* prop = arr(d).find(p);
-    return prop && !prop->written;
+    return prop && !prop->written && share.second == 1;
   };
   const bool hFixed = unchanged("h");
   // Under OpenMP the pieces without neighbours honour --omp-min-particles (their `if`).
@@ -327,7 +359,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   scene_ << in << "if (verlet_build) sphc::build_cluster_layout(cl_layout, di_x, di_y, " << zIn
          << ", static_cast<std::size_t>(n), DIM, " << side << ", CL_W);\n";
   scene_ << in << "const std::size_t n_slots = cl_layout.slots();\n";
-  scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots;\n";
+  scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots"
+         << (share.first ? std::to_string(share.first) : "") << ";\n";
   // 2xMM: after the copies and the sums, each copy doubled per cluster (cl2_NAME: cluster c's
   // CL_W values twice, the j side of a register in one contiguous load).
   // (2xMM: the positions alone in slot order, for the boxes; every copy doubled)
@@ -632,8 +665,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     const std::string inS = side == Side::Both ? "in_s" : "in_cut";
     emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
     for (const std::string& p : accs) {
-      if (iSide) scene_ << body << "double pd_acc_" << p << " = ti_" << p << "_i[s_idx];\n";
-      if (jSide) scene_ << body << "double ps_acc_" << p << " = tj_" << p << "[s_idx];\n";
+      if (iSide) scene_ << body << "double pd_" << accLocal[p] << " = ti_" << p << "_i[s_idx];\n";
+      if (jSide) scene_ << body << "double ps_" << accLocal[p] << " = tj_" << p << "[s_idx];\n";
     }
     if (iSide)
       for (const PlanEquation* eq : pass.equations)
@@ -652,9 +685,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     endPairShared();
     for (const std::string& p : accs) {
       if (iSide)
-        scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_acc_" << p << " : ti_" << p << "_i[s_idx];\n";
+        scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_" << accLocal[p] << " : ti_" << p << "_i[s_idx];\n";
       if (jSide)
-        scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_acc_" << p << " : tj_" << p << "[s_idx];\n";
+        scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_" << accLocal[p] << " : tj_" << p << "[s_idx];\n";
     }
     scene_ << c3 << "}\n";
     scene_ << c2 << "}\n";
@@ -754,15 +787,32 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "}\n";
   }
   scene_ << in << "// The slot sums onto the particles' sums (padding slots never read), in one pass.\n";
-  if (!accs.empty()) {
+  std::vector<std::string> plain, strided;  // stride 1: add_slots; components: a loop
+  for (const std::string& p : accs) (accStride[p].first == 1 ? plain : strided).push_back(p);
+  if (!plain.empty()) {
     scene_ << in << "{\n";
     scene_ << in << "  const double* const cl_sums[] = {";
-    for (size_t k = 0; k < accs.size(); ++k) scene_ << (k ? ", " : "") << "cl_acc_" << accs[k];
+    for (size_t k = 0; k < plain.size(); ++k) scene_ << (k ? ", " : "") << "cl_acc_" << plain[k];
     scene_ << "};\n";
     scene_ << in << "  double* const cl_into[] = {";
-    for (size_t k = 0; k < accs.size(); ++k) scene_ << (k ? ", " : "") << "d_" << accs[k];
+    for (size_t k = 0; k < plain.size(); ++k) scene_ << (k ? ", " : "") << "d_" << plain[k];
     scene_ << "};\n";
-    scene_ << in << "  sphc::add_slots(cl_layout, cl_sums, cl_into, " << accs.size() << par << ");\n";
+    scene_ << in << "  sphc::add_slots(cl_layout, cl_sums, cl_into, " << plain.size() << par << ");\n";
+    scene_ << in << "}\n";
+  }
+  if (!strided.empty()) {  // the components' slot sums onto d_NAME[S * i + K] (stop 40)
+    scene_ << in << "{\n";
+    scene_ << in << "  const std::uint32_t* const cl_slot_of = cl_layout.slot_of.data();\n";
+    if (openmp)
+      scene_ << in << "  #pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "  for (int i = 0; i < n; ++i) {\n";
+    scene_ << in << "    const std::uint32_t s = cl_slot_of[i];\n";
+    for (const std::string& p : strided) {
+      const auto [S, K] = accStride[p];
+      const std::string prop = p.substr(p.find('_') + 1);
+      scene_ << in << "    d_" << prop << "[" << S << " * i + " << K << "] += cl_acc_" << p << "[s];\n";
+    }
+    scene_ << in << "  }\n";
     scene_ << in << "}\n";
   }
   scene_ << "        }\n";

@@ -471,8 +471,15 @@ class ScenePrinter {
                         const std::set<std::string>& q, const RegisterSums& sums,
                         bool openmp = false);
   // The members of struct Scene a pass in tiles keeps (state: its kept lists' member name).
+  // `users`: the passes in tiles that share these kept lists (and the layout, the outer and
+  // the pruned lists), each with a slot buffer of its own (_slots, _slots1, ...; stop 40).
   static void clusterTilesMembers(std::ostream& os, const std::string& state,
-                                  const std::string& what);
+                                  const std::string& what, int users = 1);
+  // Which of the passes in tiles sharing its kept lists this one is, and how many there are
+  // ({0, 1}: the lists its own; the CPU printer's kept lists, stop 40).
+  virtual std::pair<int, int> clusterListsShare(const DestinationWork&, const NeighbourPass&) const {
+    return {0, 1};
+  }
   bool simdCluster_ = false;  // EmitOptions::simdPairsCluster (with simdOnce_)
   bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops only
   bool cluster2d8x8_ = false;     // EmitOptions::cluster2d8x8: 2D tiles 8 x 8, not 2xMM

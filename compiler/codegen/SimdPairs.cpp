@@ -370,8 +370,16 @@ std::vector<std::string> ScenePrinter::simdPairsNotes() const {
     const std::string loop =
         arr(w.array).name + " <- " + arr(pass.source).name + " in " + ph.name;
     const std::string why = simdPairsRefusal(w, pass);
-    if (!why.empty())
-      notes.push_back("pair loop not in SIMD lanes: " + loop + ": " + why);
+    if (!why.empty()) {
+      // --simd-pairs=cluster: why a 2D loop each pair once is not in the tiles either (the
+      // tiles' own refusal, clusterTilesFormRefusal; stop 40).
+      std::string tiles;
+      if (simdCluster_ && !simdClusterAuto_ && plan_.dim == 2 && onceForm(w, pass)) {
+        const std::string t = clusterTilesFormRefusal(w, pass);
+        if (!t.empty()) tiles = " (not in cluster-pair tiles: " + t + ")";
+      }
+      notes.push_back("pair loop not in SIMD lanes: " + loop + ": " + why + tiles);
+    }
     else if (onceLanes(w, pass) && clusterTilesRefusal(w, pass).empty())  // ClusterPairs.cpp
       notes.push_back("pair loop in cluster-pair tiles, each pair once: " + loop + ": " +
                       simdClusterWhy_);
