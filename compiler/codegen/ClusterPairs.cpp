@@ -166,6 +166,7 @@ std::string ScenePrinter::clusterTilesFormRefusal(const DestinationWork& w,
       if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
     for (const auto& [p, sc] : sourceValues(b))
       if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
+    if (std::string why = rareCallsRefusal(b); !why.empty()) return eq->name + ": " + why;
     if (indexUsedAsNumber(withoutSumComponents(b.source.text, sums)))
       return eq->name + " uses d_idx or s_idx otherwise than as a subscript";
     const auto sites = hoistedSites(b, host_);
@@ -650,46 +651,95 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     if (iSide)
       for (const std::string& p : accs)
         scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[" << (mm ? "r" : "ii") << "];\n";
-    scene_ << c3 << "#pragma omp simd\n";
-    scene_ << c3 << "for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
-    const std::string body = c3 + "  ";
-    if (mm) laneDest(body);
-    emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
-    scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
-    scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
-    if (side == Side::Both) {
-      scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
-      scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
-    }
-    const std::string inD = side == Side::Both ? "in_d" : "in_cut";
-    const std::string inS = side == Side::Both ? "in_s" : "in_cut";
-    emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
-    for (const std::string& p : accs) {
-      if (iSide) scene_ << body << "double pd_" << accLocal[p] << " = ti_" << p << "_i[s_idx];\n";
-      if (jSide) scene_ << body << "double ps_" << accLocal[p] << " = tj_" << p << "[s_idx];\n";
-    }
-    if (iSide)
-      for (const PlanEquation* eq : pass.equations)
-        scene_ << body << pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_");
-    // The mirrored calls index the source's arrays they are given as pointers (a source
-    // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
-    // not offset to the j-cluster (2xMM: the register's i's, d_idx the lane).
-    if (jSide) {
-      std::map<std::string, std::string> absolute;
-      const std::string pre = mm ? "ir_" : "cl_";
-      for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
-      for (const std::string& h : hoisted) absolute[h] = pre + h;
-      for (const PlanEquation* eq : pass.equations)
-        scene_ << body << withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute);
-    }
-    endPairShared();
-    for (const std::string& p : accs) {
+    // The lanes' body. `mode` (stop 40, a pass whose bodies call a math function GCC does not
+    // vectorise, rareCalls): Lanes, the bodies' _simd forms; Marked, their _simd_rare forms,
+    // a call marking the lane (sphc_rare), whose sums are then left as they were and whose
+    // pair is redone after the lanes by Fixup, the _simd forms, scalar, on the marked lanes
+    // alone. Each lane's sums get the same terms in the same order as if every lane were
+    // computed by the _simd forms (the fix-up before the next tile).
+    enum class Mode { Lanes, Marked, Fixup };
+    auto laneBody = [&](const std::string& body, Mode mode) {
+      if (mm) laneDest(body);
+      emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
+      scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
+      scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
+      if (side == Side::Both) {
+        scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
+        scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
+      }
+      std::string inD = side == Side::Both ? "in_d" : "in_cut";
+      std::string inS = side == Side::Both ? "in_s" : "in_cut";
+      emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
+      for (const std::string& p : accs) {
+        if (iSide) scene_ << body << "double pd_" << accLocal[p] << " = ti_" << p << "_i[s_idx];\n";
+        if (jSide) scene_ << body << "double ps_" << accLocal[p] << " = tj_" << p << "[s_idx];\n";
+      }
+      // Marked: the _simd_rare forms, the lane's mark last.
+      auto marked = [&](const PlanEquation& eq, std::string call) {
+        if (mode != Mode::Marked ||
+            scalarMathCallSites(methodBody(eq, ast::Method::Loop).source.text).empty())
+          return call;
+        for (const char* form : {"_simd_mirror(", "_simd("}) {
+          const size_t at = call.find(form);
+          if (at != std::string::npos && at < call.find('(')) {
+            call.insert(at + std::string(form).size() - 1, "_rare");
+            break;
+          }
+        }
+        const size_t close = call.find(");");
+        if (close != std::string::npos) call.insert(close, ", sphc_rare");
+        return call;
+      };
+      if (mode == Mode::Marked)
+        scene_ << body << "double sphc_rare = 0.0;  // a body's scalar math call: the pair is redone below\n";
       if (iSide)
-        scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_" << accLocal[p] << " : ti_" << p << "_i[s_idx];\n";
-      if (jSide)
-        scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_" << accLocal[p] << " : tj_" << p << "[s_idx];\n";
+        for (const PlanEquation* eq : pass.equations)
+          scene_ << body << marked(*eq, pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_"));
+      // The mirrored calls index the source's arrays they are given as pointers (a source
+      // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
+      // not offset to the j-cluster (2xMM: the register's i's, d_idx the lane).
+      if (jSide) {
+        std::map<std::string, std::string> absolute;
+        const std::string pre = mm ? "ir_" : "cl_";
+        for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
+        for (const std::string& h : hoisted) absolute[h] = pre + h;
+        for (const PlanEquation* eq : pass.equations)
+          scene_ << body << marked(*eq, withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute));
+      }
+      endPairShared();
+      if (mode == Mode::Marked) {
+        scene_ << body << "const bool in_rare = (" << (side == Side::Both ? "in_d | in_s" : "in_cut")
+               << ") & (sphc_rare > 0.0);  // redone below\n";
+        scene_ << body << "rare_l[s_idx] = in_rare ? 1.0 : 0.0;\n";
+        scene_ << body << "n_rare += in_rare ? 1.0 : 0.0;\n";
+        inD = "(" + inD + " & !in_rare)";
+        inS = "(" + inS + " & !in_rare)";
+      }
+      for (const std::string& p : accs) {
+        if (iSide)
+          scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_" << accLocal[p] << " : ti_" << p << "_i[s_idx];\n";
+        if (jSide)
+          scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_" << accLocal[p] << " : tj_" << p << "[s_idx];\n";
+      }
+    };
+    const bool rare = rareCalls(pass);
+    if (rare) {
+      scene_ << c3 << "// the lanes whose pair took a body's rare path (a call GCC does not vectorise)\n";
+      scene_ << c3 << "alignas(64) double rare_l[" << L << "];\n";
+      scene_ << c3 << "double n_rare = 0.0;\n";
     }
+    scene_ << c3 << "#pragma omp simd" << (rare ? " reduction(+: n_rare)" : "") << "\n";
+    scene_ << c3 << "for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
+    laneBody(c3 + "  ", rare ? Mode::Marked : Mode::Lanes);
     scene_ << c3 << "}\n";
+    if (rare) {
+      scene_ << c3 << "if (n_rare > 0.0) {  // the marked lanes' pairs, scalar, with the bodies' calls\n";
+      scene_ << c3 << "  for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
+      scene_ << c3 << "    if (!(rare_l[s_idx] > 0.0)) continue;\n";
+      laneBody(c3 + "    ", Mode::Fixup);
+      scene_ << c3 << "  }\n";
+      scene_ << c3 << "}\n";
+    }
     scene_ << c2 << "}\n";
     if (jSide) {
       if (mm) {
