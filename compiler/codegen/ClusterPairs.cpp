@@ -498,6 +498,16 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << t << "const double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
       at += 2;
     }
+  // The equations' values as locals (stop 40): read through the scene in the lanes, GCC 12
+  // loaded those read under a mask (a body's branch) by gathers with every lane at one
+  // address (8 vgatherqpd per register in the own dam break's rates pass).
+  {
+    std::set<std::string> eqs;
+    for (const PlanEquation* eq : pass.equations)
+      if (eqs.insert(eqStruct(*eq)).second)
+        scene_ << t << "const auto " << eqStruct(*eq) << " = this->" << eqStruct(*eq) << ";  // "
+               << eq->name << "'s values, a local copy\n";
+  }
   scene_ << t << "const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
   scene_ << t << "const std::uint32_t* const cl_j = cl_pruned.j.data();\n";
   scene_ << t << "const std::uint8_t* const cl_real = cl_layout.real_mask.data();\n";

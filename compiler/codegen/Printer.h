@@ -397,7 +397,7 @@ class ScenePrinter {
   // pair quantities three scalars each (XIJ_0, XIJ_1, XIJ_2; SimdPairs.cpp).
   // `mirror`: NAME_loop_simd_mirror, also its source properties values (sval_NAME).
   // `rare`: the tiles' rare form (NAME_loop_simd_rare, _simd_mirror_rare; stop 40): each
-  // scalar math call a mark of the lane, `double& sphc_rare` (SphcRareCall).
+  // scalar math call a mark of the lane, `double& sphc_rare` (sphc_rare_call).
   void printSumsFunction(const PlanEquation& eq, bool scalarPairs, std::ostringstream& os,
                          bool mirror = false, bool rare = false) const;
   // The edits of b's text for its _simd form but the sums: XIJ[k] -> XIJ_k, the destination
@@ -486,7 +486,7 @@ class ScenePrinter {
   // Whether the tiles take the pass with its scalar math calls (simdPairsBlocker lets them
   // through then).
   bool rareCallsInTiles(const DestinationWork& w, const NeighbourPass& pass) const;
-  bool rareHelperPrinted_ = false;  // SphcRareCall, before the first _simd_rare form
+  bool rareHelperPrinted_ = false;  // sphc_rare_call, before the first _simd_rare form
   // The members of struct Scene a pass in tiles keeps (state: its kept lists' member name).
   // `users`: the passes in tiles that share these kept lists (and the layout, the outer and
   // the pruned lists), each with a slot buffer of its own (_slots, _slots1, ...; stop 40).

@@ -408,8 +408,11 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
       edits.push_back({site.begin, site.end, sourceValueName(p, site.stride, site.comp)});
   }
   if (rare)  // the tiles' rare form: each scalar math call a mark of the lane (stop 40)
-    for (const auto& [begin, end] : scalarMathCallSites(b.source.text))
-      edits.push_back({begin, end, "SphcRareCall{sphc_rare}"});
+    for (const auto& [begin, end] : scalarMathCallSites(b.source.text)) {
+      size_t open = end;  // the call's '(' too: the mark is its first argument
+      while (open < b.source.text.size() && b.source.text[open] != '(') ++open;
+      edits.push_back({begin, static_cast<unsigned>(open + 1), "sphc_rare_call(sphc_rare, "});
+    }
   const std::string name = bodyFunctionName(eq.name, "loop") +
                            (mirror ? "_simd_mirror" : scalarPairs ? "_simd" : "_sums") +
                            (rare ? "_rare" : "");

@@ -610,10 +610,14 @@ void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& 
     os << "// The tiles' rare path (codegen/ClusterPairs.cpp, stop 40): in the lanes a body's call of a\n"
           "// math function GCC does not vectorise marks the lane (its pair is redone by the\n"
           "// scalar fix-up with the real call) and gives 0.\n"
-          "struct SphcRareCall {\n"
-          "  double& rare;\n"
-          "  template <class... A> double operator()(A...) const { rare = 1.0; return 0.0; }\n"
-          "};\n\n";
+          "// (The mark counts, read and written: GCC 12 if-converts that in a branch, not a\n"
+          "// plain store, `rare = 1.0`, which leaves the lanes scalar, \"control flow in loop\";\n"
+          "// nor a struct holding a reference to it, which takes its address.)\n"
+          "template <class... A>\n"
+          "static inline double sphc_rare_call(double& rare, A...) {\n"
+          "  rare = rare + 1.0;\n"
+          "  return 0.0;\n"
+          "}\n\n";
   }
   if (simdDecls_->count(eq.declIndex)) {
     if (rare) printSumsFunction(eq, true, os, false, true);
