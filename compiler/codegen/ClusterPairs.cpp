@@ -67,6 +67,7 @@
 #include "codegen/Printer.h"
 
 #include <map>
+#include <regex>
 #include <set>
 #include <vector>
 
@@ -97,6 +98,21 @@ bool indexUsedAsNumber(const std::string& text) {
     }
   }
   return false;
+}
+
+// `text` with each site of a sum's component, `d_NAME[S * d_idx + K]` (NAME in `sums`), as
+// `d_NAME[d_idx]`: the bodies' _simd forms have their locals there (stop 40).
+std::string withoutSumComponents(const std::string& text, const std::set<std::string>& sums) {
+  static const std::regex site(R"(\bd_([A-Za-z_][A-Za-z0-9_]*)\s*\[\s*\d+\s*\*\s*d_idx\s*(\+\s*\d+\s*)?\])");
+  std::string out;
+  size_t last = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), site); it != std::sregex_iterator(); ++it) {
+    const std::smatch& m = *it;
+    if (!sums.count(m[1].str())) continue;
+    out += text.substr(last, m.position(0) - last) + "d_" + m[1].str() + "[d_idx]";
+    last = m.position(0) + m.length(0);
+  }
+  return out + text.substr(last);
 }
 
 // `call` (NAME(a, b, ...);  // comment) with each argument that is a whole key of `rename`
@@ -146,16 +162,17 @@ std::string ScenePrinter::clusterTilesFormRefusal(const DestinationWork& w,
     if (std::string why = oneDouble(p); !why.empty()) return why;
   for (const std::string& p : pass.sourceProps)
     if (std::string why = oneDouble(p); !why.empty()) return why;
-  const RegisterSums rs = registerSums(w, pass);
-  for (const auto& [p, sc] : rs.props)
-    if (sc.first != 1) return "the sum " + p + " has " + std::to_string(sc.first) + " components";
+  // (sums with components: a lane array per component, stop 40)
+  std::set<std::string> sums;
+  for (const auto& [p, sc] : registerSums(w, pass).props) sums.insert(p);
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     for (const auto& [p, sc] : destinationValues(b, d))
       if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
     for (const auto& [p, sc] : sourceValues(b))
       if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
-    if (indexUsedAsNumber(b.source.text))
+    if (std::string why = rareCallsRefusal(b); !why.empty()) return eq->name + ": " + why;
+    if (indexUsedAsNumber(withoutSumComponents(b.source.text, sums)))
       return eq->name + " uses d_idx or s_idx otherwise than as a subscript";
     const auto sites = hoistedSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k)
@@ -170,13 +187,15 @@ std::string ScenePrinter::clusterTilesFormRefusal(const DestinationWork& w,
 }
 
 void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& state,
-                                       const std::string& what) {
+                                       const std::string& what, int users) {
   os << "  // " << what << " in cluster-pair tiles (--simd-pairs=cluster, sphc/cluster_pairs.h): the\n"
         "  // layout and outer list (built with the kept lists' skin), the pruned list, the\n"
         "  // slot-order copies and sums.\n";
   os << "  sphc::ClusterLayout " << state << "_layout;\n";
   os << "  sphc::ClusterPairList " << state << "_outer, " << state << "_pruned;\n";
-  os << "  std::vector<double> " << state << "_slots;\n";
+  for (int u = 0; u < users; ++u)
+    os << "  std::vector<double> " << state << "_slots" << (u ? std::to_string(u) : "")
+       << ";" << (users > 1 ? "  // the slot buffer of pass " + std::to_string(u) + " of these lists" : "") << "\n";
   os << "  double " << state << "_hmax = 0.0;  // the largest h at the build (where nothing writes h)\n";
   os << "  std::vector<std::uint32_t> " << state << "_order;  // the tiles' slot order (stop 40; update_neighbours)\n";
   os << "  // (stop 40) whether the particles are to be put in the tiles' order at the next expected\n"
@@ -304,8 +323,29 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   };
   bool allDestinationInSlots = true;
   for (const std::string& h : dhoisted) allDestinationInSlots &= inSlots.count(h) > 0;
-  std::vector<std::string> accs;  // the sums: acc_NAME
-  for (const auto& [p, sc] : sums.props) accs.push_back(p);
+  // The sums, one lane array per component (stop 40): NAME (stride 1) or K_NAME (component K
+  // of a property of stride S, d_NAME[S * d_idx + K]); their locals in the lanes acc_NAME,
+  // accK_NAME (the bodies' _simd forms' names, RegisterSums.cpp).
+  std::vector<std::string> accs;
+  std::map<std::string, std::string> accLocal;           // lane name -> the bodies' local
+  std::map<std::string, std::pair<int, int>> accStride;  // lane name -> stride, component
+  for (const auto& [p, sc] : sums.props)
+    for (int k : sc.second) {
+      const std::string lane = sc.first == 1 ? p : std::to_string(k) + "_" + p;
+      accs.push_back(lane);
+      accLocal[lane] = sumsLocalName(p, sc.first, k);
+      accStride[lane] = {sc.first, k};
+    }
+  // In order (stop 40, the tile branches merged): the sums go straight onto the particles'
+  // arrays, a component's onto d_NAME + K with the property's stride (no add-back); its
+  // tail (the padded cluster's j sides) strided the same. `idx`: a slot.
+  auto accStrideOf = [&](const std::string& p) { return inOrder ? accStride[p].first : 1; };
+  auto accAt = [&](const std::string& p, const std::string& idx) {
+    const int S = accStrideOf(p);
+    return S == 1 ? "[" + idx + "]" : "[" + std::to_string(S) + " * (" + idx + ")]";
+  };
+  size_t accTailWidths = 0;  // the sums' tails, in units of CL_W
+  for (const std::string& p : accs) accTailWidths += static_cast<size_t>(accStrideOf(p));
   const std::string in = "          ";
   if (mm)
     scene_ << "        // Each pair once for both particles in cluster-pair tiles (codegen/ClusterPairs.cpp;\n"
@@ -333,9 +373,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // this pass's own: the tiles take no pass whose kept lists another pass shares
   // (CpuPrinter.cpp, "its kept lists are shared with another pass"); were that allowed, a
   // pass would have to copy again where another one filled the buffer since.
+  // Kept lists shared with other passes in tiles (stop 40): the layout is rebuilt by
+  // whichever pass sees the rebuild first, so a pass copies everything at each evaluation.
+  const std::pair<int, int> share = clusterListsShare(w, pass);
   auto unchanged = [&](const std::string& p) {
     const PlanProperty* prop = arr(d).find(p);
-    return prop && !prop->written;
+    return prop && !prop->written && share.second == 1;
   };
   const bool hFixed = unchanged("h");
   // Under OpenMP the pieces without neighbours honour --omp-min-particles (their `if`).
@@ -392,7 +435,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   if (inOrder)
     scene_ << in << "const std::uint32_t cl_tail = static_cast<std::uint32_t>(sphc::tail_cluster(cl_layout));  // the padded cluster (n_clusters: none)\n";
   scene_ << in << "const std::size_t n_slots = cl_layout.slots();\n";
-  scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots;\n";
+  scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots"
+         << (share.first ? std::to_string(share.first) : "") << ";\n";
   // 2xMM: after the copies and the sums, each copy doubled per cluster (cl2_NAME: cluster c's
   // CL_W values twice, the j side of a register in one contiguous load).
   // (2xMM: the positions alone in slot order, for the boxes; every copy doubled)
@@ -400,7 +444,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   const size_t nAccs = inOrder ? 0 : accs.size();  // in order: the sums in the particles' arrays
   const size_t nBuf = nSlotCopies + nAccs + (mm ? 2 * copies.size() : 0);
   // In order: the tails (the padded cluster's values, CL_W each) after the slot buffers.
-  const size_t nTails = inOrder ? (mm ? 0 : copies.size()) + accs.size() : 0;
+  const size_t nTails = inOrder ? (mm ? 0 : copies.size()) + accTailWidths : 0;
   scene_ << in << "cl_buf.resize(" << nBuf << " * n_slots" << (nTails ? " + " + std::to_string(nTails) + " * CL_W" : "")
          << ");  // (kept: the copies made at the build)\n";
   size_t at = 0;
@@ -420,8 +464,10 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     if (!mm)
       for (const auto& c : copies)
         scene_ << ind << "double* const cl_t_" << c.first << " = cl_buf.data() + " << at << " * n_slots + " << k++ << " * CL_W;\n";
-    for (const std::string& p : accs)
-      scene_ << ind << "double* const cl_tacc_" << p << " = cl_buf.data() + " << at << " * n_slots + " << k++ << " * CL_W;\n";
+    for (const std::string& p : accs) {
+      scene_ << ind << "double* const cl_tacc_" << p << " = cl_buf.data() + " << at << " * n_slots + " << k << " * CL_W;\n";
+      k += static_cast<size_t>(accStrideOf(p));
+    }
   };
   if (inOrder) tailPointers(in);
   scene_ << in << "// The positions in slot order (padding slots 4 supports away from every particle)\n"
@@ -560,7 +606,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
            << in << "// the same operations on the same values as its side of the whole tile.\n";
   if (inOrder && !accs.empty()) {
     scene_ << in << "// the padded cluster's j-side sums (written by the block that holds it only)\n";
-    for (const std::string& p : accs) scene_ << in << "std::fill(cl_tacc_" << p << ", cl_tacc_" << p << " + CL_W, 0.0);\n";
+    for (const std::string& p : accs)
+      scene_ << in << "std::fill(cl_tacc_" << p << ", cl_tacc_" << p << " + "
+             << (accStrideOf(p) == 1 ? "" : std::to_string(accStrideOf(p)) + " * ") << "CL_W, 0.0);\n";
   }
   scene_ << in << "auto tiles = [&](const int cb, const int ce) SPHC_TILES_OPTIMIZE {\n";
   const std::string t = in + "  ";
@@ -583,7 +631,10 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     else ++at;  // (2xMM: the tiles read the doubled copies only)
   for (const std::string& p : accs)
     if (inOrder)
-      scene_ << t << "double* const cl_acc_" << p << " = d_" << p << ";  // (in order: the particles' sums)\n";
+      scene_ << t << "double* const cl_acc_" << p << " = "
+             << (accStride[p].first == 1 ? "d_" + p
+                                         : "d_" + p.substr(p.find('_') + 1) + " + " + std::to_string(accStride[p].second))
+             << ";  // (in order: the particles' sums" << (accStride[p].first == 1 ? "" : ", stride " + std::to_string(accStride[p].first)) << ")\n";
     else
       scene_ << t << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   if (mm)
@@ -592,6 +643,16 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       at += 2;
     }
   if (inOrder) tailPointers(t);
+  // The equations' values as locals (stop 40): read through the scene in the lanes, GCC 12
+  // loaded those read under a mask (a body's branch) by gathers with every lane at one
+  // address (8 vgatherqpd per register in the own dam break's rates pass).
+  {
+    std::set<std::string> eqs;
+    for (const PlanEquation* eq : pass.equations)
+      if (eqs.insert(eqStruct(*eq)).second)
+        scene_ << t << "const auto " << eqStruct(*eq) << " = this->" << eqStruct(*eq) << ";  // "
+               << eq->name << "'s values, a local copy\n";
+  }
   scene_ << t << "const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
   scene_ << t << "const std::uint32_t* const cl_j = cl_pruned.j.data();\n";
   scene_ << t << "const std::uint8_t* const cl_real = cl_layout.real_mask.data();\n";
@@ -764,46 +825,97 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     if (iSide)
       for (const std::string& p : accs)
         scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[" << (mm ? "r" : "ii") << "];\n";
-    scene_ << c3 << "#pragma omp simd\n";
-    scene_ << c3 << "for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
-    const std::string body = c3 + "  ";
-    if (mm) laneDest(body);
-    emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
-    scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
-    scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
-    if (side == Side::Both) {
-      scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
-      scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
-    }
-    const std::string inD = side == Side::Both ? "in_d" : "in_cut";
-    const std::string inS = side == Side::Both ? "in_s" : "in_cut";
-    emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
-    for (const std::string& p : accs) {
-      if (iSide) scene_ << body << "double pd_acc_" << p << " = ti_" << p << "_i[s_idx];\n";
-      if (jSide) scene_ << body << "double ps_acc_" << p << " = tj_" << p << "[s_idx];\n";
-    }
-    if (iSide)
-      for (const PlanEquation* eq : pass.equations)
-        scene_ << body << pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_");
-    // The mirrored calls index the source's arrays they are given as pointers (a source
-    // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
-    // not offset to the j-cluster (2xMM: the register's i's, d_idx the lane).
-    if (jSide) {
-      std::map<std::string, std::string> absolute;
-      const std::string pre = mm ? "ir_" : "cl_";
-      for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
-      for (const std::string& h : hoisted) absolute[h] = pre + h;
-      for (const PlanEquation* eq : pass.equations)
-        scene_ << body << withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute);
-    }
-    endPairShared();
-    for (const std::string& p : accs) {
+    // The lanes' body. `mode` (stop 40, a pass whose bodies call a math function GCC does not
+    // vectorise, rareCalls): Lanes, the bodies' _simd forms; Marked, their _simd_rare forms,
+    // a call marking the lane (sphc_rare), whose sums are then left as they were and whose
+    // pair is redone after the lanes by Fixup, the _simd forms, scalar, on the marked lanes
+    // alone. Each lane's sums get the same terms in the same order as if every lane were
+    // computed by the _simd forms (the fix-up before the next tile).
+    enum class Mode { Lanes, Marked, Fixup };
+    auto laneBody = [&](const std::string& body, Mode mode) {
+      if (mm) laneDest(body);
+      emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
+      scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
+      scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
+      if (side == Side::Both) {
+        scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
+        scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
+      }
+      std::string inD = side == Side::Both ? "in_d" : "in_cut";
+      std::string inS = side == Side::Both ? "in_s" : "in_cut";
+      emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
+      for (const std::string& p : accs) {
+        if (iSide) scene_ << body << "double pd_" << accLocal[p] << " = ti_" << p << "_i[s_idx];\n";
+        if (jSide) scene_ << body << "double ps_" << accLocal[p] << " = tj_" << p << "[s_idx];\n";
+      }
+      // Marked: the _simd_rare forms, the lane's mark last.
+      auto marked = [&](const PlanEquation& eq, std::string call) {
+        if (mode != Mode::Marked ||
+            scalarMathCallSites(methodBody(eq, ast::Method::Loop).source.text).empty())
+          return call;
+        for (const char* form : {"_simd_mirror(", "_simd("}) {
+          const size_t at = call.find(form);
+          if (at != std::string::npos && at < call.find('(')) {
+            call.insert(at + std::string(form).size() - 1, "_rare");
+            break;
+          }
+        }
+        const size_t close = call.find(");");
+        if (close != std::string::npos) call.insert(close, ", sphc_rare");
+        return call;
+      };
+      // (the mark loaded from rare_l, zeroed before the lanes: with `= 0.0` GCC 12 left the
+      // OpenMP build's half tiles scalar, "no vectype for stmt")
+      if (mode == Mode::Marked)
+        scene_ << body << "double sphc_rare = rare_l[s_idx];  // a body's scalar math call: the pair is redone below\n";
       if (iSide)
-        scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_acc_" << p << " : ti_" << p << "_i[s_idx];\n";
-      if (jSide)
-        scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_acc_" << p << " : tj_" << p << "[s_idx];\n";
+        for (const PlanEquation* eq : pass.equations)
+          scene_ << body << marked(*eq, pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_"));
+      // The mirrored calls index the source's arrays they are given as pointers (a source
+      // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
+      // not offset to the j-cluster (2xMM: the register's i's, d_idx the lane).
+      if (jSide) {
+        std::map<std::string, std::string> absolute;
+        const std::string pre = mm ? "ir_" : "cl_";
+        for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
+        for (const std::string& h : hoisted) absolute[h] = pre + h;
+        for (const PlanEquation* eq : pass.equations)
+          scene_ << body << marked(*eq, withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute));
+      }
+      endPairShared();
+      if (mode == Mode::Marked) {
+        scene_ << body << "const bool in_rare = (" << (side == Side::Both ? "in_d | in_s" : "in_cut")
+               << ") & (sphc_rare > 0.0);  // redone below\n";
+        scene_ << body << "rare_l[s_idx] = in_rare ? 1.0 : 0.0;\n";
+        scene_ << body << "n_rare += in_rare ? 1.0 : 0.0;\n";
+        inD = "(" + inD + " & !in_rare)";
+        inS = "(" + inS + " & !in_rare)";
+      }
+      for (const std::string& p : accs) {
+        if (iSide)
+          scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_" << accLocal[p] << " : ti_" << p << "_i[s_idx];\n";
+        if (jSide)
+          scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_" << accLocal[p] << " : tj_" << p << "[s_idx];\n";
+      }
+    };
+    const bool rare = rareCalls(pass);
+    if (rare) {
+      scene_ << c3 << "// the lanes whose pair took a body's rare path (a call GCC does not vectorise)\n";
+      scene_ << c3 << "alignas(64) double rare_l[" << L << "] = {};\n";
+      scene_ << c3 << "double n_rare = 0.0;\n";
     }
+    scene_ << c3 << "#pragma omp simd" << (rare ? " reduction(+: n_rare)" : "") << "\n";
+    scene_ << c3 << "for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
+    laneBody(c3 + "  ", rare ? Mode::Marked : Mode::Lanes);
     scene_ << c3 << "}\n";
+    if (rare) {
+      scene_ << c3 << "if (n_rare > 0.0) {  // the marked lanes' pairs, scalar, with the bodies' calls\n";
+      scene_ << c3 << "  for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
+      scene_ << c3 << "    if (!(rare_l[s_idx] > 0.0)) continue;\n";
+      laneBody(c3 + "    ", Mode::Fixup);
+      scene_ << c3 << "  }\n";
+      scene_ << c3 << "}\n";
+    }
     scene_ << c2 << "}\n";
     if (jSide) {
       if (inOrder)  // the fold's targets, chosen once per tile
@@ -813,12 +925,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
         scene_ << c2 << "#pragma omp simd  // the two halves folded (j l: lanes l, l + CL_W), onto the slot sums\n";
         scene_ << c2 << "for (int l = 0; l < CL_W; ++l) {\n";
         for (const std::string& p : accs)
-          scene_ << c2 << "  " << jAcc(p) << "[j0 + l] += tj_" << p << "[l] + tj_" << p << "[CL_W + l];\n";
+          scene_ << c2 << "  " << jAcc(p) << accAt(p, "j0 + l") << " += tj_" << p << "[l] + tj_" << p << "[CL_W + l];\n";
       } else {
         scene_ << c2 << "#pragma omp simd  // (a vector: unrolled, the tj_ arrays would be scalars)\n";
         scene_ << c2 << "for (int l = 0; l < CL_LANES; ++l) {\n";
         for (const std::string& p : accs)
-          scene_ << c2 << "  " << jAcc(p) << "[j0 + l] += tj_" << p << "[l];\n";
+          scene_ << c2 << "  " << jAcc(p) << accAt(p, "j0 + l") << " += tj_" << p << "[l];\n";
       }
       scene_ << c2 << "}\n";
     }
@@ -875,14 +987,14 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (const std::string& p : accs) {
       scene_ << c1 << "  double s_" << p << " = 0.0;\n";
       scene_ << c1 << "  for (int l = 0; l < CL_W; ++l) s_" << p << " += ti_" << p << "[k / 2][(k % 2) * CL_W + l];\n";
-      scene_ << c1 << "  cl_acc_" << p << "[ci * CL_W + k] += s_" << p << ";\n";
+      scene_ << c1 << "  cl_acc_" << p << accAt(p, "ci * CL_W + k") << " += s_" << p << ";\n";
     }
   } else {
     scene_ << c1 << "for (int ii = 0; ii < CL_W" << (inOrder ? " && (real_i >> ii & 1u)" : "") << "; ++ii) {\n";
     for (const std::string& p : accs) {
       scene_ << c1 << "  double s_" << p << " = 0.0;\n";
       scene_ << c1 << "  for (int l = 0; l < CL_LANES; ++l) s_" << p << " += ti_" << p << "[ii][l];\n";
-      scene_ << c1 << "  cl_acc_" << p << "[ci * CL_W + ii] += s_" << p << ";\n";
+      scene_ << c1 << "  cl_acc_" << p << accAt(p, "ci * CL_W + ii") << " += s_" << p << ";\n";
     }
   }
   scene_ << c1 << "}\n";
@@ -909,19 +1021,47 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
            << in << "// j sides, in its tails: added to its real particles.\n";
     scene_ << in << "if (cl_tail < cl_layout.n_clusters)\n";
     scene_ << in << "  for (std::size_t s = static_cast<std::size_t>(cl_tail) * CL_W, l = 0; s < cl_layout.n; ++s, ++l) {\n";
-    for (const std::string& p : accs) scene_ << in << "    d_" << p << "[s] += cl_tacc_" << p << "[l];\n";
+    for (const std::string& p : accs) {
+      const auto [S, K] = accStride[p];
+      if (S == 1)
+        scene_ << in << "    d_" << p << "[s] += cl_tacc_" << p << "[l];\n";
+      else
+        scene_ << in << "    d_" << p.substr(p.find('_') + 1) << "[" << S << " * s + " << K << "] += cl_tacc_" << p << "[" << S << " * l];\n";
+    }
     scene_ << in << "  }\n";
   }
   if (!inOrder) scene_ << in << "// The slot sums onto the particles' sums (padding slots never read), in one pass.\n";
-  if (!accs.empty() && !inOrder) {
+  std::vector<std::string> plain, strided;  // stride 1: add_slots; components: a loop
+  if (!inOrder)  // (in order: none, the tiles summed onto the particles' arrays)
+    for (const std::string& p : accs) (accStride[p].first == 1 ? plain : strided).push_back(p);
+  if (!plain.empty()) {
     scene_ << in << "{\n";
     scene_ << in << "  const double* const cl_sums[] = {";
-    for (size_t k = 0; k < accs.size(); ++k) scene_ << (k ? ", " : "") << "cl_acc_" << accs[k];
+    for (size_t k = 0; k < plain.size(); ++k) scene_ << (k ? ", " : "") << "cl_acc_" << plain[k];
     scene_ << "};\n";
     scene_ << in << "  double* const cl_into[] = {";
-    for (size_t k = 0; k < accs.size(); ++k) scene_ << (k ? ", " : "") << "d_" << accs[k];
+    for (size_t k = 0; k < plain.size(); ++k) scene_ << (k ? ", " : "") << "d_" << plain[k];
     scene_ << "};\n";
-    scene_ << in << "  sphc::add_slots(cl_layout, cl_sums, cl_into, " << accs.size() << par << ");\n";
+    scene_ << in << "  sphc::add_slots(cl_layout, cl_sums, cl_into, " << plain.size() << par << ");\n";
+    scene_ << in << "}\n";
+  }
+  if (!strided.empty()) {
+    // The components' slot sums onto d_NAME[S * i + K] (stop 40), in slot order: the slot
+    // sums read in order, a particle's S components written together (one pass over the
+    // particles read 2 x 7 slot arrays at random: 4% of the dam break's step at ~100k).
+    scene_ << in << "{  // the sums with components onto the particles' (padding slots skipped)\n";
+    scene_ << in << "  const std::uint32_t* const cl_slot = cl_layout.slot.data();\n";
+    if (openmp)
+      scene_ << in << "  #pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "  for (std::size_t s = 0; s < n_slots; ++s) {\n";
+    scene_ << in << "    const std::uint32_t i = cl_slot[s];\n";
+    scene_ << in << "    if (i == sphc::kPadSlot) continue;\n";
+    for (const std::string& p : strided) {
+      const auto [S, K] = accStride[p];
+      const std::string prop = p.substr(p.find('_') + 1);
+      scene_ << in << "    d_" << prop << "[" << S << " * i + " << K << "] += cl_acc_" << p << "[s];\n";
+    }
+    scene_ << in << "  }\n";
     scene_ << in << "}\n";
   }
   scene_ << "        }\n";

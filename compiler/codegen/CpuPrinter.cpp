@@ -58,6 +58,12 @@ class CpuPrinter : public ScenePrinter {
   std::string slotOrderLists(const std::string& S) const;
   bool slotOrdered(const std::string& S) const { return !slotOrderLists(S).empty(); }
   void emitSlotOrder(const std::string& S);
+  std::pair<int, int> clusterListsShare(const DestinationWork& w,
+                                        const NeighbourPass& pass) const override;
+  // The passes over the same kept lists as `pass` (walk order) with their phases.
+  std::vector<std::pair<const DestinationWork*, const NeighbourPass*>> listUsers(
+      const DestinationWork& w, const NeighbourPass& pass, std::vector<std::string>* phases = nullptr) const;
+  mutable bool sharedListsCheck_ = false;  // clusterTilesFormRefusal asking for another user
   bool anyClusterTiles() const {
     bool any = false;
     walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
@@ -333,7 +339,8 @@ void CpuPrinter::verletMembers() {
          << " <- " << arr(pass.source).name
          << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase")) << "\n";
     if (clusterTilesRefusal(w, pass).empty())  // codegen/ClusterPairs.cpp
-      clusterTilesMembers(out_, lists, arr(w.array).name + " <- " + arr(pass.source).name);
+      clusterTilesMembers(out_, lists, arr(w.array).name + " <- " + arr(pass.source).name,
+                          clusterListsShare(w, pass).second);
   });
   for (const auto& [lists, B] : crossSourceLists())
     out_ << "  sphc::CrossSources " << lists << "_by_source;  // the same lists from " << B
@@ -659,19 +666,51 @@ std::string CpuPrinter::clusterTilesFormRefusal(const DestinationWork& w,
   if (!why.empty()) return why;
   if (tuned()) return "--verlet-skin=auto (the tiles take the fixed skin's radius)";
   if (!verlet()) return "no kept lists";
-  // The tiles build no kept lists: none may be shared with another pass (verletLists).
+  // The tiles build no kept lists: a pass sharing them must be in tiles too (stop 40: the
+  // passes in tiles share the layout and the cluster-pair lists, each its slot buffer), in
+  // a phase of its own.
+  std::vector<std::string> phases;
+  const auto users = listUsers(w, pass, &phases);
+  if (users.size() < 2 || sharedListsCheck_) return "";
+  std::string refusal;
+  sharedListsCheck_ = true;
+  for (size_t u = 0; u < users.size() && refusal.empty(); ++u) {
+    if (std::count(phases.begin(), phases.end(), phases[u]) > 1)
+      refusal = "its kept lists are shared with another pass of " + phases[u];
+    else if (users[u].second != &pass) {
+      const std::string why = clusterTilesRefusal(*users[u].first, *users[u].second);
+      if (!why.empty())
+        refusal = "its kept lists are shared with a pass not in tiles (" + phases[u] + ": " + why + ")";
+    }
+  }
+  sharedListsCheck_ = false;
+  return refusal;
+}
+
+std::vector<std::pair<const DestinationWork*, const NeighbourPass*>> CpuPrinter::listUsers(
+    const DestinationWork& w, const NeighbourPass& pass, std::vector<std::string>* phases) const {
   std::string phase;
   walkPasses(sched_.equations, [&](const Phase& ph, const DestinationWork& x, const NeighbourPass&) {
     if (&x == &w) phase = ph.name;
   });
   const std::string lists = verletLists(phase, w, pass.source);
-  int users = 0;
+  std::vector<std::pair<const DestinationWork*, const NeighbourPass*>> users;
   walkPasses(sched_.equations, [&](const Phase& ph, const DestinationWork& x,
                                    const NeighbourPass& p) {
-    users += p.searches() && verletLists(ph.name, x, p.source) == lists;
+    if (p.searches() && verletLists(ph.name, x, p.source) == lists) {
+      users.push_back({&x, &p});
+      if (phases) phases->push_back(ph.name);
+    }
   });
-  if (users > 1) return "its kept lists are shared with another pass";
-  return "";
+  return users;
+}
+
+std::pair<int, int> CpuPrinter::clusterListsShare(const DestinationWork& w,
+                                                  const NeighbourPass& pass) const {
+  const auto users = listUsers(w, pass);
+  for (size_t u = 0; u < users.size(); ++u)
+    if (users[u].second == &pass) return {static_cast<int>(u), static_cast<int>(users.size())};
+  return {0, 1};
 }
 
 // Whether the pass over w's own array is printed each pair once (SymmetricPairs.cpp): not in
