@@ -339,13 +339,26 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // In order (stop 40, the tile branches merged): the sums go straight onto the particles'
   // arrays, a component's onto d_NAME + K with the property's stride (no add-back); its
   // tail (the padded cluster's j sides) strided the same. `idx`: a slot.
-  auto accStrideOf = [&](const std::string& p) { return inOrder ? accStride[p].first : 1; };
+  // Measured (docs/performance.md, "The tile branches merged"): the components' sums
+  // straight onto the particles' arrays, strided, cost the own dam break's shifting tiles 25%
+  // more than they saved (the fold's stride-2 and stride-4 writes); so in order a sum with
+  // components keeps its slot sums (zeroed per block) and an add-back in the particles'
+  // order (slot s = particle s: no slot map), unless kComponentsInPlace.
+  constexpr bool kComponentsInPlace = false;
+  auto direct = [&](const std::string& p) {
+    return inOrder && (accStride[p].first == 1 || kComponentsInPlace);
+  };
+  auto accStrideOf = [&](const std::string& p) { return direct(p) ? accStride[p].first : 1; };
   auto accAt = [&](const std::string& p, const std::string& idx) {
     const int S = accStrideOf(p);
     return S == 1 ? "[" + idx + "]" : "[" + std::to_string(S) + " * (" + idx + ")]";
   };
   size_t accTailWidths = 0;  // the sums' tails, in units of CL_W
-  for (const std::string& p : accs) accTailWidths += static_cast<size_t>(accStrideOf(p));
+  size_t nSlotAccs = 0;  // the sums with slot sums in the buffer
+  for (const std::string& p : accs) {
+    if (direct(p)) accTailWidths += static_cast<size_t>(accStrideOf(p));
+    else ++nSlotAccs;
+  }
   const std::string in = "          ";
   if (mm)
     scene_ << "        // Each pair once for both particles in cluster-pair tiles (codegen/ClusterPairs.cpp;\n"
@@ -441,7 +454,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // CL_W values twice, the j side of a register in one contiguous load).
   // (2xMM: the positions alone in slot order, for the boxes; every copy doubled)
   const size_t nSlotCopies = inOrder ? 0 : mm ? static_cast<size_t>(plan_.dim) : copies.size();
-  const size_t nAccs = inOrder ? 0 : accs.size();  // in order: the sums in the particles' arrays
+  const size_t nAccs = nSlotAccs;  // in order: the plain sums in the particles' arrays
   const size_t nBuf = nSlotCopies + nAccs + (mm ? 2 * copies.size() : 0);
   // In order: the tails (the padded cluster's values, CL_W each) after the slot buffers.
   const size_t nTails = inOrder ? (mm ? 0 : copies.size()) + accTailWidths : 0;
@@ -450,9 +463,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   size_t at = 0;
   for (size_t k = 0; k < nSlotCopies; ++k)
     scene_ << in << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
-  if (!inOrder)
-    for (const std::string& p : accs)
-      scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+  for (const std::string& p : accs)
+    if (!direct(p)) scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   if (mm)
     for (const auto& c : copies) {
       scene_ << in << "double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
@@ -465,6 +477,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       for (const auto& c : copies)
         scene_ << ind << "double* const cl_t_" << c.first << " = cl_buf.data() + " << at << " * n_slots + " << k++ << " * CL_W;\n";
     for (const std::string& p : accs) {
+      if (!direct(p)) continue;
       scene_ << ind << "double* const cl_tacc_" << p << " = cl_buf.data() + " << at << " * n_slots + " << k << " * CL_W;\n";
       k += static_cast<size_t>(accStrideOf(p));
     }
@@ -604,10 +617,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
            << in << "//     half tiles: the later block computes their j sides in its (1)).\n"
            << in << "// A tile across two blocks is computed twice, each side once; a half tile does\n"
            << in << "// the same operations on the same values as its side of the whole tile.\n";
-  if (inOrder && !accs.empty()) {
+  if (inOrder && accs.size() > nSlotAccs) {
     scene_ << in << "// the padded cluster's j-side sums (written by the block that holds it only)\n";
     for (const std::string& p : accs)
-      scene_ << in << "std::fill(cl_tacc_" << p << ", cl_tacc_" << p << " + "
+      if (direct(p))
+        scene_ << in << "std::fill(cl_tacc_" << p << ", cl_tacc_" << p << " + "
              << (accStrideOf(p) == 1 ? "" : std::to_string(accStrideOf(p)) + " * ") << "CL_W, 0.0);\n";
   }
   scene_ << in << "auto tiles = [&](const int cb, const int ce) SPHC_TILES_OPTIMIZE {\n";
@@ -630,7 +644,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     if (!mm) scene_ << t << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
     else ++at;  // (2xMM: the tiles read the doubled copies only)
   for (const std::string& p : accs)
-    if (inOrder)
+    if (direct(p))
       scene_ << t << "double* const cl_acc_" << p << " = "
              << (accStride[p].first == 1 ? "d_" + p
                                          : "d_" + p.substr(p.find('_') + 1) + " + " + std::to_string(accStride[p].second))
@@ -661,9 +675,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (const std::string& p : pass.shared)
       scene_ << t << "const double* const di_" << p << " = cl_" << p << ";\n";
   }
-  if (!inOrder) scene_ << t << "// the block's slot sums (only this block writes them)\n";
-  if (!inOrder)
+  if (nSlotAccs) scene_ << t << "// the block's slot sums (only this block writes them)\n";
   for (const std::string& p : accs)
+    if (!direct(p))
     scene_ << t << "std::fill(cl_acc_" << p << " + CL_W * static_cast<std::size_t>(cb), cl_acc_" << p
            << " + CL_W * static_cast<std::size_t>(ce), 0.0);\n";
   // 2xMM: the i-cluster's two registers' values (ri_NAME[r][lane], i = 2 r + lane / CL_W),
@@ -682,7 +696,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   };
   // The j side's sums: in order the padded cluster's in its tails.
   auto jAcc = [&](const std::string& p) {
-    return (inOrder ? "ja_" : "cl_acc_") + p;
+    return (direct(p) ? "ja_" : "cl_acc_") + p;
   };
   // One tile (j-cluster cl_j[e] of i-cluster ci): both sides, or one side's half tile.
   enum class Side { Both, I, J };
@@ -918,19 +932,21 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     }
     scene_ << c2 << "}\n";
     if (jSide) {
+      if (inOrder && nSlotAccs)  // the slot sums' (the padded cluster's in its own slots)
+        scene_ << c2 << "const int jslot = static_cast<int>(cl_j[e]) * CL_W;\n";
       if (inOrder)  // the fold's targets, chosen once per tile
         for (const std::string& p : accs)
-          scene_ << c2 << "double* const ja_" << p << " = jt ? cl_tacc_" << p << " : cl_acc_" << p << ";\n";
+          if (direct(p)) scene_ << c2 << "double* const ja_" << p << " = jt ? cl_tacc_" << p << " : cl_acc_" << p << ";\n";
       if (mm) {
         scene_ << c2 << "#pragma omp simd  // the two halves folded (j l: lanes l, l + CL_W), onto the slot sums\n";
         scene_ << c2 << "for (int l = 0; l < CL_W; ++l) {\n";
         for (const std::string& p : accs)
-          scene_ << c2 << "  " << jAcc(p) << accAt(p, "j0 + l") << " += tj_" << p << "[l] + tj_" << p << "[CL_W + l];\n";
+          scene_ << c2 << "  " << jAcc(p) << (inOrder && !direct(p) ? "[jslot + l]" : accAt(p, "j0 + l")) << " += tj_" << p << "[l] + tj_" << p << "[CL_W + l];\n";
       } else {
         scene_ << c2 << "#pragma omp simd  // (a vector: unrolled, the tj_ arrays would be scalars)\n";
         scene_ << c2 << "for (int l = 0; l < CL_LANES; ++l) {\n";
         for (const std::string& p : accs)
-          scene_ << c2 << "  " << jAcc(p) << accAt(p, "j0 + l") << " += tj_" << p << "[l];\n";
+          scene_ << c2 << "  " << jAcc(p) << (inOrder && !direct(p) ? "[jslot + l]" : accAt(p, "j0 + l")) << " += tj_" << p << "[l];\n";
       }
       scene_ << c2 << "}\n";
     }
@@ -1016,12 +1032,13 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "  for (int blk = 0; blk < n_blocks; ++blk) tiles(cl_cb[blk], cl_cb[blk + 1]);\n";
     scene_ << in << "}\n";
   }
-  if (inOrder && !accs.empty()) {
+  if (inOrder && accs.size() > nSlotAccs) {
     scene_ << in << "// In order the tiles summed onto the particles' sums, but for the padded cluster's\n"
            << in << "// j sides, in its tails: added to its real particles.\n";
     scene_ << in << "if (cl_tail < cl_layout.n_clusters)\n";
     scene_ << in << "  for (std::size_t s = static_cast<std::size_t>(cl_tail) * CL_W, l = 0; s < cl_layout.n; ++s, ++l) {\n";
     for (const std::string& p : accs) {
+      if (!direct(p)) continue;
       const auto [S, K] = accStride[p];
       if (S == 1)
         scene_ << in << "    d_" << p << "[s] += cl_tacc_" << p << "[l];\n";
@@ -1043,6 +1060,19 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (size_t k = 0; k < plain.size(); ++k) scene_ << (k ? ", " : "") << "d_" << plain[k];
     scene_ << "};\n";
     scene_ << in << "  sphc::add_slots(cl_layout, cl_sums, cl_into, " << plain.size() << par << ");\n";
+    scene_ << in << "}\n";
+  }
+  if (inOrder && nSlotAccs) {
+    scene_ << in << "{  // (in order) the components' slot sums onto the particles' (slot s = particle s)\n";
+    if (openmp)
+      scene_ << in << "  #pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "  for (std::size_t s = 0; s < cl_layout.n; ++s) {\n";
+    for (const std::string& p : accs) {
+      if (direct(p)) continue;
+      const auto [S, K] = accStride[p];
+      scene_ << in << "    d_" << p.substr(p.find('_') + 1) << "[" << S << " * s + " << K << "] += cl_acc_" << p << "[s];\n";
+    }
+    scene_ << in << "  }\n";
     scene_ << in << "}\n";
   }
   if (!strided.empty()) {
