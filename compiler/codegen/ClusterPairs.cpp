@@ -46,6 +46,15 @@
 //     i (4 lanes each) once per i-cluster; j's per tile, the two halves folded (lanes l and
 //     l + 4: j l) onto the slot sums.
 // The same OpenMP blocks and half tiles as the 8 x 8 form (bitwise the serial tiles).
+// Slot order (stop 40; docs/performance.md "Particles in the tiles' slot order (stop 40)";
+// --no-slot-order keeps the copies above): where clusterSlotOrder() allows it the array is
+// kept in the tiles' order (update_neighbours permutes it into sphc::cluster_order where the
+// lists are expected to be rebuilt and the clusters loosened, emitClusterSlotOrder), the
+// layout is built in that order (slot s = particle s, only the last cluster padded), and the
+// tiles read the pass's own arrays (8 x 8; 2xMM keeps its doubled copies for the j side,
+// contiguous reads) and sum onto the particles' own (cl_acc_NAME = d_NAME): no slot-order
+// copies of the i side, no add_slots; the padded last cluster's j side reads and sums in
+// W-value tails (cl_t_NAME, cl_tacc_NAME), picked per tile (jt, ja_NAME).
 // The tiles are a lambda compiled without jump threading (GCC 12 threads the kernel's
 // branches before if-conversion, "control flow in loop": the lanes stay scalar).
 //

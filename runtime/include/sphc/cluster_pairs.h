@@ -7,7 +7,10 @@
 // strips of width `column_side` in x, each sorted by y), each column cut into clusters of
 // `width` consecutive particles (kClusterSize = 8 by default; 1..8, e.g. 4 for 2D tiles:
 // docs/performance.md, "SIMD tiles in 2D, measured by hand (stop 38)"), the last cluster of a
-// column padded. Slot s = width c + k is lane k of cluster c (ClusterLayout). Per evaluation the loop copies the properties it reads
+// column padded. Slot s = width c + k is lane k of cluster c (ClusterLayout). (Since stop 40 the
+// generated code keeps the particles themselves in a slot order where it can: see "Particles
+// kept in the tiles' slot order" below; the copies remain with sphc --no-slot-order.)
+// Per evaluation the loop copies the properties it reads
 // into slot order (gather_slots, gather_positions: contiguous vector loads of a cluster), runs
 // its tiles (one i of an i-cluster broadcast x the lanes of a j-cluster, the cut-off a mask)
 // over a ClusterPairList, and adds its sums, accumulated in slot order, back (add_slots).
