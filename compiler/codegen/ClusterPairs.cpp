@@ -46,6 +46,15 @@
 //     i (4 lanes each) once per i-cluster; j's per tile, the two halves folded (lanes l and
 //     l + 4: j l) onto the slot sums.
 // The same OpenMP blocks and half tiles as the 8 x 8 form (bitwise the serial tiles).
+// Slot order (stop 40; docs/performance.md "Particles in the tiles' slot order (stop 40)";
+// --no-slot-order keeps the copies above): where clusterSlotOrder() allows it the array is
+// kept in the tiles' order (update_neighbours permutes it into sphc::cluster_order where the
+// lists are expected to be rebuilt and the clusters loosened, emitClusterSlotOrder), the
+// layout is built in that order (slot s = particle s, only the last cluster padded), and the
+// tiles read the pass's own arrays (8 x 8; 2xMM keeps its doubled copies for the j side,
+// contiguous reads) and sum onto the particles' own (cl_acc_NAME = d_NAME): no slot-order
+// copies of the i side, no add_slots; the padded last cluster's j side reads and sums in
+// W-value tails (cl_t_NAME, cl_tacc_NAME), picked per tile (jt, ja_NAME).
 // The tiles are a lambda compiled without jump threading (GCC 12 threads the kernel's
 // branches before if-conversion, "control flow in loop": the lanes stay scalar).
 //
@@ -67,12 +76,18 @@
 #include "codegen/Printer.h"
 
 #include <map>
+#include <regex>
 #include <set>
 #include <vector>
 
 namespace sphc {
 
 namespace {
+
+// Stop 40: the particles are put in the tiles' order again when the outer list, built in
+// their present order, holds this many times the cluster pairs per cluster that it held at
+// the first build after the last sort (the clusters loosened as the particles moved).
+constexpr const char* kSlotOrderLoosened = "1.05";
 
 // Whether `text` names d_idx or s_idx other than as a whole subscript `[d_idx]` (with the
 // slot indices of the tiles, an index used as a number would change meaning).
@@ -92,6 +107,21 @@ bool indexUsedAsNumber(const std::string& text) {
     }
   }
   return false;
+}
+
+// `text` with each site of a sum's component, `d_NAME[S * d_idx + K]` (NAME in `sums`), as
+// `d_NAME[d_idx]`: the bodies' _simd forms have their locals there (stop 40).
+std::string withoutSumComponents(const std::string& text, const std::set<std::string>& sums) {
+  static const std::regex site(R"(\bd_([A-Za-z_][A-Za-z0-9_]*)\s*\[\s*\d+\s*\*\s*d_idx\s*(\+\s*\d+\s*)?\])");
+  std::string out;
+  size_t last = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), site); it != std::sregex_iterator(); ++it) {
+    const std::smatch& m = *it;
+    if (!sums.count(m[1].str())) continue;
+    out += text.substr(last, m.position(0) - last) + "d_" + m[1].str() + "[d_idx]";
+    last = m.position(0) + m.length(0);
+  }
+  return out + text.substr(last);
 }
 
 // `call` (NAME(a, b, ...);  // comment) with each argument that is a whole key of `rename`
@@ -141,16 +171,17 @@ std::string ScenePrinter::clusterTilesFormRefusal(const DestinationWork& w,
     if (std::string why = oneDouble(p); !why.empty()) return why;
   for (const std::string& p : pass.sourceProps)
     if (std::string why = oneDouble(p); !why.empty()) return why;
-  const RegisterSums rs = registerSums(w, pass);
-  for (const auto& [p, sc] : rs.props)
-    if (sc.first != 1) return "the sum " + p + " has " + std::to_string(sc.first) + " components";
+  // (sums with components: a lane array per component, stop 40)
+  std::set<std::string> sums;
+  for (const auto& [p, sc] : registerSums(w, pass).props) sums.insert(p);
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     for (const auto& [p, sc] : destinationValues(b, d))
       if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
     for (const auto& [p, sc] : sourceValues(b))
       if (sc.first != 1) return eq->name + " reads " + p + " of " + std::to_string(sc.first) + " components";
-    if (indexUsedAsNumber(b.source.text))
+    if (std::string why = rareCallsRefusal(b); !why.empty()) return eq->name + ": " + why;
+    if (indexUsedAsNumber(withoutSumComponents(b.source.text, sums)))
       return eq->name + " uses d_idx or s_idx otherwise than as a subscript";
     const auto sites = hoistedSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k)
@@ -165,14 +196,64 @@ std::string ScenePrinter::clusterTilesFormRefusal(const DestinationWork& w,
 }
 
 void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& state,
-                                       const std::string& what) {
+                                       const std::string& what, int users) {
   os << "  // " << what << " in cluster-pair tiles (--simd-pairs=cluster, sphc/cluster_pairs.h): the\n"
         "  // layout and outer list (built with the kept lists' skin), the pruned list, the\n"
         "  // slot-order copies and sums.\n";
   os << "  sphc::ClusterLayout " << state << "_layout;\n";
   os << "  sphc::ClusterPairList " << state << "_outer, " << state << "_pruned;\n";
-  os << "  std::vector<double> " << state << "_slots;\n";
+  for (int u = 0; u < users; ++u)
+    os << "  std::vector<double> " << state << "_slots" << (u ? std::to_string(u) : "")
+       << ";" << (users > 1 ? "  // the slot buffer of pass " + std::to_string(u) + " of these lists" : "") << "\n";
   os << "  double " << state << "_hmax = 0.0;  // the largest h at the build (where nothing writes h)\n";
+  os << "  std::vector<std::uint32_t> " << state << "_order;  // the tiles' slot order (stop 40; update_neighbours)\n";
+  os << "  // (stop 40) whether the particles are to be put in the tiles' order at the next expected\n"
+        "  // rebuild; whether they were since the last build; the outer list's pairs per cluster then\n";
+  os << "  bool " << state << "_order_due = true, " << state << "_sorted = false;\n";
+  os << "  double " << state << "_pairs0 = 0.0;\n";
+}
+
+// Stop 40: the statements of update_neighbours that put the pass's array into its tiles'
+// slot order (sphc::cluster_order, the layout's column side and width as emitClusterTiles
+// builds it) where its lists are expected to be rebuilt at this evaluation
+// (VerletSkin::rebuild_expected), and make every kept list in `forget` rebuild.
+void ScenePrinter::emitClusterSlotOrder(const DestinationWork& w, const std::string& state,
+                                        const std::vector<std::string>& forget,
+                                        const std::string& ind) {
+  const int d = w.array;
+  const std::string A = arr(d).name;
+  const bool mm = plan_.dim == 2 && !cluster2d8x8_;
+  auto plainDouble = [&](const std::string& p) {
+    const PlanProperty* prop = arr(d).find(p);
+    return prop && prop->stride == 1 && propIndex(d, p) >= 0 && hostType(d, p) == "double";
+  };
+  scene_ << ind << "// --simd-pairs=cluster (stop 40): " << A << " in its tiles' slot order (sphc/cluster_pairs.h,\n"
+         << ind << "// cluster_order) where their lists are expected to be rebuilt now; every kept list\n"
+         << ind << "// of " << A << " then rebuilt (a permutation is no movement to measure).\n";
+  scene_ << ind << "if (" << state << "_order_due && " << state << ".skin.rebuild_expected(Kernel::radius_scale)) {\n";
+  const std::string in = ind + "  ";
+  std::string side = "0.0";
+  if (mm && plainDouble("m") && plainDouble("rho")) {  // emitClusterTiles' column side
+    side = "cl_side";
+    scene_ << in << "double cl_side = 0.0;\n";
+    scene_ << in << "if (" << A << ".n > 0) {\n";
+    scene_ << in << "  const double* const cl_vm = " << hostPtr(d, "m") << ";\n";
+    scene_ << in << "  const double* const cl_vrho = " << hostPtr(d, "rho") << ";\n";
+    scene_ << in << "  double cl_vol = 0.0;\n";
+    scene_ << in << "  for (std::size_t i = 0; i < " << A << ".n; ++i) cl_vol += cl_vm[i] / cl_vrho[i];\n";
+    scene_ << in << "  cl_vol /= static_cast<double>(" << A << ".n);\n";
+    scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::sqrt(cl_vol), DIM, "
+           << (mm ? "sphc::kClusterSize / 2" : "sphc::kClusterSize") << ");\n";
+    scene_ << in << "}\n";
+  }
+  scene_ << in << "sphc::cluster_order(" << state << "_order, " << hostPtr(d, "x") << ", " << hostPtr(d, "y") << ", "
+         << (plan_.dim == 3 ? hostPtr(d, "z") : std::string("nullptr")) << ", " << A << ".n, DIM, " << side << ", "
+         << (mm ? "sphc::kClusterSize / 2" : "sphc::kClusterSize") << ");\n";
+  scene_ << in << A << ".permute(" << state << "_order);\n";
+  for (const std::string& l : forget) scene_ << in << l << ".skin.forget();\n";
+  scene_ << in << state << "_order_due = false;\n";
+  scene_ << in << state << "_sorted = true;\n";
+  scene_ << ind << "}\n";
 }
 
 void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPass& pass,
@@ -185,6 +266,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // 2D (stop 39): GROMACS' 2xMM form, layouts of width 4, a register = 2 i's x the 4 j's
   // (see the top of this file); 3D (and 2D with --cluster-2d-8x8): 8 x 8 tiles.
   const bool mm = plan_.dim == 2 && !cluster2d8x8_;
+  // Stop 40: the array kept in the tiles' slot order (update_neighbours permutes it where the
+  // lists are due; the layout in that order: slot s = particle s, the last cluster padded):
+  // the tiles read and write the particles' arrays (2xMM: the doubled copies stay, now
+  // contiguous reads), the padded last cluster from W-value tails (cl_t_NAME, cl_tacc_NAME).
+  const bool inOrder = clusterSlotOrder(w, pass);
   // The copies in slot order: positions first, then every property the lanes read (by name:
   // di_NAME, sj_NAME, s_NAME and d_NAME of one array are one array), the hoisted values, the
   // sums. name -> the array it is gathered from.
@@ -239,10 +325,49 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       if (!call.empty()) inSlots[symmetricDestinationHoisted(eqStruct(*eq), std::to_string(k))] = call;
     }
   }
+  // In order: what a copy is read from (the pass's own pointers; the hoisted values' arrays
+  // in the particles' order).
+  auto origin = [&](const std::pair<std::string, std::string>& c) {
+    return c.second.empty() ? "di_" + c.first : c.second;
+  };
   bool allDestinationInSlots = true;
   for (const std::string& h : dhoisted) allDestinationInSlots &= inSlots.count(h) > 0;
-  std::vector<std::string> accs;  // the sums: acc_NAME
-  for (const auto& [p, sc] : sums.props) accs.push_back(p);
+  // The sums, one lane array per component (stop 40): NAME (stride 1) or K_NAME (component K
+  // of a property of stride S, d_NAME[S * d_idx + K]); their locals in the lanes acc_NAME,
+  // accK_NAME (the bodies' _simd forms' names, RegisterSums.cpp).
+  std::vector<std::string> accs;
+  std::map<std::string, std::string> accLocal;           // lane name -> the bodies' local
+  std::map<std::string, std::pair<int, int>> accStride;  // lane name -> stride, component
+  for (const auto& [p, sc] : sums.props)
+    for (int k : sc.second) {
+      const std::string lane = sc.first == 1 ? p : std::to_string(k) + "_" + p;
+      accs.push_back(lane);
+      accLocal[lane] = sumsLocalName(p, sc.first, k);
+      accStride[lane] = {sc.first, k};
+    }
+  // In order (stop 40, the tile branches merged): the sums go straight onto the particles'
+  // arrays, a component's onto d_NAME + K with the property's stride (no add-back); its
+  // tail (the padded cluster's j sides) strided the same. `idx`: a slot.
+  // Measured (docs/performance.md, "The tile branches merged"): the components' sums
+  // straight onto the particles' arrays, strided, cost the own dam break's shifting tiles 25%
+  // more than they saved (the fold's stride-2 and stride-4 writes); so in order a sum with
+  // components keeps its slot sums (zeroed per block) and an add-back in the particles'
+  // order (slot s = particle s: no slot map), unless kComponentsInPlace.
+  constexpr bool kComponentsInPlace = false;
+  auto direct = [&](const std::string& p) {
+    return inOrder && (accStride[p].first == 1 || kComponentsInPlace);
+  };
+  auto accStrideOf = [&](const std::string& p) { return direct(p) ? accStride[p].first : 1; };
+  auto accAt = [&](const std::string& p, const std::string& idx) {
+    const int S = accStrideOf(p);
+    return S == 1 ? "[" + idx + "]" : "[" + std::to_string(S) + " * (" + idx + ")]";
+  };
+  size_t accTailWidths = 0;  // the sums' tails, in units of CL_W
+  size_t nSlotAccs = 0;  // the sums with slot sums in the buffer
+  for (const std::string& p : accs) {
+    if (direct(p)) accTailWidths += static_cast<size_t>(accStrideOf(p));
+    else ++nSlotAccs;
+  }
   const std::string in = "          ";
   if (mm)
     scene_ << "        // Each pair once for both particles in cluster-pair tiles (codegen/ClusterPairs.cpp;\n"
@@ -261,7 +386,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // The destination-only values of every particle, for the mirrored calls (gathered below;
   // a loop without neighbours: --omp-min-particles' `if`, stop 39).
   const std::string ompIfN = openmp ? ompMinIf("n") : "";  // "" or if (n >= OMP_MIN_PARTICLES)
-  if (!allDestinationInSlots)
+  if (!allDestinationInSlots || (inOrder && !mm))
     emitDestinationHoistedAll(pass, openmp ? "        #pragma omp parallel for schedule(static)" +
                                                  (ompIfN.empty() ? "" : " " + ompIfN) + "\n" : "");
   // The properties nothing writes between two builds (no live equation or stepper writes
@@ -270,9 +395,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // this pass's own: the tiles take no pass whose kept lists another pass shares
   // (CpuPrinter.cpp, "its kept lists are shared with another pass"); were that allowed, a
   // pass would have to copy again where another one filled the buffer since.
+  // Kept lists shared with other passes in tiles (stop 40): the layout is rebuilt by
+  // whichever pass sees the rebuild first, so a pass copies everything at each evaluation.
+  const std::pair<int, int> share = clusterListsShare(w, pass);
   auto unchanged = [&](const std::string& p) {
     const PlanProperty* prop = arr(d).find(p);
-    return prop && !prop->written;
+    return prop && !prop->written && share.second == 1;
   };
   const bool hFixed = unchanged("h");
   // Under OpenMP the pieces without neighbours honour --omp-min-particles (their `if`).
@@ -324,33 +452,72 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::sqrt(cl_vol), DIM, CL_W);\n";
     scene_ << in << "}\n";
   }
-  scene_ << in << "if (verlet_build) sphc::build_cluster_layout(cl_layout, di_x, di_y, " << zIn
-         << ", static_cast<std::size_t>(n), DIM, " << side << ", CL_W);\n";
+  scene_ << in << "if (verlet_build) sphc::" << (inOrder ? "build_cluster_layout_in_order" : "build_cluster_layout")
+         << "(cl_layout, di_x, di_y, " << zIn << ", static_cast<std::size_t>(n), DIM, " << side << ", CL_W);\n";
+  if (inOrder)
+    scene_ << in << "const std::uint32_t cl_tail = static_cast<std::uint32_t>(sphc::tail_cluster(cl_layout));  // the padded cluster (n_clusters: none)\n";
   scene_ << in << "const std::size_t n_slots = cl_layout.slots();\n";
-  scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots;\n";
+  scene_ << in << "std::vector<double>& cl_buf = " << state << "_slots"
+         << (share.first ? std::to_string(share.first) : "") << ";\n";
   // 2xMM: after the copies and the sums, each copy doubled per cluster (cl2_NAME: cluster c's
   // CL_W values twice, the j side of a register in one contiguous load).
   // (2xMM: the positions alone in slot order, for the boxes; every copy doubled)
-  const size_t nSlotCopies = mm ? static_cast<size_t>(plan_.dim) : copies.size();
-  const size_t nBuf = nSlotCopies + accs.size() + (mm ? 2 * copies.size() : 0);
-  scene_ << in << "cl_buf.resize(" << nBuf << " * n_slots);  // (kept: the copies made at the build)\n";
+  const size_t nSlotCopies = inOrder ? 0 : mm ? static_cast<size_t>(plan_.dim) : copies.size();
+  const size_t nAccs = nSlotAccs;  // in order: the plain sums in the particles' arrays
+  const size_t nBuf = nSlotCopies + nAccs + (mm ? 2 * copies.size() : 0);
+  // In order: the tails (the padded cluster's values, CL_W each) after the slot buffers.
+  const size_t nTails = inOrder ? (mm ? 0 : copies.size()) + accTailWidths : 0;
+  scene_ << in << "cl_buf.resize(" << nBuf << " * n_slots" << (nTails ? " + " + std::to_string(nTails) + " * CL_W" : "")
+         << ");  // (kept: the copies made at the build)\n";
   size_t at = 0;
   for (size_t k = 0; k < nSlotCopies; ++k)
     scene_ << in << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   for (const std::string& p : accs)
-    scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+    if (!direct(p)) scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   if (mm)
     for (const auto& c : copies) {
       scene_ << in << "double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
       at += 2;
     }
+  // In order: the tails' pointers (printed again in the tiles).
+  auto tailPointers = [&](const std::string& ind) {
+    size_t k = 0;
+    if (!mm)
+      for (const auto& c : copies)
+        scene_ << ind << "double* const cl_t_" << c.first << " = cl_buf.data() + " << at << " * n_slots + " << k++ << " * CL_W;\n";
+    for (const std::string& p : accs) {
+      if (!direct(p)) continue;
+      scene_ << ind << "double* const cl_tacc_" << p << " = cl_buf.data() + " << at << " * n_slots + " << k << " * CL_W;\n";
+      k += static_cast<size_t>(accStrideOf(p));
+    }
+  };
+  if (inOrder) tailPointers(in);
   scene_ << in << "// The positions in slot order (padding slots 4 supports away from every particle)\n"
          << in << "// and the boxes in one pass, the outer list at a rebuild, the list pruned at the\n"
          << in << "// support now.\n";
-  scene_ << in << "sphc::gather_positions_boxes(cl_layout, di_x, di_y, " << zIn << ", cl_x, cl_y, "
-         << (plan_.dim == 3 ? "cl_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax" << par << ");\n";
+  if (inOrder && mm) {
+    scene_ << in << "// (in order: the boxes and the doubled positions from the particles' own)\n";
+    scene_ << in << "sphc::positions_doubled_boxes(cl_layout, di_x, di_y, " << zIn << ", cl2_x, cl2_y, "
+           << (plan_.dim == 3 ? "cl2_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax" << par << ");\n";
+  } else if (inOrder) {
+    scene_ << in << "// (in order: the boxes from the particles' positions, the padded cluster's in its tail)\n";
+    scene_ << in << "sphc::update_boxes(cl_layout, di_x, di_y, " << zIn << ");\n";
+    scene_ << in << "sphc::tail_positions(cl_layout, di_x, di_y, " << zIn << ", cl_t_x, cl_t_y, "
+           << (plan_.dim == 3 ? "cl_t_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax);\n";
+  } else {
+    scene_ << in << "sphc::gather_positions_boxes(cl_layout, di_x, di_y, " << zIn << ", cl_x, cl_y, "
+           << (plan_.dim == 3 ? "cl_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax" << par << ");\n";
+  }
   scene_ << in << "if (verlet_build) sphc::build_cluster_pairs(cl_layout, cl_layout, std::sqrt("
          << listRadius2 << ") * cl_hmax, true, " << state << "_outer" << par << ");\n";
+  if (inOrder) {
+    scene_ << in << "if (verlet_build) {  // (stop 40) sorted again where the clusters loosened: 5% more cluster pairs\n"
+           << in << "  const double cl_pairs = static_cast<double>(" << state << "_outer.pairs()) / static_cast<double>(std::max<std::size_t>(1, cl_layout.n_clusters));\n"
+           << in << "  if (" << state << "_sorted) " << state << "_pairs0 = cl_pairs;  // the reference: just sorted\n"
+           << in << "  else if (cl_pairs > " << kSlotOrderLoosened << " * " << state << "_pairs0) " << state << "_order_due = true;\n"
+           << in << "  " << state << "_sorted = false;\n"
+           << in << "}\n";
+  }
   scene_ << in << "sphc::prune_cluster_pairs(cl_layout, cl_layout, " << state
          << "_outer, Kernel::radius_scale * cl_hmax, " << state << "_pruned" << par << ");\n";
   scene_ << in << "const sphc::ClusterPairList& cl_pruned = " << state << "_pruned;\n";
@@ -373,6 +540,23 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << ind << (mm ? "sphc::gather_slots_doubled" : "sphc::gather_slots") << "(cl_layout, cl_from, cl_to, "
            << cs.size() << par << ");\n";
   };
+  if (inOrder && !mm) {  // the tiles read the arrays themselves: the padded cluster's tails only
+    fixedCopies.clear();
+    evalCopies.clear();
+    std::vector<std::string> from, to;
+    for (size_t k = static_cast<size_t>(plan_.dim); k < copies.size(); ++k) {
+      from.push_back(origin(copies[k]));
+      to.push_back("cl_t_" + copies[k].first);
+    }
+    if (!from.empty()) {
+      scene_ << in << "{  // the padded cluster's values (its padding lanes: its first particle's)\n";
+      scene_ << in << "  const double* const cl_from[] = {";
+      for (size_t k = 0; k < from.size(); ++k) scene_ << (k ? ", " : "") << from[k];
+      scene_ << "};\n" << in << "  double* const cl_to[] = {";
+      for (size_t k = 0; k < to.size(); ++k) scene_ << (k ? ", " : "") << to[k];
+      scene_ << "};\n" << in << "  sphc::gather_tail(cl_layout, cl_from, cl_to, " << from.size() << ");\n" << in << "}\n";
+    }
+  }
   if (!fixedCopies.empty()) {
     scene_ << in << "if (verlet_build) {  // the copies of what nothing writes: at the build only\n";
     gathers(fixedCopies, in + "  ");
@@ -383,7 +567,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     gathers(evalCopies, in + "  ");
     scene_ << in << "}\n";
   }
-  if (mm) {  // the positions doubled (the copies above are doubled as they are gathered)
+  if (mm && !inOrder) {  // the positions doubled (the copies above are doubled as they are gathered)
     scene_ << in << "// The positions doubled: cluster c's CL_W values twice (the j side of a register in\n"
            << in << "// one load of 8 lanes; the i-cluster's registers from its first half).\n";
     if (openmp)
@@ -412,7 +596,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       if (auto it = inSlots.find(c.first); it != inSlots.end())
         scene_ << in << "    cl2_" << c.first << "[cl_s2] = cl2_" << c.first << "[cl_s2 + CL_W] = " << it->second << ";\n";
     scene_ << in << "  }\n";
-  } else if (!inSlots.empty()) {
+  } else if (!inSlots.empty() && !inOrder) {
     scene_ << in << "// the hoisted values in slot order from the copies (the same function of the same\n"
            << in << "// doubles as in the particles' order: the values a gather would copy)\n";
     if (openmp)
@@ -442,6 +626,13 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
            << in << "//     half tiles: the later block computes their j sides in its (1)).\n"
            << in << "// A tile across two blocks is computed twice, each side once; a half tile does\n"
            << in << "// the same operations on the same values as its side of the whole tile.\n";
+  if (inOrder && accs.size() > nSlotAccs) {
+    scene_ << in << "// the padded cluster's j-side sums (written by the block that holds it only)\n";
+    for (const std::string& p : accs)
+      if (direct(p))
+        scene_ << in << "std::fill(cl_tacc_" << p << ", cl_tacc_" << p << " + "
+             << (accStrideOf(p) == 1 ? "" : std::to_string(accStrideOf(p)) + " * ") << "CL_W, 0.0);\n";
+  }
   scene_ << in << "auto tiles = [&](const int cb, const int ce) SPHC_TILES_OPTIMIZE {\n";
   const std::string t = in + "  ";
   if (mm) {
@@ -454,16 +645,37 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // The copies' pointers again, locals of the lambda (captured by reference, GCC reloads them
   // in the loops), and the lists' arrays.
   at = 0;
+  if (inOrder && !mm) {
+    scene_ << t << "// in order: slot s is particle s (cl_NAME: the arrays), the padded cluster's tails\n";
+    for (const auto& c : copies) scene_ << t << "const double* const cl_" << c.first << " = " << origin(c) << ";\n";
+  }
   for (size_t k = 0; k < nSlotCopies; ++k)
     if (!mm) scene_ << t << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
     else ++at;  // (2xMM: the tiles read the doubled copies only)
   for (const std::string& p : accs)
-    scene_ << t << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
+    if (direct(p))
+      scene_ << t << "double* const cl_acc_" << p << " = "
+             << (accStride[p].first == 1 ? "d_" + p
+                                         : "d_" + p.substr(p.find('_') + 1) + " + " + std::to_string(accStride[p].second))
+             << ";  // (in order: the particles' sums" << (accStride[p].first == 1 ? "" : ", stride " + std::to_string(accStride[p].first)) << ")\n";
+    else
+      scene_ << t << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   if (mm)
     for (const auto& c : copies) {
       scene_ << t << "const double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
       at += 2;
     }
+  if (inOrder) tailPointers(t);
+  // The equations' values as locals (stop 40): read through the scene in the lanes, GCC 12
+  // loaded those read under a mask (a body's branch) by gathers with every lane at one
+  // address (8 vgatherqpd per register in the own dam break's rates pass).
+  {
+    std::set<std::string> eqs;
+    for (const PlanEquation* eq : pass.equations)
+      if (eqs.insert(eqStruct(*eq)).second)
+        scene_ << t << "const auto " << eqStruct(*eq) << " = this->" << eqStruct(*eq) << ";  // "
+               << eq->name << "'s values, a local copy\n";
+  }
   scene_ << t << "const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
   scene_ << t << "const std::uint32_t* const cl_j = cl_pruned.j.data();\n";
   scene_ << t << "const std::uint8_t* const cl_real = cl_layout.real_mask.data();\n";
@@ -472,8 +684,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (const std::string& p : pass.shared)
       scene_ << t << "const double* const di_" << p << " = cl_" << p << ";\n";
   }
-  scene_ << t << "// the block's slot sums (only this block writes them)\n";
+  if (nSlotAccs) scene_ << t << "// the block's slot sums (only this block writes them)\n";
   for (const std::string& p : accs)
+    if (!direct(p))
     scene_ << t << "std::fill(cl_acc_" << p << " + CL_W * static_cast<std::size_t>(cb), cl_acc_" << p
            << " + CL_W * static_cast<std::size_t>(ce), 0.0);\n";
   // 2xMM: the i-cluster's two registers' values (ri_NAME[r][lane], i = 2 r + lane / CL_W),
@@ -490,19 +703,37 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     }
     scene_ << c1 << "}\n";
   };
+  // The j side's sums: in order the padded cluster's in its tails.
+  auto jAcc = [&](const std::string& p) {
+    return (direct(p) ? "ja_" : "cl_acc_") + p;
+  };
   // One tile (j-cluster cl_j[e] of i-cluster ci): both sides, or one side's half tile.
   enum class Side { Both, I, J };
   auto tile = [&](Side side, const std::string& c2) {
     const bool iSide = side != Side::J, jSide = side != Side::I;
     const std::string L = "CL_LANES";  // the lanes of a register
     if (mm) {
-      scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;  // its first slot\n";
+      if (inOrder) {
+        scene_ << c2 << "const bool jt = cl_j[e] == cl_tail;  // the padded cluster: its sums in its tails\n";
+        scene_ << c2 << "const int j0 = jt ? 0 : static_cast<int>(cl_j[e]) * CL_W;  // its first slot\n";
+      } else {
+        scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;  // its first slot\n";
+      }
       scene_ << c2 << "const int j2 = static_cast<int>(cl_j[e]) * CL_LANES;  // in the doubled copies\n";
     } else {
-      scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;\n";
+      if (inOrder) {
+        scene_ << c2 << "const bool jt = cl_j[e] == cl_tail;  // the padded cluster: from its tails\n";
+        scene_ << c2 << "const int j0 = jt ? 0 : static_cast<int>(cl_j[e]) * CL_W;\n";
+      } else {
+        scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;\n";
+      }
     }
     const std::string jOff = mm ? "cl2_" : "cl_";
     const std::string jAt = mm ? " + j2" : " + j0";
+    // (in order, 8 x 8: the padded cluster's values from its tails)
+    auto jPtr = [&](const std::string& name) {
+      return !mm && inOrder ? "(jt ? cl_t_" + name + " : cl_" + name + ")" + jAt : jOff + name + jAt;
+    };
     if (side == Side::Both)
       scene_ << c2 << "const bool diagonal = cl_j[e] == static_cast<std::uint32_t>(ci);\n";
     if (mm)
@@ -510,13 +741,13 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     else
       scene_ << c2 << "// The source side: the j-cluster's 8 slots, s_idx the lane.\n";
     for (const std::string& p : pass.shared)
-      scene_ << c2 << "const double* const sj_" << p << " = " << jOff << p << jAt << ";\n";
+      scene_ << c2 << "const double* const sj_" << p << " = " << jPtr(p) << ";\n";
     for (const std::string& p : pass.sourceProps)
-      scene_ << c2 << "const double* const s_" << p << " = " << jOff << p << jAt << ";\n";
-    for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = " << jOff << h << jAt << ";\n";
+      scene_ << c2 << "const double* const s_" << p << " = " << jPtr(p) << ";\n";
+    for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = " << jPtr(h) << ";\n";
     // (the mirrored calls read particle s_idx's destination values through d_NAME)
-    for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = " << jOff << p << jAt << ";\n";
-    for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = " << jOff << h << jAt << ";\n";
+    for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = " << jPtr(p) << ";\n";
+    for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = " << jPtr(h) << ";\n";
     if (jSide) {
       scene_ << c2 << "// j's sums over the tile's i's" << (mm ? " (lanes l and l + CL_W: j l)" : "") << "\n";
       for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[" << L << "] = {};\n";
@@ -617,58 +848,114 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     if (iSide)
       for (const std::string& p : accs)
         scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[" << (mm ? "r" : "ii") << "];\n";
-    scene_ << c3 << "#pragma omp simd\n";
-    scene_ << c3 << "for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
-    const std::string body = c3 + "  ";
-    if (mm) laneDest(body);
-    emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
-    scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
-    scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
-    if (side == Side::Both) {
-      scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
-      scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
-    }
-    const std::string inD = side == Side::Both ? "in_d" : "in_cut";
-    const std::string inS = side == Side::Both ? "in_s" : "in_cut";
-    emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
-    for (const std::string& p : accs) {
-      if (iSide) scene_ << body << "double pd_acc_" << p << " = ti_" << p << "_i[s_idx];\n";
-      if (jSide) scene_ << body << "double ps_acc_" << p << " = tj_" << p << "[s_idx];\n";
-    }
-    if (iSide)
-      for (const PlanEquation* eq : pass.equations)
-        scene_ << body << pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_");
-    // The mirrored calls index the source's arrays they are given as pointers (a source
-    // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
-    // not offset to the j-cluster (2xMM: the register's i's, d_idx the lane).
-    if (jSide) {
-      std::map<std::string, std::string> absolute;
-      const std::string pre = mm ? "ir_" : "cl_";
-      for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
-      for (const std::string& h : hoisted) absolute[h] = pre + h;
-      for (const PlanEquation* eq : pass.equations)
-        scene_ << body << withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute);
-    }
-    endPairShared();
-    for (const std::string& p : accs) {
+    // The lanes' body. `mode` (stop 40, a pass whose bodies call a math function GCC does not
+    // vectorise, rareCalls): Lanes, the bodies' _simd forms; Marked, their _simd_rare forms,
+    // a call marking the lane (sphc_rare), whose sums are then left as they were and whose
+    // pair is redone after the lanes by Fixup, the _simd forms, scalar, on the marked lanes
+    // alone. Each lane's sums get the same terms in the same order as if every lane were
+    // computed by the _simd forms (the fix-up before the next tile).
+    enum class Mode { Lanes, Marked, Fixup };
+    auto laneBody = [&](const std::string& body, Mode mode) {
+      if (mm) laneDest(body);
+      emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
+      scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
+      scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
+      if (side == Side::Both) {
+        scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
+        scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
+      }
+      std::string inD = side == Side::Both ? "in_d" : "in_cut";
+      std::string inS = side == Side::Both ? "in_s" : "in_cut";
+      emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
+      for (const std::string& p : accs) {
+        if (iSide) scene_ << body << "double pd_" << accLocal[p] << " = ti_" << p << "_i[s_idx];\n";
+        if (jSide) scene_ << body << "double ps_" << accLocal[p] << " = tj_" << p << "[s_idx];\n";
+      }
+      // Marked: the _simd_rare forms, the lane's mark last.
+      auto marked = [&](const PlanEquation& eq, std::string call) {
+        if (mode != Mode::Marked ||
+            scalarMathCallSites(methodBody(eq, ast::Method::Loop).source.text).empty())
+          return call;
+        for (const char* form : {"_simd_mirror(", "_simd("}) {
+          const size_t at = call.find(form);
+          if (at != std::string::npos && at < call.find('(')) {
+            call.insert(at + std::string(form).size() - 1, "_rare");
+            break;
+          }
+        }
+        const size_t close = call.find(");");
+        if (close != std::string::npos) call.insert(close, ", sphc_rare");
+        return call;
+      };
+      // (the mark loaded from rare_l, zeroed before the lanes: with `= 0.0` GCC 12 left the
+      // OpenMP build's half tiles scalar, "no vectype for stmt")
+      if (mode == Mode::Marked)
+        scene_ << body << "double sphc_rare = rare_l[s_idx];  // a body's scalar math call: the pair is redone below\n";
       if (iSide)
-        scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_acc_" << p << " : ti_" << p << "_i[s_idx];\n";
-      if (jSide)
-        scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_acc_" << p << " : tj_" << p << "[s_idx];\n";
+        for (const PlanEquation* eq : pass.equations)
+          scene_ << body << marked(*eq, pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_"));
+      // The mirrored calls index the source's arrays they are given as pointers (a source
+      // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
+      // not offset to the j-cluster (2xMM: the register's i's, d_idx the lane).
+      if (jSide) {
+        std::map<std::string, std::string> absolute;
+        const std::string pre = mm ? "ir_" : "cl_";
+        for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
+        for (const std::string& h : hoisted) absolute[h] = pre + h;
+        for (const PlanEquation* eq : pass.equations)
+          scene_ << body << marked(*eq, withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute));
+      }
+      endPairShared();
+      if (mode == Mode::Marked) {
+        scene_ << body << "const bool in_rare = (" << (side == Side::Both ? "in_d | in_s" : "in_cut")
+               << ") & (sphc_rare > 0.0);  // redone below\n";
+        scene_ << body << "rare_l[s_idx] = in_rare ? 1.0 : 0.0;\n";
+        scene_ << body << "n_rare += in_rare ? 1.0 : 0.0;\n";
+        inD = "(" + inD + " & !in_rare)";
+        inS = "(" + inS + " & !in_rare)";
+      }
+      for (const std::string& p : accs) {
+        if (iSide)
+          scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_" << accLocal[p] << " : ti_" << p << "_i[s_idx];\n";
+        if (jSide)
+          scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_" << accLocal[p] << " : tj_" << p << "[s_idx];\n";
+      }
+    };
+    const bool rare = rareCalls(pass);
+    if (rare) {
+      scene_ << c3 << "// the lanes whose pair took a body's rare path (a call GCC does not vectorise)\n";
+      scene_ << c3 << "alignas(64) double rare_l[" << L << "] = {};\n";
+      scene_ << c3 << "double n_rare = 0.0;\n";
     }
+    scene_ << c3 << "#pragma omp simd" << (rare ? " reduction(+: n_rare)" : "") << "\n";
+    scene_ << c3 << "for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
+    laneBody(c3 + "  ", rare ? Mode::Marked : Mode::Lanes);
     scene_ << c3 << "}\n";
+    if (rare) {
+      scene_ << c3 << "if (n_rare > 0.0) {  // the marked lanes' pairs, scalar, with the bodies' calls\n";
+      scene_ << c3 << "  for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
+      scene_ << c3 << "    if (!(rare_l[s_idx] > 0.0)) continue;\n";
+      laneBody(c3 + "    ", Mode::Fixup);
+      scene_ << c3 << "  }\n";
+      scene_ << c3 << "}\n";
+    }
     scene_ << c2 << "}\n";
     if (jSide) {
+      if (inOrder && nSlotAccs)  // the slot sums' (the padded cluster's in its own slots)
+        scene_ << c2 << "const int jslot = static_cast<int>(cl_j[e]) * CL_W;\n";
+      if (inOrder)  // the fold's targets, chosen once per tile
+        for (const std::string& p : accs)
+          if (direct(p)) scene_ << c2 << "double* const ja_" << p << " = jt ? cl_tacc_" << p << " : cl_acc_" << p << ";\n";
       if (mm) {
         scene_ << c2 << "#pragma omp simd  // the two halves folded (j l: lanes l, l + CL_W), onto the slot sums\n";
         scene_ << c2 << "for (int l = 0; l < CL_W; ++l) {\n";
         for (const std::string& p : accs)
-          scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l] + tj_" << p << "[CL_W + l];\n";
+          scene_ << c2 << "  " << jAcc(p) << (inOrder && !direct(p) ? "[jslot + l]" : accAt(p, "j0 + l")) << " += tj_" << p << "[l] + tj_" << p << "[CL_W + l];\n";
       } else {
         scene_ << c2 << "#pragma omp simd  // (a vector: unrolled, the tj_ arrays would be scalars)\n";
         scene_ << c2 << "for (int l = 0; l < CL_LANES; ++l) {\n";
         for (const std::string& p : accs)
-          scene_ << c2 << "  cl_acc_" << p << "[j0 + l] += tj_" << p << "[l];\n";
+          scene_ << c2 << "  " << jAcc(p) << (inOrder && !direct(p) ? "[jslot + l]" : accAt(p, "j0 + l")) << " += tj_" << p << "[l];\n";
       }
       scene_ << c2 << "}\n";
     }
@@ -720,18 +1007,19 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << c1 << "}\n";
   }
   if (mm) {
-    scene_ << c1 << "for (int k = 0; k < CL_W; ++k) {  // slot k: register k / 2, lanes (k % 2) CL_W ...\n";
+    scene_ << c1 << "for (int k = 0; k < CL_W" << (inOrder ? " && (real_i >> k & 1u)" : "")
+           << "; ++k) {  // slot k: register k / 2, lanes (k % 2) CL_W ...\n";
     for (const std::string& p : accs) {
       scene_ << c1 << "  double s_" << p << " = 0.0;\n";
       scene_ << c1 << "  for (int l = 0; l < CL_W; ++l) s_" << p << " += ti_" << p << "[k / 2][(k % 2) * CL_W + l];\n";
-      scene_ << c1 << "  cl_acc_" << p << "[ci * CL_W + k] += s_" << p << ";\n";
+      scene_ << c1 << "  cl_acc_" << p << accAt(p, "ci * CL_W + k") << " += s_" << p << ";\n";
     }
   } else {
-    scene_ << c1 << "for (int ii = 0; ii < CL_W; ++ii) {\n";
+    scene_ << c1 << "for (int ii = 0; ii < CL_W" << (inOrder ? " && (real_i >> ii & 1u)" : "") << "; ++ii) {\n";
     for (const std::string& p : accs) {
       scene_ << c1 << "  double s_" << p << " = 0.0;\n";
       scene_ << c1 << "  for (int l = 0; l < CL_LANES; ++l) s_" << p << " += ti_" << p << "[ii][l];\n";
-      scene_ << c1 << "  cl_acc_" << p << "[ci * CL_W + ii] += s_" << p << ";\n";
+      scene_ << c1 << "  cl_acc_" << p << accAt(p, "ci * CL_W + ii") << " += s_" << p << ";\n";
     }
   }
   scene_ << c1 << "}\n";
@@ -753,16 +1041,66 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "  for (int blk = 0; blk < n_blocks; ++blk) tiles(cl_cb[blk], cl_cb[blk + 1]);\n";
     scene_ << in << "}\n";
   }
-  scene_ << in << "// The slot sums onto the particles' sums (padding slots never read), in one pass.\n";
-  if (!accs.empty()) {
+  if (inOrder && accs.size() > nSlotAccs) {
+    scene_ << in << "// In order the tiles summed onto the particles' sums, but for the padded cluster's\n"
+           << in << "// j sides, in its tails: added to its real particles.\n";
+    scene_ << in << "if (cl_tail < cl_layout.n_clusters)\n";
+    scene_ << in << "  for (std::size_t s = static_cast<std::size_t>(cl_tail) * CL_W, l = 0; s < cl_layout.n; ++s, ++l) {\n";
+    for (const std::string& p : accs) {
+      if (!direct(p)) continue;
+      const auto [S, K] = accStride[p];
+      if (S == 1)
+        scene_ << in << "    d_" << p << "[s] += cl_tacc_" << p << "[l];\n";
+      else
+        scene_ << in << "    d_" << p.substr(p.find('_') + 1) << "[" << S << " * s + " << K << "] += cl_tacc_" << p << "[" << S << " * l];\n";
+    }
+    scene_ << in << "  }\n";
+  }
+  if (!inOrder) scene_ << in << "// The slot sums onto the particles' sums (padding slots never read), in one pass.\n";
+  std::vector<std::string> plain, strided;  // stride 1: add_slots; components: a loop
+  if (!inOrder)  // (in order: none, the tiles summed onto the particles' arrays)
+    for (const std::string& p : accs) (accStride[p].first == 1 ? plain : strided).push_back(p);
+  if (!plain.empty()) {
     scene_ << in << "{\n";
     scene_ << in << "  const double* const cl_sums[] = {";
-    for (size_t k = 0; k < accs.size(); ++k) scene_ << (k ? ", " : "") << "cl_acc_" << accs[k];
+    for (size_t k = 0; k < plain.size(); ++k) scene_ << (k ? ", " : "") << "cl_acc_" << plain[k];
     scene_ << "};\n";
     scene_ << in << "  double* const cl_into[] = {";
-    for (size_t k = 0; k < accs.size(); ++k) scene_ << (k ? ", " : "") << "d_" << accs[k];
+    for (size_t k = 0; k < plain.size(); ++k) scene_ << (k ? ", " : "") << "d_" << plain[k];
     scene_ << "};\n";
-    scene_ << in << "  sphc::add_slots(cl_layout, cl_sums, cl_into, " << accs.size() << par << ");\n";
+    scene_ << in << "  sphc::add_slots(cl_layout, cl_sums, cl_into, " << plain.size() << par << ");\n";
+    scene_ << in << "}\n";
+  }
+  if (inOrder && nSlotAccs) {
+    scene_ << in << "{  // (in order) the components' slot sums onto the particles' (slot s = particle s)\n";
+    if (openmp)
+      scene_ << in << "  #pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "  for (std::size_t s = 0; s < cl_layout.n; ++s) {\n";
+    for (const std::string& p : accs) {
+      if (direct(p)) continue;
+      const auto [S, K] = accStride[p];
+      scene_ << in << "    d_" << p.substr(p.find('_') + 1) << "[" << S << " * s + " << K << "] += cl_acc_" << p << "[s];\n";
+    }
+    scene_ << in << "  }\n";
+    scene_ << in << "}\n";
+  }
+  if (!strided.empty()) {
+    // The components' slot sums onto d_NAME[S * i + K] (stop 40), in slot order: the slot
+    // sums read in order, a particle's S components written together (one pass over the
+    // particles read 2 x 7 slot arrays at random: 4% of the dam break's step at ~100k).
+    scene_ << in << "{  // the sums with components onto the particles' (padding slots skipped)\n";
+    scene_ << in << "  const std::uint32_t* const cl_slot = cl_layout.slot.data();\n";
+    if (openmp)
+      scene_ << in << "  #pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
+    scene_ << in << "  for (std::size_t s = 0; s < n_slots; ++s) {\n";
+    scene_ << in << "    const std::uint32_t i = cl_slot[s];\n";
+    scene_ << in << "    if (i == sphc::kPadSlot) continue;\n";
+    for (const std::string& p : strided) {
+      const auto [S, K] = accStride[p];
+      const std::string prop = p.substr(p.find('_') + 1);
+      scene_ << in << "    d_" << prop << "[" << S << " * i + " << K << "] += cl_acc_" << p << "[s];\n";
+    }
+    scene_ << in << "  }\n";
     scene_ << in << "}\n";
   }
   scene_ << "        }\n";

@@ -142,6 +142,9 @@ struct EmitOptions {
   // --cluster-2d-8x8 (hidden, a measurement knob; stop 39): the 2D tiles in stop 37-38's
   // 8 x 8 form (one i x 8 j's per register) instead of the 2xMM form (codegen/ClusterPairs.cpp).
   bool cluster2d8x8 = false;
+  // --no-slot-order (hidden, a measurement knob; stop 40): false keeps the tiles' slot-order
+  // copies and add-backs; true (the default) keeps the particles in the tiles' slot order.
+  bool clusterSlotOrder = true;
   // --simd-neighbours=N: auto's threshold on a loop's expected neighbour count
   // (kSimdAutoNeighbours by default; a measurement knob: 0 puts every loop that allows it in
   // lanes under auto's rule, e.g. with --simd-pairs=once the 2D scenes' loops).

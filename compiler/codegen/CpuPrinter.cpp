@@ -49,6 +49,21 @@ class CpuPrinter : public ScenePrinter {
   // printer's: serial, the fixed skin, kept lists of the pass's own.
   std::string clusterTilesFormRefusal(const DestinationWork& w,
                                       const NeighbourPass& pass) const override;
+  // Slot order (stop 40): the pass over its own array, which is sorted (no ranged group
+  // names its particles by index), double, without ghosts or halos.
+  bool clusterSlotOrder(const DestinationWork& w, const NeighbourPass& pass) const override {
+    return clusterSlotOrder_ && !mpi_ && !cpuSingle_ && !hasDomain() && !hasZones() &&
+           w.array == pass.source && !w.ranged() && reorders(arr(w.array).name);
+  }
+  std::string slotOrderLists(const std::string& S) const;
+  bool slotOrdered(const std::string& S) const { return !slotOrderLists(S).empty(); }
+  void emitSlotOrder(const std::string& S);
+  std::pair<int, int> clusterListsShare(const DestinationWork& w,
+                                        const NeighbourPass& pass) const override;
+  // The passes over the same kept lists as `pass` (walk order) with their phases.
+  std::vector<std::pair<const DestinationWork*, const NeighbourPass*>> listUsers(
+      const DestinationWork& w, const NeighbourPass& pass, std::vector<std::string>* phases = nullptr) const;
+  mutable bool sharedListsCheck_ = false;  // clusterTilesFormRefusal asking for another user
   bool anyClusterTiles() const {
     bool any = false;
     walkPasses(sched_.equations, [&](const Phase&, const DestinationWork& w,
@@ -331,7 +346,8 @@ void CpuPrinter::verletMembers() {
          << " <- " << arr(pass.source).name
          << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase")) << "\n";
     if (clusterTilesRefusal(w, pass).empty())  // codegen/ClusterPairs.cpp
-      clusterTilesMembers(out_, lists, arr(w.array).name + " <- " + arr(pass.source).name);
+      clusterTilesMembers(out_, lists, arr(w.array).name + " <- " + arr(pass.source).name,
+                          clusterListsShare(w, pass).second);
   });
   for (const auto& [lists, B] : crossSourceLists())
     out_ << "  sphc::CrossSources " << lists << "_by_source;  // the same lists from " << B
@@ -657,19 +673,51 @@ std::string CpuPrinter::clusterTilesFormRefusal(const DestinationWork& w,
   if (!why.empty()) return why;
   if (tuned()) return "--verlet-skin=auto (the tiles take the fixed skin's radius)";
   if (!verlet()) return "no kept lists";
-  // The tiles build no kept lists: none may be shared with another pass (verletLists).
+  // The tiles build no kept lists: a pass sharing them must be in tiles too (stop 40: the
+  // passes in tiles share the layout and the cluster-pair lists, each its slot buffer), in
+  // a phase of its own.
+  std::vector<std::string> phases;
+  const auto users = listUsers(w, pass, &phases);
+  if (users.size() < 2 || sharedListsCheck_) return "";
+  std::string refusal;
+  sharedListsCheck_ = true;
+  for (size_t u = 0; u < users.size() && refusal.empty(); ++u) {
+    if (std::count(phases.begin(), phases.end(), phases[u]) > 1)
+      refusal = "its kept lists are shared with another pass of " + phases[u];
+    else if (users[u].second != &pass) {
+      const std::string why = clusterTilesRefusal(*users[u].first, *users[u].second);
+      if (!why.empty())
+        refusal = "its kept lists are shared with a pass not in tiles (" + phases[u] + ": " + why + ")";
+    }
+  }
+  sharedListsCheck_ = false;
+  return refusal;
+}
+
+std::vector<std::pair<const DestinationWork*, const NeighbourPass*>> CpuPrinter::listUsers(
+    const DestinationWork& w, const NeighbourPass& pass, std::vector<std::string>* phases) const {
   std::string phase;
   walkPasses(sched_.equations, [&](const Phase& ph, const DestinationWork& x, const NeighbourPass&) {
     if (&x == &w) phase = ph.name;
   });
   const std::string lists = verletLists(phase, w, pass.source);
-  int users = 0;
+  std::vector<std::pair<const DestinationWork*, const NeighbourPass*>> users;
   walkPasses(sched_.equations, [&](const Phase& ph, const DestinationWork& x,
                                    const NeighbourPass& p) {
-    users += p.searches() && verletLists(ph.name, x, p.source) == lists;
+    if (p.searches() && verletLists(ph.name, x, p.source) == lists) {
+      users.push_back({&x, &p});
+      if (phases) phases->push_back(ph.name);
+    }
   });
-  if (users > 1) return "its kept lists are shared with another pass";
-  return "";
+  return users;
+}
+
+std::pair<int, int> CpuPrinter::clusterListsShare(const DestinationWork& w,
+                                                  const NeighbourPass& pass) const {
+  const auto users = listUsers(w, pass);
+  for (size_t u = 0; u < users.size(); ++u)
+    if (users[u].second == &pass) return {static_cast<int>(u), static_cast<int>(users.size())};
+  return {0, 1};
 }
 
 // Whether the pass over w's own array is printed each pair once (SymmetricPairs.cpp): not in
@@ -995,6 +1043,31 @@ void CpuPrinter::updateNeighboursKeptGhosts() {
     scene_ << "    " << cellListBuild(S, S + ".n + ghosts_" + S + ".size()") << "\n";
 }
 
+// The tiled pass over S's own particles kept in slot order (stop 40), if any: its lists'
+// name, "" if none.
+std::string CpuPrinter::slotOrderLists(const std::string& S) const {
+  std::string found;
+  forEachVerletLists([&](const std::string& lists, const Phase&, const DestinationWork& w,
+                         const NeighbourPass& pass) {
+    if (found.empty() && arr(w.array).name == S && clusterTilesRefusal(w, pass).empty() &&
+        clusterSlotOrder(w, pass))
+      found = lists;
+  });
+  return found;
+}
+
+void CpuPrinter::emitSlotOrder(const std::string& S) {
+  const std::string state = slotOrderLists(S);
+  std::vector<std::string> forget;
+  const DestinationWork* tiled = nullptr;
+  forEachVerletLists([&](const std::string& lists, const Phase&, const DestinationWork& w,
+                         const NeighbourPass& pass) {
+    if (arr(w.array).name == S || arr(pass.source).name == S) forget.push_back(lists);
+    if (lists == state) tiled = &w;
+  });
+  emitClusterSlotOrder(*tiled, state, forget, "    ");
+}
+
 bool CpuPrinter::isStatic(const std::string& S) const {
   if (hasDomain() || mpi_ || hasZones()) return false;  // ghosts, halos, inlets and outlets
   auto written = [&](int a, const char* p) {
@@ -1083,6 +1156,11 @@ void CpuPrinter::updateNeighbours() {
   for (const auto& S : sourceArrays_) {
     if (isStatic(S)) continue;  // build_static_cells
     const std::string build = cellListBuild(S, S + ".n");
+    if (slotOrdered(S)) {  // in its tiles' slot order, not in cell order (stop 40)
+      emitSlotOrder(S);
+      if (!lazyCells()) scene_ << "    " << build << "\n";
+      continue;
+    }
     if (lazyCells()) {
       if (reorders(S))
         scene_ << "    if (reorder) {\n      " << cellListBuild(S, S + ".n", "order_domain")

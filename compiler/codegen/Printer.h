@@ -72,6 +72,9 @@ PairDialect pairDialectOf(const Dialect& dl);
 // `XIJ[k]` -> `XIJ_k` per indexing by a literal k < 3, appended to `edits`; false (and `why`)
 // where one is named otherwise (a pointer passed on, a computed index).
 bool scalarPairEdits(const std::string& text, std::vector<TextEdit>& edits, std::string& why);
+// The calls in a body's text of the math functions GCC does not vectorise without
+// -ffast-math (pow, exp, ...; SimdPairs.cpp): each function name's [begin, end).
+std::vector<std::pair<unsigned, unsigned>> scalarMathCallSites(const std::string& text);
 
 class ScenePrinter {
  public:
@@ -398,8 +401,10 @@ class ScenePrinter {
   // eq's loop on the locals, named NAME_loop_sums; `scalarPairs`: NAME_loop_simd, its vector
   // pair quantities three scalars each (XIJ_0, XIJ_1, XIJ_2; SimdPairs.cpp).
   // `mirror`: NAME_loop_simd_mirror, also its source properties values (sval_NAME).
+  // `rare`: the tiles' rare form (NAME_loop_simd_rare, _simd_mirror_rare; stop 40): each
+  // scalar math call a mark of the lane, `double& sphc_rare` (sphc_rare_call).
   void printSumsFunction(const PlanEquation& eq, bool scalarPairs, std::ostringstream& os,
-                         bool mirror = false) const;
+                         bool mirror = false, bool rare = false) const;
   // The edits of b's text for its _simd form but the sums: XIJ[k] -> XIJ_k, the destination
   // values dval_NAME (the pair-shared values' _simd functions, PairShared.cpp).
   std::vector<TextEdit> simdValueEdits(const PlanBody& b, int d) const;
@@ -475,12 +480,40 @@ class ScenePrinter {
                         const std::string& state, const std::string& listRadius2,
                         const std::set<std::string>& q, const RegisterSums& sums,
                         bool openmp = false);
+  // Stop 40: update_neighbours' statements that permute w's array into the tiles' slot
+  // order where the lists `state` are expected to be rebuilt, then forget the lists `forget`.
+  void emitClusterSlotOrder(const DestinationWork& w, const std::string& state,
+                            const std::vector<std::string>& forget, const std::string& ind);
+  // The tiles' rare path (stop 40): why a body's scalar math calls (scalarMathCallSites) cannot
+  // be printed as the rare path, "" where it has none or each is in a branch (an `if`, an
+  // `else`, a `?:`'s operand) outside the hoisted and pair-shared values.
+  std::string rareCallsRefusal(const PlanBody& b) const;
+  // Whether the pass's bodies have scalar math calls: its tiles have the rare path (the lanes
+  // call NAME_loop_simd_rare, each call a mark of the lane; the marked lanes redone by a
+  // scalar fix-up with the bodies' NAME_loop_simd forms).
+  bool rareCalls(const NeighbourPass& pass) const;
+  // Whether the tiles take the pass with its scalar math calls (simdPairsBlocker lets them
+  // through then).
+  bool rareCallsInTiles(const DestinationWork& w, const NeighbourPass& pass) const;
+  bool rareHelperPrinted_ = false;  // sphc_rare_call, before the first _simd_rare form
   // The members of struct Scene a pass in tiles keeps (state: its kept lists' member name).
+  // `users`: the passes in tiles that share these kept lists (and the layout, the outer and
+  // the pruned lists), each with a slot buffer of its own (_slots, _slots1, ...; stop 40).
   static void clusterTilesMembers(std::ostream& os, const std::string& state,
-                                  const std::string& what);
+                                  const std::string& what, int users = 1);
+  // Which of the passes in tiles sharing its kept lists this one is, and how many there are
+  // ({0, 1}: the lists its own; the CPU printer's kept lists, stop 40).
+  virtual std::pair<int, int> clusterListsShare(const DestinationWork&, const NeighbourPass&) const {
+    return {0, 1};
+  }
   bool simdCluster_ = false;  // EmitOptions::simdPairsCluster (with simdOnce_)
   bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops only
   bool cluster2d8x8_ = false;     // EmitOptions::cluster2d8x8: 2D tiles 8 x 8, not 2xMM
+  bool clusterSlotOrder_ = true;  // EmitOptions::clusterSlotOrder (--no-slot-order: false)
+  // Whether the pass's array is kept in its tiles' slot order (stop 40; ClusterPairs.cpp):
+  // permuted into it where its tiles' lists are due (update_neighbours) and read and written
+  // by the tiles in place. The CPU printer's answer (its own arrays, sorted, double).
+  virtual bool clusterSlotOrder(const DestinationWork&, const NeighbourPass&) const { return false; }
   std::string simdClusterWhy_;    // the report's reason (--simd-pairs=cluster, or auto's)
   // --precision=single: the float local a SIMD loop passes for a body's double argument (t,
   // dt, an equation's scalar: f_t, f_eq2_alpha), converted once before the loop; "" for

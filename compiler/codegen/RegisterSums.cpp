@@ -373,7 +373,7 @@ std::vector<TextEdit> ScenePrinter::simdValueEdits(const PlanBody& b, int d) con
 }
 
 void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
-                                     std::ostringstream& os, bool mirror) const {
+                                     std::ostringstream& os, bool mirror, bool rare) const {
   const PlanBody& b = methodBody(eq, ast::Method::Loop);
   const std::set<std::string> own = written(b, &arr(eq.dest));
   std::vector<TextEdit> edits;
@@ -407,8 +407,15 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
     for (const DestinationSite& site : sites)
       edits.push_back({site.begin, site.end, sourceValueName(p, site.stride, site.comp)});
   }
+  if (rare)  // the tiles' rare form: each scalar math call a mark of the lane (stop 40)
+    for (const auto& [begin, end] : scalarMathCallSites(b.source.text)) {
+      size_t open = end;  // the call's '(' too: the mark is its first argument
+      while (open < b.source.text.size() && b.source.text[open] != '(') ++open;
+      edits.push_back({begin, static_cast<unsigned>(open + 1), "sphc_rare_call(sphc_rare, "});
+    }
   const std::string name = bodyFunctionName(eq.name, "loop") +
-                           (mirror ? "_simd_mirror" : scalarPairs ? "_simd" : "_sums");
+                           (mirror ? "_simd_mirror" : scalarPairs ? "_simd" : "_sums") +
+                           (rare ? "_rare" : "");
   os << "// " << b.source.label << ", from " << loc(b.source.start)
      << ": the destination's sums in locals (acc_NAME, accK_NAME: component K;\n"
      << (scalarPairs ? "// the pair quantities' components scalars, XIJ_0 for XIJ[0]: the SIMD "
@@ -416,7 +423,11 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
                      : "// codegen/RegisterSums.cpp)\n")
      << (mirror ? "// For the mirrored calls of each pair once in SIMD lanes: the source's "
                   "properties as values\n// (sval_NAME, particle d_idx's).\n"
-                : "");
+                : "")
+     << (rare ? "// The tiles' rare form (codegen/ClusterPairs.cpp): a scalar math call marks "
+                "the lane (sphc_rare),\n// whose pair the tiles redo with the form without "
+                "_rare.\n"
+              : "");
   if (host_.lineDirectives) emitLineDirective(os, b.source.start);
   os << host_.functionPrefix << "void " << name << "(";
   bool first = true;
@@ -454,6 +465,7 @@ void ScenePrinter::printSumsFunction(const PlanEquation& eq, bool scalarPairs,
     os << (first ? "" : ", ") << p.decl;
     first = false;
   }
+  if (rare) os << (first ? "" : ", ") << "double& sphc_rare";
   os << ") {";
   std::string text = hoistedBodyText(b, host_, edits);
   if (host_.floatBodies) text = singlePrecisionBody(text);  // as bodyText: float, 0.5f

@@ -50,6 +50,7 @@
 #include "sema/ConstEval.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -110,6 +111,70 @@ std::string scalarMathCall(const std::string& text) {
   return found;
 }
 
+// text with its comments blanked (offsets kept).
+std::string withoutComments(std::string text) {
+  for (size_t at = 0; at < text.size();) {
+    if (text.compare(at, 2, "//") == 0) {
+      const size_t nl = text.find('\n', at);
+      const size_t end = nl == std::string::npos ? text.size() : nl;
+      std::fill(text.begin() + at, text.begin() + end, ' ');
+      at = end;
+    } else if (text.compare(at, 2, "/*") == 0) {
+      size_t end = text.find("*/", at + 2);
+      end = end == std::string::npos ? text.size() : end + 2;
+      for (size_t k = at; k < end; ++k)
+        if (text[k] != '\n') text[k] = ' ';
+      at = end;
+    } else {
+      ++at;
+    }
+  }
+  return text;
+}
+
+// Whether text[at] (comments blanked) is in a branch: an operand after a `?` of its
+// statement, or a block opened by `if (...)` or `else`, at any depth.
+bool inBranch(const std::string& text, size_t at) {
+  int paren = 0;
+  bool statement = true;  // still in the call's statement (no `;`, `{`, `}` at depth 0 met)
+  for (size_t k = at; k-- > 0;) {
+    const char c = text[k];
+    if (c == ')') ++paren;
+    else if (c == '(') paren = std::max(0, paren - 1);
+    else if (c == '?' && statement && paren == 0) return true;
+    else if (c == ';' || c == '}') {
+      if (c == '}') {  // skip the whole block before
+        int depth = 1;
+        while (k-- > 0 && depth > 0) depth += text[k] == '}' ? 1 : text[k] == '{' ? -1 : 0;
+        if (depth > 0) return false;
+      }
+      statement = false;
+      paren = 0;
+    } else if (c == '{') {  // the enclosing block: its opener
+      statement = false;
+      paren = 0;
+      size_t b = k;
+      while (b > 0 && std::isspace(static_cast<unsigned char>(text[b - 1]))) --b;
+      if (b >= 4 && text.compare(b - 4, 4, "else") == 0 && (b == 4 || !isIdentifierChar(text[b - 5])))
+        return true;
+      if (b > 0 && text[b - 1] == ')') {
+        int depth = 0;
+        size_t o = b;
+        while (o-- > 0) {
+          depth += text[o] == ')' ? 1 : text[o] == '(' ? -1 : 0;
+          if (depth == 0) break;
+        }
+        if (o == std::string::npos || o > b) return false;
+        size_t w = o;
+        while (w > 0 && std::isspace(static_cast<unsigned char>(text[w - 1]))) --w;
+        if (w >= 2 && text.compare(w - 2, 2, "if") == 0 && (w == 2 || !isIdentifierChar(text[w - 3])))
+          return true;
+      }
+    }
+  }
+  return false;
+}
+
 // The neighbours a destination of array d finds among the particles of array s in a full
 // support: the volume of the ball of radius kernelRadiusScale * h (h: the larger initial h of
 // the two arrays) over dx^dim (dx: the smallest spacing of s's geometry), with every param
@@ -148,6 +213,59 @@ std::optional<double> expectedNeighbours(const Plan& plan, int d, int s, std::st
 }
 
 }  // namespace
+
+std::vector<std::pair<unsigned, unsigned>> scalarMathCallSites(const std::string& text) {
+  std::vector<std::pair<unsigned, unsigned>> sites;
+  for (size_t from = 0; from < text.size();) {
+    const std::string rest = text.substr(from);
+    const std::string call = scalarMathCall(rest);
+    if (call.empty()) break;
+    size_t at = std::string::npos;  // where scalarMathCall found it
+    scanIdentifiers(rest, [&](const std::string& word, size_t b, size_t end) {
+      const size_t open = skipBlanks(rest, end);
+      if (word == call && open < rest.size() && rest[open] == '(') {
+        at = from + b;
+        return std::string::npos;
+      }
+      return end;
+    });
+    if (at == std::string::npos) break;
+    sites.push_back({static_cast<unsigned>(at), static_cast<unsigned>(at + call.size())});
+    from = at + call.size();
+  }
+  return sites;
+}
+
+std::string ScenePrinter::rareCallsRefusal(const PlanBody& b) const {
+  const std::string& text = b.source.text;
+  const std::string plain = withoutComments(text);
+  std::vector<std::pair<unsigned, unsigned>> values;  // the hoisted and pair-shared values' text
+  for (const SourceOnlySite& h : allHoistedSites(b)) values.push_back({h.begin, h.end});
+  for (const SourceOnlySite& h : b.facts.pairShared) {  // (every candidate: pairSharedSites asks the lanes)
+    values.push_back({h.begin, h.end});
+    if (h.stmtBegin < h.stmtEnd) values.push_back({h.stmtBegin, h.stmtEnd});
+    for (const auto& l : h.locals) values.push_back({l.initBegin, l.initEnd});
+  }
+  for (const auto& [begin, end] : scalarMathCallSites(text)) {
+    const std::string call = text.substr(begin, end - begin);
+    for (const auto& [vb, ve] : values)
+      if (vb <= begin && end <= ve)
+        return "its call of " + call + " is in a value computed outside the lanes";
+    if (!inBranch(plain, begin)) return "its call of " + call + " is in no branch (every pair takes it)";
+  }
+  return "";
+}
+
+bool ScenePrinter::rareCalls(const NeighbourPass& pass) const {
+  for (const PlanEquation* eq : pass.equations)
+    if (!scalarMathCall(methodBody(*eq, ast::Method::Loop).source.text).empty()) return true;
+  return false;
+}
+
+bool ScenePrinter::rareCallsInTiles(const DestinationWork& w, const NeighbourPass& pass) const {
+  return simdCluster_ && !(simdClusterAuto_ && plan_.dim != 3) && rareCalls(pass) &&
+         onceForm(w, pass) && clusterTilesFormRefusal(w, pass).empty();
+}
 
 bool ScenePrinter::eachPairOncePossible(const DestinationWork& w,
                                         const NeighbourPass& pass) const {
@@ -354,7 +472,7 @@ std::string ScenePrinter::simdPairsBlocker(const DestinationWork& w,
     std::string why;
     if (!scalarPairEdits(b.source.text, edits, why)) return eq->name + ": " + why;
     const std::string call = scalarMathCall(b.source.text);
-    if (!call.empty())
+    if (!call.empty() && !rareCallsInTiles(w, pass))
       return eq->name + " calls " + call + ", which GCC does not vectorise (its loop would be "
              "scalar or not depending on inlining)";
   }
@@ -370,8 +488,16 @@ std::vector<std::string> ScenePrinter::simdPairsNotes() const {
     const std::string loop =
         arr(w.array).name + " <- " + arr(pass.source).name + " in " + ph.name;
     const std::string why = simdPairsRefusal(w, pass);
-    if (!why.empty())
-      notes.push_back("pair loop not in SIMD lanes: " + loop + ": " + why);
+    if (!why.empty()) {
+      // --simd-pairs=cluster: why a 2D loop each pair once is not in the tiles either (the
+      // tiles' own refusal, clusterTilesFormRefusal; stop 40).
+      std::string tiles;
+      if (simdCluster_ && !simdClusterAuto_ && plan_.dim == 2 && onceForm(w, pass)) {
+        const std::string t = clusterTilesFormRefusal(w, pass);
+        if (!t.empty()) tiles = " (not in cluster-pair tiles: " + t + ")";
+      }
+      notes.push_back("pair loop not in SIMD lanes: " + loop + ": " + why + tiles);
+    }
     else if (onceLanes(w, pass) && clusterTilesRefusal(w, pass).empty())  // ClusterPairs.cpp
       notes.push_back("pair loop in cluster-pair tiles, each pair once: " + loop + ": " +
                       simdClusterWhy_);
@@ -477,12 +603,32 @@ void ScenePrinter::emitSimdFunction(const PlanEquation& eq, std::ostringstream& 
         }
     });
   }
+  // The tiles' rare forms (a body with scalar math calls is in lanes only in the tiles).
+  const bool rare = !scalarMathCall(methodBody(eq, ast::Method::Loop).source.text).empty();
+  if (rare && !rareHelperPrinted_ && simdDecls_->count(eq.declIndex)) {
+    rareHelperPrinted_ = true;
+    os << "// The tiles' rare path (codegen/ClusterPairs.cpp, stop 40): in the lanes a body's call of a\n"
+          "// math function GCC does not vectorise marks the lane (its pair is redone by the\n"
+          "// scalar fix-up with the real call) and gives 0.\n"
+          "// (The mark counts, read and written: GCC 12 if-converts that in a branch, not a\n"
+          "// plain store, `rare = 1.0`, which leaves the lanes scalar, \"control flow in loop\";\n"
+          "// nor a struct holding a reference to it, which takes its address.)\n"
+          "template <class... A>\n"
+          "static inline double sphc_rare_call(double& rare, A...) {\n"
+          "  rare = rare + 1.0;\n"
+          "  return 0.0;\n"
+          "}\n\n";
+  }
   if (simdDecls_->count(eq.declIndex)) {
+    if (rare) printSumsFunction(eq, true, os, false, true);
     printSumsFunction(eq, true, os);
     emitPairSharedSimdFunctions(methodBody(eq, ast::Method::Loop),
                                 bodyFunctionName(eq.name, "loop"), eq.dest, os);
   }
-  if (simdDecls_->count(-1 - eq.declIndex)) printSumsFunction(eq, true, os, /*mirror=*/true);
+  if (simdDecls_->count(-1 - eq.declIndex)) {
+    printSumsFunction(eq, true, os, /*mirror=*/true);
+    if (rare) printSumsFunction(eq, true, os, /*mirror=*/true, true);
+  }
 }
 
 // ---- Each pair once in SIMD lanes (--simd-pairs=once) ----

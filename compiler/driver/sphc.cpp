@@ -182,6 +182,13 @@ static cl::opt<bool> NoRegisterSums(
              "bodies allow it; serial and openmp, double and single precision (float locals "
              "in single); the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoSlotOrder(
+    "no-slot-order",
+    cl::desc("The cluster-pair tiles (--simd-pairs=cluster or auto's) over slot-order copies of "
+             "the particles, gathered per evaluation and their sums added back (stops 37-39), "
+             "not over the particles themselves kept in the tiles' slot order (stop 40; a "
+             "measurement knob)"),
+    cl::init(false), cl::Hidden, cl::cat(SphcCat));
 static cl::opt<bool> Cluster2d8x8(
     "cluster-2d-8x8",
     cl::desc("The 2D cluster-pair tiles (--simd-pairs=cluster) as 8 x 8 tiles of one i x 8 j's "
@@ -658,6 +665,7 @@ int main(int argc, char** argv) {
   emitOpts.simdPairsOnce = simdMode == "auto" || simdMode == "once" || simdMode == "cluster";
   emitOpts.simdPairsCluster = simdMode == "cluster";
   emitOpts.cluster2d8x8 = Cluster2d8x8;
+  emitOpts.clusterSlotOrder = !NoSlotOrder;
   emitOpts.simdAutoNeighbours = SimdNeighbours;
   emitOpts.simdOnceNeighbours = SimdOnceNeighbours;
   emitOpts.simdPerDestNeighbours = SimdPerDestNeighbours;

@@ -60,25 +60,11 @@ inline double box_distance2(const double* a, const double* b) {
   return gx * gx + gy * gy + gz * gz;
 }
 
-}  // namespace
-
-double cluster_column_side(double spacing, int dim, int width) {
-  return spacing * std::pow(static_cast<double>(width), 1.0 / dim);
-}
-
-void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, const double* z,
-                          std::size_t n, int dim, double column_side, int width) {
-  assert(dim == 2 || dim == 3);
-  assert(width >= 1 && width <= kMaxClusterSize);
-  if (width < 1) width = 1;
-  if (width > kMaxClusterSize) width = kMaxClusterSize;
-  const std::size_t C = static_cast<std::size_t>(width);
-  L.dim = dim;
-  L.width = width;
-  L.n = n;
+// The grid of columns of a layout (build_cluster_layout's rule, see sphc/cluster_pairs.h):
+// sets column_side, origin and columns; returns the side.
+double layout_grid(ClusterLayout& L, const double* x, const double* y, const double* z,
+                   std::size_t n, int dim, double column_side, std::size_t C) {
   const int ncol_axes = dim - 1;  // 3D: x, y; 2D: x
-  const double* col_axis[2] = {x, y};
-  const double* sort_axis = dim == 3 ? z : y;
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   const double* axes[3] = {x, y, dim == 3 ? z : nullptr};
   for (int a = 0; a < dim; ++a)
@@ -114,7 +100,32 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
     L.columns[a] = static_cast<std::size_t>(std::floor((hi[a] - lo[a]) / side)) + 1;
   }
   if (ncol_axes == 1) L.origin[1] = 0;
+  return side;
+}
+
+}  // namespace
+
+double cluster_column_side(double spacing, int dim, int width) {
+  return spacing * std::pow(static_cast<double>(width), 1.0 / dim);
+}
+
+void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, const double* z,
+                          std::size_t n, int dim, double column_side, int width) {
+  assert(dim == 2 || dim == 3);
+  assert(width >= 1 && width <= kMaxClusterSize);
+  if (width < 1) width = 1;
+  if (width > kMaxClusterSize) width = kMaxClusterSize;
+  const std::size_t C = static_cast<std::size_t>(width);
+  L.dim = dim;
+  L.width = width;
+  L.n = n;
+  const int ncol_axes = dim - 1;  // 3D: x, y; 2D: x
+  const double* col_axis[2] = {x, y};
+  const double* sort_axis = dim == 3 ? z : y;
+  const double side = layout_grid(L, x, y, z, n, dim, column_side, C);
   const std::size_t ncol = L.columns[0] * L.columns[1];
+  L.in_order = false;
+  L.column_cluster.clear();
 
   // Counting sort into columns (stable: particle index order within a column).
   std::vector<std::uint32_t> col(n);
@@ -168,6 +179,116 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
   gather_positions_boxes(L, x, y, z, xs.data(), ys.data(), dim == 3 ? zs.data() : nullptr, 0.0,
                          parallel);
 }
+
+void cluster_order(std::vector<std::uint32_t>& order, const double* x, const double* y,
+                   const double* z, std::size_t n, int dim, double column_side, int width) {
+  ClusterLayout L;
+  build_cluster_layout(L, x, y, z, n, dim, column_side, width);
+  const std::size_t C = static_cast<std::size_t>(L.width);
+  order.clear();
+  order.reserve(n);
+  std::vector<std::uint32_t> rest;  // the columns' last clusters' particles, if not full
+  for (std::size_t cy = 0; cy < L.columns[1]; ++cy)
+    for (std::size_t k = 0; k < L.columns[0]; ++k) {
+      const std::size_t cx = cy % 2 == 0 ? k : L.columns[0] - 1 - k;
+      const std::size_t col = cy * L.columns[0] + cx;
+      for (std::size_t c = L.column_begin[col]; c < L.column_begin[col + 1]; ++c) {
+        std::vector<std::uint32_t>& to = L.real_mask[c] == L.full_mask() ? order : rest;
+        for (std::size_t s = c * C; s < (c + 1) * C; ++s)
+          if (L.slot[s] != kPadSlot) to.push_back(L.slot[s]);
+      }
+    }
+  order.insert(order.end(), rest.begin(), rest.end());
+}
+
+void build_cluster_layout_in_order(ClusterLayout& L, const double* x, const double* y,
+                                   const double* z, std::size_t n, int dim, double column_side,
+                                   int width) {
+  assert(dim == 2 || dim == 3);
+  if (width < 1) width = 1;
+  if (width > kMaxClusterSize) width = kMaxClusterSize;
+  const std::size_t C = static_cast<std::size_t>(width);
+  L.dim = dim;
+  L.width = width;
+  L.n = n;
+  L.in_order = true;
+  const double side = layout_grid(L, x, y, z, n, dim, column_side, C);
+  const std::size_t ncol = L.columns[0] * L.columns[1];
+  const std::size_t nc = (n + C - 1) / C;
+  L.n_clusters = nc;
+  L.slot.resize(nc * C);
+  L.slot_of.resize(n);
+  for (std::size_t s = 0; s < nc * C; ++s) L.slot[s] = s < n ? static_cast<std::uint32_t>(s) : kPadSlot;
+  for (std::size_t p = 0; p < n; ++p) L.slot_of[p] = static_cast<std::uint32_t>(p);
+  L.real_mask.assign(nc, L.full_mask());
+  if (nc * C != n) L.real_mask[nc - 1] = static_cast<std::uint8_t>((1u << (n - (nc - 1) * C)) - 1u);
+  L.box.assign(nc * 6, 0.0);
+  update_boxes(L, x, y, z);  // the real slots are the particles themselves
+  // Each cluster in the column of its box's centre; a column's clusters by the low sort
+  // coordinate of their boxes (ties by index).
+  const int sa = dim == 3 ? 2 : 1;
+  std::vector<std::uint32_t> col(nc);
+  std::vector<std::uint32_t> count(ncol + 1, 0);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const double* b = &L.box[6 * c];
+    std::size_t k = column_of(0.5 * (b[0] + b[3]), L.origin[0], side, L.columns[0]);
+    if (dim == 3) k += L.columns[0] * column_of(0.5 * (b[1] + b[4]), L.origin[1], side, L.columns[1]);
+    col[c] = static_cast<std::uint32_t>(k);
+    ++count[k + 1];
+  }
+  for (std::size_t k = 0; k < ncol; ++k) count[k + 1] += count[k];
+  L.column_begin.assign(count.begin(), count.end());
+  std::vector<std::pair<double, std::uint32_t>> entry(nc);
+  {
+    std::vector<std::uint32_t> at(count.begin(), count.end() - 1);
+    for (std::size_t c = 0; c < nc; ++c)
+      entry[at[col[c]]++] = {key(L.box[6 * c + sa]), static_cast<std::uint32_t>(c)};
+  }
+  for (std::size_t k = 0; k < ncol; ++k)
+    std::sort(entry.begin() + count[k], entry.begin() + count[k + 1]);
+  L.column_cluster.resize(nc);
+  for (std::size_t k = 0; k < nc; ++k) L.column_cluster[k] = entry[k].second;
+}
+
+namespace {
+
+// The largest x of the boxes' real particles (the padding's reference).
+double boxes_xmax(const ClusterLayout& L) {
+  double xmax = -HUGE_VAL;
+  for (std::size_t c = 0; c < L.n_clusters; ++c) xmax = std::max(xmax, L.box[6 * c + 3]);
+  return xmax;
+}
+
+}  // namespace
+
+void gather_tail(const ClusterLayout& L, const double* const* src, double* const* dst,
+                 int count) {
+  const std::size_t t = tail_cluster(L);
+  if (t == L.n_clusters) return;
+  const int C = L.width;
+  const std::size_t s0 = t * static_cast<std::size_t>(C);
+  const int m = static_cast<int>(L.n - s0);
+  for (int a = 0; a < count; ++a)
+    for (int l = 0; l < C; ++l) dst[a][l] = src[a][s0 + static_cast<std::size_t>(l < m ? l : 0)];
+}
+
+void tail_positions(const ClusterLayout& L, const double* x, const double* y, const double* z,
+                    double* tx, double* ty, double* tz, double pad_offset) {
+  const std::size_t t = tail_cluster(L);
+  if (t == L.n_clusters) return;
+  const int C = L.width;
+  const std::size_t s0 = t * static_cast<std::size_t>(C);
+  const int m = static_cast<int>(L.n - s0);
+  const double xmax = boxes_xmax(L);
+  double k = 0;
+  for (int l = 0; l < C; ++l) {
+    const std::size_t p = s0 + static_cast<std::size_t>(l < m ? l : 0);
+    tx[l] = l < m ? x[p] : xmax + (k += 1) * pad_offset;
+    ty[l] = y[p];
+    if (L.dim == 3) tz[l] = z[p];
+  }
+}
+
 
 namespace {
 
@@ -445,6 +566,24 @@ void gather_slots_doubled_n(const ClusterLayout& L, const double* const* src,
   const int C = L.width;
   const std::uint8_t full = L.full_mask();
   const std::uint8_t* real = L.real_mask.data();
+  if (L.in_order && C == 4) {  // slot s is particle s: contiguous reads (stop 40)
+    gather_each_array(L, C, src, dst, count, parallel,
+                      [=](const double* s, const std::uint32_t* sl, std::size_t c, double* d2) {
+                        double* d = d2 + 8 * c;
+                        const double* v = s + 4 * c;
+                        if (real[c] == full) {
+                          const double v0 = v[0], v1 = v[1], v2 = v[2], v3 = v[3];
+                          d[0] = d[4] = v0;
+                          d[1] = d[5] = v1;
+                          d[2] = d[6] = v2;
+                          d[3] = d[7] = v3;
+                        } else {
+                          const double first = v[0];
+                          for (int k = 0; k < 4; ++k) d[k] = d[4 + k] = sl[k] == kPadSlot ? first : v[k];
+                        }
+                      });
+    return;
+  }
   gather_each_array(L, C, src, dst, count, parallel,
                     [=](const double* s, const std::uint32_t* sl, std::size_t c, double* da) {
                       double* d = da + 2 * c * C;
@@ -507,6 +646,43 @@ void gather_positions_boxes(ClusterLayout& L, const double* x, const double* y, 
     gather_positions_boxes_w<0>(L, x, y, z, xs, ys, zs, pad_offset, parallel);
 }
 
+void positions_doubled_boxes(ClusterLayout& L, const double* x, const double* y,
+                             const double* z, double* x2, double* y2, double* z2,
+                             double pad_offset, bool parallel) {
+  const int C = L.width;
+  const bool three = L.dim == 3;
+  const unsigned full = L.full_mask();
+  const std::size_t nc = L.n_clusters;
+  const std::uint8_t* real = L.real_mask.data();
+  double* box = L.box.data();
+  (void)parallel;
+#pragma omp parallel for schedule(static) if (parallel)
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::size_t s0 = c * C;
+    double* dx = x2 + 2 * s0;
+    double* dy = y2 + 2 * s0;
+    double* dz = three ? z2 + 2 * s0 : nullptr;
+    if (real[c] == full) {
+      for (int k = 0; k < C; ++k) {
+        dx[k] = dx[C + k] = x[s0 + k];
+        dy[k] = dy[C + k] = y[s0 + k];
+        if (three) dz[k] = dz[C + k] = z[s0 + k];
+      }
+    }
+    cluster_box<0>(C, real[c], full, three, x + s0, y + s0, three ? z + s0 : nullptr, box + 6 * c);
+  }
+  const std::size_t t = tail_cluster(L);
+  if (t == nc) return;
+  double tx[kMaxClusterSize], ty[kMaxClusterSize], tz[kMaxClusterSize];
+  tail_positions(L, x, y, z, tx, ty, tz, pad_offset);
+  const std::size_t s0 = t * C;
+  for (int k = 0; k < C; ++k) {
+    x2[2 * s0 + k] = x2[2 * s0 + C + k] = tx[k];
+    y2[2 * s0 + k] = y2[2 * s0 + C + k] = ty[k];
+    if (three) z2[2 * s0 + k] = z2[2 * s0 + C + k] = tz[k];
+  }
+}
+
 namespace {
 
 // Per column of b, running bounds along the sort axis: lo_up[k] = max of the clusters'
@@ -518,6 +694,10 @@ struct ColumnBounds {
   std::vector<double> up, down;
   double overhang = 0;  // the most a box sticks out of its column's x-y square (+ slack)
   double slack = 0;     // absolute slack of the reach along the sort axis
+  // In order (stop 40): per column the x and y bounds of its clusters' boxes (lo x, hi x, lo
+  // y, hi y; empty: inverted), which the search tests in place of the widened square (a
+  // cluster of the columns' tops may reach over several columns: the overhang is large).
+  std::vector<double> ext;
 };
 
 ColumnBounds column_bounds(const ClusterLayout& b) {
@@ -525,20 +705,33 @@ ColumnBounds column_bounds(const ClusterLayout& b) {
   const int sa = b.dim == 3 ? 2 : 1;
   cb.up.resize(b.n_clusters);
   cb.down.resize(b.n_clusters);
+  if (b.in_order) cb.ext.assign(4 * b.columns[0] * b.columns[1], 0.0);
   const std::size_t ncol = b.columns[0] * b.columns[1];
   double over = 0;
   for (std::size_t col = 0; col < ncol; ++col) {
     const std::size_t c0 = b.column_begin[col], c1 = b.column_begin[col + 1];
     if (c0 == c1) continue;
+    // (entries k of the column: cluster k, or column_cluster[k] in order)
+    const std::uint32_t* cc = b.in_order ? b.column_cluster.data() : nullptr;
+    auto cl = [&](std::size_t k) { return cc ? static_cast<std::size_t>(cc[k]) : k; };
     double run = -HUGE_VAL;
-    for (std::size_t c = c0; c < c1; ++c) run = std::max(run, b.box[6 * c + 3 + sa]), cb.up[c] = run;
+    for (std::size_t c = c0; c < c1; ++c) run = std::max(run, b.box[6 * cl(c) + 3 + sa]), cb.up[c] = run;
     run = HUGE_VAL;
-    for (std::size_t c = c1; c-- > c0;) run = std::min(run, b.box[6 * c + sa]), cb.down[c] = run;
+    for (std::size_t c = c1; c-- > c0;) run = std::min(run, b.box[6 * cl(c) + sa]), cb.down[c] = run;
+    if (cc) {
+      double e[4] = {HUGE_VAL, -HUGE_VAL, HUGE_VAL, -HUGE_VAL};
+      for (std::size_t c = c0; c < c1; ++c) {
+        const double* bx = &b.box[6 * cl(c)];
+        e[0] = std::min(e[0], bx[0]), e[1] = std::max(e[1], bx[3]);
+        e[2] = std::min(e[2], bx[1]), e[3] = std::max(e[3], bx[4]);
+      }
+      std::copy(e, e + 4, cb.ext.begin() + 4 * static_cast<std::ptrdiff_t>(col));
+    }
     const std::size_t cx = col % b.columns[0], cy = col / b.columns[0];
     const double x0 = b.origin[0] + static_cast<double>(cx) * b.column_side, x1 = x0 + b.column_side;
     const double y0 = b.origin[1] + static_cast<double>(cy) * b.column_side, y1 = y0 + b.column_side;
     for (std::size_t c = c0; c < c1; ++c) {
-      const double* bx = &b.box[6 * c];
+      const double* bx = &b.box[6 * cl(c)];
       over = std::max({over, x0 - bx[0], bx[3] - x1});
       if (b.dim == 3) over = std::max({over, y0 - bx[1], bx[4] - y1});
     }
@@ -582,6 +775,8 @@ void find_pairs(const ClusterLayout& b, const ColumnBounds& cb, const double* ib
   column_range(b, 0, ib[0], ib[3], reach, x0, x1);
   if (b.dim == 3) column_range(b, 1, ib[1], ib[4], reach, y0, y1);
   if (x0 > x1 || y0 > y1) return;
+  const std::uint32_t* cc = b.in_order ? b.column_cluster.data() : nullptr;
+  const std::size_t first = out.size();
   for (std::size_t cy = y0; cy <= y1; ++cy) {
     // The column's x-y square widened by the overhang: its distance to the i box.
     double gy2 = 0;
@@ -592,8 +787,19 @@ void find_pairs(const ClusterLayout& b, const ColumnBounds& cb, const double* ib
     }
     for (std::size_t cx = x0; cx <= x1; ++cx) {
       const double c0 = b.origin[0] + static_cast<double>(cx) * b.column_side - cb.overhang;
-      const double gx = gap(ib[0], ib[3], c0, c0 + b.column_side + 2 * cb.overhang);
-      const double gxy2 = gx * gx + gy2;
+      double gx = gap(ib[0], ib[3], c0, c0 + b.column_side + 2 * cb.overhang);
+      double gyc2 = gy2;
+      if (cc) {  // in order: the column's own bounds (a box's gaps are at least these)
+        const std::size_t col = cy * b.columns[0] + cx;
+        if (b.column_begin[col] == b.column_begin[col + 1]) continue;
+        const double* e = &cb.ext[4 * col];
+        gx = gap(ib[0], ib[3], e[0], e[1]);
+        if (b.dim == 3) {
+          const double gy = gap(ib[1], ib[4], e[2], e[3]);
+          gyc2 = gy * gy;
+        }
+      }
+      const double gxy2 = gx * gx + gyc2;
       if (gxy2 > r2) continue;
       // Along the sort axis a box of this column within r2 is within sqrt(r2 - gxy2).
       const double reach_z = std::sqrt(r2 - gxy2) * (1 + 1e-9) + cb.slack;
@@ -601,15 +807,24 @@ void find_pairs(const ClusterLayout& b, const ColumnBounds& cb, const double* ib
       const std::size_t col = cy * b.columns[0] + cx;
       std::size_t k = b.column_begin[col];
       const std::size_t end = b.column_begin[col + 1];
-      if (once && end <= ci) continue;
+      if (!cc && once && end <= ci) continue;
       // First cluster whose running high bound reaches zlo.
       k = static_cast<std::size_t>(
           std::lower_bound(cb.up.begin() + k, cb.up.begin() + end, zlo) - cb.up.begin());
+      if (cc) {  // in order: the entries' clusters, any index
+        for (; k < end && !(cb.down[k] > zhi); ++k) {
+          const std::size_t j = cc[k];
+          if ((!once || j >= ci) && box_distance2(ib, &b.box[6 * j]) <= r2)
+            out.push_back(static_cast<std::uint32_t>(j));
+        }
+        continue;
+      }
       if (once && k < ci) k = ci;
       for (; k < end && !(cb.down[k] > zhi); ++k)
         if (box_distance2(ib, &b.box[6 * k]) <= r2) out.push_back(static_cast<std::uint32_t>(k));
     }
   }
+  if (cc) std::sort(out.begin() + static_cast<std::ptrdiff_t>(first), out.end());  // increasing j
 }
 
 }  // namespace

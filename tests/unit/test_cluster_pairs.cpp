@@ -607,3 +607,87 @@ TEST(ClusterPairs, SmallAndDegenerateInputs) {
 }
 
 }  // namespace
+
+// Particles kept in the tiles' slot order (stop 40): cluster_order is a permutation; the
+// particles permuted into it give an in-order layout (slot s = particle s, only the last
+// cluster padded) whose once lists hold every pair within the radius (j increasing, j >= i),
+// whose clusters are compact (about as many cluster pairs as the sorted layout's), and whose
+// padded tail (gather_tail, tail_positions, positions_doubled_boxes) holds the last cluster's
+// values with its padding far from every particle.
+TEST(ClusterPairs, InOrderLayoutsOfTheClusterOrderHoldEveryPair) {
+  for (int width : kWidths)
+  for (const Case& c : cases()) {
+    SCOPED_TRACE(c.name);
+    SCOPED_TRACE(width);
+    std::vector<std::uint32_t> order;
+    sphc::cluster_order(order, c.p.x.data(), c.p.y.data(), c.p.zp(), c.p.n(), c.p.dim, c.side, width);
+    ASSERT_EQ(order.size(), c.p.n());
+    {
+      std::vector<std::uint32_t> sorted = order;
+      std::sort(sorted.begin(), sorted.end());
+      for (std::size_t i = 0; i < sorted.size(); ++i) ASSERT_EQ(sorted[i], i);
+    }
+    Points q = c.p;
+    for (std::size_t i = 0; i < order.size(); ++i)
+      q.x[i] = c.p.x[order[i]], q.y[i] = c.p.y[order[i]], q.z[i] = c.p.z[order[i]];
+    ClusterLayout L;
+    sphc::build_cluster_layout_in_order(L, q.x.data(), q.y.data(), q.zp(), q.n(), q.dim, c.side, width);
+    ASSERT_TRUE(L.in_order);
+    ASSERT_EQ(L.n_clusters, (q.n() + width - 1) / width);
+    for (std::size_t s = 0; s < L.slots(); ++s) ASSERT_EQ(L.slot[s], s < q.n() ? s : kPadSlot);
+    for (std::size_t c2 = 0; c2 + 1 < L.n_clusters; ++c2) ASSERT_EQ(L.real_mask[c2], L.full_mask());
+    ASSERT_EQ(L.column_cluster.size(), L.n_clusters);
+    ClusterPairList l;
+    build_cluster_pairs(L, L, c.radius, true, l);
+    expect_well_formed(L, L, l, true);
+    EXPECT_GT(expect_complete(q, L, q, L, l, c.radius, true), static_cast<long>(4 * q.n()));
+    // Compact: the sorted layout's cluster pairs (of more clusters, with padding) x 1.25 at most.
+    const ClusterLayout S = layout_of(c.p, c.side, width);
+    ClusterPairList ls;
+    build_cluster_pairs(S, S, c.radius, true, ls);
+    EXPECT_LE(l.pairs(), 1.25 * ls.pairs() + 16);
+    // The tail.
+    const std::size_t t = sphc::tail_cluster(L);
+    if (q.n() % width == 0) {
+      EXPECT_EQ(t, L.n_clusters);
+      continue;
+    }
+    ASSERT_EQ(t, L.n_clusters - 1);
+    const double pad = 3 * c.radius;
+    std::vector<double> tx(width), ty(width), tz(width), tm(width);
+    sphc::tail_positions(L, q.x.data(), q.y.data(), q.zp(), tx.data(), ty.data(), tz.data(), pad);
+    const double* src[] = {q.y.data()};
+    double* dst[] = {tm.data()};
+    sphc::gather_tail(L, src, dst, 1);
+    const std::size_t s0 = t * width;
+    for (int k = 0; k < width; ++k) {
+      if (s0 + k < q.n()) {
+        EXPECT_EQ(tx[k], q.x[s0 + k]);
+        EXPECT_EQ(tm[k], q.y[s0 + k]);
+      } else {
+        EXPECT_EQ(tm[k], q.y[s0]);
+        for (std::size_t i = 0; i < q.n(); ++i) ASSERT_GE(std::fabs(tx[k] - q.x[i]), pad * (1 - 1e-12));
+      }
+    }
+    if (width == 4) {  // the 2xMM tiles' doubled positions: the same values twice
+      std::vector<double> x2(2 * L.slots()), y2(2 * L.slots()), z2(2 * L.slots());
+      ClusterLayout L2 = L;
+      sphc::positions_doubled_boxes(L2, q.x.data(), q.y.data(), q.zp(), x2.data(), y2.data(),
+                                    q.dim == 3 ? z2.data() : nullptr, pad);
+      EXPECT_EQ(L2.box, L.box);
+      for (std::size_t s = 0; s < L.slots(); ++s) {
+        const std::size_t cl = s / 4, k = s % 4;
+        const double want = s < q.n() ? q.x[s] : tx[k];
+        ASSERT_EQ(x2[8 * cl + k], want);
+        ASSERT_EQ(x2[8 * cl + 4 + k], want);
+      }
+      // The doubled copies of an in-order layout: contiguous reads, the same values.
+      std::vector<double> d2(2 * L.slots()), d2ref(2 * L.slots());
+      const double* s1[] = {q.y.data()};
+      double* o1[] = {d2.data()};
+      sphc::gather_slots_doubled(L, s1, o1, 1);
+      sphc::gather_slots_doubled(L, q.y.data(), d2ref.data());
+      EXPECT_EQ(d2, d2ref);
+    }
+  }
+}

@@ -7,7 +7,10 @@
 // strips of width `column_side` in x, each sorted by y), each column cut into clusters of
 // `width` consecutive particles (kClusterSize = 8 by default; 1..8, e.g. 4 for 2D tiles:
 // docs/performance.md, "SIMD tiles in 2D, measured by hand (stop 38)"), the last cluster of a
-// column padded. Slot s = width c + k is lane k of cluster c (ClusterLayout). Per evaluation the loop copies the properties it reads
+// column padded. Slot s = width c + k is lane k of cluster c (ClusterLayout). (Since stop 40 the
+// generated code keeps the particles themselves in a slot order where it can: see "Particles
+// kept in the tiles' slot order" below; the copies remain with sphc --no-slot-order.)
+// Per evaluation the loop copies the properties it reads
 // into slot order (gather_slots, gather_positions: contiguous vector loads of a cluster), runs
 // its tiles (one i of an i-cluster broadcast x the lanes of a j-cluster, the cut-off a mask)
 // over a ClusterPairList, and adds its sums, accumulated in slot order, back (add_slots).
@@ -89,6 +92,13 @@ struct ClusterLayout {
   double origin[2] = {0, 0};
   std::size_t columns[2] = {0, 0};
   std::vector<std::uint32_t> column_begin;  // columns[0] * columns[1] + 1
+  // In order (build_cluster_layout_in_order, stop 40): slot s IS particle s (the last
+  // cluster padded), a cluster in the column of its box's centre; column_cluster[k] for k in
+  // [column_begin[col], column_begin[col + 1]) the clusters of column col by the low sort
+  // coordinate of their boxes (ties by index). Empty otherwise (the column's clusters are
+  // the indices themselves).
+  bool in_order = false;
+  std::vector<std::uint32_t> column_cluster;
 
   std::size_t slots() const { return n_clusters * static_cast<std::size_t>(width); }
   // real_mask of a cluster without padding.
@@ -108,6 +118,49 @@ double cluster_column_side(double spacing, int dim, int width = kClusterSize);
 void build_cluster_layout(ClusterLayout& layout, const double* x, const double* y,
                           const double* z, std::size_t n, int dim, double column_side,
                           int width = kClusterSize);
+
+// Particles kept in the tiles' slot order (stop 40; docs/performance.md "Particles in the
+// tiles' slot order (stop 40)"). The generated code permutes an array whose tiles' lists are
+// due into `cluster_order`'s order (ParticleArray::permute) and builds its layout in that
+// order (build_cluster_layout_in_order): slot s is particle s, the tiles read and write the
+// particles' arrays themselves; only the last cluster (n % width real particles, if any) is
+// padded, its slots copied per evaluation into `width`-value tails (gather_tail,
+// tail_positions).
+//
+// The order: build_cluster_layout's full clusters as they are (a column's clusters aligned
+// from its bottom, as in the sorted layout), the columns in boustrophedon order (3D: the rows
+// of columns along x alternately forwards and backwards), then the particles of the columns'
+// last clusters that are not full, in the same column order (the tops of neighbouring
+// columns, cut into clusters of their own).
+void cluster_order(std::vector<std::uint32_t>& order, const double* x, const double* y,
+                   const double* z, std::size_t n, int dim, double column_side,
+                   int width = kClusterSize);
+// The layout of the particles as they are: slot s = particle s, cluster c the particles
+// [width c, width c + width), the last padded (real slots first); boxes from x, y, z; the
+// grid of columns as build_cluster_layout's (column_side <= 0: the same rule).
+void build_cluster_layout_in_order(ClusterLayout& layout, const double* x, const double* y,
+                                   const double* z, std::size_t n, int dim, double column_side,
+                                   int width = kClusterSize);
+// The padded cluster of an in-order layout: its index, n_clusters if every cluster is full.
+inline std::size_t tail_cluster(const ClusterLayout& L) {
+  return L.n_clusters > 0 && L.slots() != L.n ? L.n_clusters - 1 : L.n_clusters;
+}
+// In order, per evaluation: the padded cluster's values, dst[k][l] = src[k][width t + l]
+// for its real lanes l, its first particle's value for the padding (dst: width values
+// each; nothing where every cluster is full).
+void gather_tail(const ClusterLayout& layout, const double* const* src, double* const* dst,
+                 int count);
+// In order, per evaluation, after the boxes: the padded cluster's positions (width values
+// each; tz unused in 2D), its padding lanes as gather_positions' (x = the largest x of the
+// boxes + k pad_offset, y and z the cluster's first particle's).
+void tail_positions(const ClusterLayout& layout, const double* x, const double* y,
+                    const double* z, double* tx, double* ty, double* tz, double pad_offset);
+// In order, per evaluation (the 2xMM tiles, width 4): the boxes from the particles'
+// positions and the positions doubled per cluster (x2[2 w c + k] = x2[2 w c + w + k] = x[w c
+// + k]), the padding lanes as tail_positions'; z, z2 unused in 2D.
+void positions_doubled_boxes(ClusterLayout& layout, const double* x, const double* y,
+                             const double* z, double* x2, double* y2, double* z2,
+                             double pad_offset, bool parallel = true);
 
 // Per evaluation: dst[s] = src[slot[s]] for every slot (dst: layout.slots() values); a
 // padding slot takes the value of the first slot of its cluster (a real particle).

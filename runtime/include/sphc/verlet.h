@@ -103,6 +103,16 @@ class VerletSkin {
   // What the last must_rebuild measured (2 d + radius_scale g; -1 where it answered without
   // measuring), the must_rebuild calls since the last mark(), and h_min at the last mark().
   double last_moved() const { return last_moved_; }
+  // Whether the next must_rebuild is expected to say yes: before the first mark() (or after
+  // forget()), or where the movement it measured last, extrapolated by one more evaluation
+  // (x (checks + 1) / checks), passes the skin. A guess, for work done ahead of a rebuild
+  // (the tiles' slot order, stop 40: sphc/cluster_pairs.h); must_rebuild still decides.
+  bool rebuild_expected(double radius_scale) const {
+    if (saved_.empty()) return true;
+    if (!(last_moved_ > 0.0) || checks_ <= 0) return false;
+    const double next = last_moved_ * static_cast<double>(checks_ + 1) / static_cast<double>(checks_);
+    return !(next <= skin_ * radius_scale * hmin_);
+  }
   long checks() const { return checks_; }
   double hmin() const { return hmin_; }
 
