@@ -345,25 +345,7 @@ void add_slots(const ClusterLayout& L, const float* sums, float* dst) {
 }
 
 void gather_slots_doubled(const ClusterLayout& L, const double* src, double* dst) {
-  const int C = L.width;
-  const std::uint8_t full = L.full_mask();
-  const std::uint32_t* slot = L.slot.data();
-  const std::size_t nc = L.n_clusters;
-#pragma omp parallel for schedule(static)
-  for (std::size_t c = 0; c < nc; ++c) {
-    const std::uint32_t* sl = slot + c * C;
-    double* d = dst + 2 * c * C;
-    if (C == 4 && L.real_mask[c] == full) {  // the 2xMM width: unrolled
-      const double v0 = src[sl[0]], v1 = src[sl[1]], v2 = src[sl[2]], v3 = src[sl[3]];
-      d[0] = d[4] = v0;
-      d[1] = d[5] = v1;
-      d[2] = d[6] = v2;
-      d[3] = d[7] = v3;
-    } else {
-      const double first = src[sl[0]];
-      for (int k = 0; k < C; ++k) d[k] = d[C + k] = sl[k] == kPadSlot ? first : src[sl[k]];
-    }
-  }
+  gather_slots_doubled(L, &src, &dst, 1);  // the arrays' form, one array
 }
 
 void gather_positions(const ClusterLayout& L, const double* x, const double* y, const double* z,
@@ -560,6 +542,22 @@ void gather_positions_boxes_w(ClusterLayout& L, const double* x, const double* y
   }
 }
 
+// One cluster's C values written twice into d (the 2xMM j side: d[k] = d[C + k]); value(k) is
+// the cluster's k-th value, read only for a real slot (a padding slot takes the first value).
+template <class Value>
+inline void write_doubled(double* d, int C, bool whole, const std::uint32_t* sl, Value value) {
+  if (C == 4 && whole) {  // the 2xMM width: unrolled
+    const double v0 = value(0), v1 = value(1), v2 = value(2), v3 = value(3);
+    d[0] = d[4] = v0;
+    d[1] = d[5] = v1;
+    d[2] = d[6] = v2;
+    d[3] = d[7] = v3;
+  } else {
+    const double first = value(0);
+    for (int k = 0; k < C; ++k) d[k] = d[C + k] = sl[k] == kPadSlot ? first : value(k);
+  }
+}
+
 // gather_slots_doubled's values for `count` arrays, as gather_slots_n_w: one parallel region.
 void gather_slots_doubled_n(const ClusterLayout& L, const double* const* src,
                             double* const* dst, int count, bool parallel) {
@@ -569,34 +567,16 @@ void gather_slots_doubled_n(const ClusterLayout& L, const double* const* src,
   if (L.in_order && C == 4) {  // slot s is particle s: contiguous reads (stop 40)
     gather_each_array(L, C, src, dst, count, parallel,
                       [=](const double* s, const std::uint32_t* sl, std::size_t c, double* d2) {
-                        double* d = d2 + 8 * c;
                         const double* v = s + 4 * c;
-                        if (real[c] == full) {
-                          const double v0 = v[0], v1 = v[1], v2 = v[2], v3 = v[3];
-                          d[0] = d[4] = v0;
-                          d[1] = d[5] = v1;
-                          d[2] = d[6] = v2;
-                          d[3] = d[7] = v3;
-                        } else {
-                          const double first = v[0];
-                          for (int k = 0; k < 4; ++k) d[k] = d[4 + k] = sl[k] == kPadSlot ? first : v[k];
-                        }
+                        write_doubled(d2 + 8 * c, 4, real[c] == full, sl,
+                                      [v](int k) { return v[k]; });
                       });
     return;
   }
   gather_each_array(L, C, src, dst, count, parallel,
                     [=](const double* s, const std::uint32_t* sl, std::size_t c, double* da) {
-                      double* d = da + 2 * c * C;
-                      if (C == 4 && real[c] == full) {  // the 2xMM width: unrolled
-                        const double v0 = s[sl[0]], v1 = s[sl[1]], v2 = s[sl[2]], v3 = s[sl[3]];
-                        d[0] = d[4] = v0;
-                        d[1] = d[5] = v1;
-                        d[2] = d[6] = v2;
-                        d[3] = d[7] = v3;
-                      } else {
-                        const double first = s[sl[0]];
-                        for (int k = 0; k < C; ++k) d[k] = d[C + k] = sl[k] == kPadSlot ? first : s[sl[k]];
-                      }
+                      write_doubled(da + 2 * c * C, C, real[c] == full, sl,
+                                    [s, sl](int k) { return s[sl[k]]; });
                     });
 }
 
