@@ -6,7 +6,7 @@
 // sums added back. Thread CPU time, best of --reps rounds (interleaved). Prints the tile
 // lanes within the support (pairs within 2 h over pruned cluster pairs x 64) and checks the
 // lists against a cell-list count of the pairs within the support (exit 1 if one is missing).
-// docs/performance.md, "Cluster-pair lists in the runtime (stop 37)".
+// docs/performance-log.md, "Cluster-pair lists in the runtime (stop 37)".
 //
 // Built with the runtime (tests/CMakeLists.txt: cluster_lists_check, serial runtime; ctest
 // bench.cluster_lists at nx = 16). Run: cluster_lists [--nx 47] [--hdx 1.5] [--pert 0.05]
@@ -17,7 +17,7 @@
 // --move F: before the per-evaluation pieces every particle moves by up to F x skin x 2 h
 // (a random direction; F <= 0.5 keeps the outer list complete).
 // --width W: the layout's cluster width (sphc::ClusterLayout::width; default 8).
-// --fill: also the tile shapes' fill (docs/performance.md, "SIMD tiles in 2D, measured by hand
+// --fill: also the tile shapes' fill (docs/performance-log.md, "SIMD tiles in 2D, measured by hand
 // (stop 38)"): per shape (i-cluster x j-cluster: 8x8, 4x8 = the halves of an 8-cluster x an
 // 8-cluster, 4x4, 2x4 and GROMACS' 2xMM = a 4x4 tile in two registers of 2 i's x 4 j's, 2x2,
 // 1x8) the lanes within the support over the lanes computed, every tile's lanes or only the

@@ -1,6 +1,6 @@
 // The cube's fluid <- fluid interaction (bench/cube.sph: continuity, momentum with artificial
 // viscosity, XSPH; cubic spline, h = 1.5 dx) on its 103,823-particle lattice, in three forms,
-// timed by hand (docs/performance.md, "A cluster-pair SIMD tile kernel, measured by hand
+// timed by hand (docs/performance-log.md, "A cluster-pair SIMD tile kernel, measured by hand
 // (stop 36)"; issue 16, the 25%-of-peak target). Not a test of the solver: a prototype that
 // prints figures, self-checking (exit 1 if a form's sums disagree with form (a)).
 //
@@ -1176,7 +1176,7 @@ __attribute__((noinline)) void form_c_omp(Clusters& cl, const PairList& pl, cons
   }
 }
 
-// The tile printable by sphc (stop 37, docs/performance.md "Cluster-pair tiles in the
+// The tile printable by sphc (stop 37, docs/performance-log.md "Cluster-pair tiles in the
 // printer"): form_c_omp's lane body (the generated _simd / _simd_mirror calls) under
 // `#pragma omp simd` over the 8 j's of a tile, with what makes GCC 12 vectorise it in 512-bit
 // vectors: s_idx the lane (the source arrays offset to the j-cluster: no int arithmetic in

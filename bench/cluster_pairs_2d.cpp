@@ -2,7 +2,7 @@
 // density_diffusion=off -D shifting=off: continuity, momentum with Monaghan's artificial
 // viscosity, XSPH; WendlandQuintic 2D, h = 1.3 dx, support 2 h, ~19 neighbours), timed by
 // hand in SIMD tiles against the scalar each-pair-once loop sphc prints today
-// (docs/performance.md, "SIMD tiles in 2D, measured by hand (stop 38)"; issue 16). Not a test
+// (docs/performance-log.md, "SIMD tiles in 2D, measured by hand (stop 38)"; issue 16). Not a test
 // of the solver: a prototype that prints figures, self-checking (exit 1 if a form's sums
 // disagree with form (a) beyond the tolerance, or a list misses a pair).
 //

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""CPU time of each process of a cold sphc build (docs/performance.md "Compile time").
+"""CPU time of each process of a cold sphc build (docs/performance-log.md "Compile time").
 
 For each sphc given (--sphc LABEL=PATH), scene and backend: a cold build into an empty cache
 directory with `-v`, which prints the compile and link commands; then the same commands run

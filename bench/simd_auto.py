@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Per-step cost of the generated solvers with and without the SIMD pair loops, the matrix
-behind `sphc --simd-pairs=auto` (issue 16; docs/performance.md "SIMD pair loops chosen by the
+behind `sphc --simd-pairs=auto` (issue 16; docs/performance-log.md "SIMD pair loops chosen by the
 compiler"): prints figures, is not a test.
 
 For each scene and each variant (by default: off = the scalar loops, each pair once where the

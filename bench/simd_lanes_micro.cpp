@@ -1,5 +1,5 @@
 // What the instructions of the SIMD pair loops (sphc --simd-pairs, codegen/SimdPairs.cpp)
-// cost on this CPU, per lane against the scalar unit (docs/performance.md, "SIMD pair loops
+// cost on this CPU, per lane against the scalar unit (docs/performance-log.md, "SIMD pair loops
 // by the CPU", stop 35): not a test, it prints figures. CPU time of the thread, best of 9.
 //   div:  a[i] / b[i] over 1,024 doubles (in L1), `#pragma omp simd` against a loop GCC may
 //         not vectorise; sqrt: the same with std::sqrt.

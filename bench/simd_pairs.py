@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""SIMD pair loops, measured by hand-edited generated C++ (issue 16; docs/performance.md
+"""SIMD pair loops, measured by hand-edited generated C++ (issue 16; docs/performance-log.md
 "SIMD pair loops: measured"): prints figures, is not a test.
 
 For the cube (bench/cube.sph, 3D, 103,823 particles) and the dam break with PySPH's effects

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """CPU time per step of the generated solvers with the SIMD pair loops of `sphc --simd-pairs`
-against the default (issue 16; docs/performance.md "SIMD pair loops in the printer"): prints
+against the default (issue 16; docs/performance-log.md "SIMD pair loops in the printer"): prints
 figures, is not a test.
 
 --simd-pairs prints each pair loop that allows it per destination with its neighbours under

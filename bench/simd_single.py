@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Instructions and CPU time per step in single against double precision, each with and
-without the SIMD pair loops of `sphc --simd-pairs` (issue 16; docs/performance.md "SIMD pair
+without the SIMD pair loops of `sphc --simd-pairs` (issue 16; docs/performance-log.md "SIMD pair
 loops in single precision"): prints figures, is not a test.
 
 Variants: double (the default), double --simd-pairs, --precision=single (the destination's
@@ -59,7 +59,7 @@ ALL_VARIANTS = {
     # Double without kept lists (so per destination, as single precision, which has none).
     "double_nolists": ["--verlet-skin=off"],
     "double_nolists_simd": ["--verlet-skin=off", "--simd-pairs"],
-    # Single precision with and without kept lists (stop 34; docs/performance.md "Kept lists
+    # Single precision with and without kept lists (stop 34; docs/performance-log.md "Kept lists
     # in single precision"): 0.1 is --verlet-skin=auto's skin.
     "single_nolists": ["--precision=single", "--verlet-skin=off"],
     "single_lists": ["--precision=single", "--verlet-skin=0.1"],

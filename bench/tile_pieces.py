@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Where a cluster-pair tile pass's time goes (docs/performance.md, "The tiles' per-evaluation
+"""Where a cluster-pair tile pass's time goes (docs/performance-log.md, "The tiles' per-evaluation
 pieces (stop 39)").
 
 Prints the scene's C++ (`sphc SCENE --emit=cpp ...`), puts timers between the pieces of every

@@ -1,7 +1,7 @@
 // Whether the scene sees where a particle is only through differences and increments: then
 // a periodic axis may wrap the particles lazily (kept neighbour lists with periodic or mirror
 // sides: between permutations a particle may sit up to WRAP_MARGIN supports outside the box,
-// docs/performance.md, "Neighbour lists with periodic and mirror sides") and no equation can
+// docs/performance-log.md, "Neighbour lists with periodic and mirror sides") and no equation can
 // tell, but for the rounding of the increments (x + P + d against x + d + P).
 //
 // A position property is x, y or z, or a property set from one of them by a copy or an

@@ -26,7 +26,7 @@
 // x but -0 (-0 + +0 = +0), so the sums are the same bit for bit unless a sum is -0 when the
 // self pair comes (it starts as -0, e.g. set to a -0 velocity, and everything added before is
 // -0), and unless a factor of the product was not finite (inf * 0 = NaN: a sum the run's
-// checks would have stopped on). docs/performance.md, "The self pair" (stop 35).
+// checks would have stopped on). docs/performance-log.md, "The self pair" (stop 35).
 //
 // The same check at the edge of the support (BodyFacts::vanishesAtSupport, stop 38): a pair
 // is a neighbour while r < support h_max (the cut-off test), and at r = support h_max the

@@ -244,7 +244,7 @@ bool ScenePrinter::intPowUsed() const {
 
 // A `pow` of the scene's namespace, which the bodies' unqualified calls find before the C
 // library's: sphc::pow_int multiplies where the exponent is a small integer (docs/
-// performance.md, "Cheaper arithmetic"); the OpenCL device the same (devicePowFunction).
+// performance-log.md, "Cheaper arithmetic"); the OpenCL device the same (devicePowFunction).
 // Not in single precision.
 void ScenePrinter::emitPowFunction() {
   if (!intPowUsed()) return;

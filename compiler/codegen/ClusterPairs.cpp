@@ -1,5 +1,5 @@
 // Each pair once in cluster-pair tiles (sphc --simd-pairs=cluster; opt-in since stop 37;
-// docs/performance.md "Cluster-pair tiles in the printer (stop 37)"; GROMACS' nbnxm scheme,
+// docs/performance-log.md "Cluster-pair tiles in the printer (stop 37)"; GROMACS' nbnxm scheme,
 // Pall & Hess 2013, as measured by hand in bench/cluster_pairs.cpp).
 //
 // A pass that --simd-pairs=once prints each pair once in SIMD lanes (onceLanes: same array,
@@ -25,7 +25,7 @@
 //     for d_idx where the self pair is evaluated);
 //   - the tile's j sums added to the slot sums once per tile, i's lane sums once per
 //     i-cluster; the slot sums added to the particles' sums (add_slots).
-// 2D (stop 39; docs/performance.md "2D tiles in the 2xMM form (stop 39)"): GROMACS' AVX-512
+// 2D (stop 39; docs/performance-log.md "2D tiles in the 2xMM form (stop 39)"): GROMACS' AVX-512
 // double "2xMM" form instead (--cluster-2d-8x8 keeps the 8 x 8 one, a measurement knob): the
 // layout of width CL_W = 4 (the column side 2 spacings, the spacing sqrt(mean m / rho) where
 // the array has m and rho), a tile = a 4-cluster of i's x a 4-cluster of j's in two
@@ -46,7 +46,7 @@
 //     i (4 lanes each) once per i-cluster; j's per tile, the two halves folded (lanes l and
 //     l + 4: j l) onto the slot sums.
 // The same OpenMP blocks and half tiles as the 8 x 8 form (bitwise the serial tiles).
-// Slot order (stop 40; docs/performance.md "Particles in the tiles' slot order (stop 40)";
+// Slot order (stop 40; docs/performance-log.md "Particles in the tiles' slot order (stop 40)";
 // --no-slot-order keeps the copies above): where clusterSlotOrder() allows it the array is
 // kept in the tiles' order (update_neighbours permutes it into sphc::cluster_order where the
 // lists are expected to be rebuilt and the clusters loosened, emitClusterSlotOrder), the
@@ -348,7 +348,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // In order (stop 40, the tile branches merged): the sums go straight onto the particles'
   // arrays, a component's onto d_NAME + K with the property's stride (no add-back); its
   // tail (the padded cluster's j sides) strided the same. `idx`: a slot.
-  // Measured (docs/performance.md, "The tile branches merged"): the components' sums
+  // Measured (docs/performance-log.md, "The tile branches merged"): the components' sums
   // straight onto the particles' arrays, strided, cost the own dam break's shifting tiles 25%
   // more than they saved (the fold's stride-2 and stride-4 writes); so in order a sum with
   // components keeps its slot sums (zeroed per block) and an add-back in the particles'
@@ -434,7 +434,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   }
   // The column side: from the particle spacing where the array has m and rho (2xMM: columns
   // of 2 spacings, clusters about square; the bounding box's rule grows with the flow's empty
-  // space: docs/performance.md, stop 38), else the layout's rule from the bounding box (0).
+  // space: docs/performance-log.md, stop 38), else the layout's rule from the bounding box (0).
   std::string side = "0.0";
   auto plainDouble = [&](const std::string& p) {
     const PlanProperty* prop = arr(d).find(p);

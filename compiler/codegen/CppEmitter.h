@@ -52,7 +52,7 @@ struct EmitOptions {
   // of launches (sphc::ocl::build_tables); false (--no-batched-tables): CellTable::build per
   // source. The same tables, the same results bit for bit.
   bool batchedTables = true;
-  // --backend=opencl: fewer kernel launches per step (docs/performance.md, "OpenCL: fewer
+  // --backend=opencl: fewer kernel launches per step (docs/performance-log.md, "OpenCL: fewer
   // launches per step (stop 39)"); false (--no-fused-launches): a kernel each. The same
   // results bit for bit.
   bool fusedLaunches = true;
@@ -158,7 +158,7 @@ struct EmitOptions {
 };
 
 // --simd-pairs=auto: a pair loop is put in SIMD lanes where its expected neighbour count
-// (the kernel support's ball over dx^dim) reaches this (docs/performance.md, "SIMD pair loops
+// (the kernel support's ball over dx^dim) reaches this (docs/performance-log.md, "SIMD pair loops
 // chosen by the compiler": the measurements between which it lies). Where h or dx is not
 // known before the run, by the dimension: 3D yes, 1D and 2D no (with h = 1.3 dx and a support
 // of 2 h, 74 and 21 neighbours).

@@ -1,6 +1,6 @@
 // The CPU printer, --verlet-skin without a periodic or mirror domain: the search domain and
 // the cell lists of the moving sources are built only at the neighbour updates where some
-// pair loop rebuilds its kept lists (docs/performance.md, "Cell lists only when a kept list is
+// pair loop rebuilds its kept lists (docs/performance-log.md, "Cell lists only when a kept list is
 // rebuilt").
 //
 // With kept lists the cells are read only where lists are built (the gather of a rebuild):

@@ -1,6 +1,6 @@
 // The CPU printer's lazy cell lists (CpuLazyCells.cpp): --verlet-skin without a periodic or
 // mirror domain builds the search domain and the moving sources' cell lists only at the
-// neighbour updates where some pair loop rebuilds its kept lists (docs/performance.md, "Cell
+// neighbour updates where some pair loop rebuilds its kept lists (docs/performance-log.md, "Cell
 // lists only when a kept list is rebuilt"). Internal to codegen; CpuPrinter.cpp calls them.
 #ifndef SPHC_CODEGEN_CPULAZYCELLS_H
 #define SPHC_CODEGEN_CPULAZYCELLS_H

@@ -142,7 +142,7 @@ class CpuPrinter : public ScenePrinter {
   void tunedUpdateNeighbours();
   // --verlet-skin without a periodic or mirror domain: the search domain and the moving
   // sources' cell lists are built only where a pair loop rebuilds its kept lists
-  // (CpuLazyCells.cpp; docs/performance.md, "Cell lists only when a kept list is rebuilt").
+  // (CpuLazyCells.cpp; docs/performance-log.md, "Cell lists only when a kept list is rebuilt").
   bool lazyCells() const { return lazyCells_ && verlet() && !hasDomain(); }
   void emitLazyCells();
   void lazyCellsMembers();
@@ -984,7 +984,7 @@ std::string CpuPrinter::removeGhosts() const {
 }
 
 // update_neighbours of a scene with a periodic or mirror domain and kept lists
-// (docs/performance.md, "Neighbour lists with periodic and mirror sides"). The ghosts are found
+// (docs/performance-log.md, "Neighbour lists with periodic and mirror sides"). The ghosts are found
 // (within the lists' radius and the wrap margin of a side) only when the lists must be built
 // again: when ghost_skin finds that some particle moved too far since (the kept lists' own
 // test, over every array of a pair loop), and at a permutation, before which the particles are

@@ -1,6 +1,6 @@
 // --simd-pairs=auto by the CPU the solver is built for (SimdCpu.h).
 //
-// What was measured (docs/performance.md, "SIMD pair loops by the CPU"), CPU per step of the
+// What was measured (docs/performance-log.md, "SIMD pair loops by the CPU"), CPU per step of the
 // lanes against the scalar loops that evaluate each pair once, serial:
 //   AMD EPYC Zen 5 (family 0x1A, AVX-512; stop 33): the cube 0.82-0.86, the 3D dam breaks
 //     0.86-0.93.
@@ -18,7 +18,7 @@
 // Rapids, measured) and 143 (Sapphire Rapids, the same cores), with AVX-512F; the scalar
 // loops on other Intel CPUs, without AVX-512F, and on every CPU not measured (the scalar loops
 // were the default before stop 33 on every machine).
-// The cluster-pair tiles (codegen/ClusterPairs.cpp; docs/performance.md, "Cluster-pair tiles
+// The cluster-pair tiles (codegen/ClusterPairs.cpp; docs/performance-log.md, "Cluster-pair tiles
 // under OpenMP (stop 38)") for auto's 3D loops each pair once in lanes: on the Intel models of
 // the lanes (measured on Emerald Rapids: the cube, the 3D dam break and the DualSPHysics
 // scene, serial and OpenMP); not on AMD (not measured: the lanes).

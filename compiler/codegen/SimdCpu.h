@@ -3,7 +3,7 @@
 // The solvers are built with -march=native (runtime/CMakeLists.txt, SPHC_SCENE_CXXFLAGS), so
 // the CPU that runs sphc is the one the solver's code is compiled for: sphc reads its cpuid
 // (vendor, family, model) and puts the pair loops in SIMD lanes only on a CPU class where
-// the lanes were measured to pay (docs/performance.md, "SIMD pair loops by the CPU").
+// the lanes were measured to pay (docs/performance-log.md, "SIMD pair loops by the CPU").
 // `sphc --simd-cpu=VENDOR:FAMILY:MODEL` names another CPU (the lit tests; a solver built for
 // another machine's CPU with --cxxflags); --simd-pairs=on|off override the choice.
 #pragma once

@@ -10,7 +10,7 @@
 // Kernel::gradient_factor times XIJ_k), and each body called in a third printing,
 // NAME_loop_simd: the _sums form with `XIJ[k]` written `XIJ_k`. GCC vectorises such a loop
 // (source properties gathered, the sums in vector registers, one horizontal sum per
-// destination); local arrays passed by pointer (XIJ[3]) it does not (docs/performance.md,
+// destination); local arrays passed by pointer (XIJ[3]) it does not (docs/performance-log.md,
 // "SIMD pair loops: measured"). The bodies' `if`s are left to GCC's if-conversion: where it
 // cannot, the loop stays scalar, with the same results. The build adds -fopenmp-simd
 // (driver/Build.cpp). In single precision the bodies' double arguments (t, dt, the equations'
@@ -28,7 +28,7 @@
 // named otherwise than indexed by a literal component.
 //
 // --simd-pairs=auto (the default): the SIMD form only where it pays (simdPairsAutoChoice;
-// docs/performance.md "SIMD pair loops chosen by the compiler"): where the loop's expected
+// docs/performance-log.md "SIMD pair loops chosen by the compiler"): where the loop's expected
 // neighbour count (the kernel support's ball over dx^dim, from the scene's defaults) reaches
 // kSimdAutoNeighbours. Below it, each pair once saves more than the lanes (the 2D dam
 // breaks: in the each-pair-once lane form too, stop 36: 1.19-1.24x the scalar step at dx =
@@ -334,7 +334,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // sum) otherwise, one particle moves 1 ulp otherwise, and the pair at the cut-off is in one
   // build and out in the other: EDACAveragePressure's count and sum of p jump there (p_avg
   // by 1/26), not the kernel-weighted sums. Stop 38: the channel 0.76-0.82 of the scalar CPU
-  // time, the cylinder (EDACAveragePressure) scalar (docs/performance.md, "Loose ends (stop
+  // time, the cylinder (EDACAveragePressure) scalar (docs/performance-log.md, "Loose ends (stop
   // 38)").
   // Not where the scalar loop evaluates each pair once with the ghosts kept with the lists
   // (stop 36, CpuPrinter::symmetricPass): Taylor-Green EDAC nx = 100 took 1.05x the CPU of
@@ -378,7 +378,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // the threshold goes to the lanes where the tiles take it (clusterTilesFormRefusal), to be
   // printed as tiles, never as lanes (the lanes lose in 2D; a loop the tiles refuse keeps the
   // scalar loop). Not auto's rule: the tiles took 0.76x of the default's CPU on the dam break
-  // with PySPH's effects at dx = 0.03 but 1.04-1.11x at ~100k particles (docs/performance.md,
+  // with PySPH's effects at dx = 0.03 but 1.04-1.11x at ~100k particles (docs/performance-log.md,
   // "Cluster-pair tiles for the 2D scenes (stop 38)").
   if (!lanes && simdCluster_ && !simdClusterAuto_ && plan_.dim == 2 && simdCpu_.lanes &&
       onceForm(w, pass) && clusterTilesFormRefusal(w, pass).empty())

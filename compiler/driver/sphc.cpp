@@ -112,9 +112,9 @@ static cl::opt<bool> NoFoldZeroTerms(
              "a factor the dimension leaves out (default: dropped, e.g. the z row and column of "
              "a 3x3 tensor, the z term of a dot product: a * DWIJ[2] + c is c; the results are "
              "the same bit for bit but where a factor is infinite or NaN or in the sign of a "
-             "zero sum, docs/performance.md)"),
+             "zero sum, docs/performance-log.md)"),
     cl::init(false), cl::cat(SphcCat));
-// --omp-min-particles (default): measured in docs/performance.md, "OpenMP on small scenes".
+// --omp-min-particles (default): measured in docs/performance-log.md, "OpenMP on small scenes".
 static constexpr unsigned kDefaultOmpMinParticles = 10000;
 static cl::opt<unsigned> OmpMinParticles(
     "omp-min-particles",
@@ -156,7 +156,7 @@ static cl::opt<std::string> KeptCells(
              "particle moved farther than F times the support (a check kernel per update: 20 "
              "launches per dam-break step, not 26); off (default): built at every update. Sums "
              "over neighbours round differently with and without (not measured to pay on PoCL: "
-             "docs/performance.md)"),
+             "docs/performance-log.md)"),
     cl::value_desc("off|F"), cl::init("off"), cl::cat(SphcCat));
 static cl::opt<bool> NoSymmetricPairs(
     "no-symmetric-pairs",
@@ -172,7 +172,7 @@ static cl::opt<std::string> PairSharedValues(
              "per pair and pass them to both calls (serial and openmp, double and single "
              "precision). on "
              "(default, or --pair-shared-values alone); off: each of the two calls computes "
-             "its own values. The results are the same bit for bit (docs/performance.md)"),
+             "its own values. The results are the same bit for bit (docs/performance-log.md)"),
     cl::value_desc("on|off"), cl::ValueOptional, cl::init("on"), cl::cat(SphcCat));
 static cl::opt<bool> NoRegisterSums(
     "no-register-sums",
@@ -285,7 +285,7 @@ static cl::opt<bool> SingleUnit(
     cl::init(false), cl::cat(SphcCat));
 // --verlet-skin=auto (the default): the starting skin (the solver then chooses it,
 // sphc/verlet_tune.h, where SkinTuner::kStart is the same 0.1), as a fraction of the support radius. Measured (callgrind
-// and CPU time, docs/performance.md, "Neighbour lists kept across steps"): 0.1 pays more
+// and CPU time, docs/performance-log.md, "Neighbour lists kept across steps"): 0.1 pays more
 // than 0.2 on the cube and the dam break (0.2 keeps ~1.33x (3D) the candidates of 0.1 in
 // every list for fewer rebuilds).
 static constexpr double kAutoVerletSkin = 0.1;
@@ -442,7 +442,7 @@ int main(int argc, char** argv) {
     // positions only as copies and increments, or in groups with a condition before which
     // the printer wraps every particle (analysis/PositionReads.cpp); else opt in with a number.
     // Single precision too since stop 37 (Taylor-Green nx = 100, EDAC and WCSPH: 0.96 of the
-    // gathered lists' CPU time; docs/performance.md, "Loose ends (stop 37)").
+    // gathered lists' CPU time; docs/performance-log.md, "Loose ends (stop 37)").
     if (p.domain.any()) {
       const sphc::PositionReads reads = sphc::positionReads(p);
       if (!reads.refusal.empty())

@@ -621,7 +621,7 @@ void Context::init(const Selection& sel, bool double_precision, const std::strin
 
   // No FMA contraction on the device either (the host solvers are built with
   // -ffp-contract=off): + - * / and sqrt then round as on the host, so a pair at exactly the
-  // cut-off is decided alike on both (docs/performance.md, "Rounding").
+  // cut-off is decided alike on both (docs/performance-log.md, "Rounding").
   std::string source = std::string("#pragma OPENCL FP_CONTRACT OFF\n") +
                        std::string(dp_ ? "#pragma OPENCL EXTENSION cl_khr_fp64 : enable\n"
                                          "typedef double real;\n"

@@ -1,7 +1,7 @@
 // sphc runtime: the kept neighbour lists' displacement checks and marks, and the order of a
 // kept list (see sphc/verlet.h). In the library rather than the header: every phase of a
 // solver with kept lists calls them, and a solver compiled them anew at -O3 in each cold
-// build (~0.3 s of the dam break's phases unit; docs/performance.md, "Compile time: the
+// build (~0.3 s of the dam break's phases unit; docs/performance-log.md, "Compile time: the
 // runtime's code in its library"). The code is the header's as it was, bit for bit the same
 // answers; libsphc_runtime_omp compiles the scan's OpenMP reduction as the OpenMP solvers did.
 #include "sphc/verlet.h"

@@ -1,13 +1,13 @@
 #!/bin/sh
 # A scene run with its same-array pair loop in cluster-pair tiles (sphc --simd-pairs=cluster,
-# codegen/ClusterPairs.cpp; docs/performance.md, "Cluster-pair tiles in the printer (stop
+# codegen/ClusterPairs.cpp; docs/performance-log.md, "Cluster-pair tiles in the printer (stop
 # 37)") and as another --simd-pairs mode prints it, the two runs compared snapshot by
 # snapshot (compare_runs.py: positions in dx, density in rho0, velocities). The sums are
 # reassociated in the tiles, so the runs differ by round-off that the flow may amplify; the
 # limits are the caller's (--max-pos, --max-rho). Fails also where the generated code has no
 # loop in tiles (the form stopped applying).
 #
-# With --omp (stop 38: the tiles under OpenMP, docs/performance.md "Cluster-pair tiles under
+# With --omp (stop 38: the tiles under OpenMP, docs/performance-log.md "Cluster-pair tiles under
 # OpenMP (stop 38)"): the reference is the serial build's tiles, and the OpenMP build's tiles
 # run with 1 and 2 threads must write every snapshot bitwise as the serial run
 # (tests/lit/Inputs/restart_bitwise.py: every dataset's bytes and the root attributes); the

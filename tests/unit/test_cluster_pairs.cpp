@@ -74,7 +74,7 @@ Points lattice(int nx, int dim, double dx, double pert, unsigned seed) {
 }
 
 // The cluster widths every test runs with: the default (8, by the API without a width), the 2D
-// tiles' 4 (docs/performance.md, "SIMD tiles in 2D, measured by hand (stop 38)"), and 2, 1, 5.
+// tiles' 4 (docs/performance-log.md, "SIMD tiles in 2D, measured by hand (stop 38)"), and 2, 1, 5.
 const int kWidths[] = {kClusterSize, 4, 2, 1, 5};
 
 ClusterLayout layout_of(const Points& p, double side, int width = kClusterSize) {

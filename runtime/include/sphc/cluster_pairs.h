@@ -1,12 +1,12 @@
 // sphc runtime: cluster-pair lists for SIMD tile loops (GROMACS' nbnxm scheme, Pall & Hess
-// 2013; docs/performance.md, "A cluster-pair SIMD tile kernel, measured by hand (stop 36)" and
+// 2013; docs/performance-log.md, "A cluster-pair SIMD tile kernel, measured by hand (stop 36)" and
 // "Cluster-pair lists in the runtime (stop 37)"). Plain data and free functions.
 //
 // A pair loop in tiles sees one particle array in *cluster order*: the particles sorted into
 // columns (3D: squares of side `column_side` in the x-y plane, each column sorted by z; 2D:
 // strips of width `column_side` in x, each sorted by y), each column cut into clusters of
 // `width` consecutive particles (kClusterSize = 8 by default; 1..8, e.g. 4 for 2D tiles:
-// docs/performance.md, "SIMD tiles in 2D, measured by hand (stop 38)"), the last cluster of a
+// docs/performance-log.md, "SIMD tiles in 2D, measured by hand (stop 38)"), the last cluster of a
 // column padded. Slot s = width c + k is lane k of cluster c (ClusterLayout). (Since stop 40 the
 // generated code keeps the particles themselves in a slot order where it can: see "Particles
 // kept in the tiles' slot order" below; the copies remain with sphc --no-slot-order.)
@@ -119,7 +119,7 @@ void build_cluster_layout(ClusterLayout& layout, const double* x, const double* 
                           const double* z, std::size_t n, int dim, double column_side,
                           int width = kClusterSize);
 
-// Particles kept in the tiles' slot order (stop 40; docs/performance.md "Particles in the
+// Particles kept in the tiles' slot order (stop 40; docs/performance-log.md "Particles in the
 // tiles' slot order (stop 40)"). The generated code permutes an array whose tiles' lists are
 // due into `cluster_order`'s order (ParticleArray::permute) and builds its layout in that
 // order (build_cluster_layout_in_order): slot s is particle s, the tiles read and write the
@@ -191,7 +191,7 @@ void add_slots(const ClusterLayout& layout, const float* sums, float* dst);
 // unused in 2D).
 void update_boxes(ClusterLayout& layout, const double* xs, const double* ys, const double* zs);
 
-// The per-evaluation pieces in fewer passes (docs/performance.md, "The tiles' per-evaluation
+// The per-evaluation pieces in fewer passes (docs/performance-log.md, "The tiles' per-evaluation
 // pieces (stop 39)"); each gives exactly the values of the calls it replaces. `parallel`:
 // under OpenMP (libsphc_runtime_omp) the pass is one parallel region when true (the
 // generated code passes n >= OMP_MIN_PARTICLES), on the calling thread when false; without

@@ -1,5 +1,5 @@
 // sphc runtime: the pairs of two arrays once for both particles under OpenMP
-// (codegen/SymmetricPairs.cpp, emitCrossPass; docs/performance.md, "Pairs of two arrays once
+// (codegen/SymmetricPairs.cpp, emitCrossPass; docs/performance-log.md, "Pairs of two arrays once
 // under OpenMP").
 //
 // The pass takes the particles a of array A in contiguous blocks, one per thread, and for each

@@ -139,7 +139,7 @@ void refresh_ghosts(const Domain& d, ParticleArray& a, const Ghosts& g,
 // Removes the ghosts: the storage of every property back to a.n particles; g emptied.
 void remove_ghosts(ParticleArray& a, Ghosts& g);
 
-// Kept ghosts (neighbour lists kept across steps, sphc --verlet-skin; docs/performance.md,
+// Kept ghosts (neighbour lists kept across steps, sphc --verlet-skin; docs/performance-log.md,
 // "Neighbour lists with periodic and mirror sides"). Between two rebuilds of the lists the
 // ghosts stay the same particles, in the same order, so the kept lists' indices stay valid:
 //   - wrap_periodic_far moves back into the box only the real particles further than

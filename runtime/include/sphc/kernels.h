@@ -73,7 +73,7 @@ namespace detail {
 // solver, each loop in its own outlined function, inlines it. A call in a SIMD pair loop
 // (codegen/SimdPairs.cpp) keeps that loop scalar, and a scalar `omp simd` reduction sums in
 // another order than the vector one: serial and OpenMP then differed in the last bits
-// (docs/performance.md, "Loose ends (stop 37)").
+// (docs/performance-log.md, "Loose ends (stop 37)").
 #if defined(__GNUC__)
 #define SPHC_KERNEL_INLINE inline __attribute__((always_inline))
 #else

@@ -1,7 +1,7 @@
 // sphc/pow.h: pow(x, y) with a small integer exponent by multiplications.
 //
 // The generated solvers call it for the `pow` of equation and stepper bodies (sphc
-// --int-pow=on, the default; docs/performance.md, "Cheaper arithmetic"): the Tait equation of
+// --int-pow=on, the default; docs/performance-log.md, "Cheaper arithmetic"): the Tait equation of
 // state raises rho / rho0 to gamma = 7 and to (gamma - 1) / 2 = 3 per particle and
 // evaluation, and the C library's pow costs ~100 instructions where x^7 is 4 products.
 //

@@ -52,7 +52,7 @@ struct EffectParamInfo {
 
 // The generated main's lists of parameters, options and effects' parameters, as plain data
 // appended in order: `sphc::add_params(prog.params, {{"dx", 0.03, ""}, ...})` puts no code per
-// entry in the solver's text, as a push_back of each would (docs/performance.md, "Compile
+// entry in the solver's text, as a push_back of each would (docs/performance-log.md, "Compile
 // time: the runtime's code in its library").
 struct ParamSpec {
   const char* name;

@@ -45,7 +45,7 @@ struct MarkedPositions {
   double hmin = HUGE_VAL;  // the smallest h (NaN skipped)
 };
 
-// One scan of each array's displacements per phase (docs/performance.md, "The dam break's
+// One scan of each array's displacements per phase (docs/performance-log.md, "The dam break's
 // step: one displacement check per array set"). The generated phase declares one where
 // nothing in it writes positions, h or counts; each rebuild check of the phase's kept lists
 // passes it to must_rebuild and mark: an array whose positions several lists marked within
@@ -121,7 +121,7 @@ class VerletSkin {
   // (or h grew) too far. NaN positions also give true. With `phase`, an array's displacement
   // already measured in this phase from the same marked copy is not scanned again.
   // Defined in the runtime library (src/verlet.cpp), as mark: a solver calls them, it does
-  // not compile them (docs/performance.md, "Compile time: the runtime's code in its library").
+  // not compile them (docs/performance-log.md, "Compile time: the runtime's code in its library").
   bool must_rebuild(const std::vector<const ParticleArray*>& arrays, double radius_scale,
                     PhaseDisplacements* phase = nullptr) const;
   // --precision=single: the same over the float copies the scene computes on (their floats

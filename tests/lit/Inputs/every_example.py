@@ -78,7 +78,7 @@ def main():
     if a.precision == 'single' and a.opencl:
         ap.error('--opencl compares with a double tolerance: not with --precision single')
     # Every build writes the particles' global ids: the CPU backends keep the arrays of the
-    # cluster-pair tiles in the tiles' slot order (docs/performance.md, "Particles in the
+    # cluster-pair tiles in the tiles' slot order (docs/performance-log.md, "Particles in the
     # tiles' slot order (stop 40)"), the device in cell order, so OpenCL's snapshots are
     # compared particle by particle through gid (h5close.py --key gid); serial and OpenMP
     # keep the same order and are compared bitwise as they are.
