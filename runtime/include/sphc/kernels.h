@@ -156,13 +156,16 @@ struct RadialKernel {
   // and none after it (the exact forms: sqrt, then r / h, then dwdq / (h r) in one chain). In
   // the DualSPHysics scene's tiles 0.91x of the exact forms' time (docs/performance-log.md,
   // "The tiles' divisions (stop 41)"). Error against the exact forms, from the algebra (u =
-  // 2^-53, checked by tests/unit/test_kernels_tile.cpp over h in [1e-9, 1e9], q in [0, 2.5)
-  // and r down to 0): q within 3 ulp (two roundings against one); the gradient's 1 / (h rij)
+  // 2^-53; checked by tests/unit/test_kernels.cpp, TileReciprocalFormsWithinBounds, over h
+  // in [1e-9, 1e9], q over the support and past it, r down to 0): q within 3 ulp (two roundings against one); the gradient's 1 / (h rij)
   // within 6 u relative (1 / h, 1 / r2, two products, rij^2 / r2 = (1 + e)^2); the kernel
-  // values then differ by what f and f' do with q's 3 ulp (relative to sigma / h^d f_max,
-  // resp. sigma / h^(d+1) f'_max / rij: within 32 u). Exactly 0 where the exact forms are:
-  // beyond the support and, for the gradient, at rij <= 1e-12 (1 / r2 of a safe divisor).
-  // Valid while 1 / r2 is a normal number: rij below 1.3e154 (double).
+  // values then differ by what f and f' do with q's 3 ulp and by the shapes' own rounding at
+  // two points: within 64 u of the kernel's scale (sigma / h^d max f, resp. sigma / h^(d+1)
+  // max |f'| / rij; observed 47 u for the quintic spline's gradient, whose terms cancel, 3.5-14 u
+  // for the others). Exactly 0 beyond the support (q past the edge by more than 3 ulp) and,
+  // for the gradient, at rij <= 1e-12 (1 / r2 of a safe divisor); within 3 ulp of the edge q
+  // may fall on its other side (the truncated Gaussians: their jump, e^-9 of W(0)). Valid while
+  // 1 / r2 is a normal number: rij below 1.3e154 (double).
   template <class T>
   static SPHC_KERNEL_INLINE T w_tile(T rij, T h) {
     const T ih = T(1) / h;
