@@ -59,6 +59,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   simdClusterAuto_ = opts.simdPairsClusterAuto;
   cluster2d8x8_ = opts.cluster2d8x8;
   clusterSlotOrder_ = opts.clusterSlotOrder;
+  tileMathRecip_ = opts.tileMathRecip;
   simdClusterWhy_ = opts.simdPairsClusterAuto ? "--simd-pairs=auto: " + opts.simdCpu.tilesWhy
                                               : std::string("--simd-pairs=cluster");
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in

@@ -857,7 +857,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     enum class Mode { Lanes, Marked, Fixup };
     auto laneBody = [&](const std::string& body, Mode mode) {
       if (mm) laneDest(body);
-      emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true);
+      emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true,
+                             /*tileRecip=*/tileMathRecip_);
       scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
       scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
       if (side == Side::Both) {

@@ -145,6 +145,11 @@ struct EmitOptions {
   // --no-slot-order (hidden, a measurement knob; stop 40): false keeps the tiles' slot-order
   // copies and add-backs; true (the default) keeps the particles in the tiles' slot order.
   bool clusterSlotOrder = true;
+  // --tile-math (stop 41): true (recip, the default) prints the cluster-pair tiles' kernel
+  // values in their reciprocal forms (Kernel::w_tile, Kernel::gradient_factor_tile: q = r (1/h),
+  // 1/r = r (1/r^2), no division after the square root); false (exact) the forms of the
+  // other loops (Kernel::w, Kernel::gradient_factor).
+  bool tileMathRecip = true;
   // --simd-neighbours=N: auto's threshold on a loop's expected neighbour count
   // (kSimdAutoNeighbours by default; a measurement knob: 0 puts every loop that allows it in
   // lanes under auto's rule, e.g. with --simd-pairs=once the 2D scenes' loops).

@@ -452,9 +452,11 @@ class ScenePrinter {
   // sumsPrefix + acc_NAME.
   // `negatedMirrors`: the mirrored differences as negations (-XIJ_0: the same doubles but
   // for the sign of a zero difference; the cluster-pair tiles).
+  // `tileRecip`: the kernel values in the tiles' reciprocal forms (Kernel::w_tile,
+  // gradient_factor_tile: no division after the square root; --tile-math=recip, stop 41).
   void emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q, bool both,
                               const std::string& body, bool mask,
-                              bool negatedMirrors = false) const;
+                              bool negatedMirrors = false, bool tileRecip = false) const;
   void emitDestinationValueLoads(std::ostream& os, const DestinationWork& w,
                                  const NeighbourPass& pass, const std::string& in) const;
   std::string simdMirroredCall(const PlanEquation& eq, int d, const RegisterSums& sums,
@@ -510,6 +512,7 @@ class ScenePrinter {
   bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops only
   bool cluster2d8x8_ = false;     // EmitOptions::cluster2d8x8: 2D tiles 8 x 8, not 2xMM
   bool clusterSlotOrder_ = true;  // EmitOptions::clusterSlotOrder (--no-slot-order: false)
+  bool tileMathRecip_ = true;     // EmitOptions::tileMathRecip (--tile-math=exact: false)
   // Whether the pass's array is kept in its tiles' slot order (stop 40; ClusterPairs.cpp):
   // permuted into it where its tiles' lists are due (update_neighbours) and read and written
   // by the tiles in place. The CPU printer's answer (its own arrays, sorted, double).

@@ -756,7 +756,7 @@ std::string ScenePrinter::simdMirroredCall(const PlanEquation& eq, int d,
 
 void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q,
                                           bool both, const std::string& body, bool mask,
-                                          bool negatedMirrors) const {
+                                          bool negatedMirrors, bool tileRecip) const {
   const std::string& R = host_.real;
   const PairDialect dialect = pairDialectOf(host_);
   os << body << "const " << R << " hj = sj_h[s_idx];\n";
@@ -782,8 +782,12 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
       // (h_j) -> DWI_ji; the factor of (RIJ, h) once for both.
       const std::string partner =
           pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
-      os << body << "const " << R << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
-         << pq.h << ");\n";
+      if (tileRecip)  // (the tiles: no division after the square root, kernels.h)
+        os << body << "const " << R << " " << pq.name
+           << "_f = Kernel::gradient_factor_tile(RIJ, R2IJ, " << pq.h << ");\n";
+      else
+        os << body << "const " << R << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
+           << pq.h << ");\n";
       for (int k = 0; k < 3; ++k)
         os << body << "const " << R << " " << pq.name << "_" << k << " = " << pq.name
            << "_f * XIJ_" << k << ";\n";
@@ -791,6 +795,9 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
         for (int k = 0; k < 3; ++k)
           os << body << "const " << R << " " << partner << "_" << k << " = " << pq.name
              << "_f * XIJ_ji_" << k << ";\n";
+    } else if (pq.form == PairForm::Kernel && tileRecip) {
+      os << body << "const " << R << " " << pq.name << " = Kernel::w_tile(RIJ, " << pq.h
+         << ");\n";
     } else {
       os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
     }

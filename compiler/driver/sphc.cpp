@@ -72,6 +72,20 @@ static cl::opt<OnOff, false, NamedValues<OnOff>> FmaOpt(
                           "backend (default)"),
                clEnumValN(OnOff::Off, "off", "a multiply and an add, each rounded")),
     cl::cat(SphcCat));
+enum class TileMath { Recip, Exact };
+static cl::opt<TileMath, false, NamedValues<TileMath>> TileMathOpt(
+    "tile-math",
+    cl::desc("The kernel values W and grad W in the cluster-pair tiles (--simd-pairs=cluster "
+             "or auto's tiles):"),
+    cl::init(TileMath::Recip),
+    cl::values(clEnumValN(TileMath::Recip, "recip",
+                          "q = r (1/h) and 1/r = r (1/r^2): no division after the square root "
+                          "(default; within 3 ulp of the exact forms' q, 6 u of their 1/(h r); "
+                          "runtime/include/sphc/kernels.h)"),
+               clEnumValN(TileMath::Exact, "exact",
+                          "r / h and dW/dq / (h r), the forms of the other pair loops (before "
+                          "stop 41)")),
+    cl::cat(SphcCat));
 static cl::opt<OnOff, false, NamedValues<OnOff>> IntPowOpt(
     "int-pow", cl::desc("pow(x, y) in the bodies (double precision, every backend):"),
     cl::init(OnOff::On),
@@ -673,6 +687,7 @@ int main(int argc, char** argv) {
   emitOpts.simdPairsCluster = simdMode == "cluster";
   emitOpts.cluster2d8x8 = Cluster2d8x8;
   emitOpts.clusterSlotOrder = !NoSlotOrder;
+  emitOpts.tileMathRecip = TileMathOpt == TileMath::Recip;
   emitOpts.simdAutoNeighbours = SimdNeighbours;
   emitOpts.simdOnceNeighbours = SimdOnceNeighbours;
   emitOpts.simdPerDestNeighbours = SimdPerDestNeighbours;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <type_traits>
 #include <random>
 #include <string>
@@ -696,4 +697,109 @@ TEST(Kernels, GradientFactorIsGradientsFactor) {
   expect_gradient_factor_exact<sphc::WendlandQuinticC4<2>>();
   expect_gradient_factor_exact<sphc::WendlandQuinticC6<3>>();
   expect_gradient_factor_exact<sphc::SuperGaussian<2>>();
+}
+
+// The cluster-pair tiles' reciprocal forms (Kernel::w_tile, Kernel::gradient_factor_tile;
+// sphc --tile-math=recip, the default since stop 41) against the exact forms (w,
+// gradient_factor), with rij = sqrt(r2) as the tiles compute it, over h from 1e-9 to 1e9,
+// q over the support and past it, rij down to 0 and across the 1e-12 guard. The bounds, from
+// the algebra (u = 2^-53; kernels.h):
+//   q = rij * (1/h)                       within 3 ulp of rij / h (two roundings against one);
+//   1/(h rij) = (1/h) (rij (1/r2))        within 6 u of 1/(h rij) (four roundings, and
+//                                         rij^2 / r2 = (1 + e)^2 from the square root);
+//   W, the gradient factor                the exact forms' f, f' at the shifted q, the factor
+//                                         above: within 64 u of the kernel's scale (sigma /
+//                                         h^d max f, resp. sigma / h^(d+1) max |f'| / rij),
+//                                         the q shift (6 u q |f'|, resp. |f''|) and the
+//                                         shapes' own rounding at two points (their
+//                                         cancellations: the quintic spline's terms reach 7x
+//                                         its value); observed (printed): the quintic spline
+//                                         28 u (W) and 47 u (gradient), the others 3.5-14 u;
+//   exactly 0 beyond the support (q past the edge by more than its 3 ulp) and the gradient
+//   at rij <= 1e-12 (at rij = 0 too: 1 / r2 of a safe divisor). Within 3 ulp of the edge q
+//   may fall on the other side: the continuous kernels' values there are within the bound,
+//   the truncated Gaussians' (Gaussian, SuperGaussian: cut at 3h) differ by their jump, the
+//   value just inside (e^-9 of W(0)), for such a pair (the tiles' cut-off is R2IJ's).
+template <class K>
+void expect_tile_forms_within_bounds(double& worst_w, double& worst_g) {
+  const double u = std::ldexp(1.0, -53);
+  // the kernel's scales at h = 1: max f (at q = 0 for every kernel here) and max |f'|
+  double fmax = 0.0, dfmax = 0.0;
+  for (int k = 0; k <= 30000; ++k) {
+    const double q = K::radius_scale * k / 30000.0;
+    fmax = std::max(fmax, std::fabs(K::w(q, 1.0)));
+    dfmax = std::max(dfmax, std::fabs(K::dwdq(q, 1.0)));
+  }
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> jitter(0.5, 2.0);
+  const double hs[] = {1e-9, 1e-6, 1e-3, 0.013, 0.0319, 1.0, 1e3, 1e6, 1e9};
+  for (double h0 : hs)
+    for (int rep = 0; rep < 3; ++rep) {
+      const double h = rep == 0 ? h0 : h0 * jitter(rng);
+      const double ih = 1.0 / h;
+      const double wscale = fmax * std::pow(ih, K::dim);
+      std::vector<double> qs = {0.0, 1.0, 2.0, 3.0, K::radius_scale, 0.5e-12 * ih, 1e-12 * ih,
+                                2e-12 * ih, std::nextafter(1.0, 0.0), std::nextafter(2.0, 0.0)};
+      for (int k = 0; k < 4000; ++k) qs.push_back(1.25 * K::radius_scale * k / 4000.0);
+      for (double q0 : qs) {
+        const double r2 = (q0 * h) * (q0 * h);
+        const double rij = std::sqrt(r2);  // as the tiles: RIJ = sqrt(R2IJ)
+        // q within 3 ulp
+        const double qa = rij / h, qt = rij * ih;
+        const double ulp = std::nextafter(qa, 2 * qa + 1.0) - qa;
+        EXPECT_LE(std::fabs(qt - qa), 3 * ulp) << K::name << " h=" << h << " r=" << rij;
+        // 1/(h rij) within 6 u (where rij is past the guard)
+        if (rij > 1e-12) {
+          const double rt = ih * (rij * (1.0 / r2));
+          const long double ra = 1.0L / (static_cast<long double>(h) * rij);
+          EXPECT_LE(std::fabs(static_cast<long double>(rt) - ra), 6.0L * u * ra)
+              << K::name << " h=" << h << " r=" << rij;
+        }
+        const double wa = K::w(rij, h), wt = K::w_tile(rij, h);
+        const double ga = K::gradient_factor(rij, h), gt = K::gradient_factor_tile(rij, r2, h);
+        ASSERT_TRUE(std::isfinite(wt) && std::isfinite(gt)) << K::name << " h=" << h << " r=" << rij;
+        // beyond the support (past q's 3 ulp): both 0; the gradient 0 at the guard
+        if (qa > K::radius_scale * (1.0 + 8 * u)) {
+          EXPECT_EQ(wt, 0.0) << K::name << " h=" << h << " r=" << rij;
+          EXPECT_EQ(gt, 0.0) << K::name << " h=" << h << " r=" << rij;
+        }
+        if (!(rij > 1e-12)) EXPECT_EQ(gt, 0.0);
+        // q on the two sides of the support's edge: the truncated Gaussians jump there (by
+        // e^-9 of W(0)), the allowed difference is the value just inside
+        const bool straddle = (qa < K::radius_scale) != (qt < K::radius_scale);
+        const double below = std::nextafter(K::radius_scale, 0.0);
+        const double wjump = straddle ? std::fabs(K::w(below * h, h)) : 0.0;
+        const double gjump = straddle && rij > 1e-12 ? std::fabs(K::gradient_factor(below * h, h)) : 0.0;
+        const double ew = (std::fabs(wt - wa) - wjump) / (u * wscale);
+        EXPECT_LE(ew, 64.0) << K::name << " h=" << h << " r=" << rij;
+        worst_w = std::max(worst_w, ew);
+        if (rij > 1e-12) {
+          const double gscale = dfmax * std::pow(ih, K::dim + 1) / rij;
+          const double eg = (std::fabs(gt - ga) - gjump) / (u * gscale);
+          EXPECT_LE(eg, 64.0) << K::name << " h=" << h << " r=" << rij;
+          worst_g = std::max(worst_g, eg);
+        }
+      }
+    }
+}
+
+template <class... Ks>
+void expect_tile_forms_all() {
+  (
+      [] {
+        double ww = 0.0, wg = 0.0;
+        expect_tile_forms_within_bounds<Ks>(ww, wg);
+        std::printf("tile forms %s<%d>: W within %.2f u, gradient factor within %.2f u of the scale\n",
+                    Ks::name, Ks::dim, ww, wg);
+      }(),
+      ...);
+}
+
+TEST(Kernels, TileReciprocalFormsWithinBounds) {
+  expect_tile_forms_all<sphc::CubicSpline<1>, sphc::CubicSpline<2>, sphc::CubicSpline<3>,
+                        sphc::QuinticSpline<2>, sphc::QuinticSpline<3>, sphc::WendlandQuintic<1>,
+                        sphc::WendlandQuintic<2>, sphc::WendlandQuintic<3>, sphc::Gaussian<3>,
+                        sphc::WendlandQuinticC4<2>, sphc::WendlandQuinticC4<3>,
+                        sphc::WendlandQuinticC6<2>, sphc::WendlandQuinticC6<3>,
+                        sphc::SuperGaussian<2>, sphc::SuperGaussian<3>>();
 }

@@ -147,6 +147,39 @@ struct RadialKernel {
     const T s = dwdq(rij, h) / (h * (apart ? rij : T(1)));
     return apart ? s : T(0);
   }
+  // The cluster-pair tiles' forms (codegen/ClusterPairs.cpp, sphc --tile-math=recip, the
+  // default; stop 41): w() and gradient_factor() with their divisions after the square root
+  // turned into multiplications by reciprocals that do not wait for it: q = rij * (1 / h) and 1
+  // / rij = rij * (1 / rij^2) (r2 = rij^2 as the caller has it, rij = sqrt(r2)), so that a
+  // lane's kernel values take the divisions 1 / h (the same double as inv_h_pow's, shared by
+  // every value of the pair with that h) and 1 / r2, both started before the square root ends,
+  // and none after it (the exact forms: sqrt, then r / h, then dwdq / (h r) in one chain). In
+  // the DualSPHysics scene's tiles 0.90x of the exact forms' time, the cube's 0.965x
+  // (docs/performance-log.md, "The tiles' divisions and square root (stop 41)"). Error against
+  // the exact forms, from the algebra (u = 2^-53; checked by tests/unit/test_kernels.cpp,
+  // TileReciprocalFormsWithinBounds, over h in [1e-9, 1e9], q over the support and past it, r
+  // down to 0): q within 3 ulp (two roundings against one); the gradient's 1 / (h rij) within 6
+  // u relative (1 / h, 1 / r2, two products, rij^2 / r2 = (1 + e)^2); the kernel values then
+  // differ by what f and f' do with q's 3 ulp and by the shapes' own rounding at two points:
+  // within 64 u of the kernel's scale (sigma / h^d max f, resp. sigma / h^(d+1) max |f'| / rij;
+  // observed 47 u for the quintic spline's gradient, whose terms cancel, 3.5-14 u for the
+  // others). Exactly 0 beyond the support (q past the edge by more than 3 ulp) and, for the
+  // gradient, at rij <= 1e-12 (1 / r2 of a safe divisor); within 3 ulp of the edge q may fall
+  // on its other side (the truncated Gaussians: their jump, e^-9 of W(0)). Valid while 1 / r2
+  // is a normal number: rij below 1.3e154 (double).
+  template <class T>
+  static SPHC_KERNEL_INLINE T w_tile(T rij, T h) {
+    const T ih = T(1) / h;
+    return T(S::sigma) * inv_h_pow<Dim>(h) * S::f(rij * ih);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T gradient_factor_tile(T rij, T r2, T h) {
+    const bool apart = rij > T(1e-12);
+    const T ih = T(1) / h;
+    const T irij = rij * (T(1) / (r2 > T(0) ? r2 : T(1)));
+    const T s = T(S::sigma) * inv_h_pow<Dim>(h) * S::df(rij * ih) * (ih * irij);
+    return apart ? s : T(0);
+  }
   // The gradients of one pair for both particles (sphc's pair loops that evaluate each pair
   // once): grad_ij = gradient(xij, rij, h) and grad_ji = gradient(xji, rij, h), xji = x_j -
   // x_i, with the factor s computed once; each is gradient()'s value bit for bit.
