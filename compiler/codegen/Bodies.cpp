@@ -58,6 +58,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   simdCluster_ = opts.simdPairsCluster && simdOnce_;  // ClusterPairs.cpp
   simdClusterAuto_ = opts.simdPairsClusterAuto;
   cluster2d8x8_ = opts.cluster2d8x8;
+  cluster2dDoubled_ = opts.cluster2dDoubled;
   clusterSlotOrder_ = opts.clusterSlotOrder;
   simdClusterWhy_ = opts.simdPairsClusterAuto ? "--simd-pairs=auto: " + opts.simdCpu.tilesWhy
                                               : std::string("--simd-pairs=cluster");

@@ -509,6 +509,7 @@ class ScenePrinter {
   bool simdCluster_ = false;  // EmitOptions::simdPairsCluster (with simdOnce_)
   bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops only
   bool cluster2d8x8_ = false;     // EmitOptions::cluster2d8x8: 2D tiles 8 x 8, not 2xMM
+  bool cluster2dDoubled_ = false; // EmitOptions::cluster2dDoubled: 2xMM j side from doubled copies
   bool clusterSlotOrder_ = true;  // EmitOptions::clusterSlotOrder (--no-slot-order: false)
   // Whether the pass's array is kept in its tiles' slot order (stop 40; ClusterPairs.cpp):
   // permuted into it where its tiles' lists are due (update_neighbours) and read and written
