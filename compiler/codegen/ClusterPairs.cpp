@@ -474,8 +474,17 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   const size_t nBuf = nSlotCopies + nAccs + (dbl ? 2 * copies.size() : 0);
   // In order: the tails (the padded cluster's values, CL_W each) after the slot buffers.
   const size_t nTails = inOrder ? (dbl ? 0 : copies.size()) + accTailWidths : 0;
-  scene_ << in << "cl_buf.resize(" << nBuf << " * n_slots" << (nTails ? " + " + std::to_string(nTails) + " * CL_W" : "")
-         << ");  // (kept: the copies made at the build)\n";
+  // In order (stop 41): the slot sums (of the sums with components) are zero between
+  // evaluations, their add-back zeroing them as it reads them (no fill per evaluation); a
+  // buffer of another size (n_slots changed: the tails move) zeroed here.
+  const bool zeroedSlotSums = inOrder && nSlotAccs > 0;
+  const std::string bufSize = std::to_string(nBuf) + " * n_slots" + (nTails ? " + " + std::to_string(nTails) + " * CL_W" : "");
+  if (zeroedSlotSums)
+    scene_ << in << "const bool cl_resized = cl_buf.size() != " << bufSize << ";\n";
+  scene_ << in << "cl_buf.resize(" << bufSize << ");  // (kept: the copies made at the build)\n";
+  if (zeroedSlotSums)
+    scene_ << in << "if (cl_resized) std::fill(cl_buf.begin(), cl_buf.begin() + " << nSlotAccs
+           << " * n_slots, 0.0);  // the slot sums: zero (then kept so by their add-back)\n";
   size_t at = 0;
   for (size_t k = 0; k < nSlotCopies; ++k)
     scene_ << in << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
@@ -691,9 +700,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (const std::string& p : pass.shared)
       scene_ << t << "const double* const di_" << p << " = cl_" << p << ";\n";
   }
-  if (nSlotAccs) scene_ << t << "// the block's slot sums (only this block writes them)\n";
+  if (nSlotAccs && !zeroedSlotSums) scene_ << t << "// the block's slot sums (only this block writes them)\n";
   for (const std::string& p : accs)
-    if (!direct(p))
+    if (!direct(p) && !zeroedSlotSums)
     scene_ << t << "std::fill(cl_acc_" << p << " + CL_W * static_cast<std::size_t>(cb), cl_acc_" << p
            << " + CL_W * static_cast<std::size_t>(ce), 0.0);\n";
   // 2xMM: the i-cluster's two registers' values (ri_NAME[r][lane], i = 2 r + lane / CL_W),
@@ -1101,7 +1110,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       const auto [S, K] = accStride[p];
       scene_ << in << "    d_" << p.substr(p.find('_') + 1) << "[" << S << " * s + " << K << "] += cl_acc_" << p << "[s];\n";
     }
+    for (const std::string& p : accs)  // (stop 41) zero for the next evaluation: no fill there
+      if (!direct(p)) scene_ << in << "    cl_acc_" << p << "[s] = 0.0;\n";
     scene_ << in << "  }\n";
+    for (const std::string& p : accs)  // the padding slots' (only zeros are added there)
+      if (!direct(p))
+        scene_ << in << "  std::fill(cl_acc_" << p << " + cl_layout.n, cl_acc_" << p << " + n_slots, 0.0);\n";
     scene_ << in << "}\n";
   }
   if (!strided.empty()) {
