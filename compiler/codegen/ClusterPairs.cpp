@@ -149,7 +149,7 @@ std::string withArguments(const std::string& call, const std::map<std::string, s
 std::string ScenePrinter::clusterTilesRefusal(const DestinationWork& w,
                                               const NeighbourPass& pass) const {
   if (!simdCluster_) return "off";
-  if (simdClusterAuto_ && plan_.dim != 3) return "off";  // auto: the 3D loops (measured there)
+  if (clusterAutoSkipsDim()) return "off";  // auto: the 3D loops, the 2D ones where measured (stop 41)
   if (!onceLanes(w, pass)) return "not each pair once in SIMD lanes";
   return clusterTilesFormRefusal(w, pass);
 }

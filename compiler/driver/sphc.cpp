@@ -710,6 +710,7 @@ int main(int argc, char** argv) {
     if (simdMode == "auto" && emitOpts.simdCpu.lanes && emitOpts.simdCpu.tiles) {
       emitOpts.simdPairsCluster = true;
       emitOpts.simdPairsClusterAuto = true;
+      emitOpts.simdPairsClusterAuto2d = emitOpts.simdCpu.tiles2d;  // (stop 41) the 2D loops too
     }
     if (Verbose && emitOpts.simdPairsAuto && emitOpts.simdPairs &&
         Backend != sphc::Backend::OpenCL && !Mpi)  // the CPU backends' lanes
