@@ -51,8 +51,11 @@
 // kept in the tiles' order (update_neighbours permutes it into sphc::cluster_order where the
 // lists are expected to be rebuilt and the clusters loosened, emitClusterSlotOrder), the
 // layout is built in that order (slot s = particle s, only the last cluster padded), and the
-// tiles read the pass's own arrays (8 x 8; 2xMM keeps its doubled copies for the j side,
-// contiguous reads) and sum onto the particles' own (cl_acc_NAME = d_NAME): no slot-order
+// tiles read the pass's own arrays (8 x 8; 2xMM since stop 41 too: a j-cluster's 4 values
+// doubled per tile into tile-local registers, sphc::load_doubled4, the i registers from the
+// arrays; --cluster-2d-doubled keeps stop 39-40's doubled copies, contiguous reads) and sum
+// onto the particles' own (cl_acc_NAME = d_NAME; the components' slot sums zeroed by their
+// add-back, stop 41): no slot-order
 // copies of the i side, no add_slots; the padded last cluster's j side reads and sums in
 // W-value tails (cl_t_NAME, cl_tacc_NAME), picked per tile (jt, ja_NAME).
 // The tiles are a lambda compiled without jump threading (GCC 12 threads the kernel's

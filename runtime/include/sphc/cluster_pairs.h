@@ -147,7 +147,7 @@ inline std::size_t tail_cluster(const ClusterLayout& L) {
   return L.n_clusters > 0 && L.slots() != L.n ? L.n_clusters - 1 : L.n_clusters;
 }
 // The 2xMM tiles in order (stop 41; docs/performance-log.md "The 2D tiles' j side from the
-// particles' arrays (stop 41)"): a 4-cluster's values p[0..3] twice into a tile-local
+// particles' arrays; 2D tiles by default? (stop 41)"): a 4-cluster's values p[0..3] twice into a tile-local
 // register, t[k] = t[4 + k] = p[k] (t: 8 doubles, 64-byte aligned), the j side of a register
 // of 2 i's x 4 j's read from the particles' own arrays instead of copies doubled per
 // evaluation. GCC 12 and clang: one 256-bit load and a lane shuffle (vshuff64x2), the result
