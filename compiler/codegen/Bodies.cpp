@@ -57,7 +57,9 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   simdOnce_ = opts.simdPairsOnce && simdPairs_ && simdSymmetric_ && !singlePrecision_;
   simdCluster_ = opts.simdPairsCluster && simdOnce_;  // ClusterPairs.cpp
   simdClusterAuto_ = opts.simdPairsClusterAuto;
+  simdClusterAuto2d_ = opts.simdPairsClusterAuto2d;
   cluster2d8x8_ = opts.cluster2d8x8;
+  cluster2dDoubled_ = opts.cluster2dDoubled;
   clusterSlotOrder_ = opts.clusterSlotOrder;
   tileMathRecip_ = opts.tileMathRecip;
   simdClusterWhy_ = opts.simdPairsClusterAuto ? "--simd-pairs=auto: " + opts.simdCpu.tilesWhy

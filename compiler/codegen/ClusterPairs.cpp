@@ -51,8 +51,11 @@
 // kept in the tiles' order (update_neighbours permutes it into sphc::cluster_order where the
 // lists are expected to be rebuilt and the clusters loosened, emitClusterSlotOrder), the
 // layout is built in that order (slot s = particle s, only the last cluster padded), and the
-// tiles read the pass's own arrays (8 x 8; 2xMM keeps its doubled copies for the j side,
-// contiguous reads) and sum onto the particles' own (cl_acc_NAME = d_NAME): no slot-order
+// tiles read the pass's own arrays (8 x 8; 2xMM since stop 41 too: a j-cluster's 4 values
+// doubled per tile into tile-local registers, sphc::load_doubled4, the i registers from the
+// arrays; --cluster-2d-doubled keeps stop 39-40's doubled copies, contiguous reads) and sum
+// onto the particles' own (cl_acc_NAME = d_NAME; the components' slot sums zeroed by their
+// add-back, stop 41): no slot-order
 // copies of the i side, no add_slots; the padded last cluster's j side reads and sums in
 // W-value tails (cl_t_NAME, cl_tacc_NAME), picked per tile (jt, ja_NAME).
 // The tiles are a lambda compiled without jump threading (GCC 12 threads the kernel's
@@ -149,7 +152,7 @@ std::string withArguments(const std::string& call, const std::map<std::string, s
 std::string ScenePrinter::clusterTilesRefusal(const DestinationWork& w,
                                               const NeighbourPass& pass) const {
   if (!simdCluster_) return "off";
-  if (simdClusterAuto_ && plan_.dim != 3) return "off";  // auto: the 3D loops (measured there)
+  if (clusterAutoSkipsDim()) return "off";  // auto: the 3D loops, the 2D ones where measured (stop 41)
   if (!onceLanes(w, pass)) return "not each pair once in SIMD lanes";
   return clusterTilesFormRefusal(w, pass);
 }
@@ -271,6 +274,13 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // the tiles read and write the particles' arrays (2xMM: the doubled copies stay, now
   // contiguous reads), the padded last cluster from W-value tails (cl_t_NAME, cl_tacc_NAME).
   const bool inOrder = clusterSlotOrder(w, pass);
+  // Stop 41: in order the 2xMM tiles read their j side from the particles' arrays too, a
+  // j-cluster's 4 values doubled into a tile-local register per tile (sphc::load_doubled4),
+  // the padded cluster from its tails; `dbl`: the copies doubled per cluster per evaluation
+  // instead (stops 39-40: out of order, or --cluster-2d-doubled). `arrays`: the tiles read
+  // the particles' arrays (in order, but for the doubled copies).
+  const bool dbl = mm && (!inOrder || cluster2dDoubled_);
+  const bool arrays = inOrder && !dbl;
   // The copies in slot order: positions first, then every property the lanes read (by name:
   // di_NAME, sj_NAME, s_NAME and d_NAME of one array are one array), the hoisted values, the
   // sums. name -> the array it is gathered from.
@@ -310,9 +320,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   std::map<std::string, std::string> rename;
   for (const auto& c : copies)
     if (c.second.rfind("di_", 0) == 0 || c.second.rfind("s_", 0) == 0 || c.second.rfind("d_", 0) == 0)
-      rename[c.first] = (mm ? "cl2_" : "cl_") + c.first;  // 2xMM: the doubled copies
+      rename[c.first] = (dbl ? "cl2_" : "cl_") + c.first;  // 2xMM: the doubled copies
   // (2xMM: computed into the doubled arrays, at cl_s2 = CL_LANES c + l for slot CL_W c + l.)
-  const std::string slotIndex = mm ? "cl_s2" : "s_idx";
+  const std::string slotIndex = dbl ? "cl_s2" : "s_idx";
   std::map<std::string, std::string> inSlots;
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
@@ -386,7 +396,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // The destination-only values of every particle, for the mirrored calls (gathered below;
   // a loop without neighbours: --omp-min-particles' `if`, stop 39).
   const std::string ompIfN = openmp ? ompMinIf("n") : "";  // "" or if (n >= OMP_MIN_PARTICLES)
-  if (!allDestinationInSlots || (inOrder && !mm))
+  if (!allDestinationInSlots || arrays)
     emitDestinationHoistedAll(pass, openmp ? "        #pragma omp parallel for schedule(static)" +
                                                  (ompIfN.empty() ? "" : " " + ompIfN) + "\n" : "");
   // The properties nothing writes between two builds (no live equation or stepper writes
@@ -464,17 +474,26 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // (2xMM: the positions alone in slot order, for the boxes; every copy doubled)
   const size_t nSlotCopies = inOrder ? 0 : mm ? static_cast<size_t>(plan_.dim) : copies.size();
   const size_t nAccs = nSlotAccs;  // in order: the plain sums in the particles' arrays
-  const size_t nBuf = nSlotCopies + nAccs + (mm ? 2 * copies.size() : 0);
+  const size_t nBuf = nSlotCopies + nAccs + (dbl ? 2 * copies.size() : 0);
   // In order: the tails (the padded cluster's values, CL_W each) after the slot buffers.
-  const size_t nTails = inOrder ? (mm ? 0 : copies.size()) + accTailWidths : 0;
-  scene_ << in << "cl_buf.resize(" << nBuf << " * n_slots" << (nTails ? " + " + std::to_string(nTails) + " * CL_W" : "")
-         << ");  // (kept: the copies made at the build)\n";
+  const size_t nTails = inOrder ? (dbl ? 0 : copies.size()) + accTailWidths : 0;
+  // In order (stop 41): the slot sums (of the sums with components) are zero between
+  // evaluations, their add-back zeroing them as it reads them (no fill per evaluation); a
+  // buffer of another size (n_slots changed: the tails move) zeroed here.
+  const bool zeroedSlotSums = inOrder && nSlotAccs > 0;
+  const std::string bufSize = std::to_string(nBuf) + " * n_slots" + (nTails ? " + " + std::to_string(nTails) + " * CL_W" : "");
+  if (zeroedSlotSums)
+    scene_ << in << "const bool cl_resized = cl_buf.size() != " << bufSize << ";\n";
+  scene_ << in << "cl_buf.resize(" << bufSize << ");  // (kept: the copies made at the build)\n";
+  if (zeroedSlotSums)
+    scene_ << in << "if (cl_resized) std::fill(cl_buf.begin(), cl_buf.begin() + " << nSlotAccs
+           << " * n_slots, 0.0);  // the slot sums: zero (then kept so by their add-back)\n";
   size_t at = 0;
   for (size_t k = 0; k < nSlotCopies; ++k)
     scene_ << in << "double* const cl_" << copies[k].first << " = cl_buf.data() + " << at++ << " * n_slots;\n";
   for (const std::string& p : accs)
     if (!direct(p)) scene_ << in << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
-  if (mm)
+  if (dbl)
     for (const auto& c : copies) {
       scene_ << in << "double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
       at += 2;
@@ -482,7 +501,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // In order: the tails' pointers (printed again in the tiles).
   auto tailPointers = [&](const std::string& ind) {
     size_t k = 0;
-    if (!mm)
+    if (!dbl)
       for (const auto& c : copies)
         scene_ << ind << "double* const cl_t_" << c.first << " = cl_buf.data() + " << at << " * n_slots + " << k++ << " * CL_W;\n";
     for (const std::string& p : accs) {
@@ -495,7 +514,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   scene_ << in << "// The positions in slot order (padding slots 4 supports away from every particle)\n"
          << in << "// and the boxes in one pass, the outer list at a rebuild, the list pruned at the\n"
          << in << "// support now.\n";
-  if (inOrder && mm) {
+  if (inOrder && dbl) {
     scene_ << in << "// (in order: the boxes and the doubled positions from the particles' own)\n";
     scene_ << in << "sphc::positions_doubled_boxes(cl_layout, di_x, di_y, " << zIn << ", cl2_x, cl2_y, "
            << (plan_.dim == 3 ? "cl2_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax" << par << ");\n";
@@ -535,12 +554,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (size_t k = 0; k < cs.size(); ++k) scene_ << (k ? ", " : "") << cs[k].second;
     scene_ << "};\n";
     scene_ << ind << "double* const cl_to[] = {";
-    for (size_t k = 0; k < cs.size(); ++k) scene_ << (k ? ", " : "") << (mm ? "cl2_" : "cl_") << cs[k].first;
+    for (size_t k = 0; k < cs.size(); ++k) scene_ << (k ? ", " : "") << (dbl ? "cl2_" : "cl_") << cs[k].first;
     scene_ << "};\n";
-    scene_ << ind << (mm ? "sphc::gather_slots_doubled" : "sphc::gather_slots") << "(cl_layout, cl_from, cl_to, "
+    scene_ << ind << (dbl ? "sphc::gather_slots_doubled" : "sphc::gather_slots") << "(cl_layout, cl_from, cl_to, "
            << cs.size() << par << ");\n";
   };
-  if (inOrder && !mm) {  // the tiles read the arrays themselves: the padded cluster's tails only
+  if (arrays) {  // the tiles read the arrays themselves: the padded cluster's tails only
     fixedCopies.clear();
     evalCopies.clear();
     std::vector<std::string> from, to;
@@ -584,7 +603,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "  }\n";
     scene_ << in << "}\n";
   }
-  if (mm && !inSlots.empty()) {
+  if (dbl && !inSlots.empty()) {
     scene_ << in << "// the hoisted values in slot order from the doubled copies (the same function of the\n"
            << in << "// same doubles as in the particles' order: the values a gather would copy), doubled\n";
     if (openmp)
@@ -645,7 +664,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // The copies' pointers again, locals of the lambda (captured by reference, GCC reloads them
   // in the loops), and the lists' arrays.
   at = 0;
-  if (inOrder && !mm) {
+  if (arrays) {
     scene_ << t << "// in order: slot s is particle s (cl_NAME: the arrays), the padded cluster's tails\n";
     for (const auto& c : copies) scene_ << t << "const double* const cl_" << c.first << " = " << origin(c) << ";\n";
   }
@@ -660,7 +679,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
              << ";  // (in order: the particles' sums" << (accStride[p].first == 1 ? "" : ", stride " + std::to_string(accStride[p].first)) << ")\n";
     else
       scene_ << t << "double* const cl_acc_" << p << " = cl_buf.data() + " << at++ << " * n_slots;\n";
-  if (mm)
+  if (dbl)
     for (const auto& c : copies) {
       scene_ << t << "const double* const cl2_" << c.first << " = cl_buf.data() + " << at << " * n_slots;\n";
       at += 2;
@@ -684,9 +703,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (const std::string& p : pass.shared)
       scene_ << t << "const double* const di_" << p << " = cl_" << p << ";\n";
   }
-  if (nSlotAccs) scene_ << t << "// the block's slot sums (only this block writes them)\n";
+  if (nSlotAccs && !zeroedSlotSums) scene_ << t << "// the block's slot sums (only this block writes them)\n";
   for (const std::string& p : accs)
-    if (!direct(p))
+    if (!direct(p) && !zeroedSlotSums)
     scene_ << t << "std::fill(cl_acc_" << p << " + CL_W * static_cast<std::size_t>(cb), cl_acc_" << p
            << " + CL_W * static_cast<std::size_t>(ce), 0.0);\n";
   // 2xMM: the i-cluster's two registers' values (ri_NAME[r][lane], i = 2 r + lane / CL_W),
@@ -694,9 +713,14 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   auto iRegisters = [&](const std::string& c1) {
     scene_ << c1 << "// its two registers' i's: lane l of register r holds slot ci CL_W + 2 r + l / CL_W\n";
     for (const auto& c : copies) scene_ << c1 << "alignas(64) double ri_" << c.first << "[2][CL_LANES];\n";
+    if (arrays) {  // (stop 41) from the particles' arrays, the padded cluster from its tails
+      scene_ << c1 << "const bool cl_it = static_cast<std::uint32_t>(ci) == cl_tail;\n";
+      scene_ << c1 << "const int i0 = cl_it ? 0 : ci * CL_W;  // its first slot (the tails': 0)\n";
+    }
     scene_ << c1 << "for (int l = 0; l < CL_W; ++l) {\n";
     for (const auto& c : copies) {
-      const std::string src = "cl2_" + c.first + "[CL_LANES * ci + ";
+      const std::string src = arrays ? "(cl_it ? cl_t_" + c.first + " : cl_" + c.first + ")[i0 + "
+                                     : "cl2_" + c.first + "[CL_LANES * ci + ";
       scene_ << c1 << "  ri_" << c.first << "[0][l] = " << src << "0]; ri_" << c.first << "[0][CL_W + l] = "
              << src << "1]; ri_" << c.first << "[1][l] = " << src << "2]; ri_" << c.first
              << "[1][CL_W + l] = " << src << "3];\n";
@@ -719,7 +743,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       } else {
         scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;  // its first slot\n";
       }
-      scene_ << c2 << "const int j2 = static_cast<int>(cl_j[e]) * CL_LANES;  // in the doubled copies\n";
+      if (dbl) scene_ << c2 << "const int j2 = static_cast<int>(cl_j[e]) * CL_LANES;  // in the doubled copies\n";
     } else {
       if (inOrder) {
         scene_ << c2 << "const bool jt = cl_j[e] == cl_tail;  // the padded cluster: from its tails\n";
@@ -728,15 +752,23 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
         scene_ << c2 << "const int j0 = static_cast<int>(cl_j[e]) * CL_W;\n";
       }
     }
-    const std::string jOff = mm ? "cl2_" : "cl_";
-    const std::string jAt = mm ? " + j2" : " + j0";
-    // (in order, 8 x 8: the padded cluster's values from its tails)
+    const std::string jOff = dbl ? "cl2_" : "cl_";
+    const std::string jAt = dbl ? " + j2" : " + j0";
+    // (in order, 8 x 8: the padded cluster's values from its tails; 2xMM reading the arrays:
+    // the tile-local doubled registers tj2_NAME)
     auto jPtr = [&](const std::string& name) {
+      if (mm && arrays) return "tj2_" + name;
       return !mm && inOrder ? "(jt ? cl_t_" + name + " : cl_" + name + ")" + jAt : jOff + name + jAt;
     };
     if (side == Side::Both)
       scene_ << c2 << "const bool diagonal = cl_j[e] == static_cast<std::uint32_t>(ci);\n";
-    if (mm)
+    if (mm && arrays) {
+      scene_ << c2 << "// The source side: the j-cluster's CL_W values twice in tile-local registers, s_idx the\n"
+             << c2 << "// lane (stop 41: from the particles' arrays, the padded cluster from its tails).\n";
+      for (const auto& c : copies) scene_ << c2 << "alignas(64) double tj2_" << c.first << "[CL_LANES];\n";
+      for (const auto& c : copies)
+        scene_ << c2 << "sphc::load_doubled4(tj2_" << c.first << ", (jt ? cl_t_" << c.first << " : cl_" << c.first << ") + j0);\n";
+    } else if (mm)
       scene_ << c2 << "// The source side: the j-cluster's CL_W slots twice (the doubled copies), s_idx the lane.\n";
     else
       scene_ << c2 << "// The source side: the j-cluster's 8 slots, s_idx the lane.\n";
@@ -1082,7 +1114,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       const auto [S, K] = accStride[p];
       scene_ << in << "    d_" << p.substr(p.find('_') + 1) << "[" << S << " * s + " << K << "] += cl_acc_" << p << "[s];\n";
     }
+    for (const std::string& p : accs)  // (stop 41) zero for the next evaluation: no fill there
+      if (!direct(p)) scene_ << in << "    cl_acc_" << p << "[s] = 0.0;\n";
     scene_ << in << "  }\n";
+    for (const std::string& p : accs)  // the padding slots' (only zeros are added there)
+      if (!direct(p))
+        scene_ << in << "  std::fill(cl_acc_" << p << " + cl_layout.n, cl_acc_" << p << " + n_slots, 0.0);\n";
     scene_ << in << "}\n";
   }
   if (!strided.empty()) {

@@ -139,9 +139,16 @@ struct EmitOptions {
   // --simd-pairs=auto (stop 38): simdPairsCluster set by auto's rule (the CPU's verdict,
   // SimdCpuVerdict::tiles), for the 3D loops only; a 2D loop stays in the lanes silently.
   bool simdPairsClusterAuto = false;
+  // --simd-pairs=auto (stop 41): the 2D loops too, as --simd-pairs=cluster takes them
+  // (SimdCpuVerdict::tiles2d).
+  bool simdPairsClusterAuto2d = false;
   // --cluster-2d-8x8 (hidden, a measurement knob; stop 39): the 2D tiles in stop 37-38's
   // 8 x 8 form (one i x 8 j's per register) instead of the 2xMM form (codegen/ClusterPairs.cpp).
   bool cluster2d8x8 = false;
+  // --cluster-2d-doubled (hidden, a measurement knob; stop 41): the 2xMM tiles in slot order
+  // read their j side from per-evaluation copies doubled per cluster (stops 39-40) instead of
+  // the particles' arrays (codegen/ClusterPairs.cpp).
+  bool cluster2dDoubled = false;
   // --no-slot-order (hidden, a measurement knob; stop 40): false keeps the tiles' slot-order
   // copies and add-backs; true (the default) keeps the particles in the tiles' slot order.
   bool clusterSlotOrder = true;

@@ -509,8 +509,15 @@ class ScenePrinter {
     return {0, 1};
   }
   bool simdCluster_ = false;  // EmitOptions::simdPairsCluster (with simdOnce_)
-  bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops only
+  bool simdClusterAuto_ = false;  // EmitOptions::simdPairsClusterAuto: 3D loops (2D: the next)
+  bool simdClusterAuto2d_ = false;  // EmitOptions::simdPairsClusterAuto2d: auto's 2D loops too (stop 41)
+  // Whether --simd-pairs=auto leaves this scene's loops out of the tiles (its dimension not
+  // measured to pay on this CPU: 1D; 2D without SimdCpuVerdict::tiles2d).
+  bool clusterAutoSkipsDim() const {
+    return simdClusterAuto_ && plan_.dim != 3 && !(plan_.dim == 2 && simdClusterAuto2d_);
+  }
   bool cluster2d8x8_ = false;     // EmitOptions::cluster2d8x8: 2D tiles 8 x 8, not 2xMM
+  bool cluster2dDoubled_ = false; // EmitOptions::cluster2dDoubled: 2xMM j side from doubled copies
   bool clusterSlotOrder_ = true;  // EmitOptions::clusterSlotOrder (--no-slot-order: false)
   bool tileMathRecip_ = true;     // EmitOptions::tileMathRecip (--tile-math=exact: false)
   // Whether the pass's array is kept in its tiles' slot order (stop 40; ClusterPairs.cpp):

@@ -40,6 +40,9 @@ struct SimdCpuVerdict {
   // (codegen/ClusterPairs.cpp) on `cpu`, and why: where the tiles were measured to pay.
   bool tiles = false;
   std::string tilesWhy;
+  // Whether auto also puts the 2D loops each pair once over their own array in the tiles
+  // (GROMACS' 2xMM form; stop 41), where `tiles` holds: measured to pay on this CPU's model.
+  bool tiles2d = false;
 };
 SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu);
 

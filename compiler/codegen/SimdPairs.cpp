@@ -263,7 +263,7 @@ bool ScenePrinter::rareCalls(const NeighbourPass& pass) const {
 }
 
 bool ScenePrinter::rareCallsInTiles(const DestinationWork& w, const NeighbourPass& pass) const {
-  return simdCluster_ && !(simdClusterAuto_ && plan_.dim != 3) && rareCalls(pass) &&
+  return simdCluster_ && !clusterAutoSkipsDim() && rareCalls(pass) &&
          onceForm(w, pass) && clusterTilesFormRefusal(w, pass).empty();
 }
 
@@ -377,12 +377,15 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // --simd-pairs=cluster (opt-in; stop 38): a 2D loop each pair once over its own array below
   // the threshold goes to the lanes where the tiles take it (clusterTilesFormRefusal), to be
   // printed as tiles, never as lanes (the lanes lose in 2D; a loop the tiles refuse keeps the
-  // scalar loop). Not auto's rule: the tiles took 0.76x of the default's CPU on the dam break
-  // with PySPH's effects at dx = 0.03 but 1.04-1.11x at ~100k particles (docs/performance-log.md,
-  // "Cluster-pair tiles for the 2D scenes (stop 38)").
-  if (!lanes && simdCluster_ && !simdClusterAuto_ && plan_.dim == 2 && simdCpu_.lanes &&
+  // scalar loop). Stops 38-40 kept it out of auto's rule (at ~100k particles the tiles lost to
+  // the scalar loops: docs/performance-log.md, "Cluster-pair tiles for the 2D scenes (stop 38)",
+  // "The tile branches merged; 2D tiles by default? (stop 40)").
+  // Auto's rule too where SimdCpuVerdict::tiles2d holds (stop 41: no CPU yet; with the j
+  // side read from the particles' arrays the tiles beat the scalar loops at dx = 0.03 and
+  // ~100k, docs/performance-log.md, "2D tiles by default? (stop 41)").
+  if (!lanes && simdCluster_ && !clusterAutoSkipsDim() && plan_.dim == 2 && simdCpu_.lanes &&
       onceForm(w, pass) && clusterTilesFormRefusal(w, pass).empty())
-    return {true, why + "in cluster-pair tiles at any count (--simd-pairs=cluster)"};
+    return {true, why + "in cluster-pair tiles at any count (" + simdClusterWhy_ + ")"};
   if (onceAnyway || ghostOnceScalar)
     why += lanes ? (simdOnce_ && pass.source == w.array ? "the lanes pay, each pair once in them"
                                                          : "the lanes pay more than each pair once")
@@ -492,7 +495,7 @@ std::vector<std::string> ScenePrinter::simdPairsNotes() const {
       // --simd-pairs=cluster: why a 2D loop each pair once is not in the tiles either (the
       // tiles' own refusal, clusterTilesFormRefusal; stop 40).
       std::string tiles;
-      if (simdCluster_ && !simdClusterAuto_ && plan_.dim == 2 && onceForm(w, pass)) {
+      if (simdCluster_ && !clusterAutoSkipsDim() && plan_.dim == 2 && onceForm(w, pass)) {
         const std::string t = clusterTilesFormRefusal(w, pass);
         if (!t.empty()) tiles = " (not in cluster-pair tiles: " + t + ")";
       }

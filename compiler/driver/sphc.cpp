@@ -209,6 +209,12 @@ static cl::opt<bool> Cluster2d8x8(
              "per register (stops 37-38), not GROMACS' 2xMM form of 4 x 4 cluster pairs in "
              "registers of 2 i's x 4 j's (stop 39; a measurement knob)"),
     cl::init(false), cl::Hidden, cl::cat(SphcCat));
+static cl::opt<bool> Cluster2dDoubled(
+    "cluster-2d-doubled",
+    cl::desc("The 2D cluster-pair tiles (2xMM) in slot order read their j side from copies "
+             "doubled per cluster at every evaluation (stops 39-40), not from the particles' "
+             "arrays through a tile-local doubled register (stop 41; a measurement knob)"),
+    cl::init(false), cl::Hidden, cl::cat(SphcCat));
 static cl::opt<bool> NoSelfPairSkip(
     "no-self-pair-skip",
     cl::desc("Evaluate the self pair (a particle with itself, r = 0) in the each-pair-once "
@@ -686,6 +692,7 @@ int main(int argc, char** argv) {
   emitOpts.simdPairsOnce = simdMode == "auto" || simdMode == "once" || simdMode == "cluster";
   emitOpts.simdPairsCluster = simdMode == "cluster";
   emitOpts.cluster2d8x8 = Cluster2d8x8;
+  emitOpts.cluster2dDoubled = Cluster2dDoubled;
   emitOpts.clusterSlotOrder = !NoSlotOrder;
   emitOpts.tileMathRecip = TileMathOpt == TileMath::Recip;
   emitOpts.simdAutoNeighbours = SimdNeighbours;
@@ -718,6 +725,7 @@ int main(int argc, char** argv) {
     if (simdMode == "auto" && emitOpts.simdCpu.lanes && emitOpts.simdCpu.tiles) {
       emitOpts.simdPairsCluster = true;
       emitOpts.simdPairsClusterAuto = true;
+      emitOpts.simdPairsClusterAuto2d = emitOpts.simdCpu.tiles2d;  // (stop 41) the 2D loops too
     }
     if (Verbose && emitOpts.simdPairsAuto && emitOpts.simdPairs &&
         Backend != sphc::Backend::OpenCL && !Mpi)  // the CPU backends' lanes

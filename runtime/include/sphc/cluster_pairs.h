@@ -58,6 +58,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 namespace sphc {
@@ -144,6 +145,25 @@ void build_cluster_layout_in_order(ClusterLayout& layout, const double* x, const
 // The padded cluster of an in-order layout: its index, n_clusters if every cluster is full.
 inline std::size_t tail_cluster(const ClusterLayout& L) {
   return L.n_clusters > 0 && L.slots() != L.n ? L.n_clusters - 1 : L.n_clusters;
+}
+// The 2xMM tiles in order (stop 41; docs/performance-log.md "The 2D tiles' j side from the
+// particles' arrays; 2D tiles by default? (stop 41)"): a 4-cluster's values p[0..3] twice into a tile-local
+// register, t[k] = t[4 + k] = p[k] (t: 8 doubles, 64-byte aligned), the j side of a register
+// of 2 i's x 4 j's read from the particles' own arrays instead of copies doubled per
+// evaluation. GCC 12 and clang: one 256-bit load and a lane shuffle (vshuff64x2), the result
+// kept in a register where the tile allows; an 8-lane loop over p[l % 4] is stored as two
+// 256-bit halves and reloaded as one 512-bit vector (a store-forwarding stall).
+inline void load_doubled4(double* t, const double* p) {
+#if defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 12)
+  typedef double sphc_v4d __attribute__((vector_size(32)));
+  typedef double sphc_v8d __attribute__((vector_size(64)));
+  sphc_v4d x;
+  std::memcpy(&x, p, sizeof x);
+  const sphc_v8d y = __builtin_shufflevector(x, x, 0, 1, 2, 3, 0, 1, 2, 3);
+  std::memcpy(t, &y, sizeof y);
+#else
+  for (int k = 0; k < 4; ++k) t[k] = t[4 + k] = p[k];
+#endif
 }
 // In order, per evaluation: the padded cluster's values, dst[k][l] = src[k][width t + l]
 // for its real lanes l, its first particle's value for the padding (dst: width values
