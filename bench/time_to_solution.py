@@ -220,17 +220,20 @@ def sphc_build(args, case, tmp, backend):
     return exe, cold, cached
 
 
+def steps_and_output(args, output, max_steps, no_output):
+    """A run's options: max_steps steps without output (no_output, the solver's option) where
+    given, else the case's output options `output` (and the command line's --max-steps)."""
+    if max_steps is not None:
+        return ["--max-steps", str(max_steps), no_output]
+    return output + (["--max-steps", str(args.max_steps)] if args.max_steps else [])
+
+
 def sphc_run(args, case, exe, threads, outdir, max_steps=None):
     env = environment(threads, args.omp_wait)
     cmd = [exe, "--timing", "--quiet", "-d", outdir] + case.sphc_args
     if threads > 1:
         cmd += ["--threads", str(threads)]
-    if max_steps is not None:
-        cmd += ["--max-steps", str(max_steps), "--no-output"]
-    else:
-        cmd += case.output[0]
-        if args.max_steps:
-            cmd += ["--max-steps", str(args.max_steps)]
+    cmd += steps_and_output(args, case.output[0], max_steps, "--no-output")
     wall, out = run(cmd, env=env)
     cpu = run.cpu
     m = timing_line(out, cmd)
@@ -245,12 +248,7 @@ def pysph_run(args, case, threads, outdir, home, max_steps=None):
     cmd += ["-d", outdir]
     if threads > 1:
         cmd.append("--openmp")
-    if max_steps is not None:
-        cmd += ["--max-steps", str(max_steps), "--disable-output"]
-    else:
-        cmd += case.output[1]
-        if args.max_steps:
-            cmd += ["--max-steps", str(args.max_steps)]
+    cmd += steps_and_output(args, case.output[1], max_steps, "--disable-output")
     wall, out = run(cmd, env=env)
     cpu = run.cpu
     r = pysph_timing(out, outdir)

@@ -114,6 +114,13 @@ void ScenePrinter::distributedMain() {
   out_ << "  sphc::mpi::set_output(prog, [] {\n";
   out_ << "    return std::vector<sphc::ParticleArray*>" << allArrays("scene.") << ";\n  });\n";
   out_ << "  prog.default_limits = [] { return scene.default_limits; };\n";
+  bool removes = false;
+  for (const auto& l : plan_.limits) removes |= l.hasRemove;
+  if (removes)
+    out_ << "  // limits' remove: each rank removes its own, rank 0 logs every rank's "
+            "(sphc/mpi/output.h).\n"
+         << "  sphc::mpi::set_removal(prog, scene.decomposition, " << allArrays("scene.")
+         << ");\n";
 }
 
 }  // namespace sphc

@@ -455,18 +455,14 @@ std::string ScenePrinter::hoistedValueType(const PlanBody& b, const Dialect& d, 
 }
 
 void ScenePrinter::emitHoistMembers(std::ostream& os) const {
-  for (const PlanEquation& eq : plan_.equations) {
-    if (!eq.live) continue;
-    const auto& methods = plan_.equationDecls[eq.declIndex].methods;
-    if (!methods.count(ast::Method::Loop)) continue;
-    const PlanBody& b = methodBody(eq, ast::Method::Loop);
+  forEachLoopBody([&](const PlanEquation& eq, const PlanBody& b) {
     const auto sites = hoistedSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k)
       os << "  std::vector<" << hoistedValueType(b, host_, true, k) << "> hoist_" << eqStruct(eq)
          << "_" << k << ";  // " << eq.name
          << ": " << oneLine(b.source.text.substr(sites[k].begin, sites[k].end - sites[k].begin))
          << " per source particle\n";
-  }
+  });
 }
 
 }  // namespace sphc

@@ -679,6 +679,13 @@ class ScenePrinter {
   const PlanBody& methodBody(const PlanEquation& eq, ast::Method::Kind kind) const {
     return plan_.bodies[plan_.equationDecls[eq.declIndex].methods.at(kind)];
   }
+  // f(eq, body) for every live equation with a pair loop, in order, with its loop's body.
+  template <class F>
+  void forEachLoopBody(F&& f) const {
+    for (const PlanEquation& eq : plan_.equations)
+      if (eq.live && plan_.equationDecls[eq.declIndex].methods.count(ast::Method::Loop))
+        f(eq, methodBody(eq, ast::Method::Loop));
+  }
   // The statement that calls equation eq's method `kind` for destination array d, with its
   // provenance: "CALL;  // NAME, from FILE:LINE\n" (sep: as callBody's).
   std::string equationCall(const PlanEquation& eq, ast::Method::Kind kind, int d,

@@ -273,18 +273,14 @@ std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest,
 }
 
 void ScenePrinter::emitSymmetricMembers(std::ostream& os) const {
-  for (const PlanEquation& eq : plan_.equations) {
-    if (!eq.live) continue;
-    const auto& methods = plan_.equationDecls[eq.declIndex].methods;
-    if (!methods.count(ast::Method::Loop)) continue;
-    const PlanBody& b = methodBody(eq, ast::Method::Loop);
+  forEachLoopBody([&](const PlanEquation& eq, const PlanBody& b) {
     const auto sites = hoistedDestinationSites(b, host_);
     for (size_t k = 0; k < sites.size(); ++k)
       os << "  std::vector<" << hoistedValueType(b, host_, false, k) << "> dhoist_" << eqStruct(eq)
          << "_" << k << ";  // " << eq.name
          << ": its loop's destination-only value " << k
          << " per particle (each pair once for both particles)\n";
-  }
+  });
 }
 
 void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPass& pass,

@@ -526,28 +526,18 @@ int main(int argc, char** argv) {
   }
   plan->distributed = Mpi;
   // A limit's `remove` takes particles out of the host arrays between steps (the run loop,
-  // sphc/sanity.h), which then go back where the scene computes (afterRemoval): written for
-  // one process without periodic or mirror sides (whose kept ghosts are made from the
-  // particles' places). A distributed solver leaves it out with a warning (the bundled dam
-  // breaks build with --mpi as before it: the stop bound judges those particles); periodic
-  // or mirror sides refuse it.
-  for (auto& l : plan->limits) {
-    if (!l.hasRemove) continue;
-    if (Mpi) {
-      diags.warning(l.removeLoc, llvm::Twine("'remove' in limit '") + plan->arrays[l.array].name +
-                                     "." + l.quantity + "' is not supported by a distributed "
-                                     "solver (--mpi) and is left out: the particles past its "
-                                     "bound are judged by the limit's stop bound, as without it");
-      l.hasRemove = false;
-      continue;
-    }
-    if (plan->domain.any())
-      diags.error(l.removeLoc, llvm::Twine("'remove' in limit '") + plan->arrays[l.array].name +
-                                   "." + l.quantity + "' is not supported with periodic or "
-                                   "mirror sides (their ghosts, kept with the neighbour lists): "
-                                   "the run loop takes particles out of the host arrays between "
-                                   "steps, in one process (serial, openmp, opencl), without "
-                                   "periodic or mirror sides");
+  // sphc/sanity.h), which then go back where the scene computes (afterRemoval); a distributed
+  // solver removes each rank's own and gathers them to rank 0 (sphc/mpi/output.h,
+  // set_removal). Periodic or mirror sides refuse it (their ghosts are made from the
+  // particles' places, kept with the neighbour lists).
+  for (const auto& l : plan->limits) {
+    if (!l.hasRemove || !plan->domain.any()) continue;
+    diags.error(l.removeLoc, llvm::Twine("'remove' in limit '") + plan->arrays[l.array].name +
+                                 "." + l.quantity + "' is not supported with periodic or "
+                                 "mirror sides (their ghosts, kept with the neighbour lists): "
+                                 "the run loop takes particles out of the host arrays between "
+                                 "steps (serial, openmp, opencl, mpi), without periodic or "
+                                 "mirror sides");
   }
   if (diags.hasErrors()) return fail();
   // Inlets and outlets are distributed (sphc/mpi/zones.h), metrics too: their sums are

@@ -995,6 +995,7 @@ class Simulation {
 
   static constexpr const char* kRemovedHeader =
       "step,t,limit,array,index,gid,x,y,z,u,v,w,m,rho";
+  static constexpr const char* kRemovedValues[8] = {"x", "y", "z", "u", "v", "w", "m", "rho"};
 
   void set_up_removals() {
     if (!prog_.limits) return;
@@ -1011,6 +1012,7 @@ class Simulation {
       r.mass = m >= 0 && (*it)->props[m].type == PropType::F64 ? 0.0 : std::nan("");
       if (m >= 0 && (*it)->props[m].type == PropType::F64)
         for (std::size_t i = 0; i < (*it)->n; ++i) r.mass_at_start += (*it)->f64(m)[i];
+      if (prog_.sum_over_ranks) r.mass_at_start = prog_.sum_over_ranks(r.mass_at_start);
       removing_.push_back(std::move(r));
     }
   }
@@ -1055,61 +1057,103 @@ class Simulation {
     removed_csv_ << std::flush;
   }
 
+  // The particles `mask` of `a` with the CSV's columns: index (in `a`), gid (where `a` has
+  // global ids) and the positions, velocities (up to dim), m and rho that `a` has.
+  ParticleArray removed_rows(const ParticleArray& a, const std::vector<std::uint8_t>& mask) const {
+    ParticleArray g;
+    g.name = a.name;
+    std::vector<std::pair<int, int>> from;  // (a's property, g's)
+    from.push_back({-1, g.add_property("index", PropType::U32)});
+    const int gid = a.find("gid");
+    if (gid >= 0 && a.props[gid].type == PropType::U32)
+      from.push_back({gid, g.add_property("gid", PropType::U32)});
+    for (int k = 0; k < 8; ++k) {
+      const int p = k % 3 < prog_.dim || k >= 6 ? a.find(kRemovedValues[k]) : -1;
+      if (p >= 0 && a.props[p].type == PropType::F64 && a.props[p].stride == 1)
+        from.push_back({p, g.add_property(kRemovedValues[k])});
+    }
+    std::size_t count = 0;
+    for (std::uint8_t m : mask) count += m != 0;
+    g.resize(count);
+    for (std::size_t i = 0, j = 0; i < mask.size(); ++i) {
+      if (!mask[i]) continue;
+      g.u32(from[0].second)[j] = static_cast<std::uint32_t>(i);
+      for (std::size_t c = 1; c < from.size(); ++c) copy_particle_values(g.props[from[c].second], j, a.props[from[c].first], i);
+      ++j;
+    }
+    return g;
+  }
+
+  // Takes the particles past each remove bound out of their array, and logs them (rank 0):
+  // in gid order where the array has global ids (--global-ids, --mpi), else in particle order.
+  // A distributed run removes each rank's own and gathers them to rank 0 (gather_removed,
+  // collective: every rank at every check).
   void remove_particles() {
     for (Removing& r : removing_) {
       ParticleArray& a = *r.array;
       const std::vector<std::uint8_t> mask = removal_mask(r.limit, a, prog_.dim);
-      if (mask.empty()) continue;
-      auto column = [&](const char* name) -> const double* {
-        const int k = a.find(name);
-        return k >= 0 && a.props[k].type == PropType::F64 && a.props[k].stride == 1 ? a.f64(k)
-                                                                                   : nullptr;
-      };
-      const char* const names[] = {"x", "y", "z", "u", "v", "w", "m", "rho"};
-      const double* col[8];
-      for (int k = 0; k < 8; ++k) col[k] = k % 3 < prog_.dim || k >= 6 ? column(names[k]) : nullptr;
-      const int gid = a.find("gid");
-      const std::uint32_t* ids =
-          gid >= 0 && a.props[gid].type == PropType::U32 ? a.u32(gid) : nullptr;
-      std::size_t count = 0;
-      double mass = 0.0;
-      std::string positions;
-      for (std::size_t i = 0; i < a.n; ++i) {
-        if (!mask[i]) continue;
-        std::string pos;
-        for (int k = 0; k < prog_.dim && k < 3; ++k)
-          pos += fmt::format("{}{:.6g}", k ? ", " : "", col[k] ? col[k][i] : 0.0);
-        if (count < 4) positions += fmt::format("{}({})", count ? ", " : "", pos);
-        ++count;
-        if (col[6]) mass += col[6][i];
-        r.last = fmt::format("({}) at t={}", pos, t_);
-        if (removed_csv_.is_open()) {
-          removed_csv_ << fmt::format("{},{:.17g},{},{},{},{}", step_, t_, r.limit.name(), a.name,
-                                      i, ids ? std::to_string(ids[i]) : std::string());
-          for (int k = 0; k < 8; ++k)
-            removed_csv_ << "," << (col[k] ? fmt::format("{:.17g}", col[k][i]) : std::string());
-          removed_csv_ << "\n";
-        }
+      if (mask.empty() && !prog_.gather_removed) continue;
+      ParticleArray gone = removed_rows(a, mask);
+      if (!mask.empty()) {
+        a.remove_particles(mask);
+        if (prog_.after_removal) prog_.after_removal(a);
       }
-      if (removed_csv_.is_open()) removed_csv_ << std::flush;
-      if (r.removed == 0) r.first_t = t_;
-      r.last_t = t_;
-      r.removed += count;
-      r.mass += mass;
-      a.remove_particles(mask);
-      if (prog_.after_removal) prog_.after_removal(a);
-      if (prog_.rank > 0) continue;
-      progress_.break_line();
-      const std::string from = r.limit.where.empty() ? "" : " (" + r.limit.where + ")";
-      fmt::print(stderr,
-                 "removed at t={}, step {}: {} particle{} of array '{}' {} (limit '{}'{}){}: "
-                 "{}{}; {} removed so far{}\n",
-                 t_, step_, count, count == 1 ? "" : "s", a.name, r.limit.remove_text(),
-                 r.limit.name(), from,
-                 col[6] ? fmt::format(", mass {:.6g}", mass) : "", "at ",
-                 positions + (count > 4 ? ", ..." : ""), r.removed,
-                 col[6] ? fmt::format(" (mass {:.6g})", r.mass) : "");
+      if (prog_.gather_removed) {
+        prog_.gather_removed(a, mask, gone);
+      } else if (const int g = gone.find("gid"); g >= 0) {
+        std::vector<std::uint32_t> order(gone.n);
+        for (std::uint32_t j = 0; j < order.size(); ++j) order[j] = j;
+        const std::uint32_t* id = gone.u32(g);
+        std::stable_sort(order.begin(), order.end(),
+                         [&](std::uint32_t x, std::uint32_t y) { return id[x] < id[y]; });
+        gone.permute(order);
+      }
+      if (gone.n == 0 || prog_.rank > 0) continue;
+      log_removal(r, gone);
     }
+  }
+
+  // The removed particles `gone` (removed_rows) of one check: the CSV's rows, the counts and
+  // the log line.
+  void log_removal(Removing& r, const ParticleArray& gone) {
+    const int gid = gone.find("gid"), index = gone.find("index");
+    const double* col[8];
+    for (int k = 0; k < 8; ++k) {
+      const int p = gone.find(kRemovedValues[k]);
+      col[k] = p >= 0 ? gone.f64(p) : nullptr;
+    }
+    double mass = 0.0;
+    std::string positions;
+    for (std::size_t i = 0; i < gone.n; ++i) {
+      std::string pos;
+      for (int k = 0; k < prog_.dim && k < 3; ++k)
+        pos += fmt::format("{}{:.6g}", k ? ", " : "", col[k] ? col[k][i] : 0.0);
+      if (i < 4) positions += fmt::format("{}({})", i ? ", " : "", pos);
+      if (col[6]) mass += col[6][i];
+      r.last = fmt::format("({}) at t={}", pos, t_);
+      if (!removed_csv_.is_open()) continue;
+      removed_csv_ << fmt::format("{},{:.17g},{},{},{},{}", step_, t_, r.limit.name(),
+                                  gone.name, gone.props[index].u32[i],
+                                  gid >= 0 ? std::to_string(gone.props[gid].u32[i]) : std::string());
+      for (int k = 0; k < 8; ++k)
+        removed_csv_ << "," << (col[k] ? fmt::format("{:.17g}", col[k][i]) : std::string());
+      removed_csv_ << "\n";
+    }
+    if (removed_csv_.is_open()) removed_csv_ << std::flush;
+    const std::size_t count = gone.n;
+    if (r.removed == 0) r.first_t = t_;
+    r.last_t = t_;
+    r.removed += count;
+    r.mass += mass;
+    progress_.break_line();
+    const std::string from = r.limit.where.empty() ? "" : " (" + r.limit.where + ")";
+    fmt::print(stderr,
+               "removed at t={}, step {}: {} particle{} of array '{}' {} (limit '{}'{}){}: "
+               "{}{}; {} removed so far{}\n",
+               t_, step_, count, count == 1 ? "" : "s", gone.name, r.limit.remove_text(),
+               r.limit.name(), from, col[6] ? fmt::format(", mass {:.6g}", mass) : "", "at ",
+               positions + (count > 4 ? ", ..." : ""), r.removed,
+               col[6] ? fmt::format(" (mass {:.6g})", r.mass) : "");
   }
 
   // At the end of a run: what each remove bound took out.

@@ -15,10 +15,7 @@
 set -eu
 SPHC=$1; SRC=$2; SCENE=$3; STEPS=$4; HALF=$5; SPHC_ARGS=$6; RUN_ARGS=$7
 . "$SRC/tests/validation/common.sh"
-find_python "mpi restart"
-W=$(mktemp -d "${TMPDIR:-/tmp}/sphc-mpi-restart.XXXXXX")
-trap 'rm -rf "$W"' EXIT
-MPIRUN=${SPHC_MPIRUN:-mpirun}
+mpi_test_setup "mpi restart" mpi-restart
 run_mpi() {
   np=$1; shift
   # shellcheck disable=SC2086

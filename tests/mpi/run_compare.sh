@@ -15,10 +15,7 @@ set -eu
 SPHC=$1; SRC=$2; SCENE=$3; STEPS=$4; SPHC_ARGS=$5; RUN_ARGS=$6
 shift 6
 . "$SRC/tests/validation/common.sh"
-find_python "mpi compare"
-W=$(mktemp -d "${TMPDIR:-/tmp}/sphc-mpi.XXXXXX")
-trap 'rm -rf "$W"' EXIT
-MPIRUN=${SPHC_MPIRUN:-mpirun}
+mpi_test_setup "mpi compare" mpi
 # shellcheck disable=SC2086
 "$SPHC" "$SCENE" $SPHC_ARGS --global-ids -o "$W/serial"
 # shellcheck disable=SC2086

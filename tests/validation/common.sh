@@ -15,6 +15,16 @@ find_python() {
   exit 1
 }
 
+# mpi_test_setup WHO NAME: what the distributed tests (tests/mpi/*.sh) start with: PY
+# (find_python WHO), W a fresh work directory (sphc-NAME.XXXXXX in $TMPDIR or /tmp) removed at
+# exit, MPIRUN ($SPHC_MPIRUN, else mpirun).
+mpi_test_setup() {
+  find_python "$1"
+  W=$(mktemp -d "${TMPDIR:-/tmp}/sphc-$2.XXXXXX")
+  trap 'rm -rf "$W"' EXIT
+  MPIRUN=${SPHC_MPIRUN:-mpirun}
+}
+
 # fresh_output EXE OUT: empties the output directory OUT and makes the folder of the solver EXE.
 fresh_output() {
   rm -rf "$2"

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <initializer_list>
 #include <chrono>
@@ -195,6 +196,17 @@ struct SceneProgram {
   // copy) and forgets what depended on its particles (a static array's cells); empty: nothing
   // to do (kept lists see the new count and are rebuilt).
   std::function<void(const ParticleArray& a)> after_removal;
+  // Distributed runs with a limit's `remove` (sphc/mpi/output.h, set_removal). Collective:
+  // every rank calls them in the same order. gather_removed, at every check for each remove
+  // bound, after the rank took its particles `mask` (empty: none) out of `a` (and
+  // after_removal): the domain decomposition forgets their counted work, and `gone` (those
+  // particles, the removed-particles file's columns) becomes every rank's on rank 0, in gid
+  // order (empty on the others). sum_over_ranks: a sum over the ranks (the array's mass at
+  // the start). Empty: one process.
+  std::function<void(const ParticleArray& a, const std::vector<std::uint8_t>& mask,
+                     ParticleArray& gone)>
+      gather_removed;
+  std::function<double(double)> sum_over_ranks;
   // The scene's metrics { } (sphc/metrics.h): what they are, and their values at time t from
   // the host arrays (the run loop calls it where it writes output); empty: none declared.
   std::vector<MetricInfo> metrics;

@@ -460,6 +460,20 @@ std::vector<double> pass_scales(const Decomposition& d,
 
 }  // namespace
 
+void forget_particles(Decomposition& d, std::size_t k, const std::vector<std::uint8_t>& removed) {
+  // Counts of another particle set (the array changed since the passes, or none counted):
+  // unused already (pass_n differs from the count), left so.
+  if (k >= d.particle_work.size() || d.pass_n[k] != removed.size() ||
+      d.particle_work[k].size() < removed.size())
+    return;
+  std::vector<long>& w = d.particle_work[k];
+  std::size_t out = 0;
+  for (std::size_t i = 0; i < removed.size(); ++i)
+    if (!removed[i]) w[out++] = w[i];
+  w.resize(out);  // the halo's counts (after the real particles) are not read
+  d.pass_n[k] = out;
+}
+
 void update(Decomposition& d, const std::vector<ParticleArray*>& arrays) {
   ++d.evaluations;
   // Close the last evaluation's count (the arrays still hold its particles).

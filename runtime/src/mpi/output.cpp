@@ -361,4 +361,17 @@ void set_output(SceneProgram& prog, std::function<std::vector<ParticleArray*>()>
   };
 }
 
+void set_removal(SceneProgram& prog, Decomposition& d, std::vector<ParticleArray*> arrays) {
+  prog.sum_over_ranks = [](double x) { return sum(x); };
+  prog.gather_removed = [&d, arrays = std::move(arrays)](const ParticleArray& a,
+                                                         const std::vector<std::uint8_t>& mask,
+                                                         ParticleArray& gone) {
+    for (std::size_t k = 0; k < arrays.size() && !mask.empty(); ++k)
+      if (arrays[k] == &a) forget_particles(d, k, mask);
+    std::vector<ParticleArray> all;
+    gather_arrays({&gone}, all);
+    gone = std::move(all.front());
+  };
+}
+
 }  // namespace sphc::mpi

@@ -222,13 +222,24 @@ TEST(MpiDecomposition, MeasuredWeightsAreTheMeanSinceTheLastRebalance) {
 // The neighbours of every real particle among real + halo particles are exactly those of a
 // serial brute force over all particles and their periodic images (or mirror images), with
 // the carried properties transformed.
-void check_halo(const sphc::Domain& box, bool mirror) {
-  const int nx = 12;
-  const sphc::ParticleArray all = lattice(nx);
-  sphc::ParticleArray a = lattice(nx);
+// A 12 x 12 lattice: `all` of it, and `a` this rank's part of it (decomposition `d`).
+constexpr int kHaloNx = 12;
+struct SplitLattice {
+  const sphc::ParticleArray all = lattice(kHaloNx);
+  sphc::ParticleArray a = lattice(kHaloNx);
   sphc::mpi::Decomposition d;
-  sphc::mpi::init_decomposition(d, 2);
-  sphc::mpi::distribute(d, {&a});
+  SplitLattice() {
+    sphc::mpi::init_decomposition(d, 2);
+    sphc::mpi::distribute(d, {&a});
+  }
+};
+
+void check_halo(const sphc::Domain& box, bool mirror) {
+  const int nx = kHaloNx;
+  SplitLattice split;
+  const sphc::ParticleArray& all = split.all;
+  sphc::ParticleArray& a = split.a;
+  sphc::mpi::Decomposition& d = split.d;
   const double cutoff = 2.0 / nx;  // radius_scale 2, h = dx
   sphc::mpi::Halo h;
   const std::vector<int> carried = {a.find("x"), a.find("y"), a.find("u"), a.find("v"),
@@ -324,6 +335,51 @@ TEST(MpiHalo, RefreshSendsNewValues) {
   EXPECT_TRUE(everywhere(ok));
   if (sphc::mpi::size() > 1) EXPECT_GT(sphc::mpi::sum(static_cast<long>(h.size())), 0);
   else EXPECT_EQ(h.size(), 0u);  // one rank, open domain: no halo
+}
+
+// A limit's `remove` between evaluations (sphc/solver.h, gather_removed): each rank takes its
+// particles with gid % 7 == 0 out; the passes' counts of the others stay theirs
+// (forget_particles), and the next halo holds no copy of a removed particle: every real
+// particle's neighbours among real + halo particles are a brute force's over the lattice
+// without them.
+TEST(MpiDecomposition, RemovedParticlesLeaveTheCountsAndTheHalo) {
+  const int nx = kHaloNx;
+  SplitLattice split;
+  const sphc::ParticleArray& all = split.all;
+  sphc::ParticleArray& a = split.a;
+  sphc::mpi::Decomposition& d = split.d;
+  const int g = a.find("gid");
+  long* pw = sphc::mpi::pass_work(d, 0, a.n, a.n);
+  for (std::size_t i = 0; i < a.n; ++i) pw[i] = 10 * static_cast<long>(a.props[g].u32[i]);
+  std::vector<std::uint8_t> mask(a.n, 0);
+  for (std::size_t i = 0; i < a.n; ++i) mask[i] = a.props[g].u32[i] % 7 == 0;
+  a.remove_particles(mask);
+  sphc::mpi::forget_particles(d, 0, mask);
+  bool ok = d.pass_n[0] == a.n && d.particle_work[0].size() == a.n;
+  for (std::size_t i = 0; ok && i < a.n; ++i)
+    ok = d.particle_work[0][i] == 10 * static_cast<long>(a.props[g].u32[i]);
+  EXPECT_TRUE(everywhere(ok));
+  const double cutoff = 2.0 / nx;
+  sphc::Domain open;
+  sphc::mpi::Halo h;
+  sphc::mpi::exchange_halo(d, open, a, cutoff, h, {a.find("x"), a.find("y"), g});
+  long pairs = 0, want = 0;
+  for (std::size_t i = 0; i < a.n; ++i) {
+    const double xi = a.f64("x")[i], yi = a.f64("y")[i];
+    for (std::size_t j = 0; j < a.n + h.size(); ++j) {
+      ok = ok && a.props[g].u32[j] % 7 != 0;
+      const double dx = xi - a.f64("x")[j], dy = yi - a.f64("y")[j];
+      pairs += j != i && dx * dx + dy * dy < cutoff * cutoff;
+    }
+    for (std::size_t k = 0; k < all.n; ++k) {
+      const double dx = xi - all.f64("x")[k], dy = yi - all.f64("y")[k];
+      want += k % 7 != 0 && k != a.props[g].u32[i] && dx * dx + dy * dy < cutoff * cutoff;
+    }
+  }
+  EXPECT_TRUE(everywhere(ok));
+  EXPECT_EQ(pairs, want);
+  EXPECT_EQ(sphc::mpi::sum(static_cast<long>(a.n)), static_cast<long>(nx * nx - (nx * nx + 6) / 7));
+  sphc::mpi::remove_halo(a, h);
 }
 
 TEST(MpiGather, RankZeroGetsEveryParticleInGidOrder) {

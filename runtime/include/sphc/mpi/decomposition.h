@@ -174,6 +174,12 @@ std::size_t migrate(Decomposition& d, const std::vector<ParticleArray*>& arrays)
 // modes above). Collective.
 void update(Decomposition& d, const std::vector<ParticleArray*>& arrays);
 
+// A limit's `remove` took the particles `removed` (removed[i] != 0, over the real particles
+// before it) out of array k (in the order the arrays are passed) between evaluations: the
+// work the last passes counted for them goes with them, so a re-cut before the next passes
+// weighs the others by their own counts (as without the removal). Not collective.
+void forget_particles(Decomposition& d, std::size_t k, const std::vector<std::uint8_t>& removed);
+
 // Largest particle count of a rank over the mean (1 = perfect balance). Collective.
 double imbalance(const std::vector<ParticleArray*>& arrays);
 // The same in d's weights (the particle count without weights).

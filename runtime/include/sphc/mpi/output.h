@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "sphc/hdf5_io.h"
+#include "sphc/mpi/decomposition.h"
 #include "sphc/particle_array.h"
 #include "sphc/solver.h"
 
@@ -33,6 +34,13 @@ bool parallel_output_available();
 
 // Sets prog's output to one of the two ways above. `arrays` gives this rank's arrays.
 void set_output(SceneProgram& prog, std::function<std::vector<ParticleArray*>()> arrays);
+
+// A limit's `remove` (sphc/solver.h, SceneProgram::gather_removed): each rank removes its
+// own particles; the decomposition `d` of `arrays` forgets their counted work and they are
+// gathered to rank 0 in gid order (sphc/mpi/gather.h), which logs them and writes the
+// removed-particles file as a serial run does; the array's mass at the start is summed over
+// the ranks.
+void set_removal(SceneProgram& prog, Decomposition& d, std::vector<ParticleArray*> arrays);
 
 // Collective: writes `path` (through path + ".tmp", renamed by rank 0 when complete) from
 // every rank's particles of `arrays` (each rank passes its own, the same arrays and
