@@ -898,4 +898,56 @@ void prune_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b,
   out.j.resize(total);
 }
 
+namespace {
+
+// The CPU time of a half tile against a whole one in the OpenMP tiles (each pair once, 8 x 8,
+// the cube's bodies; the two blocks' thread CPU at 2 threads, their (1) part timed apart, in a
+// hand-instrumented cube solver, stop 41: docs/performance-log.md): the i side (the calls for
+// the i's, their lane sums) 0.55, the j side (the mirrored calls, the j sums and their fold)
+// 0.85: a tile across two blocks costs 1.4 tiles, more of it in the later block.
+constexpr double kHalfTileI = 0.55;
+constexpr double kHalfTileJ = 0.85;
+
+}  // namespace
+
+void tile_block_cuts(const ClusterPairList& list, int blocks, std::vector<int>& cut) {
+  const std::size_t nc = list.begin.empty() ? 0 : list.begin.size() - 1;
+  blocks = static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(std::max(blocks, 1)), nc)));
+  cut.assign(static_cast<std::size_t>(blocks) + 1, static_cast<int>(nc));
+  cut[0] = 0;
+  if (blocks == 1) return;
+  const std::uint32_t* b = list.begin.data();
+  const std::uint32_t* j = list.j.data();
+  const double total = static_cast<double>(b[nc]);
+  // The first i-cluster whose list starts at or after q pairs.
+  auto at = [&](double q) {
+    const double c = std::min(std::max(q, 0.0), total);
+    return static_cast<int>(std::lower_bound(b, b + nc, static_cast<std::uint32_t>(c)) - b);
+  };
+  // The cuts by pairs, and the tiles across each (i before the cut, j at or after it).
+  std::vector<double> across(static_cast<std::size_t>(blocks) + 1, 0.0);
+  for (int k = 1; k < blocks; ++k) cut[k] = at(total * k / blocks);
+  const std::size_t last = static_cast<std::size_t>(cut[blocks - 1]);
+  for (std::size_t i = 0; i < last; ++i) {
+    const std::uint32_t e0 = b[i], e1 = b[i + 1];
+    if (e0 == e1) continue;
+    for (int k = 1; k < blocks; ++k) {
+      const std::uint32_t c = static_cast<std::uint32_t>(cut[k]);
+      if (i < c && j[e1 - 1] >= c)
+        across[k] += static_cast<double>(j + e1 - std::lower_bound(j + e0, j + e1, c));
+    }
+  }
+  // Block k's work: its i-clusters' pairs, less (1 - kHalfTileI) of those across its end
+  // (computed as i-side halves), plus kHalfTileJ of those across its start (j-side halves):
+  // the same for every block where the cuts are at these prefix sums of the pairs.
+  double sum = 0;
+  for (int k = 1; k < blocks; ++k) sum += across[k];
+  const double each = (total + (kHalfTileI + kHalfTileJ - 1.0) * sum) / blocks;
+  double q = 0;
+  for (int k = 1; k < blocks; ++k) {
+    q += each + (1.0 - kHalfTileI) * across[k] - kHalfTileJ * across[k - 1];
+    cut[k] = std::max(cut[k - 1], at(q));
+  }
+}
+
 }  // namespace sphc
