@@ -422,6 +422,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "// the largest h: at the build (nothing writes h)\n";
     scene_ << in << "if (verlet_build) {\n";
     scene_ << in << "  double cl_hmax_build = 0.0;\n";
+    if (openmp)  // (stop 41; max is exact: the same value whatever the threads)
+      scene_ << in << "  #pragma omp parallel for schedule(static) reduction(max: cl_hmax_build)"
+             << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
     scene_ << in << "  for (int i = 0; i < n; ++i) cl_hmax_build = std::max(cl_hmax_build, di_h[i]);\n";
     scene_ << in << "  " << state << "_hmax = cl_hmax_build;\n";
     scene_ << in << "}\n";
