@@ -67,7 +67,8 @@
 // codegen/simd-pairs-cluster*.sph, stability.cluster_compare_*).
 //
 // OpenMP (stop 38): contiguous blocks of i-clusters, one per thread (balanced by the pruned
-// list's pairs), each writing only its own slots' sums, in the serial order whatever the
+// list's pairs, since stop 41 a tile across two blocks counted as its two halves:
+// sphc::tile_block_cuts), each writing only its own slots' sums, in the serial order whatever the
 // blocks: (1) the j sides of the tiles of earlier i-clusters whose j-cluster is in the block
 // (half tiles, i-clusters in increasing order), (2) the block's i-clusters, their tiles with
 // j-clusters in the block whole, those with j-clusters in later blocks for the i side only.
@@ -431,6 +432,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "// the largest h: at the build (nothing writes h)\n";
     scene_ << in << "if (verlet_build) {\n";
     scene_ << in << "  double cl_hmax_build = 0.0;\n";
+    if (openmp)  // (stop 41; max is exact: the same value whatever the threads)
+      scene_ << in << "  #pragma omp parallel for schedule(static) reduction(max: cl_hmax_build)"
+             << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
     scene_ << in << "  for (int i = 0; i < n; ++i) cl_hmax_build = std::max(cl_hmax_build, di_h[i]);\n";
     scene_ << in << "  " << state << "_hmax = cl_hmax_build;\n";
     scene_ << in << "}\n";
@@ -635,8 +639,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
             "#endif\n";
   if (openmp)
     scene_ << in << "// OpenMP: contiguous blocks of i-clusters, one per thread, balanced by the pruned\n"
-           << in << "// list's pairs; a block writes only its own slots' sums, each sum in the serial\n"
-           << in << "// order whatever the blocks (so the serial tiles' bits for any thread count):\n"
+           << in << "// list's pairs and half tiles; a block writes only its own slots' sums, each sum\n"
+           << in << "// in the serial order whatever the blocks (so the serial tiles' bits for any\n"
+           << in << "// thread count):\n"
            << in << "// (1) the j sides of the tiles of EARLIER i-clusters whose j-cluster is in the\n"
            << in << "//     block (j-side half tiles, i-clusters in increasing order: the serial order\n"
            << in << "//     of those tiles' sums, which come before the block's own),\n"
@@ -1061,15 +1066,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   if (!openmp) {
     scene_ << in << "tiles(0, static_cast<int>(cl_layout.n_clusters));\n";
   } else {
-    scene_ << in << "{  // the blocks: balanced by the pruned list's pairs (the sums do not depend on them)\n";
+    scene_ << in << "{  // the blocks: balanced by the pruned list's pairs, a tile across two blocks as its\n"
+           << in << "   // two halves (sphc::tile_block_cuts; the sums do not depend on them)\n";
     scene_ << in << "  const int n_ci = static_cast<int>(cl_layout.n_clusters);\n";
     scene_ << in << "  const int n_blocks = std::max(1, std::min(n_ci, omp_get_max_threads()));\n";
-    scene_ << in << "  const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
-    scene_ << in << "  std::vector<int> cl_cb(n_blocks + 1, n_ci);\n";
-    scene_ << in << "  cl_cb[0] = 0;\n";
-    scene_ << in << "  for (int blk = 1; blk < n_blocks; ++blk)\n";
-    scene_ << in << "    cl_cb[blk] = static_cast<int>(std::lower_bound(cl_begin, cl_begin + n_ci, static_cast<std::uint32_t>(\n";
-    scene_ << in << "        static_cast<std::uint64_t>(cl_begin[n_ci]) * blk / n_blocks)) - cl_begin);\n";
+    scene_ << in << "  std::vector<int> cl_cb;\n";
+    scene_ << in << "  sphc::tile_block_cuts(cl_pruned, n_blocks, cl_cb);\n";
     scene_ << in << "  #pragma omp parallel for schedule(static, 1)\n";
     scene_ << in << "  for (int blk = 0; blk < n_blocks; ++blk) tiles(cl_cb[blk], cl_cb[blk + 1]);\n";
     scene_ << in << "}\n";

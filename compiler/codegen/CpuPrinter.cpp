@@ -96,7 +96,8 @@ class CpuPrinter : public ScenePrinter {
   bool verlet() const { return verletSkin_ > 0; }
   void verletMembers();
   // The rebuild check of the kept lists `lists` of w's pass over source s (verlet_build).
-  void listsRebuildCheck(const std::string& lists, const DestinationWork& w, int s);
+  void listsRebuildCheck(const std::string& lists, const DestinationWork& w, int s,
+                         bool cells = true);
   // One displacement scan per array and phase (sphc::PhaseDisplacements): declared where the
   // phase checks two kept lists or more and nothing in it writes positions or h; its checks
   // then pass it.
@@ -480,7 +481,10 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
                       parallelFor("        ", pass.order, ompIf("n_src")));
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, w, s) : "";
-    listsRebuildCheck(lists, w, s);
+    // A pass in cluster-pair tiles searches its own layout (ClusterPairs.cpp): no cells.
+    const bool tiles = symmetricPass(w, pass) && onceLanes(w, pass) &&
+                       clusterTilesRefusal(w, pass).empty();
+    listsRebuildCheck(lists, w, s, !tiles);
     if (symmetricPass(w, pass)) {
       emitSymmetricPass(w, pass, lists, openmp_,
                         tuned() ? "verlet_radius2" : "VERLET_RADIUS2");  // codegen/SymmetricPairs.cpp
@@ -604,7 +608,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
   ghostRefresh(w);
 }
 
-void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWork& w, int s) {
+void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWork& w, int s,
+                                   bool cells) {
   const int d = w.array;
   const std::string& D = arr(d).name;
   const std::string& S = arr(s).name;
@@ -643,8 +648,10 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
       scene_ << "          " << lists << "_by_source.clear();  // found again by the pass over pairs of two arrays once\n";
     scene_ << "        }\n";
   }
-  if (lazyCells() && !isStatic(S))  // CpuLazyCells.cpp
+  if (lazyCells() && !isStatic(S) && cells)  // CpuLazyCells.cpp
     scene_ << "        if (verlet_build) build_cells_" << S << "();  // the cells of this update, once\n";
+  else if (lazyCells() && !isStatic(S))  // (stop 41: they cost ~1 ms per rebuild at 100k)
+    scene_ << "        // (no cells: the tiles search their own layout's columns)\n";
 }
 
 std::pair<const DestinationWork*, const DestinationWork*> CpuPrinter::crossPair(

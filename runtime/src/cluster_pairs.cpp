@@ -67,11 +67,21 @@ double layout_grid(ClusterLayout& L, const double* x, const double* y, const dou
   const int ncol_axes = dim - 1;  // 3D: x, y; 2D: x
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   const double* axes[3] = {x, y, dim == 3 ? z : nullptr};
-  for (int a = 0; a < dim; ++a)
+  // The extent of the finite coordinates (a NaN fails both comparisons: skipped), under
+  // OpenMP per thread then over the threads (stop 41): min and max are exact, so the same
+  // extent whatever the threads (but for the sign of a zero bound, which moves no column).
+  const bool parallel = n >= kLayoutParallelMin;
+  (void)parallel;
+  for (int a = 0; a < dim; ++a) {
+    const double* v = axes[a];
+    double l = HUGE_VAL, h = -HUGE_VAL;
+#pragma omp parallel for schedule(static) reduction(min : l) reduction(max : h) if (parallel)
     for (std::size_t p = 0; p < n; ++p) {
-      const double v = axes[a][p];
-      if (v == v) lo[a] = std::min(lo[a], v), hi[a] = std::max(hi[a], v);
+      l = v[p] < l ? v[p] : l;
+      h = v[p] > h ? v[p] : h;
     }
+    lo[a] = l, hi[a] = h;
+  }
   for (int a = 0; a < dim; ++a)
     if (!(lo[a] <= hi[a])) lo[a] = hi[a] = 0;  // no finite coordinate
   double side = column_side;
@@ -109,8 +119,11 @@ double cluster_column_side(double spacing, int dim, int width) {
   return spacing * std::pow(static_cast<double>(width), 1.0 / dim);
 }
 
-void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, const double* z,
-                          std::size_t n, int dim, double column_side, int width) {
+namespace {
+
+// build_cluster_layout without the boxes (cluster_order reads the slots only).
+void layout_slots(ClusterLayout& L, const double* x, const double* y, const double* z,
+                  std::size_t n, int dim, double column_side, int width) {
   assert(dim == 2 || dim == 3);
   assert(width >= 1 && width <= kMaxClusterSize);
   if (width < 1) width = 1;
@@ -127,27 +140,54 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
   L.in_order = false;
   L.column_cluster.clear();
 
-  // Counting sort into columns (stable: particle index order within a column).
+  // Counting sort into columns (stable: particle index order within a column). Under OpenMP
+  // (stop 41) each thread its static block of particles: their columns, its counts per
+  // column, then its block scattered from its own offsets (a column's earlier blocks' first):
+  // the serial order exactly.
+  const bool parallel = n >= kLayoutParallelMin;
+  (void)parallel;
   std::vector<std::uint32_t> col(n);
   std::vector<std::uint32_t> count(ncol + 1, 0);
-  for (std::size_t p = 0; p < n; ++p) {
-    std::size_t c = column_of(col_axis[0][p], L.origin[0], side, L.columns[0]);
-    if (ncol_axes == 2) c += L.columns[0] * column_of(col_axis[1][p], L.origin[1], side, L.columns[1]);
-    col[p] = static_cast<std::uint32_t>(c);
-    ++count[c + 1];
-  }
-  for (std::size_t c = 0; c < ncol; ++c) count[c + 1] += count[c];
   std::vector<std::pair<double, std::uint32_t>> order(n);  // (sort key, particle)
+  std::vector<std::vector<std::uint32_t>> at;  // per thread: its next slot per column
+#pragma omp parallel if (parallel)
   {
-    std::vector<std::uint32_t> at(count.begin(), count.end() - 1);
-    for (std::size_t p = 0; p < n; ++p)
-      order[at[col[p]]++] = {key(sort_axis[p]), static_cast<std::uint32_t>(p)};
+#ifdef _OPENMP
+    const int nt = omp_get_num_threads(), t = omp_get_thread_num();
+#else
+    const int nt = 1, t = 0;
+#endif
+#pragma omp single
+    at.assign(static_cast<std::size_t>(nt), std::vector<std::uint32_t>(ncol, 0));
+    const std::size_t p0 = n * static_cast<std::size_t>(t) / static_cast<std::size_t>(nt);
+    const std::size_t p1 = n * static_cast<std::size_t>(t + 1) / static_cast<std::size_t>(nt);
+    std::vector<std::uint32_t>& mine = at[static_cast<std::size_t>(t)];
+    for (std::size_t p = p0; p < p1; ++p) {
+      std::size_t c = column_of(col_axis[0][p], L.origin[0], side, L.columns[0]);
+      if (ncol_axes == 2) c += L.columns[0] * column_of(col_axis[1][p], L.origin[1], side, L.columns[1]);
+      col[p] = static_cast<std::uint32_t>(c);
+      ++mine[c];
+    }
+#pragma omp barrier
+#pragma omp single
+    {  // offsets: column by column, within a column thread by thread
+      std::uint32_t sum = 0;
+      for (std::size_t c = 0; c < ncol; ++c) {
+        count[c] = sum;
+        for (int k = 0; k < nt; ++k) {
+          const std::uint32_t m = at[static_cast<std::size_t>(k)][c];
+          at[static_cast<std::size_t>(k)][c] = sum;
+          sum += m;
+        }
+      }
+      count[ncol] = sum;
+    }
+    for (std::size_t p = p0; p < p1; ++p)
+      order[mine[col[p]]++] = {key(sort_axis[p]), static_cast<std::uint32_t>(p)};
   }
   // Each column by its sort key (ties by particle index: a total order, so the same layout
   // whatever the threads), then cut into clusters. Under OpenMP the columns' sorts and their
   // slots in parallel (stop 39) where there are at least kLayoutParallelMin particles.
-  const bool parallel = n >= kLayoutParallelMin;
-  (void)parallel;
   const long ncols = static_cast<long>(ncol);
 #pragma omp parallel for schedule(dynamic, 16) if (parallel)
   for (long c = 0; c < ncols; ++c)
@@ -173,17 +213,24 @@ void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, co
       L.real_mask[s / C] |= static_cast<std::uint8_t>(1u << (s % C));
     }
   }
+}
+
+}  // namespace
+
+void build_cluster_layout(ClusterLayout& L, const double* x, const double* y, const double* z,
+                          std::size_t n, int dim, double column_side, int width) {
+  layout_slots(L, x, y, z, n, dim, column_side, width);
   // Boxes from these positions (of the real slots: the positions' gather with the boxes).
-  L.box.assign(clusters * 6, 0.0);
+  L.box.assign(L.n_clusters * 6, 0.0);
   std::vector<double> xs(L.slots()), ys(L.slots()), zs(dim == 3 ? L.slots() : 0);
   gather_positions_boxes(L, x, y, z, xs.data(), ys.data(), dim == 3 ? zs.data() : nullptr, 0.0,
-                         parallel);
+                         n >= kLayoutParallelMin);
 }
 
 void cluster_order(std::vector<std::uint32_t>& order, const double* x, const double* y,
                    const double* z, std::size_t n, int dim, double column_side, int width) {
   ClusterLayout L;
-  build_cluster_layout(L, x, y, z, n, dim, column_side, width);
+  layout_slots(L, x, y, z, n, dim, column_side, width);  // (no boxes: stop 41)
   const std::size_t C = static_cast<std::size_t>(L.width);
   order.clear();
   order.reserve(n);
@@ -218,8 +265,19 @@ void build_cluster_layout_in_order(ClusterLayout& L, const double* x, const doub
   L.n_clusters = nc;
   L.slot.resize(nc * C);
   L.slot_of.resize(n);
-  for (std::size_t s = 0; s < nc * C; ++s) L.slot[s] = s < n ? static_cast<std::uint32_t>(s) : kPadSlot;
-  for (std::size_t p = 0; p < n; ++p) L.slot_of[p] = static_cast<std::uint32_t>(p);
+  {
+    const bool parallel = n >= kLayoutParallelMin;
+    (void)parallel;
+    std::uint32_t* const slot = L.slot.data();
+    std::uint32_t* const slot_of = L.slot_of.data();
+    const long ns = static_cast<long>(nc * C);
+#pragma omp parallel for schedule(static) if (parallel)
+    for (long s = 0; s < ns; ++s) {
+      const std::size_t u = static_cast<std::size_t>(s);
+      slot[u] = u < n ? static_cast<std::uint32_t>(u) : kPadSlot;
+      if (u < n) slot_of[u] = static_cast<std::uint32_t>(u);
+    }
+  }
   L.real_mask.assign(nc, L.full_mask());
   if (nc * C != n) L.real_mask[nc - 1] = static_cast<std::uint8_t>((1u << (n - (nc - 1) * C)) - 1u);
   L.box.assign(nc * 6, 0.0);
@@ -896,6 +954,58 @@ void prune_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b,
     total += kept[blk];
   }
   out.j.resize(total);
+}
+
+namespace {
+
+// The CPU time of a half tile against a whole one in the OpenMP tiles (each pair once, 8 x 8,
+// the cube's bodies; the two blocks' thread CPU at 2 threads, their (1) part timed apart, in a
+// hand-instrumented cube solver, stop 41: docs/performance-log.md): the i side (the calls for
+// the i's, their lane sums) 0.55, the j side (the mirrored calls, the j sums and their fold)
+// 0.85: a tile across two blocks costs 1.4 tiles, more of it in the later block.
+constexpr double kHalfTileI = 0.55;
+constexpr double kHalfTileJ = 0.85;
+
+}  // namespace
+
+void tile_block_cuts(const ClusterPairList& list, int blocks, std::vector<int>& cut) {
+  const std::size_t nc = list.begin.empty() ? 0 : list.begin.size() - 1;
+  blocks = static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(std::max(blocks, 1)), nc)));
+  cut.assign(static_cast<std::size_t>(blocks) + 1, static_cast<int>(nc));
+  cut[0] = 0;
+  if (blocks == 1) return;
+  const std::uint32_t* b = list.begin.data();
+  const std::uint32_t* j = list.j.data();
+  const double total = static_cast<double>(b[nc]);
+  // The first i-cluster whose list starts at or after q pairs.
+  auto at = [&](double q) {
+    const double c = std::min(std::max(q, 0.0), total);
+    return static_cast<int>(std::lower_bound(b, b + nc, static_cast<std::uint32_t>(c)) - b);
+  };
+  // The cuts by pairs, and the tiles across each (i before the cut, j at or after it).
+  std::vector<double> across(static_cast<std::size_t>(blocks) + 1, 0.0);
+  for (int k = 1; k < blocks; ++k) cut[k] = at(total * k / blocks);
+  const std::size_t last = static_cast<std::size_t>(cut[blocks - 1]);
+  for (std::size_t i = 0; i < last; ++i) {
+    const std::uint32_t e0 = b[i], e1 = b[i + 1];
+    if (e0 == e1) continue;
+    for (int k = 1; k < blocks; ++k) {
+      const std::uint32_t c = static_cast<std::uint32_t>(cut[k]);
+      if (i < c && j[e1 - 1] >= c)
+        across[k] += static_cast<double>(j + e1 - std::lower_bound(j + e0, j + e1, c));
+    }
+  }
+  // Block k's work: its i-clusters' pairs, less (1 - kHalfTileI) of those across its end
+  // (computed as i-side halves), plus kHalfTileJ of those across its start (j-side halves):
+  // the same for every block where the cuts are at these prefix sums of the pairs.
+  double sum = 0;
+  for (int k = 1; k < blocks; ++k) sum += across[k];
+  const double each = (total + (kHalfTileI + kHalfTileJ - 1.0) * sum) / blocks;
+  double q = 0;
+  for (int k = 1; k < blocks; ++k) {
+    q += each + (1.0 - kHalfTileI) * across[k] - kHalfTileJ * across[k - 1];
+    cut[k] = std::max(cut[k - 1], at(q));
+  }
 }
 
 }  // namespace sphc

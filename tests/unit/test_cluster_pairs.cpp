@@ -691,3 +691,71 @@ TEST(ClusterPairs, InOrderLayoutsOfTheClusterOrderHoldEveryPair) {
     }
   }
 }
+
+// The OpenMP tiles' blocks (stop 41, sphc::tile_block_cuts): contiguous blocks covering every
+// i-cluster, clamped to [1, n_clusters]; on the cube's lattice in cluster order each block's
+// work (whole tiles 1, a tile across blocks 0.55 in the i's block and 0.85 in the j's, counted
+// by brute force) within 2% of the mean, and no block more than the pair cuts' largest.
+TEST(ClusterPairs, TileBlockCutsBalanceTheHalfTiles) {
+  {
+    std::vector<int> cut;
+    sphc::tile_block_cuts(ClusterPairList{}, 4, cut);
+    EXPECT_EQ(cut, (std::vector<int>{0, 0}));
+    ClusterPairList two;
+    two.begin = {0, 2, 3};
+    two.j = {0, 1, 1};
+    sphc::tile_block_cuts(two, 8, cut);
+    EXPECT_EQ(cut.size(), 3u);
+    EXPECT_EQ(cut.front(), 0);
+    EXPECT_EQ(cut.back(), 2);
+    sphc::tile_block_cuts(two, 1, cut);
+    EXPECT_EQ(cut, (std::vector<int>{0, 2}));
+    sphc::tile_block_cuts(two, 0, cut);
+    EXPECT_EQ(cut, (std::vector<int>{0, 2}));
+  }
+  const int nx = 32;
+  const Points p0 = lattice(nx, 3, 1.0 / nx, 0.05, 3);
+  std::vector<std::uint32_t> order;
+  sphc::cluster_order(order, p0.x.data(), p0.y.data(), p0.zp(), p0.n(), 3, 0.0, kClusterSize);
+  Points q = p0;
+  for (std::size_t i = 0; i < order.size(); ++i)
+    q.x[i] = p0.x[order[i]], q.y[i] = p0.y[order[i]], q.z[i] = p0.z[order[i]];
+  ClusterLayout L;
+  sphc::build_cluster_layout_in_order(L, q.x.data(), q.y.data(), q.zp(), q.n(), 3, 0.0, kClusterSize);
+  ClusterPairList l;
+  build_cluster_pairs(L, L, 2.0 * 1.5 / nx, true, l);
+  const int nc = static_cast<int>(L.n_clusters);
+  auto work = [&](const std::vector<int>& cut) {
+    const int B = static_cast<int>(cut.size()) - 1;
+    std::vector<double> w(B, 0.0);
+    auto block = [&](int c) { return static_cast<int>(std::upper_bound(cut.begin() + 1, cut.end() - 1, c) - cut.begin()) - 1; };
+    for (int i = 0; i < nc; ++i)
+      for (std::uint32_t e = l.begin[i]; e < l.begin[i + 1]; ++e) {
+        const int bi = block(i), bj = block(static_cast<int>(l.j[e]));
+        if (bi == bj) w[bi] += 1.0;
+        else w[bi] += 0.55, w[bj] += 0.85;
+      }
+    return w;
+  };
+  for (int B : {2, 3, 4}) {
+    SCOPED_TRACE(B);
+    std::vector<int> cut;
+    sphc::tile_block_cuts(l, B, cut);
+    ASSERT_EQ(cut.size(), static_cast<std::size_t>(B) + 1);
+    EXPECT_EQ(cut.front(), 0);
+    EXPECT_EQ(cut.back(), nc);
+    for (int k = 0; k < B; ++k) EXPECT_LT(cut[k], cut[k + 1]);
+    const std::vector<double> w = work(cut);
+    double mean = 0;
+    for (double v : w) mean += v / B;
+    for (double v : w) EXPECT_NEAR(v, mean, 0.02 * mean);
+    // The cuts by pairs (stop 38-40's printed blocks).
+    std::vector<int> by_pairs(B + 1, nc);
+    by_pairs[0] = 0;
+    for (int k = 1; k < B; ++k)
+      by_pairs[k] = static_cast<int>(std::lower_bound(l.begin.begin(), l.begin.end() - 1,
+                                                      static_cast<std::uint32_t>(static_cast<std::uint64_t>(l.pairs()) * k / B)) - l.begin.begin());
+    const std::vector<double> wp = work(by_pairs);
+    EXPECT_LE(*std::max_element(w.begin(), w.end()), *std::max_element(wp.begin(), wp.end()));
+  }
+}

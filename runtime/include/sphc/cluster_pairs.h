@@ -253,4 +253,13 @@ void prune_cluster_pairs(const ClusterLayout& a, const ClusterLayout& b,
                          const ClusterPairList& outer, double radius, ClusterPairList& out,
                          bool parallel = true);
 
+// The OpenMP tiles' blocks (codegen/ClusterPairs.cpp; stop 41): cut[0..blocks] cuts the
+// i-clusters of `list` (a once list) into `blocks` contiguous blocks [cut[k], cut[k + 1]) of
+// about the same work, counting a tile whose j-cluster lies in a later block as the two half
+// tiles the blocks compute (an i-side half in its i's block, a j-side half in its j's block,
+// each weighed by its measured cost against a whole tile). Any cuts give the same sums (the
+// tiles' OpenMP scheme), so this only balances the threads. blocks is clamped to
+// [1, n_clusters] (1 with no clusters).
+void tile_block_cuts(const ClusterPairList& list, int blocks, std::vector<int>& cut);
+
 }  // namespace sphc

@@ -140,6 +140,51 @@ TEST_F(ClusterPairsOmp, LargeLayoutsOfAnyThreadCountEqualOneThreads) {
       EXPECT_EQ(l.real_mask, one.real_mask);
       EXPECT_EQ(l.column_begin, one.column_begin);
       EXPECT_EQ(l.box, one.box);
+      EXPECT_EQ(l.origin[0], one.origin[0]);
+      EXPECT_EQ(l.origin[1], one.origin[1]);
+      EXPECT_EQ(l.columns[0], one.columns[0]);
+      EXPECT_EQ(l.columns[1], one.columns[1]);
+    }
+  }
+}
+
+// Stop 41: the rebuild path of the tiles' slot order in parallel (the extent, the counting
+// sort into columns, cluster_order's slots without boxes, the in-order layout's slots): the
+// same order and layouts as one thread's, with a NaN coordinate and ties in the sort key.
+TEST_F(ClusterPairsOmp, ClusterOrderAndInOrderLayoutsOfAnyThreadCountEqualOneThreads) {
+  for (int dim : {2, 3}) {
+    SCOPED_TRACE(dim);
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const std::size_t n = 40001;
+    std::vector<double> x(n), y(n), z(n);
+    for (std::size_t i = 0; i < n; ++i) x[i] = u(rng), y[i] = u(rng), z[i] = dim == 3 ? u(rng) : 0.0;
+    for (std::size_t i = 0; i < n; i += 89) (dim == 3 ? z : y)[i] = 0.25;
+    x[n / 3] = std::nan("");
+    auto run = [&](int t, std::vector<std::uint32_t>& order, sphc::ClusterLayout& in) {
+      omp_set_num_threads(t);
+      sphc::cluster_order(order, x.data(), y.data(), z.data(), n, dim, 0.0, sphc::kClusterSize);
+      std::vector<double> px(n), py(n), pz(n);
+      for (std::size_t i = 0; i < n; ++i) px[i] = x[order[i]], py[i] = y[order[i]], pz[i] = z[order[i]];
+      sphc::build_cluster_layout_in_order(in, px.data(), py.data(), pz.data(), n, dim, 0.0, sphc::kClusterSize);
+    };
+    std::vector<std::uint32_t> order1;
+    sphc::ClusterLayout in1;
+    run(1, order1, in1);
+    for (int t = 2; t <= 4; ++t) {
+      SCOPED_TRACE(t);
+      std::vector<std::uint32_t> order;
+      sphc::ClusterLayout in;
+      run(t, order, in);
+      EXPECT_EQ(order, order1);
+      EXPECT_EQ(in.slot, in1.slot);
+      EXPECT_EQ(in.slot_of, in1.slot_of);
+      EXPECT_EQ(in.box, in1.box);
+      EXPECT_EQ(in.column_begin, in1.column_begin);
+      EXPECT_EQ(in.column_cluster, in1.column_cluster);
+      EXPECT_EQ(in.origin[0], in1.origin[0]);
+      EXPECT_EQ(in.origin[1], in1.origin[1]);
+      EXPECT_EQ(in.column_side, in1.column_side);
     }
   }
 }
