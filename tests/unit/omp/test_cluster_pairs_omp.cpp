@@ -115,18 +115,28 @@ TEST_F(ClusterPairsOmp, ListsOfAnyThreadCountEqualOneThreads) {
   }
 }
 
+// n random particles in the unit square (2D) or cube (3D), with ties in the layouts' sort
+// key (every tie_every-th particle at the height tie).
+struct Cloud {
+  std::vector<double> x, y, z;
+};
+Cloud random_cloud(int dim, std::size_t n, unsigned seed, std::size_t tie_every, double tie) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Cloud c{std::vector<double>(n), std::vector<double>(n), std::vector<double>(n)};
+  for (std::size_t i = 0; i < n; ++i) c.x[i] = u(rng), c.y[i] = u(rng), c.z[i] = dim == 3 ? u(rng) : 0.0;
+  for (std::size_t i = 0; i < n; i += tie_every) (dim == 3 ? c.z : c.y)[i] = tie;
+  return c;
+}
+
 // Stop 39: the layout's columns sorted and cut into slots in parallel (from 10,000
 // particles): the same layout as one thread's, boxes included.
 TEST_F(ClusterPairsOmp, LargeLayoutsOfAnyThreadCountEqualOneThreads) {
   for (int dim : {2, 3}) {
     SCOPED_TRACE(dim);
-    std::mt19937_64 rng(9);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
     const std::size_t n = 30000;
-    std::vector<double> x(n), y(n), z(n);
-    for (std::size_t i = 0; i < n; ++i) x[i] = u(rng), y[i] = u(rng), z[i] = dim == 3 ? u(rng) : 0.0;
-    // ties in the sort key: a few particles at one height
-    for (std::size_t i = 0; i < n; i += 97) (dim == 3 ? z : y)[i] = 0.5;
+    Cloud c = random_cloud(dim, n, 9, 97, 0.5);
+    std::vector<double>&x = c.x, &y = c.y, &z = c.z;
     omp_set_num_threads(1);
     sphc::ClusterLayout one;
     sphc::build_cluster_layout(one, x.data(), y.data(), z.data(), n, dim, 0.0);
@@ -154,12 +164,9 @@ TEST_F(ClusterPairsOmp, LargeLayoutsOfAnyThreadCountEqualOneThreads) {
 TEST_F(ClusterPairsOmp, ClusterOrderAndInOrderLayoutsOfAnyThreadCountEqualOneThreads) {
   for (int dim : {2, 3}) {
     SCOPED_TRACE(dim);
-    std::mt19937_64 rng(11);
-    std::uniform_real_distribution<double> u(0.0, 1.0);
     const std::size_t n = 40001;
-    std::vector<double> x(n), y(n), z(n);
-    for (std::size_t i = 0; i < n; ++i) x[i] = u(rng), y[i] = u(rng), z[i] = dim == 3 ? u(rng) : 0.0;
-    for (std::size_t i = 0; i < n; i += 89) (dim == 3 ? z : y)[i] = 0.25;
+    Cloud c = random_cloud(dim, n, 11, 89, 0.25);
+    std::vector<double>&x = c.x, &y = c.y, &z = c.z;
     x[n / 3] = std::nan("");
     auto run = [&](int t, std::vector<std::uint32_t>& order, sphc::ClusterLayout& in) {
       omp_set_num_threads(t);
