@@ -61,6 +61,10 @@
 #include <cstring>
 #include <vector>
 
+#if defined(__AVX512F__)
+#include <immintrin.h>  // tile_row_any
+#endif
+
 namespace sphc {
 
 // The default width of a cluster: one AVX-512 register of doubles (the j-cluster of a tile).
@@ -165,6 +169,42 @@ inline void load_doubled4(double* t, const double* p) {
   for (int k = 0; k < 4; ++k) t[k] = t[4 + k] = p[k];
 #endif
 }
+#if defined(__AVX512F__)
+// The 8 x 8 tiles' row test under AVX-512 (codegen/ClusterPairs.cpp; stop 42, docs/performance-log.md
+// "The 3D tiles' rows (stop 42)"): whether any lane l of a tile row, particle i (xi, yi, zi, hi)
+// against the j-cluster's 8 slots (xj[l], yj[l], zj[l] (Dim 3), hj[l]), is within the cut-off,
+// !(r2 >= radius2 hmax^2) (r2 = dx dx + dy dy (+ dz dz), hmax = hi > hj ? hi : hj, the lanes'
+// operations), among the lanes the tile takes, lane[l] > lane_d (lane_d < 0: all of them): one
+// compare mask tested at once (kortest), where the lanes' own test reduced a double per lane to a
+// branch (a longer chain before it resolves: the branch is data-dependent, ~1.7 of a tile's 8
+// rows have no pair). The row is skipped only where this says no; the lanes keep their own cut-off
+// (in_cut): the test is theirs, the same operations in the same order (sphc compiles with
+// -ffp-contract=off: no fma on either side), so the same rows are skipped and the sums are the
+// same bit for bit. (No margin on radius2: in a lattice such as the cube's many pairs lie at the
+// support's edge to the last bit, and 1 + 1e-12 let ~10% more rows through to lanes all masked.)
+template <int Dim>
+inline __attribute__((always_inline)) bool tile_row_any(double xi, double yi, double zi, double hi,
+                                                        const double* xj, const double* yj,
+                                                        const double* zj, const double* hj,
+                                                        const double* lane, double lane_d,
+                                                        double radius2) {
+  const __m512d dx = _mm512_sub_pd(_mm512_set1_pd(xi), _mm512_loadu_pd(xj));
+  const __m512d dy = _mm512_sub_pd(_mm512_set1_pd(yi), _mm512_loadu_pd(yj));
+  __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+  if constexpr (Dim == 3) {
+    const __m512d dz = _mm512_sub_pd(_mm512_set1_pd(zi), _mm512_loadu_pd(zj));
+    r2 = _mm512_add_pd(r2, _mm512_mul_pd(dz, dz));
+  } else {
+    (void)zi;
+    (void)zj;
+  }
+  const __m512d hm = _mm512_max_pd(_mm512_set1_pd(hi), _mm512_loadu_pd(hj));  // hi > hj ? hi : hj
+  const __m512d lim = _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(radius2), hm), hm);
+  const __mmask8 in = _mm512_cmp_pd_mask(r2, lim, _CMP_NGE_UQ) &  // !(r2 >= lim), the lanes' form
+                      _mm512_cmp_pd_mask(_mm512_loadu_pd(lane), _mm512_set1_pd(lane_d), _CMP_GT_OQ);
+  return in != 0;
+}
+#endif
 // In order, per evaluation: the padded cluster's values, dst[k][l] = src[k][width t + l]
 // for its real lanes l, its first particle's value for the padding (dst: width values
 // each; nothing where every cluster is full).
