@@ -209,6 +209,12 @@ static cl::opt<bool> Cluster2d8x8(
              "per register (stops 37-38), not GROMACS' 2xMM form of 4 x 4 cluster pairs in "
              "registers of 2 i's x 4 j's (stop 39; a measurement knob)"),
     cl::init(false), cl::Hidden, cl::cat(SphcCat));
+static cl::opt<bool> Cluster3d2xmm(
+    "cluster-3d-2xmm",
+    cl::desc("The 3D cluster-pair tiles (--simd-pairs=cluster or auto's) in GROMACS' 2xMM form, "
+             "4-clusters (columns of 2 spacings: 2 x 2 x 1 lattice cells) in registers of 2 i's x "
+             "4 j's, as the 2D tiles (stop 42; a measurement knob), not 8 x 8 tiles"),
+    cl::init(false), cl::Hidden, cl::cat(SphcCat));
 static cl::opt<bool> Cluster2dDoubled(
     "cluster-2d-doubled",
     cl::desc("The 2D cluster-pair tiles (2xMM) in slot order read their j side from copies "
@@ -683,6 +689,7 @@ int main(int argc, char** argv) {
   emitOpts.simdPairsCluster = simdMode == "cluster";
   emitOpts.cluster2d8x8 = Cluster2d8x8;
   emitOpts.cluster2dDoubled = Cluster2dDoubled;
+  emitOpts.cluster3d2xmm = Cluster3d2xmm;
   emitOpts.clusterSlotOrder = !NoSlotOrder;
   emitOpts.tileMathRecip = TileMathOpt == TileMath::Recip;
   emitOpts.simdAutoNeighbours = SimdNeighbours;
