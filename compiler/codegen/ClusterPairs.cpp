@@ -46,6 +46,11 @@
 //     i (4 lanes each) once per i-cluster; j's per tile, the two halves folded (lanes l and
 //     l + 4: j l) onto the slot sums.
 // The same OpenMP blocks and half tiles as the 8 x 8 form (bitwise the serial tiles).
+// 3D (stop 42; docs/performance-log.md "3D tiles in the 2xMM form (stop 42)"): the same 2xMM
+// form where clusterTiles2xMM() says so (--simd-pairs=auto on the CPUs SimdCpuVerdict::
+// tiles3d2xmm names, or --cluster-3d-2xmm; --cluster-3d-8x8 keeps the 8 x 8 tiles): the
+// column side 2 spacings from the spacing cbrt(mean m / rho), so the 4-clusters are mostly 2 x 2
+// x 1 lattice cells; every other piece is printed per dimension as in 2D.
 // Slot order (stop 40; docs/performance-log.md "Particles in the tiles' slot order (stop 40)";
 // --no-slot-order keeps the copies above): where clusterSlotOrder() allows it the array is
 // kept in the tiles' order (update_neighbours permutes it into sphc::cluster_order where the
@@ -270,8 +275,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   const int d = w.array;
   const std::string R = "double";
   const bool selfPair = !skipsSelfPair(pass);
-  // 2D (stop 39): GROMACS' 2xMM form, layouts of width 4, a register = 2 i's x the 4 j's
-  // (see the top of this file); 3D (and 2D with --cluster-2d-8x8): 8 x 8 tiles.
+  // 2D (stop 39; 3D where clusterTiles2xMM(), stop 42): GROMACS' 2xMM form, layouts of
+  // width 4, a register = 2 i's x the 4 j's (see the top of this file); else 8 x 8 tiles.
   const bool mm = clusterTiles2xMM();
   // Stop 40: the array kept in the tiles' slot order (update_neighbours permutes it where the
   // lists are due; the layout in that order: slot s = particle s, the last cluster padded):
