@@ -35,7 +35,7 @@ For each scene (the 3D cube and the 2D dam break by default):
                    time those bytes take at the measured bandwidth.
 
 Usage: python3 bench/roofline.py [--scenes cube,dambreak2d] [--sphc build/bin/sphc] [--keep]
-                                  [--count-flags=--simd-pairs=off]
+                                  [--count-flags=--simd-pairs=off] [--time-flags=OPTS]
 Needs valgrind, objdump (binutils), perf (linux-perf; without it the callgrind instruction
 share stands in for the time share), scipy, h5py.
 """
@@ -197,6 +197,10 @@ def main():
                     "arithmetic per pair, where the default counts every executed lane "
                     "(a SIMD loop's masked tail lanes included); the timed build is the "
                     "default either way")
+    ap.add_argument("--time-flags", default="",
+                    help="sphc options of the timed (native) build only, e.g. "
+                    "'--cluster-3d-2xmm' (stop 42): another form's loop time over the same "
+                    "counted flops")
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix="sphc-roofline-")
     env = dict(os.environ)
@@ -242,7 +246,7 @@ def main():
             ipp = d_ins / pairs_small
             # Timed run: default (native) build at the benchmark size, perf for the share.
             print("%s: timing %d steps (perf record) ..." % (scene, tsteps), flush=True)
-            nexe = pair_rate.build(args.sphc, scene, tmp)
+            nexe = pair_rate.build(args.sphc, scene, tmp, sphc_opts=args.time_flags.split())
             tout = os.path.join(tmp, scene + "-timed")
             e = dict(env, OMP_NUM_THREADS="1")
             short = re.search(r"group_\w+", loop_fn).group(0)

@@ -46,6 +46,11 @@
 //     i (4 lanes each) once per i-cluster; j's per tile, the two halves folded (lanes l and
 //     l + 4: j l) onto the slot sums.
 // The same OpenMP blocks and half tiles as the 8 x 8 form (bitwise the serial tiles).
+// 3D (stop 42; docs/performance-log.md "3D tiles in the 2xMM form (stop 42)"): the same 2xMM
+// form where clusterTiles2xMM() says so (--simd-pairs=auto on the CPUs SimdCpuVerdict::
+// tiles3d2xmm names, or --cluster-3d-2xmm; --cluster-3d-8x8 keeps the 8 x 8 tiles): the
+// column side 2 spacings from the spacing cbrt(mean m / rho), so the 4-clusters are mostly 2 x 2
+// x 1 lattice cells; every other piece is printed per dimension as in 2D.
 // Slot order (stop 40; docs/performance-log.md "Particles in the tiles' slot order (stop 40)";
 // --no-slot-order keeps the copies above): where clusterSlotOrder() allows it the array is
 // kept in the tiles' order (update_neighbours permutes it into sphc::cluster_order where the
@@ -226,7 +231,7 @@ void ScenePrinter::emitClusterSlotOrder(const DestinationWork& w, const std::str
                                         const std::string& ind) {
   const int d = w.array;
   const std::string A = arr(d).name;
-  const bool mm = plan_.dim == 2 && !cluster2d8x8_;
+  const bool mm = clusterTiles2xMM();
   auto plainDouble = [&](const std::string& p) {
     const PlanProperty* prop = arr(d).find(p);
     return prop && prop->stride == 1 && propIndex(d, p) >= 0 && hostType(d, p) == "double";
@@ -246,8 +251,11 @@ void ScenePrinter::emitClusterSlotOrder(const DestinationWork& w, const std::str
     scene_ << in << "  double cl_vol = 0.0;\n";
     scene_ << in << "  for (std::size_t i = 0; i < " << A << ".n; ++i) cl_vol += cl_vm[i] / cl_vrho[i];\n";
     scene_ << in << "  cl_vol /= static_cast<double>(" << A << ".n);\n";
-    scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::sqrt(cl_vol), DIM, "
-           << (mm ? "sphc::kClusterSize / 2" : "sphc::kClusterSize") << ");\n";
+    // (3D, stop 42: the spacing's cube root, columns of 2 spacings as the 8-clusters': the
+    // 4-clusters 2 x 2 x 1 lattice cells; spacing 4^(1/3) would give 1 x 1 x 4 and 2 x 1 x 2.)
+    scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side("
+           << (plan_.dim == 3 ? "std::cbrt(cl_vol), DIM, sphc::kClusterSize" : "std::sqrt(cl_vol), DIM, sphc::kClusterSize / 2")
+           << ");\n";
     scene_ << in << "}\n";
   }
   scene_ << in << "sphc::cluster_order(" << state << "_order, " << hostPtr(d, "x") << ", " << hostPtr(d, "y") << ", "
@@ -267,9 +275,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   const int d = w.array;
   const std::string R = "double";
   const bool selfPair = !skipsSelfPair(pass);
-  // 2D (stop 39): GROMACS' 2xMM form, layouts of width 4, a register = 2 i's x the 4 j's
-  // (see the top of this file); 3D (and 2D with --cluster-2d-8x8): 8 x 8 tiles.
-  const bool mm = plan_.dim == 2 && !cluster2d8x8_;
+  // 2D (stop 39; 3D where clusterTiles2xMM(), stop 42): GROMACS' 2xMM form, layouts of
+  // width 4, a register = 2 i's x the 4 j's (see the top of this file); else 8 x 8 tiles.
+  const bool mm = clusterTiles2xMM();
   // Stop 40: the array kept in the tiles' slot order (update_neighbours permutes it where the
   // lists are due; the layout in that order: slot s = particle s, the last cluster padded):
   // the tiles read and write the particles' arrays (2xMM: the doubled copies stay, now
@@ -456,14 +464,19 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   };
   if (mm && plainDouble("m") && plainDouble("rho")) {
     side = "cl_side";
-    scene_ << in << "double cl_side = 0.0;  // the column side: the spacing sqrt(mean m / rho) x 2 (2xMM)\n";
+    scene_ << in << "double cl_side = 0.0;  // the column side: the spacing "
+           << (plan_.dim == 3 ? "cbrt" : "sqrt") << "(mean m / rho) x 2 (2xMM)\n";
     scene_ << in << "if (verlet_build && n > 0) {\n";
     scene_ << in << "  const double* const cl_vm = " << hostPtr(d, "m") << ";\n";
     scene_ << in << "  const double* const cl_vrho = " << hostPtr(d, "rho") << ";\n";
     scene_ << in << "  double cl_vol = 0.0;\n";
     scene_ << in << "  for (int i = 0; i < n; ++i) cl_vol += cl_vm[i] / cl_vrho[i];\n";
     scene_ << in << "  cl_vol /= n;\n";
-    scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::sqrt(cl_vol), DIM, CL_W);\n";
+    // (3D, stop 42: 2 spacings, the 4-clusters 2 x 2 x 1 lattice cells; see emitClusterSlotOrder.)
+    if (plan_.dim == 3)
+      scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::cbrt(cl_vol), DIM, CL_LANES);\n";
+    else
+      scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::sqrt(cl_vol), DIM, CL_W);\n";
     scene_ << in << "}\n";
   }
   scene_ << in << "if (verlet_build) sphc::" << (inOrder ? "build_cluster_layout_in_order" : "build_cluster_layout")

@@ -149,6 +149,10 @@ struct EmitOptions {
   // read their j side from per-evaluation copies doubled per cluster (stops 39-40) instead of
   // the particles' arrays (codegen/ClusterPairs.cpp).
   bool cluster2dDoubled = false;
+  // The 3D tiles in the 2xMM form (4-clusters, registers of 2 i's x 4 j's) as the 2D tiles,
+  // not 8 x 8 (stop 42): --cluster-3d-2xmm (hidden), or --simd-pairs=auto where
+  // SimdCpuVerdict::tiles3d2xmm; --cluster-3d-8x8 (hidden) clears it.
+  bool cluster3d2xmm = false;
   // --no-slot-order (hidden, a measurement knob; stop 40): false keeps the tiles' slot-order
   // copies and add-backs; true (the default) keeps the particles in the tiles' slot order.
   bool clusterSlotOrder = true;

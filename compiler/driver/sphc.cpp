@@ -209,6 +209,19 @@ static cl::opt<bool> Cluster2d8x8(
              "per register (stops 37-38), not GROMACS' 2xMM form of 4 x 4 cluster pairs in "
              "registers of 2 i's x 4 j's (stop 39; a measurement knob)"),
     cl::init(false), cl::Hidden, cl::cat(SphcCat));
+static cl::opt<bool> Cluster3d2xmm(
+    "cluster-3d-2xmm",
+    cl::desc("The 3D cluster-pair tiles of --simd-pairs=cluster in GROMACS' 2xMM form, "
+             "4-clusters (columns of 2 spacings: 2 x 2 x 1 lattice cells) in registers of 2 i's x "
+             "4 j's, as the 2D tiles (stop 42; --simd-pairs=auto's 3D tiles are in that form "
+             "where the CPU's model was measured for it), not 8 x 8 tiles"),
+    cl::init(false), cl::Hidden, cl::cat(SphcCat));
+static cl::opt<bool> Cluster3d8x8(
+    "cluster-3d-8x8",
+    cl::desc("The 3D cluster-pair tiles as 8 x 8 tiles of one i x 8 j's per register (stops "
+             "37-41), not the 2xMM form that --simd-pairs=auto takes on some CPUs (stop 42; a "
+             "measurement knob)"),
+    cl::init(false), cl::Hidden, cl::cat(SphcCat));
 static cl::opt<bool> Cluster2dDoubled(
     "cluster-2d-doubled",
     cl::desc("The 2D cluster-pair tiles (2xMM) in slot order read their j side from copies "
@@ -683,6 +696,7 @@ int main(int argc, char** argv) {
   emitOpts.simdPairsCluster = simdMode == "cluster";
   emitOpts.cluster2d8x8 = Cluster2d8x8;
   emitOpts.cluster2dDoubled = Cluster2dDoubled;
+  emitOpts.cluster3d2xmm = Cluster3d2xmm;
   emitOpts.clusterSlotOrder = !NoSlotOrder;
   emitOpts.tileMathRecip = TileMathOpt == TileMath::Recip;
   emitOpts.simdAutoNeighbours = SimdNeighbours;
@@ -716,7 +730,10 @@ int main(int argc, char** argv) {
       emitOpts.simdPairsCluster = true;
       emitOpts.simdPairsClusterAuto = true;
       emitOpts.simdPairsClusterAuto2d = emitOpts.simdCpu.tiles2d;  // (stop 41) the 2D loops too
+      // (stop 42) the 3D tiles in the 2xMM form where measured so
+      emitOpts.cluster3d2xmm = emitOpts.cluster3d2xmm || emitOpts.simdCpu.tiles3d2xmm;
     }
+    if (Cluster3d8x8) emitOpts.cluster3d2xmm = false;
     if (Verbose && emitOpts.simdPairsAuto && emitOpts.simdPairs &&
         Backend != sphc::Backend::OpenCL && !Mpi)  // the CPU backends' lanes
       llvm::errs() << "sphc: --simd-pairs=auto: " << emitOpts.simdCpu.why
