@@ -884,7 +884,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << "#else\n";
     }
     scene_ << c3 << "double any = 0.0;\n";
-    scene_ << c3 << (mm ? "#pragma omp simd reduction(+: any)\n" : "#pragma omp simd reduction(max: any)  // (a tree: + adds the lanes in a chain)\n");
+    scene_ << c3 << "#pragma omp simd reduction(max: any)  // (a tree: + adds the lanes in a chain)\n";
     scene_ << c3 << "for (int s_idx = 0; s_idx < " << L << "; ++s_idx) {\n";
     {
       const std::string b = c3 + "  ";
@@ -903,12 +903,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << b << "const double hmax = hi > hj ? hi : hj;\n";
       const std::string in = side == Side::Both ? "!(R2IJ >= RADIUS2 * hmax * hmax) & (" + jl + " > " + il + "lane_d)"
                                                 : "!(R2IJ >= RADIUS2 * hmax * hmax)";
-      if (mm) {
-        scene_ << b << "any += " << in << " ? 1.0 : 0.0;\n";
-      } else {
-        scene_ << b << "const double in_l = " << in << " ? 1.0 : 0.0;\n";
-        scene_ << b << "any = any > in_l ? any : in_l;\n";
-      }
+      scene_ << b << "const double in_l = " << in << " ? 1.0 : 0.0;\n";
+      scene_ << b << "any = any > in_l ? any : in_l;\n";
     }
     scene_ << c3 << "}\n";
     scene_ << c3 << "if (!(any > 0.0)) continue;  // no pair of the " << (mm ? "register" : "row") << " within the support\n";

@@ -22,8 +22,8 @@
 // under OpenMP (stop 38)") for auto's 3D loops each pair once in lanes: on the Intel models of
 // the lanes (measured on Emerald Rapids: the cube, the 3D dam break and the DualSPHysics
 // scene, serial and OpenMP); not on AMD (not measured: the lanes).
-// Since stop 42 those 3D tiles in GROMACS' 2xMM form (SimdCpuVerdict::tiles3d2xmm; measured on
-// Emerald Rapids: the cube and the DualSPHysics scene).
+// Stop 42 measured those 3D tiles in GROMACS' 2xMM form too (SimdCpuVerdict::tiles3d2xmm): no
+// better than the 8 x 8 tiles with their row test as one mask, so auto keeps 8 x 8.
 #include "codegen/SimdCpu.h"
 
 #include <cstdio>
@@ -123,12 +123,14 @@ SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu) {
     v.tiles2d = false;
     // 3D (stop 42): the 2xMM form (the 2D tiles' 4-clusters, here 2 x 2 x 1 lattice cells, 2
     // i's x 4 j's per register) took 0.89x of the 8 x 8 tiles' loop CPU on the cube and
-    // 0.87x on the DualSPHysics scene (their lists' pruning 2.5-3x, the whole step 0.93-0.95x;
-    // dambreak3d at h = 1.3 dx 1.01x), measured on model 207 (docs/performance-log.md, "3D
-    // tiles in the 2xMM form (stop 42)"); --cluster-3d-8x8 keeps the 8 x 8 tiles.
-    v.tiles3d2xmm = true;
+    // 0.87x on the DualSPHysics scene against stop 41's 8 x 8 rows, but with the 8 x 8 rows'
+    // test as one compare mask (stop 42) the 8 x 8 tiles' loop is as fast on the cube and
+    // 0.985-0.99x of the 2xMM form's on the DualSPHysics scene and dambreak3d (measured on
+    // model 207; docs/performance-log.md, "3D tiles in the 2xMM form (stop 42)"): auto keeps
+    // 8 x 8; --cluster-3d-2xmm names the 2xMM form.
+    v.tiles3d2xmm = false;
     v.tilesWhy = "on " + cpu.describe() +
-                 " the cluster-pair tiles pay in 3D (serial and OpenMP; stop 38; 2xMM: stop 42)" +
+                 " the cluster-pair tiles pay in 3D (serial and OpenMP; stop 38)" +
                  (v.tiles2d ? std::string(" and in 2D (stop 41)") : std::string());
   } else if (cpu.vendor == "GenuineIntel") {
     v.lanes = false;

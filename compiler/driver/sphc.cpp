@@ -213,14 +213,15 @@ static cl::opt<bool> Cluster3d2xmm(
     "cluster-3d-2xmm",
     cl::desc("The 3D cluster-pair tiles of --simd-pairs=cluster in GROMACS' 2xMM form, "
              "4-clusters (columns of 2 spacings: 2 x 2 x 1 lattice cells) in registers of 2 i's x "
-             "4 j's, as the 2D tiles (stop 42; --simd-pairs=auto's 3D tiles are in that form "
-             "where the CPU's model was measured for it), not 8 x 8 tiles"),
+             "4 j's, as the 2D tiles (stop 42; with --simd-pairs=auto too), not 8 x 8 tiles: "
+             "measured no faster than the 8 x 8 tiles on the cube, slower on the DualSPHysics "
+             "scene and dambreak3d (a measurement knob)"),
     cl::init(false), cl::Hidden, cl::cat(SphcCat));
 static cl::opt<bool> Cluster3d8x8(
     "cluster-3d-8x8",
     cl::desc("The 3D cluster-pair tiles as 8 x 8 tiles of one i x 8 j's per register (stops "
-             "37-41), not the 2xMM form that --simd-pairs=auto takes on some CPUs (stop 42; a "
-             "measurement knob)"),
+             "37-42), not the 2xMM form that --simd-pairs=auto would take on a CPU measured for "
+             "it (none is: stop 42; a measurement knob)"),
     cl::init(false), cl::Hidden, cl::cat(SphcCat));
 static cl::opt<bool> Cluster2dDoubled(
     "cluster-2d-doubled",
