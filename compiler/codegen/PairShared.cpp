@@ -188,14 +188,22 @@ void ScenePrinter::printPairShared(const PlanBody& b, const std::string& name, i
          << "\n";
     const std::string fn = name + "_pairshared" + K(k) + (simd ? "_simd" : "");
     os << d.functionPrefix << (single ? "auto" : d.real) << " " << fn << "(" << params << ") {\n";
-    if (guarded)  // the body reads the value only where the condition holds
-      os << "  if (!(" << guard << ")) return " << inDialect("0.0") << ";\n";
+    // The body reads the value only where the condition holds: tested first; in the lanes'
+    // form (simd) a select after the value instead, no branch in the lanes (the value where
+    // the condition fails, an infinity of a division by 0 perhaps, is dropped).
+    if (guarded && !simd)
+      os << "  if (!(" << guard << (endStatement(guard) == ";" ? "" : "\n") << ")) return "
+         << inDialect("0.0") << ";\n";
     for (const auto& l : s.locals) {
       std::string init = inDialect(fusedRange(text, facts, l.initBegin, l.initEnd, d.fma));
       os << "  const " << inDialect(l.type) << " " << l.name << " = " << init
          << endStatement(init) << "\n";
     }
-    if (s.result.empty()) {
+    if (s.result.empty() && guarded && simd) {
+      const auto close = [](const std::string& e) { return endStatement(e) == ";" ? "" : "\n"; };
+      os << "  return (" << guard << close(guard) << ") ? (" << value << close(value) << ") : "
+         << inDialect("0.0") << ";\n}\n";
+    } else if (s.result.empty()) {
       os << "  return " << value << endStatement(value) << "\n}\n";
     } else {
       os << "  " << inDialect("double") << " " << s.result << " = " << value
