@@ -485,6 +485,7 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
     if (!rangeOf_(e, site.begin, site.end)) return false;
     if (!addLocals(e, site)) return false;
     if (underGuard) {
+      if (!laneCallsOnly(e)) return false;
       if (!guard_ || !rangeOf_(guard_, site.guardBegin, site.guardEnd)) return false;
       if (!addLocals(guard_, site)) return false;  // none (guardable): its scalars, t, dt
     }
@@ -499,6 +500,27 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
     Canon c0 = condition(i->getCond(), false), c1 = condition(i->getCond(), true);
     if (!c0.ok || !c1.ok || c0.s != c1.s) return false;
     return !readsLocal(i->getCond());
+  }
+
+  // Whether the expression (through its locals' initial values) calls no function but
+  // sqrt, fabs, fma, fmin, fmax and the kernel's (KERNEL_*): a guarded site computes its calls
+  // outside the body's branch, where the SIMD pair loops would refuse a call such as pow or
+  // exp (codegen/SimdPairs.cpp, rareCallsRefusal: they take it only in a branch), so such a
+  // value stays in the calls and the loops' choice stays what it was.
+  bool laneCallsOnly(const clang::Stmt* s) {
+    if (auto* call = llvm::dyn_cast<clang::CallExpr>(s)) {
+      const clang::FunctionDecl* fn = call->getDirectCallee();
+      const std::string name = fn ? fn->getName().str() : "";
+      static const std::set<std::string> ok = {"sqrt", "fabs", "fma", "fmin", "fmax"};
+      if (!ok.count(name) && name.rfind("KERNEL_", 0) != 0) return false;
+    }
+    if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(s))
+      if (auto* v = llvm::dyn_cast<clang::VarDecl>(ref->getDecl());
+          v && !llvm::isa<clang::ParmVarDecl>(v) && v->getInit() && !laneCallsOnly(v->getInit()))
+        return false;
+    for (const clang::Stmt* c : s->children())
+      if (c && !laneCallsOnly(c)) return false;
+    return true;
   }
 
   static bool readsLocal(const clang::Stmt* s) {
