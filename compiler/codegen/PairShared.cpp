@@ -190,8 +190,11 @@ void ScenePrinter::printPairShared(const PlanBody& b, const std::string& name, i
     os << d.functionPrefix << (single ? "auto" : d.real) << " " << fn << "(" << params << ") {\n";
     // The body reads the value only where the condition holds: tested first; in the lanes'
     // form (simd) a select after the value instead, no branch in the lanes (the value where
-    // the condition fails, an infinity of a division by 0 perhaps, is dropped).
-    if (guarded && !simd)
+    // the condition fails, an infinity of a division by 0 perhaps, is dropped); in single
+    // precision too, with the int 0, so that the function's `auto` is the value's own type
+    // (float, or double where the value is, e.g. a kernel function's).
+    const bool select = guarded && (simd || single);
+    if (guarded && !select)
       os << "  if (!(" << guard << (endStatement(guard) == ";" ? "" : "\n") << ")) return "
          << inDialect("0.0") << ";\n";
     for (const auto& l : s.locals) {
@@ -199,10 +202,10 @@ void ScenePrinter::printPairShared(const PlanBody& b, const std::string& name, i
       os << "  const " << inDialect(l.type) << " " << l.name << " = " << init
          << endStatement(init) << "\n";
     }
-    if (s.result.empty() && guarded && simd) {
+    if (s.result.empty() && select) {
       const auto close = [](const std::string& e) { return endStatement(e) == ";" ? "" : "\n"; };
       os << "  return (" << guard << close(guard) << ") ? (" << value << close(value) << ") : "
-         << inDialect("0.0") << ";\n}\n";
+         << (single ? "0" : "0.0") << ";\n}\n";
     } else if (s.result.empty()) {
       os << "  return " << value << endStatement(value) << "\n}\n";
     } else {
