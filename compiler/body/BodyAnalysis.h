@@ -129,6 +129,11 @@ struct SourceOnlySite {
   int sign = 1;
   std::string result;
   unsigned stmtBegin = 0, stmtEnd = 0;
+  // BodyFacts::pairShared only: a value that divides or calls a function inside a top-level
+  // `if` whose condition is the same both ways: text[guardBegin, guardEnd) is that condition
+  // (it reads no local), and the value is computed only where it holds (0 elsewhere, where
+  // the body does not read it).
+  unsigned guardBegin = 0, guardEnd = 0;
   int id = 0;
 };
 

@@ -27,8 +27,14 @@
 // every pair is what the body does); (2) an `if` without else at the body's top level whose
 // condition is the same both ways and whose block only declares locals and assigns symmetric
 // values to one local declared before it with a symmetric initial value (the viscosity's
-// piij): the value of that local after the `if`. Properties of the pair are recorded through
-// the sites; the printer keeps only sites whose properties no pair loop writes.
+// piij): the value of that local after the `if`; (3) in the block of an `if` without else
+// at the body's top level whose condition is the same both ways and reads no local
+// (FourtakasDensityDiffusion's `if (R2IJ > 0.0)`), outside any conditional or loop nested in
+// it, also expressions that divide or call a function: the site records the condition
+// (guardBegin, guardEnd) and its value is computed only where the condition holds, where the
+// body reads it (so such a division is done once per pair, as the body would do it in each
+// call). Properties of the pair are recorded through the sites (the condition's too); the
+// printer keeps only sites whose properties no pair loop writes.
 #include "body/BodyBatch.h"
 
 #include "clang/AST/ASTContext.h"
@@ -70,7 +76,16 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
     if (!top) return {};
     zeroSignMatters_ = zeroSignMatters(fn->getBody());
     for (clang::Stmt* s : top->body()) {
-      if (auto* i = llvm::dyn_cast<clang::IfStmt>(s); i && ifSite(i, top)) continue;
+      if (auto* i = llvm::dyn_cast<clang::IfStmt>(s)) {
+        if (ifSite(i, top)) continue;
+        if (guardable(i)) {  // rule (3)
+          walk(i->getCond(), true);
+          guard_ = i->getCond();
+          walk(i->getThen(), true, false, true);
+          guard_ = nullptr;
+          continue;
+        }
+      }
       walk(s, false);
     }
     return std::move(sites_);
@@ -441,29 +456,80 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
   }
 
   // conditional: inside an if or ?: (a site there is computed for every pair: only cheap
-  // ones); loop: inside a loop (none: its locals change).
-  void walk(clang::Stmt* s, bool conditional, bool loop = false) {
+  // ones); loop: inside a loop (none: its locals change); guarded: directly in the block of
+  // rule (3)'s `if` (guard_), where a costly site is computed under its condition.
+  void walk(clang::Stmt* s, bool conditional, bool loop = false, bool guarded = false) {
     if (!s) return;
     if (auto* e = llvm::dyn_cast<clang::Expr>(s); e && !loop) {
       if (e->getType()->isSpecificBuiltinType(clang::BuiltinType::Double) && !e->isLValue() &&
-          operations(e) > 0 && (!conditional || !costly(e))) {
-        if (int sign = shared(e); sign != 0 && record(e, sign)) return;
+          operations(e) > 0 && (!conditional || guarded || !costly(e))) {
+        const bool underGuard = conditional && costly(e);
+        if (int sign = shared(e); sign != 0 && record(e, sign, underGuard)) return;
       }
     }
+    const auto* b = llvm::dyn_cast<clang::BinaryOperator>(s);
+    const bool branch = llvm::isa<clang::IfStmt>(s) || llvm::isa<clang::ConditionalOperator>(s) ||
+                        (b && (b->getOpcode() == clang::BO_LAnd || b->getOpcode() == clang::BO_LOr));
     loop = loop || llvm::isa<clang::ForStmt>(s) || llvm::isa<clang::WhileStmt>(s) ||
            llvm::isa<clang::DoStmt>(s) || llvm::isa<clang::SwitchStmt>(s);
     conditional = conditional || llvm::isa<clang::IfStmt>(s) ||
                   llvm::isa<clang::ConditionalOperator>(s);
-    for (clang::Stmt* c : s->children()) walk(c, conditional, loop);
+    guarded = guarded && !branch && !loop;
+    for (clang::Stmt* c : s->children()) walk(c, conditional, loop, guarded);
   }
 
-  bool record(const clang::Expr* e, int sign) {
+  // underGuard: the site is computed under guard_'s condition (rule (3)).
+  bool record(const clang::Expr* e, int sign, bool underGuard = false) {
     SourceOnlySite site;
     site.sign = sign;
     if (!rangeOf_(e, site.begin, site.end)) return false;
     if (!addLocals(e, site)) return false;
+    if (underGuard) {
+      if (!laneCallsOnly(e)) return false;
+      if (!guard_ || !rangeOf_(guard_, site.guardBegin, site.guardEnd)) return false;
+      if (!addLocals(guard_, site)) return false;  // none (guardable): its scalars, t, dt
+    }
     sites_.push_back(site);
     return true;
+  }
+
+  // Rule (3): `if (cond) { ... }` at the top level, no else, cond the same both ways and
+  // reading no local (the site's function tests it before anything else).
+  bool guardable(const clang::IfStmt* i) {
+    if (i->getElse() || i->getInit() || i->getConditionVariable()) return false;
+    Canon c0 = condition(i->getCond(), false), c1 = condition(i->getCond(), true);
+    if (!c0.ok || !c1.ok || c0.s != c1.s) return false;
+    return !readsLocal(i->getCond());
+  }
+
+  // Whether the expression (through its locals' initial values) calls no function but
+  // sqrt, fabs, fma, fmin, fmax and the kernel's (KERNEL_*): a guarded site computes its calls
+  // outside the body's branch, where the SIMD pair loops would refuse a call such as pow or
+  // exp (codegen/SimdPairs.cpp, rareCallsRefusal: they take it only in a branch), so such a
+  // value stays in the calls and the loops' choice stays what it was.
+  bool laneCallsOnly(const clang::Stmt* s) {
+    if (auto* call = llvm::dyn_cast<clang::CallExpr>(s)) {
+      const clang::FunctionDecl* fn = call->getDirectCallee();
+      const std::string name = fn ? fn->getName().str() : "";
+      static const std::set<std::string> ok = {"sqrt", "fabs", "fma", "fmin", "fmax"};
+      if (!ok.count(name) && name.rfind("KERNEL_", 0) != 0) return false;
+    }
+    if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(s))
+      if (auto* v = llvm::dyn_cast<clang::VarDecl>(ref->getDecl());
+          v && !llvm::isa<clang::ParmVarDecl>(v) && v->getInit() && !laneCallsOnly(v->getInit()))
+        return false;
+    for (const clang::Stmt* c : s->children())
+      if (c && !laneCallsOnly(c)) return false;
+    return true;
+  }
+
+  static bool readsLocal(const clang::Stmt* s) {
+    if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(s))
+      if (auto* v = llvm::dyn_cast<clang::VarDecl>(ref->getDecl()); v && !llvm::isa<clang::ParmVarDecl>(v))
+        return true;
+    for (const clang::Stmt* c : s->children())
+      if (c && readsLocal(c)) return true;
+    return false;
   }
 
   // The locals an expression (or statement) reads, and those their values read, in order of
@@ -569,6 +635,7 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
   std::map<std::pair<const clang::Expr*, bool>, Canon> memo_;
   std::vector<SourceOnlySite> sites_;
   bool zeroSignMatters_ = true;
+  const clang::Expr* guard_ = nullptr;  // rule (3)'s condition while its block is walked
 };
 
 }  // namespace

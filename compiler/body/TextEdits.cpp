@@ -80,6 +80,7 @@ bool applyTextEdits(std::string& text, std::vector<TextEdit> edits, BodyFacts& f
     for (SourceOnlySite s : *list) {
       bool ok = map.moveRange(s.begin, s.end);
       if (s.stmtBegin < s.stmtEnd) ok = ok && map.moveRange(s.stmtBegin, s.stmtEnd);
+      if (s.guardBegin < s.guardEnd) ok = ok && map.moveRange(s.guardBegin, s.guardEnd);
       for (auto& l : s.locals) ok = ok && map.moveRange(l.initBegin, l.initEnd);
       if (ok) kept.push_back(s);
     }

@@ -9,7 +9,10 @@
 //
 //   - after the body's function, one function per site, NAME_loop_pairsharedK, with the
 //     body's parameters but its written d_ properties, returning the site's value (its locals
-//     declared first, as the body declares them; an `if` site runs the `if` on its local);
+//     declared first, as the body declares them; an `if` site runs the `if` on its local; a
+//     site under a symmetric `if`'s condition, a division or call in `if (R2IJ > 0.0) {...}`,
+//     returns 0 where the condition fails, before computing anything: the body reads the
+//     value only where it holds);
 //   - the body takes `double pair_sharedK` and reads it where it had the expression (an `if`
 //     site: `piij = pair_sharedK;` where it had the `if`);
 //   - in a pair loop that calls the body both ways, a local `pshared_eqN_K` computed once per
@@ -45,6 +48,7 @@ bool inside(unsigned b, unsigned e, unsigned begin, unsigned end) { return begin
 std::vector<std::pair<unsigned, unsigned>> siteRanges(const SourceOnlySite& s) {
   std::vector<std::pair<unsigned, unsigned>> r = {{s.begin, s.end}};
   if (s.stmtBegin < s.stmtEnd) r.push_back({s.stmtBegin, s.stmtEnd});
+  if (s.guardBegin < s.guardEnd) r.push_back({s.guardBegin, s.guardEnd});
   for (const auto& l : s.locals) r.push_back({l.initBegin, l.initEnd});
   return r;
 }
@@ -173,19 +177,36 @@ void ScenePrinter::printPairShared(const PlanBody& b, const std::string& name, i
        << ": a value the pair shares, " << (s.sign < 0 ? "negated" : "the same")
        << " for the mirrored pair (once per pair\n// where each pair is evaluated once; "
           "codegen/PairShared.cpp; --pair-shared-values=off: in each call)\n";
+    const bool guarded = s.guardBegin < s.guardEnd;
+    const std::string guard =
+        guarded ? inDialect(fusedRange(text, facts, s.guardBegin, s.guardEnd, d.fma)) : "";
     if (s.result.empty())
-      os << "//   " << oneLine(text.substr(s.begin, s.end - s.begin)) << "\n";
+      os << "//   " << oneLine(text.substr(s.begin, s.end - s.begin))
+         << (guarded ? "   (where " + oneLine(guard) + ")" : "") << "\n";
     else
       os << "//   " << s.result << " after " << oneLine(text.substr(s.stmtBegin, s.stmtEnd - s.stmtBegin))
          << "\n";
     const std::string fn = name + "_pairshared" + K(k) + (simd ? "_simd" : "");
     os << d.functionPrefix << (single ? "auto" : d.real) << " " << fn << "(" << params << ") {\n";
+    // The body reads the value only where the condition holds: tested first; in the lanes'
+    // form (simd) a select after the value instead, no branch in the lanes (the value where
+    // the condition fails, an infinity of a division by 0 perhaps, is dropped); in single
+    // precision too, with the int 0, so that the function's `auto` is the value's own type
+    // (float, or double where the value is, e.g. a kernel function's).
+    const bool select = guarded && (simd || single);
+    if (guarded && !select)
+      os << "  if (!(" << guard << (endStatement(guard) == ";" ? "" : "\n") << ")) return "
+         << inDialect("0.0") << ";\n";
     for (const auto& l : s.locals) {
       std::string init = inDialect(fusedRange(text, facts, l.initBegin, l.initEnd, d.fma));
       os << "  const " << inDialect(l.type) << " " << l.name << " = " << init
          << endStatement(init) << "\n";
     }
-    if (s.result.empty()) {
+    if (s.result.empty() && select) {
+      const auto close = [](const std::string& e) { return endStatement(e) == ";" ? "" : "\n"; };
+      os << "  return (" << guard << close(guard) << ") ? (" << value << close(value) << ") : "
+         << (single ? "0" : "0.0") << ";\n}\n";
+    } else if (s.result.empty()) {
       os << "  return " << value << endStatement(value) << "\n}\n";
     } else {
       os << "  " << inDialect("double") << " " << s.result << " = " << value
