@@ -51,6 +51,12 @@ const std::vector<std::string>& allowedMathFunctions() {
   return names;
 }
 
+bool laneMathFunction(const std::string& name) {
+  static const std::set<std::string> lanes = {"sqrt",  "fabs",  "fmin",  "fmax",    "floor",
+                                              "ceil",  "round", "trunc", "copysign"};
+  return lanes.count(name) > 0;
+}
+
 bool writesStates(BodyKind k) { return k == BodyKind::Converged || k == BodyKind::HostReduce; }
 
 bool isState(const BodySource& b, const std::string& name) {

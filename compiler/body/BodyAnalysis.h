@@ -168,6 +168,12 @@ struct BodyFacts {
 // The identifiers every body may use, besides d_/s_ properties and the scalars it is given
 // (and, in a loop, the pair quantities: pairQuantityNames()).
 const std::vector<std::string>& allowedMathFunctions();
+// Whether GCC vectorises a call of this allowed math function without -ffast-math (no SIMD
+// clone in glibc is needed: sqrt, fabs, fmin, fmax, floor, ceil, round, trunc, copysign).
+// The one list behind both the SIMD pair loops' refusal of the others
+// (codegen/SimdPairs.cpp, scalarMathCall) and the values a pair shares under a guard
+// (body/PairShared.cpp, rule (3)), so the two cannot disagree.
+bool laneMathFunction(const std::string& name);
 // Functions of the scene's smoothing kernel that bodies may call: KERNEL_W(r, h) (the kernel)
 // and KERNEL_DWDR(r, h) (its radial derivative), at any smoothing length h.
 const std::vector<std::string>& kernelFunctions();

@@ -502,17 +502,17 @@ class PairSharedFinder : public clang::RecursiveASTVisitor<PairSharedFinder> {
     return !readsLocal(i->getCond());
   }
 
-  // Whether the expression (through its locals' initial values) calls no function but
-  // sqrt, fabs, fma, fmin, fmax and the kernel's (KERNEL_*): a guarded site computes its calls
-  // outside the body's branch, where the SIMD pair loops would refuse a call such as pow or
-  // exp (codegen/SimdPairs.cpp, rareCallsRefusal: they take it only in a branch), so such a
-  // value stays in the calls and the loops' choice stays what it was.
+  // Whether the expression (through its locals' initial values) calls no function but the
+  // math functions the SIMD lanes take (laneMathFunction, body/BodyAnalysis.h) and the
+  // kernel's (KERNEL_*): a guarded site computes its calls outside the body's branch, where
+  // the SIMD pair loops would refuse a call such as pow or exp (codegen/SimdPairs.cpp,
+  // scalarMathCall, the same list: they take it only in a branch), so such a value stays in
+  // the calls and the loops' choice stays what it was. A scene's own functions stay too.
   bool laneCallsOnly(const clang::Stmt* s) {
     if (auto* call = llvm::dyn_cast<clang::CallExpr>(s)) {
       const clang::FunctionDecl* fn = call->getDirectCallee();
       const std::string name = fn ? fn->getName().str() : "";
-      static const std::set<std::string> ok = {"sqrt", "fabs", "fma", "fmin", "fmax"};
-      if (!ok.count(name) && name.rfind("KERNEL_", 0) != 0) return false;
+      if (!laneMathFunction(name) && name.rfind("KERNEL_", 0) != 0) return false;
     }
     if (auto* ref = llvm::dyn_cast<clang::DeclRefExpr>(s))
       if (auto* v = llvm::dyn_cast<clang::VarDecl>(ref->getDecl());

@@ -47,8 +47,7 @@
 //     l + 4: j l) onto the slot sums.
 // The same OpenMP blocks and half tiles as the 8 x 8 form (bitwise the serial tiles).
 // 3D (stop 42; docs/performance-log.md "3D tiles in the 2xMM form (stop 42)"): the same 2xMM
-// form where clusterTiles2xMM() says so (--simd-pairs=auto on the CPUs SimdCpuVerdict::
-// tiles3d2xmm names, or --cluster-3d-2xmm; --cluster-3d-8x8 keeps the 8 x 8 tiles): the
+// form where clusterTiles2xMM() says so (--cluster-3d-2xmm; auto keeps the 8 x 8 tiles): the
 // column side 2 spacings from the spacing cbrt(mean m / rho), so the 4-clusters are mostly 2 x 2
 // x 1 lattice cells; every other piece is printed per dimension as in 2D.
 // Slot order (stop 40; docs/performance-log.md "Particles in the tiles' slot order (stop 40)";
@@ -222,6 +221,37 @@ void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& stat
   os << "  double " << state << "_pairs0 = 0.0;\n";
 }
 
+// The column side of the 2xMM layout, from the particle spacing where the array has m and
+// rho (columns of 2 spacings, clusters about square; the bounding box's rule grows with the
+// flow's empty space: docs/performance-log.md, stop 38), else "0.0": the layout's rule from
+// the bounding box. 3D (stop 42): the spacing's cube root, columns of 2 spacings as the
+// 8-clusters': the 4-clusters 2 x 2 x 1 lattice cells (spacing 4^(1/3) would give 1 x 1 x 4
+// and 2 x 1 x 2). emitClusterSlotOrder and emitClusterTiles build the same layout with it.
+std::string ScenePrinter::emitClusterColumnSide(int d, bool mm, const std::string& guard,
+                                                const std::string& count,
+                                                const std::string& in) {
+  auto plainDouble = [&](const std::string& p) {
+    const PlanProperty* prop = arr(d).find(p);
+    return prop && prop->stride == 1 && propIndex(d, p) >= 0 && hostType(d, p) == "double";
+  };
+  if (!mm || !plainDouble("m") || !plainDouble("rho")) return "0.0";
+  const bool three = plan_.dim == 3;
+  scene_ << in << "double cl_side = 0.0;  // the column side: the spacing "
+         << (three ? "cbrt" : "sqrt") << "(mean m / rho) x 2 (2xMM)\n";
+  scene_ << in << "if (" << guard << ") {\n";
+  scene_ << in << "  const double* const cl_vm = " << hostPtr(d, "m") << ";\n";
+  scene_ << in << "  const double* const cl_vrho = " << hostPtr(d, "rho") << ";\n";
+  scene_ << in << "  double cl_vol = 0.0;\n";
+  scene_ << in << "  for (std::size_t i = 0; i < static_cast<std::size_t>(" << count
+         << "); ++i) cl_vol += cl_vm[i] / cl_vrho[i];\n";
+  scene_ << in << "  cl_vol /= static_cast<double>(" << count << ");\n";
+  scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side("
+         << (three ? "std::cbrt(cl_vol), DIM, sphc::kClusterSize" : "std::sqrt(cl_vol), DIM, sphc::kClusterSize / 2")
+         << ");\n";
+  scene_ << in << "}\n";
+  return "cl_side";
+}
+
 // Stop 40: the statements of update_neighbours that put the pass's array into its tiles'
 // slot order (sphc::cluster_order, the layout's column side and width as emitClusterTiles
 // builds it) where its lists are expected to be rebuilt at this evaluation
@@ -232,32 +262,12 @@ void ScenePrinter::emitClusterSlotOrder(const DestinationWork& w, const std::str
   const int d = w.array;
   const std::string A = arr(d).name;
   const bool mm = clusterTiles2xMM();
-  auto plainDouble = [&](const std::string& p) {
-    const PlanProperty* prop = arr(d).find(p);
-    return prop && prop->stride == 1 && propIndex(d, p) >= 0 && hostType(d, p) == "double";
-  };
   scene_ << ind << "// --simd-pairs=cluster (stop 40): " << A << " in its tiles' slot order (sphc/cluster_pairs.h,\n"
          << ind << "// cluster_order) where their lists are expected to be rebuilt now; every kept list\n"
          << ind << "// of " << A << " then rebuilt (a permutation is no movement to measure).\n";
   scene_ << ind << "if (" << state << "_order_due && " << state << ".skin.rebuild_expected(Kernel::radius_scale)) {\n";
   const std::string in = ind + "  ";
-  std::string side = "0.0";
-  if (mm && plainDouble("m") && plainDouble("rho")) {  // emitClusterTiles' column side
-    side = "cl_side";
-    scene_ << in << "double cl_side = 0.0;\n";
-    scene_ << in << "if (" << A << ".n > 0) {\n";
-    scene_ << in << "  const double* const cl_vm = " << hostPtr(d, "m") << ";\n";
-    scene_ << in << "  const double* const cl_vrho = " << hostPtr(d, "rho") << ";\n";
-    scene_ << in << "  double cl_vol = 0.0;\n";
-    scene_ << in << "  for (std::size_t i = 0; i < " << A << ".n; ++i) cl_vol += cl_vm[i] / cl_vrho[i];\n";
-    scene_ << in << "  cl_vol /= static_cast<double>(" << A << ".n);\n";
-    // (3D, stop 42: the spacing's cube root, columns of 2 spacings as the 8-clusters': the
-    // 4-clusters 2 x 2 x 1 lattice cells; spacing 4^(1/3) would give 1 x 1 x 4 and 2 x 1 x 2.)
-    scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side("
-           << (plan_.dim == 3 ? "std::cbrt(cl_vol), DIM, sphc::kClusterSize" : "std::sqrt(cl_vol), DIM, sphc::kClusterSize / 2")
-           << ");\n";
-    scene_ << in << "}\n";
-  }
+  const std::string side = emitClusterColumnSide(d, mm, A + ".n > 0", A + ".n", in);
   scene_ << in << "sphc::cluster_order(" << state << "_order, " << hostPtr(d, "x") << ", " << hostPtr(d, "y") << ", "
          << (plan_.dim == 3 ? hostPtr(d, "z") : std::string("nullptr")) << ", " << A << ".n, DIM, " << side << ", "
          << (mm ? "sphc::kClusterSize / 2" : "sphc::kClusterSize") << ");\n";
@@ -454,31 +464,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
              << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
     scene_ << in << "for (int i = 0; i < n; ++i) cl_hmax = std::max(cl_hmax, di_h[i]);\n";
   }
-  // The column side: from the particle spacing where the array has m and rho (2xMM: columns
-  // of 2 spacings, clusters about square; the bounding box's rule grows with the flow's empty
-  // space: docs/performance-log.md, stop 38), else the layout's rule from the bounding box (0).
-  std::string side = "0.0";
-  auto plainDouble = [&](const std::string& p) {
-    const PlanProperty* prop = arr(d).find(p);
-    return prop && prop->stride == 1 && propIndex(d, p) >= 0 && hostType(d, p) == "double";
-  };
-  if (mm && plainDouble("m") && plainDouble("rho")) {
-    side = "cl_side";
-    scene_ << in << "double cl_side = 0.0;  // the column side: the spacing "
-           << (plan_.dim == 3 ? "cbrt" : "sqrt") << "(mean m / rho) x 2 (2xMM)\n";
-    scene_ << in << "if (verlet_build && n > 0) {\n";
-    scene_ << in << "  const double* const cl_vm = " << hostPtr(d, "m") << ";\n";
-    scene_ << in << "  const double* const cl_vrho = " << hostPtr(d, "rho") << ";\n";
-    scene_ << in << "  double cl_vol = 0.0;\n";
-    scene_ << in << "  for (int i = 0; i < n; ++i) cl_vol += cl_vm[i] / cl_vrho[i];\n";
-    scene_ << in << "  cl_vol /= n;\n";
-    // (3D, stop 42: 2 spacings, the 4-clusters 2 x 2 x 1 lattice cells; see emitClusterSlotOrder.)
-    if (plan_.dim == 3)
-      scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::cbrt(cl_vol), DIM, CL_LANES);\n";
-    else
-      scene_ << in << "  if (cl_vol > 0.0 && std::isfinite(cl_vol)) cl_side = sphc::cluster_column_side(std::sqrt(cl_vol), DIM, CL_W);\n";
-    scene_ << in << "}\n";
-  }
+  const std::string side = emitClusterColumnSide(d, mm, "verlet_build && n > 0", "n", in);
   scene_ << in << "if (verlet_build) sphc::" << (inOrder ? "build_cluster_layout_in_order" : "build_cluster_layout")
          << "(cl_layout, di_x, di_y, " << zIn << ", static_cast<std::size_t>(n), DIM, " << side << ", CL_W);\n";
   if (inOrder)

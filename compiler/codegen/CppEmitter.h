@@ -150,8 +150,8 @@ struct EmitOptions {
   // the particles' arrays (codegen/ClusterPairs.cpp).
   bool cluster2dDoubled = false;
   // The 3D tiles in the 2xMM form (4-clusters, registers of 2 i's x 4 j's) as the 2D tiles,
-  // not 8 x 8 (stop 42): --cluster-3d-2xmm (hidden), or --simd-pairs=auto where
-  // SimdCpuVerdict::tiles3d2xmm; --cluster-3d-8x8 (hidden) clears it.
+  // not 8 x 8 (stop 42): --cluster-3d-2xmm (hidden; --simd-pairs=auto keeps 8 x 8 on every
+  // CPU: measured no faster).
   bool cluster3d2xmm = false;
   // --no-slot-order (hidden, a measurement knob; stop 40): false keeps the tiles' slot-order
   // copies and add-backs; true (the default) keeps the particles in the tiles' slot order.

@@ -486,6 +486,12 @@ class ScenePrinter {
   // order where the lists `state` are expected to be rebuilt, then forget the lists `forget`.
   void emitClusterSlotOrder(const DestinationWork& w, const std::string& state,
                             const std::vector<std::string>& forget, const std::string& ind);
+  // The 2xMM layout's column side (both of the above build the same layout): prints
+  // `double cl_side` from the spacing (mean m / rho of array d's first `count` particles,
+  // where `guard` holds) and returns "cl_side", or prints nothing and returns "0.0" (the
+  // layout's rule from the bounding box) where the form is 8 x 8 or m, rho are not plain doubles.
+  std::string emitClusterColumnSide(int d, bool mm, const std::string& guard,
+                                    const std::string& count, const std::string& in);
   // The tiles' rare path (stop 40): why a body's scalar math calls (scalarMathCallSites) cannot
   // be printed as the rare path, "" where it has none or each is in a branch (an `if`, an
   // `else`, a `?:`'s operand) outside the hoisted and pair-shared values.

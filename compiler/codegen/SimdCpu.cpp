@@ -22,8 +22,8 @@
 // under OpenMP (stop 38)") for auto's 3D loops each pair once in lanes: on the Intel models of
 // the lanes (measured on Emerald Rapids: the cube, the 3D dam break and the DualSPHysics
 // scene, serial and OpenMP); not on AMD (not measured: the lanes).
-// Stop 42 measured those 3D tiles in GROMACS' 2xMM form too (SimdCpuVerdict::tiles3d2xmm): no
-// better than the 8 x 8 tiles with their row test as one mask, so auto keeps 8 x 8.
+// Stop 42 measured those 3D tiles in GROMACS' 2xMM form too (--cluster-3d-2xmm): no better
+// than the 8 x 8 tiles with their row test as one mask, so auto keeps 8 x 8.
 #include "codegen/SimdCpu.h"
 
 #include <cstdio>
@@ -127,8 +127,7 @@ SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu) {
     // test as one compare mask (stop 42) the 8 x 8 tiles' loop is as fast on the cube and
     // 0.985-0.99x of the 2xMM form's on the DualSPHysics scene and dambreak3d (measured on
     // model 207; docs/performance-log.md, "3D tiles in the 2xMM form (stop 42)"): auto keeps
-    // 8 x 8; --cluster-3d-2xmm names the 2xMM form.
-    v.tiles3d2xmm = false;
+    // 8 x 8 on every CPU; --cluster-3d-2xmm names the 2xMM form.
     v.tilesWhy = "on " + cpu.describe() +
                  " the cluster-pair tiles pay in 3D (serial and OpenMP; stop 38)" +
                  (v.tiles2d ? std::string(" and in 2D (stop 41)") : std::string());

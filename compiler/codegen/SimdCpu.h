@@ -43,9 +43,6 @@ struct SimdCpuVerdict {
   // Whether auto also puts the 2D loops each pair once over their own array in the tiles
   // (GROMACS' 2xMM form; stop 41), where `tiles` holds: measured to pay on this CPU's model.
   bool tiles2d = false;
-  // Whether auto's 3D tiles are GROMACS' 2xMM form (4-clusters, registers of 2 i's x 4 j's;
-  // stop 42) rather than 8 x 8, where `tiles` holds: measured to pay on this CPU's model.
-  bool tiles3d2xmm = false;
 };
 SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu);
 

@@ -44,6 +44,7 @@
 // pair once in the lanes (emitSymmetricSimdLoops, below): the values the pair shares once per
 // pair, the source side scattered.
 #include "analysis/PairQuantityTable.h"
+#include "body/BodyAnalysis.h"
 #include "codegen/CppText.h"
 #include "codegen/Printer.h"
 #include "codegen/SymmetricPairs.h"
@@ -91,14 +92,17 @@ void scanIdentifiers(const std::string& text,
 }
 
 // The first call in `text` of a math function GCC does not vectorise without -ffast-math
-// (no SIMD clone in glibc then), "" if none. With one in a body the loop may or may not
-// vectorise depending on where GCC inlines it (the serial and the OpenMP builds would differ
-// in their bits): refused instead.
+// (no SIMD clone in glibc then: the allowed math functions but laneMathFunction's,
+// body/BodyAnalysis.h), "" if none. With one in a body the loop may or may not vectorise
+// depending on where GCC inlines it (the serial and the OpenMP builds would differ in their
+// bits): refused instead.
 std::string scalarMathCall(const std::string& text) {
-  static const std::set<std::string> scalarOnly = {
-      "pow",  "exp",  "exp2", "expm1", "log",   "log2",  "log10", "log1p", "sin",    "cos",
-      "tan",  "asin", "acos", "atan",  "atan2", "sinh",  "cosh",  "tanh",  "cbrt",   "erf",
-      "erfc", "tgamma", "lgamma", "hypot", "fmod"};
+  static const std::set<std::string> scalarOnly = [] {
+    std::set<std::string> names;
+    for (const std::string& f : allowedMathFunctions())
+      if (!laneMathFunction(f)) names.insert(f);
+    return names;
+  }();
   std::string found;
   scanIdentifiers(text, [&](const std::string& word, size_t, size_t end) {
     const size_t open = skipBlanks(text, end);

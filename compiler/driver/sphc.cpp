@@ -217,12 +217,6 @@ static cl::opt<bool> Cluster3d2xmm(
              "measured no faster than the 8 x 8 tiles on the cube, slower on the DualSPHysics "
              "scene and dambreak3d (a measurement knob)"),
     cl::init(false), cl::Hidden, cl::cat(SphcCat));
-static cl::opt<bool> Cluster3d8x8(
-    "cluster-3d-8x8",
-    cl::desc("The 3D cluster-pair tiles as 8 x 8 tiles of one i x 8 j's per register (stops "
-             "37-42), not the 2xMM form that --simd-pairs=auto would take on a CPU measured for "
-             "it (none is: stop 42; a measurement knob)"),
-    cl::init(false), cl::Hidden, cl::cat(SphcCat));
 static cl::opt<bool> Cluster2dDoubled(
     "cluster-2d-doubled",
     cl::desc("The 2D cluster-pair tiles (2xMM) in slot order read their j side from copies "
@@ -731,10 +725,7 @@ int main(int argc, char** argv) {
       emitOpts.simdPairsCluster = true;
       emitOpts.simdPairsClusterAuto = true;
       emitOpts.simdPairsClusterAuto2d = emitOpts.simdCpu.tiles2d;  // (stop 41) the 2D loops too
-      // (stop 42) the 3D tiles in the 2xMM form where measured so
-      emitOpts.cluster3d2xmm = emitOpts.cluster3d2xmm || emitOpts.simdCpu.tiles3d2xmm;
     }
-    if (Cluster3d8x8) emitOpts.cluster3d2xmm = false;
     if (Verbose && emitOpts.simdPairsAuto && emitOpts.simdPairs &&
         Backend != sphc::Backend::OpenCL && !Mpi)  // the CPU backends' lanes
       llvm::errs() << "sphc: --simd-pairs=auto: " << emitOpts.simdCpu.why

@@ -65,9 +65,6 @@ TEST(SimdCpu, VerdictsWhereMeasuredToPay) {
     EXPECT_EQ(v.tiles, c.tiles);
     EXPECT_NE(v.why.find(cpu.describe()), std::string::npos) << v.why;
     if (v.tiles) EXPECT_NE(v.tilesWhy.find(cpu.describe()), std::string::npos) << v.tilesWhy;
-    // Stop 42: the 3D tiles in the 2xMM form on no CPU (measured on model 207 no better than
-    // the 8 x 8 tiles: docs/performance-log.md, "3D tiles in the 2xMM form (stop 42)").
-    EXPECT_FALSE(v.tiles3d2xmm);
   }
 }
 
