@@ -857,6 +857,8 @@ class Simulation {
     if (prog_.before_output) prog_.before_output();
     writer_->write(prog_.output_arrays ? prog_.output_arrays() : arrays_, meta());
     last_output_step_ = step_;
+    // A restart file: the state it cannot carry starts afresh, as in a run restarted from it.
+    if (opt_.restartable && prog_.restart_point) prog_.restart_point();
     record_metrics();
   }
 
