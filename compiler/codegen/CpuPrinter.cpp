@@ -241,6 +241,27 @@ class CpuPrinter : public ScenePrinter {
       r += "    scene.static_cells_built = false;  // the file's particles: their cells anew\n";
     return r;
   }
+  // Stop 43: the tiles' layout, outer list and slot order are built from the positions at
+  // their builds and sorts, whose times follow from the particles' history (the kept lists'
+  // marks, the cluster pairs at the last sort): none of it is in a restart file. At each
+  // restart file a --restartable run starts it afresh as a restarted run does (the lists
+  // forgotten, the slot order due; the next evaluation sorts and builds them from the
+  // particles now), so both go on bitwise. Without tiles nothing: the scalar loops' kept
+  // lists are in index order (sphc/verlet.h).
+  std::string restartPoint() const override {
+    std::string r;
+    if (!verlet()) return r;
+    forEachVerletLists([&](const std::string& lists, const Phase&, const DestinationWork& w,
+                           const NeighbourPass& pass) {
+      if (!clusterTilesRefusal(w, pass).empty()) return;  // as clusterTilesMembers
+      r += "    scene." + lists + ".skin.forget();  // " + arr(w.array).name + " <- " +
+           arr(pass.source).name + " in tiles: built again at the next evaluation\n";
+      r += "    scene." + lists + "_order_due = true;\n";
+      r += "    scene." + lists + "_sorted = false;\n";
+      r += "    scene." + lists + "_pairs0 = 0.0;\n";
+    });
+    return r;
+  }
   std::string afterRemoval(int a) const override {
     const std::string& A = arr(a).name;
     std::string r;

@@ -143,6 +143,11 @@ class ScenePrinter {
   // --restart: the statements that move the restored host arrays to where the scene computes
   // on them (OpenCL: uploads; --precision=single: the float copies); "" where they are it.
   virtual std::string restoreData() const { return ""; }
+  // --restartable: the statements (in main, on `scene.`) run after each output is written
+  // (prog.restart_point) that start afresh the state a restart cannot read from the file, as a
+  // run restarted from it starts it (the cluster-pair tiles' layout and sort bookkeeping:
+  // CpuPrinter); "" where there is none.
+  virtual std::string restartPoint() const { return ""; }
   // A limit's `remove` took particles out of the host array a (the run loop, sphc/sanity.h):
   // the statements (in main, on `scene.`) that move it back where the scene computes and
   // forget what depended on its particles; "" where nothing does (kept lists are rebuilt when

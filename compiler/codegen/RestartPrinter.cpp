@@ -1,6 +1,7 @@
 // The printing of restart support (--restart FILE, runtime sphc/restart.h): the scene's state
 // beyond its particles that every output carries (prog.run_state), and what sets it again
-// after the run loop has read a file's particles (prog.restore). Kept apart so that the host
+// after the run loop has read a file's particles (prog.restore), and what a --restartable run
+// starts afresh after each output (prog.restart_point). Kept apart so that the host
 // program reads as before.
 #include "codegen/Printer.h"
 
@@ -28,6 +29,11 @@ void ScenePrinter::emitRestart() {
          << ");\n";
   }
   out_ << "  };\n";
+  // --restartable (stop 43): what a restart cannot read from the file starts afresh after each
+  // output, as in the restarted run (restartPoint: the cluster-pair tiles' layout).
+  if (std::string r = restartPoint(); !r.empty())
+    out_ << "  prog.restart_point = [] {  // --restartable: after each output, as in a run restarted from it\n"
+         << r << "  };\n";
 }
 
 }  // namespace sphc

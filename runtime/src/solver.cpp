@@ -281,7 +281,9 @@ void print_help(const std::string& program, const SceneProgram& prog) {
       "  --quiet               no progress line and no summary\n"
       "  --no-output           write no snapshots (benchmarks)\n"
       "  --restartable         write every property of every array into each output, so\n"
-      "                        that a run can restart from it (--restart)\n"
+      "                        that a run can restart from it (--restart); the\n"
+      "                        cluster-pair tiles' layout is built afresh after each\n"
+      "                        output, as in a run restarted from it (bitwise restarts)\n"
       "  --restart FILE        continue the run from the output FILE (written with\n"
       "                        --restartable): its particles, time, step and run state;\n"
       "                        outputs follow from the next output time on; --max-steps\n"
@@ -857,6 +859,8 @@ class Simulation {
     if (prog_.before_output) prog_.before_output();
     writer_->write(prog_.output_arrays ? prog_.output_arrays() : arrays_, meta());
     last_output_step_ = step_;
+    // A restart file: the state it cannot carry starts afresh, as in a run restarted from it.
+    if (opt_.restartable && prog_.restart_point) prog_.restart_point();
     record_metrics();
   }
 

@@ -289,6 +289,24 @@ TEST(Solver, MaxStepsStopsEarlyAndWritesTheLastState) {
   EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000007.h5"}));
 }
 
+// --restartable (stop 43): prog.restart_point after each output is written (the step count
+// then is the file's), the last one's included; never without --restartable.
+TEST(Solver, RestartPointFollowsEachOutputOnlyWhenRestartable) {
+  for (const bool restartable : {true, false}) {
+    const fs::path dir = fresh_dir();
+    Mover m;
+    std::vector<long> at;  // the steps completed at each call
+    m.prog.restart_point = [&] { at.push_back(m.steps); };
+    std::vector<std::string> args = {"--quiet", "-d", dir.string(), "--max-steps", "60"};
+    if (restartable) args.push_back("--restartable");
+    EXPECT_EQ(run(m.prog, args), 0);
+    EXPECT_EQ(h5_files(dir), (std::vector<std::string>{"mover_000000.h5", "mover_000025.h5",
+                                                       "mover_000050.h5", "mover_000060.h5"}));
+    EXPECT_EQ(at, restartable ? (std::vector<long>{0, 25, 50, 60}) : std::vector<long>{})
+        << "restartable " << restartable;
+  }
+}
+
 TEST(Solver, TimingLineAndNoOutput) {
   const fs::path dir = fresh_dir() / "never";
   Mover m;

@@ -9,7 +9,11 @@
 // The output times already written follow from t (the run loop marks the times up to it as
 // written, as the uninterrupted run had). A restart from a file written at the end of a step
 // therefore continues exactly as the run that wrote it: on the serial and OpenMP backends the
-// outputs are bitwise those of the uninterrupted run (tests/lit/restart).
+// outputs are bitwise those of the uninterrupted run (tests/lit/restart). The cluster-pair
+// tiles' layout and slot order are in no file: a --restartable run starts them afresh after
+// each output (SceneProgram::restart_point, stop 43), as the restarted run does, so a restart
+// from one of its outputs is bitwise in the tiles too (from a last file at a step that was no
+// output of the uninterrupted run, only in the scalar loops and the lanes).
 #pragma once
 
 #include <cstddef>

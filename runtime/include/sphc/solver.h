@@ -236,6 +236,13 @@ struct SceneProgram {
   // solver cannot restart (--restart is refused).
   std::function<std::vector<std::pair<std::string, double>>()> run_state;
   std::function<void(const std::vector<std::pair<std::string, double>>& state)> restore;
+  // --restartable: called after each output is written (a restart file). A scene whose pair
+  // loops keep state a restart cannot read from the file (the cluster-pair tiles' layout,
+  // slot order and sort bookkeeping, built from the particles' history: stop 43) starts it
+  // afresh here, as a run restarted from that file starts it, so that the restarted run goes
+  // on bitwise as this one. Empty: nothing to start afresh (the scalar loops' kept lists are
+  // in index order, a function of the particles now: sphc/verlet.h).
+  std::function<void()> restart_point;
   // Distributed runs: the number of ranks (rank r of a restart reads block r of the file).
   int ranks = 1;
   // The default box limits (sanity.h), when not those of `arrays` after the set-up
