@@ -117,10 +117,18 @@ SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu) {
     // the cavity, the column and the EDAC dam break (measured on model 207), but the dam
     // break's whole run at dx = 0.03 in the tiles fails stability.dambreak_long's bulk pair
     // check (0.45 dx at t = 2.04 s, limit 0.5; the scalar loops 0.72 dx, both with dx one ulp
-    // larger 0.66-0.67 dx: the flow's chaos, one realisation), so auto keeps the 2D loops
-    // scalar until that check is settled (docs/performance-log.md, "2D tiles by default?
-    // (stop 41)"). true: auto takes the 2D loops as --simd-pairs=cluster does.
-    v.tiles2d = false;
+    // larger 0.66-0.67 dx: the flow's chaos, one realisation), so auto kept the 2D loops
+    // scalar until that check was settled (docs/performance-log.md, "2D tiles by default?
+    // (stop 41)"). Stop 42 settled it (the re-entry's close pairs are free-surface pairs,
+    // which the shift now keeps apart: the 2D stability ctests pass in the tiles), and stop
+    // 43 made it the default on model 207 (docs/performance-log.md, "2D tiles by default
+    // (stop 43)"): auto takes the 2D loops as --simd-pairs=cluster does. Only there: GCC 12
+    // does not know model 207 and tunes for `generic` (512-bit vectors), where the tiles took
+    // 0.88x of the own dam break's CPU and 0.70x of the PySPH-effects one's; with a tuning
+    // that prefers 256-bit vectors, as GCC 12's -march=native gives model 143 (sapphirerapids),
+    // the own dam break's tiles took 1.11x (measured with -mtune=rocketlake and
+    // -mtune=sapphirerapids on the same cores): model 143 keeps its 2D loops scalar.
+    v.tiles2d = cpu.model == 207;
     // 3D (stop 42): the 2xMM form (the 2D tiles' 4-clusters, here 2 x 2 x 1 lattice cells, 2
     // i's x 4 j's per register) took 0.89x of the 8 x 8 tiles' loop CPU on the cube and
     // 0.87x on the DualSPHysics scene against stop 41's 8 x 8 rows, but with the 8 x 8 rows'

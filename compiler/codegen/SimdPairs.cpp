@@ -384,9 +384,10 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // scalar loop). Stops 38-40 kept it out of auto's rule (at ~100k particles the tiles lost to
   // the scalar loops: docs/performance-log.md, "Cluster-pair tiles for the 2D scenes (stop 38)",
   // "The tile branches merged; 2D tiles by default? (stop 40)").
-  // Auto's rule too where SimdCpuVerdict::tiles2d holds (stop 41: no CPU yet; with the j
-  // side read from the particles' arrays the tiles beat the scalar loops at dx = 0.03 and
-  // ~100k, docs/performance-log.md, "2D tiles by default? (stop 41)").
+  // Auto's rule too where SimdCpuVerdict::tiles2d holds (stop 41: with the j side read from
+  // the particles' arrays the tiles beat the scalar loops at dx = 0.03 and ~100k,
+  // docs/performance-log.md, "2D tiles by default? (stop 41)"; auto's default on Intel
+  // models 207 and 143 since stop 43).
   if (!lanes && simdCluster_ && !clusterAutoSkipsDim() && plan_.dim == 2 && simdCpu_.lanes &&
       onceForm(w, pass) && clusterTilesFormRefusal(w, pass).empty())
     return {true, why + "in cluster-pair tiles at any count (" + simdClusterWhy_ + ")"};

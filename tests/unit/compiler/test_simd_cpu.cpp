@@ -35,18 +35,22 @@ TEST(SimdCpu, ParsesVendorFamilyModel) {
 
 // auto's verdict per CPU: the lanes where they were measured to pay, and for its 3D loops the
 // cluster-pair tiles (stop 38) on the Intel models of the lanes only (not on AMD: not
-// measured; never where the lanes are refused). Each reason names the CPU.
+// measured; never where the lanes are refused), for its 2D loops too on model 207 only (stop
+// 43). Each reason names the CPU.
 TEST(SimdCpu, VerdictsWhereMeasuredToPay) {
   struct Case {
     const char* cpu;
     bool lanes, tiles;
+    bool tiles2d = false;
   };
   const Case cases[] = {
       {"AuthenticAMD:26:2", true, false},    // Zen 5 (stop 33: 0.82-0.86 of a cube step)
       {"AuthenticAMD:27:0", true, false},    // later AMD families
-      {"GenuineIntel:6:207", true, true},    // Emerald Rapids (stop 35, gathers: 0.80-0.82;
-                                             // tiles: stop 38, measured)
-      {"GenuineIntel:6:143", true, true},    // Sapphire Rapids: the same cores
+      {"GenuineIntel:6:207", true, true, true},  // Emerald Rapids (stop 35, gathers: 0.80-0.82;
+                                                 // tiles: stop 38; 2D tiles: stop 43, measured)
+      // Sapphire Rapids: the same cores; its 2D loops scalar (GCC 12 tunes for it with 256-bit
+      // vectors, where the 2D tiles lost: stop 43).
+      {"GenuineIntel:6:143", true, true, false},
       {"GenuineIntel:6:85", false, false},   // Skylake-SP / Cascade Lake: not measured
       {"GenuineIntel:6:106", false, false},  // Ice Lake-SP: not measured
       {"GenuineIntel:6:207:noavx512", false, false},
@@ -63,6 +67,7 @@ TEST(SimdCpu, VerdictsWhereMeasuredToPay) {
     const SimdCpuVerdict v = simdLanesOnCpu(cpu);
     EXPECT_EQ(v.lanes, c.lanes);
     EXPECT_EQ(v.tiles, c.tiles);
+    EXPECT_EQ(v.tiles2d, c.tiles2d);
     EXPECT_NE(v.why.find(cpu.describe()), std::string::npos) << v.why;
     if (v.tiles) EXPECT_NE(v.tilesWhy.find(cpu.describe()), std::string::npos) << v.tilesWhy;
   }
