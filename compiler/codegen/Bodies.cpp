@@ -61,6 +61,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   cluster2d8x8_ = opts.cluster2d8x8;
   cluster2dDoubled_ = opts.cluster2dDoubled;
   cluster3d2xmm_ = opts.cluster3d2xmm;
+  clusterQueue_ = opts.clusterQueue;
   clusterSlotOrder_ = opts.clusterSlotOrder;
   tileMathRecip_ = opts.tileMathRecip;
   simdClusterWhy_ = opts.simdPairsClusterAuto ? "--simd-pairs=auto: " + opts.simdCpu.tilesWhy

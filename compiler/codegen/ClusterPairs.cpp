@@ -737,6 +737,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   };
   // One tile (j-cluster cl_j[e] of i-cluster ci): both sides, or one side's half tile.
   enum class Side { Both, I, J };
+  // --cluster-queue (stop 43; docs/performance-log.md "The tiles' pairs compacted (stop 43)"):
+  // the 8 x 8 tiles' pairs within the support compacted, 8 to a register. Not for the 2xMM
+  // form, a pass that keeps the self pair (its two sides' masks differ on the diagonal) or one
+  // whose bodies call a rare math function (their marked lanes' fix-up is per row).
+  const bool queueTiles = clusterQueue_ && !mm && !selfPair && !rareCalls(pass);
   auto tile = [&](Side side, const std::string& c2) {
     const bool iSide = side != Side::J, jSide = side != Side::I;
     const std::string L = "CL_LANES";  // the lanes of a register
@@ -789,6 +794,10 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[" << L << "] = {};\n";
     }
     std::string c3 = c2 + "  ";
+    // --cluster-queue (stop 43): the rows below are printed, then moved after the queue's
+    // form as its #else (the queue's lanes print with laneBody, defined with the rows).
+    const bool queue = queueTiles;
+    const std::streampos rowsAt = scene_.tellp();
     if (mm) {
       scene_ << c2 << "for (int r = 0; r < 2 && (real_i >> (2 * r) & 1u); ++r) {  // the registers with a real i (first)\n";
       scene_ << c3 << "// the register's i's: d_idx is the lane too (ir_NAME: the i of lane d_idx)\n";
@@ -905,18 +914,25 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     // alone. Each lane's sums get the same terms in the same order as if every lane were
     // computed by the _simd forms (the fix-up before the next tile).
     enum class Mode { Lanes, Marked, Fixup };
+    // inQueue: the lanes of a register of queued pairs (--cluster-queue): d_idx the lane too
+    // (the i's values ir_NAME), every lane before q_cnt a pair within the support.
+    bool inQueue = false;
     auto laneBody = [&](const std::string& body, Mode mode) {
-      if (mm) laneDest(body);
+      if (mm || inQueue) laneDest(body);
       emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true,
                              /*tileRecip=*/tileMathRecip_);
       scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
       scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
-      if (side == Side::Both) {
+      if (side == Side::Both && !inQueue) {
         scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
         scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
       }
       std::string inD = side == Side::Both ? "in_d" : "in_cut";
       std::string inS = side == Side::Both ? "in_s" : "in_cut";
+      if (inQueue) {  // (the self pair is never queued: --cluster-queue refuses a pass that keeps it)
+        scene_ << body << "const bool in_q = in_cut & (s_idx < q_cnt);  // a queued pair (in_cut: the queue's own test)\n";
+        inD = inS = "in_q";
+      }
       emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
       for (const std::string& p : accs) {
         if (iSide) scene_ << body << "double pd_" << accLocal[p] << " = ti_" << p << "_i[s_idx];\n";
@@ -950,7 +966,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       // not offset to the j-cluster (2xMM: the register's i's, d_idx the lane).
       if (jSide) {
         std::map<std::string, std::string> absolute;
-        const std::string pre = mm ? "ir_" : "cl_";
+        const std::string pre = mm || inQueue ? "ir_" : "cl_";
         for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
         for (const std::string& h : hoisted) absolute[h] = pre + h;
         for (const PlanEquation* eq : pass.equations)
@@ -991,6 +1007,71 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << c3 << "}\n";
     }
     scene_ << c2 << "}\n";
+    if (queue) {
+      const std::string all = scene_.str();
+      const std::string rows = all.substr(static_cast<size_t>(rowsAt));
+      scene_.str(all.substr(0, static_cast<size_t>(rowsAt)));
+      scene_.seekp(0, std::ios_base::end);
+      scene_ << "#if defined(__AVX512F__) && defined(__AVX512VBMI2__)\n";
+      scene_ << c2 << "// The tile's pairs within the support compacted (--cluster-queue, stop 43): the rows'\n"
+             << c2 << "// masks (bit 8 ii + l), their pairs' indices packed in order, 8 pairs to a register:\n"
+             << c2 << "// the values by permutes of the clusters' 8 slots, the sums back per row (i: its lane\n"
+             << c2 << "// partial sums, lane by lane; j: through the inverse of the row's compaction).\n";
+      const std::string z = plan_.dim == 3 ? "di_z + ci * CL_W" : "nullptr";
+      scene_ << c2 << "const std::uint64_t q_mask = sphc::tile_pair_mask<DIM>(di_x + ci * CL_W, di_y + ci * CL_W, "
+             << z << ", di_h + ci * CL_W, real_i, sj_x, sj_y, " << (plan_.dim == 3 ? "sj_z" : "nullptr")
+             << ", sj_h, " << (side == Side::Both ? "diagonal" : "false") << ", RADIUS2);\n";
+      scene_ << c2 << "alignas(64) std::uint8_t q_idx[64];\n";
+      scene_ << c2 << "const int q_n = q_mask ? sphc::tile_pair_list(q_mask, q_idx) : 0;\n";
+      scene_ << c2 << "for (int q_v = 0; q_v < q_n; q_v += CL_LANES) {\n";
+      const std::string v = c2 + "  ";
+      scene_ << v << "const int q_cnt = q_n - q_v < CL_LANES ? q_n - q_v : CL_LANES;\n";
+      scene_ << v << "const sphc::TileQueueLanes q_at = sphc::tile_queue_lanes(q_idx + q_v);\n";
+      scene_ << v << "// the pairs' i values (ir_NAME) and j values (q_NAME, then the j pointers' names)\n";
+      for (const auto& c : copies) {
+        scene_ << v << "alignas(64) double ir_" << c.first << "[CL_LANES];\n";
+        scene_ << v << "sphc::tile_queue_take(ir_" << c.first << ", q_at.i, cl_" << c.first
+               << " + ci * CL_W, static_cast<__mmask8>(real_i));\n";
+      }
+      std::vector<std::string> jNames;
+      for (const std::string& p : pass.shared) jNames.push_back("sj_" + p);
+      for (const std::string& p : pass.sourceProps) jNames.push_back("s_" + p);
+      for (const std::string& h : hoisted) jNames.push_back(h);
+      for (const std::string& p : dvals) jNames.push_back("d_" + p);
+      for (const std::string& h : dhoisted) jNames.push_back(h);
+      for (const std::string& n : jNames) {
+        scene_ << v << "alignas(64) double q_" << n << "[CL_LANES];\n";
+        scene_ << v << "sphc::tile_queue_take(q_" << n << ", q_at.j, " << n << ", 0xff);\n";
+      }
+      scene_ << v << "{\n";
+      const std::string b = v + "  ";
+      for (const std::string& n : jNames) scene_ << b << "const double* const " << n << " = q_" << n << ";\n";
+      for (const std::string& p : pass.shared) scene_ << b << "const double* const di_" << p << " = ir_" << p << ";\n";
+      for (const std::string& p : accs) {
+        if (iSide) scene_ << b << "alignas(64) double qr_i_" << p << "[CL_LANES] = {};\n";
+        if (iSide) scene_ << b << "double* const ti_" << p << "_i = qr_i_" << p << ";\n";
+        if (jSide) scene_ << b << "double* const q_tj_" << p << " = tj_" << p << ";\n";
+        if (jSide) scene_ << b << "alignas(64) double qr_j_" << p << "[CL_LANES] = {};\n";
+        if (jSide) scene_ << b << "double* const tj_" << p << " = qr_j_" << p << ";\n";
+      }
+      scene_ << b << "#pragma omp simd\n";
+      scene_ << b << "for (int s_idx = 0; s_idx < CL_LANES; ++s_idx) {\n";
+      inQueue = true;
+      laneBody(b + "  ", Mode::Lanes);
+      inQueue = false;
+      scene_ << b << "}\n";
+      scene_ << b << "for (int q_k = 0; q_k < q_cnt;) {  // the sums back, row by row\n";
+      scene_ << b << "  const sphc::TileQueueSegment q_s = sphc::tile_queue_segment(q_idx + q_v, q_k, q_cnt);\n";
+      for (const std::string& p : accs) {
+        if (iSide) scene_ << b << "  sphc::tile_queue_add_i(ti_" << p << "[q_s.ii], q_s, qr_i_" << p << ");\n";
+        if (jSide) scene_ << b << "  sphc::tile_queue_add_j(q_tj_" << p << ", q_s, qr_j_" << p << ");\n";
+      }
+      scene_ << b << "  q_k = q_s.end;\n";
+      scene_ << b << "}\n";
+      scene_ << v << "}\n";
+      scene_ << c2 << "}\n";
+      scene_ << "#else\n" << rows << "#endif\n";
+    }
     if (jSide) {
       if (inOrder && nSlotAccs)  // the slot sums' (the padded cluster's in its own slots)
         scene_ << c2 << "const int jslot = static_cast<int>(cl_j[e]) * CL_W;\n";

@@ -153,6 +153,9 @@ struct EmitOptions {
   // not 8 x 8 (stop 42): --cluster-3d-2xmm (hidden; --simd-pairs=auto keeps 8 x 8 on every
   // CPU: measured no faster).
   bool cluster3d2xmm = false;
+  // --cluster-queue (stop 43): the 8 x 8 tiles' pairs within the support compacted into
+  // registers of 8 pairs (codegen/ClusterPairs.cpp), under AVX-512 with VBMI2.
+  bool clusterQueue = false;
   // --no-slot-order (hidden, a measurement knob; stop 40): false keeps the tiles' slot-order
   // copies and add-backs; true (the default) keeps the particles in the tiles' slot order.
   bool clusterSlotOrder = true;

@@ -530,6 +530,7 @@ class ScenePrinter {
   bool cluster2d8x8_ = false;     // EmitOptions::cluster2d8x8: 2D tiles 8 x 8, not 2xMM
   bool cluster2dDoubled_ = false; // EmitOptions::cluster2dDoubled: 2xMM j side from doubled copies
   bool cluster3d2xmm_ = false;    // EmitOptions::cluster3d2xmm: 3D tiles in the 2xMM form
+  bool clusterQueue_ = false;     // EmitOptions::clusterQueue: 8 x 8 tiles' pairs compacted
   // Whether the tiles are GROMACS' 2xMM form (2D by default, 3D with --cluster-3d-2xmm).
   bool clusterTiles2xMM() const {
     return plan_.dim == 2 ? !cluster2d8x8_ : cluster3d2xmm_;

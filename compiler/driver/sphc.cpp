@@ -217,6 +217,15 @@ static cl::opt<bool> Cluster3d2xmm(
              "measured no faster than the 8 x 8 tiles on the cube, slower on the DualSPHysics "
              "scene and dambreak3d (a measurement knob)"),
     cl::init(false), cl::Hidden, cl::cat(SphcCat));
+static cl::opt<bool> ClusterQueue(
+    "cluster-queue",
+    cl::desc("The 8 x 8 cluster-pair tiles' pairs within the support compacted, 8 to a register "
+             "(a tile's rows' masks, their pairs' indices packed by vpcompressb, the values by "
+             "permutes of the clusters' registers, the sums back per row; under AVX-512 with "
+             "VBMI2, else the rows as before; not for the 2xMM form, bodies with a rare math "
+             "call, or a pass that keeps the self pair). Sums reassociated; serial = OpenMP "
+             "bitwise (stop 43, docs/performance-log.md \"The tiles' pairs compacted (stop 43)\")"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> Cluster2dDoubled(
     "cluster-2d-doubled",
     cl::desc("The 2D cluster-pair tiles (2xMM) in slot order read their j side from copies "
@@ -692,6 +701,7 @@ int main(int argc, char** argv) {
   emitOpts.cluster2d8x8 = Cluster2d8x8;
   emitOpts.cluster2dDoubled = Cluster2dDoubled;
   emitOpts.cluster3d2xmm = Cluster3d2xmm;
+  emitOpts.clusterQueue = ClusterQueue;
   emitOpts.clusterSlotOrder = !NoSlotOrder;
   emitOpts.tileMathRecip = TileMathOpt == TileMath::Recip;
   emitOpts.simdAutoNeighbours = SimdNeighbours;

@@ -62,7 +62,7 @@
 #include <vector>
 
 #if defined(__AVX512F__)
-#include <immintrin.h>  // tile_row_any
+#include <immintrin.h>  // tile_row_any, the pair queue
 #endif
 
 namespace sphc {
@@ -183,11 +183,11 @@ inline void load_doubled4(double* t, const double* p) {
 // same bit for bit. (No margin on radius2: in a lattice such as the cube's many pairs lie at the
 // support's edge to the last bit, and 1 + 1e-12 let ~10% more rows through to lanes all masked.)
 template <int Dim>
-inline __attribute__((always_inline)) bool tile_row_any(double xi, double yi, double zi, double hi,
-                                                        const double* xj, const double* yj,
-                                                        const double* zj, const double* hj,
-                                                        const double* lane, double lane_d,
-                                                        double radius2) {
+inline __attribute__((always_inline)) __mmask8 tile_row_mask(double xi, double yi, double zi, double hi,
+                                                             const double* xj, const double* yj,
+                                                             const double* zj, const double* hj,
+                                                             const double* lane, double lane_d,
+                                                             double radius2) {
   const __m512d dx = _mm512_sub_pd(_mm512_set1_pd(xi), _mm512_loadu_pd(xj));
   const __m512d dy = _mm512_sub_pd(_mm512_set1_pd(yi), _mm512_loadu_pd(yj));
   __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
@@ -200,10 +200,98 @@ inline __attribute__((always_inline)) bool tile_row_any(double xi, double yi, do
   }
   const __m512d hm = _mm512_max_pd(_mm512_set1_pd(hi), _mm512_loadu_pd(hj));  // hi > hj ? hi : hj
   const __m512d lim = _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(radius2), hm), hm);
-  const __mmask8 in = _mm512_cmp_pd_mask(r2, lim, _CMP_NGE_UQ) &  // !(r2 >= lim), the lanes' form
-                      _mm512_cmp_pd_mask(_mm512_loadu_pd(lane), _mm512_set1_pd(lane_d), _CMP_GT_OQ);
-  return in != 0;
+  return _mm512_cmp_pd_mask(r2, lim, _CMP_NGE_UQ) &  // !(r2 >= lim), the lanes' form
+         _mm512_cmp_pd_mask(_mm512_loadu_pd(lane), _mm512_set1_pd(lane_d), _CMP_GT_OQ);
 }
+template <int Dim>
+inline __attribute__((always_inline)) bool tile_row_any(double xi, double yi, double zi, double hi,
+                                                        const double* xj, const double* yj,
+                                                        const double* zj, const double* hj,
+                                                        const double* lane, double lane_d,
+                                                        double radius2) {
+  return tile_row_mask<Dim>(xi, yi, zi, hi, xj, yj, zj, hj, lane, lane_d, radius2) != 0;
+}
+#if defined(__AVX512VBMI2__)
+// The pair queue of an 8 x 8 tile (sphc --cluster-queue, codegen/ClusterPairs.cpp; stop 43,
+// docs/performance-log.md "The tiles' pairs compacted (stop 43)"): the tile's pairs within the
+// support packed 8 to a register, so that the lanes' arithmetic runs on pairs only (the rows
+// fill 3.97 of their 8 lanes in the cube).
+//
+// tile_pair_mask: bit 8 ii + l for row ii (the i-cluster's real i's, the first bits of real_i;
+// (xi, yi, zi, hi) its 8 slots) and lane l of the j-cluster, where tile_row_mask says so (the
+// lanes' own cut-off, bit for bit; the diagonal tile: l > ii).
+template <int Dim>
+inline __attribute__((always_inline)) std::uint64_t tile_pair_mask(
+    const double* xi, const double* yi, const double* zi, const double* hi, unsigned real_i,
+    const double* xj, const double* yj, const double* zj, const double* hj, bool diagonal,
+    double radius2) {
+  alignas(64) static constexpr double lane[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  std::uint64_t m = 0;
+  for (int ii = 0; ii < 8 && (real_i >> ii & 1u); ++ii)
+    m |= static_cast<std::uint64_t>(tile_row_mask<Dim>(
+             xi[ii], yi[ii], Dim == 3 ? zi[ii] : 0.0, hi[ii], xj, yj, zj, hj, lane,
+             diagonal ? static_cast<double>(ii) : -1.0, radius2))
+         << (8 * ii);
+  return m;
+}
+// The set bits of m in order as bytes 8 ii + l (idx: 64 bytes; past the count, 0); the count.
+inline __attribute__((always_inline)) int tile_pair_list(std::uint64_t m, std::uint8_t* idx) {
+  const __m512i iota = _mm512_set_epi8(63, 62, 61, 60, 59, 58, 57, 56, 55, 54, 53, 52, 51, 50, 49,
+                                       48, 47, 46, 45, 44, 43, 42, 41, 40, 39, 38, 37, 36, 35, 34,
+                                       33, 32, 31, 30, 29, 28, 27, 26, 25, 24, 23, 22, 21, 20, 19,
+                                       18, 17, 16, 15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2,
+                                       1, 0);
+  _mm512_storeu_si512(idx, _mm512_maskz_compress_epi8(m, iota));
+  return __builtin_popcountll(m);
+}
+// A register of 8 queued pairs from idx (8 bytes): its rows ii (i) and its lanes l (j).
+struct TileQueueLanes {
+  __m512i i, j;
+};
+inline __attribute__((always_inline)) TileQueueLanes tile_queue_lanes(const std::uint8_t* idx) {
+  const __m512i q = _mm512_cvtepu8_epi64(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(idx)));
+  return {_mm512_srli_epi64(q, 3), _mm512_and_si512(q, _mm512_set1_epi64(7))};
+}
+// dst[k] = src[at[k]] (src: the cluster's 8 slots, those outside `real` not read).
+inline __attribute__((always_inline)) void tile_queue_take(double* dst, __m512i at,
+                                                           const double* src, __mmask8 real) {
+  _mm512_store_pd(dst, _mm512_permutexvar_pd(at, _mm512_maskz_loadu_pd(real, src)));
+}
+// One row's pairs in a register of queued pairs: lanes [k, end) (the rows come in order), row
+// ii, `lanes` those lanes as a mask, `jm` the j lanes they hold, inv[l] the register lane that
+// holds (ii, l) for l in jm (the row's j's are distinct: the inverse of the compaction).
+struct TileQueueSegment {
+  int ii, end;
+  __mmask8 lanes, jm;
+  __m512i inv;
+};
+inline __attribute__((always_inline)) TileQueueSegment tile_queue_segment(const std::uint8_t* idx,
+                                                                          int k, int count) {
+  TileQueueSegment s;
+  s.ii = idx[k] >> 3;
+  unsigned jm = 1u << (idx[k] & 7);
+  int e = k + 1;
+  while (e < count && (idx[e] >> 3) == s.ii) jm |= 1u << (idx[e++] & 7);
+  s.end = e;
+  s.lanes = static_cast<__mmask8>(((1u << e) - 1u) & ~((1u << k) - 1u));
+  s.jm = static_cast<__mmask8>(jm);
+  s.inv = _mm512_maskz_expand_epi64(
+      s.jm, _mm512_add_epi64(_mm512_set1_epi64(k), _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0)));
+  return s;
+}
+// The segment's terms onto a row's lane partial sums (i side: sums[k] += r[k] on its lanes)
+// and onto the j-cluster's sums (j side: sums[l] += r[inv[l]] for l in jm).
+inline __attribute__((always_inline)) void tile_queue_add_i(double* sums, const TileQueueSegment& s,
+                                                            const double* r) {
+  const __m512d a = _mm512_load_pd(sums);
+  _mm512_store_pd(sums, _mm512_mask_add_pd(a, s.lanes, a, _mm512_load_pd(r)));
+}
+inline __attribute__((always_inline)) void tile_queue_add_j(double* sums, const TileQueueSegment& s,
+                                                            const double* r) {
+  const __m512d a = _mm512_load_pd(sums);
+  _mm512_store_pd(sums, _mm512_mask_add_pd(a, s.jm, a, _mm512_permutexvar_pd(s.inv, _mm512_load_pd(r))));
+}
+#endif
 #endif
 // In order, per evaluation: the padded cluster's values, dst[k][l] = src[k][width t + l]
 // for its real lanes l, its first particle's value for the padding (dst: width values
