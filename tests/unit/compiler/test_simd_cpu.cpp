@@ -51,6 +51,9 @@ TEST(SimdCpu, VerdictsWhereMeasuredToPay) {
       // Sapphire Rapids: the same cores; its 2D loops scalar (GCC 12 tunes for it with 256-bit
       // vectors, where the 2D tiles lost: stop 43).
       {"GenuineIntel:6:143", true, true, false},
+      // A VM reporting model 167 with Sapphire Rapids-class cores (AMX, AVX512-FP16): measured
+      // with the SIMD builds' 512-bit preference (stop 43).
+      {"GenuineIntel:6:167", true, true, true},
       {"GenuineIntel:6:85", false, false},   // Skylake-SP / Cascade Lake: not measured
       {"GenuineIntel:6:106", false, false},  // Ice Lake-SP: not measured
       {"GenuineIntel:6:207:noavx512", false, false},
