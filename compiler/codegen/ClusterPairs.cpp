@@ -217,8 +217,14 @@ void ScenePrinter::clusterTilesMembers(std::ostream& os, const std::string& stat
   os << "  std::vector<std::uint32_t> " << state << "_order;  // the tiles' slot order (stop 40; update_neighbours)\n";
   os << "  // (stop 40) whether the particles are to be put in the tiles' order at the next expected\n"
         "  // rebuild; whether they were since the last build; the outer list's pairs per cluster then\n";
+  // (the values clusterSortFresh sets again: change both together)
   os << "  bool " << state << "_order_due = true, " << state << "_sorted = false;\n";
   os << "  double " << state << "_pairs0 = 0.0;\n";
+}
+
+std::string ScenePrinter::clusterSortFresh(const std::string& prefix, const std::string& ind) {
+  return ind + prefix + "_order_due = true;\n" + ind + prefix + "_sorted = false;\n" + ind +
+         prefix + "_pairs0 = 0.0;\n";
 }
 
 // The column side of the 2xMM layout, from the particle spacing where the array has m and

@@ -256,9 +256,7 @@ class CpuPrinter : public ScenePrinter {
       if (!clusterTilesRefusal(w, pass).empty()) return;  // as clusterTilesMembers
       r += "    scene." + lists + ".skin.forget();  // " + arr(w.array).name + " <- " +
            arr(pass.source).name + " in tiles: built again at the next evaluation\n";
-      r += "    scene." + lists + "_order_due = true;\n";
-      r += "    scene." + lists + "_sorted = false;\n";
-      r += "    scene." + lists + "_pairs0 = 0.0;\n";
+      r += clusterSortFresh("scene." + lists, "    ");
     });
     return r;
   }

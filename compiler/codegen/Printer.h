@@ -514,6 +514,11 @@ class ScenePrinter {
   // the pruned lists), each with a slot buffer of its own (_slots, _slots1, ...; stop 40).
   static void clusterTilesMembers(std::ostream& os, const std::string& state,
                                   const std::string& what, int users = 1);
+  // The tiles' sort bookkeeping members of `state` as a run starts them (stop 40: the slot
+  // order due, not yet sorted, no reference pair count): the statements (on `prefix`, each
+  // line after `ind`) that set them so. clusterTilesMembers declares them with these values;
+  // a --restartable run sets them again after each output (CpuPrinter::restartPoint).
+  static std::string clusterSortFresh(const std::string& prefix, const std::string& ind);
   // Which of the passes in tiles sharing its kept lists this one is, and how many there are
   // ({0, 1}: the lists its own; the CPU printer's kept lists, stop 40).
   virtual std::pair<int, int> clusterListsShare(const DestinationWork&, const NeighbourPass&) const {
