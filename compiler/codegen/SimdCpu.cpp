@@ -192,16 +192,19 @@ SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu) {
     // (stop 41)"). Stop 42 settled it (the re-entry's close pairs are free-surface pairs,
     // which the shift now keeps apart: the 2D stability ctests pass in the tiles), and stop
     // 43 made it the default on model 207 (docs/performance-log.md, "2D tiles by default
-    // (stop 43)"): auto takes the 2D loops as --simd-pairs=cluster does. Only there: GCC 12
-    // does not know model 207 and tunes for `generic` (512-bit vectors), where the tiles took
-    // 0.88x of the own dam break's CPU and 0.70x of the PySPH-effects one's; with a tuning
-    // that prefers 256-bit vectors, as GCC 12's -march=native gives model 143 (sapphirerapids),
-    // the own dam break's tiles took 1.11x (measured with -mtune=rocketlake and
-    // -mtune=sapphirerapids on the same cores): model 143 keeps its 2D loops scalar.
-    // With the SIMD builds' -mprefer-vector-width=512 (stop 43) the tuning's preference no
-    // longer decides: model 167 takes the 2D tiles too (measured 0.91x, above); model 143's
-    // 2D tiles were not measured with it, so it keeps its 2D loops scalar.
-    v.tiles2d = !(cpu.family == 6 && cpu.model == 143);  // TODO(stop 44): model 143 measured
+    // (stop 43)"): auto takes the 2D loops as --simd-pairs=cluster does. GCC 12 does not know
+    // model 207 and tunes for `generic` (512-bit vectors), where the tiles took 0.88x of the own
+    // dam break's CPU and 0.70x of the PySPH-effects one's; with a tuning that prefers 256-bit
+    // vectors, as GCC 12's -march=native gives model 143 (sapphirerapids) and stop 43's VM
+    // (rocketlake), the own dam break's tiles took 1.10-1.11x. With the SIMD builds'
+    // -mprefer-vector-width=512 (stop 43) the tuning's preference no longer decides: stop 43's
+    // VM took 0.91x, and stop 44 measured a model-143 build (emulated on that VM's cores:
+    // -march=sapphirerapids, the SIMD flags as sphc adds them): the own dam break's tiles
+    // 0.885x of the scalar loops' CPU, the PySPH-effects one's 0.72x, the cube's 3D tiles
+    // 0.52x; the same build without the 512-bit preference lost again (docs/performance-log.md,
+    // "The verdict by features; model 143 emulated (stop 44)"). So every CPU of this verdict
+    // takes the 2D tiles.
+    v.tiles2d = true;
     // 3D (stop 42): the 2xMM form (the 2D tiles' 4-clusters, here 2 x 2 x 1 lattice cells, 2
     // i's x 4 j's per register) took 0.89x of the 8 x 8 tiles' loop CPU on the cube and
     // 0.87x on the DualSPHysics scene against stop 41's 8 x 8 rows, but with the 8 x 8 rows'

@@ -57,7 +57,8 @@ struct SimdCpuVerdict {
   bool tiles = false;
   std::string tilesWhy;
   // Whether auto also puts the 2D loops each pair once over their own array in the tiles
-  // (GROMACS' 2xMM form; stop 41), where `tiles` holds: measured to pay on this CPU's model.
+  // (GROMACS' 2xMM form; stop 41), where `tiles` holds: measured to pay on those CPUs (stop
+  // 43: models 207 and 167 with FP16 and AMX; stop 44: a model 143 build, emulated).
   bool tiles2d = false;
 };
 SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu);
