@@ -212,7 +212,7 @@ SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu) {
     // 0.985-0.99x of the 2xMM form's on the DualSPHysics scene and dambreak3d (measured on
     // model 207; docs/performance-log.md, "3D tiles in the 2xMM form (stop 42)"): auto keeps
     // 8 x 8 on every CPU; --cluster-3d-2xmm names the 2xMM form.
-    v.tilesWhy = "on " + cpu.describe() +
+    v.tilesWhy = "on " + cpu.describe() + " (" + decided + ")" +
                  " the cluster-pair tiles pay in 3D (serial and OpenMP; stop 38)" +
                  (v.tiles2d ? std::string(" and in 2D (stop 41)") : std::string());
   } else if (cpu.vendor == "GenuineIntel") {

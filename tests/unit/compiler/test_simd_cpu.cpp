@@ -138,6 +138,7 @@ TEST(SimdCpu, VerdictsWhereMeasuredToPay) {
     EXPECT_NE(v.why.find(cpu.describe()), std::string::npos) << v.why;
     EXPECT_NE(v.why.find(c.decided), std::string::npos) << v.why;
     if (v.tiles) EXPECT_NE(v.tilesWhy.find(cpu.describe()), std::string::npos) << v.tilesWhy;
+    if (v.tiles) EXPECT_NE(v.tilesWhy.find(c.decided), std::string::npos) << v.tilesWhy;
     EXPECT_EQ(v.tilesWhy.find("in 2D") != std::string::npos, v.tiles2d) << v.tilesWhy;
   }
 }
