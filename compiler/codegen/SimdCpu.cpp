@@ -16,9 +16,9 @@
 //     bodies' divisions under an `if` need masked divisions to be if-converted.
 // The rule (stop 44: by features, the models only as measured exceptions): the lanes on AMD
 // family 0x1A and later with AVX-512F; on Intel with AVX-512F and AVX512-FP16 or AMX-TILE
-// (Sapphire Rapids-class cores and later: every Intel CPU measured to gain had them, models
-// 207 and 143 as the hardware reports them and stop 43's VM, which reports model 167 on such
-// cores), and on Intel family 6 models 207 (Emerald Rapids, measured) and 143 (Sapphire
+// (Sapphire Rapids-class cores and later: every Intel CPU measured to gain has them, model 207
+// and stop 43's VM, which reports model 167 on such cores; model 143 has them too, its code
+// measured emulated in stop 44), and on Intel family 6 models 207 (Emerald Rapids, measured) and 143 (Sapphire
 // Rapids) whatever features a VM shows; the scalar loops on other Intel CPUs (AVX-512 without
 // FP16 or AMX: Skylake-SP, Cascade Lake, Ice Lake servers, Rocket Lake; not measured, scalar
 // as before), without AVX-512F, and on every CPU not measured (the scalar loops were the
@@ -158,8 +158,7 @@ SimdCpuVerdict simdLanesOnCpu(const SimdCpu& cpu) {
              (cpu.avx512fp16 || cpu.amxTile ||
               (cpu.family == 6 && (cpu.model == 207 || cpu.model == 143)))) {
     // By features (stop 44): AVX-512F with AVX512-FP16 or AMX-TILE is a Sapphire Rapids-class
-    // core or later (Golden Cove and later server cores: two 512-bit FMA units), whatever
-    // model a VM reports. Stop 43's VM reports model 167 (Rocket Lake's number) on such cores
+    // core or later (Golden Cove and later server cores), whatever model a VM reports. Stop 43's VM reports model 167 (Rocket Lake's number) on such cores
     // (AMX, AVX512-FP16): measured there with the SIMD builds' 512-bit preference
     // (runtime/CMakeLists.txt), the 2D dam break's tiles 0.91x of the scalar loops' CPU,
     // dambreak3d's lanes and tiles 0.74x, the cube's tiles 0.38x (docs/performance-log.md,
