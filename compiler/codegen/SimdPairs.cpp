@@ -387,7 +387,7 @@ ScenePrinter::SimdAutoChoice ScenePrinter::simdPairsAutoChoice(const Destination
   // Auto's rule too where SimdCpuVerdict::tiles2d holds (stop 41: with the j side read from
   // the particles' arrays the tiles beat the scalar loops at dx = 0.03 and ~100k,
   // docs/performance-log.md, "2D tiles by default? (stop 41)"; auto's default on Intel
-  // models 207 and 143 since stop 43).
+  // model 207 since stop 43, on every CPU of the tiles since stop 44: SimdCpu.cpp).
   if (!lanes && simdCluster_ && !clusterAutoSkipsDim() && plan_.dim == 2 && simdCpu_.lanes &&
       onceForm(w, pass) && clusterTilesFormRefusal(w, pass).empty())
     return {true, why + "in cluster-pair tiles at any count (" + simdClusterWhy_ + ")"};

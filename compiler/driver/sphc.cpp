@@ -269,8 +269,10 @@ static cl::opt<std::string> SimdPairs(
              "or mirror domain, zones) at any count; on (or --simd-pairs alone): every loop that allows it; off: the "
              "scalar loops. Under auto a loop in lanes over its own array (kept lists, double "
              "precision) evaluates each pair once in them, the values the pair shares once, "
-             "the source side gathered and scattered; on Intel Sapphire/Emerald Rapids a 3D "
-             "such loop in cluster-pair tiles of 8 x 8 particles instead (stop 38) (once: the "
+             "the source side gathered and scattered; on Intel Sapphire Rapids-class cores "
+             "and later (AVX512-FP16 or AMX; --simd-cpu) a 3D such loop in cluster-pair tiles "
+             "of 8 x 8 particles instead (stop 38), a 2D one over its own array in 2xMM tiles "
+             "(stop 43) (once: the "
              "lanes; perdest: auto's loops "
              "per destination, the default before stop 35; docs/performance.md). --report says "
              "per loop which and why. The sums are reassociated "
@@ -281,13 +283,18 @@ static cl::opt<std::string> SimdCpuOpt(
     "simd-cpu",
     cl::desc("The CPU --simd-pairs=auto chooses for (codegen/SimdCpu.cpp): host (default: "
              "this machine's cpuid, the CPU that -march=native builds for) or "
-             "VENDOR:FAMILY:MODEL as cpuid gives them (GenuineIntel:6:207, AuthenticAMD:26:2), "
-             "with :noavx512 for a CPU without AVX-512F. The lanes where they were measured "
-             "to pay: AMD family 26 (Zen 5) and later and Intel family 6 models 207 and 143 "
-             "(Emerald and Sapphire Rapids; the build allows GCC gathers), with AVX-512F; the "
-             "scalar loops on other Intel CPUs, without AVX-512F (GCC does not vectorise them) "
-             "and on CPUs not measured. sphc -v and --report say which and why"),
-    cl::value_desc("host|VENDOR:FAMILY:MODEL[:noavx512]"), cl::init("host"), cl::cat(SphcCat));
+             "VENDOR:FAMILY:MODEL[:FEATURES] as cpuid gives them (GenuineIntel:6:207, "
+             "AuthenticAMD:26:2, GenuineIntel:6:167:+avx512fp16,+amx), FEATURES a comma list "
+             "of +F or -F with F one of avx512f, avx512fp16, amx, avx512vbmi2 (without it: "
+             "AVX-512F and none of the others; :noavx512 is -avx512f). The lanes where they "
+             "were measured to pay, with AVX-512F: AMD family 26 (Zen 5) and later; Intel with "
+             "AVX512-FP16 or AMX (Sapphire Rapids-class cores and later, whatever the model a "
+             "VM reports) and Intel family 6 models 207 and 143 (Emerald and Sapphire Rapids) "
+             "without them; there the 3D and 2D loops in cluster-pair tiles. The scalar loops "
+             "on other Intel CPUs (AVX-512 without FP16 or AMX: not measured), without "
+             "AVX-512F (GCC does not vectorise them) and on CPUs not measured. sphc -v and "
+             "--report say which, and which features decided"),
+    cl::value_desc("host|VENDOR:FAMILY:MODEL[:FEATURES]"), cl::init("host"), cl::cat(SphcCat));
 static cl::opt<double> SimdNeighbours(
     "simd-neighbours",
     cl::desc("--simd-pairs=auto (and once, perdest): the expected neighbour count from which a "
