@@ -196,6 +196,14 @@ static cl::opt<bool> NoRegisterSums(
              "bodies allow it; serial and openmp, double and single precision (float locals "
              "in single); the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoKernelLanes(
+    "no-kernel-lanes",
+    cl::desc("In the serial CPU loops that evaluate each pair once with scalar code, compute "
+             "the kernel in the pair loop (default: a destination's candidates first in SIMD "
+             "lanes: the cut-off, W and the gradient's factor of each, then the bodies over "
+             "the neighbours among them; double precision, kernels without exp; the results "
+             "are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoSlotOrder(
     "no-slot-order",
     cl::desc("The cluster-pair tiles (--simd-pairs=cluster or auto's) over slot-order copies of "
@@ -675,6 +683,7 @@ int main(int argc, char** argv) {
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;
+  emitOpts.kernelLanes = !NoKernelLanes;
   emitOpts.skipSelfPairs = !NoSelfPairSkip;
   emitOpts.filteredLists = FilteredLists;
   emitOpts.constantValues = !NoConstantValues;
@@ -770,8 +779,9 @@ int main(int argc, char** argv) {
   req.backend = backendName(Backend);
   req.mpi = Mpi;
   req.useCache = !NoCache;
-  // -fopenmp-simd where a loop is printed in SIMD lanes (codegen/SimdPairs.cpp).
-  req.simd = cpp.find("#pragma omp simd reduction") != std::string::npos;
+  // -fopenmp-simd where a loop is printed in SIMD lanes (codegen/SimdPairs.cpp,
+  // ClusterPairs.cpp; the kernel lanes of SymmetricPairs.cpp).
+  req.simd = cpp.find("#pragma omp simd") != std::string::npos;
   req.verbose = Verbose;
   BuildResult res = buildExecutable(install, req);
   log("build");
