@@ -404,7 +404,7 @@ class ScenePrinter {
   // After eq's loop function: its form on the locals (NAME_loop_sums), where a loop uses it.
   void emitSumsFunction(const PlanEquation& eq, std::ostringstream& os);
   bool registerSums_ = false;                // EmitOptions::registerSums (CPU, not mpi)
-  bool kernelLanes_ = false;                 // EmitOptions::kernelLanes (CPU, not mpi)
+  std::string kernelLanes_ = "off";          // EmitOptions::kernelLanes (CPU, not mpi)
   // Why the serial each-pair-once loop of the pass does not compute its candidates' kernel
   // values in SIMD lanes first ("" where it does; SymmetricPairs.cpp).
   std::string kernelLanesRefusal(const NeighbourPass& pass, const std::set<std::string>& q,

@@ -304,7 +304,7 @@ void ScenePrinter::emitSymmetricMembers(std::ostream& os) const {
 std::string ScenePrinter::kernelLanesRefusal(const NeighbourPass& pass,
                                              const std::set<std::string>& q, bool openmp) const {
   (void)pass;
-  if (!kernelLanes_) return "--no-kernel-lanes";
+  if (kernelLanes_ == "off") return "--kernel-lanes=off";
   if (openmp) return "the OpenMP blocks";
   if (singlePrecision_) return "single precision";
   if (plan_.kernel == "Gaussian" || plan_.kernel == "SuperGaussian")
@@ -312,6 +312,21 @@ std::string ScenePrinter::kernelLanesRefusal(const NeighbourPass& pass,
   for (const char* k : {"WI", "WJ", "DWI", "DWJ"})
     if (q.count(k)) return std::string("the pass uses ") + k;
   if (!q.count("WIJ") && !q.count("DWIJ")) return "no kernel value in the pass";
+  // auto: where measured to pay (stop 44): Taylor-Green (one array, periodic, the quintic
+  // spline, W summed: its summation density, its shifting's sums), EDAC 0.90x and WCSPH 0.92x
+  // of the serial CPU at nx = 100, 0.87x at nx = 50. Measured losing: the dam break 1.13x
+  // (WendlandQuintic, walls, no domain; `--simd-pairs=off`), poiseuille 1.07x and the cavity
+  // 1.03x (walls), heat_conduction 1.05x (periodic and the quintic spline, no W summed: its
+  // one pass a gradient), square_droplet 1.02x (WendlandQuintic).
+  if (kernelLanes_ == "auto") {
+    bool sumsW = false;
+    forEachLoopBody([&](const PlanEquation&, const PlanBody& b) {
+      sumsW = sumsW || b.facts.pairQuantities.count("WIJ");
+    });
+    if (!(hasDomain() && plan_.arrays.size() == 1 && plan_.kernel == "QuinticSpline" && sumsW))
+      return "--kernel-lanes=auto: only a scene of one array in a periodic or mirror domain, "
+             "with the quintic spline and a pair loop that uses WIJ (measured to pay there)";
+  }
   return "";
 }
 
@@ -450,6 +465,30 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     const std::string first = sg.skipSelf ? std::string("k_first") : from;
     emitSumsLoad(scene_, in, sums);  // codegen/RegisterSums.cpp
     const std::string body = in + "  ";
+    // The mirrored calls: with the sums in locals, particle s_idx's too, for the pair's
+    // calls (loaded before them, stored after: the same operations on the same values, but
+    // the bodies' stores no longer alias what the next body reads, so the C++ compiler
+    // computes the values they share, e.g. m / rho of s_idx, once for the pair).
+    auto mirroredCalls = [&](const std::string& mb) {
+      if (!sums.active()) {
+        for (const PlanEquation* eq : pass.equations) scene_ << mb << callBodyMirrored(*eq, d);
+        return;
+      }
+      scene_ << mb << "// s_idx's sums in locals for its calls (codegen/SymmetricPairs.cpp)\n";
+      for (const auto& [p, sc] : sums.props)
+        for (int k : sc.second)
+          scene_ << mb << host_.real << " m_" << sumsLocalName(p, sc.first, k) << " = d_" << p
+                 << "[" << sumsIndexText(sc.first, k, "s_idx") << "];\n";
+      for (const PlanEquation* eq : pass.equations) {
+        std::string call = pairCall(*eq, d, sums, false, "m_", mirroredArgument(*eq));
+        call.insert(call.size() - 1, ": destination s_idx, source d_idx");
+        scene_ << mb << call;
+      }
+      for (const auto& [p, sc] : sums.props)
+        for (int k : sc.second)
+          scene_ << mb << "d_" << p << "[" << sumsIndexText(sc.first, k, "s_idx") << "] = m_"
+                 << sumsLocalName(p, sc.first, k) << ";\n";
+    };
     if (lanes) {  // serial: the segment `all` (kernelLanesRefusal)
       const char* ax[3] = {"x", "y", "z"};
       std::string ptrs;
@@ -495,31 +534,13 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
         emitPairQuantitiesOnce(q, bothSides, body, true);
         if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
         for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
-        if (bothSides) {
-          const std::string mb = sg.skipSelf ? body : body + "  ";
-          if (sg.skipSelf)
-            scene_ << body << "// the same pair for particle s_idx\n";
-          else
-            scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
-          if (!sums.active()) {
-            for (const PlanEquation* eq : pass.equations) scene_ << mb << callBodyMirrored(*eq, d);
-          } else {
-            scene_ << mb << "// s_idx's sums in locals for its calls (codegen/SymmetricPairs.cpp)\n";
-            for (const auto& [p, sc] : sums.props)
-              for (int k : sc.second)
-                scene_ << mb << host_.real << " m_" << sumsLocalName(p, sc.first, k) << " = d_" << p
-                       << "[" << sumsIndexText(sc.first, k, "s_idx") << "];\n";
-            for (const PlanEquation* eq : pass.equations) {
-              std::string call = pairCall(*eq, d, sums, false, "m_", mirroredArgument(*eq));
-              call.insert(call.size() - 1, ": destination s_idx, source d_idx");
-              scene_ << mb << call;
-            }
-            for (const auto& [p, sc] : sums.props)
-              for (int k : sc.second)
-                scene_ << mb << "d_" << p << "[" << sumsIndexText(sc.first, k, "s_idx") << "] = m_"
-                       << sumsLocalName(p, sc.first, k) << ";\n";
-          }
-          if (!sg.skipSelf) scene_ << body << "}\n";
+        if (bothSides && sg.skipSelf) {  // s_idx > d_idx: the self pair is not in the list's part
+          scene_ << body << "// the same pair for particle s_idx\n";
+          mirroredCalls(body);
+        } else if (bothSides) {
+          scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
+          mirroredCalls(body + "  ");
+          scene_ << body << "}\n";
         }
         endPairShared();
         scene_ << in << "}\n";
@@ -536,30 +557,6 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       emitPairQuantitiesOnce(q, bothSides, body);
       if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
       for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
-      // The mirrored calls: with the sums in locals, particle s_idx's too, for the pair's
-      // calls (loaded before them, stored after: the same operations on the same values, but
-      // the bodies' stores no longer alias what the next body reads, so the C++ compiler
-      // computes the values they share, e.g. m / rho of s_idx, once for the pair).
-      auto mirroredCalls = [&](const std::string& mb) {
-        if (!sums.active()) {
-          for (const PlanEquation* eq : pass.equations) scene_ << mb << callBodyMirrored(*eq, d);
-          return;
-        }
-        scene_ << mb << "// s_idx's sums in locals for its calls (codegen/SymmetricPairs.cpp)\n";
-        for (const auto& [p, sc] : sums.props)
-          for (int k : sc.second)
-            scene_ << mb << host_.real << " m_" << sumsLocalName(p, sc.first, k) << " = d_" << p
-                   << "[" << sumsIndexText(sc.first, k, "s_idx") << "];\n";
-        for (const PlanEquation* eq : pass.equations) {
-          std::string call = pairCall(*eq, d, sums, false, "m_", mirroredArgument(*eq));
-          call.insert(call.size() - 1, ": destination s_idx, source d_idx");
-          scene_ << mb << call;
-        }
-        for (const auto& [p, sc] : sums.props)
-          for (int k : sc.second)
-            scene_ << mb << "d_" << p << "[" << sumsIndexText(sc.first, k, "s_idx") << "] = m_"
-                   << sumsLocalName(p, sc.first, k) << ";\n";
-      };
       if (bothSides && sg.skipSelf) {  // s_idx > d_idx: the self pair is not in [k_first, ...)
         scene_ << body << "// the same pair for particle s_idx\n";
         mirroredCalls(body);

@@ -196,14 +196,15 @@ static cl::opt<bool> NoRegisterSums(
              "bodies allow it; serial and openmp, double and single precision (float locals "
              "in single); the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
-static cl::opt<bool> NoKernelLanes(
-    "no-kernel-lanes",
-    cl::desc("In the serial CPU loops that evaluate each pair once with scalar code, compute "
-             "the kernel in the pair loop (default: a destination's candidates first in SIMD "
-             "lanes: the cut-off, W and the gradient's factor of each, then the bodies over "
-             "the neighbours among them; double precision, kernels without exp; the results "
-             "are the same bit for bit)"),
-    cl::init(false), cl::cat(SphcCat));
+static cl::opt<std::string> KernelLanesOpt(
+    "kernel-lanes",
+    cl::desc("The serial CPU loops that evaluate each pair once with scalar code: a "
+             "destination's candidates first in SIMD lanes (the cut-off, W and the gradient's "
+             "factor of each), then the bodies over the neighbours among them; double "
+             "precision, kernels without exp. auto (default): in a scene of one array in a "
+             "periodic or mirror domain (measured to pay there); on: wherever the loop allows "
+             "it; off: the kernel in the pair loop. The results are the same bit for bit"),
+    cl::value_desc("auto|on|off"), cl::init("auto"), cl::cat(SphcCat));
 static cl::opt<bool> NoSlotOrder(
     "no-slot-order",
     cl::desc("The cluster-pair tiles (--simd-pairs=cluster or auto's) over slot-order copies of "
@@ -683,7 +684,11 @@ int main(int argc, char** argv) {
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;
-  emitOpts.kernelLanes = !NoKernelLanes;
+  if (KernelLanesOpt != "auto" && KernelLanesOpt != "on" && KernelLanesOpt != "off") {
+    llvm::errs() << "sphc: error: --kernel-lanes=" << KernelLanesOpt << ": it is auto, on or off\n";
+    return fail();
+  }
+  emitOpts.kernelLanes = KernelLanesOpt;
   emitOpts.skipSelfPairs = !NoSelfPairSkip;
   emitOpts.filteredLists = FilteredLists;
   emitOpts.constantValues = !NoConstantValues;
