@@ -370,7 +370,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     std::string ptrs;
     for (int k = 0; k < plan_.dim; ++k) ptrs += std::string("const double* const sj_") + ax[k] + ", ";
     scene_ << "        // The kernel in SIMD lanes first (codegen/SymmetricPairs.cpp, kernelLanesRefusal;\n"
-              "        // sphc --no-kernel-lanes: in the pair loop): per candidate of a destination's list,\n"
+              "        // sphc --kernel-lanes=off: in the pair loop): per candidate of a destination's list,\n"
               "        // whether it is a neighbour, its W and its gradient's factor; then the bodies over\n"
               "        // the neighbours among them in the list's order. The same values bit for bit.\n";
     scene_ << "        std::vector<int> kl_in_v(64), kl_c_v(64);\n";
