@@ -42,6 +42,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   // In single precision too: the locals are of the scene's real type (float), as the sums in
   // memory, so the same operations round alike (RegisterSums.cpp).
   registerSums_ = opts.registerSums && opts.backend != Backend::OpenCL && !mpi_;
+  kernelLanes_ = opts.backend != Backend::OpenCL && !mpi_ ? opts.kernelLanes : "off";
   simdPairs_ = opts.simdPairs && registerSums_;  // SimdPairs.cpp: on the sums in locals
   simdAuto_ = opts.simdPairsAuto;
   simdCpu_ = opts.simdCpu;

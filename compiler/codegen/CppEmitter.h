@@ -98,6 +98,14 @@ struct EmitOptions {
   // precision, not --mpi); false (--no-register-sums): updated in memory at every pair, as
   // before. The values are the same bit for bit.
   bool registerSums = true;
+  // In the serial each-pair-once loops (codegen/SymmetricPairs.cpp) whose kernel values are
+  // WIJ and DWIJ (of HIJ), a destination's candidates first in SIMD lanes: the cut-off, W and
+  // the gradient's factor of each, into short arrays; then the bodies over the neighbours
+  // among them, in the list's order (kernelLanesRefusal says where). "auto" (--kernel-lanes,
+  // the default): where measured to pay, a scene of one array in a periodic or mirror domain
+  // (Taylor-Green); "on": wherever the loop allows it; "off": the kernel in the pair loop, as
+  // before. The values are the same bit for bit (the same IEEE operations per candidate).
+  std::string kernelLanes = "auto";
   // In the each-pair-once loops of one array (codegen/SymmetricPairs.cpp) whose bodies all
   // add only zeros at the self pair (body/SelfPair.cpp: momentum, continuity, XSPH, the
   // shifting's sums, ...), particle i's pairs start after i itself; false

@@ -371,7 +371,9 @@ class ScenePrinter {
   // a neighbour s_idx, with `both` the mirrored ones too (XIJ_ji, DWIJ_ji, ...).
   void emitKeptListsBuild(const std::string& lists, bool openmp, const std::string& listRadius2);
   void emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma);
-  void emitPairQuantitiesOnce(const std::set<std::string>& q, bool both, const std::string& body);
+  // lanes: WIJ and DWIJ from the kernel lanes' arrays (kl_w, kl_s at kl_k).
+  void emitPairQuantitiesOnce(const std::set<std::string>& q, bool both, const std::string& body,
+                              bool lanes = false);
   // Whether an each-pair-once pass leaves out the self pair: every body adds zeros there
   // (BodyFacts::vanishesOnSelfPair, body/SelfPair.cpp) and EmitOptions::skipSelfPairs.
   bool skipsSelfPair(const NeighbourPass& pass) const;
@@ -402,6 +404,11 @@ class ScenePrinter {
   // After eq's loop function: its form on the locals (NAME_loop_sums), where a loop uses it.
   void emitSumsFunction(const PlanEquation& eq, std::ostringstream& os);
   bool registerSums_ = false;                // EmitOptions::registerSums (CPU, not mpi)
+  std::string kernelLanes_ = "off";          // EmitOptions::kernelLanes (CPU, not mpi)
+  // Why the serial each-pair-once loop of the pass does not compute its candidates' kernel
+  // values in SIMD lanes first ("" where it does; SymmetricPairs.cpp).
+  std::string kernelLanesRefusal(const NeighbourPass& pass, const std::set<std::string>& q,
+                                 bool openmp) const;
   std::unique_ptr<std::set<int>> sumsDecls_;  // equation declarations whose _sums form is used
   // eq's loop on the locals, named NAME_loop_sums; `scalarPairs`: NAME_loop_simd, its vector
   // pair quantities three scalars each (XIJ_0, XIJ_1, XIJ_2; SimdPairs.cpp).

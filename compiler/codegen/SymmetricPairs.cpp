@@ -283,6 +283,53 @@ void ScenePrinter::emitSymmetricMembers(std::ostream& os) const {
   });
 }
 
+// The kernel lanes (EmitOptions::kernelLanes; docs/performance-log.md, "Taylor-Green's kernel
+// in SIMD lanes (stop 44)"). In a scalar each-pair-once loop a pair's kernel values wait for
+// a chain of the square root, r / h, the shape's polynomial and, for the gradient, a second
+// division; and the cut-off test's branch, taken for about one candidate in six within a
+// list's skin, flushes what the core had started of the next pairs. So each destination's
+// candidates of [first, end of its list) go first through a loop in SIMD lanes (a lambda
+// compiled without jump threading, as the tiles: GCC 12 threads the shape's branches before
+// if-conversion), which writes per candidate whether it is a neighbour (the test's own
+// operands and comparison, negated: a NaN distance passes as in the scalar test) and its
+// W(RIJ, HIJ) and the gradient's factor s (Kernel::gradient_factor, gradient()'s s bit for
+// bit); then the positions of the neighbours among them, in the list's order (no branch),
+// and the pair loops over those, their other pair quantities as before, DWIJ = s XIJ as
+// gradient() and gradient_pair() compute it. Every value is the one the loop computed
+// before (the same IEEE operations per candidate; -ffp-contract=off), the neighbours come in
+// the same order: the same sums bit for bit. Where: the serial printer (the OpenMP blocks
+// keep the kernel in the pair loop, so OpenMP = serial bitwise still holds), double
+// precision, the kernel values of the pass WIJ and DWIJ only (not WI, WJ, DWI, DWJ), a kernel
+// without exp (the Gaussians: a vector exp is not the scalar one's bits).
+std::string ScenePrinter::kernelLanesRefusal(const NeighbourPass& pass,
+                                             const std::set<std::string>& q, bool openmp) const {
+  (void)pass;
+  if (kernelLanes_ == "off") return "--kernel-lanes=off";
+  if (openmp) return "the OpenMP blocks";
+  if (singlePrecision_) return "single precision";
+  if (plan_.kernel == "Gaussian" || plan_.kernel == "SuperGaussian")
+    return "the kernel " + plan_.kernel + " calls exp";
+  for (const char* k : {"WI", "WJ", "DWI", "DWJ"})
+    if (q.count(k)) return std::string("the pass uses ") + k;
+  if (!q.count("WIJ") && !q.count("DWIJ")) return "no kernel value in the pass";
+  // auto: where measured to pay (stop 44): Taylor-Green (one array, periodic, the quintic
+  // spline, W summed: its summation density, its shifting's sums), EDAC 0.90x and WCSPH 0.92x
+  // of the serial CPU at nx = 100, 0.87x at nx = 50. Measured losing: the dam break 1.13x
+  // (WendlandQuintic, walls, no domain; `--simd-pairs=off`), poiseuille 1.07x and the cavity
+  // 1.03x (walls), heat_conduction 1.05x (periodic and the quintic spline, no W summed: its
+  // one pass a gradient), square_droplet 1.02x (WendlandQuintic).
+  if (kernelLanes_ == "auto") {
+    bool sumsW = false;
+    forEachLoopBody([&](const PlanEquation&, const PlanBody& b) {
+      sumsW = sumsW || b.facts.pairQuantities.count("WIJ");
+    });
+    if (!(hasDomain() && plan_.arrays.size() == 1 && plan_.kernel == "QuinticSpline" && sumsW))
+      return "--kernel-lanes=auto: only a scene of one array in a periodic or mirror domain, "
+             "with the quintic spline and a pair loop that uses WIJ (measured to pay there)";
+  }
+  return "";
+}
+
 void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPass& pass,
                                      const std::string& lists, bool openmp,
                                      const std::string& listRadius2) {
@@ -317,6 +364,47 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   emitDestinationHoistedAll(pass, pragma);
   const RegisterSums sums = registerSums(w, pass);
   if (simd) return emitSymmetricSimdLoops(w, pass, lists, openmp, q, sums);
+  const bool lanes = kernelLanesRefusal(pass, q, openmp).empty();
+  if (lanes) {
+    const char* ax[3] = {"x", "y", "z"};
+    std::string ptrs;
+    for (int k = 0; k < plan_.dim; ++k) ptrs += std::string("const double* const sj_") + ax[k] + ", ";
+    scene_ << "        // The kernel in SIMD lanes first (codegen/SymmetricPairs.cpp, kernelLanesRefusal;\n"
+              "        // sphc --kernel-lanes=off: in the pair loop): per candidate of a destination's list,\n"
+              "        // whether it is a neighbour, its W and its gradient's factor; then the bodies over\n"
+              "        // the neighbours among them in the list's order. The same values bit for bit.\n";
+    scene_ << "        std::vector<int> kl_in_v(64), kl_c_v(64);\n";
+    scene_ << "        std::vector<double> kl_w_v(64), kl_s_v(64);\n";
+    scene_ << "#if defined(__GNUC__) && !defined(__clang__)\n"
+              "#define SPHC_KERNEL_LANES_OPTIMIZE __attribute__((optimize(\"no-thread-jumps\")))\n"
+              "#else\n"
+              "#define SPHC_KERNEL_LANES_OPTIMIZE\n"
+              "#endif\n";
+    scene_ << "        auto kernel_lanes = [](const std::uint32_t* const kb, const int k_count, "
+              "const double xi, const double yi, const double zi, const double hi, " << ptrs
+           << "const double* const sj_h, int* const kl_in, double* const kl_w, double* const kl_s) "
+              "SPHC_KERNEL_LANES_OPTIMIZE {\n";
+    scene_ << "          (void)xi; (void)yi; (void)zi; (void)kl_w; (void)kl_s;\n";
+    scene_ << "          #pragma omp simd\n";
+    scene_ << "          for (int kl_k = 0; kl_k < k_count; ++kl_k) {\n";
+    const std::string lb = "            ";
+    scene_ << lb << "const int s_idx = static_cast<int>(kb[kl_k]);\n";
+    std::ostringstream test;
+    emitNeighbourTest(test, host_, "continue;", lb);
+    std::string t = test.str();
+    // The test's comparison as a value: !(R2IJ >= RADIUS2 * hmax * hmax), as the scalar loop skips.
+    const std::string ifs = "if (R2IJ >= RADIUS2 * hmax * hmax) continue;";
+    const size_t at = t.find(ifs);
+    if (at == std::string::npos) SPHC_INTERNAL("kernel lanes: the neighbour test's text");
+    const size_t eol = t.find('\n', at);
+    t.replace(at, eol - at, "kl_in[kl_k] = !(R2IJ >= RADIUS2 * hmax * hmax) ? 1 : 0;  // a neighbour");
+    scene_ << t;
+    scene_ << lb << "const double HIJ = 0.5 * (hi + hj);\n";
+    scene_ << lb << "const double RIJ = std::sqrt(R2IJ);\n";
+    if (q.count("WIJ")) scene_ << lb << "kl_w[kl_k] = Kernel::w(RIJ, HIJ);\n";
+    if (q.count("DWIJ")) scene_ << lb << "kl_s[kl_k] = Kernel::gradient_factor(RIJ, HIJ);\n";
+    scene_ << "          }\n        };\n";
+  }
   // One destination's neighbours in [from, to) of its kept list (sorted): the pair
   // quantities, the bodies for d_idx and, with `both`, for s_idx (unless the self pair).
   // With `tail` (OpenMP blocks), the rest of the list after `to` follows for d_idx alone, in
@@ -377,36 +465,98 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     const std::string first = sg.skipSelf ? std::string("k_first") : from;
     emitSumsLoad(scene_, in, sums);  // codegen/RegisterSums.cpp
     const std::string body = in + "  ";
+    // The mirrored calls: with the sums in locals, particle s_idx's too, for the pair's
+    // calls (loaded before them, stored after: the same operations on the same values, but
+    // the bodies' stores no longer alias what the next body reads, so the C++ compiler
+    // computes the values they share, e.g. m / rho of s_idx, once for the pair).
+    auto mirroredCalls = [&](const std::string& mb) {
+      if (!sums.active()) {
+        for (const PlanEquation* eq : pass.equations) scene_ << mb << callBodyMirrored(*eq, d);
+        return;
+      }
+      scene_ << mb << "// s_idx's sums in locals for its calls (codegen/SymmetricPairs.cpp)\n";
+      for (const auto& [p, sc] : sums.props)
+        for (int k : sc.second)
+          scene_ << mb << host_.real << " m_" << sumsLocalName(p, sc.first, k) << " = d_" << p
+                 << "[" << sumsIndexText(sc.first, k, "s_idx") << "];\n";
+      for (const PlanEquation* eq : pass.equations) {
+        std::string call = pairCall(*eq, d, sums, false, "m_", mirroredArgument(*eq));
+        call.insert(call.size() - 1, ": destination s_idx, source d_idx");
+        scene_ << mb << call;
+      }
+      for (const auto& [p, sc] : sums.props)
+        for (int k : sc.second)
+          scene_ << mb << "d_" << p << "[" << sumsIndexText(sc.first, k, "s_idx") << "] = m_"
+                 << sumsLocalName(p, sc.first, k) << ";\n";
+    };
+    if (lanes) {  // serial: the segment `all` (kernelLanesRefusal)
+      const char* ax[3] = {"x", "y", "z"};
+      std::string ptrs;
+      for (int k = 0; k < plan_.dim; ++k) ptrs += std::string("sj_") + ax[k] + ", ";
+      scene_ << in << "const std::uint32_t* const k_lanes = " << first << ";\n";
+      scene_ << in << "const int k_count = static_cast<int>(k_end - k_lanes);\n";
+      scene_ << in << "if (kl_in_v.size() < static_cast<std::size_t>(k_count)) {\n"
+             << in << "  kl_in_v.resize(2 * k_count + 64);\n"
+             << in << "  kl_c_v.resize(2 * k_count + 64);\n"
+             << in << "  kl_w_v.resize(2 * k_count + 64);\n"
+             << in << "  kl_s_v.resize(2 * k_count + 64);\n"
+             << in << "}\n";
+      scene_ << in << "int* const kl_c = kl_c_v.data();\n";
+      scene_ << in << "const int* const kl_in = kl_in_v.data();\n";
+      scene_ << in << "const double* const kl_w = kl_w_v.data();\n";
+      scene_ << in << "const double* const kl_s = kl_s_v.data();\n";
+      scene_ << in << "(void)kl_w; (void)kl_s;\n";
+      scene_ << in << "kernel_lanes(k_lanes, k_count, xi, yi, zi, hi, " << ptrs
+             << "sj_h, kl_in_v.data(), kl_w_v.data(), kl_s_v.data());\n";
+      if (sg.tail)
+        scene_ << in << "const int k_mid = k_count == 0 || k_lanes[k_count - 1] < static_cast<std::uint32_t>("
+               << to << ")\n"
+               << in << "    ? k_count : static_cast<int>(std::lower_bound(k_lanes, k_end, "
+                        "static_cast<std::uint32_t>(" << to << ")) - k_lanes);\n";
+      else
+        scene_ << in << "const int k_mid = k_count;\n";
+      scene_ << in << "// the neighbours' positions in the list, in its order (no branch)\n";
+      scene_ << in << "int e_n = 0;\n";
+      scene_ << in << "for (int kl_k = 0; kl_k < k_mid; ++kl_k) {\n"
+             << in << "  kl_c[e_n] = kl_k;\n" << in << "  e_n += kl_in[kl_k];\n" << in << "}\n";
+      scene_ << in << "const int e_mid = e_n;\n";
+      if (sg.tail)
+        scene_ << in << "for (int kl_k = k_mid; kl_k < k_count; ++kl_k) {\n"
+               << in << "  kl_c[e_n] = kl_k;\n" << in << "  e_n += kl_in[kl_k];\n" << in << "}\n";
+      auto lanePairs = [&](bool bothSides, const std::string& range, const std::string& note) {
+        scene_ << in << "for (int e = " << range << "; ++e) {" << note << "\n";
+        scene_ << body << "const int kl_k = kl_c[e];\n";
+        scene_ << body << "const int s_idx = static_cast<int>(k_lanes[kl_k]);\n";
+        scene_ << body << "const double hj = sj_h[s_idx];\n";
+        for (const PairQuantity& pq : pairQuantityTable())
+          if (pq.when == PairWhen::BeforeTest)
+            scene_ << pairQuantityStatement(pq, plan_.dim, pairDialectOf(host_), body);
+        emitPairQuantitiesOnce(q, bothSides, body, true);
+        if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
+        for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
+        if (bothSides && sg.skipSelf) {  // s_idx > d_idx: the self pair is not in the list's part
+          scene_ << body << "// the same pair for particle s_idx\n";
+          mirroredCalls(body);
+        } else if (bothSides) {
+          scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
+          mirroredCalls(body + "  ");
+          scene_ << body << "}\n";
+        }
+        endPairShared();
+        scene_ << in << "}\n";
+      };
+      lanePairs(sg.both, "0; e < e_mid", "");
+      if (sg.tail) lanePairs(false, "e_mid; e < e_n", "  // the ghosts: d_idx only");
+      emitSumsStore(scene_, in, sums);
+      scene_ << indent << "}\n";
+      return;
+    }
     auto pairs = [&](bool bothSides) {
       scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
       emitNeighbourTest(scene_, host_, "continue;", body);
       emitPairQuantitiesOnce(q, bothSides, body);
       if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
       for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
-      // The mirrored calls: with the sums in locals, particle s_idx's too, for the pair's
-      // calls (loaded before them, stored after: the same operations on the same values, but
-      // the bodies' stores no longer alias what the next body reads, so the C++ compiler
-      // computes the values they share, e.g. m / rho of s_idx, once for the pair).
-      auto mirroredCalls = [&](const std::string& mb) {
-        if (!sums.active()) {
-          for (const PlanEquation* eq : pass.equations) scene_ << mb << callBodyMirrored(*eq, d);
-          return;
-        }
-        scene_ << mb << "// s_idx's sums in locals for its calls (codegen/SymmetricPairs.cpp)\n";
-        for (const auto& [p, sc] : sums.props)
-          for (int k : sc.second)
-            scene_ << mb << host_.real << " m_" << sumsLocalName(p, sc.first, k) << " = d_" << p
-                   << "[" << sumsIndexText(sc.first, k, "s_idx") << "];\n";
-        for (const PlanEquation* eq : pass.equations) {
-          std::string call = pairCall(*eq, d, sums, false, "m_", mirroredArgument(*eq));
-          call.insert(call.size() - 1, ": destination s_idx, source d_idx");
-          scene_ << mb << call;
-        }
-        for (const auto& [p, sc] : sums.props)
-          for (int k : sc.second)
-            scene_ << mb << "d_" << p << "[" << sumsIndexText(sc.first, k, "s_idx") << "] = m_"
-                   << sumsLocalName(p, sc.first, k) << ";\n";
-      };
       if (bothSides && sg.skipSelf) {  // s_idx > d_idx: the self pair is not in [k_first, ...)
         scene_ << body << "// the same pair for particle s_idx\n";
         mirroredCalls(body);
@@ -549,7 +699,7 @@ void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const st
 }
 
 void ScenePrinter::emitPairQuantitiesOnce(const std::set<std::string>& q, bool both,
-                                          const std::string& body) {
+                                          const std::string& body, bool lanes) {
   const PairDialect dialect = pairDialectOf(host_);
   auto difference = [&](const PairQuantity& pq, bool mirror) {
     scene_ << body << "const " << dialect.real << " " << pq.name << (mirror ? "_ji" : "") << "[3] = {";
@@ -568,6 +718,17 @@ void ScenePrinter::emitPairQuantitiesOnce(const std::set<std::string>& q, bool b
   for (const PairQuantity& pq : pairQuantityTable()) {
     if (!(pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name))))
       continue;
+    if (lanes && pq.name == "WIJ") {  // the kernel lanes' value (kernelLanesRefusal)
+      scene_ << body << "const " << dialect.real << " WIJ = kl_w[kl_k];\n";
+      continue;
+    }
+    if (lanes && pq.name == "DWIJ") {  // s XIJ with the lanes' factor s: gradient()'s values
+      scene_ << body << "const " << dialect.real << " kl_sf = kl_s[kl_k];\n";
+      for (const char* side : both ? std::vector<const char*>{"", "_ji"} : std::vector<const char*>{""})
+        scene_ << body << dialect.real << " DWIJ" << side << "[3] = {kl_sf * XIJ" << side
+               << "[0], kl_sf * XIJ" << side << "[1], kl_sf * XIJ" << side << "[2]};\n";
+      continue;
+    }
     if (both && pq.form == PairForm::Difference) {
       difference(pq, false);
       difference(pq, true);

@@ -196,6 +196,15 @@ static cl::opt<bool> NoRegisterSums(
              "bodies allow it; serial and openmp, double and single precision (float locals "
              "in single); the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<std::string> KernelLanesOpt(
+    "kernel-lanes",
+    cl::desc("The serial CPU loops that evaluate each pair once with scalar code: a "
+             "destination's candidates first in SIMD lanes (the cut-off, W and the gradient's "
+             "factor of each), then the bodies over the neighbours among them; double "
+             "precision, kernels without exp. auto (default): in a scene of one array in a "
+             "periodic or mirror domain (measured to pay there); on: wherever the loop allows "
+             "it; off: the kernel in the pair loop. The results are the same bit for bit"),
+    cl::value_desc("auto|on|off"), cl::init("auto"), cl::cat(SphcCat));
 static cl::opt<bool> NoSlotOrder(
     "no-slot-order",
     cl::desc("The cluster-pair tiles (--simd-pairs=cluster or auto's) over slot-order copies of "
@@ -682,6 +691,11 @@ int main(int argc, char** argv) {
   emitOpts.intPow = IntPowOpt == OnOff::On;
   emitOpts.lazyCells = !NoLazyCells;
   emitOpts.registerSums = !NoRegisterSums;
+  if (KernelLanesOpt != "auto" && KernelLanesOpt != "on" && KernelLanesOpt != "off") {
+    llvm::errs() << "sphc: error: --kernel-lanes=" << KernelLanesOpt << ": it is auto, on or off\n";
+    return fail();
+  }
+  emitOpts.kernelLanes = KernelLanesOpt;
   emitOpts.skipSelfPairs = !NoSelfPairSkip;
   emitOpts.filteredLists = FilteredLists;
   emitOpts.constantValues = !NoConstantValues;
@@ -777,8 +791,9 @@ int main(int argc, char** argv) {
   req.backend = backendName(Backend);
   req.mpi = Mpi;
   req.useCache = !NoCache;
-  // -fopenmp-simd where a loop is printed in SIMD lanes (codegen/SimdPairs.cpp).
-  req.simd = cpp.find("#pragma omp simd reduction") != std::string::npos;
+  // -fopenmp-simd where a loop is printed in SIMD lanes (codegen/SimdPairs.cpp,
+  // ClusterPairs.cpp; the kernel lanes of SymmetricPairs.cpp).
+  req.simd = cpp.find("#pragma omp simd") != std::string::npos;
   req.verbose = Verbose;
   BuildResult res = buildExecutable(install, req);
   log("build");
