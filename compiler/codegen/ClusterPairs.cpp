@@ -637,8 +637,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   }
   // The tiles, in a lambda without jump threading (see above), over the i-clusters [cb, ce)
   // of one block: serial, one block of them all; OpenMP, blocks in parallel, the same sums.
+  // OpenMP (stop 44): without loop splitting too, which cut the loop over the i-clusters at
+  // ci == cb into two copies of the tile code, the earlier blocks' and the block's own
+  // (docs/performance-log.md "Cold compile back under 3 s (stop 44)").
   scene_ << "#if defined(__GNUC__) && !defined(__clang__)\n"
-            "#define SPHC_TILES_OPTIMIZE __attribute__((optimize(\"no-thread-jumps\")))\n"
+            "#define SPHC_TILES_OPTIMIZE __attribute__((optimize(\"no-thread-jumps\""
+         << (openmp ? ", \"no-split-loops\"" : "") << ")))\n"
             "#else\n"
             "#define SPHC_TILES_OPTIMIZE\n"
             "#endif\n";
@@ -748,7 +752,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   // form, a pass that keeps the self pair (its two sides' masks differ on the diagonal) or one
   // whose bodies call a rare math function (their marked lanes' fix-up is per row).
   const bool queueTiles = clusterQueue_ && !mm && !selfPair && !rareCalls(pass);
-  auto tile = [&](Side side, const std::string& c2) {
+  // jKept (OpenMP): the condition under which the tile's j sums are added (its j-cluster in
+  // the block), empty: always.
+  auto tile = [&](Side side, const std::string& c2, const std::string& jKept) {
     const bool iSide = side != Side::J, jSide = side != Side::I;
     const std::string L = "CL_LANES";  // the lanes of a register
     if (mm) {
@@ -1079,6 +1085,10 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << "#else\n" << rows << "#endif\n";
     }
     if (jSide) {
+      const std::string c2o = c2;  // (the tile's indent; the fold's under jKept)
+      const std::string c2 = jKept.empty() ? c2o : c2o + "  ";
+      if (!jKept.empty())
+        scene_ << c2o << "if (" << jKept << ") {  // the j side: its j-cluster in the block\n";
       if (inOrder && nSlotAccs)  // the slot sums' (the padded cluster's in its own slots)
         scene_ << c2 << "const int jslot = static_cast<int>(cl_j[e]) * CL_W;\n";
       if (inOrder)  // the fold's targets, chosen once per tile
@@ -1096,29 +1106,34 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
           scene_ << c2 << "  " << jAcc(p) << (inOrder && !direct(p) ? "[jslot + l]" : accAt(p, "j0 + l")) << " += tj_" << p << "[l];\n";
       }
       scene_ << c2 << "}\n";
+      if (!jKept.empty()) scene_ << c2o << "}\n";
     }
   };
-  if (openmp) {
-    scene_ << t << "// (1) the j sides of earlier i-clusters' tiles with j-clusters in [cb, ce)\n";
-    scene_ << t << "for (int ci = 0; ci < cb; ++ci) {\n";
-    const std::string c1 = t + "  ";
-    scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
-    scene_ << c1 << "if (cl_begin[ci] == e_end || cl_j[e_end - 1] < static_cast<std::uint32_t>(cb)) continue;\n";
-    scene_ << c1 << "std::uint32_t e = static_cast<std::uint32_t>(std::lower_bound(cl_j + cl_begin[ci], cl_j + e_end, "
-                    "static_cast<std::uint32_t>(cb)) - cl_j);\n";
-    if (mm) scene_ << c1 << "if (e == e_end || cl_j[e] >= static_cast<std::uint32_t>(ce)) continue;\n";
-    scene_ << c1 << "const unsigned real_i = cl_real[ci];\n";
-    if (mm) iRegisters(c1);
-    scene_ << c1 << "for (; e < e_end && cl_j[e] < static_cast<std::uint32_t>(ce); ++e) {\n";
-    tile(Side::J, c1 + "  ");
-    scene_ << c1 << "}\n";
-    scene_ << t << "}\n";
-    scene_ << t << "// (2) the block's i-clusters\n";
-  }
-  scene_ << t << "for (int ci = cb; ci < ce; ++ci) {\n";
+  // OpenMP (stop 44): each i-cluster's tiles printed once, whole (the half tiles were copies
+  // of them: three tile bodies per pass for GCC to optimise, the pair loops' unit 1.8x the
+  // serial one's CPU); a half tile computes the whole tile and keeps one side's sums.
   const std::string c1 = t + "  ";
-  scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
-  scene_ << c1 << "if (cl_begin[ci] == e_end) continue;\n";
+  if (openmp) {
+    scene_ << t << "// (1) the i-clusters of EARLIER blocks (ci < cb): their tiles with j-clusters in\n"
+           << t << "//     [cb, ce), the j sides kept (j-side half tiles);\n"
+           << t << "// (2) the block's i-clusters: the i sides of all their tiles, the j sides of those\n"
+           << t << "//     with j-clusters in the block (later blocks': i-side half tiles).\n"
+           << t << "// A half tile is computed whole, its other side's sums left unwritten: its side is\n"
+           << t << "// the same operations on the same values as in the whole tile.\n";
+    scene_ << t << "for (int ci = 0; ci < ce; ++ci) {\n";
+    scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
+    scene_ << c1 << "if (cl_begin[ci] == e_end || (ci < cb && cl_j[e_end - 1] < static_cast<std::uint32_t>(cb))) continue;\n";
+    scene_ << c1 << "std::uint32_t e_first = cl_begin[ci], e_last = e_end;\n";
+    scene_ << c1 << "if (ci < cb) {  // an earlier block's i-cluster: its tiles with j-clusters in [cb, ce)\n";
+    scene_ << c1 << "  e_first = static_cast<std::uint32_t>(std::lower_bound(cl_j + e_first, cl_j + e_end, static_cast<std::uint32_t>(cb)) - cl_j);\n";
+    scene_ << c1 << "  e_last = static_cast<std::uint32_t>(std::lower_bound(cl_j + e_first, cl_j + e_end, static_cast<std::uint32_t>(ce)) - cl_j);\n";
+    scene_ << c1 << "  if (e_first == e_last) continue;\n";
+    scene_ << c1 << "}\n";
+  } else {
+    scene_ << t << "for (int ci = cb; ci < ce; ++ci) {\n";
+    scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
+    scene_ << c1 << "if (cl_begin[ci] == e_end) continue;\n";
+  }
   scene_ << c1 << "const unsigned real_i = cl_real[ci];\n";
   if (mm) {
     iRegisters(c1);
@@ -1129,19 +1144,15 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (const std::string& p : accs) scene_ << c1 << "alignas(64) double ti_" << p << "[CL_W][CL_LANES] = {};\n";
   }
   if (openmp) {
-    scene_ << c1 << "// the tiles with j-clusters in the block (both sides), then those in later blocks\n";
-    scene_ << c1 << "const std::uint32_t e_mid = static_cast<std::uint32_t>(std::lower_bound(cl_j + cl_begin[ci], "
-                    "cl_j + e_end, static_cast<std::uint32_t>(ce)) - cl_j);\n";
-    scene_ << c1 << "std::uint32_t e = cl_begin[ci];\n";
-    scene_ << c1 << "for (; e < e_mid; ++e) {\n";
+    scene_ << c1 << "for (std::uint32_t e = e_first; e < e_last; ++e) {\n";
+    // (the j-cluster's block by its index, not by e: GCC's -fsplit-loops would split the loop
+    // where e reaches the later blocks, a copy of the tile each side)
+    tile(Side::Both, c1 + "  ", "cl_j[e] < static_cast<std::uint32_t>(ce)");
+    scene_ << c1 << "}\n";
+    scene_ << c1 << "if (ci < cb) continue;  // an earlier block's i-cluster: its i sums are that block's\n";
   } else {
     scene_ << c1 << "for (std::uint32_t e = cl_begin[ci]; e < e_end; ++e) {\n";
-  }
-  tile(Side::Both, c1 + "  ");
-  scene_ << c1 << "}\n";
-  if (openmp) {
-    scene_ << c1 << "for (; e < e_end; ++e) {  // the i side only: the later block adds the j side\n";
-    tile(Side::I, c1 + "  ");
+    tile(Side::Both, c1 + "  ", "");
     scene_ << c1 << "}\n";
   }
   if (mm) {
