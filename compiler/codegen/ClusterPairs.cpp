@@ -1090,7 +1090,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     }
   };
   // OpenMP (stop 44): each i-cluster's tiles printed once, whole (the half tiles were copies
-  // of them: three tile bodies per pass for GCC to optimise, the pair loops' unit 1.8x the
+  // of them: three tile bodies per pass for GCC to optimise, the pair loops' unit 1.6x the
   // serial one's CPU); a half tile computes the whole tile and keeps one side's sums.
   const std::string c1 = t + "  ";
   if (openmp) {
