@@ -78,7 +78,8 @@
 // j-clusters in the block whole, those with j-clusters in later blocks for the i side only.
 // A tile across two blocks is computed twice, each side once (the scalar loops' OpenMP
 // scheme, SymmetricPairs.cpp, in tiles), so the OpenMP build's sums are the serial tiles'
-// bit for bit for any thread count (test: stability.cluster_omp_*).
+// bit for bit for any thread count (test: stability.cluster_omp_*). Since stop 44 a half tile
+// is the whole tile with its other side's sums left unwritten (one copy of the tile's code).
 #include "analysis/PairQuantityTable.h"
 #include "codegen/CppText.h"
 #include "codegen/Printer.h"
@@ -637,8 +638,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   }
   // The tiles, in a lambda without jump threading (see above), over the i-clusters [cb, ce)
   // of one block: serial, one block of them all; OpenMP, blocks in parallel, the same sums.
+  // OpenMP (stop 44): without loop splitting too, which cut the loop over the i-clusters at
+  // ci == cb into two copies of the tile code, the earlier blocks' and the block's own
+  // (docs/performance-log.md "Cold compile back under 3 s (stop 44)").
   scene_ << "#if defined(__GNUC__) && !defined(__clang__)\n"
-            "#define SPHC_TILES_OPTIMIZE __attribute__((optimize(\"no-thread-jumps\")))\n"
+            "#define SPHC_TILES_OPTIMIZE __attribute__((optimize(\"no-thread-jumps\""
+         << (openmp ? ", \"no-split-loops\"" : "") << ")))\n"
             "#else\n"
             "#define SPHC_TILES_OPTIMIZE\n"
             "#endif\n";
@@ -653,8 +658,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
            << in << "// (2) the block's i-clusters: their tiles with j-clusters in the block for both\n"
            << in << "//     sides, those with j-clusters in LATER blocks for the i side only (i-side\n"
            << in << "//     half tiles: the later block computes their j sides in its (1)).\n"
-           << in << "// A tile across two blocks is computed twice, each side once; a half tile does\n"
-           << in << "// the same operations on the same values as its side of the whole tile.\n";
+           << in << "// A tile across two blocks is computed twice, each side once: a half tile is the\n"
+           << in << "// whole tile with its other side's sums left unwritten (one copy of the tile's code).\n";
   if (inOrder && accs.size() > nSlotAccs) {
     scene_ << in << "// the padded cluster's j-side sums (written by the block that holds it only)\n";
     for (const std::string& p : accs)
@@ -741,15 +746,14 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   auto jAcc = [&](const std::string& p) {
     return (direct(p) ? "ja_" : "cl_acc_") + p;
   };
-  // One tile (j-cluster cl_j[e] of i-cluster ci): both sides, or one side's half tile.
-  enum class Side { Both, I, J };
   // --cluster-queue (stop 43; docs/performance-log.md "The tiles' pairs compacted (stop 43)"):
   // the 8 x 8 tiles' pairs within the support compacted, 8 to a register. Not for the 2xMM
   // form, a pass that keeps the self pair (its two sides' masks differ on the diagonal) or one
   // whose bodies call a rare math function (their marked lanes' fix-up is per row).
   const bool queueTiles = clusterQueue_ && !mm && !selfPair && !rareCalls(pass);
-  auto tile = [&](Side side, const std::string& c2) {
-    const bool iSide = side != Side::J, jSide = side != Side::I;
+  // One tile (j-cluster cl_j[e] of i-cluster ci), both sides; jKept (OpenMP): the condition
+  // under which its j sums are added (its j-cluster in the block), empty: always.
+  auto tile = [&](const std::string& c2, const std::string& jKept) {
     const std::string L = "CL_LANES";  // the lanes of a register
     if (mm) {
       if (inOrder) {
@@ -775,8 +779,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       if (mm && arrays) return "tj2_" + name;
       return !mm && inOrder ? "(jt ? cl_t_" + name + " : cl_" + name + ")" + jAt : jOff + name + jAt;
     };
-    if (side == Side::Both)
-      scene_ << c2 << "const bool diagonal = cl_j[e] == static_cast<std::uint32_t>(ci);\n";
+    scene_ << c2 << "const bool diagonal = cl_j[e] == static_cast<std::uint32_t>(ci);\n";
     if (mm && arrays) {
       scene_ << c2 << "// The source side: the j-cluster's CL_W values twice in tile-local registers, s_idx the\n"
              << c2 << "// lane (stop 41: from the particles' arrays, the padded cluster from its tails).\n";
@@ -795,10 +798,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     // (the mirrored calls read particle s_idx's destination values through d_NAME)
     for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = " << jPtr(p) << ";\n";
     for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = " << jPtr(h) << ";\n";
-    if (jSide) {
-      scene_ << c2 << "// j's sums over the tile's i's" << (mm ? " (lanes l and l + CL_W: j l)" : "") << "\n";
-      for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[" << L << "] = {};\n";
-    }
+    scene_ << c2 << "// j's sums over the tile's i's" << (mm ? " (lanes l and l + CL_W: j l)" : "") << "\n";
+    for (const std::string& p : accs) scene_ << c2 << "alignas(64) double tj_" << p << "[" << L << "] = {};\n";
     std::string c3 = c2 + "  ";
     // --cluster-queue (stop 43): the rows below are printed, then moved after the queue's
     // form as its #else (the queue's lanes print with laneBody, defined with the rows).
@@ -809,13 +810,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << c3 << "// the register's i's: d_idx is the lane too (ir_NAME: the i of lane d_idx)\n";
       for (const auto& c : copies) scene_ << c3 << "const double* const ir_" << c.first << " = ri_" << c.first << "[r];\n";
       for (const std::string& p : pass.shared) scene_ << c3 << "const double* const di_" << p << " = ir_" << p << ";\n";
-      if (side == Side::Both) {
-        scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
-        scene_ << c3 << "const double lane_s = diagonal ? 2.0 * r : -8.0;  // + cl_ilane: the lane's i in the cluster\n";
-        scene_ << c3 << "const double lane_d = lane_s" << (selfPair ? " - 1.0" : "") << ";\n";
-      } else {
-        scene_ << c3 << "// (a half tile is never on the diagonal: every lane within the cut-off counts)\n";
-      }
+      scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
+      scene_ << c3 << "const double lane_s = diagonal ? 2.0 * r : -8.0;  // + cl_ilane: the lane's i in the cluster\n";
+      scene_ << c3 << "const double lane_d = lane_s" << (selfPair ? " - 1.0" : "") << ";\n";
     } else {
       scene_ << c2 << "for (int ii = 0; ii < CL_W && (real_i >> ii & 1u); ++ii) {  // the real i's (first)\n";
       scene_ << c3 << "const int d_idx = ci * CL_W + ii;\n";
@@ -837,13 +834,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
             if (loads.insert(sourceValueName(p, 1, 0)).second)
               scene_ << c3 << "const double " << sourceValueName(p, 1, 0) << " = cl_" << p << "[d_idx];\n";
       }
-      if (side == Side::Both) {
-        scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
-        scene_ << c3 << "const double lane_s = diagonal ? static_cast<double>(ii) : -1.0;\n";
-        scene_ << c3 << "const double lane_d = diagonal ? static_cast<double>(ii" << (selfPair ? " - 1" : "") << ") : -1.0;\n";
-      } else {
-        scene_ << c3 << "// (a half tile is never on the diagonal: every lane within the cut-off counts)\n";
-      }
+      scene_ << c3 << "// the diagonal tile: lanes j > i (" << (selfPair ? "and the self pair j == i for d_idx" : "the self pair skipped: every body adds zeros there") << ")\n";
+      scene_ << c3 << "const double lane_s = diagonal ? static_cast<double>(ii) : -1.0;\n";
+      scene_ << c3 << "const double lane_d = diagonal ? static_cast<double>(ii" << (selfPair ? " - 1" : "") << ") : -1.0;\n";
     }
     // 2xMM: the i's values of a lane (d_idx = the lane), at the top of a lane loop's body.
     auto laneDest = [&](const std::string& b) {
@@ -881,7 +874,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << "#if defined(__AVX512F__)\n";
       scene_ << c3 << "if (!sphc::tile_row_any<DIM>(xi, yi, " << (plan_.dim == 3 ? "zi" : "0.0")
              << ", hi, sj_x, sj_y, " << (plan_.dim == 3 ? "sj_z" : "nullptr") << ", sj_h, cl_lane, "
-             << (side == Side::Both ? "lane_d" : "-1.0") << ", RADIUS2)) continue;  // no pair of the row within the support\n";
+             << "lane_d, RADIUS2)) continue;  // no pair of the row within the support\n";
       scene_ << "#else\n";
     }
     scene_ << c3 << "double any = 0.0;\n";
@@ -902,17 +895,15 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       }
       scene_ << b << "const double R2IJ = " << r2 << ";\n";
       scene_ << b << "const double hmax = hi > hj ? hi : hj;\n";
-      const std::string in = side == Side::Both ? "!(R2IJ >= RADIUS2 * hmax * hmax) & (" + jl + " > " + il + "lane_d)"
-                                                : "!(R2IJ >= RADIUS2 * hmax * hmax)";
+      const std::string in = "!(R2IJ >= RADIUS2 * hmax * hmax) & (" + jl + " > " + il + "lane_d)";
       scene_ << b << "const double in_l = " << in << " ? 1.0 : 0.0;\n";
       scene_ << b << "any = any > in_l ? any : in_l;\n";
     }
     scene_ << c3 << "}\n";
     scene_ << c3 << "if (!(any > 0.0)) continue;  // no pair of the " << (mm ? "register" : "row") << " within the support\n";
     if (!mm) scene_ << "#endif\n";
-    if (iSide)
-      for (const std::string& p : accs)
-        scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[" << (mm ? "r" : "ii") << "];\n";
+    for (const std::string& p : accs)
+      scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[" << (mm ? "r" : "ii") << "];\n";
     // The lanes' body. `mode` (stop 40, a pass whose bodies call a math function GCC does not
     // vectorise, rareCalls): Lanes, the bodies' _simd forms; Marked, their _simd_rare forms,
     // a call marking the lane (sphc_rare), whose sums are then left as they were and whose
@@ -929,20 +920,19 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
                              /*tileRecip=*/tileMathRecip_);
       scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
       scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
-      if (side == Side::Both && !inQueue) {
+      if (!inQueue) {
         scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
         scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
       }
-      std::string inD = side == Side::Both ? "in_d" : "in_cut";
-      std::string inS = side == Side::Both ? "in_s" : "in_cut";
+      std::string inD = "in_d", inS = "in_s";
       if (inQueue) {  // (the self pair is never queued: --cluster-queue refuses a pass that keeps it)
         scene_ << body << "const bool in_q = in_cut & (s_idx < q_cnt);  // a queued pair (in_cut: the queue's own test)\n";
         inD = inS = "in_q";
       }
       emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
       for (const std::string& p : accs) {
-        if (iSide) scene_ << body << "double pd_" << accLocal[p] << " = ti_" << p << "_i[s_idx];\n";
-        if (jSide) scene_ << body << "double ps_" << accLocal[p] << " = tj_" << p << "[s_idx];\n";
+        scene_ << body << "double pd_" << accLocal[p] << " = ti_" << p << "_i[s_idx];\n";
+        scene_ << body << "double ps_" << accLocal[p] << " = tj_" << p << "[s_idx];\n";
       }
       // Marked: the _simd_rare forms, the lane's mark last.
       auto marked = [&](const PlanEquation& eq, std::string call) {
@@ -964,13 +954,12 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       // OpenMP build's half tiles scalar, "no vectype for stmt")
       if (mode == Mode::Marked)
         scene_ << body << "double sphc_rare = rare_l[s_idx];  // a body's scalar math call: the pair is redone below\n";
-      if (iSide)
-        for (const PlanEquation* eq : pass.equations)
-          scene_ << body << marked(*eq, pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_"));
+      for (const PlanEquation* eq : pass.equations)
+        scene_ << body << marked(*eq, pairCall(*eq, d, sums, /*scalarPairs=*/true, "pd_"));
       // The mirrored calls index the source's arrays they are given as pointers (a source
       // property, a source-hoisted value) with their s_idx, d_idx here: the copies themselves,
       // not offset to the j-cluster (2xMM: the register's i's, d_idx the lane).
-      if (jSide) {
+      {
         std::map<std::string, std::string> absolute;
         const std::string pre = mm || inQueue ? "ir_" : "cl_";
         for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
@@ -980,18 +969,15 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       }
       endPairShared();
       if (mode == Mode::Marked) {
-        scene_ << body << "const bool in_rare = (" << (side == Side::Both ? "in_d | in_s" : "in_cut")
-               << ") & (sphc_rare > 0.0);  // redone below\n";
+        scene_ << body << "const bool in_rare = (in_d | in_s) & (sphc_rare > 0.0);  // redone below\n";
         scene_ << body << "rare_l[s_idx] = in_rare ? 1.0 : 0.0;\n";
         scene_ << body << "n_rare += in_rare ? 1.0 : 0.0;\n";
         inD = "(" + inD + " & !in_rare)";
         inS = "(" + inS + " & !in_rare)";
       }
       for (const std::string& p : accs) {
-        if (iSide)
-          scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_" << accLocal[p] << " : ti_" << p << "_i[s_idx];\n";
-        if (jSide)
-          scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_" << accLocal[p] << " : tj_" << p << "[s_idx];\n";
+        scene_ << body << "ti_" << p << "_i[s_idx] = " << inD << " ? pd_" << accLocal[p] << " : ti_" << p << "_i[s_idx];\n";
+        scene_ << body << "tj_" << p << "[s_idx] = " << inS << " ? ps_" << accLocal[p] << " : tj_" << p << "[s_idx];\n";
       }
     };
     const bool rare = rareCalls(pass);
@@ -1026,7 +1012,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       const std::string z = plan_.dim == 3 ? "di_z + ci * CL_W" : "nullptr";
       scene_ << c2 << "const std::uint64_t q_mask = sphc::tile_pair_mask<DIM>(di_x + ci * CL_W, di_y + ci * CL_W, "
              << z << ", di_h + ci * CL_W, real_i, sj_x, sj_y, " << (plan_.dim == 3 ? "sj_z" : "nullptr")
-             << ", sj_h, " << (side == Side::Both ? "diagonal" : "false") << ", RADIUS2);\n";
+             << ", sj_h, diagonal, RADIUS2);\n";
       scene_ << c2 << "alignas(64) std::uint8_t q_idx[64];\n";
       scene_ << c2 << "const int q_n = q_mask ? sphc::tile_pair_list(q_mask, q_idx) : 0;\n";
       scene_ << c2 << "for (int q_v = 0; q_v < q_n; q_v += CL_LANES) {\n";
@@ -1054,11 +1040,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       for (const std::string& n : jNames) scene_ << b << "const double* const " << n << " = q_" << n << ";\n";
       for (const std::string& p : pass.shared) scene_ << b << "const double* const di_" << p << " = ir_" << p << ";\n";
       for (const std::string& p : accs) {
-        if (iSide) scene_ << b << "alignas(64) double qr_i_" << p << "[CL_LANES] = {};\n";
-        if (iSide) scene_ << b << "double* const ti_" << p << "_i = qr_i_" << p << ";\n";
-        if (jSide) scene_ << b << "double* const q_tj_" << p << " = tj_" << p << ";\n";
-        if (jSide) scene_ << b << "alignas(64) double qr_j_" << p << "[CL_LANES] = {};\n";
-        if (jSide) scene_ << b << "double* const tj_" << p << " = qr_j_" << p << ";\n";
+        scene_ << b << "alignas(64) double qr_i_" << p << "[CL_LANES] = {};\n";
+        scene_ << b << "double* const ti_" << p << "_i = qr_i_" << p << ";\n";
+        scene_ << b << "double* const q_tj_" << p << " = tj_" << p << ";\n";
+        scene_ << b << "alignas(64) double qr_j_" << p << "[CL_LANES] = {};\n";
+        scene_ << b << "double* const tj_" << p << " = qr_j_" << p << ";\n";
       }
       scene_ << b << "#pragma omp simd\n";
       scene_ << b << "for (int s_idx = 0; s_idx < CL_LANES; ++s_idx) {\n";
@@ -1069,8 +1055,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << b << "for (int q_k = 0; q_k < q_cnt;) {  // the sums back, row by row\n";
       scene_ << b << "  const sphc::TileQueueSegment q_s = sphc::tile_queue_segment(q_idx + q_v, q_k, q_cnt);\n";
       for (const std::string& p : accs) {
-        if (iSide) scene_ << b << "  sphc::tile_queue_add_i(ti_" << p << "[q_s.ii], q_s, qr_i_" << p << ");\n";
-        if (jSide) scene_ << b << "  sphc::tile_queue_add_j(q_tj_" << p << ", q_s, qr_j_" << p << ");\n";
+        scene_ << b << "  sphc::tile_queue_add_i(ti_" << p << "[q_s.ii], q_s, qr_i_" << p << ");\n";
+        scene_ << b << "  sphc::tile_queue_add_j(q_tj_" << p << ", q_s, qr_j_" << p << ");\n";
       }
       scene_ << b << "  q_k = q_s.end;\n";
       scene_ << b << "}\n";
@@ -1078,7 +1064,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << c2 << "}\n";
       scene_ << "#else\n" << rows << "#endif\n";
     }
-    if (jSide) {
+    {  // the j sums folded onto the slots' sums
+      const std::string c2o = c2;  // (the tile's indent; the fold's under jKept)
+      const std::string c2 = jKept.empty() ? c2o : c2o + "  ";
+      if (!jKept.empty())
+        scene_ << c2o << "if (" << jKept << ") {  // the j side: its j-cluster in the block\n";
       if (inOrder && nSlotAccs)  // the slot sums' (the padded cluster's in its own slots)
         scene_ << c2 << "const int jslot = static_cast<int>(cl_j[e]) * CL_W;\n";
       if (inOrder)  // the fold's targets, chosen once per tile
@@ -1096,29 +1086,28 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
           scene_ << c2 << "  " << jAcc(p) << (inOrder && !direct(p) ? "[jslot + l]" : accAt(p, "j0 + l")) << " += tj_" << p << "[l];\n";
       }
       scene_ << c2 << "}\n";
+      if (!jKept.empty()) scene_ << c2o << "}\n";
     }
   };
-  if (openmp) {
-    scene_ << t << "// (1) the j sides of earlier i-clusters' tiles with j-clusters in [cb, ce)\n";
-    scene_ << t << "for (int ci = 0; ci < cb; ++ci) {\n";
-    const std::string c1 = t + "  ";
-    scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
-    scene_ << c1 << "if (cl_begin[ci] == e_end || cl_j[e_end - 1] < static_cast<std::uint32_t>(cb)) continue;\n";
-    scene_ << c1 << "std::uint32_t e = static_cast<std::uint32_t>(std::lower_bound(cl_j + cl_begin[ci], cl_j + e_end, "
-                    "static_cast<std::uint32_t>(cb)) - cl_j);\n";
-    if (mm) scene_ << c1 << "if (e == e_end || cl_j[e] >= static_cast<std::uint32_t>(ce)) continue;\n";
-    scene_ << c1 << "const unsigned real_i = cl_real[ci];\n";
-    if (mm) iRegisters(c1);
-    scene_ << c1 << "for (; e < e_end && cl_j[e] < static_cast<std::uint32_t>(ce); ++e) {\n";
-    tile(Side::J, c1 + "  ");
-    scene_ << c1 << "}\n";
-    scene_ << t << "}\n";
-    scene_ << t << "// (2) the block's i-clusters\n";
-  }
-  scene_ << t << "for (int ci = cb; ci < ce; ++ci) {\n";
+  // OpenMP (stop 44): each i-cluster's tiles printed once, whole (the half tiles were copies
+  // of them: three tile bodies per pass for GCC to optimise, the pair loops' unit 1.6x the
+  // serial one's CPU); a half tile computes the whole tile and keeps one side's sums.
   const std::string c1 = t + "  ";
-  scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
-  scene_ << c1 << "if (cl_begin[ci] == e_end) continue;\n";
+  if (openmp) {
+    scene_ << t << "for (int ci = 0; ci < ce; ++ci) {  // (1) the earlier blocks' i-clusters, (2) the block's\n";
+    scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
+    scene_ << c1 << "if (cl_begin[ci] == e_end || (ci < cb && cl_j[e_end - 1] < static_cast<std::uint32_t>(cb))) continue;\n";
+    scene_ << c1 << "std::uint32_t e_first = cl_begin[ci], e_last = e_end;\n";
+    scene_ << c1 << "if (ci < cb) {  // an earlier block's i-cluster: its tiles with j-clusters in [cb, ce)\n";
+    scene_ << c1 << "  e_first = static_cast<std::uint32_t>(std::lower_bound(cl_j + e_first, cl_j + e_end, static_cast<std::uint32_t>(cb)) - cl_j);\n";
+    scene_ << c1 << "  e_last = static_cast<std::uint32_t>(std::lower_bound(cl_j + e_first, cl_j + e_end, static_cast<std::uint32_t>(ce)) - cl_j);\n";
+    scene_ << c1 << "  if (e_first == e_last) continue;\n";
+    scene_ << c1 << "}\n";
+  } else {
+    scene_ << t << "for (int ci = cb; ci < ce; ++ci) {\n";
+    scene_ << c1 << "const std::uint32_t e_end = cl_begin[ci + 1];\n";
+    scene_ << c1 << "if (cl_begin[ci] == e_end) continue;\n";
+  }
   scene_ << c1 << "const unsigned real_i = cl_real[ci];\n";
   if (mm) {
     iRegisters(c1);
@@ -1129,19 +1118,15 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (const std::string& p : accs) scene_ << c1 << "alignas(64) double ti_" << p << "[CL_W][CL_LANES] = {};\n";
   }
   if (openmp) {
-    scene_ << c1 << "// the tiles with j-clusters in the block (both sides), then those in later blocks\n";
-    scene_ << c1 << "const std::uint32_t e_mid = static_cast<std::uint32_t>(std::lower_bound(cl_j + cl_begin[ci], "
-                    "cl_j + e_end, static_cast<std::uint32_t>(ce)) - cl_j);\n";
-    scene_ << c1 << "std::uint32_t e = cl_begin[ci];\n";
-    scene_ << c1 << "for (; e < e_mid; ++e) {\n";
+    scene_ << c1 << "for (std::uint32_t e = e_first; e < e_last; ++e) {\n";
+    // (the j-cluster's block by its index, not by e: GCC's -fsplit-loops would split the loop
+    // where e reaches the later blocks, a copy of the tile each side)
+    tile(c1 + "  ", "cl_j[e] < static_cast<std::uint32_t>(ce)");
+    scene_ << c1 << "}\n";
+    scene_ << c1 << "if (ci < cb) continue;  // an earlier block's i-cluster: its i sums are that block's\n";
   } else {
     scene_ << c1 << "for (std::uint32_t e = cl_begin[ci]; e < e_end; ++e) {\n";
-  }
-  tile(Side::Both, c1 + "  ");
-  scene_ << c1 << "}\n";
-  if (openmp) {
-    scene_ << c1 << "for (; e < e_end; ++e) {  // the i side only: the later block adds the j side\n";
-    tile(Side::I, c1 + "  ");
+    tile(c1 + "  ", "");
     scene_ << c1 << "}\n";
   }
   if (mm) {
