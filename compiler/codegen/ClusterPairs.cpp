@@ -926,7 +926,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       }
       std::string inD = "in_d", inS = "in_s";
       if (inQueue) {  // (the self pair is never queued: --cluster-queue refuses a pass that keeps it)
-        scene_ << body << "const bool in_q = in_cut & (s_idx < q_cnt);  // a queued pair (in_cut: the queue's own test)\n";
+        // (the lane against q_cnt as doubles, cl_lane[s_idx] < q_lanes: an int compare in the
+        // lanes made GCC 12 vectorize the whole register in ymm halves under
+        // -mprefer-vector-width=512; stop 44, docs/performance-log.md "The interaction loop
+        // against the measured peak (stop 44)")
+        scene_ << body << "const bool in_q = in_cut & (cl_lane[s_idx] < q_lanes);  // a queued pair (in_cut: the queue's own test)\n";
         inD = inS = "in_q";
       }
       emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations, /*simd=*/true);
@@ -1018,6 +1022,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << c2 << "for (int q_v = 0; q_v < q_n; q_v += CL_LANES) {\n";
       const std::string v = c2 + "  ";
       scene_ << v << "const int q_cnt = q_n - q_v < CL_LANES ? q_n - q_v : CL_LANES;\n";
+      scene_ << v << "const double q_lanes = static_cast<double>(q_cnt);  // (the lanes' test in doubles: zmm)\n";
       scene_ << v << "const sphc::TileQueueLanes q_at = sphc::tile_queue_lanes(q_idx + q_v);\n";
       scene_ << v << "// the pairs' i values (ir_NAME) and j values (q_NAME, then the j pointers' names)\n";
       for (const auto& c : copies) {

@@ -162,7 +162,8 @@ struct EmitOptions {
   // CPU: measured no faster).
   bool cluster3d2xmm = false;
   // --cluster-queue (stop 43): the 8 x 8 tiles' pairs within the support compacted into
-  // registers of 8 pairs (codegen/ClusterPairs.cpp), under AVX-512 with VBMI2.
+  // registers of 8 pairs (codegen/ClusterPairs.cpp), under AVX-512 with VBMI2 (measured
+  // slower than the rows since the SIMD builds' 512-bit vectors, stop 44).
   bool clusterQueue = false;
   // --no-slot-order (hidden, a measurement knob; stop 40): false keeps the tiles' slot-order
   // copies and add-backs; true (the default) keeps the particles in the tiles' slot order.

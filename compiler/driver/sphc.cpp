@@ -233,7 +233,10 @@ static cl::opt<bool> ClusterQueue(
              "permutes of the clusters' registers, the sums back per row; under AVX-512 with "
              "VBMI2, else the rows as before; not for the 2xMM form, bodies with a rare math "
              "call, or a pass that keeps the self pair). Sums reassociated; serial = OpenMP "
-             "bitwise (stop 43, docs/performance-log.md \"The tiles' pairs compacted (stop 43)\")"),
+             "bitwise (stop 43, docs/performance-log.md \"The tiles' pairs compacted (stop 43)\"). "
+             "Measured slower than the rows since the SIMD builds prefer 512-bit vectors: 0.91x "
+             "their pairs per second on the cube and the DualSPHysics scene (stop 44, \"The "
+             "interaction loop against the measured peak (stop 44)\"); a measurement knob"),
     cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> Cluster2dDoubled(
     "cluster-2d-doubled",

@@ -85,3 +85,13 @@ if _py:
 # it among the same two, compiler/driver/Study.cpp) draws its plots.
 if _python_with('matplotlib'):
     config.available_features.add('matplotlib')
+# `REQUIRES: avx512vbmi2`: this CPU has AVX-512 F and VBMI2 (/proc/cpuinfo), so a solver
+# built -march=native takes the --cluster-queue form (its #if), for the tests that look at
+# that form's instructions (objdump).
+try:
+    with open('/proc/cpuinfo') as _f:
+        _flags = next((l.split(':', 1)[1].split() for l in _f if l.startswith('flags')), [])
+    if 'avx512f' in _flags and 'avx512_vbmi2' in _flags:
+        config.available_features.add('avx512vbmi2')
+except OSError:
+    pass
