@@ -489,6 +489,22 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
           scene_ << mb << "d_" << p << "[" << sumsIndexText(sc.first, k, "s_idx") << "] = m_"
                  << sumsLocalName(p, sc.first, k) << ";\n";
     };
+    // A pair's calls for d_idx, then (each pair once) the mirrored ones for s_idx, and the
+    // close of the neighbour loop: the same in the kernel lanes' loop and the plain one.
+    auto pairCallsAndClose = [&](bool bothSides) {
+      if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
+      for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
+      if (bothSides && sg.skipSelf) {  // s_idx > d_idx: the self pair is not in the loop's range
+        scene_ << body << "// the same pair for particle s_idx\n";
+        mirroredCalls(body);
+      } else if (bothSides) {
+        scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
+        mirroredCalls(body + "  ");
+        scene_ << body << "}\n";
+      }
+      endPairShared();
+      scene_ << in << "}\n";
+    };
     if (lanes) {  // serial: the segment `all` (kernelLanesRefusal)
       const char* ax[3] = {"x", "y", "z"};
       std::string ptrs;
@@ -532,18 +548,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
           if (pq.when == PairWhen::BeforeTest)
             scene_ << pairQuantityStatement(pq, plan_.dim, pairDialectOf(host_), body);
         emitPairQuantitiesOnce(q, bothSides, body, true);
-        if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
-        for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
-        if (bothSides && sg.skipSelf) {  // s_idx > d_idx: the self pair is not in the list's part
-          scene_ << body << "// the same pair for particle s_idx\n";
-          mirroredCalls(body);
-        } else if (bothSides) {
-          scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
-          mirroredCalls(body + "  ");
-          scene_ << body << "}\n";
-        }
-        endPairShared();
-        scene_ << in << "}\n";
+        pairCallsAndClose(bothSides);
       };
       lanePairs(sg.both, "0; e < e_mid", "");
       if (sg.tail) lanePairs(false, "e_mid; e < e_n", "  // the ghosts: d_idx only");
@@ -555,18 +560,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       scene_ << body << "const int s_idx = static_cast<int>(*k);\n";
       emitNeighbourTest(scene_, host_, "continue;", body);
       emitPairQuantitiesOnce(q, bothSides, body);
-      if (bothSides) emitPairSharedLocals(scene_, body, d, pass.equations, pass.equations);
-      for (const PlanEquation* eq : pass.equations) scene_ << body << pairCall(*eq, d, sums);
-      if (bothSides && sg.skipSelf) {  // s_idx > d_idx: the self pair is not in [k_first, ...)
-        scene_ << body << "// the same pair for particle s_idx\n";
-        mirroredCalls(body);
-      } else if (bothSides) {
-        scene_ << body << "if (s_idx != d_idx) {  // the same pair for particle s_idx\n";
-        mirroredCalls(body + "  ");
-        scene_ << body << "}\n";
-      }
-      endPairShared();
-      scene_ << in << "}\n";
+      pairCallsAndClose(bothSides);
     };
     if (!sg.tail) {
       scene_ << in << "for (const std::uint32_t* k = " << first << "; k != k_end" << to
