@@ -432,15 +432,19 @@ PairDialect pairDialectOf(const Dialect& dl) {
   return dialect;
 }
 
-void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
-                                     const std::string& indent, const std::string& radius2) {
-  const std::string& R = dl.real;
+void ScenePrinter::emitTestOperands(std::ostream& os, const Dialect& dl,
+                                    const std::string& indent) const {
   const PairDialect dialect = pairDialectOf(dl);
-  os << indent << "const " << R << " hj = sj_h[s_idx];\n";
+  os << indent << "const " << dl.real << " hj = sj_h[s_idx];\n";
   for (const PairQuantity& pq : pairQuantityTable())
     if (pq.when == PairWhen::BeforeTest)
       os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
-  os << indent << "const " << R << " hmax = hi > hj ? hi : hj;\n";
+}
+
+void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
+                                     const std::string& indent, const std::string& radius2) {
+  emitTestOperands(os, dl, indent);
+  os << indent << "const " << dl.real << " hmax = hi > hj ? hi : hj;\n";
   os << indent << "if (R2IJ >= " << radius2 << " * hmax * hmax) " << skip
      << (radius2 == "RADIUS2" ? "  // not a neighbour\n" : "  // beyond the list's radius\n");
 }
@@ -454,10 +458,7 @@ void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::stri
   if (test) {
     emitNeighbourTest(os, dl, skip.empty() ? dl.skipCandidate : skip, indent);
   } else {  // a neighbour: what the test computes, without the test
-    os << indent << "const " << dl.real << " hj = sj_h[s_idx];\n";
-    for (const PairQuantity& pq : pairQuantityTable())
-      if (pq.when == PairWhen::BeforeTest)
-        os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
+    emitTestOperands(os, dl, indent);
   }
   for (const PairQuantity& pq : pairQuantityTable())
     if (pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name)))

@@ -211,6 +211,8 @@ class ScenePrinter {
   // in units of hmax (RADIUS2, the support; VERLET_RADIUS2 for the lists of --verlet-skin).
   void emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
                          const std::string& indent, const std::string& radius2 = "RADIUS2");
+  // What the test reads of candidate s_idx: hj and the quantities before it (XIJ, R2IJ).
+  void emitTestOperands(std::ostream& os, const Dialect& dl, const std::string& indent) const;
   // The pair quantities of one candidate (XIJ, R2IJ, the cut-off test, HIJ, RIJ, ...); the
   // test leaves with `skip` (empty: the dialect's skipCandidate).
   void emitPairQuantities(std::ostream& os, const std::set<std::string>& q, const Dialect& dl,
@@ -407,7 +409,7 @@ class ScenePrinter {
   std::string kernelLanes_ = "off";          // EmitOptions::kernelLanes (CPU, not mpi)
   // Why the serial each-pair-once loop of the pass does not compute its candidates' kernel
   // values in SIMD lanes first ("" where it does; SymmetricPairs.cpp).
-  std::string kernelLanesRefusal(const NeighbourPass& pass, const std::set<std::string>& q,
+  std::string kernelLanesRefusal(const std::set<std::string>& q,
                                  bool openmp) const;
   std::unique_ptr<std::set<int>> sumsDecls_;  // equation declarations whose _sums form is used
   // eq's loop on the locals, named NAME_loop_sums; `scalarPairs`: NAME_loop_simd, its vector

@@ -301,9 +301,7 @@ void ScenePrinter::emitSymmetricMembers(std::ostream& os) const {
 // keep the kernel in the pair loop, so OpenMP = serial bitwise still holds), double
 // precision, the kernel values of the pass WIJ and DWIJ only (not WI, WJ, DWI, DWJ), a kernel
 // without exp (the Gaussians: a vector exp is not the scalar one's bits).
-std::string ScenePrinter::kernelLanesRefusal(const NeighbourPass& pass,
-                                             const std::set<std::string>& q, bool openmp) const {
-  (void)pass;
+std::string ScenePrinter::kernelLanesRefusal(const std::set<std::string>& q, bool openmp) const {
   if (kernelLanes_ == "off") return "--kernel-lanes=off";
   if (openmp) return "the OpenMP blocks";
   if (singlePrecision_) return "single precision";
@@ -364,7 +362,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
   emitDestinationHoistedAll(pass, pragma);
   const RegisterSums sums = registerSums(w, pass);
   if (simd) return emitSymmetricSimdLoops(w, pass, lists, openmp, q, sums);
-  const bool lanes = kernelLanesRefusal(pass, q, openmp).empty();
+  const bool lanes = kernelLanesRefusal(q, openmp).empty();
   if (lanes) {
     const char* ax[3] = {"x", "y", "z"};
     std::string ptrs;
@@ -389,16 +387,11 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     scene_ << "          for (int kl_k = 0; kl_k < k_count; ++kl_k) {\n";
     const std::string lb = "            ";
     scene_ << lb << "const int s_idx = static_cast<int>(kb[kl_k]);\n";
-    std::ostringstream test;
-    emitNeighbourTest(test, host_, "continue;", lb);
-    std::string t = test.str();
-    // The test's comparison as a value: !(R2IJ >= RADIUS2 * hmax * hmax), as the scalar loop skips.
-    const std::string ifs = "if (R2IJ >= RADIUS2 * hmax * hmax) continue;";
-    const size_t at = t.find(ifs);
-    if (at == std::string::npos) SPHC_INTERNAL("kernel lanes: the neighbour test's text");
-    const size_t eol = t.find('\n', at);
-    t.replace(at, eol - at, "kl_in[kl_k] = !(R2IJ >= RADIUS2 * hmax * hmax) ? 1 : 0;  // a neighbour");
-    scene_ << t;
+    // The neighbour test's operands and its comparison as a value (emitNeighbourTest skips
+    // where R2IJ >= RADIUS2 * hmax * hmax).
+    emitTestOperands(scene_, host_, lb);
+    scene_ << lb << "const double hmax = hi > hj ? hi : hj;\n";
+    scene_ << lb << "kl_in[kl_k] = !(R2IJ >= RADIUS2 * hmax * hmax) ? 1 : 0;  // a neighbour\n";
     scene_ << lb << "const double HIJ = 0.5 * (hi + hj);\n";
     scene_ << lb << "const double RIJ = std::sqrt(R2IJ);\n";
     if (q.count("WIJ")) scene_ << lb << "kl_w[kl_k] = Kernel::w(RIJ, HIJ);\n";
@@ -543,10 +536,7 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
         scene_ << in << "for (int e = " << range << "; ++e) {" << note << "\n";
         scene_ << body << "const int kl_k = kl_c[e];\n";
         scene_ << body << "const int s_idx = static_cast<int>(k_lanes[kl_k]);\n";
-        scene_ << body << "const double hj = sj_h[s_idx];\n";
-        for (const PairQuantity& pq : pairQuantityTable())
-          if (pq.when == PairWhen::BeforeTest)
-            scene_ << pairQuantityStatement(pq, plan_.dim, pairDialectOf(host_), body);
+        emitTestOperands(scene_, host_, body);
         emitPairQuantitiesOnce(q, bothSides, body, true);
         pairCallsAndClose(bothSides);
       };
