@@ -28,122 +28,63 @@ volatile double g_sink;  // keeps the chains' results alive
 
 constexpr int kChains = 12;
 
-// Each returns the flops it did (2 per lane per FMA).
+// One register kind: its vector type, lanes, and the operations the chains need.
 #if defined(__AVX512F__)
-__attribute__((noinline)) double fma_zmm(long iters) {
-  __m512d a0 = _mm512_set1_pd(1.000);
-  __m512d a1 = _mm512_set1_pd(1.001);
-  __m512d a2 = _mm512_set1_pd(1.002);
-  __m512d a3 = _mm512_set1_pd(1.003);
-  __m512d a4 = _mm512_set1_pd(1.004);
-  __m512d a5 = _mm512_set1_pd(1.005);
-  __m512d a6 = _mm512_set1_pd(1.006);
-  __m512d a7 = _mm512_set1_pd(1.007);
-  __m512d a8 = _mm512_set1_pd(1.008);
-  __m512d a9 = _mm512_set1_pd(1.009);
-  __m512d a10 = _mm512_set1_pd(1.010);
-  __m512d a11 = _mm512_set1_pd(1.011);
-  const __m512d a = _mm512_set1_pd(0.999999), b = _mm512_set1_pd(1e-6);
-  for (long i = 0; i < iters; ++i) {
-    a0 = _mm512_fmadd_pd(a0, a, b);
-    a1 = _mm512_fmadd_pd(a1, a, b);
-    a2 = _mm512_fmadd_pd(a2, a, b);
-    a3 = _mm512_fmadd_pd(a3, a, b);
-    a4 = _mm512_fmadd_pd(a4, a, b);
-    a5 = _mm512_fmadd_pd(a5, a, b);
-    a6 = _mm512_fmadd_pd(a6, a, b);
-    a7 = _mm512_fmadd_pd(a7, a, b);
-    a8 = _mm512_fmadd_pd(a8, a, b);
-    a9 = _mm512_fmadd_pd(a9, a, b);
-    a10 = _mm512_fmadd_pd(a10, a, b);
-    a11 = _mm512_fmadd_pd(a11, a, b);
-    __asm__ volatile("" : "+v"(a0), "+v"(a1), "+v"(a2), "+v"(a3), "+v"(a4), "+v"(a5), "+v"(a6), "+v"(a7), "+v"(a8), "+v"(a9), "+v"(a10), "+v"(a11));
-  }
-  const __m512d s = _mm512_add_pd(_mm512_add_pd(_mm512_add_pd(a0, a1), _mm512_add_pd(a2, a3)),
-      _mm512_add_pd(_mm512_add_pd(_mm512_add_pd(a4, a5), _mm512_add_pd(a6, a7)),
-                    _mm512_add_pd(_mm512_add_pd(a8, a9), _mm512_add_pd(a10, a11))));
-  alignas(64) double t[8];
-  _mm512_store_pd(t, s);
-  g_sink = t[0] + t[1] + t[2] + t[3] + t[4] + t[5] + t[6] + t[7];
-  return 2.0 * 8 * kChains * static_cast<double>(iters);
-}
+struct Zmm {
+  using V = __m512d;
+  static constexpr int kLanes = 8;
+  static V set1(double x) { return _mm512_set1_pd(x); }
+  static V fma(V x, V a, V b) { return _mm512_fmadd_pd(x, a, b); }
+  static V add(V x, V y) { return _mm512_add_pd(x, y); }
+  static double sum(V x) { return _mm512_reduce_add_pd(x); }
+};
 #endif
-
 #if defined(__AVX2__) && defined(__FMA__)
-__attribute__((noinline)) double fma_ymm(long iters) {
-  __m256d a0 = _mm256_set1_pd(1.000);
-  __m256d a1 = _mm256_set1_pd(1.001);
-  __m256d a2 = _mm256_set1_pd(1.002);
-  __m256d a3 = _mm256_set1_pd(1.003);
-  __m256d a4 = _mm256_set1_pd(1.004);
-  __m256d a5 = _mm256_set1_pd(1.005);
-  __m256d a6 = _mm256_set1_pd(1.006);
-  __m256d a7 = _mm256_set1_pd(1.007);
-  __m256d a8 = _mm256_set1_pd(1.008);
-  __m256d a9 = _mm256_set1_pd(1.009);
-  __m256d a10 = _mm256_set1_pd(1.010);
-  __m256d a11 = _mm256_set1_pd(1.011);
-  const __m256d a = _mm256_set1_pd(0.999999), b = _mm256_set1_pd(1e-6);
-  for (long i = 0; i < iters; ++i) {
-    a0 = _mm256_fmadd_pd(a0, a, b);
-    a1 = _mm256_fmadd_pd(a1, a, b);
-    a2 = _mm256_fmadd_pd(a2, a, b);
-    a3 = _mm256_fmadd_pd(a3, a, b);
-    a4 = _mm256_fmadd_pd(a4, a, b);
-    a5 = _mm256_fmadd_pd(a5, a, b);
-    a6 = _mm256_fmadd_pd(a6, a, b);
-    a7 = _mm256_fmadd_pd(a7, a, b);
-    a8 = _mm256_fmadd_pd(a8, a, b);
-    a9 = _mm256_fmadd_pd(a9, a, b);
-    a10 = _mm256_fmadd_pd(a10, a, b);
-    a11 = _mm256_fmadd_pd(a11, a, b);
-    __asm__ volatile("" : "+x"(a0), "+x"(a1), "+x"(a2), "+x"(a3), "+x"(a4), "+x"(a5), "+x"(a6), "+x"(a7), "+x"(a8), "+x"(a9), "+x"(a10), "+x"(a11));
+struct Ymm {
+  using V = __m256d;
+  static constexpr int kLanes = 4;
+  static V set1(double x) { return _mm256_set1_pd(x); }
+  static V fma(V x, V a, V b) { return _mm256_fmadd_pd(x, a, b); }
+  static V add(V x, V y) { return _mm256_add_pd(x, y); }
+  static double sum(V x) {
+    alignas(32) double t[4];
+    _mm256_store_pd(t, x);
+    return t[0] + t[1] + t[2] + t[3];
   }
-  const __m256d s = _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(a0, a1), _mm256_add_pd(a2, a3)),
-      _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(a4, a5), _mm256_add_pd(a6, a7)),
-                    _mm256_add_pd(_mm256_add_pd(a8, a9), _mm256_add_pd(a10, a11))));
-  alignas(32) double t[4];
-  _mm256_store_pd(t, s);
-  g_sink = t[0] + t[1] + t[2] + t[3];
-  return 2.0 * 4 * kChains * static_cast<double>(iters);
-}
-
-__attribute__((noinline)) double fma_scalar(long iters) {
-  __m128d a0 = _mm_set_sd(1.000);
-  __m128d a1 = _mm_set_sd(1.001);
-  __m128d a2 = _mm_set_sd(1.002);
-  __m128d a3 = _mm_set_sd(1.003);
-  __m128d a4 = _mm_set_sd(1.004);
-  __m128d a5 = _mm_set_sd(1.005);
-  __m128d a6 = _mm_set_sd(1.006);
-  __m128d a7 = _mm_set_sd(1.007);
-  __m128d a8 = _mm_set_sd(1.008);
-  __m128d a9 = _mm_set_sd(1.009);
-  __m128d a10 = _mm_set_sd(1.010);
-  __m128d a11 = _mm_set_sd(1.011);
-  const __m128d a = _mm_set_sd(0.999999), b = _mm_set_sd(1e-6);
-  for (long i = 0; i < iters; ++i) {
-    a0 = _mm_fmadd_sd(a0, a, b);
-    a1 = _mm_fmadd_sd(a1, a, b);
-    a2 = _mm_fmadd_sd(a2, a, b);
-    a3 = _mm_fmadd_sd(a3, a, b);
-    a4 = _mm_fmadd_sd(a4, a, b);
-    a5 = _mm_fmadd_sd(a5, a, b);
-    a6 = _mm_fmadd_sd(a6, a, b);
-    a7 = _mm_fmadd_sd(a7, a, b);
-    a8 = _mm_fmadd_sd(a8, a, b);
-    a9 = _mm_fmadd_sd(a9, a, b);
-    a10 = _mm_fmadd_sd(a10, a, b);
-    a11 = _mm_fmadd_sd(a11, a, b);
-    __asm__ volatile("" : "+x"(a0), "+x"(a1), "+x"(a2), "+x"(a3), "+x"(a4), "+x"(a5), "+x"(a6), "+x"(a7), "+x"(a8), "+x"(a9), "+x"(a10), "+x"(a11));
-  }
-  const __m128d s = _mm_add_sd(_mm_add_sd(_mm_add_sd(a0, a1), _mm_add_sd(a2, a3)),
-      _mm_add_sd(_mm_add_sd(_mm_add_sd(a4, a5), _mm_add_sd(a6, a7)),
-                 _mm_add_sd(_mm_add_sd(a8, a9), _mm_add_sd(a10, a11))));
-  g_sink = _mm_cvtsd_f64(s);
-  return 2.0 * 1 * kChains * static_cast<double>(iters);
-}
+};
+struct Scalar {  // one double in an xmm register (vfmadd...sd)
+  using V = __m128d;
+  static constexpr int kLanes = 1;
+  static V set1(double x) { return _mm_set_sd(x); }
+  static V fma(V x, V a, V b) { return _mm_fmadd_sd(x, a, b); }
+  static V add(V x, V y) { return _mm_add_sd(x, y); }
+  static double sum(V x) { return _mm_cvtsd_f64(x); }
+};
 #endif
+
+// kChains independent chains of FMAs in registers of kind K, `iters` FMAs each: returns the
+// flops it did (2 per lane per FMA). The empty asm after each FMA keeps every chain a
+// register that the compiler may not fold or merge ("v": any vector register, zmm16-31
+// included).
+template <class K>
+__attribute__((noinline)) double fma_chains(long iters) {
+  typename K::V c[kChains];
+#pragma GCC unroll 12
+  for (int k = 0; k < kChains; ++k) c[k] = K::set1(1.0 + 0.001 * k);
+  const typename K::V a = K::set1(0.999999), b = K::set1(1e-6);
+  for (long i = 0; i < iters; ++i) {
+#pragma GCC unroll 12
+    for (int k = 0; k < kChains; ++k) {
+      c[k] = K::fma(c[k], a, b);
+      __asm__ volatile("" : "+v"(c[k]));
+    }
+  }
+  typename K::V s = c[0];
+#pragma GCC unroll 12
+  for (int k = 1; k < kChains; ++k) s = K::add(s, c[k]);
+  g_sink = K::sum(s);
+  return 2.0 * K::kLanes * kChains * static_cast<double>(iters);
+}
 
 // Dependent integer adds of a register, 1 cycle each: returns the cycles (the adds) it took.
 // (Not adds of an immediate: Golden Cove-class cores fold a chain of those at rename, several
@@ -195,12 +136,12 @@ int main(int argc, char** argv) {
   std::printf("clock_GHz=%.3f clock_imul_GHz=%.3f", hz / 1e9, hz3 / 1e9);
   double zmm = 0, ymm = 0, sc = 0;
 #if defined(__AVX512F__)
-  zmm = best_rate(fma_zmm, iters, reps);
+  zmm = best_rate(fma_chains<Zmm>, iters, reps);
   std::printf(" fma_GFLOPs_zmm=%.2f", zmm / 1e9);
 #endif
 #if defined(__AVX2__) && defined(__FMA__)
-  ymm = best_rate(fma_ymm, iters, reps);
-  sc = best_rate(fma_scalar, iters, reps);
+  ymm = best_rate(fma_chains<Ymm>, iters, reps);
+  sc = best_rate(fma_chains<Scalar>, iters, reps);
   std::printf(" fma_GFLOPs_ymm=%.2f fma_GFLOPs_scalar=%.2f", ymm / 1e9, sc / 1e9);
 #endif
   std::printf("\n");
