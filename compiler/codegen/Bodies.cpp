@@ -72,6 +72,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   pairShared_ = opts.pairShared && host_.hoist && (!simdPairs_ || simdAuto_);
   skipSelfPairs_ = opts.skipSelfPairs;
   filteredLists_ = opts.filteredLists;
+  skipEmptyLists_ = opts.skipEmptyLists;
   constantValues_ = opts.constantValues;
 }
 

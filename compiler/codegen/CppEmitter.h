@@ -114,6 +114,11 @@ struct EmitOptions {
   bool skipSelfPairs = true;
   // --filtered-lists: the per-destination loops filter the kept list, then loop (CpuPrinter.cpp).
   bool filteredLists = false;
+  // The CPU pair loops of two arrays with kept lists (fluid <- wall; CpuPrinter.cpp and
+  // SymmetricPairs.cpp's emitCrossPass): after a build of the lists, only the destinations
+  // whose kept list is not empty (sphc/verlet.h, find_occupied); false
+  // (--no-skip-empty-lists): every destination at every evaluation. The same bits.
+  bool skipEmptyLists = true;
   // The equation instances' values that are literals (`dim = 2`, defaults such as R = 0.2)
   // as constants of the C++ (HostProgram.cpp); false (--no-constant-values): members set at
   // set-up, as the others. The values are the same bit for bit.

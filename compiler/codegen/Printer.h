@@ -260,6 +260,7 @@ class ScenePrinter {
   bool pairShared_ = false;  // EmitOptions::pairShared (CPU double, not mpi, not --simd-pairs)
   bool skipSelfPairs_ = false;  // EmitOptions::skipSelfPairs (SymmetricPairs.cpp)
   bool filteredLists_ = false;  // EmitOptions::filteredLists (CpuPrinter.cpp)
+  bool skipEmptyLists_ = true;  // EmitOptions::skipEmptyLists (occupiedRefusal)
   bool constantValues_ = true;  // EmitOptions::constantValues (HostProgram.cpp)
   mutable std::unique_ptr<std::set<const PlanBody*>> pairSharedBodies_;  // (once)
 
@@ -365,6 +366,16 @@ class ScenePrinter {
                      const std::string& hoistPragma = "");
   void emitCrossBlocksHead(const std::string& lists, const std::string& nameA,
                            const std::string& nameB);
+  // Pair loops of two arrays with kept lists (fluid <- wall; the per-destination loops with
+  // the support's test inline, CpuPrinter.cpp, and emitCrossPass): "" where, after a build
+  // of the lists, they visit only the destinations whose kept list is not empty
+  // (sphc/verlet.h, find_occupied), else why not. A destination without candidates only
+  // loads and stores its sums: skipped, the results are the same bits.
+  std::string occupiedRefusal(const DestinationWork& w, const NeighbourPass& pass) const;
+  // The per-destination loop's head in that form over [begin, end): every destination while
+  // the lists' `occupied` is not found (a build: it is found after the loop), else those.
+  void emitOccupiedHead(const std::string& lists, const std::string& begin,
+                        const std::string& end, const std::string& pragma);
   void emitCrossSpanning(const NeighbourPass& ba, int b, const std::set<std::string>& q,
                          const std::string& lists, const std::string& nameA,
                          const std::string& nameB);
