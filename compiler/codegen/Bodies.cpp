@@ -73,6 +73,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   skipSelfPairs_ = opts.skipSelfPairs;
   filteredLists_ = opts.filteredLists;
   skipEmptyLists_ = opts.skipEmptyLists;
+  initInAddBack_on_ = opts.initInAddBack;
   constantValues_ = opts.constantValues;
 }
 

@@ -453,10 +453,23 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     for (const auto* eq : with) scene_ << "        " << equationCall(*eq, kind, d);
     scene_ << "      }\n";
   };
-  perParticle(ast::Method::Initialize, "initialize");
   // Pair loops A <- B and B <- A as one pass (codegen/SymmetricPairs.cpp, crossPairsRefusal):
   // A's last pass runs in B's first's place.
   const auto cross = crossPair(w);
+  // The initialize per particle in the add-back of the first pass's tiles (ClusterPairs.cpp,
+  // initInAddBackRefusal), else in its own loop here.
+  const NeighbourPass* first = w.passes.empty() ? nullptr : &w.passes.front();
+  const bool initInTiles = first && first->searches() && verlet() && !mpi_ &&
+                           !(cross.second == &w) && !(cross.first == &w && w.passes.size() == 1) &&
+                           symmetricPass(w, *first) && onceLanes(w, *first) &&
+                           clusterTilesRefusal(w, *first).empty() &&
+                           initInAddBackRefusal(w, *first).empty();
+  if (initInTiles)
+    scene_ << "      // (initialize: in the add-back of the tiles of " << arr(first->source).name
+           << ", per particle)\n";
+  else
+    perParticle(ast::Method::Initialize, "initialize");
+  initInAddBack_ = initInTiles ? &w : nullptr;
   // One neighbour pass per source.
   for (const NeighbourPass& pass : w.passes) {
     if (cross.first == &w && &pass == &w.passes.back()) continue;  // in cross.second's
@@ -632,6 +645,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
              << ", n_candidates);  // " << loops << " loop(s) over the pairs\n";
     scene_ << "      }\n";
   }
+  initInAddBack_ = nullptr;
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions over the destination array into its constants.
   for (const Reduction& r : w.reductions) reduction(w, r);

@@ -266,6 +266,13 @@ static cl::opt<bool> NoSkipEmptyLists(
              "only those whose kept list is not empty; the others add nothing to their sums: "
              "the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoInitInAddBack(
+    "no-init-in-add-back",
+    cl::desc("Run a destination's initialize in a loop of its own before its first pair loop "
+             "also where that loop is in cluster-pair tiles whose add-back could run it "
+             "(default: per particle in the tiles' add-back, where the tiles write only slot "
+             "sums that the initialize alone writes; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoConstantValues(
     "no-constant-values",
     cl::desc("Set every parameter and const of the equation instances at set-up (default: "
@@ -709,6 +716,7 @@ int main(int argc, char** argv) {
   emitOpts.skipSelfPairs = !NoSelfPairSkip;
   emitOpts.filteredLists = FilteredLists;
   emitOpts.skipEmptyLists = !NoSkipEmptyLists;
+  emitOpts.initInAddBack = !NoInitInAddBack;
   emitOpts.constantValues = !NoConstantValues;
   // --simd-pairs: auto (the default), on (also bare), off; the lanes only on the CPU backends.
   const std::string simdMode = SimdPairs.empty() ? std::string("on") : SimdPairs.getValue();
