@@ -72,6 +72,8 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   pairShared_ = opts.pairShared && host_.hoist && (!simdPairs_ || simdAuto_);
   skipSelfPairs_ = opts.skipSelfPairs;
   filteredLists_ = opts.filteredLists;
+  skipEmptyLists_ = opts.skipEmptyLists;
+  initInAddBack_on_ = opts.initInAddBack;
   constantValues_ = opts.constantValues;
 }
 

@@ -87,6 +87,7 @@
 #include <map>
 #include <regex>
 #include <set>
+#include <stdexcept>
 #include <vector>
 
 namespace sphc {
@@ -161,6 +162,33 @@ std::string ScenePrinter::clusterTilesRefusal(const DestinationWork& w,
   if (clusterAutoSkipsDim()) return "off";  // auto: the 3D loops, the 2D ones where measured (stop 41)
   if (!onceLanes(w, pass)) return "not each pair once in SIMD lanes";
   return clusterTilesFormRefusal(w, pass);
+}
+
+std::string ScenePrinter::initInAddBackRefusal(const DestinationWork& w,
+                                               const NeighbourPass& pass) const {
+  if (!initInAddBack_on_) return "--no-init-in-add-back";
+  if (w.initialize.empty()) return "no initialize";
+  if (w.ranged() || w.onGhosts || hasDomain()) return "a range, ghosts or a periodic domain";
+  if (!pass.initializePair.empty()) return "an initialize_pair";
+  if (&pass != &w.passes.front()) return "not the destination's first pass";
+  if (!clusterSlotOrder(w, pass)) return "the tiles not in the particles' order";
+  // Every sum with components (slot sums and an add-back in the particles' order; a sum of
+  // stride 1 goes straight onto its array in the tiles, kComponentsInPlace false).
+  const RegisterSums sums = registerSums(w, pass);
+  if (!sums.active()) return "no sums";
+  for (const auto& [p, sc] : sums.props)
+    if (sc.first == 1) return "the sum " + p + " is written in the tiles (stride 1)";
+  // The initialize writes only those sums (nothing the pass reads: its bodies read no sum,
+  // RegisterSums.cpp); not the positions, h or what the pass reads by name, to be sure.
+  std::set<std::string> read(pass.shared.begin(), pass.shared.end());
+  read.insert(pass.sourceProps.begin(), pass.sourceProps.end());
+  for (const char* p : {"x", "y", "z", "h", "m", "rho"}) read.insert(p);
+  for (const PlanEquation* eq : w.initialize)
+    for (const PropAccess& x : methodBody(*eq, ast::Method::Initialize).facts.dWrites) {
+      if (!sums.props.count(x.prop)) return "an initialize writes " + x.prop + ", not a sum of the tiles";
+      if (read.count(x.prop)) return "an initialize writes " + x.prop + ", which the pass reads";
+    }
+  return "";
 }
 
 // Everything but the switch and the lanes (onceLanes): --simd-pairs=cluster's choice of the
@@ -1196,11 +1224,23 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     scene_ << in << "  sphc::add_slots(cl_layout, cl_sums, cl_into, " << plain.size() << par << ");\n";
     scene_ << in << "}\n";
   }
+  const bool initHere = initInAddBack_ == &w;
+  initInAddBack_ = nullptr;  // (the first pass's only)
+  if (initHere && !(inOrder && nSlotAccs == accs.size() && nSlotAccs > 0))
+    throw std::logic_error("codegen/ClusterPairs.cpp: the initialize in the add-back of tiles without one");
   if (inOrder && nSlotAccs) {
     scene_ << in << "{  // (in order) the components' slot sums onto the particles' (slot s = particle s)\n";
+    if (initHere)
+      scene_ << in << "  // with the destination's initialize first, per particle (initInAddBackRefusal;\n"
+             << in << "  // sphc --no-init-in-add-back: in a loop before the pass)\n";
     if (openmp)
       scene_ << in << "  #pragma omp parallel for schedule(static)" << (ompIfN.empty() ? "" : " " + ompIfN) << "\n";
     scene_ << in << "  for (std::size_t s = 0; s < cl_layout.n; ++s) {\n";
+    if (initHere) {
+      scene_ << in << "    const int d_idx = static_cast<int>(s);\n";
+      for (const PlanEquation* eq : w.initialize)
+        scene_ << in << "    " << equationCall(*eq, ast::Method::Initialize, d);
+    }
     for (const std::string& p : accs) {
       if (direct(p)) continue;
       const auto [S, K] = accStride[p];

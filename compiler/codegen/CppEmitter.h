@@ -114,6 +114,16 @@ struct EmitOptions {
   bool skipSelfPairs = true;
   // --filtered-lists: the per-destination loops filter the kept list, then loop (CpuPrinter.cpp).
   bool filteredLists = false;
+  // The CPU pair loops of two arrays with kept lists (fluid <- wall; CpuPrinter.cpp and
+  // SymmetricPairs.cpp's emitCrossPass): after a build of the lists, only the destinations
+  // whose kept list is not empty (sphc/verlet.h, find_occupied); false
+  // (--no-skip-empty-lists): every destination at every evaluation. The same bits.
+  bool skipEmptyLists = true;
+  // The cluster-pair tiles' add-back runs the destination's initialize per particle where
+  // the tiles are its first pass and write only slot sums that the initialize alone writes
+  // (ClusterPairs.cpp, initInAddBackRefusal); false (--no-init-in-add-back): the initialize
+  // in its own loop before the pass. The same bits.
+  bool initInAddBack = true;
   // The equation instances' values that are literals (`dim = 2`, defaults such as R = 0.2)
   // as constants of the C++ (HostProgram.cpp); false (--no-constant-values): members set at
   // set-up, as the others. The values are the same bit for bit.

@@ -453,10 +453,23 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     for (const auto* eq : with) scene_ << "        " << equationCall(*eq, kind, d);
     scene_ << "      }\n";
   };
-  perParticle(ast::Method::Initialize, "initialize");
   // Pair loops A <- B and B <- A as one pass (codegen/SymmetricPairs.cpp, crossPairsRefusal):
   // A's last pass runs in B's first's place.
   const auto cross = crossPair(w);
+  // The initialize per particle in the add-back of the first pass's tiles (ClusterPairs.cpp,
+  // initInAddBackRefusal), else in its own loop here.
+  const NeighbourPass* first = w.passes.empty() ? nullptr : &w.passes.front();
+  const bool initInTiles = first && first->searches() && verlet() && !mpi_ &&
+                           !(cross.second == &w) && !(cross.first == &w && w.passes.size() == 1) &&
+                           symmetricPass(w, *first) && onceLanes(w, *first) &&
+                           clusterTilesRefusal(w, *first).empty() &&
+                           initInAddBackRefusal(w, *first).empty();
+  if (initInTiles)
+    scene_ << "      // (initialize: in the add-back of the tiles of " << arr(first->source).name
+           << ", per particle)\n";
+  else
+    perParticle(ast::Method::Initialize, "initialize");
+  initInAddBack_ = initInTiles ? &w : nullptr;
   // One neighbour pass per source.
   for (const NeighbourPass& pass : w.passes) {
     if (cross.first == &w && &pass == &w.passes.back()) continue;  // in cross.second's
@@ -526,11 +539,28 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "        const long candidate_cost = decomposition.candidate_cost;\n";
       scene_ << "        const long pair_cost = " << loops << " * decomposition.pair_cost;\n";
     }
-    scene_ << parallelFor("        ", pass.order,
-                          std::string("default(firstprivate) shared(cells)") +
-                              (mpi_ ? " reduction(+ : n_pairs, n_candidates)" : ""));
-    scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
-           << "; ++d_idx) {\n";
+    // The kept list walked once with the support's test inline (as the each-pair-once loops,
+    // SymmetricPairs.cpp): XIJ and R2IJ once per candidate, no filtered list. Where nothing
+    // needs that list (no loop_all, not in SIMD lanes, not --mpi's counts); the same
+    // candidates in the same order, the same test and arithmetic: the same bits.
+    // --filtered-lists prints the filtered list and the loop over it.
+    const bool inlineTest = verlet() && !mpi_ && !filteredLists_ && pass.loopAll.empty() &&
+                            !pass.equations.empty() &&
+                            (!simdPairs_ || !simdPairsRefusal(w, pass).empty());
+    // Pairs of two arrays (fluid <- wall): most destinations have no candidate; after a
+    // build only those with one are visited (occupiedRefusal).
+    const bool occupied = inlineTest && occupiedRefusal(w, pass).empty();
+    const std::string pragma =
+        parallelFor("        ", pass.order,
+                    std::string("default(firstprivate) shared(cells)") +
+                        (mpi_ ? " reduction(+ : n_pairs, n_candidates)" : ""));
+    if (occupied) {
+      emitOccupiedHead(lists, rangeBegin(w), rangeEnd(w), pragma);
+    } else {
+      scene_ << pragma;
+      scene_ << "        for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
+             << "; ++d_idx) {\n";
+    }
     emitDestLocals(scene_, "          ", q, host_);
     emitDestinationHoisted(scene_, pass, "          ");  // codegen/Hoist.cpp
     // The neighbour list first (in candidate order; CellList::gather_neighbours), then every
@@ -552,14 +582,6 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "            sphc::keep_in_index_order(kept, nbrs_list.data(), n_kept);\n";
       scene_ << "          }\n";
     };
-    // The kept list walked once with the support's test inline (as the each-pair-once loops,
-    // SymmetricPairs.cpp): XIJ and R2IJ once per candidate, no filtered list. Where nothing
-    // needs that list (no loop_all, not in SIMD lanes, not --mpi's counts); the same
-    // candidates in the same order, the same test and arithmetic: the same bits.
-    // --filtered-lists prints the filtered list and the loop over it.
-    const bool inlineTest = verlet() && !mpi_ && !filteredLists_ && pass.loopAll.empty() &&
-                            !pass.equations.empty() &&
-                            (!simdPairs_ || !simdPairsRefusal(w, pass).empty());
     if (inlineTest) {
       emitKeptList();
       const RegisterSums sums = registerSums(w, pass);  // codegen/RegisterSums.cpp
@@ -574,6 +596,9 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
       scene_ << "          }\n";
       emitSumsStore(scene_, "          ", sums);
       scene_ << "        }\n";
+      if (occupied)
+        scene_ << "        if (occ_all) sphc::find_occupied(" << lists
+               << ");  // the destinations with a candidate, for the next evaluations\n";
       scene_ << "      }\n";
       continue;
     }
@@ -620,6 +645,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
              << ", n_candidates);  // " << loops << " loop(s) over the pairs\n";
     scene_ << "      }\n";
   }
+  initInAddBack_ = nullptr;
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions over the destination array into its constants.
   for (const Reduction& r : w.reductions) reduction(w, r);
@@ -665,6 +691,8 @@ void CpuPrinter::listsRebuildCheck(const std::string& lists, const DestinationWo
     if (d == s && symmetric_ && (!hasDomain() || !cpuSingle_)) scene_ << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
     if (crossSourceLists().count(lists))
       scene_ << "          " << lists << "_by_source.clear();  // found again by the pass over pairs of two arrays once\n";
+    if (d != s && skipEmptyLists_)
+      scene_ << "          " << lists << ".occupied_found = false;  // found again by the loops over two arrays\n";
     scene_ << "        }\n";
   }
   if (lazyCells() && !isStatic(S) && cells)  // CpuLazyCells.cpp
@@ -1315,6 +1343,7 @@ void CpuPrinter::tunedRebuildCheck(const std::string& lists, const DestinationWo
   loop.ranged = w.ranged();
   loop.clearUpper = d == s && symmetric_;
   loop.clearCross = crossSourceLists().count(lists) > 0;
+  loop.clearOccupied = d != s && skipEmptyLists_;
   verlet_tune::rebuildCheck(scene_, loop);
 }
 

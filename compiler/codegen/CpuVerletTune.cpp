@@ -59,6 +59,7 @@ void rebuildCheck(std::ostream& scene, const KeptLoop& loop) {
   scene << "          " << lists << ".lists.resize(" << loop.dest << ".n);\n";
   if (loop.clearUpper) scene << "          " << lists << ".upper.clear();  // found again by the loops over each pair once\n";
   if (loop.clearCross) scene << "          " << lists << "_by_source.clear();  // found again by the pass over pairs of two arrays once\n";
+  if (loop.clearOccupied) scene << "          " << lists << ".occupied_found = false;  // found again by the loops over two arrays\n";
   scene << "        }\n";
 }
 

@@ -25,6 +25,7 @@ struct KeptLoop {
   bool ranged = false;              // a range of its own (start_idx, stop_idx)
   bool clearUpper = false;          // a symmetric loop's `upper` found again after a build
   bool clearCross = false;          // OpenMP pairs of two arrays once: LISTS_by_source too
+  bool clearOccupied = false;       // pairs of two arrays: LISTS.occupied found again
 };
 // `verlet_build` and the rebuild: skin, positions, range.
 void rebuildCheck(std::ostream& scene, const KeptLoop& loop);

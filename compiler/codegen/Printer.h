@@ -260,6 +260,8 @@ class ScenePrinter {
   bool pairShared_ = false;  // EmitOptions::pairShared (CPU double, not mpi, not --simd-pairs)
   bool skipSelfPairs_ = false;  // EmitOptions::skipSelfPairs (SymmetricPairs.cpp)
   bool filteredLists_ = false;  // EmitOptions::filteredLists (CpuPrinter.cpp)
+  bool skipEmptyLists_ = true;  // EmitOptions::skipEmptyLists (occupiedRefusal)
+  bool initInAddBack_on_ = true;  // EmitOptions::initInAddBack (initInAddBackRefusal)
   bool constantValues_ = true;  // EmitOptions::constantValues (HostProgram.cpp)
   mutable std::unique_ptr<std::set<const PlanBody*>> pairSharedBodies_;  // (once)
 
@@ -365,6 +367,16 @@ class ScenePrinter {
                      const std::string& hoistPragma = "");
   void emitCrossBlocksHead(const std::string& lists, const std::string& nameA,
                            const std::string& nameB);
+  // Pair loops of two arrays with kept lists (fluid <- wall; the per-destination loops with
+  // the support's test inline, CpuPrinter.cpp, and emitCrossPass): "" where, after a build
+  // of the lists, they visit only the destinations whose kept list is not empty
+  // (sphc/verlet.h, find_occupied), else why not. A destination without candidates only
+  // loads and stores its sums: skipped, the results are the same bits.
+  std::string occupiedRefusal(const DestinationWork& w, const NeighbourPass& pass) const;
+  // The per-destination loop's head in that form over [begin, end): every destination while
+  // the lists' `occupied` is not found (a build: it is found after the loop), else those.
+  void emitOccupiedHead(const std::string& lists, const std::string& begin,
+                        const std::string& end, const std::string& pragma);
   void emitCrossSpanning(const NeighbourPass& ba, int b, const std::set<std::string>& q,
                          const std::string& lists, const std::string& nameA,
                          const std::string& nameB);
@@ -482,6 +494,17 @@ class ScenePrinter {
   // printed as cluster-pair tiles, "" if it is ("off" without the switch). The CPU printer
   // adds its own conditions (kept lists shared with another pass, the tuned skin).
   std::string clusterTilesRefusal(const DestinationWork& w, const NeighbourPass& pass) const;
+  // The destination's initialize in the tiles' add-back (stop 45; --no-init-in-add-back):
+  // "" where the tiles pass `pass` (w's first, in tiles: the caller asks) may run w's
+  // initialize per particle in its add-back loop, just before that particle's slot sums are
+  // added, instead of in a loop of its own before the pass; else why not. The tiles then
+  // write only the slot sums (every sum has components: in the slot order, an add-back in
+  // the particles' order), and the initialize writes only those sums, which nothing before
+  // the add-back reads: the same operations on the same values, one sweep less.
+  std::string initInAddBackRefusal(const DestinationWork& w, const NeighbourPass& pass) const;
+  // Set by the printer of w's pass while it prints the tiles with w's initialize in their
+  // add-back (initInAddBackRefusal ""), else null.
+  const DestinationWork* initInAddBack_ = nullptr;
   // The same without the switch and the lanes (the bodies, the properties; the CPU printer's
   // conditions): for --simd-pairs=cluster's choice of the 2D loops (simdPairsAutoChoice),
   // which puts a loop in the lanes only where the tiles take it.

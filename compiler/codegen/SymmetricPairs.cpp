@@ -779,12 +779,32 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   scene_ << "        const sphc::CellList& cells = cells_" << nameB << ";\n";
   listsCheck();
   emitKeptListsBuild(lists, openmp, listRadius2);
+  const bool occupied = occupiedRefusal(A, ab).empty();
+  if (occupied) {
+    scene_ << "        // Only " << nameA << "'s particles with a candidate (occupiedRefusal; "
+              "sphc --no-skip-empty-lists:\n"
+              "        // every one): found once per build of the lists.\n";
+    scene_ << "        if (!" << lists << ".occupied_found) sphc::find_occupied(" << lists << ");\n";
+    scene_ << "        const std::uint32_t* const occ = " << lists << ".occupied.data();\n";
+    scene_ << "        const int n_occ = static_cast<int>(" << lists << ".occupied.size());\n";
+  }
   if (openmp) emitCrossBlocksHead(lists, nameA, nameB);
   // OpenMP: blocks of A's particles (emitCrossBlocksHead), two spaces further in.
   const std::string in = openmp ? "  " : "";
-  scene_ << in << "        for (int d_idx = " << (openmp ? "b_begin" : "0") << "; d_idx < "
-         << (openmp ? "b_end" : "n") << "; ++d_idx) {  // pairs (d_idx of " << nameA
-         << ", s_idx of " << nameB << ")\n";
+  if (occupied) {
+    if (openmp) {  // the block's: those in [b_begin, b_end)
+      scene_ << in << "        const int v_begin = static_cast<int>(std::lower_bound(occ, occ + n_occ, u_begin) - occ);\n";
+      scene_ << in << "        const int v_end = static_cast<int>(std::lower_bound(occ, occ + n_occ, u_end) - occ);\n";
+    }
+    scene_ << in << "        for (int v = " << (openmp ? "v_begin" : "0") << "; v < "
+           << (openmp ? "v_end" : "n_occ") << "; ++v) {  // pairs (d_idx of " << nameA
+           << ", s_idx of " << nameB << ")\n";
+    scene_ << in << "          const int d_idx = static_cast<int>(occ[v]);\n";
+  } else {
+    scene_ << in << "        for (int d_idx = " << (openmp ? "b_begin" : "0") << "; d_idx < "
+           << (openmp ? "b_end" : "n") << "; ++d_idx) {  // pairs (d_idx of " << nameA
+           << ", s_idx of " << nameB << ")\n";
+  }
   emitDestLocals(scene_, in + "          ", q, host_);
   emitDestinationHoisted(scene_, ab, in + "          ");
   scene_ << in << "          const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
@@ -810,6 +830,29 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   scene_ << in << "        }\n";
   if (openmp) emitCrossSpanning(ba, B.array, q, lists, nameA, nameB);
   scene_ << "        }\n      }\n";
+}
+
+std::string ScenePrinter::occupiedRefusal(const DestinationWork& w,
+                                         const NeighbourPass& pass) const {
+  if (!skipEmptyLists_) return "--no-skip-empty-lists";
+  if (w.array == pass.source) return "one array (every particle has candidates)";
+  return "";
+}
+
+void ScenePrinter::emitOccupiedHead(const std::string& lists, const std::string& begin,
+                                    const std::string& end, const std::string& pragma) {
+  const bool zero = begin == "0";
+  scene_ << "        // Only the destinations with a candidate (occupiedRefusal; sphc "
+            "--no-skip-empty-lists:\n"
+            "        // every one): all while the lists' are not found (a build), then those.\n";
+  scene_ << "        const bool occ_all = !" << lists << ".occupied_found;\n";
+  scene_ << "        const std::uint32_t* const occ = " << lists << ".occupied.data();\n";
+  scene_ << "        const int n_visit = occ_all ? " << (zero ? end : end + " - " + begin)
+         << " : static_cast<int>(" << lists << ".occupied.size());\n";
+  scene_ << pragma;
+  scene_ << "        for (int v = 0; v < n_visit; ++v) {\n";
+  scene_ << "          const int d_idx = occ_all ? " << (zero ? "v" : begin + " + v")
+         << " : static_cast<int>(occ[v]);\n";
 }
 
 void ScenePrinter::emitCrossBlocksHead(const std::string& lists, const std::string& nameA,

@@ -259,6 +259,20 @@ static cl::opt<bool> FilteredLists(
              "once with the support's test inline, where no loop_all, SIMD lanes or --mpi "
              "need the filtered list; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoSkipEmptyLists(
+    "no-skip-empty-lists",
+    cl::desc("In the CPU pair loops of two arrays with kept lists (fluid <- wall), visit every "
+             "destination particle at every evaluation (default: after a build of the lists "
+             "only those whose kept list is not empty; the others add nothing to their sums: "
+             "the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoInitInAddBack(
+    "no-init-in-add-back",
+    cl::desc("Run a destination's initialize in a loop of its own before its first pair loop "
+             "also where that loop is in cluster-pair tiles whose add-back could run it "
+             "(default: per particle in the tiles' add-back, where the tiles write only slot "
+             "sums that the initialize alone writes; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoConstantValues(
     "no-constant-values",
     cl::desc("Set every parameter and const of the equation instances at set-up (default: "
@@ -701,6 +715,8 @@ int main(int argc, char** argv) {
   emitOpts.kernelLanes = KernelLanesOpt;
   emitOpts.skipSelfPairs = !NoSelfPairSkip;
   emitOpts.filteredLists = FilteredLists;
+  emitOpts.skipEmptyLists = !NoSkipEmptyLists;
+  emitOpts.initInAddBack = !NoInitInAddBack;
   emitOpts.constantValues = !NoConstantValues;
   // --simd-pairs: auto (the default), on (also bare), off; the lanes only on the CPU backends.
   const std::string simdMode = SimdPairs.empty() ? std::string("on") : SimdPairs.getValue();

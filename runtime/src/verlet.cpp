@@ -211,4 +211,12 @@ void keep_in_index_order(std::vector<std::uint32_t>& kept, const std::uint32_t* 
   }
 }
 
+void find_occupied(VerletLists& lists) {
+  lists.occupied.clear();
+  for (long d = lists.begin; d < lists.end; ++d)
+    if (!lists.lists[static_cast<std::size_t>(d)].empty())
+      lists.occupied.push_back(static_cast<std::uint32_t>(d));
+  lists.occupied_found = true;
+}
+
 }  // namespace sphc

@@ -125,6 +125,35 @@ TEST(VerletSkin, KeptListsAreInIncreasingIndex) {
 // Lists up to kInsertionSortMax are sorted by insertion, longer ones by std::sort: both give
 // the increasing order of std::sort, for lists sorted, in ascending runs (as the cells give
 // them), reversed and shuffled, of every length around the switch.
+// find_occupied (stop 45): the destinations of [begin, end) with a candidate, in increasing
+// index; those outside the range and those with empty lists left out, found again after a
+// build (the flag cleared, the lists changed).
+TEST(VerletLists, OccupiedAreTheDestinationsWithACandidateInTheRange) {
+  sphc::VerletLists v(0.1);
+  v.lists.resize(8);
+  v.lists[0] = {3};
+  v.lists[2] = {1, 5};
+  v.lists[5] = {0};
+  v.lists[7] = {2};
+  v.begin = 1;
+  v.end = 7;
+  EXPECT_FALSE(v.occupied_found);
+  sphc::find_occupied(v);
+  EXPECT_TRUE(v.occupied_found);
+  EXPECT_EQ(v.occupied, (std::vector<std::uint32_t>{2, 5}));
+  v.lists[2].clear();
+  v.lists[3] = {4};
+  v.begin = 0;
+  v.end = 8;
+  v.occupied_found = false;
+  sphc::find_occupied(v);
+  EXPECT_EQ(v.occupied, (std::vector<std::uint32_t>{0, 3, 5, 7}));
+  for (auto& l : v.lists) l.clear();
+  sphc::find_occupied(v);
+  EXPECT_TRUE(v.occupied.empty());
+  EXPECT_TRUE(v.occupied_found);
+}
+
 TEST(VerletSkin, KeptListsByInsertionAreThoseOfStdSort) {
   std::mt19937_64 rng(5);
   for (std::size_t n = 0; n <= 2 * sphc::kInsertionSortMax + 5; ++n) {

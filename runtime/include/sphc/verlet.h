@@ -168,7 +168,16 @@ struct VerletLists {
   // The loops over each pair once (destination = source): per particle i, where j >= i
   // starts in its kept list (upper_start), found once per build; cleared at every build.
   std::vector<std::uint32_t> upper;
+  // The loops over pairs of two arrays: the destinations of [begin, end) whose kept list is
+  // not empty, in increasing index (find_occupied), found once per build by the first such
+  // loop after it; `occupied_found` cleared at every build. Those loops visit only them: a
+  // destination without candidates adds nothing to its sums.
+  std::vector<std::uint32_t> occupied;
+  bool occupied_found = false;
 };
+
+// lists.occupied = the destinations [begin, end) with a candidate, in increasing index.
+void find_occupied(VerletLists& lists);  // src/verlet.cpp
 
 // The position of the first j >= i in the kept list of particle i (in increasing index).
 inline std::uint32_t upper_start(const std::vector<std::uint32_t>& kept, std::uint32_t i) {
