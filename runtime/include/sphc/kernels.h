@@ -331,19 +331,21 @@ struct SuperGaussianShape {
 // The cluster-pair tiles' reciprocals of a lane from one division (sphc --tile-math=batched,
 // the tiles' default since stop 45; codegen/SimdPairs.cpp prints them where a lane needs 1 /
 // RHOIJ (RHOIJ1) and one or both of 1 / r2 (the gradient's) and 1 / h (the kernel's, one h for
-// every kernel value of the lane)). A divide takes the 512-bit divider ~16 cycles where a
-// multiply takes a port half a cycle, and the tiles' rows are bound by the divider
-// (docs/performance-log.md, "The interaction loop against the measured peak (stop 44)").
+// every kernel value of the lane)). A 512-bit divide takes the divider ~16 cycles where a
+// multiply takes a port half a cycle; two divisions fewer per row: the cube's tiles 0.944x of
+// recip's time, the DualSPHysics scene's 0.86x (docs/performance-log.md, "One division for the
+// tiles' reciprocals (stop 45; `--tile-math=batched`)").
 // inv = 1 / (a b c), then 1 / c = (a b) inv, 1 / (a b) = c inv, 1 / a = b / (a b), 1 / b = a /
 // (a b): one division and 6 multiplications for three reciprocals (two: inv = 1 / (a b), 1 / a
 // = b inv, 1 / b = a inv). Error (u = 2^-53, relative, first order; every operand and product
 // normal): 1 / c within 3 u (the rounding of a b cancels), 1 / a and 1 / b within 5 u; of two,
 // each within 3 u (tests/unit/test_kernels.cpp, TileReciprocalsWithinBounds). The domain: the
 // product a b c must be a normal number; in the tiles a = r2 guarded by tile_r2_guard (at least
-// 1e-25 or 1), b = RHOIJ, c = h, so a lane within the support (r2 < (radius_scale hmax)^2) has
-// a b c below radius_scale^2 hmax^2 rho h and above 1e-25 rho h: normal for any h and rho a simulation in SI units (or scaled ones) has
-// (rho h between 1e-283 and 1e300 in double, 1e-13 and 1e36 in float). Lanes outside the support
-// may overflow to inf or 0 (their values are masked out of every sum, as the exact forms').
+// 1e-25, or 1), b = RHOIJ, c = h, so a lane within the support (r2 < (radius_scale hmax)^2) has
+// a b c below radius_scale^2 hmax^2 rho h and above 1e-25 rho h: normal for any h and rho a
+// simulation in SI units (or scaled ones) has (double: rho h >= 2.2e-283 and rho h hmax^2 <=
+// 4e307; float: 1.2e-13 and 8e37). Lanes outside the support may overflow or underflow (inf, 0,
+// NaN): their values are masked out of every sum, as the exact forms' are.
 template <class T>
 SPHC_KERNEL_INLINE T tile_r2_guard(T r2) {
   // r2 <= 1e-25 means rij < 1e-12: the gradient is 0 there and 1 / r2 unused (gradient_factor)
