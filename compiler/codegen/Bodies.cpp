@@ -65,6 +65,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   clusterQueue_ = opts.clusterQueue;
   clusterSlotOrder_ = opts.clusterSlotOrder;
   tileMathRecip_ = opts.tileMathRecip;
+  tileMathBatched_ = opts.tileMathBatched;
   simdClusterWhy_ = opts.simdPairsClusterAuto ? "--simd-pairs=auto: " + opts.simdCpu.tilesWhy
                                               : std::string("--simd-pairs=cluster");
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in

@@ -183,6 +183,10 @@ struct EmitOptions {
   // 1/r = r (1/r^2), no division after the square root); false (exact) the forms of the
   // other loops (Kernel::w, Kernel::gradient_factor).
   bool tileMathRecip = true;
+  // --tile-math=batched (stop 45, the default): with tileMathRecip, a tile lane's reciprocals
+  // 1/r^2, 1/RHOIJ and 1/h from one division where it needs RHOIJ1 and one or both of the
+  // others (sphc::tile_reciprocals); false (recip, exact) a division for each.
+  bool tileMathBatched = true;
   // --simd-neighbours=N: auto's threshold on a loop's expected neighbour count
   // (kSimdAutoNeighbours by default; a measurement knob: 0 puts every loop that allows it in
   // lanes under auto's rule, e.g. with --simd-pairs=once the 2D scenes' loops).

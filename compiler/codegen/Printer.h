@@ -479,7 +479,9 @@ class ScenePrinter {
   // `negatedMirrors`: the mirrored differences as negations (-XIJ_0: the same doubles but
   // for the sign of a zero difference; the cluster-pair tiles).
   // `tileRecip`: the kernel values in the tiles' reciprocal forms (Kernel::w_tile,
-  // gradient_factor_tile: no division after the square root; --tile-math=recip, stop 41).
+  // gradient_factor_tile: no division after the square root; --tile-math=recip, stop 41);
+  // with tileMathBatched_ (--tile-math=batched, stop 45) a lane's 1/r^2, RHOIJ1 and 1/h from
+  // one division where it needs RHOIJ1 and one or both of the others (sphc::tile_reciprocals).
   void emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q, bool both,
                               const std::string& body, bool mask,
                               bool negatedMirrors = false, bool tileRecip = false) const;
@@ -574,6 +576,7 @@ class ScenePrinter {
   }
   bool clusterSlotOrder_ = true;  // EmitOptions::clusterSlotOrder (--no-slot-order: false)
   bool tileMathRecip_ = true;     // EmitOptions::tileMathRecip (--tile-math=exact: false)
+  bool tileMathBatched_ = true;   // EmitOptions::tileMathBatched (--tile-math=batched)
   // Whether the pass's array is kept in its tiles' slot order (stop 40; ClusterPairs.cpp):
   // permuted into it where its tiles' lists are due (update_neighbours) and read and written
   // by the tiles in place. The CPU printer's answer (its own arrays, sorted, double).

@@ -768,10 +768,54 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
   const std::string& R = host_.real;
   const PairDialect dialect = pairDialectOf(host_);
   os << body << "const " << R << " hj = sj_h[s_idx];\n";
+  auto printed = [&](const PairQuantity& pq) {
+    return pq.when == PairWhen::BeforeTest || pq.when == PairWhen::EveryNeighbour ||
+           q.count(pq.name);
+  };
+  // --tile-math=batched (stop 45): where a lane needs RHOIJ1 and the kernel's 1/r^2 (a
+  // gradient) or 1/h (one h for every kernel value), those reciprocals from one division
+  // (sphc::tile_reciprocals, kernels.h), printed before the first kernel value, with RHOIJ
+  // moved there; a kernel h not in the batch its own division. Without RHOIJ1: recip's forms
+  // (docs/performance-log.md, "One division for the tiles' reciprocals (stop 45)").
+  std::set<std::string> kernelHs;
+  bool needR2 = false, needRho = false;
+  if (tileRecip && tileMathBatched_)
+    for (const PairQuantity& pq : pairQuantityTable()) {
+      if (!printed(pq)) continue;
+      if (pq.form == PairForm::Kernel || pq.form == PairForm::Gradient) kernelHs.insert(pq.h);
+      needR2 |= pq.form == PairForm::Gradient;
+      needRho |= pq.name == "RHOIJ1";
+    }
+  const bool batchH = kernelHs.size() == 1;
+  const bool batched = needRho && (needR2 || batchH);
+  bool batchPrinted = false;
+  auto printBatch = [&] {
+    batchPrinted = true;
+    if (needRho)
+      for (const PairQuantity& pq : pairQuantityTable())
+        if (pq.name == "RHOIJ")
+          os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
+    const std::string H = batchH ? *kernelHs.begin() : "";
+    std::vector<std::pair<std::string, std::string>> terms;  // (operand, its reciprocal)
+    if (needR2) terms.push_back({"sphc::tile_r2_guard(R2IJ)", "tile_ir2"});
+    if (needRho) terms.push_back({"RHOIJ", "RHOIJ1"});
+    if (batchH) terms.push_back({H, "tile_ih_" + H});
+    os << body << R << " ";
+    for (size_t k = 0; k < terms.size(); ++k) os << (k ? ", " : "") << terms[k].second;
+    os << ";  // one division for " << terms.size() << " reciprocals (--tile-math=batched)\n";
+    os << body << "sphc::tile_reciprocals(";
+    for (const auto& t : terms) os << t.first << ", ";
+    for (size_t k = 0; k < terms.size(); ++k) os << (k ? ", " : "") << terms[k].second;
+    os << ");\n";
+    for (const std::string& h : kernelHs)  // a kernel h not in the batch: its own division
+      if (!batchH) os << body << "const " << R << " tile_ih_" << h << " = 1.0 / " << h << ";\n";
+  };
   for (const PairQuantity& pq : pairQuantityTable()) {
-    if (!(pq.when == PairWhen::BeforeTest || pq.when == PairWhen::EveryNeighbour ||
-          q.count(pq.name)))
-      continue;
+    if (!printed(pq)) continue;
+    if (batched && !batchPrinted &&
+        (pq.form == PairForm::Kernel || pq.form == PairForm::Gradient || pq.name == "RHOIJ1"))
+      printBatch();
+    if (batched && (pq.name == "RHOIJ" || pq.name == "RHOIJ1") && needRho) continue;
     if (pq.form == PairForm::Difference) {
       for (int k = 0; k < 3; ++k)
         os << body << "const " << R << " " << pq.name << "_" << k << " = "
@@ -790,7 +834,10 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
       // (h_j) -> DWI_ji; the factor of (RIJ, h) once for both.
       const std::string partner =
           pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
-      if (tileRecip)  // (the tiles: no division after the square root, kernels.h)
+      if (batched)  // (1/r^2 and 1/h from the batch above)
+        os << body << "const " << R << " " << pq.name
+           << "_f = Kernel::gradient_factor_tile_ih(RIJ, tile_ir2, tile_ih_" << pq.h << ");\n";
+      else if (tileRecip)  // (the tiles: no division after the square root, kernels.h)
         os << body << "const " << R << " " << pq.name
            << "_f = Kernel::gradient_factor_tile(RIJ, R2IJ, " << pq.h << ");\n";
       else
@@ -803,6 +850,9 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
         for (int k = 0; k < 3; ++k)
           os << body << "const " << R << " " << partner << "_" << k << " = " << pq.name
              << "_f * XIJ_ji_" << k << ";\n";
+    } else if (pq.form == PairForm::Kernel && batched) {
+      os << body << "const " << R << " " << pq.name << " = Kernel::w_tile_ih(RIJ, tile_ih_" << pq.h
+         << ");\n";
     } else if (pq.form == PairForm::Kernel && tileRecip) {
       os << body << "const " << R << " " << pq.name << " = Kernel::w_tile(RIJ, " << pq.h
          << ");\n";

@@ -72,16 +72,21 @@ static cl::opt<OnOff, false, NamedValues<OnOff>> FmaOpt(
                           "backend (default)"),
                clEnumValN(OnOff::Off, "off", "a multiply and an add, each rounded")),
     cl::cat(SphcCat));
-enum class TileMath { Recip, Exact };
+enum class TileMath { Batched, Recip, Exact };
 static cl::opt<TileMath, false, NamedValues<TileMath>> TileMathOpt(
     "tile-math",
     cl::desc("The kernel values W and grad W in the cluster-pair tiles (--simd-pairs=cluster "
              "or auto's tiles):"),
-    cl::init(TileMath::Recip),
-    cl::values(clEnumValN(TileMath::Recip, "recip",
+    cl::init(TileMath::Batched),
+    cl::values(clEnumValN(TileMath::Batched, "batched",
+                          "recip's forms, and a lane's 1/r^2, 1/RHOIJ (RHOIJ1) and 1/h from one "
+                          "division where it needs RHOIJ1 and one of the others (default; within 5 u "
+                          "of the divisions; q within 5 ulp, 1/(h r) 12 u; "
+                          "runtime/include/sphc/kernels.h, sphc::tile_reciprocals)"),
+               clEnumValN(TileMath::Recip, "recip",
                           "q = r (1/h) and 1/r = r (1/r^2): no division after the square root "
-                          "(default; within 3 ulp of the exact forms' q, 6 u of their 1/(h r); "
-                          "runtime/include/sphc/kernels.h)"),
+                          "(within 3 ulp of the exact forms' q, 6 u of their 1/(h r); "
+                          "runtime/include/sphc/kernels.h; the default of stops 41-44)"),
                clEnumValN(TileMath::Exact, "exact",
                           "r / h and dW/dq / (h r), the forms of the other pair loops (before "
                           "stop 41)")),
@@ -743,7 +748,8 @@ int main(int argc, char** argv) {
   emitOpts.cluster3d2xmm = Cluster3d2xmm;
   emitOpts.clusterQueue = ClusterQueue;
   emitOpts.clusterSlotOrder = !NoSlotOrder;
-  emitOpts.tileMathRecip = TileMathOpt == TileMath::Recip;
+  emitOpts.tileMathRecip = TileMathOpt != TileMath::Exact;
+  emitOpts.tileMathBatched = TileMathOpt == TileMath::Batched;
   emitOpts.simdAutoNeighbours = SimdNeighbours;
   emitOpts.simdOnceNeighbours = SimdOnceNeighbours;
   emitOpts.simdPerDestNeighbours = SimdPerDestNeighbours;

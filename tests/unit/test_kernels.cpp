@@ -720,8 +720,12 @@ TEST(Kernels, GradientFactorIsGradientsFactor) {
 //   may fall on the other side: the continuous kernels' values there are within the bound,
 //   the truncated Gaussians' (Gaussian, SuperGaussian: cut at 3h) differ by their jump, the
 //   value just inside (e^-9 of W(0)), for such a pair (the tiles' cut-off is R2IJ's).
+// batched: the forms of --tile-math=batched (stop 45), w_tile_ih and gradient_factor_tile_ih
+// from sphc::tile_reciprocals(tile_r2_guard(r2), rho, h) with rho from 1e-3 to 1e5: q within 5
+// ulp (1/h within 3 u, a product), 1/(h rij) within 12 u (1/h 3 u, 1/r2 5 u, two products,
+// (1 + e)^2), W and the gradient factor within the same 64 u of the kernel's scale.
 template <class K>
-void expect_tile_forms_within_bounds(double& worst_w, double& worst_g) {
+void expect_tile_forms_within_bounds(double& worst_w, double& worst_g, bool batched = false) {
   const double u = std::ldexp(1.0, -53);
   // the kernel's scales at h = 1: max f (at q = 0 for every kernel here) and max |f'|
   double fmax = 0.0, dfmax = 0.0;
@@ -730,13 +734,14 @@ void expect_tile_forms_within_bounds(double& worst_w, double& worst_g) {
     fmax = std::max(fmax, std::fabs(K::w(q, 1.0)));
     dfmax = std::max(dfmax, std::fabs(K::dwdq(q, 1.0)));
   }
-  std::mt19937_64 rng(41);
+  std::mt19937_64 rng(41), rng_rho(45);  // (rho's own: the h's as before stop 45)
   std::uniform_real_distribution<double> jitter(0.5, 2.0);
   const double hs[] = {1e-9, 1e-6, 1e-3, 0.013, 0.0319, 1.0, 1e3, 1e6, 1e9};
   for (double h0 : hs)
     for (int rep = 0; rep < 3; ++rep) {
       const double h = rep == 0 ? h0 : h0 * jitter(rng);
       const double ih = 1.0 / h;
+      const double rho = std::pow(10.0, -3 + 2 * rep) * jitter(rng_rho);  // 1e-3 .. 1e5
       const double wscale = fmax * std::pow(ih, K::dim);
       std::vector<double> qs = {0.0, 1.0, 2.0, 3.0, K::radius_scale, 0.5e-12 * ih, 1e-12 * ih,
                                 2e-12 * ih, std::nextafter(1.0, 0.0), std::nextafter(2.0, 0.0)};
@@ -744,19 +749,25 @@ void expect_tile_forms_within_bounds(double& worst_w, double& worst_g) {
       for (double q0 : qs) {
         const double r2 = (q0 * h) * (q0 * h);
         const double rij = std::sqrt(r2);  // as the tiles: RIJ = sqrt(R2IJ)
-        // q within 3 ulp
-        const double qa = rij / h, qt = rij * ih;
+        double bir2 = 0.0, birho = 0.0, bih = 0.0;  // the batched reciprocals
+        sphc::tile_reciprocals(sphc::tile_r2_guard(r2), rho, h, bir2, birho, bih);
+        const double tih = batched ? bih : ih;
+        // q within 3 ulp (batched: 5)
+        const double qa = rij / h, qt = rij * tih;
         const double ulp = std::nextafter(qa, 2 * qa + 1.0) - qa;
-        EXPECT_LE(std::fabs(qt - qa), 3 * ulp) << K::name << " h=" << h << " r=" << rij;
-        // 1/(h rij) within 6 u (where rij is past the guard)
+        EXPECT_LE(std::fabs(qt - qa), (batched ? 5 : 3) * ulp) << K::name << " h=" << h << " r=" << rij;
+        // 1/(h rij) within 6 u (batched: 12; where rij is past the guard)
         if (rij > 1e-12) {
-          const double rt = ih * (rij * (1.0 / r2));
+          const double rt = tih * (rij * (batched ? bir2 : 1.0 / r2));
           const long double ra = 1.0L / (static_cast<long double>(h) * rij);
-          EXPECT_LE(std::fabs(static_cast<long double>(rt) - ra), 6.0L * u * ra)
+          EXPECT_LE(std::fabs(static_cast<long double>(rt) - ra), (batched ? 12.0L : 6.0L) * u * ra)
               << K::name << " h=" << h << " r=" << rij;
         }
-        const double wa = K::w(rij, h), wt = K::w_tile(rij, h);
-        const double ga = K::gradient_factor(rij, h), gt = K::gradient_factor_tile(rij, r2, h);
+        const double wa = K::w(rij, h);
+        const double wt = batched ? K::w_tile_ih(rij, bih) : K::w_tile(rij, h);
+        const double ga = K::gradient_factor(rij, h);
+        const double gt = batched ? K::gradient_factor_tile_ih(rij, bir2, bih)
+                                  : K::gradient_factor_tile(rij, r2, h);
         ASSERT_TRUE(std::isfinite(wt) && std::isfinite(gt)) << K::name << " h=" << h << " r=" << rij;
         // beyond the support (past q's 3 ulp): both 0; the gradient 0 at the guard
         if (qa > K::radius_scale * (1.0 + 8 * u)) {
@@ -784,13 +795,13 @@ void expect_tile_forms_within_bounds(double& worst_w, double& worst_g) {
 }
 
 template <class... Ks>
-void expect_tile_forms_all() {
+void expect_tile_forms_all(bool batched = false) {
   (
-      [] {
+      [batched] {
         double ww = 0.0, wg = 0.0;
-        expect_tile_forms_within_bounds<Ks>(ww, wg);
-        std::printf("tile forms %s<%d>: W within %.2f u, gradient factor within %.2f u of the scale\n",
-                    Ks::name, Ks::dim, ww, wg);
+        expect_tile_forms_within_bounds<Ks>(ww, wg, batched);
+        std::printf("tile forms%s %s<%d>: W within %.2f u, gradient factor within %.2f u of the scale\n",
+                    batched ? " (batched)" : "", Ks::name, Ks::dim, ww, wg);
       }(),
       ...);
 }
@@ -802,4 +813,67 @@ TEST(Kernels, TileReciprocalFormsWithinBounds) {
                         sphc::WendlandQuinticC4<2>, sphc::WendlandQuinticC4<3>,
                         sphc::WendlandQuinticC6<2>, sphc::WendlandQuinticC6<3>,
                         sphc::SuperGaussian<2>, sphc::SuperGaussian<3>>();
+}
+
+// --tile-math=batched (stop 45): the same forms from the batched reciprocals.
+TEST(Kernels, TileBatchedFormsWithinBounds) {
+  expect_tile_forms_all<sphc::CubicSpline<1>, sphc::CubicSpline<2>, sphc::CubicSpline<3>,
+                        sphc::QuinticSpline<2>, sphc::QuinticSpline<3>, sphc::WendlandQuintic<1>,
+                        sphc::WendlandQuintic<2>, sphc::WendlandQuintic<3>, sphc::Gaussian<3>,
+                        sphc::WendlandQuinticC4<2>, sphc::WendlandQuinticC4<3>,
+                        sphc::WendlandQuinticC6<2>, sphc::WendlandQuinticC6<3>,
+                        sphc::SuperGaussian<2>, sphc::SuperGaussian<3>>(/*batched=*/true);
+}
+
+// With 1 / h from a plain division the reciprocal forms are w_tile's and gradient_factor_tile's
+// values bit for bit (the printer's batch of two, 1/r^2 and RHOIJ1, keeps 1/h so).
+TEST(Kernels, TileIhFormsAreTileForms) {
+  using K = sphc::CubicSpline<3>;
+  for (double h : {1e-3, 0.013, 1.0, 7.5})
+    for (int k = 0; k <= 2000; ++k) {
+      const double rij = 2.2 * h * k / 2000.0, r2 = rij * rij;
+      EXPECT_EQ(K::w_tile_ih(rij, 1.0 / h), K::w_tile(rij, h));
+      EXPECT_EQ(K::gradient_factor_tile_ih(rij, 1.0 / (r2 > 0 ? r2 : 1.0), 1.0 / h),
+                K::gradient_factor_tile(rij, r2, h));
+    }
+}
+
+// sphc::tile_reciprocals (stop 45): one division for two or three reciprocals, relative error
+// against long double within 3 u (1 / c; of two, both) and 5 u (1 / a, 1 / b), u = 2^-53,
+// over operands whose product is normal (magnitudes 1e-100 to 1e100); and the tiles' guard.
+TEST(Kernels, TileReciprocalsWithinBounds) {
+  const long double u = std::ldexp(1.0L, -53);
+  std::mt19937_64 rng(45);
+  std::uniform_real_distribution<double> mant(1.0, 10.0);
+  std::uniform_int_distribution<int> ex(-100, 100);
+  long double worst2 = 0, worst3ab = 0, worst3c = 0;
+  auto rel = [](double x, long double exact) {
+    return std::fabs(static_cast<long double>(x) - exact) / exact;
+  };
+  for (int k = 0; k < 200000; ++k) {
+    const double a = mant(rng) * std::pow(10.0, ex(rng));
+    const double b = mant(rng) * std::pow(10.0, ex(rng));
+    const double c = mant(rng) * std::pow(10.0, ex(rng));
+    double ia, ib, ic;
+    sphc::tile_reciprocals(a, b, c, ia, ib, ic);
+    const long double ea = rel(ia, 1.0L / a) / u, eb = rel(ib, 1.0L / b) / u,
+                      ec = rel(ic, 1.0L / c) / u;
+    EXPECT_LE(ea, 5.0L) << a << " " << b << " " << c;
+    EXPECT_LE(eb, 5.0L) << a << " " << b << " " << c;
+    EXPECT_LE(ec, 3.0L) << a << " " << b << " " << c;
+    worst3ab = std::max({worst3ab, ea, eb});
+    worst3c = std::max(worst3c, ec);
+    double ja, jb;
+    sphc::tile_reciprocals(a, b, ja, jb);
+    const long double fa = rel(ja, 1.0L / a) / u, fb = rel(jb, 1.0L / b) / u;
+    EXPECT_LE(fa, 3.0L) << a << " " << b;
+    EXPECT_LE(fb, 3.0L) << a << " " << b;
+    worst2 = std::max({worst2, fa, fb});
+  }
+  std::printf("tile_reciprocals: of three 1/a, 1/b within %.2Lf u, 1/c within %.2Lf u; of two within %.2Lf u\n",
+              worst3ab, worst3c, worst2);
+  EXPECT_EQ(sphc::tile_r2_guard(0.0), 1.0);
+  EXPECT_EQ(sphc::tile_r2_guard(1e-26), 1.0);
+  EXPECT_EQ(sphc::tile_r2_guard(1e-24), 1e-24);  // rij = 1e-12: past the gradient's guard
+  EXPECT_EQ(sphc::tile_r2_guard(0.25), 0.25);
 }

@@ -100,6 +100,19 @@ SPHC_KERNEL_INLINE T inv_h_pow(T h) {
   }
 }
 
+// 1 / h^Dim from 1 / h (inv_h_pow's powers: inv_h_pow<Dim>(h) == ih_pow<Dim>(T(1) / h)).
+template <int Dim, class T>
+SPHC_KERNEL_INLINE T ih_pow(T ih) {
+  static_assert(Dim >= 1 && Dim <= 3, "sphc kernels: Dim must be 1, 2 or 3");
+  if constexpr (Dim == 1) {
+    return ih;
+  } else if constexpr (Dim == 2) {
+    return ih * ih;
+  } else {
+    return ih * ih * ih;
+  }
+}
+
 // The shape functions f(q), f'(q) of every kernel, as templates on the floating point type
 // (sphc/kernel_shapes.h: the same text is the OpenCL program's, see runtime/src/opencl.cpp).
 namespace shapes {
@@ -178,6 +191,24 @@ struct RadialKernel {
     const T ih = T(1) / h;
     const T irij = rij * (T(1) / (r2 > T(0) ? r2 : T(1)));
     const T s = T(S::sigma) * inv_h_pow<Dim>(h) * S::df(rij * ih) * (ih * irij);
+    return apart ? s : T(0);
+  }
+  // The same forms from reciprocals the caller has (sphc --tile-math=batched, stop 45): ih =
+  // 1 / h and ir2 = 1 / r2 (r2 guarded as tile_r2_guard does), as tile_reciprocals derives
+  // them from one division. With ih = T(1) / h they are w_tile's value bit for bit; from
+  // tile_reciprocals, whose reciprocals are within 3-5 u of 1 / h and 1 / r2 (below), q is
+  // within 5 ulp of r / h, the gradient's 1 / (h rij) within 12 u, W and the gradient factor
+  // within 64 u of the kernel's scale (tests/unit/test_kernels.cpp,
+  // TileBatchedFormsWithinBounds).
+  template <class T>
+  static SPHC_KERNEL_INLINE T w_tile_ih(T rij, T ih) {
+    return T(S::sigma) * ih_pow<Dim>(ih) * S::f(rij * ih);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T gradient_factor_tile_ih(T rij, T ir2, T ih) {
+    const bool apart = rij > T(1e-12);
+    const T irij = rij * ir2;
+    const T s = T(S::sigma) * ih_pow<Dim>(ih) * S::df(rij * ih) * (ih * irij);
     return apart ? s : T(0);
   }
   // The gradients of one pair for both particles (sphc's pair loops that evaluate each pair
@@ -296,6 +327,45 @@ struct SuperGaussianShape {
 #undef SPHC_SHAPE_FUNCTIONS
 
 }  // namespace detail
+
+// The cluster-pair tiles' reciprocals of a lane from one division (sphc --tile-math=batched,
+// the tiles' default since stop 45; codegen/SimdPairs.cpp prints them where a lane needs 1 /
+// RHOIJ (RHOIJ1) and one or both of 1 / r2 (the gradient's) and 1 / h (the kernel's, one h for
+// every kernel value of the lane)). A 512-bit divide takes the divider ~16 cycles where a
+// multiply takes a port half a cycle; two divisions fewer per row: the cube's tiles 0.944x of
+// recip's time, the DualSPHysics scene's 0.86x (docs/performance-log.md, "One division for the
+// tiles' reciprocals (stop 45; `--tile-math=batched`)").
+// inv = 1 / (a b c), then 1 / c = (a b) inv, 1 / (a b) = c inv, 1 / a = b / (a b), 1 / b = a /
+// (a b): one division and 6 multiplications for three reciprocals (two: inv = 1 / (a b), 1 / a
+// = b inv, 1 / b = a inv). Error (u = 2^-53, relative, first order; every operand and product
+// normal): 1 / c within 3 u (the rounding of a b cancels), 1 / a and 1 / b within 5 u; of two,
+// each within 3 u (tests/unit/test_kernels.cpp, TileReciprocalsWithinBounds). The domain: the
+// product a b c must be a normal number; in the tiles a = r2 guarded by tile_r2_guard (at least
+// 1e-25, or 1), b = RHOIJ, c = h, so a lane within the support (r2 < (radius_scale hmax)^2) has
+// a b c below radius_scale^2 hmax^2 rho h and above 1e-25 rho h: normal for any h and rho a
+// simulation in SI units (or scaled ones) has (double: rho h >= 2.2e-283 and rho h hmax^2 <=
+// 4e307; float: 1.2e-13 and 8e37). Lanes outside the support may overflow or underflow (inf, 0,
+// NaN): their values are masked out of every sum, as the exact forms' are.
+template <class T>
+SPHC_KERNEL_INLINE T tile_r2_guard(T r2) {
+  // r2 <= 1e-25 means rij < 1e-12: the gradient is 0 there and 1 / r2 unused (gradient_factor)
+  return r2 > T(1e-25) ? r2 : T(1);
+}
+template <class T>
+SPHC_KERNEL_INLINE void tile_reciprocals(T a, T b, T c, T& ia, T& ib, T& ic) {
+  const T ab = a * b;
+  const T inv = T(1) / (ab * c);
+  ic = ab * inv;
+  const T iab = c * inv;
+  ia = b * iab;
+  ib = a * iab;
+}
+template <class T>
+SPHC_KERNEL_INLINE void tile_reciprocals(T a, T b, T& ia, T& ib) {
+  const T inv = T(1) / (a * b);
+  ia = b * inv;
+  ib = a * inv;
+}
 
 template <int Dim>
 struct CubicSpline : detail::RadialKernel<detail::CubicShape<Dim>, Dim> {
