@@ -183,6 +183,12 @@ struct EmitOptions {
   // kSimdPerDestNeighbours). Measurement knobs.
   double simdOnceNeighbours = -1;
   double simdPerDestNeighbours = -1;
+  // The CPU pair loops (serial and openmp, not --mpi) of a destination or source array whose h
+  // is one value for the whole run (analysis/UniformH.h: nothing writes it, its initial value
+  // is an expression of params) read it once per pass, and compute hmax, the cut-off's
+  // RADIUS2 * hmax * hmax and HIJ once (codegen/Bodies.cpp, beginUniformH; stop 45); false
+  // (--no-uniform-h): per particle and per pair, as before. The same results bit for bit.
+  bool uniformH = true;
 };
 
 // --simd-pairs=auto: a pair loop is put in SIMD lanes where its expected neighbour count

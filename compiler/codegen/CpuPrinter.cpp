@@ -459,6 +459,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
   const auto cross = crossPair(w);
   // One neighbour pass per source.
   for (const NeighbourPass& pass : w.passes) {
+    endUniformH();  // (a pass that sets it: its own)
     if (cross.first == &w && &pass == &w.passes.back()) continue;  // in cross.second's
     if (cross.second == &w && &pass == &w.passes.front()) {
       const DestinationWork& A = *cross.first;
@@ -482,6 +483,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     for (const auto& p : pass.sourceProps)
       scene_ << "        const " << hostType(s, p) << "* s_" << p << " = " << propPtr(s, p)
              << ";\n";
+    // h once per pass where it is one value (Bodies.cpp, beginUniformH; stop 45).
+    if (pass.searches() && pass.shared.count("h")) beginUniformH(d, s, "        ");
     // PySPH's initialize_pair: per destination particle, before this source's neighbours.
     if (!pass.initializePair.empty()) {
       scene_ << parallelFor("        ", w.perParticle, ompIf(rangeCount(w)));
@@ -620,6 +623,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
              << ", n_candidates);  // " << loops << " loop(s) over the pairs\n";
     scene_ << "      }\n";
   }
+  endUniformH();
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions over the destination array into its constants.
   for (const Reduction& r : w.reductions) reduction(w, r);

@@ -559,7 +559,7 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
   os << in << "for (int k_nbr = 0; k_nbr < n_nbrs; ++k_nbr) {\n";
   const std::string body = in + "  ";
   os << body << "const int s_idx = static_cast<int>(NBRS[k_nbr]);\n";
-  os << body << "const " << host_.real << " hj = sj_h[s_idx];\n";
+  os << body << "const " << host_.real << " hj = " << hjValue("sj_h[s_idx]") << ";\n";
   // The pair quantities as scalars: vectors by component, gradients as a factor times XIJ.
   const PairDialect dialect = pairDialectOf(host_);
   for (const PairQuantity& pq : pairQuantityTable()) {
@@ -573,13 +573,13 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
                              : std::string(host_.floatBodies ? "0.0f" : "0.0"))
            << ";\n";
     } else if (pq.form == PairForm::Gradient) {
-      os << body << "const " << host_.real << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
-         << pq.h << ");\n";
+      os << body << "const " << host_.real << " " << pq.name << "_f = "
+         << kernelCall("gradient_factor", "RIJ, ", pq.h, "") << ";\n";
       for (int k = 0; k < 3; ++k)
         os << body << "const " << host_.real << " " << pq.name << "_" << k << " = " << pq.name
            << "_f * XIJ_" << k << ";\n";
     } else {
-      os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
+      os << scalarPairStatement(pairStatement(pq, dialect, body));
     }
   }
   for (const PlanEquation* eq : pass.equations)
@@ -767,7 +767,7 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
                                           bool negatedMirrors, bool tileRecip) const {
   const std::string& R = host_.real;
   const PairDialect dialect = pairDialectOf(host_);
-  os << body << "const " << R << " hj = sj_h[s_idx];\n";
+  os << body << "const " << R << " hj = " << hjValue("sj_h[s_idx]") << ";\n";
   for (const PairQuantity& pq : pairQuantityTable()) {
     if (!(pq.when == PairWhen::BeforeTest || pq.when == PairWhen::EveryNeighbour ||
           q.count(pq.name)))
@@ -792,10 +792,10 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
           pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
       if (tileRecip)  // (the tiles: no division after the square root, kernels.h)
         os << body << "const " << R << " " << pq.name
-           << "_f = Kernel::gradient_factor_tile(RIJ, R2IJ, " << pq.h << ");\n";
+           << "_f = " << kernelCall("gradient_factor_tile", "RIJ, R2IJ, ", pq.h, "") << ";\n";
       else
-        os << body << "const " << R << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
-           << pq.h << ");\n";
+        os << body << "const " << R << " " << pq.name << "_f = "
+           << kernelCall("gradient_factor", "RIJ, ", pq.h, "") << ";\n";
       for (int k = 0; k < 3; ++k)
         os << body << "const " << R << " " << pq.name << "_" << k << " = " << pq.name
            << "_f * XIJ_" << k << ";\n";
@@ -804,15 +804,15 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
           os << body << "const " << R << " " << partner << "_" << k << " = " << pq.name
              << "_f * XIJ_ji_" << k << ";\n";
     } else if (pq.form == PairForm::Kernel && tileRecip) {
-      os << body << "const " << R << " " << pq.name << " = Kernel::w_tile(RIJ, " << pq.h
-         << ");\n";
+      os << body << "const " << R << " " << pq.name << " = " << kernelCall("w_tile", "RIJ, ", pq.h, "")
+         << ";\n";
     } else {
-      os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
+      os << scalarPairStatement(pairStatement(pq, dialect, body));
     }
   }
   if (!mask) return;
-  os << body << "const " << R << " hmax = hi > hj ? hi : hj;\n";
-  os << body << "const bool in_support = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
+  os << body << "const " << R << " hmax = " << hmaxValue() << ";\n";
+  os << body << "const bool in_support = !(R2IJ >= " << cutoffValue("RADIUS2") << ");  // the cut-off\n";
 }
 
 void ScenePrinter::emitSymmetricSimdLoops(const DestinationWork& w, const NeighbourPass& pass,

@@ -389,7 +389,13 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     scene_ << lb << "const int s_idx = static_cast<int>(kb[kl_k]);\n";
     // The neighbour test's operands and its comparison as a value (emitNeighbourTest skips
     // where R2IJ >= RADIUS2 * hmax * hmax).
-    emitTestOperands(scene_, host_, lb);
+    {  // (a lambda without captures: hj per candidate, hi its argument, as before stop 45)
+      const bool i = uhI_, j = uhJ_;
+      uhI_ = uhJ_ = false;
+      emitTestOperands(scene_, host_, lb);
+      uhI_ = i;
+      uhJ_ = j;
+    }
     scene_ << lb << "const double hmax = hi > hj ? hi : hj;\n";
     scene_ << lb << "kl_in[kl_k] = !(R2IJ >= RADIUS2 * hmax * hmax) ? 1 : 0;  // a neighbour\n";
     scene_ << lb << "const double HIJ = 0.5 * (hi + hj);\n";
@@ -722,10 +728,10 @@ void ScenePrinter::emitPairQuantitiesOnce(const std::set<std::string>& q, bool b
       const std::string partner =
           pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
       scene_ << body << dialect.real << " " << pq.name << "[3], " << partner << "[3];\n";
-      scene_ << body << "Kernel::gradient_pair(XIJ, XIJ_ji, RIJ, " << pq.h << ", " << pq.name
-             << ", " << partner << ");\n";
+      scene_ << body << kernelCall("gradient_pair", "XIJ, XIJ_ji, RIJ, ", pq.h,
+                                   ", " + pq.name + ", " + partner) << ";\n";
     } else {
-      scene_ << pairQuantityStatement(pq, plan_.dim, dialect, body);
+      scene_ << pairStatement(pq, dialect, body);
     }
   }
 }
@@ -772,6 +778,7 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
     scene_ << "        const " << host_.real << "* di_" << p << " = " << propPtr(A.array, p) << ";\n";
     scene_ << "        const " << host_.real << "* sj_" << p << " = " << propPtr(B.array, p) << ";\n";
   }
+  if (shared.count("h")) beginUniformH(A.array, B.array, "        ");  // (stop 45; d_idx of A)
   for (const auto& p : ab.sourceProps)
     scene_ << "        const " << hostType(B.array, p) << "* s_" << p << " = "
            << propPtr(B.array, p) << ";\n";
@@ -810,6 +817,7 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   scene_ << in << "        }\n";
   if (openmp) emitCrossSpanning(ba, B.array, q, lists, nameA, nameB);
   scene_ << "        }\n      }\n";
+  endUniformH();
 }
 
 void ScenePrinter::emitCrossBlocksHead(const std::string& lists, const std::string& nameA,

@@ -5,6 +5,7 @@
 #include "analysis/Passes.h"
 #include "analysis/KeptGhostSpan.h"
 #include "analysis/PositionReads.h"
+#include "analysis/UniformH.h"
 #include "body/BodyAnalysis.h"
 #include "codegen/CppEmitter.h"
 #include "driver/Build.h"
@@ -119,6 +120,15 @@ static cl::opt<bool> NoHoist(
              "those that depend on the source particle only and divide or call sqrt, pow, ... "
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double and single precision; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoUniformH(
+    "no-uniform-h",
+    cl::desc("In the CPU pair loops, read every particle's h and compute hmax, the cut-off and "
+             "HIJ per pair (default: where an array's h is one value for the whole run, i.e. "
+             "nothing writes it, its initial value is an expression of params, no file or inlet "
+             "or outlet gives it particles, they read it once per pass and compute those once; "
+             "serial and openmp, not --mpi; --report says which arrays; the results are the "
+             "same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoFoldZeroTerms(
     "no-fold-zero-terms",
@@ -652,6 +662,12 @@ int main(int argc, char** argv) {
     }
     if (!why.empty()) verletSkin = 0.0;
   }
+  {  // h as one value per array (analysis/UniformH.cpp, stop 45)
+    const std::string off = NoUniformH ? "--no-uniform-h"
+                            : Mpi      ? "--mpi"
+                            : Backend == sphc::Backend::OpenCL ? "--backend=opencl" : "";
+    if (std::string note = uniformHNote(*plan, off); !note.empty()) plan->notes.push_back(note);
+  }
   if (Report) printPlan(*plan, llvm::outs(), true);
   if (Emit == EmitKind::Plan) {
     if (!Report) printPlan(*plan, llvm::outs(), true);
@@ -728,6 +744,7 @@ int main(int argc, char** argv) {
   emitOpts.clusterQueue = ClusterQueue;
   emitOpts.clusterSlotOrder = !NoSlotOrder;
   emitOpts.tileMathRecip = TileMathOpt == TileMath::Recip;
+  emitOpts.uniformH = !NoUniformH;
   emitOpts.simdAutoNeighbours = SimdNeighbours;
   emitOpts.simdOnceNeighbours = SimdOnceNeighbours;
   emitOpts.simdPerDestNeighbours = SimdPerDestNeighbours;

@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <type_traits>
 #include <random>
 #include <string>
@@ -802,4 +804,74 @@ TEST(Kernels, TileReciprocalFormsWithinBounds) {
                         sphc::WendlandQuinticC4<2>, sphc::WendlandQuinticC4<3>,
                         sphc::WendlandQuinticC6<2>, sphc::WendlandQuinticC6<3>,
                         sphc::SuperGaussian<2>, sphc::SuperGaussian<3>>();
+}
+
+// The forms with h's factors given (Kernel::w_ih, gradient_ih, gradient_factor_ih,
+// gradient_pair_ih, w_tile_ih, gradient_factor_tile_ih; stop 45: the pair loops of arrays whose
+// h is one value compute ih = inv_h(h) and ihd = inv_h_dim(h) once per pass) against their
+// models, bit for bit, over h from 1e-9 to 1e9, q over the support and past it, rij down to 0
+// and across the 1e-12 guard; in double and in float.
+template <class T>
+std::uint64_t bits_of(T v) {
+  std::uint64_t b = 0;
+  std::memcpy(&b, &v, sizeof v);
+  return b;
+}
+
+template <class K, class T>
+void expect_factor_forms_bitwise() {
+  std::mt19937_64 rng(45);
+  std::uniform_real_distribution<double> jitter(0.5, 2.0);
+  const double hs[] = {1e-9, 1e-6, 1e-3, 0.013, 0.0319, 1.0, 1e3, 1e6, 1e9};
+  int compared = 0;
+  for (double h0 : hs)
+    for (int rep = 0; rep < 3; ++rep) {
+      const T h = static_cast<T>(rep == 0 ? h0 : h0 * jitter(rng));
+      const T ih = K::inv_h(h), ihd = K::inv_h_dim(h);
+      std::vector<double> qs = {0.0, 1.0, 2.0, 3.0, K::radius_scale, 0.5e-12 / h0, 1e-12 / h0,
+                                2e-12 / h0, std::nextafter(2.0, 0.0)};
+      for (int k = 0; k < 1000; ++k) qs.push_back(1.25 * K::radius_scale * k / 1000.0);
+      for (double q0 : qs) {
+        const T r = static_cast<T>(q0) * h;
+        const T r2 = r * r;
+        const T rij = std::sqrt(r2);
+        const T xij[3] = {rij * T(0.6), -rij * T(0.8), T(0)};
+        const T xji[3] = {-xij[0], -xij[1], -xij[2]};
+        EXPECT_EQ(bits_of(K::w_ih(rij, h, ihd)), bits_of(K::w(rij, h))) << K::name << " h=" << h << " r=" << rij;
+        EXPECT_EQ(bits_of(K::gradient_factor_ih(rij, h, ihd)), bits_of(K::gradient_factor(rij, h)))
+            << K::name << " h=" << h << " r=" << rij;
+        EXPECT_EQ(bits_of(K::w_tile_ih(rij, ih, ihd)), bits_of(K::w_tile(rij, h)))
+            << K::name << " h=" << h << " r=" << rij;
+        EXPECT_EQ(bits_of(K::gradient_factor_tile_ih(rij, r2, ih, ihd)),
+                  bits_of(K::gradient_factor_tile(rij, r2, h)))
+            << K::name << " h=" << h << " r=" << rij;
+        T g[3], gf[3], gij[3], gji[3], gij_f[3], gji_f[3];
+        K::gradient(xij, rij, h, g);
+        K::gradient_ih(xij, rij, h, ihd, gf);
+        K::gradient_pair(xij, xji, rij, h, gij, gji);
+        K::gradient_pair_ih(xij, xji, rij, h, ihd, gij_f, gji_f);
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_EQ(bits_of(gf[c]), bits_of(g[c])) << K::name << " h=" << h << " r=" << rij;
+          EXPECT_EQ(bits_of(gij_f[c]), bits_of(gij[c])) << K::name << " h=" << h << " r=" << rij;
+          EXPECT_EQ(bits_of(gji_f[c]), bits_of(gji[c])) << K::name << " h=" << h << " r=" << rij;
+        }
+        ++compared;
+      }
+    }
+  EXPECT_GT(compared, 9000);
+}
+
+template <class... Ks>
+void expect_factor_forms_all() {
+  (expect_factor_forms_bitwise<Ks, double>(), ...);
+  (expect_factor_forms_bitwise<Ks, float>(), ...);
+}
+
+TEST(Kernels, FactorFormsBitwise) {
+  expect_factor_forms_all<sphc::CubicSpline<1>, sphc::CubicSpline<2>, sphc::CubicSpline<3>,
+                          sphc::QuinticSpline<2>, sphc::QuinticSpline<3>, sphc::WendlandQuintic<1>,
+                          sphc::WendlandQuintic<2>, sphc::WendlandQuintic<3>, sphc::Gaussian<3>,
+                          sphc::WendlandQuinticC4<2>, sphc::WendlandQuinticC4<3>,
+                          sphc::WendlandQuinticC6<2>, sphc::WendlandQuinticC6<3>,
+                          sphc::SuperGaussian<2>, sphc::SuperGaussian<3>>();
 }

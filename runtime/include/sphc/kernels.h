@@ -194,6 +194,62 @@ struct RadialKernel {
     grad_ji[1] = s * xji[1];
     grad_ji[2] = s * xji[2];
   }
+  // The forms above with h's factors given (stop 45: a pair loop whose arrays' h is one value
+  // for the whole run, sphc's analysis/UniformH.cpp, computes them once per pass): ih =
+  // inv_h(h) = 1 / h, ihd = inv_h_dim(h) = 1 / h^Dim, the doubles w, dwdq, w_tile, ... compute
+  // from h; each form does the same operations in the same order as its model's, so its values
+  // are the model's bit for bit (tests/unit/test_kernels.cpp, FactorFormsBitwise).
+  template <class T>
+  static SPHC_KERNEL_INLINE T inv_h(T h) {
+    return T(1) / h;
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T inv_h_dim(T h) {
+    return inv_h_pow<Dim>(h);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T w_ih(T rij, T h, T ihd) {  // w
+    return T(S::sigma) * ihd * S::f(rij / h);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T dwdq_ih(T rij, T h, T ihd) {  // dwdq
+    return T(S::sigma) * ihd * S::df(rij / h);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE void gradient_ih(const T xij[3], T rij, T h, T ihd, T grad[3]) {
+    const T s = rij > T(1e-12) ? dwdq_ih(rij, h, ihd) / (h * rij) : T(0);  // gradient
+    grad[0] = s * xij[0];
+    grad[1] = s * xij[1];
+    grad[2] = s * xij[2];
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T gradient_factor_ih(T rij, T h, T ihd) {  // gradient_factor
+    const bool apart = rij > T(1e-12);
+    const T s = dwdq_ih(rij, h, ihd) / (h * (apart ? rij : T(1)));
+    return apart ? s : T(0);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE void gradient_pair_ih(const T xij[3], const T xji[3], T rij, T h,
+                                                  T ihd, T grad_ij[3], T grad_ji[3]) {
+    const T s = rij > T(1e-12) ? dwdq_ih(rij, h, ihd) / (h * rij) : T(0);  // gradient_pair
+    grad_ij[0] = s * xij[0];
+    grad_ij[1] = s * xij[1];
+    grad_ij[2] = s * xij[2];
+    grad_ji[0] = s * xji[0];
+    grad_ji[1] = s * xji[1];
+    grad_ji[2] = s * xji[2];
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T w_tile_ih(T rij, T ih, T ihd) {  // w_tile
+    return T(S::sigma) * ihd * S::f(rij * ih);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T gradient_factor_tile_ih(T rij, T r2, T ih, T ihd) {  // gradient_factor_tile
+    const bool apart = rij > T(1e-12);
+    const T irij = rij * (T(1) / (r2 > T(0) ? r2 : T(1)));
+    const T s = T(S::sigma) * ihd * S::df(rij * ih) * (ih * irij);
+    return apart ? s : T(0);
+  }
 };
 
 // The members f(q) and df(q) of a shape: the functions NAME_f and NAME_df of kernel_shapes.h.
