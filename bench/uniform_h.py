@@ -31,12 +31,12 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 from common import ROOT, SCENE_FILES, load_average, remove_tmp, run  # noqa: E402
 
-# scene: (file, sphc flags, run-time options, short steps, long steps)
+# scene: (file, sphc flags, run-time options, short steps, long steps); a tf past the steps
 SCENES = {
-    "cube": (SCENE_FILES["cube"], [], [], 1, 25),
-    "dambreak": (SCENE_FILES["dambreak"], [], [], 1, 1500),
+    "cube": (SCENE_FILES["cube"], [], ["--tf", "1"], 1, 25),
+    "dambreak": (SCENE_FILES["dambreak"], [], ["--tf", "10"], 1, 1500),
     "dambreak-pysph": (SCENE_FILES["dambreak"], ["-D", "density_diffusion=off", "-D", "shifting=off"],
-                       ["--set", "cfl=0.3"], 1, 1500),
+                       ["--set", "cfl=0.3", "--tf", "10"], 1, 1500),
 }
 VARIANTS = [("per-particle", ["--no-uniform-h"]), ("uniform", [])]
 DONE_RE = re.compile(r"done: t=\S+ after (\d+) steps.*?, ([0-9.eE+-]+) s,")
