@@ -3,6 +3,7 @@
 // a Dialect (the C++ of the CPU backends or the OpenCL C of the kernels).
 #include "analysis/Access.h"
 #include "analysis/PairQuantityTable.h"
+#include "analysis/UniformH.h"
 #include "body/BodyAnalysis.h"
 #include "codegen/FusedMultiplyAdd.h"
 #include "codegen/Printer.h"
@@ -66,6 +67,12 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   clusterSlotOrder_ = opts.clusterSlotOrder;
   tileMathRecip_ = opts.tileMathRecip;
   tileMathBatched_ = opts.tileMathBatched;
+  // h read once per pass where it is one value (stop 45): the CPU backends, not --mpi (its
+  // halos are not looked at).
+  hUniform_.assign(plan_.arrays.size(), false);
+  if (opts.uniformH && opts.backend != Backend::OpenCL && !mpi_)
+    for (int a = 0; a < static_cast<int>(plan_.arrays.size()); ++a)
+      hUniform_[a] = hPerParticleReason(plan_, a).empty();
   simdClusterWhy_ = opts.simdPairsClusterAuto ? "--simd-pairs=auto: " + opts.simdCpu.tilesWhy
                                               : std::string("--simd-pairs=cluster");
   // PairShared.cpp: with --simd-pairs=auto too (its each-pair-once loops are those not in
@@ -416,7 +423,7 @@ void ScenePrinter::emitDestLocals(std::ostream& os, const std::string& indent,
   for (int k = 0; k < 3; ++k)
     os << indent << "const " << R << " " << axes[k] << "i = "
        << (k < plan_.dim ? std::string("di_") + axes[k] + "[d_idx]" : d.lit("0.0")) << ";\n";
-  os << indent << "const " << R << " hi = di_h[d_idx];\n";
+  os << indent << "const " << R << " hi = " << hiValue("di_h[d_idx]") << ";\n";
   // The other vectors of which a pair quantity is a difference (VIJ: ui, vi, wi).
   for (const PairQuantity& pq : pairQuantityTable())
     if (pq.form == PairForm::Difference && pq.when != PairWhen::BeforeTest && q.count(pq.name))
@@ -438,17 +445,86 @@ PairDialect pairDialectOf(const Dialect& dl) {
 void ScenePrinter::emitTestOperands(std::ostream& os, const Dialect& dl,
                                     const std::string& indent) const {
   const PairDialect dialect = pairDialectOf(dl);
-  os << indent << "const " << dl.real << " hj = sj_h[s_idx];\n";
+  os << indent << "const " << dl.real << " hj = " << hjValue("sj_h[s_idx]") << ";\n";
   for (const PairQuantity& pq : pairQuantityTable())
     if (pq.when == PairWhen::BeforeTest)
-      os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
+      os << pairStatement(pq, dialect, indent);
+}
+
+std::string ScenePrinter::pairStatement(const PairQuantity& pq, const PairDialect& dialect,
+                                        const std::string& indent) const {
+  if (uhI_ && uhJ_ && pq.name == "HIJ")
+    return indent + "const " + dialect.real + " HIJ = " + uhPrefix_ + "HIJ;  // h uniform: once per pass\n";
+  if (uhI_ && uhJ_ && pq.h == "HIJ" && pq.form == PairForm::Kernel)
+    return indent + "const " + dialect.real + " " + pq.name + " = " + kernelCall("w", "RIJ, ", "HIJ", "") + ";\n";
+  if (uhI_ && uhJ_ && pq.h == "HIJ" && pq.form == PairForm::Gradient)
+    return indent + dialect.real + " " + pq.name + "[3];\n" + indent +
+           kernelCall("gradient", "XIJ, RIJ, ", "HIJ", ", " + pq.name) + ";\n";
+  return pairQuantityStatement(pq, plan_.dim, dialect, indent);
+}
+
+std::string ScenePrinter::kernelCall(const std::string& fn, const std::string& before,
+                                     const std::string& h, const std::string& after) const {
+  if (!(uhI_ && uhJ_) || h != "HIJ") return "Kernel::" + fn + "(" + before + h + after + ")";
+  const bool tile = fn == "w_tile" || fn == "gradient_factor_tile";  // (1 / h in h's place)
+  return "Kernel::" + fn + "_ih(" + before + (tile ? uhPrefix_ + "ih" : h) + ", " + uhPrefix_ +
+         "ihd" + after + ")";
+}
+
+void ScenePrinter::beginUniformH(int d, int s, const std::string& in) {
+  endUniformH();
+  uhI_ = hUniform_[d];
+  uhJ_ = hUniform_[s];
+  if (!uhI_ && !uhJ_) return;
+  const std::string& R = host_.real;
+  const std::string& D = arr(d).name;
+  const std::string& S = arr(s).name;
+  scene_ << in << "// h the same for every particle of "
+         << (uhI_ && uhJ_ ? (d == s ? D : D + " and of " + S)
+                          : uhI_ ? D + " (not of " + S + ")" : S + " (not of " + D + ")")
+         << " all the run (analysis/UniformH.cpp): read once\n";
+  scene_ << in << "// (sphc --no-uniform-h: per particle; the same values bit for bit)\n";
+  if (uhI_)
+    scene_ << in << "const " << R << " uh_hi = " << arr(d).name << ".n > 0 ? di_h[0] : " << R << "(0);\n";
+  if (uhJ_)
+    scene_ << in << "const " << R << " uh_hj = " << arr(s).name << ".n > 0 ? sj_h[0] : " << R << "(0);\n";
+  if (!(uhI_ && uhJ_)) return;
+  // hmax, the cut-off and HIJ as the pair loops write them, once.
+  scene_ << in << R << " uh_hmax, uh_cut2, uh_HIJ, uh_ih, uh_ihd;\n";
+  scene_ << in << "{\n";
+  scene_ << in << "  const " << R << " hi = uh_hi;\n";
+  scene_ << in << "  const " << R << " hj = uh_hj;\n";
+  scene_ << in << "  const " << R << " hmax = hi > hj ? hi : hj;\n";
+  for (const PairQuantity& pq : pairQuantityTable())
+    if (pq.name == "HIJ")
+      scene_ << pairQuantityStatement(pq, plan_.dim, pairDialectOf(host_), in + "  ");
+  scene_ << in << "  uh_hmax = hmax;\n";
+  scene_ << in << "  uh_cut2 = RADIUS2 * hmax * hmax;\n";
+  scene_ << in << "  uh_HIJ = HIJ;\n";
+  scene_ << in << "  uh_ih = Kernel::inv_h(HIJ);  // the kernel's 1 / h and 1 / h^dim (kernels.h, FN_ih)\n";
+  scene_ << in << "  uh_ihd = Kernel::inv_h_dim(HIJ);\n";
+  scene_ << in << "}\n";
+}
+
+void ScenePrinter::uniformHLocals(const std::string& in) {
+  if (!uhI_ && !uhJ_) return;
+  const std::string& R = host_.real;
+  for (const char* v : {"hi", "hj", "hmax", "cut2", "HIJ", "ih", "ihd"}) {
+    const std::string n = v;
+    if ((n == "hi" && !uhI_) || (n == "hj" && !uhJ_) || (n != "hi" && n != "hj" && !(uhI_ && uhJ_)))
+      continue;
+    scene_ << in << "const " << R << " uhl_" << n << " = uh_" << n << ";  // h uniform: a local copy\n";
+  }
+  uhPrefix_ = "uhl_";
 }
 
 void ScenePrinter::emitNeighbourTest(std::ostream& os, const Dialect& dl, const std::string& skip,
                                      const std::string& indent, const std::string& radius2) {
   emitTestOperands(os, dl, indent);
-  os << indent << "const " << dl.real << " hmax = hi > hj ? hi : hj;\n";
-  os << indent << "if (R2IJ >= " << radius2 << " * hmax * hmax) " << skip
+  const std::string cut = cutoffValue(radius2);
+  if (cut.find("hmax") != std::string::npos)
+    os << indent << "const " << dl.real << " hmax = " << hmaxValue() << ";\n";
+  os << indent << "if (R2IJ >= " << cut << ") " << skip
      << (radius2 == "RADIUS2" ? "  // not a neighbour\n" : "  // beyond the list's radius\n");
 }
 
@@ -465,7 +541,7 @@ void ScenePrinter::emitPairQuantities(std::ostream& os, const std::set<std::stri
   }
   for (const PairQuantity& pq : pairQuantityTable())
     if (pq.when == PairWhen::EveryNeighbour || (pq.when == PairWhen::IfUsed && q.count(pq.name)))
-      os << pairQuantityStatement(pq, plan_.dim, dialect, indent);
+      os << pairStatement(pq, dialect, indent);
 }
 
 void ScenePrinter::emitCandidate(std::ostream& os, const std::set<std::string>& q,

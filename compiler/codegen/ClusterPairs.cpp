@@ -738,6 +738,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
         scene_ << t << "const auto " << eqStruct(*eq) << " = this->" << eqStruct(*eq) << ";  // "
                << eq->name << "'s values, a local copy\n";
   }
+  uniformHLocals(t);  // h uniform (stop 45): the lambda's own copies
   scene_ << t << "const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
   scene_ << t << "const std::uint32_t* const cl_j = cl_pruned.j.data();\n";
   scene_ << t << "const std::uint8_t* const cl_real = cl_layout.real_mask.data();\n";
@@ -898,7 +899,13 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     // (sphc::tile_row_any, kortest), else the lanes' test reduced by max (a tree of 3 steps)
     // rather than + (8 scalar adds in a chain): the cube's tiles 0.91x and 0.93x of the sum's
     // time, the same rows skipped (the sums bit for bit).
-    if (!mm) {
+    if (!mm && uhI_ && uhJ_) {  // h uniform (stop 45): the row's test against one cut-off
+      scene_ << "#if defined(__AVX512F__)\n";
+      scene_ << c3 << "if (!sphc::tile_row_any_cut<DIM>(xi, yi, " << (plan_.dim == 3 ? "zi" : "0.0")
+             << ", sj_x, sj_y, " << (plan_.dim == 3 ? "sj_z" : "nullptr") << ", cl_lane, "
+             << "lane_d, " << cutoffValue("RADIUS2") << ")) continue;  // no pair of the row within the support\n";
+      scene_ << "#else\n";
+    } else if (!mm) {
       scene_ << "#if defined(__AVX512F__)\n";
       scene_ << c3 << "if (!sphc::tile_row_any<DIM>(xi, yi, " << (plan_.dim == 3 ? "zi" : "0.0")
              << ", hi, sj_x, sj_y, " << (plan_.dim == 3 ? "sj_z" : "nullptr") << ", sj_h, cl_lane, "
@@ -911,19 +918,19 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     {
       const std::string b = c3 + "  ";
       if (mm) {
-        scene_ << b << "const double hi = ir_h[s_idx];\n";
+        scene_ << b << "const double hi = " << hiValue("ir_h[s_idx]") << ";\n";
         for (int k = 0; k < plan_.dim; ++k)
           scene_ << b << "const double " << axes[k] << "i = ir_" << axes[k] << "[s_idx];\n";
       }
-      scene_ << b << "const double hj = sj_h[s_idx];\n";
+      scene_ << b << "const double hj = " << hjValue("sj_h[s_idx]") << ";\n";
       std::string r2;
       for (int k = 0; k < plan_.dim; ++k) {
         scene_ << b << "const double XIJ_" << k << " = " << axes[k] << "i - sj_" << axes[k] << "[s_idx];\n";
         r2 += (k ? " + " : "") + std::string("XIJ_") + std::to_string(k) + " * XIJ_" + std::to_string(k);
       }
       scene_ << b << "const double R2IJ = " << r2 << ";\n";
-      scene_ << b << "const double hmax = hi > hj ? hi : hj;\n";
-      const std::string in = "!(R2IJ >= RADIUS2 * hmax * hmax) & (" + jl + " > " + il + "lane_d)";
+      scene_ << b << "const double hmax = " << hmaxValue() << ";\n";
+      const std::string in = "!(R2IJ >= " + cutoffValue("RADIUS2") + ") & (" + jl + " > " + il + "lane_d)";
       scene_ << b << "const double in_l = " << in << " ? 1.0 : 0.0;\n";
       scene_ << b << "any = any > in_l ? any : in_l;\n";
     }
@@ -946,8 +953,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       if (mm || inQueue) laneDest(body);
       emitLanePairQuantities(scene_, q, true, body, false, /*negatedMirrors=*/true,
                              /*tileRecip=*/tileMathRecip_);
-      scene_ << body << "const double hmax = hi > hj ? hi : hj;\n";
-      scene_ << body << "const bool in_cut = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
+      scene_ << body << "const double hmax = " << hmaxValue() << ";\n";
+      scene_ << body << "const bool in_cut = !(R2IJ >= " << cutoffValue("RADIUS2") << ");  // the cut-off\n";
       if (!inQueue) {
         scene_ << body << "const bool in_d = in_cut & (" << jl << " > " << il << "lane_d);  // for d_idx\n";
         scene_ << body << "const bool in_s = in_cut & (" << jl << " > " << il << "lane_s);  // for the lane's particle\n";
@@ -1181,6 +1188,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   scene_ << c1 << "}\n";
   scene_ << t << "}\n";
   scene_ << in << "};\n";
+  if (uhPrefix_ == "uhl_") uhPrefix_ = "uh_";  // (the lambda's copies: in it only)
   if (!openmp) {
     scene_ << in << "tiles(0, static_cast<int>(cl_layout.n_clusters));\n";
   } else {

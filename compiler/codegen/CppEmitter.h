@@ -184,8 +184,8 @@ struct EmitOptions {
   // other loops (Kernel::w, Kernel::gradient_factor).
   bool tileMathRecip = true;
   // --tile-math=batched (stop 45, the default): with tileMathRecip, a tile lane's reciprocals
-  // 1/r^2, 1/RHOIJ and 1/h from one division where it needs RHOIJ1 and one or both of the
-  // others (sphc::tile_reciprocals); false (recip, exact) a division for each.
+  // 1/r^2 and 1/RHOIJ from one division where it needs both (sphc::tile_reciprocals; 1/h a
+  // division of its own); false (recip, exact) a division for each.
   bool tileMathBatched = true;
   // --simd-neighbours=N: auto's threshold on a loop's expected neighbour count
   // (kSimdAutoNeighbours by default; a measurement knob: 0 puts every loop that allows it in
@@ -197,6 +197,12 @@ struct EmitOptions {
   // kSimdPerDestNeighbours). Measurement knobs.
   double simdOnceNeighbours = -1;
   double simdPerDestNeighbours = -1;
+  // The CPU pair loops (serial and openmp, not --mpi) of a destination or source array whose h
+  // is one value for the whole run (analysis/UniformH.h: nothing writes it, its initial value
+  // is an expression of params) read it once per pass, and compute hmax, the cut-off's
+  // RADIUS2 * hmax * hmax and HIJ once (codegen/Bodies.cpp, beginUniformH; stop 45); false
+  // (--no-uniform-h): per particle and per pair, as before. The same results bit for bit.
+  bool uniformH = true;
 };
 
 // --simd-pairs=auto: a pair loop is put in SIMD lanes where its expected neighbour count

@@ -472,6 +472,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
   initInAddBack_ = initInTiles ? &w : nullptr;
   // One neighbour pass per source.
   for (const NeighbourPass& pass : w.passes) {
+    endUniformH();  // (a pass that sets it: its own)
     if (cross.first == &w && &pass == &w.passes.back()) continue;  // in cross.second's
     if (cross.second == &w && &pass == &w.passes.front()) {
       const DestinationWork& A = *cross.first;
@@ -495,6 +496,8 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     for (const auto& p : pass.sourceProps)
       scene_ << "        const " << hostType(s, p) << "* s_" << p << " = " << propPtr(s, p)
              << ";\n";
+    // h once per pass where it is one value (Bodies.cpp, beginUniformH; stop 45).
+    if (pass.searches() && pass.shared.count("h")) beginUniformH(d, s, "        ");
     // PySPH's initialize_pair: per destination particle, before this source's neighbours.
     if (!pass.initializePair.empty()) {
       scene_ << parallelFor("        ", w.perParticle, ompIf(rangeCount(w)));
@@ -646,6 +649,7 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     scene_ << "      }\n";
   }
   initInAddBack_ = nullptr;
+  endUniformH();
   perParticle(ast::Method::PostLoop, "post_loop");
   // Reductions over the destination array into its constants.
   for (const Reduction& r : w.reductions) reduction(w, r);

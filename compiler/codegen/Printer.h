@@ -66,6 +66,7 @@ std::string oneLine(const std::string& text);
 std::string endStatement(const std::string& expr);
 
 struct PairDialect;  // analysis/PairQuantityTable.h
+struct PairQuantity;  // analysis/PairQuantityTable.h
 // The spellings the pair-quantity statements take in a dialect (codegen/Bodies.cpp).
 PairDialect pairDialectOf(const Dialect& dl);
 // The vector pair quantities of a body's text as scalars (SimdPairs.cpp): an edit
@@ -480,8 +481,8 @@ class ScenePrinter {
   // for the sign of a zero difference; the cluster-pair tiles).
   // `tileRecip`: the kernel values in the tiles' reciprocal forms (Kernel::w_tile,
   // gradient_factor_tile: no division after the square root; --tile-math=recip, stop 41);
-  // with tileMathBatched_ (--tile-math=batched, stop 45) a lane's 1/r^2, RHOIJ1 and 1/h from
-  // one division where it needs RHOIJ1 and one or both of the others (sphc::tile_reciprocals).
+  // with tileMathBatched_ (--tile-math=batched, stop 45) a lane's 1/r^2 and RHOIJ1 from one
+  // division where it needs both (sphc::tile_reciprocals; 1/h a division of its own).
   void emitLanePairQuantities(std::ostream& os, const std::set<std::string>& q, bool both,
                               const std::string& body, bool mask,
                               bool negatedMirrors = false, bool tileRecip = false) const;
@@ -577,6 +578,40 @@ class ScenePrinter {
   bool clusterSlotOrder_ = true;  // EmitOptions::clusterSlotOrder (--no-slot-order: false)
   bool tileMathRecip_ = true;     // EmitOptions::tileMathRecip (--tile-math=exact: false)
   bool tileMathBatched_ = true;   // EmitOptions::tileMathBatched (--tile-math=batched)
+  // ---- h as one value per array (EmitOptions::uniformH; analysis/UniformH.h, stop 45) ----
+  std::vector<bool> hUniform_;    // per array: its h the same for every particle, all the run
+  // The pass being printed: its destination's (uhI_) and source's (uhJ_) h is uniform, read
+  // once into uh_hi and uh_hj; with both, uh_hmax, uh_cut2 (RADIUS2 * hmax * hmax) and uh_HIJ
+  // too (beginUniformH). uhPrefix_: "uh_", or "uhl_" for the tiles' local copies.
+  bool uhI_ = false, uhJ_ = false;
+  std::string uhPrefix_ = "uh_";
+  // Prints the pass's uniform values (after its di_h, sj_h) and sets uhI_, uhJ_; endUniformH:
+  // the pass is over.
+  void beginUniformH(int d, int s, const std::string& in);
+  void endUniformH() { uhI_ = uhJ_ = false; uhPrefix_ = "uh_"; }
+  // The tiles' lambda: the values as locals of its own (read through the capture, GCC would
+  // load them again after every store to a double).
+  void uniformHLocals(const std::string& in);
+  // What a pair loop prints for hi, hj, hmax and the cut-off `radius2 * hmax * hmax`.
+  std::string hiValue(const std::string& perParticle) const {
+    return uhI_ ? uhPrefix_ + "hi" : perParticle;
+  }
+  std::string hjValue(const std::string& perParticle) const {
+    return uhJ_ ? uhPrefix_ + "hj" : perParticle;
+  }
+  std::string hmaxValue() const { return uhI_ && uhJ_ ? uhPrefix_ + "hmax" : "hi > hj ? hi : hj"; }
+  std::string cutoffValue(const std::string& radius2) const {
+    return uhI_ && uhJ_ && radius2 == "RADIUS2" ? uhPrefix_ + "cut2" : radius2 + " * hmax * hmax";
+  }
+  // pairQuantityStatement, with HIJ the pass's uh_HIJ where both sides are uniform (and the
+  // kernel's values of it by kernelCall).
+  std::string pairStatement(const PairQuantity& pq, const PairDialect& dialect,
+                            const std::string& indent) const;
+  // The call Kernel::FN(BEFORE H AFTER); where H is the pass's uniform HIJ, FN's form taking
+  // h's factors computed once per pass (kernels.h, FN_ih: uh_ihd = 1 / h^dim, and for the
+  // tiles' forms uh_ih = 1 / h in h's place), the same values bit for bit.
+  std::string kernelCall(const std::string& fn, const std::string& before, const std::string& h,
+                         const std::string& after) const;
   // Whether the pass's array is kept in its tiles' slot order (stop 40; ClusterPairs.cpp):
   // permuted into it where its tiles' lists are due (update_neighbours) and read and written
   // by the tiles in place. The CPU printer's answer (its own arrays, sorted, double).

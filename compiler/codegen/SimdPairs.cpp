@@ -559,7 +559,7 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
   os << in << "for (int k_nbr = 0; k_nbr < n_nbrs; ++k_nbr) {\n";
   const std::string body = in + "  ";
   os << body << "const int s_idx = static_cast<int>(NBRS[k_nbr]);\n";
-  os << body << "const " << host_.real << " hj = sj_h[s_idx];\n";
+  os << body << "const " << host_.real << " hj = " << hjValue("sj_h[s_idx]") << ";\n";
   // The pair quantities as scalars: vectors by component, gradients as a factor times XIJ.
   const PairDialect dialect = pairDialectOf(host_);
   for (const PairQuantity& pq : pairQuantityTable()) {
@@ -573,13 +573,13 @@ bool ScenePrinter::emitSimdNeighbours(std::ostream& os, const DestinationWork& w
                              : std::string(host_.floatBodies ? "0.0f" : "0.0"))
            << ";\n";
     } else if (pq.form == PairForm::Gradient) {
-      os << body << "const " << host_.real << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
-         << pq.h << ");\n";
+      os << body << "const " << host_.real << " " << pq.name << "_f = "
+         << kernelCall("gradient_factor", "RIJ, ", pq.h, "") << ";\n";
       for (int k = 0; k < 3; ++k)
         os << body << "const " << host_.real << " " << pq.name << "_" << k << " = " << pq.name
            << "_f * XIJ_" << k << ";\n";
     } else {
-      os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
+      os << scalarPairStatement(pairStatement(pq, dialect, body));
     }
   }
   for (const PlanEquation* eq : pass.equations)
@@ -767,16 +767,18 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
                                           bool negatedMirrors, bool tileRecip) const {
   const std::string& R = host_.real;
   const PairDialect dialect = pairDialectOf(host_);
-  os << body << "const " << R << " hj = sj_h[s_idx];\n";
+  os << body << "const " << R << " hj = " << hjValue("sj_h[s_idx]") << ";\n";
   auto printed = [&](const PairQuantity& pq) {
     return pq.when == PairWhen::BeforeTest || pq.when == PairWhen::EveryNeighbour ||
            q.count(pq.name);
   };
   // --tile-math=batched (stop 45): where a lane needs RHOIJ1 and the kernel's 1/r^2 (a
-  // gradient) or 1/h (one h for every kernel value), those reciprocals from one division
-  // (sphc::tile_reciprocals, kernels.h), printed before the first kernel value, with RHOIJ
-  // moved there; a kernel h not in the batch its own division. Without RHOIJ1: recip's forms
-  // (docs/performance-log.md, "One division for the tiles' reciprocals (stop 45)").
+  // gradient), those two reciprocals from one division (sphc::tile_reciprocals, kernels.h),
+  // printed before the first kernel value, with RHOIJ moved there. The kernel's 1/h stays a
+  // division of its own, once per pass where h is uniform (uh_ih; analysis/UniformH.cpp), so
+  // that --no-uniform-h gives the same values bit for bit; without RHOIJ1 or a gradient:
+  // recip's forms (docs/performance-log.md, "One division for the tiles' reciprocals (stop
+  // 45)").
   std::set<std::string> kernelHs;
   bool needR2 = false, needRho = false;
   if (tileRecip && tileMathBatched_)
@@ -786,29 +788,20 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
       needR2 |= pq.form == PairForm::Gradient;
       needRho |= pq.name == "RHOIJ1";
     }
-  const bool batchH = kernelHs.size() == 1;
-  const bool batched = needRho && (needR2 || batchH);
+  const bool batched = needRho && needR2;
   bool batchPrinted = false;
   auto printBatch = [&] {
     batchPrinted = true;
-    if (needRho)
-      for (const PairQuantity& pq : pairQuantityTable())
-        if (pq.name == "RHOIJ")
-          os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
-    const std::string H = batchH ? *kernelHs.begin() : "";
-    std::vector<std::pair<std::string, std::string>> terms;  // (operand, its reciprocal)
-    if (needR2) terms.push_back({"sphc::tile_r2_guard(R2IJ)", "tile_ir2"});
-    if (needRho) terms.push_back({"RHOIJ", "RHOIJ1"});
-    if (batchH) terms.push_back({H, "tile_ih_" + H});
-    os << body << R << " ";
-    for (size_t k = 0; k < terms.size(); ++k) os << (k ? ", " : "") << terms[k].second;
-    os << ";  // one division for " << terms.size() << " reciprocals (--tile-math=batched)\n";
-    os << body << "sphc::tile_reciprocals(";
-    for (const auto& t : terms) os << t.first << ", ";
-    for (size_t k = 0; k < terms.size(); ++k) os << (k ? ", " : "") << terms[k].second;
-    os << ");\n";
-    for (const std::string& h : kernelHs)  // a kernel h not in the batch: its own division
-      if (!batchH) os << body << "const " << R << " tile_ih_" << h << " = 1.0 / " << h << ";\n";
+    for (const PairQuantity& pq : pairQuantityTable())
+      if (pq.name == "RHOIJ")
+        os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
+    os << body << R << " tile_ir2, RHOIJ1;  // one division for 2 reciprocals (--tile-math=batched)\n";
+    os << body << "sphc::tile_reciprocals(sphc::tile_r2_guard(R2IJ), RHOIJ, tile_ir2, RHOIJ1);\n";
+    for (const std::string& h : kernelHs)  // the kernel's 1 / h: once per pass where uniform
+      os << body << "const " << R << " tile_ih_" << h << " = "
+         << (uhI_ && uhJ_ && h == "HIJ" ? uhPrefix_ + "ih;  // h uniform: once per pass"
+                                        : "1.0 / " + h + ";")
+         << "\n";
   };
   for (const PairQuantity& pq : pairQuantityTable()) {
     if (!printed(pq)) continue;
@@ -834,15 +827,15 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
       // (h_j) -> DWI_ji; the factor of (RIJ, h) once for both.
       const std::string partner =
           pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
-      if (batched)  // (1/r^2 and 1/h from the batch above)
+      if (batched)  // (1/r^2 from the batch above, 1/h beside it)
         os << body << "const " << R << " " << pq.name
-           << "_f = Kernel::gradient_factor_tile_ih(RIJ, tile_ir2, tile_ih_" << pq.h << ");\n";
+           << "_f = Kernel::gradient_factor_tile_rcp(RIJ, tile_ir2, tile_ih_" << pq.h << ");\n";
       else if (tileRecip)  // (the tiles: no division after the square root, kernels.h)
         os << body << "const " << R << " " << pq.name
-           << "_f = Kernel::gradient_factor_tile(RIJ, R2IJ, " << pq.h << ");\n";
+           << "_f = " << kernelCall("gradient_factor_tile", "RIJ, R2IJ, ", pq.h, "") << ";\n";
       else
-        os << body << "const " << R << " " << pq.name << "_f = Kernel::gradient_factor(RIJ, "
-           << pq.h << ");\n";
+        os << body << "const " << R << " " << pq.name << "_f = "
+           << kernelCall("gradient_factor", "RIJ, ", pq.h, "") << ";\n";
       for (int k = 0; k < 3; ++k)
         os << body << "const " << R << " " << pq.name << "_" << k << " = " << pq.name
            << "_f * XIJ_" << k << ";\n";
@@ -851,18 +844,18 @@ void ScenePrinter::emitLanePairQuantities(std::ostream& os, const std::set<std::
           os << body << "const " << R << " " << partner << "_" << k << " = " << pq.name
              << "_f * XIJ_ji_" << k << ";\n";
     } else if (pq.form == PairForm::Kernel && batched) {
-      os << body << "const " << R << " " << pq.name << " = Kernel::w_tile_ih(RIJ, tile_ih_" << pq.h
+      os << body << "const " << R << " " << pq.name << " = Kernel::w_tile_rcp(RIJ, tile_ih_" << pq.h
          << ");\n";
     } else if (pq.form == PairForm::Kernel && tileRecip) {
-      os << body << "const " << R << " " << pq.name << " = Kernel::w_tile(RIJ, " << pq.h
-         << ");\n";
+      os << body << "const " << R << " " << pq.name << " = " << kernelCall("w_tile", "RIJ, ", pq.h, "")
+         << ";\n";
     } else {
-      os << scalarPairStatement(pairQuantityStatement(pq, plan_.dim, dialect, body));
+      os << scalarPairStatement(pairStatement(pq, dialect, body));
     }
   }
   if (!mask) return;
-  os << body << "const " << R << " hmax = hi > hj ? hi : hj;\n";
-  os << body << "const bool in_support = !(R2IJ >= RADIUS2 * hmax * hmax);  // the cut-off\n";
+  os << body << "const " << R << " hmax = " << hmaxValue() << ";\n";
+  os << body << "const bool in_support = !(R2IJ >= " << cutoffValue("RADIUS2") << ");  // the cut-off\n";
 }
 
 void ScenePrinter::emitSymmetricSimdLoops(const DestinationWork& w, const NeighbourPass& pass,

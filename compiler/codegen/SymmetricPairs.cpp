@@ -378,10 +378,15 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
               "#else\n"
               "#define SPHC_KERNEL_LANES_OPTIMIZE\n"
               "#endif\n";
+    // h uniform on both sides (stop 45): the pass's values as arguments (kl_hj, kl_cut2,
+    // kl_HIJ, kl_ihd: a lambda without captures), no h per candidate.
+    const bool klUniform = uhI_ && uhJ_;
     scene_ << "        auto kernel_lanes = [](const std::uint32_t* const kb, const int k_count, "
               "const double xi, const double yi, const double zi, const double hi, " << ptrs
-           << "const double* const sj_h, int* const kl_in, double* const kl_w, double* const kl_s) "
-              "SPHC_KERNEL_LANES_OPTIMIZE {\n";
+           << "const double* const sj_h, int* const kl_in, double* const kl_w, double* const kl_s"
+           << (klUniform ? ", const double kl_hj, const double kl_cut2, const double kl_HIJ, const double kl_ihd" : "")
+           << ") SPHC_KERNEL_LANES_OPTIMIZE {\n";
+    if (klUniform) scene_ << "          (void)hi; (void)sj_h;  // h uniform: kl_hj, kl_cut2, kl_HIJ, kl_ihd\n";
     scene_ << "          (void)xi; (void)yi; (void)zi; (void)kl_w; (void)kl_s;\n";
     scene_ << "          #pragma omp simd\n";
     scene_ << "          for (int kl_k = 0; kl_k < k_count; ++kl_k) {\n";
@@ -389,13 +394,23 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
     scene_ << lb << "const int s_idx = static_cast<int>(kb[kl_k]);\n";
     // The neighbour test's operands and its comparison as a value (emitNeighbourTest skips
     // where R2IJ >= RADIUS2 * hmax * hmax).
+    // (a lambda without captures: one side uniform, hj per candidate and hi its argument as
+    // before stop 45; both, the arguments kl_NAME)
+    const bool i = uhI_, j = uhJ_;
+    const std::string prefix = uhPrefix_;
+    uhI_ = uhJ_ = klUniform;
+    uhPrefix_ = "kl_";
     emitTestOperands(scene_, host_, lb);
-    scene_ << lb << "const double hmax = hi > hj ? hi : hj;\n";
-    scene_ << lb << "kl_in[kl_k] = !(R2IJ >= RADIUS2 * hmax * hmax) ? 1 : 0;  // a neighbour\n";
-    scene_ << lb << "const double HIJ = 0.5 * (hi + hj);\n";
+    if (!klUniform) scene_ << lb << "const double hmax = hi > hj ? hi : hj;\n";
+    scene_ << lb << "kl_in[kl_k] = !(R2IJ >= " << cutoffValue("RADIUS2") << ") ? 1 : 0;  // a neighbour\n";
+    scene_ << lb << "const double HIJ = " << (klUniform ? "kl_HIJ" : "0.5 * (hi + hj)") << ";\n";
     scene_ << lb << "const double RIJ = std::sqrt(R2IJ);\n";
-    if (q.count("WIJ")) scene_ << lb << "kl_w[kl_k] = Kernel::w(RIJ, HIJ);\n";
-    if (q.count("DWIJ")) scene_ << lb << "kl_s[kl_k] = Kernel::gradient_factor(RIJ, HIJ);\n";
+    if (q.count("WIJ")) scene_ << lb << "kl_w[kl_k] = " << kernelCall("w", "RIJ, ", "HIJ", "") << ";\n";
+    if (q.count("DWIJ"))
+      scene_ << lb << "kl_s[kl_k] = " << kernelCall("gradient_factor", "RIJ, ", "HIJ", "") << ";\n";
+    uhI_ = i;
+    uhJ_ = j;
+    uhPrefix_ = prefix;
     scene_ << "          }\n        };\n";
   }
   // One destination's neighbours in [from, to) of its kept list (sorted): the pair
@@ -516,7 +531,8 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       scene_ << in << "const double* const kl_s = kl_s_v.data();\n";
       scene_ << in << "(void)kl_w; (void)kl_s;\n";
       scene_ << in << "kernel_lanes(k_lanes, k_count, xi, yi, zi, hi, " << ptrs
-             << "sj_h, kl_in_v.data(), kl_w_v.data(), kl_s_v.data());\n";
+             << "sj_h, kl_in_v.data(), kl_w_v.data(), kl_s_v.data()"
+             << (uhI_ && uhJ_ ? ", uh_hj, uh_cut2, uh_HIJ, uh_ihd" : "") << ");\n";
       if (sg.tail)
         scene_ << in << "const int k_mid = k_count == 0 || k_lanes[k_count - 1] < static_cast<std::uint32_t>("
                << to << ")\n"
@@ -722,10 +738,10 @@ void ScenePrinter::emitPairQuantitiesOnce(const std::set<std::string>& q, bool b
       const std::string partner =
           pq.name == "DWI" ? "DWJ_ji" : pq.name == "DWJ" ? "DWI_ji" : pq.name + "_ji";
       scene_ << body << dialect.real << " " << pq.name << "[3], " << partner << "[3];\n";
-      scene_ << body << "Kernel::gradient_pair(XIJ, XIJ_ji, RIJ, " << pq.h << ", " << pq.name
-             << ", " << partner << ");\n";
+      scene_ << body << kernelCall("gradient_pair", "XIJ, XIJ_ji, RIJ, ", pq.h,
+                                   ", " + pq.name + ", " + partner) << ";\n";
     } else {
-      scene_ << pairQuantityStatement(pq, plan_.dim, dialect, body);
+      scene_ << pairStatement(pq, dialect, body);
     }
   }
 }
@@ -772,6 +788,7 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
     scene_ << "        const " << host_.real << "* di_" << p << " = " << propPtr(A.array, p) << ";\n";
     scene_ << "        const " << host_.real << "* sj_" << p << " = " << propPtr(B.array, p) << ";\n";
   }
+  if (shared.count("h")) beginUniformH(A.array, B.array, "        ");  // (stop 45; d_idx of A)
   for (const auto& p : ab.sourceProps)
     scene_ << "        const " << hostType(B.array, p) << "* s_" << p << " = "
            << propPtr(B.array, p) << ";\n";
@@ -830,6 +847,7 @@ void ScenePrinter::emitCrossPass(const DestinationWork& A, const NeighbourPass& 
   scene_ << in << "        }\n";
   if (openmp) emitCrossSpanning(ba, B.array, q, lists, nameA, nameB);
   scene_ << "        }\n      }\n";
+  endUniformH();
 }
 
 std::string ScenePrinter::occupiedRefusal(const DestinationWork& w,

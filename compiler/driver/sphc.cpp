@@ -5,6 +5,7 @@
 #include "analysis/Passes.h"
 #include "analysis/KeptGhostSpan.h"
 #include "analysis/PositionReads.h"
+#include "analysis/UniformH.h"
 #include "body/BodyAnalysis.h"
 #include "codegen/CppEmitter.h"
 #include "driver/Build.h"
@@ -79,10 +80,10 @@ static cl::opt<TileMath, false, NamedValues<TileMath>> TileMathOpt(
              "or auto's tiles):"),
     cl::init(TileMath::Batched),
     cl::values(clEnumValN(TileMath::Batched, "batched",
-                          "recip's forms, and a lane's 1/r^2, 1/RHOIJ (RHOIJ1) and 1/h from one "
-                          "division where it needs RHOIJ1 and one of the others (default; within 5 u "
-                          "of the divisions; q within 5 ulp, 1/(h r) 12 u; "
-                          "runtime/include/sphc/kernels.h, sphc::tile_reciprocals)"),
+                          "recip's forms, and a lane's 1/r^2 and 1/RHOIJ (RHOIJ1) from one "
+                          "division where it needs both (default; each within 3 u of its division, "
+                          "1/(h r) within 12 u; 1/h a division of its own, once per pass where h is "
+                          "one value; runtime/include/sphc/kernels.h, sphc::tile_reciprocals)"),
                clEnumValN(TileMath::Recip, "recip",
                           "q = r (1/h) and 1/r = r (1/r^2): no division after the square root "
                           "(within 3 ulp of the exact forms' q, 6 u of their 1/(h r); "
@@ -124,6 +125,15 @@ static cl::opt<bool> NoHoist(
              "those that depend on the source particle only and divide or call sqrt, pow, ... "
              "are computed once per particle before the neighbour pass; serial and openmp, "
              "double and single precision; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoUniformH(
+    "no-uniform-h",
+    cl::desc("In the CPU pair loops, read every particle's h and compute hmax, the cut-off and "
+             "HIJ per pair (default: where an array's h is one value for the whole run, i.e. "
+             "nothing writes it, its initial value is an expression of params, no file or inlet "
+             "or outlet gives it particles, they read it once per pass and compute those once; "
+             "serial and openmp, not --mpi; --report says which arrays; the results are the "
+             "same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoFoldZeroTerms(
     "no-fold-zero-terms",
@@ -671,6 +681,12 @@ int main(int argc, char** argv) {
     }
     if (!why.empty()) verletSkin = 0.0;
   }
+  {  // h as one value per array (analysis/UniformH.cpp, stop 45)
+    const std::string off = NoUniformH ? "--no-uniform-h"
+                            : Mpi      ? "--mpi"
+                            : Backend == sphc::Backend::OpenCL ? "--backend=opencl" : "";
+    if (std::string note = uniformHNote(*plan, off); !note.empty()) plan->notes.push_back(note);
+  }
   if (Report) printPlan(*plan, llvm::outs(), true);
   if (Emit == EmitKind::Plan) {
     if (!Report) printPlan(*plan, llvm::outs(), true);
@@ -750,6 +766,7 @@ int main(int argc, char** argv) {
   emitOpts.clusterSlotOrder = !NoSlotOrder;
   emitOpts.tileMathRecip = TileMathOpt != TileMath::Exact;
   emitOpts.tileMathBatched = TileMathOpt == TileMath::Batched;
+  emitOpts.uniformH = !NoUniformH;
   emitOpts.simdAutoNeighbours = SimdNeighbours;
   emitOpts.simdOnceNeighbours = SimdOnceNeighbours;
   emitOpts.simdPerDestNeighbours = SimdPerDestNeighbours;

@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <type_traits>
 #include <random>
 #include <string>
@@ -720,10 +722,10 @@ TEST(Kernels, GradientFactorIsGradientsFactor) {
 //   may fall on the other side: the continuous kernels' values there are within the bound,
 //   the truncated Gaussians' (Gaussian, SuperGaussian: cut at 3h) differ by their jump, the
 //   value just inside (e^-9 of W(0)), for such a pair (the tiles' cut-off is R2IJ's).
-// batched: the forms of --tile-math=batched (stop 45), w_tile_ih and gradient_factor_tile_ih
-// from sphc::tile_reciprocals(tile_r2_guard(r2), rho, h) with rho from 1e-3 to 1e5: q within 5
-// ulp (1/h within 3 u, a product), 1/(h rij) within 12 u (1/h 3 u, 1/r2 5 u, two products,
-// (1 + e)^2), W and the gradient factor within the same 64 u of the kernel's scale.
+// batched: the forms of --tile-math=batched (stop 45), w_tile_rcp and gradient_factor_tile_rcp
+// with 1/r2 from sphc::tile_reciprocals(tile_r2_guard(r2), rho) (rho from 1e-3 to 1e5) and
+// 1/h a division of its own: q as recip's, 1/(h rij) within 12 u (1/r2 3 u, three products), W
+// and the gradient factor within the same 64 u of the kernel's scale.
 template <class K>
 void expect_tile_forms_within_bounds(double& worst_w, double& worst_g, bool batched = false) {
   const double u = std::ldexp(1.0, -53);
@@ -749,13 +751,13 @@ void expect_tile_forms_within_bounds(double& worst_w, double& worst_g, bool batc
       for (double q0 : qs) {
         const double r2 = (q0 * h) * (q0 * h);
         const double rij = std::sqrt(r2);  // as the tiles: RIJ = sqrt(R2IJ)
-        double bir2 = 0.0, birho = 0.0, bih = 0.0;  // the batched reciprocals
-        sphc::tile_reciprocals(sphc::tile_r2_guard(r2), rho, h, bir2, birho, bih);
-        const double tih = batched ? bih : ih;
-        // q within 3 ulp (batched: 5)
+        double bir2 = 0.0, birho = 0.0;  // the batched reciprocals
+        sphc::tile_reciprocals(sphc::tile_r2_guard(r2), rho, bir2, birho);
+        const double tih = ih;
+        // q within 3 ulp
         const double qa = rij / h, qt = rij * tih;
         const double ulp = std::nextafter(qa, 2 * qa + 1.0) - qa;
-        EXPECT_LE(std::fabs(qt - qa), (batched ? 5 : 3) * ulp) << K::name << " h=" << h << " r=" << rij;
+        EXPECT_LE(std::fabs(qt - qa), 3 * ulp) << K::name << " h=" << h << " r=" << rij;
         // 1/(h rij) within 6 u (batched: 12; where rij is past the guard)
         if (rij > 1e-12) {
           const double rt = tih * (rij * (batched ? bir2 : 1.0 / r2));
@@ -764,9 +766,9 @@ void expect_tile_forms_within_bounds(double& worst_w, double& worst_g, bool batc
               << K::name << " h=" << h << " r=" << rij;
         }
         const double wa = K::w(rij, h);
-        const double wt = batched ? K::w_tile_ih(rij, bih) : K::w_tile(rij, h);
+        const double wt = batched ? K::w_tile_rcp(rij, ih) : K::w_tile(rij, h);
         const double ga = K::gradient_factor(rij, h);
-        const double gt = batched ? K::gradient_factor_tile_ih(rij, bir2, bih)
+        const double gt = batched ? K::gradient_factor_tile_rcp(rij, bir2, ih)
                                   : K::gradient_factor_tile(rij, r2, h);
         ASSERT_TRUE(std::isfinite(wt) && std::isfinite(gt)) << K::name << " h=" << h << " r=" << rij;
         // beyond the support (past q's 3 ulp): both 0; the gradient 0 at the guard
@@ -832,37 +834,26 @@ TEST(Kernels, TileIhFormsAreTileForms) {
   for (double h : {1e-3, 0.013, 1.0, 7.5})
     for (int k = 0; k <= 2000; ++k) {
       const double rij = 2.2 * h * k / 2000.0, r2 = rij * rij;
-      EXPECT_EQ(K::w_tile_ih(rij, 1.0 / h), K::w_tile(rij, h));
-      EXPECT_EQ(K::gradient_factor_tile_ih(rij, 1.0 / (r2 > 0 ? r2 : 1.0), 1.0 / h),
+      EXPECT_EQ(K::w_tile_rcp(rij, 1.0 / h), K::w_tile(rij, h));
+      EXPECT_EQ(K::gradient_factor_tile_rcp(rij, 1.0 / (r2 > 0 ? r2 : 1.0), 1.0 / h),
                 K::gradient_factor_tile(rij, r2, h));
     }
 }
 
-// sphc::tile_reciprocals (stop 45): one division for two or three reciprocals, relative error
-// against long double within 3 u (1 / c; of two, both) and 5 u (1 / a, 1 / b), u = 2^-53,
-// over operands whose product is normal (magnitudes 1e-100 to 1e100); and the tiles' guard.
+// sphc::tile_reciprocals (stop 45): one division for two reciprocals, relative error
+// against long double within 3 u each, u = 2^-53, over operands whose product is normal (magnitudes 1e-100 to 1e100); and the tiles' guard.
 TEST(Kernels, TileReciprocalsWithinBounds) {
   const long double u = std::ldexp(1.0L, -53);
   std::mt19937_64 rng(45);
   std::uniform_real_distribution<double> mant(1.0, 10.0);
   std::uniform_int_distribution<int> ex(-100, 100);
-  long double worst2 = 0, worst3ab = 0, worst3c = 0;
+  long double worst2 = 0;
   auto rel = [](double x, long double exact) {
     return std::fabs(static_cast<long double>(x) - exact) / exact;
   };
   for (int k = 0; k < 200000; ++k) {
     const double a = mant(rng) * std::pow(10.0, ex(rng));
     const double b = mant(rng) * std::pow(10.0, ex(rng));
-    const double c = mant(rng) * std::pow(10.0, ex(rng));
-    double ia, ib, ic;
-    sphc::tile_reciprocals(a, b, c, ia, ib, ic);
-    const long double ea = rel(ia, 1.0L / a) / u, eb = rel(ib, 1.0L / b) / u,
-                      ec = rel(ic, 1.0L / c) / u;
-    EXPECT_LE(ea, 5.0L) << a << " " << b << " " << c;
-    EXPECT_LE(eb, 5.0L) << a << " " << b << " " << c;
-    EXPECT_LE(ec, 3.0L) << a << " " << b << " " << c;
-    worst3ab = std::max({worst3ab, ea, eb});
-    worst3c = std::max(worst3c, ec);
     double ja, jb;
     sphc::tile_reciprocals(a, b, ja, jb);
     const long double fa = rel(ja, 1.0L / a) / u, fb = rel(jb, 1.0L / b) / u;
@@ -870,10 +861,79 @@ TEST(Kernels, TileReciprocalsWithinBounds) {
     EXPECT_LE(fb, 3.0L) << a << " " << b;
     worst2 = std::max({worst2, fa, fb});
   }
-  std::printf("tile_reciprocals: of three 1/a, 1/b within %.2Lf u, 1/c within %.2Lf u; of two within %.2Lf u\n",
-              worst3ab, worst3c, worst2);
+  std::printf("tile_reciprocals: of two within %.2Lf u\n", worst2);
   EXPECT_EQ(sphc::tile_r2_guard(0.0), 1.0);
   EXPECT_EQ(sphc::tile_r2_guard(1e-26), 1.0);
   EXPECT_EQ(sphc::tile_r2_guard(1e-24), 1e-24);  // rij = 1e-12: past the gradient's guard
   EXPECT_EQ(sphc::tile_r2_guard(0.25), 0.25);
+}
+
+// The forms with h's factors given (Kernel::w_ih, gradient_ih, gradient_factor_ih,
+// gradient_pair_ih, w_tile_ih, gradient_factor_tile_ih; stop 45: the pair loops of arrays whose
+// h is one value compute ih = inv_h(h) and ihd = inv_h_dim(h) once per pass) against their
+// models, bit for bit, over h from 1e-9 to 1e9, q over the support and past it, rij down to 0
+// and across the 1e-12 guard; in double and in float.
+template <class T>
+std::uint64_t bits_of(T v) {
+  std::uint64_t b = 0;
+  std::memcpy(&b, &v, sizeof v);
+  return b;
+}
+
+template <class K, class T>
+void expect_factor_forms_bitwise() {
+  std::mt19937_64 rng(45);
+  std::uniform_real_distribution<double> jitter(0.5, 2.0);
+  const double hs[] = {1e-9, 1e-6, 1e-3, 0.013, 0.0319, 1.0, 1e3, 1e6, 1e9};
+  int compared = 0;
+  for (double h0 : hs)
+    for (int rep = 0; rep < 3; ++rep) {
+      const T h = static_cast<T>(rep == 0 ? h0 : h0 * jitter(rng));
+      const T ih = K::inv_h(h), ihd = K::inv_h_dim(h);
+      std::vector<double> qs = {0.0, 1.0, 2.0, 3.0, K::radius_scale, 0.5e-12 / h0, 1e-12 / h0,
+                                2e-12 / h0, std::nextafter(2.0, 0.0)};
+      for (int k = 0; k < 1000; ++k) qs.push_back(1.25 * K::radius_scale * k / 1000.0);
+      for (double q0 : qs) {
+        const T r = static_cast<T>(q0) * h;
+        const T r2 = r * r;
+        const T rij = std::sqrt(r2);
+        const T xij[3] = {rij * T(0.6), -rij * T(0.8), T(0)};
+        const T xji[3] = {-xij[0], -xij[1], -xij[2]};
+        EXPECT_EQ(bits_of(K::w_ih(rij, h, ihd)), bits_of(K::w(rij, h))) << K::name << " h=" << h << " r=" << rij;
+        EXPECT_EQ(bits_of(K::gradient_factor_ih(rij, h, ihd)), bits_of(K::gradient_factor(rij, h)))
+            << K::name << " h=" << h << " r=" << rij;
+        EXPECT_EQ(bits_of(K::w_tile_ih(rij, ih, ihd)), bits_of(K::w_tile(rij, h)))
+            << K::name << " h=" << h << " r=" << rij;
+        EXPECT_EQ(bits_of(K::gradient_factor_tile_ih(rij, r2, ih, ihd)),
+                  bits_of(K::gradient_factor_tile(rij, r2, h)))
+            << K::name << " h=" << h << " r=" << rij;
+        T g[3], gf[3], gij[3], gji[3], gij_f[3], gji_f[3];
+        K::gradient(xij, rij, h, g);
+        K::gradient_ih(xij, rij, h, ihd, gf);
+        K::gradient_pair(xij, xji, rij, h, gij, gji);
+        K::gradient_pair_ih(xij, xji, rij, h, ihd, gij_f, gji_f);
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_EQ(bits_of(gf[c]), bits_of(g[c])) << K::name << " h=" << h << " r=" << rij;
+          EXPECT_EQ(bits_of(gij_f[c]), bits_of(gij[c])) << K::name << " h=" << h << " r=" << rij;
+          EXPECT_EQ(bits_of(gji_f[c]), bits_of(gji[c])) << K::name << " h=" << h << " r=" << rij;
+        }
+        ++compared;
+      }
+    }
+  EXPECT_GT(compared, 9000);
+}
+
+template <class... Ks>
+void expect_factor_forms_all() {
+  (expect_factor_forms_bitwise<Ks, double>(), ...);
+  (expect_factor_forms_bitwise<Ks, float>(), ...);
+}
+
+TEST(Kernels, FactorFormsBitwise) {
+  expect_factor_forms_all<sphc::CubicSpline<1>, sphc::CubicSpline<2>, sphc::CubicSpline<3>,
+                          sphc::QuinticSpline<2>, sphc::QuinticSpline<3>, sphc::WendlandQuintic<1>,
+                          sphc::WendlandQuintic<2>, sphc::WendlandQuintic<3>, sphc::Gaussian<3>,
+                          sphc::WendlandQuinticC4<2>, sphc::WendlandQuinticC4<3>,
+                          sphc::WendlandQuinticC6<2>, sphc::WendlandQuinticC6<3>,
+                          sphc::SuperGaussian<2>, sphc::SuperGaussian<3>>();
 }

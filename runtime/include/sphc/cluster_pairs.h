@@ -211,6 +211,28 @@ inline __attribute__((always_inline)) bool tile_row_any(double xi, double yi, do
                                                         double radius2) {
   return tile_row_mask<Dim>(xi, yi, zi, hi, xj, yj, zj, hj, lane, lane_d, radius2) != 0;
 }
+// tile_row_any where every particle of both clusters has the same h (stop 45; sphc's
+// analysis/UniformH.cpp): the cut-off `cut2` = radius2 hmax hmax computed once per pass by the
+// caller (the same operations in the same order as tile_row_mask's lim, so the same bits), no
+// h loaded.
+template <int Dim>
+inline __attribute__((always_inline)) bool tile_row_any_cut(double xi, double yi, double zi,
+                                                            const double* xj, const double* yj,
+                                                            const double* zj, const double* lane,
+                                                            double lane_d, double cut2) {
+  const __m512d dx = _mm512_sub_pd(_mm512_set1_pd(xi), _mm512_loadu_pd(xj));
+  const __m512d dy = _mm512_sub_pd(_mm512_set1_pd(yi), _mm512_loadu_pd(yj));
+  __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+  if constexpr (Dim == 3) {
+    const __m512d dz = _mm512_sub_pd(_mm512_set1_pd(zi), _mm512_loadu_pd(zj));
+    r2 = _mm512_add_pd(r2, _mm512_mul_pd(dz, dz));
+  } else {
+    (void)zi;
+    (void)zj;
+  }
+  return (_mm512_cmp_pd_mask(r2, _mm512_set1_pd(cut2), _CMP_NGE_UQ) &  // !(r2 >= cut2)
+          _mm512_cmp_pd_mask(_mm512_loadu_pd(lane), _mm512_set1_pd(lane_d), _CMP_GT_OQ)) != 0;
+}
 #if defined(__AVX512VBMI2__)
 // The pair queue of an 8 x 8 tile (sphc --cluster-queue, codegen/ClusterPairs.cpp; stop 43,
 // docs/performance-log.md "The tiles' pairs compacted (stop 43)"): the tile's pairs within the

@@ -194,18 +194,17 @@ struct RadialKernel {
     return apart ? s : T(0);
   }
   // The same forms from reciprocals the caller has (sphc --tile-math=batched, stop 45): ih =
-  // 1 / h and ir2 = 1 / r2 (r2 guarded as tile_r2_guard does), as tile_reciprocals derives
-  // them from one division. With ih = T(1) / h they are w_tile's value bit for bit; from
-  // tile_reciprocals, whose reciprocals are within 3-5 u of 1 / h and 1 / r2 (below), q is
-  // within 5 ulp of r / h, the gradient's 1 / (h rij) within 12 u, W and the gradient factor
-  // within 64 u of the kernel's scale (tests/unit/test_kernels.cpp,
-  // TileBatchedFormsWithinBounds).
+  // 1 / h and ir2 = 1 / r2 (r2 guarded as tile_r2_guard does), ir2 as tile_reciprocals derives
+  // it with RHOIJ1 from one division. With ih = T(1) / h they are w_tile's value bit for bit;
+  // with tile_reciprocals' ir2, within 3 u of 1 / r2 (below), the gradient's 1 / (h rij) is
+  // within a few u, W and the gradient factor within recip's 64 u of the kernel's scale
+  // (tests/unit/test_kernels.cpp, TileBatchedFormsWithinBounds).
   template <class T>
-  static SPHC_KERNEL_INLINE T w_tile_ih(T rij, T ih) {
+  static SPHC_KERNEL_INLINE T w_tile_rcp(T rij, T ih) {
     return T(S::sigma) * ih_pow<Dim>(ih) * S::f(rij * ih);
   }
   template <class T>
-  static SPHC_KERNEL_INLINE T gradient_factor_tile_ih(T rij, T ir2, T ih) {
+  static SPHC_KERNEL_INLINE T gradient_factor_tile_rcp(T rij, T ir2, T ih) {
     const bool apart = rij > T(1e-12);
     const T irij = rij * ir2;
     const T s = T(S::sigma) * ih_pow<Dim>(ih) * S::df(rij * ih) * (ih * irij);
@@ -224,6 +223,62 @@ struct RadialKernel {
     grad_ji[0] = s * xji[0];
     grad_ji[1] = s * xji[1];
     grad_ji[2] = s * xji[2];
+  }
+  // The forms above with h's factors given (stop 45: a pair loop whose arrays' h is one value
+  // for the whole run, sphc's analysis/UniformH.cpp, computes them once per pass): ih =
+  // inv_h(h) = 1 / h, ihd = inv_h_dim(h) = 1 / h^Dim, the doubles w, dwdq, w_tile, ... compute
+  // from h; each form does the same operations in the same order as its model's, so its values
+  // are the model's bit for bit (tests/unit/test_kernels.cpp, FactorFormsBitwise).
+  template <class T>
+  static SPHC_KERNEL_INLINE T inv_h(T h) {
+    return T(1) / h;
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T inv_h_dim(T h) {
+    return inv_h_pow<Dim>(h);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T w_ih(T rij, T h, T ihd) {  // w
+    return T(S::sigma) * ihd * S::f(rij / h);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T dwdq_ih(T rij, T h, T ihd) {  // dwdq
+    return T(S::sigma) * ihd * S::df(rij / h);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE void gradient_ih(const T xij[3], T rij, T h, T ihd, T grad[3]) {
+    const T s = rij > T(1e-12) ? dwdq_ih(rij, h, ihd) / (h * rij) : T(0);  // gradient
+    grad[0] = s * xij[0];
+    grad[1] = s * xij[1];
+    grad[2] = s * xij[2];
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T gradient_factor_ih(T rij, T h, T ihd) {  // gradient_factor
+    const bool apart = rij > T(1e-12);
+    const T s = dwdq_ih(rij, h, ihd) / (h * (apart ? rij : T(1)));
+    return apart ? s : T(0);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE void gradient_pair_ih(const T xij[3], const T xji[3], T rij, T h,
+                                                  T ihd, T grad_ij[3], T grad_ji[3]) {
+    const T s = rij > T(1e-12) ? dwdq_ih(rij, h, ihd) / (h * rij) : T(0);  // gradient_pair
+    grad_ij[0] = s * xij[0];
+    grad_ij[1] = s * xij[1];
+    grad_ij[2] = s * xij[2];
+    grad_ji[0] = s * xji[0];
+    grad_ji[1] = s * xji[1];
+    grad_ji[2] = s * xji[2];
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T w_tile_ih(T rij, T ih, T ihd) {  // w_tile
+    return T(S::sigma) * ihd * S::f(rij * ih);
+  }
+  template <class T>
+  static SPHC_KERNEL_INLINE T gradient_factor_tile_ih(T rij, T r2, T ih, T ihd) {  // gradient_factor_tile
+    const bool apart = rij > T(1e-12);
+    const T irij = rij * (T(1) / (r2 > T(0) ? r2 : T(1)));
+    const T s = T(S::sigma) * ihd * S::df(rij * ih) * (ih * irij);
+    return apart ? s : T(0);
   }
 };
 
@@ -330,35 +385,23 @@ struct SuperGaussianShape {
 
 // The cluster-pair tiles' reciprocals of a lane from one division (sphc --tile-math=batched,
 // the tiles' default since stop 45; codegen/SimdPairs.cpp prints them where a lane needs 1 /
-// RHOIJ (RHOIJ1) and one or both of 1 / r2 (the gradient's) and 1 / h (the kernel's, one h for
-// every kernel value of the lane)). A 512-bit divide takes the divider ~16 cycles where a
-// multiply takes a port half a cycle; two divisions fewer per row: the cube's tiles 0.944x of
-// recip's time, the DualSPHysics scene's 0.86x (docs/performance-log.md, "One division for the
-// tiles' reciprocals (stop 45; `--tile-math=batched`)").
-// inv = 1 / (a b c), then 1 / c = (a b) inv, 1 / (a b) = c inv, 1 / a = b / (a b), 1 / b = a /
-// (a b): one division and 6 multiplications for three reciprocals (two: inv = 1 / (a b), 1 / a
-// = b inv, 1 / b = a inv). Error (u = 2^-53, relative, first order; every operand and product
-// normal): 1 / c within 3 u (the rounding of a b cancels), 1 / a and 1 / b within 5 u; of two,
+// RHOIJ (RHOIJ1) and 1 / r2 (a gradient's); the kernel's 1 / h stays a division of its own,
+// once per pass where h is one value, analysis/UniformH.cpp). A 512-bit divide takes the
+// divider ~16 cycles where a multiply takes a port half a cycle (docs/performance-log.md, "One
+// division for the tiles' reciprocals (stop 45; `--tile-math=batched`)").
+// inv = 1 / (a b), 1 / a = b inv, 1 / b = a inv: one division and 3 multiplications for two
+// reciprocals. Error (u = 2^-53, relative, first order; every operand and product normal):
 // each within 3 u (tests/unit/test_kernels.cpp, TileReciprocalsWithinBounds). The domain: the
-// product a b c must be a normal number; in the tiles a = r2 guarded by tile_r2_guard (at least
-// 1e-25, or 1), b = RHOIJ, c = h, so a lane within the support (r2 < (radius_scale hmax)^2) has
-// a b c below radius_scale^2 hmax^2 rho h and above 1e-25 rho h: normal for any h and rho a
-// simulation in SI units (or scaled ones) has (double: rho h >= 2.2e-283 and rho h hmax^2 <=
-// 4e307; float: 1.2e-13 and 8e37). Lanes outside the support may overflow or underflow (inf, 0,
-// NaN): their values are masked out of every sum, as the exact forms' are.
+// product a b must be a normal number; in the tiles a = r2 guarded by tile_r2_guard (at least
+// 1e-25, or 1) and b = RHOIJ, so a lane within the support (r2 < (radius_scale hmax)^2) has a
+// b below radius_scale^2 hmax^2 rho and above 1e-25 rho: normal for any h and rho a simulation
+// in SI units (or scaled ones) has (double: rho >= 2.2e-283 and rho hmax^2 <= 4e307; float:
+// rho >= 1.2e-13 and rho hmax^2 <= 8e37). Lanes outside the support may overflow or underflow
+// (inf, 0, NaN): their values are masked out of every sum, as the exact forms' are.
 template <class T>
 SPHC_KERNEL_INLINE T tile_r2_guard(T r2) {
   // r2 <= 1e-25 means rij < 1e-12: the gradient is 0 there and 1 / r2 unused (gradient_factor)
   return r2 > T(1e-25) ? r2 : T(1);
-}
-template <class T>
-SPHC_KERNEL_INLINE void tile_reciprocals(T a, T b, T c, T& ia, T& ib, T& ic) {
-  const T ab = a * b;
-  const T inv = T(1) / (ab * c);
-  ic = ab * inv;
-  const T iab = c * inv;
-  ia = b * iab;
-  ib = a * iab;
 }
 template <class T>
 SPHC_KERNEL_INLINE void tile_reciprocals(T a, T b, T& ia, T& ib) {
