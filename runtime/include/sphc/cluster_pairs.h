@@ -182,12 +182,11 @@ inline void load_doubled4(double* t, const double* p) {
 // -ffp-contract=off: no fma on either side), so the same rows are skipped and the sums are the
 // same bit for bit. (No margin on radius2: in a lattice such as the cube's many pairs lie at the
 // support's edge to the last bit, and 1 + 1e-12 let ~10% more rows through to lanes all masked.)
+// The row's r2 in the 8 lanes, as the lanes compute R2IJ.
 template <int Dim>
-inline __attribute__((always_inline)) __mmask8 tile_row_mask(double xi, double yi, double zi, double hi,
-                                                             const double* xj, const double* yj,
-                                                             const double* zj, const double* hj,
-                                                             const double* lane, double lane_d,
-                                                             double radius2) {
+inline __attribute__((always_inline)) __m512d tile_row_r2(double xi, double yi, double zi,
+                                                          const double* xj, const double* yj,
+                                                          const double* zj) {
   const __m512d dx = _mm512_sub_pd(_mm512_set1_pd(xi), _mm512_loadu_pd(xj));
   const __m512d dy = _mm512_sub_pd(_mm512_set1_pd(yi), _mm512_loadu_pd(yj));
   __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
@@ -198,6 +197,15 @@ inline __attribute__((always_inline)) __mmask8 tile_row_mask(double xi, double y
     (void)zi;
     (void)zj;
   }
+  return r2;
+}
+template <int Dim>
+inline __attribute__((always_inline)) __mmask8 tile_row_mask(double xi, double yi, double zi, double hi,
+                                                             const double* xj, const double* yj,
+                                                             const double* zj, const double* hj,
+                                                             const double* lane, double lane_d,
+                                                             double radius2) {
+  const __m512d r2 = tile_row_r2<Dim>(xi, yi, zi, xj, yj, zj);
   const __m512d hm = _mm512_max_pd(_mm512_set1_pd(hi), _mm512_loadu_pd(hj));  // hi > hj ? hi : hj
   const __m512d lim = _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(radius2), hm), hm);
   return _mm512_cmp_pd_mask(r2, lim, _CMP_NGE_UQ) &  // !(r2 >= lim), the lanes' form
@@ -220,16 +228,7 @@ inline __attribute__((always_inline)) bool tile_row_any_cut(double xi, double yi
                                                             const double* xj, const double* yj,
                                                             const double* zj, const double* lane,
                                                             double lane_d, double cut2) {
-  const __m512d dx = _mm512_sub_pd(_mm512_set1_pd(xi), _mm512_loadu_pd(xj));
-  const __m512d dy = _mm512_sub_pd(_mm512_set1_pd(yi), _mm512_loadu_pd(yj));
-  __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
-  if constexpr (Dim == 3) {
-    const __m512d dz = _mm512_sub_pd(_mm512_set1_pd(zi), _mm512_loadu_pd(zj));
-    r2 = _mm512_add_pd(r2, _mm512_mul_pd(dz, dz));
-  } else {
-    (void)zi;
-    (void)zj;
-  }
+  const __m512d r2 = tile_row_r2<Dim>(xi, yi, zi, xj, yj, zj);
   return (_mm512_cmp_pd_mask(r2, _mm512_set1_pd(cut2), _CMP_NGE_UQ) &  // !(r2 >= cut2)
           _mm512_cmp_pd_mask(_mm512_loadu_pd(lane), _mm512_set1_pd(lane_d), _CMP_GT_OQ)) != 0;
 }

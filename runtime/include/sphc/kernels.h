@@ -136,29 +136,27 @@ struct RadialKernel {
   static constexpr double radius_scale = S::radius_scale;
   static constexpr double sigma = S::sigma;  // W = sigma / h^d f(r / h)
 
+  // Each form is its `_ih` form below (h's factors 1 / h^Dim and 1 / h given) with the factors
+  // computed from h: the same operations in the same order.
+  // W = sigma / h^d f(r / h).
   template <class T>
   static SPHC_KERNEL_INLINE T w(T rij, T h) {
-    return T(S::sigma) * inv_h_pow<Dim>(h) * S::f(rij / h);
+    return w_ih(rij, h, inv_h_dim(h));
   }
   template <class T>
   static SPHC_KERNEL_INLINE T dwdq(T rij, T h) {
-    return T(S::sigma) * inv_h_pow<Dim>(h) * S::df(rij / h);
+    return dwdq_ih(rij, h, inv_h_dim(h));
   }
+  // dW/dx_i = dW/dq * dq/dr * dr/dx_i = dwdq * (1/h) * xij / rij.
   template <class T>
   static SPHC_KERNEL_INLINE void gradient(const T xij[3], T rij, T h, T grad[3]) {
-    // dW/dx_i = dW/dq * dq/dr * dr/dx_i = dwdq * (1/h) * xij / rij.
-    const T s = rij > T(1e-12) ? dwdq(rij, h) / (h * rij) : T(0);
-    grad[0] = s * xij[0];
-    grad[1] = s * xij[1];
-    grad[2] = s * xij[2];
+    gradient_ih(xij, rij, h, inv_h_dim(h), grad);
   }
   // The factor s of gradient() (grad = s * xij), its value bit for bit, as a select on a
   // safe divisor (no branch: the SIMD pair loops of sphc --simd-pairs, codegen/SimdPairs.cpp).
   template <class T>
   static SPHC_KERNEL_INLINE T gradient_factor(T rij, T h) {
-    const bool apart = rij > T(1e-12);
-    const T s = dwdq(rij, h) / (h * (apart ? rij : T(1)));
-    return apart ? s : T(0);
+    return gradient_factor_ih(rij, h, inv_h_dim(h));
   }
   // The cluster-pair tiles' forms (codegen/ClusterPairs.cpp, sphc --tile-math=recip, the
   // default; stop 41): w() and gradient_factor() with their divisions after the square root
@@ -182,16 +180,11 @@ struct RadialKernel {
   // is a normal number: rij below 1.3e154 (double).
   template <class T>
   static SPHC_KERNEL_INLINE T w_tile(T rij, T h) {
-    const T ih = T(1) / h;
-    return T(S::sigma) * inv_h_pow<Dim>(h) * S::f(rij * ih);
+    return w_tile_ih(rij, inv_h(h), inv_h_dim(h));
   }
   template <class T>
   static SPHC_KERNEL_INLINE T gradient_factor_tile(T rij, T r2, T h) {
-    const bool apart = rij > T(1e-12);
-    const T ih = T(1) / h;
-    const T irij = rij * (T(1) / (r2 > T(0) ? r2 : T(1)));
-    const T s = T(S::sigma) * inv_h_pow<Dim>(h) * S::df(rij * ih) * (ih * irij);
-    return apart ? s : T(0);
+    return gradient_factor_tile_ih(rij, r2, inv_h(h), inv_h_dim(h));
   }
   // The same forms from reciprocals the caller has (sphc --tile-math=batched, stop 45): ih =
   // 1 / h and ir2 = 1 / r2 (r2 guarded as tile_r2_guard does), ir2 as tile_reciprocals derives
@@ -201,7 +194,7 @@ struct RadialKernel {
   // (tests/unit/test_kernels.cpp, TileBatchedFormsWithinBounds).
   template <class T>
   static SPHC_KERNEL_INLINE T w_tile_rcp(T rij, T ih) {
-    return T(S::sigma) * ih_pow<Dim>(ih) * S::f(rij * ih);
+    return w_tile_ih(rij, ih, ih_pow<Dim>(ih));
   }
   template <class T>
   static SPHC_KERNEL_INLINE T gradient_factor_tile_rcp(T rij, T ir2, T ih) {
@@ -216,13 +209,7 @@ struct RadialKernel {
   template <class T>
   static SPHC_KERNEL_INLINE void gradient_pair(const T xij[3], const T xji[3], T rij, T h,
                                                T grad_ij[3], T grad_ji[3]) {
-    const T s = rij > T(1e-12) ? dwdq(rij, h) / (h * rij) : T(0);
-    grad_ij[0] = s * xij[0];
-    grad_ij[1] = s * xij[1];
-    grad_ij[2] = s * xij[2];
-    grad_ji[0] = s * xji[0];
-    grad_ji[1] = s * xji[1];
-    grad_ji[2] = s * xji[2];
+    gradient_pair_ih(xij, xji, rij, h, inv_h_dim(h), grad_ij, grad_ji);
   }
   // The forms above with h's factors given (stop 45: a pair loop whose arrays' h is one value
   // for the whole run, sphc's analysis/UniformH.cpp, computes them once per pass): ih =
