@@ -87,20 +87,8 @@ constexpr double kInvPi32 = 0.17958712212516656169;       // 1 / pi^(3/2)
 // The kernels are templates on the floating point type T of their arguments (double, or
 // float for --precision=single): every literal is converted to T, so a float call computes in
 // float, and a double call does the operations of the plain double formulas.
-template <int Dim, class T>
-SPHC_KERNEL_INLINE T inv_h_pow(T h) {
-  static_assert(Dim >= 1 && Dim <= 3, "sphc kernels: Dim must be 1, 2 or 3");
-  const T ih = T(1) / h;
-  if constexpr (Dim == 1) {
-    return ih;
-  } else if constexpr (Dim == 2) {
-    return ih * ih;
-  } else {
-    return ih * ih * ih;
-  }
-}
 
-// 1 / h^Dim from 1 / h (inv_h_pow's powers: inv_h_pow<Dim>(h) == ih_pow<Dim>(T(1) / h)).
+// 1 / h^Dim from 1 / h (inv_h_pow: from h).
 template <int Dim, class T>
 SPHC_KERNEL_INLINE T ih_pow(T ih) {
   static_assert(Dim >= 1 && Dim <= 3, "sphc kernels: Dim must be 1, 2 or 3");
@@ -111,6 +99,10 @@ SPHC_KERNEL_INLINE T ih_pow(T ih) {
   } else {
     return ih * ih * ih;
   }
+}
+template <int Dim, class T>
+SPHC_KERNEL_INLINE T inv_h_pow(T h) {
+  return ih_pow<Dim>(T(1) / h);
 }
 
 // The shape functions f(q), f'(q) of every kernel, as templates on the floating point type
