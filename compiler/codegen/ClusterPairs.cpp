@@ -481,7 +481,9 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
                   "its lane tables for registers of 8 doubles (sphc::kClusterSize)\");\n";
   scene_ << in << "sphc::ClusterLayout& cl_layout = " << state << "_layout;\n";
   const std::string zIn = plan_.dim == 3 ? "di_z" : "nullptr";
-  if (hFixed) {
+  if (hUniform_[d]) {  // (analysis/UniformH.cpp: every particle's h the same, all the run)
+    scene_ << in << "const double cl_hmax = n > 0 ? std::max(0.0, di_h[0]) : 0.0;  // the largest h: h uniform\n";
+  } else if (hFixed) {
     scene_ << in << "// the largest h: at the build (nothing writes h)\n";
     scene_ << in << "if (verlet_build) {\n";
     scene_ << in << "  double cl_hmax_build = 0.0;\n";

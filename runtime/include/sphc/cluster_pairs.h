@@ -199,6 +199,12 @@ inline __attribute__((always_inline)) __m512d tile_row_r2(double xi, double yi, 
   }
   return r2;
 }
+// The lanes within the cut-off lim (!(r2 >= lim), the lanes' form) and past lane_d.
+inline __attribute__((always_inline)) __mmask8 tile_row_in(__m512d r2, __m512d lim,
+                                                           const double* lane, double lane_d) {
+  return _mm512_cmp_pd_mask(r2, lim, _CMP_NGE_UQ) &
+         _mm512_cmp_pd_mask(_mm512_loadu_pd(lane), _mm512_set1_pd(lane_d), _CMP_GT_OQ);
+}
 template <int Dim>
 inline __attribute__((always_inline)) __mmask8 tile_row_mask(double xi, double yi, double zi, double hi,
                                                              const double* xj, const double* yj,
@@ -208,8 +214,7 @@ inline __attribute__((always_inline)) __mmask8 tile_row_mask(double xi, double y
   const __m512d r2 = tile_row_r2<Dim>(xi, yi, zi, xj, yj, zj);
   const __m512d hm = _mm512_max_pd(_mm512_set1_pd(hi), _mm512_loadu_pd(hj));  // hi > hj ? hi : hj
   const __m512d lim = _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(radius2), hm), hm);
-  return _mm512_cmp_pd_mask(r2, lim, _CMP_NGE_UQ) &  // !(r2 >= lim), the lanes' form
-         _mm512_cmp_pd_mask(_mm512_loadu_pd(lane), _mm512_set1_pd(lane_d), _CMP_GT_OQ);
+  return tile_row_in(r2, lim, lane, lane_d);
 }
 template <int Dim>
 inline __attribute__((always_inline)) bool tile_row_any(double xi, double yi, double zi, double hi,
@@ -229,8 +234,7 @@ inline __attribute__((always_inline)) bool tile_row_any_cut(double xi, double yi
                                                             const double* zj, const double* lane,
                                                             double lane_d, double cut2) {
   const __m512d r2 = tile_row_r2<Dim>(xi, yi, zi, xj, yj, zj);
-  return (_mm512_cmp_pd_mask(r2, _mm512_set1_pd(cut2), _CMP_NGE_UQ) &  // !(r2 >= cut2)
-          _mm512_cmp_pd_mask(_mm512_loadu_pd(lane), _mm512_set1_pd(lane_d), _CMP_GT_OQ)) != 0;
+  return tile_row_in(r2, _mm512_set1_pd(cut2), lane, lane_d) != 0;
 }
 #if defined(__AVX512VBMI2__)
 // The pair queue of an 8 x 8 tile (sphc --cluster-queue, codegen/ClusterPairs.cpp; stop 43,
