@@ -361,7 +361,13 @@ void CpuPrinter::verletMembers() {
   }
   forEachVerletLists([&](const std::string& lists, const Phase& ph, const DestinationWork& w,
                          const NeighbourPass& pass) {
-    out_ << "  sphc::VerletLists " << lists << (tuned() ? "{verlet_skin};  // " : "{VERLET_SKIN};  // ")
+    // h fixed (analysis/UniformH.cpp) in every array the lists' check reads: the check reads
+    // no h (sphc/verlet.h, VerletSkin's h_fixed; stop 46).
+    const std::vector<int> moving = movingArrays(w.array, pass.source);
+    bool hFixed = !tuned() && !moving.empty();
+    for (int a : moving) hFixed = hFixed && hUniform_[a];
+    out_ << "  sphc::VerletLists " << lists
+         << (tuned() ? "{verlet_skin};  // " : hFixed ? "{VERLET_SKIN, true};  // h fixed; " : "{VERLET_SKIN};  // ")
          << arr(w.array).name
          << " <- " << arr(pass.source).name
          << (w.ranged() ? " (" + ph.name + ", its range)" : std::string(", every phase")) << "\n";
@@ -1257,10 +1263,17 @@ void CpuPrinter::stepperCall(const StepStatement& st,
   scene_ << "    " << run.name << "(" << args << "dt);\n";
 }
 
-// The adaptive time step's limits over one moving array: minima of a parallel loop.
+// The adaptive time step's limits over one moving array: minima of a parallel loop. Where
+// the array's h is one value for the whole run (analysis/UniformH.cpp; double precision), the
+// minima of h / (c + |v|) and sqrt(h / |a|) are those of the largest c + |v| and |a|^2: for
+// h > 0 and positive denominators, a correctly rounded division, and sqrt, are monotonic, so
+// f(max) is min f bit for bit; the loop then takes one square root per particle, not three
+// and two divisions (stop 46). A non-positive c + |v|, or an h that is not positive and
+// finite, runs the per-particle loop (sphc --no-uniform-h: always).
 void CpuPrinter::adaptiveDtArray(int a) {
   const AdaptiveDt& ad = sched_.adaptiveDt;
   const std::vector<std::string> vel = {"u", "v", "w"}, acc = {"au", "av", "aw"};
+  const std::string& N = arr(a).name;
   scene_ << "      const " << real_ << "* h = " << propPtr(a, "h") << ";\n";
   if (ad.cfl) {
     scene_ << "      const " << real_ << "* cs = " << propPtr(a, "cs") << ";\n";
@@ -1270,35 +1283,90 @@ void CpuPrinter::adaptiveDtArray(int a) {
   if (ad.force)
     for (int k = 0; k < plan_.dim; ++k)
       scene_ << "      const " << real_ << "* " << acc[k] << " = " << propPtr(a, acc[k]) << ";\n";
-  scene_ << parallelFor("      ", ad.order,
-                        withIf("reduction(min : dt_cfl, dt_force, h2min)", ompIf("static_cast<long>(" + arr(a).name + ".n)")));
-  scene_ << "      for (std::size_t i = 0; i < " << arr(a).name << ".n; ++i) {\n";
-  // |v| or |a| of particle i: "std::sqrt(u[i] * u[i] + v[i] * v[i])".
-  auto magnitude = [&](const std::vector<std::string>& c) {
-    std::string s = "std::sqrt(";
+  // |v|^2 or |a|^2 of particle i: "u[i] * u[i] + v[i] * v[i]".
+  auto squared = [&](const std::vector<std::string>& c) {
+    std::string s;
     for (int k = 0; k < plan_.dim; ++k) s += (k ? " + " : "") + c[k] + "[i] * " + c[k] + "[i]";
-    return s + ")";
+    return s;
   };
-  // The minima by a compare, not std::fmin (a call into libm per particle: GCC does not
-  // inline it): the running minimum starts at HUGE_VAL and never becomes NaN, and for such a
-  // minimum m, `v < m ? v : m` is fmin(m, v) bit for bit (a NaN v leaves m, as fmin does).
-  if (ad.cfl) {
-    scene_ << "        const double vmag = " << magnitude(vel) << ";\n";
-    scene_ << "        const double cfl_i = h[i] / (cs[i] + vmag);\n";
-    scene_ << "        dt_cfl = cfl_i < dt_cfl ? cfl_i : dt_cfl;\n";
+  const std::string ompN = ompIf("static_cast<long>(" + N + ".n)");
+  // The loop over every particle (`in`: its indentation).
+  auto perParticle = [&](const std::string& in) {
+    scene_ << parallelFor(in, ad.order,
+                          withIf("reduction(min : dt_cfl, dt_force, h2min)", ompN));
+    scene_ << in << "for (std::size_t i = 0; i < " << N << ".n; ++i) {\n";
+    // The minima by a compare, not std::fmin (a call into libm per particle: GCC does not
+    // inline it): the running minimum starts at HUGE_VAL and never becomes NaN, and for such a
+    // minimum m, `v < m ? v : m` is fmin(m, v) bit for bit (a NaN v leaves m, as fmin does).
+    if (ad.cfl) {
+      scene_ << in << "  const double vmag = std::sqrt(" << squared(vel) << ");\n";
+      scene_ << in << "  const double cfl_i = h[i] / (cs[i] + vmag);\n";
+      scene_ << in << "  dt_cfl = cfl_i < dt_cfl ? cfl_i : dt_cfl;\n";
+    }
+    if (ad.viscous) {
+      scene_ << in << "  const double h2_i = h[i] * h[i];\n";
+      scene_ << in << "  h2min = h2_i < h2min ? h2_i : h2min;\n";
+    }
+    if (ad.force) {
+      scene_ << in << "  const double amag = std::sqrt(" << squared(acc) << ");\n";
+      scene_ << in << "  if (amag > 0) {\n";
+      scene_ << in << "    const double force_i = std::sqrt(h[i] / amag);\n";
+      scene_ << in << "    dt_force = force_i < dt_force ? force_i : dt_force;\n";
+      scene_ << in << "  }\n";
+    }
+    scene_ << in << "}\n";
+  };
+  if (!(hUniform_[a] && real_ == "double" && (ad.cfl || ad.force))) {
+    perParticle("      ");
+    scene_ << "    }\n";
+    return;
   }
-  if (ad.viscous) {
-    scene_ << "        const double h2_i = h[i] * h[i];\n";
-    scene_ << "        h2min = h2_i < h2min ? h2_i : h2min;\n";
+  scene_ << "      // h the same for every particle of " << N
+         << " all the run (analysis/UniformH.cpp): the minima\n"
+            "      // from the largest c + |v| and |a|^2 (monotonic: the same bits; stop 46)\n";
+  scene_ << "      const double h_all = " << N << ".n > 0 ? h[0] : 0.0;\n";
+  if (ad.cfl) scene_ << "      double den_max = -HUGE_VAL;  // the largest c + |v|\n";
+  if (ad.force) scene_ << "      double a2max = 0.0;  // the largest |a|^2\n";
+  scene_ << "      bool den_low = !(std::isfinite(h_all) && h_all > 0.0);  // then per particle\n";
+  scene_ << "      if (!den_low) {\n";
+  std::string red = ad.cfl ? "reduction(max : den_max" : "reduction(max : a2max";
+  if (ad.cfl && ad.force) red += ", a2max";
+  red += ")";
+  if (ad.cfl) red += " reduction(|| : den_low)";
+  scene_ << parallelFor("        ", ad.order, withIf(red, ompN));
+  scene_ << "        for (std::size_t i = 0; i < " << N << ".n; ++i) {\n";
+  if (ad.cfl) {
+    scene_ << "          const double den = cs[i] + std::sqrt(" << squared(vel) << ");\n";
+    scene_ << "          den_max = den > den_max ? den : den_max;  // NaN: skipped, as h / NaN\n";
+    scene_ << "          den_low = den_low || den <= 0.0;\n";
   }
   if (ad.force) {
-    scene_ << "        const double amag = " << magnitude(acc) << ";\n";
-    scene_ << "        if (amag > 0) {\n";
-    scene_ << "          const double force_i = std::sqrt(h[i] / amag);\n";
-    scene_ << "          dt_force = force_i < dt_force ? force_i : dt_force;\n";
+    scene_ << "          const double a2 = " << squared(acc) << ";\n";
+    scene_ << "          a2max = a2 > a2max ? a2 : a2max;  // |a| > 0 where |a|^2 > 0\n";
+  }
+  scene_ << "        }\n";
+  scene_ << "      }\n";
+  scene_ << "      if (den_low) {\n";
+  perParticle("        ");
+  scene_ << "      } else {\n";
+  if (ad.cfl) {
+    scene_ << "        if (den_max > 0.0) {\n";
+    scene_ << "          const double cfl_all = h_all / den_max;\n";
+    scene_ << "          dt_cfl = cfl_all < dt_cfl ? cfl_all : dt_cfl;\n";
     scene_ << "        }\n";
   }
-  scene_ << "      }\n    }\n";
+  if (ad.viscous) {
+    scene_ << "        const double h2_all = h_all * h_all;\n";
+    scene_ << "        h2min = h2_all < h2min ? h2_all : h2min;\n";
+  }
+  if (ad.force) {
+    scene_ << "        if (a2max > 0.0) {\n";
+    scene_ << "          const double force_all = std::sqrt(h_all / std::sqrt(a2max));\n";
+    scene_ << "          dt_force = force_all < dt_force ? force_all : dt_force;\n";
+    scene_ << "        }\n";
+  }
+  scene_ << "      }\n";
+  scene_ << "    }\n";
 }
 
 // --verlet-skin=auto (CpuVerletTune.cpp) with this scene's arrays, lists and statements.

@@ -398,7 +398,11 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
       }
       if (!key.empty()) computed.emplace(key, ptr);
       const std::string member = "hoist_" + eqStruct(*eq) + "_" + K;
-      os << "        " << member << ".resize(n_src);  // " << eq->name << ": "
+      // Grown, never shrunk: an equation with several sources fills its member for each in
+      // turn, and a resize down then up value-initialises every double again (a memset of the
+      // larger array per evaluation: the own dam break's fluid after its boundary, stop 46).
+      os << "        if (" << member << ".size() < static_cast<std::size_t>(n_src)) " << member
+         << ".resize(n_src);  // " << eq->name << ": "
          << oneLine(b.source.text.substr(s.begin, s.end - s.begin)) << "\n";
       os << "        " << type << "* const " << ptr << " = "
          << member << ".data();\n";

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 namespace sphc {
@@ -41,14 +42,19 @@ std::shared_ptr<const MarkedPositions> copy_positions(const Array& pa) {
       to[k]->assign(pa.n, 0.0);
   }
   s->h.assign(h_of(pa), h_of(pa) + pa.n);
-  for (double h : s->h) s->hmin = h < s->hmin ? h : s->hmin;
+  for (double h : s->h) {
+    s->hmin = h < s->hmin ? h : s->hmin;
+    s->hnan = s->hnan || h != h;
+  }
   return s;
 }
 // The largest squared displacement and growth of h of one array since mark(), and whether
 // a NaN was met. OpenMP (from 16,384 particles, the runtime's threshold): a max reduction,
 // whose value does not depend on the order. T: double, or float (--precision=single; each
 // float read as the double it is).
-template <bool HasY, bool HasZ, class T>
+// HasH false (VerletSkin::h_fixed): h unchanged since mark(), so h - saved h is +0, or NaN
+// where h is NaN: growth 0 and the NaN recorded at mark(), without reading h.
+template <bool HasY, bool HasZ, class T, bool HasH = true>
 void moved_since_mark(const T* x, const T* y, const T* z, const T* h, const MarkedPositions& s,
                       long n, double& d2max, double& growth, bool& nan_met) {
   const double* sx = s.x.data();
@@ -69,14 +75,17 @@ void moved_since_mark(const T* x, const T* y, const T* z, const T* h, const Mark
         d2 = dx * dx + dy * dy + dz * dz;
       }
     }
-    const double dh = static_cast<double>(h[i]) - sh[i];
     d2m = d2 > d2m ? d2 : d2m;
-    gm = dh > gm ? dh : gm;
-    nan = nan | (d2 != d2) | (dh != dh);
+    if (HasH) {
+      const double dh = static_cast<double>(h[i]) - sh[i];
+      gm = dh > gm ? dh : gm;
+      nan = nan | (dh != dh);
+    }
+    nan = nan | (d2 != d2);
   }
   d2max = d2m;
   growth = gm;
-  nan_met = nan;
+  nan_met = HasH ? nan : nan || s.hnan;
 }
 
 // An axis missing below a present one: the 3D loop with the saved zeros read for it.
@@ -96,8 +105,8 @@ void moved_since_missing(const float* x, const float* y, const float* z,
 }
 // The largest squared displacement and growth of h of one array since its mark.
 template <class Array>
-void moved_since(const Array& pa, const MarkedPositions& s, double& d2m, double& gm,
-                 bool& nan) {
+void moved_since(const Array& pa, const MarkedPositions& s, bool h_fixed, double& d2m,
+                 double& gm, bool& nan) {
   const auto* x = coordinate(pa, "x");
   const auto* y = coordinate(pa, "y");
   const auto* z = coordinate(pa, "z");
@@ -109,10 +118,18 @@ void moved_since(const Array& pa, const MarkedPositions& s, double& d2m, double&
   // the answer, is bit for bit the same without it. Any other set (an axis missing below a
   // present one) is the 3D loop with the saved zeros read for a missing axis: 0 - 0 = +0,
   // as a missing axis read as 0 gave.
-  if (x && y && z)
+  // h_fixed: h is not read (moved_since_mark<..., false>).
+  using T = std::remove_cv_t<std::remove_pointer_t<decltype(h)>>;
+  if (x && y && z && h_fixed)
+    moved_since_mark<true, true, T, false>(x, y, z, h, s, n, d2m, gm, nan);
+  else if (x && y && z)
     moved_since_mark<true, true>(x, y, z, h, s, n, d2m, gm, nan);
+  else if (x && y && !z && h_fixed)
+    moved_since_mark<true, false, T, false>(x, y, none, h, s, n, d2m, gm, nan);
   else if (x && y && !z)
     moved_since_mark<true, false>(x, y, none, h, s, n, d2m, gm, nan);
+  else if (x && !y && !z && h_fixed)
+    moved_since_mark<false, false, T, false>(x, none, none, h, s, n, d2m, gm, nan);
   else if (x && !y && !z)
     moved_since_mark<false, false>(x, none, none, h, s, n, d2m, gm, nan);
   else
@@ -141,7 +158,7 @@ bool VerletSkin::must_rebuild_of(const std::vector<const Array*>& arrays, double
       gm = known->growth;
       nan = known->nan;
     } else {
-      moved_since(pa, s, d2m, gm, nan);
+      moved_since(pa, s, h_fixed_, d2m, gm, nan);
       if (phase) phase->add({saved_[a], d2m, gm, nan});
     }
     if (nan) return true;  // NaN

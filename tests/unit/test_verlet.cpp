@@ -245,6 +245,60 @@ TEST(VerletSkin, DisplacementCheckPerAxisSetIsTheGenericOne) {
   }
 }
 
+// VerletSkin's h_fixed (stop 46: the compiler passes it where nothing writes h): while h is
+// what it was at mark(), a skin that reads no h answers as one that does, bit for bit
+// (last_moved() too), in 1D, 2D and 3D; a NaN among h at mark() forces every rebuild, as a
+// NaN growth does.
+TEST(VerletSkin, HFixedAnswersAsTheCheckThatReadsH) {
+  const double skin = 0.1, h0 = 0.1;
+  for (int dim = 1; dim <= 3; ++dim) {
+    ParticleArray pa;
+    pa.name = "fluid";
+    pa.resize(500);
+    const char* axes[3] = {"x", "y", "z"};
+    for (int k = 0; k < dim; ++k) pa.add_property(axes[k]);
+    pa.add_property("h", sphc::PropType::F64, 1, h0);
+    std::mt19937_64 rng(29 + dim);
+    std::uniform_real_distribution<double> pos(0.0, 1.0);
+    for (std::size_t i = 0; i < pa.n; ++i)
+      for (int k = 0; k < dim; ++k) pa.f64(axes[k])[i] = pos(rng);
+    std::vector<const ParticleArray*> all = {&pa};
+    VerletSkin reads(skin), fixed(skin, true);
+    EXPECT_FALSE(reads.h_fixed());
+    EXPECT_TRUE(fixed.h_fixed());
+    reads.mark(all);
+    fixed.mark(all);
+    const double step = 0.02 * h0;
+    std::uniform_real_distribution<double> d(-step, step);
+    int yes = 0, no = 0;
+    for (int s = 0; s < 100; ++s) {
+      for (std::size_t i = 0; i < pa.n; ++i)
+        for (int k = 0; k < dim; ++k) pa.f64(axes[k])[i] += d(rng);
+      const bool want = reads.must_rebuild(all, kRadiusScale);
+      EXPECT_EQ(fixed.must_rebuild(all, kRadiusScale), want) << "dim " << dim << ", step " << s;
+      EXPECT_EQ(fixed.last_moved(), reads.last_moved()) << "dim " << dim << ", step " << s;
+      (want ? yes : no) += 1;
+      if (want) {
+        reads.mark(all);
+        fixed.mark(all);
+      }
+    }
+    EXPECT_GT(yes, 2) << "dim " << dim;  // both answers met
+    EXPECT_GT(no, 10) << "dim " << dim;
+    pa.f64("h")[7] = std::nan("");  // a NaN h at the mark: every check says rebuild
+    reads.mark(all);
+    fixed.mark(all);
+    EXPECT_TRUE(reads.must_rebuild(all, kRadiusScale));
+    EXPECT_TRUE(fixed.must_rebuild(all, kRadiusScale));
+    pa.f64("h")[7] = h0;
+    reads.mark(all);
+    fixed.mark(all);
+    EXPECT_FALSE(fixed.must_rebuild(all, kRadiusScale));
+    pa.f64(axes[0])[3] = std::nan("");  // a NaN position, as before
+    EXPECT_TRUE(fixed.must_rebuild(all, kRadiusScale));
+  }
+}
+
 // sphc::PhaseDisplacements: several skins over the same arrays checked and marked within one
 // phase (positions unchanged) give the answers and last_moved() of skins without it, bit for
 // bit; the skins that marked an array in the phase share one copy, and each array's

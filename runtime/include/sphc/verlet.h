@@ -43,6 +43,7 @@ struct MarkedPositions {
   std::size_t n = 0;
   std::vector<double> x, y, z, h;
   double hmin = HUGE_VAL;  // the smallest h (NaN skipped)
+  bool hnan = false;       // a NaN among h
 };
 
 // One scan of each array's displacements per phase (docs/performance-log.md, "The dam break's
@@ -92,7 +93,11 @@ class PhaseDisplacements {
 
 class VerletSkin {
  public:
-  explicit VerletSkin(double skin) : skin_(skin) {}
+  // h_fixed: nothing writes the h of the arrays these lists are checked over (the compiler's
+  // analysis/UniformH.cpp); must_rebuild then reads no h: its growth is 0 and a NaN among h
+  // the one recorded at mark(), the same answers as from h read (stop 46).
+  explicit VerletSkin(double skin, bool h_fixed = false) : skin_(skin), h_fixed_(h_fixed) {}
+  bool h_fixed() const { return h_fixed_; }
 
   double skin() const { return skin_; }
   // --verlet-skin=auto (sphc/verlet_tune.h): the skin of the next mark().
@@ -146,6 +151,7 @@ class VerletSkin {
   void mark_of(const std::vector<const Array*>& arrays, PhaseDisplacements* phase);
 
   double skin_;
+  bool h_fixed_ = false;
   double hmin_ = 0.0;
   std::vector<std::shared_ptr<const MarkedPositions>> saved_;
   mutable double last_moved_ = -1.0;  // measurements for sphc/verlet_tune.h
@@ -158,7 +164,7 @@ class VerletSkin {
 // them from the cell lists when due; a permutation of the particles into cell order moves
 // them far and so rebuilds them too.
 struct VerletLists {
-  explicit VerletLists(double skin_fraction) : skin(skin_fraction) {}
+  explicit VerletLists(double skin_fraction, bool h_fixed = false) : skin(skin_fraction, h_fixed) {}
   VerletSkin skin;
   std::vector<std::vector<std::uint32_t>> lists;
   // The destination particles [begin, end) the lists were built for (a group with start_idx
