@@ -278,12 +278,13 @@ std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest,
 void ScenePrinter::emitSymmetricMembers(std::ostream& os) const {
   forEachLoopBody([&](const PlanEquation& eq, const PlanBody& b) {
     const auto sites = hoistedDestinationSites(b, host_);
-    for (size_t k = 0; k < sites.size(); ++k)
-      if (passDestinationHoisted(eq, k).empty())  // (a value of the parameters alone: the pass's)
+    for (size_t k = 0; k < sites.size(); ++k) {
+      if (!passDestinationHoisted(eq, k).empty()) continue;  // a value of the parameters alone: the pass's
       os << "  std::vector<" << hoistedValueType(b, host_, false, k) << "> dhoist_" << eqStruct(eq)
          << "_" << k << ";  // " << eq.name
          << ": its loop's destination-only value " << k
          << " per particle (each pair once for both particles)\n";
+    }
   });
 }
 
