@@ -354,19 +354,44 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       dvals.insert(p);
     }
   std::vector<std::string> hoisted, dhoisted;  // pointers in the tiles: source, destination
+  // Stop 46: a source-hoisted value another equation of the pass hoists too (the same doubles
+  // in one array, Hoist.cpp) is loaded once, its pointer that one's (hoistedAlias); a
+  // destination-only value of the parameters alone is the pass's (passDestinationHoisted, a
+  // local copy in the tiles), not a per-particle array loaded per tile.
+  const std::map<std::string, std::string> hoistedAlias = sameSourceHoisted(pass);
+  std::map<std::string, std::string> passValues;  // the pass's value -> the tiles' local copy
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
     for (size_t k = 0; k < hoistedSites(b, host_).size(); ++k) {
       const std::string ptr = hoistArgument(eqStruct(*eq), std::to_string(k));
+      if (hoistedAlias.count(ptr)) continue;
       hoisted.push_back(ptr);
       copy(ptr, ptr);
     }
     for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
+      const std::string once = passDestinationHoisted(*eq, k);
+      if (!once.empty()) {
+        passValues[once] = "tile_" + once;
+        continue;
+      }
       const std::string ptr = symmetricDestinationHoisted(eqStruct(*eq), std::to_string(k));
       dhoisted.push_back(ptr);
       copy(ptr, ptr);
     }
   }
+  // A lane's destination-only value k of eq: the pass's (its tiles' copy) or i's (ir_ or cl_).
+  auto destinationHoistedIn = [&](const PlanEquation& eq, size_t k, const std::string& pre) {
+    const std::string once = passDestinationHoisted(eq, k);
+    if (!once.empty()) return passValues.at(once);
+    return pre + symmetricDestinationHoisted(eqStruct(eq), std::to_string(k)) + "[d_idx]";
+  };
+  // The j side's pointers of the aliases, after those of the values they alias (the i side:
+  // the mirrored calls' `absolute` names).
+  auto hoistedAliases = [&](const std::string& ind) {
+    for (const auto& [alias, of] : hoistedAlias)
+      scene_ << ind << "const double* const " << alias << " = " << of
+             << ";  // the same values (Hoist.cpp): loaded once\n";
+  };
   // The hoisted values computed in slot order from the copies of what they read (the same
   // function of the same doubles, so the values a gather would give, padding included: a
   // padding slot holds its cluster's first particle's values; stop 39), where every property
@@ -741,6 +766,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
                << eq->name << "'s values, a local copy\n";
   }
   uniformHLocals(t);  // h uniform (stop 45): the lambda's own copies
+  for (const auto& [once, local] : passValues)
+    scene_ << t << "const double " << local << " = " << once << ";  // the pass's value: a local copy\n";
   scene_ << t << "const std::uint32_t* const cl_begin = cl_pruned.begin.data();\n";
   scene_ << t << "const std::uint32_t* const cl_j = cl_pruned.j.data();\n";
   scene_ << t << "const std::uint8_t* const cl_real = cl_layout.real_mask.data();\n";
@@ -826,6 +853,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     for (const std::string& p : pass.sourceProps)
       scene_ << c2 << "const double* const s_" << p << " = " << jPtr(p) << ";\n";
     for (const std::string& h : hoisted) scene_ << c2 << "const double* const " << h << " = " << jPtr(h) << ";\n";
+    hoistedAliases(c2);
     // (the mirrored calls read particle s_idx's destination values through d_NAME)
     for (const std::string& p : dvals) scene_ << c2 << "const double* const d_" << p << " = " << jPtr(p) << ";\n";
     for (const std::string& h : dhoisted) scene_ << c2 << "const double* const " << h << " = " << jPtr(h) << ";\n";
@@ -852,8 +880,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
         const PlanBody& b = methodBody(*eq, ast::Method::Loop);
         for (size_t k = 0; k < hoistedDestinationSites(b, host_).size(); ++k) {
           const std::string K = std::to_string(k);
-          scene_ << c3 << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = cl_"
-                 << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+          scene_ << c3 << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
+                 << destinationHoistedIn(*eq, k, "cl_") << ";\n";
         }
       }
       for (const std::string& p : dvals)  // the destination's values (the d_NAME above are offset)
@@ -877,8 +905,8 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
         const PlanBody& pb = methodBody(*eq, ast::Method::Loop);
         for (size_t k = 0; k < hoistedDestinationSites(pb, host_).size(); ++k) {
           const std::string K = std::to_string(k);
-          scene_ << b << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = ir_"
-                 << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+          scene_ << b << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
+                 << destinationHoistedIn(*eq, k, "ir_") << ";\n";
         }
       }
       for (const std::string& p : dvals)
@@ -913,6 +941,21 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
              << ", hi, sj_x, sj_y, " << (plan_.dim == 3 ? "sj_z" : "nullptr") << ", sj_h, cl_lane, "
              << "lane_d, RADIUS2)) continue;  // no pair of the row within the support\n";
       scene_ << "#else\n";
+    } else {
+      // 2xMM (stop 46): the register's test the same way (sphc::tile_row_any2, each lane's i
+      // from the register's ri_NAME[r]): the max reduction's chain took ~11% of the own dam
+      // break's shifting tiles (docs/performance-log.md "The own dam break's shifting tiles
+      // (stop 46)"); the same registers skipped.
+      const std::string zs = plan_.dim == 3 ? "ir_z, " : "nullptr, ";
+      const std::string zj = plan_.dim == 3 ? "sj_z, " : "nullptr, ";
+      scene_ << "#if defined(__AVX512F__)\n";
+      if (uhI_ && uhJ_)
+        scene_ << c3 << "if (!sphc::tile_row_any2_cut<DIM>(ir_x, ir_y, " << zs << "sj_x, sj_y, " << zj
+               << "cl_jlane, cl_ilane, lane_d, " << cutoffValue("RADIUS2") << ")) continue;  // no pair of the register within the support\n";
+      else
+        scene_ << c3 << "if (!sphc::tile_row_any2<DIM>(ir_x, ir_y, " << zs << "ir_h, sj_x, sj_y, " << zj
+               << "sj_h, cl_jlane, cl_ilane, lane_d, RADIUS2)) continue;  // no pair of the register within the support\n";
+      scene_ << "#else\n";
     }
     scene_ << c3 << "double any = 0.0;\n";
     scene_ << c3 << "#pragma omp simd reduction(max: any)  // (a tree: + adds the lanes in a chain)\n";
@@ -938,7 +981,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     }
     scene_ << c3 << "}\n";
     scene_ << c3 << "if (!(any > 0.0)) continue;  // no pair of the " << (mm ? "register" : "row") << " within the support\n";
-    if (!mm) scene_ << "#endif\n";
+    scene_ << "#endif\n";
     for (const std::string& p : accs)
       scene_ << c3 << "double* const ti_" << p << "_i = ti_" << p << "[" << (mm ? "r" : "ii") << "];\n";
     // The lanes' body. `mode` (stop 40, a pass whose bodies call a math function GCC does not
@@ -1005,6 +1048,14 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
         const std::string pre = mm || inQueue ? "ir_" : "cl_";
         for (const std::string& p : pass.sourceProps) absolute["s_" + p] = pre + p;
         for (const std::string& h : hoisted) absolute[h] = pre + h;
+        for (const auto& [alias, of] : hoistedAlias) absolute[alias] = pre + of;
+        // the pass's values: the lane's local (the same double for both particles)
+        for (const PlanEquation* eq : pass.equations) {
+          const PlanBody& pb = methodBody(*eq, ast::Method::Loop);
+          for (size_t k = 0; k < hoistedDestinationSites(pb, host_).size(); ++k)
+            if (!passDestinationHoisted(*eq, k).empty())
+              absolute[passDestinationHoisted(*eq, k)] = hoistDestinationArgument(eqStruct(*eq), std::to_string(k));
+        }
         for (const PlanEquation* eq : pass.equations)
           scene_ << body << marked(*eq, withArguments(simdMirroredCall(*eq, d, sums, "ps_"), absolute));
       }
@@ -1080,6 +1131,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
       scene_ << v << "{\n";
       const std::string b = v + "  ";
       for (const std::string& n : jNames) scene_ << b << "const double* const " << n << " = q_" << n << ";\n";
+      hoistedAliases(b);
       for (const std::string& p : pass.shared) scene_ << b << "const double* const di_" << p << " = ir_" << p << ";\n";
       for (const std::string& p : accs) {
         scene_ << b << "alignas(64) double qr_i_" << p << "[CL_LANES] = {};\n";

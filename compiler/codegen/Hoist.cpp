@@ -318,6 +318,30 @@ ScenePrinter::SameHoisted ScenePrinter::sameDestinationHoisted(const NeighbourPa
   return same;
 }
 
+std::map<std::string, std::string> ScenePrinter::sameSourceHoisted(const NeighbourPass& pass) const {
+  std::map<std::string, std::string> same;
+  std::map<std::string, std::string> first;  // hoistedSiteKey -> the first pointer
+  for (const PlanEquation* eq : pass.equations) {
+    const PlanBody& b = methodBody(*eq, ast::Method::Loop);
+    const auto sites = hoistedSites(b, host_);
+    for (size_t k = 0; k < sites.size(); ++k) {
+      const std::string key = hoistedSiteKey(b, sites[k], hoistedValueType(b, host_, true, k));
+      if (key.empty()) continue;
+      const std::string ptr = hoistArgument(eqStruct(*eq), std::to_string(k));
+      const auto found = first.emplace(key, ptr);
+      if (!found.second) same.emplace(ptr, found.first->second);
+    }
+  }
+  return same;
+}
+
+std::string ScenePrinter::passDestinationHoisted(const PlanEquation& eq, size_t k) const {
+  const PlanBody& b = methodBody(eq, ast::Method::Loop);
+  const auto sites = hoistedDestinationSites(b, host_);
+  if (k >= sites.size() || !particleFree(b.source.text, b.facts, sites[k])) return "";
+  return passHoisted(eqStruct(eq), k);
+}
+
 void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass& pass,
                                           const std::string& indent) const {
   const SameHoisted sameAs = sameDestinationHoisted(pass);
@@ -373,7 +397,7 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
   // A value another equation of the pass already computes (the same function of the same
   // source properties: e.g. the shifting's two bodies' s_m[s_idx] / s_rho[s_idx]) reads that
   // equation's array: the same doubles, computed once.
-  std::map<std::string, std::string> computed;  // hoistedSiteKey -> the array's pointer
+  const std::map<std::string, std::string> computed = sameSourceHoisted(pass);  // pointer -> the earlier one
   bool any = false;
   for (const PlanEquation* eq : pass.equations) {
     const PlanBody& b = methodBody(*eq, ast::Method::Loop);
@@ -388,15 +412,13 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
       const std::string K = std::to_string(k);
       const std::string ptr = hoistArgument(eqStruct(*eq), K);
       const std::string type = hoistedValueType(b, host_, true, k);
-      const std::string key = hoistedSiteKey(b, s, type);
-      auto same = key.empty() ? computed.end() : computed.find(key);
+      const auto same = computed.find(ptr);
       if (same != computed.end()) {
         os << "        " << type << "* const " << ptr << " = " << same->second << ";  // "
            << eq->name << ": " << oneLine(b.source.text.substr(s.begin, s.end - s.begin))
            << ", computed above\n";
         continue;
       }
-      if (!key.empty()) computed.emplace(key, ptr);
       const std::string member = "hoist_" + eqStruct(*eq) + "_" + K;
       // Grown, never shrunk: an equation with several sources fills its member for each in
       // turn, and a resize down then up value-initialises every double again (a memset of the

@@ -327,6 +327,16 @@ class ScenePrinter {
   using SameHoisted =
       std::map<std::pair<const PlanEquation*, size_t>, std::pair<std::string, std::string>>;
   SameHoisted sameDestinationHoisted(const NeighbourPass& pass) const;
+  // The source-hoisted values of a pass's loops that an earlier equation of the pass hoists
+  // too (the same hoistedSiteKey: e.g. the shifting's two bodies' s_m / s_rho): each one's
+  // pointer (hoisted_eqN_K) mapped to that earlier equation's, which holds the same doubles
+  // (emitHoistedValues computes them once; the tiles load them once, stop 46).
+  std::map<std::string, std::string> sameSourceHoisted(const NeighbourPass& pass) const;
+  // Where eq's loop's destination-only site k is a value of the parameters alone (no
+  // property, local or d_idx: the shifting's 1 / KERNEL_W(1 / hdx, 1)): the local that holds
+  // it once per pass (pass_dhoisted_eqN_K, emitHoistedValues), else "". The passes of each
+  // pair once and the tiles read that value, not a per-particle array (stop 46).
+  std::string passDestinationHoisted(const PlanEquation& eq, size_t k) const;
   // The call of eq's loop's hoisted site k's function (source: per source particle, else
   // per destination) for `index`, each property it reads as the array `rename` names for it
   // (stop 39: the tiles' slot-order copies); "" where one is not in `rename`, or a

@@ -722,7 +722,10 @@ std::string ScenePrinter::simdMirroredCall(const PlanEquation& eq, int d,
         const std::string m = mirroredPairQuantity(p.name);
         return findPairQuantity(p.name)->vector ? m + "_0, " + m + "_1, " + m + "_2" : m;
       }
-      case BodyParam::DHoisted: return symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]";
+      case BodyParam::DHoisted: {  // (a value of the parameters alone: the pass's, stop 46)
+        const std::string once = passDestinationHoisted(eq, std::stoul(p.name));
+        return once.empty() ? symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]" : once;
+      }
       case BodyParam::PairShared: {  // computed once for the pair in the lanes
         auto it = pairSharedScope_.find(eqValues + "/" + p.name);
         if (it == pairSharedScope_.end())
@@ -896,9 +899,10 @@ void ScenePrinter::emitSymmetricSimdLoops(const DestinationWork& w, const Neighb
     for (const PlanEquation* eq : pass.equations) {
       const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
       for (size_t k = 0; k < sites.size(); ++k) {
-        const std::string K = std::to_string(k);
+        const std::string K = std::to_string(k), once = passDestinationHoisted(*eq, k);
         scene_ << in << "const double " << hoistDestinationArgument(eqStruct(*eq), K) << " = "
-               << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+               << (once.empty() ? symmetricDestinationHoisted(eqStruct(*eq), K) + "[d_idx]" : once)
+               << ";\n";
       }
     }
     scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";

@@ -242,13 +242,16 @@ std::function<std::string(const ScenePrinter::BodyParam&)> ScenePrinter::mirrore
     const PlanEquation& eq, const std::string& pointers) const {
   const std::string eqValues = eqStruct(eq);
   // callBody's arguments but for the swapped indices, the mirrored pair quantities and the
-  // destination-only values of particle s_idx.
-  return [this, eqValues, pointers](const BodyParam& p) -> std::string {
+  // destination-only values of particle s_idx (a value of the parameters alone: the pass's).
+  return [this, &eq, eqValues, pointers](const BodyParam& p) -> std::string {
     switch (p.kind) {
       case BodyParam::Idx: return "s_idx";
       case BodyParam::SIdx: return "d_idx";
       case BodyParam::Pair: return mirrored(p.name);
-      case BodyParam::DHoisted: return symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]";
+      case BodyParam::DHoisted: {
+        const std::string once = passDestinationHoisted(eq, std::stoul(p.name));
+        return once.empty() ? symmetricDestinationHoisted(eqValues, p.name) + "[s_idx]" : once;
+      }
       case BodyParam::PairShared: {  // computed once for the pair (codegen/PairShared.cpp)
         auto it = pairSharedScope_.find(eqValues + "/" + p.name);
         if (it == pairSharedScope_.end()) return "";  // callBody: computed in the call
@@ -275,11 +278,13 @@ std::string ScenePrinter::callBodyMirrored(const PlanEquation& eq, int dest,
 void ScenePrinter::emitSymmetricMembers(std::ostream& os) const {
   forEachLoopBody([&](const PlanEquation& eq, const PlanBody& b) {
     const auto sites = hoistedDestinationSites(b, host_);
-    for (size_t k = 0; k < sites.size(); ++k)
+    for (size_t k = 0; k < sites.size(); ++k) {
+      if (!passDestinationHoisted(eq, k).empty()) continue;  // a value of the parameters alone: the pass's
       os << "  std::vector<" << hoistedValueType(b, host_, false, k) << "> dhoist_" << eqStruct(eq)
          << "_" << k << ";  // " << eq.name
          << ": its loop's destination-only value " << k
          << " per particle (each pair once for both particles)\n";
+    }
   });
 }
 
@@ -455,10 +460,11 @@ void ScenePrinter::emitSymmetricPass(const DestinationWork& w, const NeighbourPa
       const PlanBody& b = methodBody(*eq, ast::Method::Loop);
       const auto sites = hoistedDestinationSites(b, host_);
       for (size_t k = 0; k < sites.size(); ++k) {
-        const std::string K = std::to_string(k);
+        const std::string K = std::to_string(k), once = passDestinationHoisted(*eq, k);
         scene_ << in << "const " << hoistedValueType(b, host_, false, k) << " "
                << hoistDestinationArgument(eqStruct(*eq), K) << " = "
-               << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx];\n";
+               << (once.empty() ? symmetricDestinationHoisted(eqStruct(*eq), K) + "[d_idx]" : once)
+               << ";\n";
       }
     }
     scene_ << in << "const std::vector<std::uint32_t>& kept = " << lists << ".lists[d_idx];\n";
@@ -668,6 +674,7 @@ void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const st
     for (size_t k = 0; k < sites.size(); ++k) {
       const std::string K = std::to_string(k), E = eqStruct(*eq);
       const std::string ptr = symmetricDestinationHoisted(E, K);
+      if (!passDestinationHoisted(*eq, k).empty()) continue;  // the pass's value (stop 46)
       const auto same = sameAs.find({eq, k});
       if (same != sameAs.end()) {
         scene_ << "        " << hoistedValueType(b, host_, false, k) << "* const " << ptr
@@ -689,7 +696,7 @@ void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const st
       const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
       for (size_t k = 0; k < sites.size(); ++k) {
         const std::string K = std::to_string(k);
-        if (sameAs.count({eq, k})) continue;  // filled above
+        if (sameAs.count({eq, k}) || !passDestinationHoisted(*eq, k).empty()) continue;  // filled above; the pass's
         scene_ << "          " << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx] = "
                << hoistDestinationArgument(eqStruct(*eq), K) << ";\n";
       }

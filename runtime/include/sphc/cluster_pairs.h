@@ -236,6 +236,57 @@ inline __attribute__((always_inline)) bool tile_row_any_cut(double xi, double yi
   const __m512d r2 = tile_row_r2<Dim>(xi, yi, zi, xj, yj, zj);
   return tile_row_in(r2, _mm512_set1_pd(cut2), lane, lane_d) != 0;
 }
+// The 2xMM tiles' register test under AVX-512 (stop 46; codegen/ClusterPairs.cpp): a register
+// of 2 i's x 4 j's, lane l's i at xi[l], yi[l], zi[l] (the i-cluster's register ri_NAME[r]) and
+// its j at xj[l], ... (the doubled j-cluster): whether any lane is within the cut-off and a pair
+// the register takes (jlane[l] > ilane[l] + lane_d), as the lanes' own test computes it (the
+// same operations in the same order: the same registers skipped), one compare mask tested at
+// once where the lanes' test was reduced by max to a double (a chain of ~8 dependent
+// instructions before the branch). hi, hj: every lane's h (hmax = hi > hj ? hi : hj, the cut-off
+// radius2 hmax hmax), or cut2 where h is uniform (tile_row_any2_cut).
+template <int Dim>
+inline __attribute__((always_inline)) __m512d tile_row_r2_lanes(const double* xi, const double* yi,
+                                                                const double* zi, const double* xj,
+                                                                const double* yj, const double* zj) {
+  const __m512d dx = _mm512_sub_pd(_mm512_loadu_pd(xi), _mm512_loadu_pd(xj));
+  const __m512d dy = _mm512_sub_pd(_mm512_loadu_pd(yi), _mm512_loadu_pd(yj));
+  __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+  if constexpr (Dim == 3) {
+    const __m512d dz = _mm512_sub_pd(_mm512_loadu_pd(zi), _mm512_loadu_pd(zj));
+    r2 = _mm512_add_pd(r2, _mm512_mul_pd(dz, dz));
+  } else {
+    (void)zi;
+    (void)zj;
+  }
+  return r2;
+}
+inline __attribute__((always_inline)) bool tile_row_in2(__m512d r2, __m512d lim, const double* jlane,
+                                                        const double* ilane, double lane_d) {
+  const __m512d il = _mm512_add_pd(_mm512_loadu_pd(ilane), _mm512_set1_pd(lane_d));
+  return (_mm512_cmp_pd_mask(r2, lim, _CMP_NGE_UQ) &
+          _mm512_cmp_pd_mask(_mm512_loadu_pd(jlane), il, _CMP_GT_OQ)) != 0;
+}
+template <int Dim>
+inline __attribute__((always_inline)) bool tile_row_any2(const double* xi, const double* yi,
+                                                         const double* zi, const double* hi,
+                                                         const double* xj, const double* yj,
+                                                         const double* zj, const double* hj,
+                                                         const double* jlane, const double* ilane,
+                                                         double lane_d, double radius2) {
+  const __m512d r2 = tile_row_r2_lanes<Dim>(xi, yi, zi, xj, yj, zj);
+  const __m512d hm = _mm512_max_pd(_mm512_loadu_pd(hi), _mm512_loadu_pd(hj));  // hi > hj ? hi : hj
+  const __m512d lim = _mm512_mul_pd(_mm512_mul_pd(_mm512_set1_pd(radius2), hm), hm);
+  return tile_row_in2(r2, lim, jlane, ilane, lane_d);
+}
+template <int Dim>
+inline __attribute__((always_inline)) bool tile_row_any2_cut(const double* xi, const double* yi,
+                                                             const double* zi, const double* xj,
+                                                             const double* yj, const double* zj,
+                                                             const double* jlane, const double* ilane,
+                                                             double lane_d, double cut2) {
+  const __m512d r2 = tile_row_r2_lanes<Dim>(xi, yi, zi, xj, yj, zj);
+  return tile_row_in2(r2, _mm512_set1_pd(cut2), jlane, ilane, lane_d);
+}
 #if defined(__AVX512VBMI2__)
 // The pair queue of an 8 x 8 tile (sphc --cluster-queue, codegen/ClusterPairs.cpp; stop 43,
 // docs/performance-log.md "The tiles' pairs compacted (stop 43)"): the tile's pairs within the
