@@ -32,6 +32,7 @@
 #include "codegen/Printer.h"
 
 #include <algorithm>
+#include <sstream>
 
 namespace sphc {
 
@@ -46,6 +47,12 @@ void ScenePrinter::ompLoop(std::ostream& os, const std::string& pragma, const st
   if (!ompQueueing_ || pragma.empty()) {
     os << pragma << loop;
     return;
+  }
+  if (ompQueue_.empty()) {
+    ompQueueOs_ = static_cast<const void*>(&os) == static_cast<const void*>(&scene_)
+                      ? const_cast<std::ostringstream*>(&scene_)
+                      : nullptr;
+    ompQueueAt_ = os.tellp();
   }
   ompQueue_.push_back({pragma, loop, space});
 }
@@ -102,8 +109,16 @@ void ScenePrinter::ompQueueFlush(std::ostream& os) const {
   std::vector<OmpQueuedLoop> loops;
   loops.swap(ompQueue_);
   if (loops.empty()) return;
-  if (loops.size() == 1) {
-    os << loops[0].pragma << loops[0].loop;
+  if (loops.size() == 1) {  // where it was given, as without the queue
+    std::ostringstream* at = ompQueueOs_;
+    if (at && ompQueueAt_ >= 0) {
+      std::string text = at->str();
+      text.insert(static_cast<size_t>(ompQueueAt_), loops[0].pragma + loops[0].loop);
+      at->str(text);
+      at->seekp(0, std::ios_base::end);
+    } else {
+      os << loops[0].pragma << loops[0].loop;
+    }
     return;
   }
   const std::string& in = ompQueueIndent_;

@@ -287,6 +287,10 @@ class ScenePrinter {
   mutable bool ompQueueing_ = false;
   mutable std::vector<OmpQueuedLoop> ompQueue_;
   mutable std::string ompQueueIndent_;
+  // Where the first kept loop would have been printed (its stream and offset): one loop
+  // alone goes there, as without the queue.
+  mutable std::ostringstream* ompQueueOs_ = nullptr;  // scene_, else null
+  mutable std::streampos ompQueueAt_ = 0;
   // Starts keeping loops (OpenMP and the switch on; else nothing is kept).
   void ompQueueOpen(bool openmp, const std::string& indent) const;
   // Prints `pragma` and `loop` to os, or keeps them (a queue open and the pragma not empty).

@@ -900,8 +900,9 @@ void ScenePrinter::emitCrossBlocksHead(const std::string& lists, const std::stri
               "        // in the blocks' region: codegen/OmpRegions.cpp, sphc --no-omp-regions: "
               "a region each).\n";
     emitSpanningHead(lists);
-    scene_ << "        #pragma omp parallel default(firstprivate) shared(cells, spanning)\n";
-    scene_ << "        {\n";
+    // (the region's braces two spaces out: its loops keep their indentation)
+    scene_ << "      #pragma omp parallel default(firstprivate) shared(cells, spanning)\n";
+    scene_ << "      {\n";
     scene_ << "        #pragma omp for schedule(static) nowait\n";
   } else {
     scene_ << "        #pragma omp parallel for schedule(static) default(firstprivate) shared(cells)\n";
@@ -939,7 +940,7 @@ void ScenePrinter::emitCrossSpanning(const NeighbourPass& ba, int b, const std::
   emitPairQuantitiesOnce(q, true, body);
   for (const PlanEquation* eq : ba.equations) scene_ << body << callBodyMirrored(*eq, b, "mirror_");
   scene_ << "          }\n        }\n";
-  if (ompRegions_on_) scene_ << "        }  // the blocks' and the spanning particles' region\n";
+  if (ompRegions_on_) scene_ << "      }  // the blocks' and the spanning particles' region\n";
 }
 
 void ScenePrinter::emitSpanningHead(const std::string& lists) {
