@@ -130,12 +130,20 @@ def instrument(lines):
             out.append(ind + "sphc_instr::leave(rid_); }")
             i = j + 1
             continue
-        m = re.match(r"(\s*)#pragma omp parallel( if.*)?$", line)
+        m = re.match(r"(\s*)#pragma omp parallel( .*)?$", line)
         if m and lines[i + 1].strip() == "{":
             j = i + 2
-            while not (indent(lines[j]) == indent(lines[i + 1]) and lines[j].strip() == "}"):
+            while not (indent(lines[j]) == indent(lines[i + 1]) and lines[j].strip().startswith("}")):
                 j += 1
-            names.append("%s:%d region" % (func, i + 1))
+            # A destination's loops without neighbours in one region (codegen/OmpRegions.cpp,
+            # stop 46), a pass of two arrays' blocks with its spanning particles: named by the
+            # pass, as their loops were.
+            if "in one parallel region" in lines[i - 1] + lines[i - 2]:
+                names.append("%s:%d %s: loops without neighbours (one region)" % (func, i + 1, label))
+            elif "shared(cells, spanning)" in line:
+                names.append("%s:%d %s: pairs of two arrays (blocks, spanning)" % (func, i + 1, label))
+            else:
+                names.append("%s:%d region" % (func, i + 1))
             rid = len(names) - 1
             out.append(m.group(1) + "{ const int rid_ = %d; sphc_instr::enter(rid_);" % rid)
             out.append(line)

@@ -82,6 +82,7 @@ ScenePrinter::ScenePrinter(const Schedule& sched, const DiagnosticEngine& diags,
   filteredLists_ = opts.filteredLists;
   skipEmptyLists_ = opts.skipEmptyLists;
   initInAddBack_on_ = opts.initInAddBack;
+  ompRegions_on_ = opts.ompRegions;
   constantValues_ = opts.constantValues;
 }
 

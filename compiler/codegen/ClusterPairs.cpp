@@ -477,7 +477,11 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
   const std::string ompIfN = openmp ? ompMinIf("n") : "";  // "" or if (n >= OMP_MIN_PARTICLES)
   if (!allDestinationInSlots || arrays)
     emitDestinationHoistedAll(pass, openmp ? "        #pragma omp parallel for schedule(static)" +
-                                                 (ompIfN.empty() ? "" : " " + ompIfN) + "\n" : "");
+                                                 (ompIfN.empty() ? "" : " " + ompIfN) + "\n" : "",
+                              ompSpace(w));
+  // The loops the CPU printer kept before this pass (its initialize, the hoisted values) and
+  // the one above: one parallel region (OmpRegions.cpp); nothing below before the tiles.
+  ompQueueFlush(scene_);
   // The properties nothing writes between two builds (no live equation or stepper writes
   // them: PlanProperty::written; a sort of the particles rebuilds the layout) are copied at
   // the build only; the largest h too where nothing writes h (stop 39). The slot buffer is

@@ -124,6 +124,10 @@ struct EmitOptions {
   // (ClusterPairs.cpp, initInAddBackRefusal); false (--no-init-in-add-back): the initialize
   // in its own loop before the pass. The same bits.
   bool initInAddBack = true;
+  // OpenMP: a destination's per-particle loops before its first pair loop (initialize, the
+  // hoisted values) in one parallel region of `omp for nowait` loops (OmpRegions.cpp);
+  // false (--no-omp-regions): each loop its own region. The same bits.
+  bool ompRegions = true;
   // The equation instances' values that are literals (`dim = 2`, defaults such as R = 0.2)
   // as constants of the C++ (HostProgram.cpp); false (--no-constant-values): members set at
   // set-up, as the others. The values are the same bit for bit.

@@ -14,6 +14,7 @@
 
 #include <cstdio>
 #include <functional>
+#include <stdexcept>
 #include <set>
 
 namespace sphc {
@@ -453,11 +454,13 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     const std::vector<const PlanEquation*>& with =
         kind == ast::Method::Initialize ? w.initialize : w.postLoop;
     if (with.empty()) return;
-    scene_ << parallelFor("      ", w.perParticle, ompIf(rangeCount(w)));
-    scene_ << "      for (int d_idx = " << rangeBegin(w) << "; d_idx < " << rangeEnd(w)
-           << "; ++d_idx) {  // " << what << "\n";
-    for (const auto* eq : with) scene_ << "        " << equationCall(*eq, kind, d);
-    scene_ << "      }\n";
+    std::string loop = "      for (int d_idx = " + rangeBegin(w) + "; d_idx < " + rangeEnd(w) +
+                       "; ++d_idx) {  // " + what + "\n";
+    for (const auto* eq : with) loop += "        " + equationCall(*eq, kind, d);
+    loop += "      }\n";
+    // (kept for one region with the first pass's hoisted values where a queue is open)
+    ompLoop(scene_, parallelFor("      ", w.perParticle, ompIf(rangeCount(w))), loop,
+            w.ranged() ? D + "|" + rangeBegin(w) + ":" + rangeEnd(w) : ompSpace(w));
   };
   // Pair loops A <- B and B <- A as one pass (codegen/SymmetricPairs.cpp, crossPairsRefusal):
   // A's last pass runs in B's first's place.
@@ -470,6 +473,20 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
                            symmetricPass(w, *first) && onceLanes(w, *first) &&
                            clusterTilesRefusal(w, *first).empty() &&
                            initInAddBackRefusal(w, *first).empty();
+  // OpenMP (stop 46; --no-omp-regions): the initialize and the first pass's source-only and
+  // destination-only values in one parallel region (OmpRegions.cpp), printed just before the
+  // pass's pair loop. They move past the pass's pointers, h where uniform, the scratch
+  // arrays' resize and the kept lists' rebuild check, none of which reads what they write:
+  // not where the initialize writes the positions or h, nor before an initialize_pair (it may
+  // index as it likes) or a pass of two arrays printed as one (emitCrossPass).
+  bool initMoves = false;
+  for (const PlanEquation* eq : w.initialize)
+    for (const PropAccess& x : methodBody(*eq, ast::Method::Initialize).facts.dWrites)
+      initMoves = initMoves || x.prop == "x" || x.prop == "y" || x.prop == "z" || x.prop == "h";
+  const bool oneRegion = openmp_ && !mpi_ && first && first->searches() &&
+                         first->initializePair.empty() && !initMoves && !(cross.second == &w) &&
+                         !(cross.first == &w && w.passes.size() == 1);
+  if (oneRegion) ompQueueOpen(openmp_, "        ");
   if (initInTiles)
     scene_ << "      // (initialize: in the add-back of the tiles of " << arr(first->source).name
            << ", per particle)\n";
@@ -519,16 +536,21 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
     }
     // Source-only values of the loop bodies, once per source particle (codegen/Hoist.cpp).
     emitHoistedValues(scene_, pass, hasDomain() ? S + ".n + ghosts_" + S + ".size()" : S + ".n",
-                      parallelFor("        ", pass.order, ompIf("n_src")));
+                      parallelFor("        ", pass.order, ompIf("n_src")),
+                      S + (hasDomain() ? "|all+ghosts" : "|all"));
     scene_ << "        const sphc::CellList& cells = cells_" << S << ";\n";
     const std::string lists = verlet() ? verletLists(phase, w, s) : "";
     // A pass in cluster-pair tiles searches its own layout (ClusterPairs.cpp): no cells.
     const bool tiles = symmetricPass(w, pass) && onceLanes(w, pass) &&
                        clusterTilesRefusal(w, pass).empty();
     listsRebuildCheck(lists, w, s, !tiles);
+    // The loops kept for one region (oneRegion): here, before the pair loop; the tiles print
+    // them after their destination-only values (ClusterPairs.cpp).
+    if (!tiles) ompQueueFlush(scene_);
     if (symmetricPass(w, pass)) {
       emitSymmetricPass(w, pass, lists, openmp_,
                         tuned() ? "verlet_radius2" : "VERLET_RADIUS2");  // codegen/SymmetricPairs.cpp
+      if (!ompQueue_.empty()) throw std::logic_error("codegen: per-particle loops kept past a pair loop");
       scene_ << "      }\n";
       continue;
     }
@@ -656,9 +678,62 @@ void CpuPrinter::destination(const DestinationWork& w, const std::string& phase)
   }
   initInAddBack_ = nullptr;
   endUniformH();
-  perParticle(ast::Method::PostLoop, "post_loop");
-  // Reductions over the destination array into its constants.
-  for (const Reduction& r : w.reductions) reduction(w, r);
+  // OpenMP (stop 46; --no-omp-regions): the post_loop and the max and min reductions after
+  // it in one parallel region (OmpRegions.cpp), each reduction's value in a local of its own
+  // (acc_K), the reductions `omp for reduction(...) nowait`: complete at the region's end.
+  std::vector<const Reduction*> joined;
+  if (openmp_ && ompRegions_on_ && !mpi_ && !w.onGhosts && !w.ranged())
+    for (const Reduction& r : w.reductions) {
+      const std::string& op = plan_.equationDecls[r.equation->declIndex].reduceOp;
+      if (r.combine != LoopOrder::Parallel || (op != "max" && op != "min")) break;
+      joined.push_back(&r);
+    }
+  if (joined.size() < 2 && (joined.empty() || w.postLoop.empty())) joined.clear();
+  if (!joined.empty()) {
+    std::set<std::string> postWrites;  // a reduction reading one: a barrier before it
+    for (const PlanEquation* eq : w.postLoop)
+      for (const PropAccess& x : methodBody(*eq, ast::Method::PostLoop).facts.dWrites)
+        postWrites.insert(x.prop);
+    scene_ << "      {  // the post_loop and the reductions after it in one parallel region\n";
+    for (size_t k = 0; k < joined.size(); ++k) {
+      const PlanEquation* eq = joined[k]->equation;
+      const auto& pd = plan_.equationDecls[eq->declIndex];
+      scene_ << "        " << real_ << " acc_" << k << " = "
+             << (pd.reduceOp == "max" ? "-HUGE_VAL" : "HUGE_VAL") << ";  // reduce "
+             << pd.reduceOp << " into " << D << "." << pd.reduceTarget << ": " << eq->name
+             << ", from " << loc(eq->loc) << "\n";
+    }
+    ompQueueOpen(openmp_, "        ");
+    perParticle(ast::Method::PostLoop, "post_loop");
+    for (size_t k = 0; k < joined.size(); ++k) {
+      const PlanEquation* eq = joined[k]->equation;
+      const auto& pd = plan_.equationDecls[eq->declIndex];
+      const PlanBody& b = plan_.bodies[pd.methods.at(ast::Method::Reduce)];
+      const std::string acc = "acc_" + std::to_string(k);
+      bool reads = false;
+      for (const PropAccess& x : b.facts.dReads) reads = reads || postWrites.count(x.prop);
+      const std::string loop =
+          "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n          const " + real_ + " v = " +
+          callBody(bodyFunctionName(eq->name, "reduce"), b, d, eqStruct(*eq), "t") +
+          ";\n          " + acc + " = v " + (pd.reduceOp == "max" ? ">" : "<") + " " + acc +
+          " ? v : " + acc + ";\n        }\n";
+      ompLoop(scene_,
+              parallelFor("        ", LoopOrder::Parallel,
+                          withIf("reduction(" + pd.reduceOp + " : " + acc + ")", ompIf("n"))),
+              loop, reads ? D + "|reduce" + std::to_string(k) : ompSpace(w));
+    }
+    ompQueueFlush(scene_);
+    for (size_t k = 0; k < joined.size(); ++k) {
+      const auto& pd = plan_.equationDecls[joined[k]->equation->declIndex];
+      scene_ << "        " << propPtr(d, pd.reduceTarget) << "[0] = acc_" << k << ";\n";
+    }
+    scene_ << "      }\n";
+    for (size_t k = joined.size(); k < w.reductions.size(); ++k) reduction(w, w.reductions[k]);
+  } else {
+    perParticle(ast::Method::PostLoop, "post_loop");
+    // Reductions over the destination array into its constants.
+    for (const Reduction& r : w.reductions) reduction(w, r);
+  }
   emitHostReduces(w);
   ghostRefresh(w);
 }

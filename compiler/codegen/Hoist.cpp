@@ -377,7 +377,8 @@ void ScenePrinter::emitDestinationHoisted(std::ostream& os, const NeighbourPass&
 }
 
 void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass,
-                                     const std::string& count, const std::string& pragma) const {
+                                     const std::string& count, const std::string& pragma,
+                                     const std::string& space) const {
   // The destination-only values of the parameters alone, once per pass (particleFree; read
   // by emitDestinationHoisted's locals).
   for (const PlanEquation* eq : pass.equations) {
@@ -433,10 +434,10 @@ void ScenePrinter::emitHoistedValues(std::ostream& os, const NeighbourPass& pass
     }
   }
   if (calls.empty()) return;
-  os << pragma;
-  os << "        for (int s_idx = 0; s_idx < n_src; ++s_idx) {\n";
-  for (const auto& c : calls) os << "          " << c << "\n";
-  os << "        }\n";
+  std::string loop = "        for (int s_idx = 0; s_idx < n_src; ++s_idx) {\n";
+  for (const auto& c : calls) loop += "          " + c + "\n";
+  loop += "        }\n";
+  ompLoop(os, pragma, loop, space);  // kept for one region where a queue is open (OmpRegions.cpp)
 }
 
 std::string ScenePrinter::hoistedSiteKey(const PlanBody& b, const SourceOnlySite& s,

@@ -266,6 +266,43 @@ class ScenePrinter {
   bool constantValues_ = true;  // EmitOptions::constantValues (HostProgram.cpp)
   mutable std::unique_ptr<std::set<const PlanBody*>> pairSharedBodies_;  // (once)
 
+  // ---- Per-particle loops in one OpenMP region (OmpRegions.cpp; stop 46) ----
+  // Under OpenMP every `#pragma omp parallel` wakes the team: ~127 us a region on a VM
+  // under OMP_WAIT_POLICY=passive. Where the CPU printer opens a queue (ompQueueOpen), the
+  // per-particle loops that ompLoop is given (a destination's initialize, the source-only
+  // and destination-only values of its first pass) are kept and printed at ompQueueFlush
+  // as one `#pragma omp parallel` of `#pragma omp for schedule(static) nowait` loops: a
+  // thread runs the same iterations of loops over the same particles (the same count and
+  // static schedule in one region), so a loop that reads what an earlier one wrote for the
+  // same particle needs no barrier; loops over another array's particles touch nothing of
+  // the first's. A loop over the same array with another count gets a barrier before it.
+  // One loop alone is printed as given. EmitOptions::ompRegions (--no-omp-regions: each
+  // loop its own region).
+  struct OmpQueuedLoop {
+    std::string pragma;  // `#pragma omp parallel for schedule(static) [if (...)]`, as given
+    std::string loop;    // the loop's text, from `for`
+    std::string space;   // "ARRAY|count": the particles it runs over
+  };
+  bool ompRegions_on_ = true;  // EmitOptions::ompRegions
+  mutable bool ompQueueing_ = false;
+  mutable std::vector<OmpQueuedLoop> ompQueue_;
+  mutable std::string ompQueueIndent_;
+  // Where the first kept loop would have been printed (its stream and offset): one loop
+  // alone goes there, as without the queue.
+  mutable std::ostringstream* ompQueueOs_ = nullptr;  // scene_, else null
+  mutable std::streampos ompQueueAt_ = 0;
+  // Starts keeping loops (OpenMP and the switch on; else nothing is kept).
+  void ompQueueOpen(bool openmp, const std::string& indent) const;
+  // Prints `pragma` and `loop` to os, or keeps them (a queue open and the pragma not empty).
+  void ompLoop(std::ostream& os, const std::string& pragma, const std::string& loop,
+               const std::string& space) const;
+  // Prints what is kept (one region, or the one loop as given) and closes the queue.
+  void ompQueueFlush(std::ostream& os) const;
+  // The space of a loop over w's particles from 0 to n (ghosts too where w runs on them).
+  std::string ompSpace(const DestinationWork& w) const {
+    return arr(w.array).name + (w.onGhosts ? "|all+ghosts" : "|all");
+  }
+
   // ---- Source-only values hoisted out of the pair loops (Hoist.cpp) ----
   // The sites of a loop body computed once per source particle (none unless d.hoist), and
   // those computed once per destination particle (of properties no pair loop writes).
@@ -292,9 +329,9 @@ class ScenePrinter {
                           std::ostringstream& os) const;
   // Before a neighbour pass over source s (with `count` particles): the hoisted values of
   // its loop equations, one array each, filled in a loop over the source particles (with
-  // `pragma` before it).
+  // `pragma` before it; `space`: the particles it runs over, for ompLoop).
   void emitHoistedValues(std::ostream& os, const NeighbourPass& pass, const std::string& count,
-                         const std::string& pragma) const;
+                         const std::string& pragma, const std::string& space = "") const;
   // In the destination loop of a pass, before the neighbours: the destination-only values,
   // locals `dhoisted_eqN_K`.
   void emitDestinationHoisted(std::ostream& os, const NeighbourPass& pass,
@@ -391,11 +428,14 @@ class ScenePrinter {
   void emitCrossSpanning(const NeighbourPass& ba, int b, const std::set<std::string>& q,
                          const std::string& lists, const std::string& nameA,
                          const std::string& nameB);
+  // Its list of the spanning particles and the pointers into the lists from nameB's side.
+  void emitSpanningHead(const std::string& lists);
   // Pieces of both: the kept lists of every destination particle when due (verlet_build);
   // the destination-only values of every particle (dhoisted_all_*); the pair quantities of
   // a neighbour s_idx, with `both` the mirrored ones too (XIJ_ji, DWIJ_ji, ...).
   void emitKeptListsBuild(const std::string& lists, bool openmp, const std::string& listRadius2);
-  void emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma);
+  void emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma,
+                                 const std::string& space = "");
   // lanes: WIJ and DWIJ from the kernel lanes' arrays (kl_w, kl_s at kl_k).
   void emitPairQuantitiesOnce(const std::set<std::string>& q, bool both, const std::string& body,
                               bool lanes = false);

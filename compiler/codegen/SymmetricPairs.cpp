@@ -664,7 +664,8 @@ void ScenePrinter::emitKeptListsBuild(const std::string& lists, bool openmp,
   scene_ << "          }\n        }\n";
 }
 
-void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma) {
+void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const std::string& pragma,
+                                             const std::string& space) {
   std::vector<std::string> fills;
   // The same value as an earlier equation's of the pass: its array (Hoist.cpp).
   const SameHoisted sameAs = sameDestinationHoisted(pass);
@@ -689,19 +690,20 @@ void ScenePrinter::emitDestinationHoistedAll(const NeighbourPass& pass, const st
     }
   }
   if (!fills.empty()) {
-    scene_ << pragma;
-    scene_ << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
-    emitDestinationHoisted(scene_, pass, "          ");
+    std::ostringstream loop;  // kept for one region where a queue is open (OmpRegions.cpp)
+    loop << "        for (int d_idx = 0; d_idx < n; ++d_idx) {\n";
+    emitDestinationHoisted(loop, pass, "          ");
     for (const PlanEquation* eq : pass.equations) {
       const auto sites = hoistedDestinationSites(methodBody(*eq, ast::Method::Loop), host_);
       for (size_t k = 0; k < sites.size(); ++k) {
         const std::string K = std::to_string(k);
         if (sameAs.count({eq, k}) || !passDestinationHoisted(*eq, k).empty()) continue;  // filled above; the pass's
-        scene_ << "          " << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx] = "
-               << hoistDestinationArgument(eqStruct(*eq), K) << ";\n";
+        loop << "          " << symmetricDestinationHoisted(eqStruct(*eq), K) << "[d_idx] = "
+             << hoistDestinationArgument(eqStruct(*eq), K) << ";\n";
       }
     }
-    scene_ << "        }\n";
+    loop << "        }\n";
+    ompLoop(scene_, pragma, loop.str(), space);
   }
 }
 
@@ -894,7 +896,24 @@ void ScenePrinter::emitCrossBlocksHead(const std::string& lists, const std::stri
   scene_ << "        const std::uint32_t* const by_source_first = " << lists << "_by_source.first.data();\n";
   scene_ << "        const std::uint32_t* const by_source_last = " << lists << "_by_source.last.data();\n";
   scene_ << "        const int n_blocks = std::max(1, std::min(n, omp_get_max_threads()));\n";
-  scene_ << "        #pragma omp parallel for schedule(static) default(firstprivate) shared(cells)\n";
+  if (ompRegions_on_) {
+    // The blocks and the spanning particles (emitCrossSpanning) in one parallel region
+    // (stop 46; --no-omp-regions: a region each), `omp for nowait`: the spanning loop writes
+    // only the sums of nameB's particles that no block writes (those whose candidates lie in
+    // several blocks) and reads no sum (a pass reads no property its group writes while the
+    // passes run: analysis/Hazards.cpp); which ones span is a function of the lists alone.
+    scene_ << "        // The " << nameB << " particles whose candidates lie in several blocks "
+              "(emitCrossSpanning's loop,\n"
+              "        // in the blocks' region: codegen/OmpRegions.cpp, sphc --no-omp-regions: "
+              "a region each).\n";
+    emitSpanningHead(lists);
+    // (the region's braces two spaces out: its loops keep their indentation)
+    scene_ << "      #pragma omp parallel default(firstprivate) shared(cells, spanning)\n";
+    scene_ << "      {\n";
+    scene_ << "        #pragma omp for schedule(static) nowait\n";
+  } else {
+    scene_ << "        #pragma omp parallel for schedule(static) default(firstprivate) shared(cells)\n";
+  }
   scene_ << "        for (int blk = 0; blk < n_blocks; ++blk) {\n";
   scene_ << "          const int b_begin = static_cast<int>(static_cast<long>(n) * blk / n_blocks);\n";
   scene_ << "          const int b_end = static_cast<int>(static_cast<long>(n) * (blk + 1) / n_blocks);\n";
@@ -910,14 +929,12 @@ void ScenePrinter::emitCrossSpanning(const NeighbourPass& ba, int b, const std::
             "each over its\n"
             "        // candidates in increasing " << nameA << " index, the pair as above (d_idx of "
          << nameA << ", s_idx of " << nameB << ").\n";
-  scene_ << "        const std::vector<std::uint32_t>& spanning = " << lists
-         << "_by_source.spanning_blocks(n, n_blocks);\n";
-  scene_ << "        const int n_spanning = static_cast<int>(spanning.size());\n";
-  scene_ << "        const std::uint32_t* const by_source_starts = " << lists
-         << "_by_source.starts.data();\n";
-  scene_ << "        const std::uint32_t* const by_source_dests = " << lists
-         << "_by_source.dests.data();\n";
-  scene_ << "        #pragma omp parallel for schedule(static) default(firstprivate) shared(spanning)\n";
+  if (ompRegions_on_) {
+    scene_ << "        #pragma omp for schedule(static) nowait\n";
+  } else {
+    emitSpanningHead(lists);
+    scene_ << "        #pragma omp parallel for schedule(static) default(firstprivate) shared(spanning)\n";
+  }
   scene_ << "        for (int m = 0; m < n_spanning; ++m) {\n";
   scene_ << "          const int s_idx = static_cast<int>(spanning[m]);\n";
   scene_ << "          const std::uint32_t* const k_end = by_source_dests + by_source_starts[s_idx + 1];\n";
@@ -930,6 +947,17 @@ void ScenePrinter::emitCrossSpanning(const NeighbourPass& ba, int b, const std::
   emitPairQuantitiesOnce(q, true, body);
   for (const PlanEquation* eq : ba.equations) scene_ << body << callBodyMirrored(*eq, b, "mirror_");
   scene_ << "          }\n        }\n";
+  if (ompRegions_on_) scene_ << "      }  // the blocks' and the spanning particles' region\n";
+}
+
+void ScenePrinter::emitSpanningHead(const std::string& lists) {
+  scene_ << "        const std::vector<std::uint32_t>& spanning = " << lists
+         << "_by_source.spanning_blocks(n, n_blocks);\n";
+  scene_ << "        const int n_spanning = static_cast<int>(spanning.size());\n";
+  scene_ << "        const std::uint32_t* const by_source_starts = " << lists
+         << "_by_source.starts.data();\n";
+  scene_ << "        const std::uint32_t* const by_source_dests = " << lists
+         << "_by_source.dests.data();\n";
 }
 
 // --report's notes as this printer prints the loops: a pass it puts in SIMD lanes per

@@ -288,6 +288,13 @@ static cl::opt<bool> NoInitInAddBack(
              "(default: per particle in the tiles' add-back, where the tiles write only slot "
              "sums that the initialize alone writes; the results are the same bit for bit)"),
     cl::init(false), cl::cat(SphcCat));
+static cl::opt<bool> NoOmpRegions(
+    "no-omp-regions",
+    cl::desc("OpenMP: print each loop without neighbours before a destination's first pair "
+             "loop (its initialize, the hoisted values) as a parallel region of its own "
+             "(default: those loops in one region, each `omp for nowait`: the same "
+             "iterations on the same threads; the results are the same bit for bit)"),
+    cl::init(false), cl::cat(SphcCat));
 static cl::opt<bool> NoConstantValues(
     "no-constant-values",
     cl::desc("Set every parameter and const of the equation instances at set-up (default: "
@@ -738,6 +745,7 @@ int main(int argc, char** argv) {
   emitOpts.filteredLists = FilteredLists;
   emitOpts.skipEmptyLists = !NoSkipEmptyLists;
   emitOpts.initInAddBack = !NoInitInAddBack;
+  emitOpts.ompRegions = !NoOmpRegions;
   emitOpts.constantValues = !NoConstantValues;
   // --simd-pairs: auto (the default), on (also bare), off; the lanes only on the CPU backends.
   const std::string simdMode = SimdPairs.empty() ? std::string("on") : SimdPairs.getValue();
