@@ -182,22 +182,31 @@ inline void load_doubled4(double* t, const double* p) {
 // -ffp-contract=off: no fma on either side), so the same rows are skipped and the sums are the
 // same bit for bit. (No margin on radius2: in a lattice such as the cube's many pairs lie at the
 // support's edge to the last bit, and 1 + 1e-12 let ~10% more rows through to lanes all masked.)
-// The row's r2 in the 8 lanes, as the lanes compute R2IJ.
+// The r2 of 8 lanes from their i's coordinates (xi, yi, zi: broadcast or per lane) and the
+// j's at xj, yj, zj, as the lanes compute R2IJ (zi and zj read only in 3D).
 template <int Dim>
-inline __attribute__((always_inline)) __m512d tile_row_r2(double xi, double yi, double zi,
-                                                          const double* xj, const double* yj,
-                                                          const double* zj) {
-  const __m512d dx = _mm512_sub_pd(_mm512_set1_pd(xi), _mm512_loadu_pd(xj));
-  const __m512d dy = _mm512_sub_pd(_mm512_set1_pd(yi), _mm512_loadu_pd(yj));
+inline __attribute__((always_inline)) __m512d tile_r2(__m512d xi, __m512d yi, __m512d zi,
+                                                      const double* xj, const double* yj,
+                                                      const double* zj) {
+  const __m512d dx = _mm512_sub_pd(xi, _mm512_loadu_pd(xj));
+  const __m512d dy = _mm512_sub_pd(yi, _mm512_loadu_pd(yj));
   __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
   if constexpr (Dim == 3) {
-    const __m512d dz = _mm512_sub_pd(_mm512_set1_pd(zi), _mm512_loadu_pd(zj));
+    const __m512d dz = _mm512_sub_pd(zi, _mm512_loadu_pd(zj));
     r2 = _mm512_add_pd(r2, _mm512_mul_pd(dz, dz));
   } else {
     (void)zi;
     (void)zj;
   }
   return r2;
+}
+// The row's r2 in the 8 lanes: one i against 8 j's.
+template <int Dim>
+inline __attribute__((always_inline)) __m512d tile_row_r2(double xi, double yi, double zi,
+                                                          const double* xj, const double* yj,
+                                                          const double* zj) {
+  return tile_r2<Dim>(_mm512_set1_pd(xi), _mm512_set1_pd(yi),
+                      Dim == 3 ? _mm512_set1_pd(zi) : _mm512_setzero_pd(), xj, yj, zj);
 }
 // The lanes within the cut-off lim (!(r2 >= lim), the lanes' form) and past lane_d.
 inline __attribute__((always_inline)) __mmask8 tile_row_in(__m512d r2, __m512d lim,
@@ -248,17 +257,8 @@ template <int Dim>
 inline __attribute__((always_inline)) __m512d tile_row_r2_lanes(const double* xi, const double* yi,
                                                                 const double* zi, const double* xj,
                                                                 const double* yj, const double* zj) {
-  const __m512d dx = _mm512_sub_pd(_mm512_loadu_pd(xi), _mm512_loadu_pd(xj));
-  const __m512d dy = _mm512_sub_pd(_mm512_loadu_pd(yi), _mm512_loadu_pd(yj));
-  __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
-  if constexpr (Dim == 3) {
-    const __m512d dz = _mm512_sub_pd(_mm512_loadu_pd(zi), _mm512_loadu_pd(zj));
-    r2 = _mm512_add_pd(r2, _mm512_mul_pd(dz, dz));
-  } else {
-    (void)zi;
-    (void)zj;
-  }
-  return r2;
+  return tile_r2<Dim>(_mm512_loadu_pd(xi), _mm512_loadu_pd(yi),
+                      Dim == 3 ? _mm512_loadu_pd(zi) : _mm512_setzero_pd(), xj, yj, zj);
 }
 inline __attribute__((always_inline)) bool tile_row_in2(__m512d r2, __m512d lim, const double* jlane,
                                                         const double* ilane, double lane_d) {
