@@ -589,7 +589,7 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
            << (plan_.dim == 3 ? "cl2_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax" << par << ");\n";
   } else if (inOrder) {
     scene_ << in << "// (in order: the boxes from the particles' positions, the padded cluster's in its tail)\n";
-    scene_ << in << "sphc::update_boxes(cl_layout, di_x, di_y, " << zIn << ");\n";
+    scene_ << in << "sphc::update_boxes(cl_layout, di_x, di_y, " << zIn << par << ");\n";
     scene_ << in << "sphc::tail_positions(cl_layout, di_x, di_y, " << zIn << ", cl_t_x, cl_t_y, "
            << (plan_.dim == 3 ? "cl_t_z" : "nullptr") << ", 4.0 * Kernel::radius_scale * cl_hmax);\n";
   } else {

@@ -429,13 +429,15 @@ void gather_positions(const ClusterLayout& L, const double* x, const double* y, 
 namespace {
 
 template <int W>
-void update_boxes_w(ClusterLayout& L, const double* xs, const double* ys, const double* zs) {
+void update_boxes_w(ClusterLayout& L, const double* xs, const double* ys, const double* zs,
+                    bool parallel) {
   const int C = W > 0 ? W : L.width;
   const std::uint8_t full = L.full_mask();
   const bool three = L.dim == 3;
   const std::size_t nc = L.n_clusters;
   double* box = L.box.data();
-#pragma omp parallel for schedule(static)
+  (void)parallel;
+#pragma omp parallel for schedule(static) if (parallel)
   for (std::size_t c = 0; c < nc; ++c) {
     const std::size_t s0 = c * C;
     double* b = box + 6 * c;
@@ -467,11 +469,12 @@ void update_boxes_w(ClusterLayout& L, const double* xs, const double* ys, const 
 
 }  // namespace
 
-void update_boxes(ClusterLayout& L, const double* xs, const double* ys, const double* zs) {
+void update_boxes(ClusterLayout& L, const double* xs, const double* ys, const double* zs,
+                  bool parallel) {
   if (L.width == kClusterSize)
-    update_boxes_w<kClusterSize>(L, xs, ys, zs);
+    update_boxes_w<kClusterSize>(L, xs, ys, zs, parallel);
   else
-    update_boxes_w<0>(L, xs, ys, zs);
+    update_boxes_w<0>(L, xs, ys, zs, parallel);
 }
 
 namespace {

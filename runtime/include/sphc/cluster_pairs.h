@@ -412,8 +412,11 @@ void add_slots(const ClusterLayout& layout, const double* sums, double* dst);
 void add_slots(const ClusterLayout& layout, const float* sums, float* dst);
 
 // The boxes from positions in slot order (gather_positions' xs, ys, zs; real slots only; zs
-// unused in 2D).
-void update_boxes(ClusterLayout& layout, const double* xs, const double* ys, const double* zs);
+// unused in 2D); under OpenMP in a parallel region only where `parallel` (the solvers pass
+// n >= OMP_MIN_PARTICLES, as to the other per-evaluation pieces: a small array's pass then
+// wakes no team for it, stop 46).
+void update_boxes(ClusterLayout& layout, const double* xs, const double* ys, const double* zs,
+                  bool parallel = true);
 
 // The per-evaluation pieces in fewer passes (docs/performance-log.md, "The tiles' per-evaluation
 // pieces (stop 39)"); each gives exactly the values of the calls it replaces. `parallel`:
