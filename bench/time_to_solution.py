@@ -9,9 +9,11 @@ time per particle-step. For each case this script runs, interleaved in one go,
   PySPH serial       (its Cython, no --openmp, OMP_NUM_THREADS=1)
   PySPH OpenMP       (--openmp, OMP_NUM_THREADS=T)
 
-with OMP_WAIT_POLICY=passive for all of them (on a shared machine libgomp's spinning default
-makes 2-thread runs several times slower; --omp-wait active changes it, --omp-wait default
-leaves it unset: what a user who sets nothing gets), and reports for each
+with each code's own OpenMP wait policy, what a user who sets nothing gets (--omp-wait
+default: OMP_WAIT_POLICY unset; libgomp's policy for PySPH, the solver's --omp-wait auto for
+sphc). On a shared, loaded machine libgomp's spinning makes 2-thread runs several times
+slower: there --omp-wait passive sets OMP_WAIT_POLICY=passive for all of them (--omp-wait
+active: active), and reports for each
 
   - wall time of the time loop to tf (sphc: wall_s of --timing; PySPH: "Run took"),
   - CPU time (user + system) of the time loop: the CPU time of the whole process less that
@@ -379,10 +381,10 @@ def main():
                          "--sphc-flag=--verlet-skin=0.1")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--skip-omp", action="store_true", help="serial runs only")
-    ap.add_argument("--omp-wait", default="passive", choices=("passive", "active", "default"),
-                    help="OMP_WAIT_POLICY of every run (default passive); default: none set, "
+    ap.add_argument("--omp-wait", default="default", choices=("passive", "active", "default"),
+                    help="OMP_WAIT_POLICY of every run; default (the default): none set, "
                     "what a user who sets nothing gets (libgomp's policy for PySPH, the "
-                    "solver's --omp-wait auto for sphc)")
+                    "solver's --omp-wait auto for sphc); passive on a loaded machine")
     ap.add_argument("--repeat", type=int, default=1, help="rounds; the fastest is kept")
     ap.add_argument("--tf-dambreak", type=float, default=None)
     ap.add_argument("--dambreak-large-tf", type=float, default=0.0,

@@ -2,6 +2,7 @@
 #include "analysis/UniformH.h"
 
 #include "sema/ConstEval.h"
+#include "sema/Sema.h"
 
 #include <cmath>
 #include <optional>
@@ -24,7 +25,7 @@ std::string hPerParticleReason(const Plan& plan, int a) {
   namesOf(*h->init, names);
   for (const auto* p : plan.params) params.insert(p->name.name);
   for (const std::string& n : names)
-    if (!params.count(n) && n != "pi" && n != "e" && n != "true" && n != "false")
+    if (!params.count(n) && !builtinConstant(n))
       return "its initial h reads " + n;
   const std::optional<double> v = ConstEval(plan)(*h->init);
   if (!v || !std::isfinite(*v)) return "its initial h is not an expression of params";

@@ -1,4 +1,5 @@
 #include "codegen/CppText.h"
+#include "sema/Sema.h"
 
 #include <cctype>
 #include <set>
@@ -14,10 +15,7 @@ std::string exprCpp(const ast::Expr& e, const NameMap& names) {
       return t;
     }
     case ast::Expr::Name:
-      if (e.text == "pi") return "M_PI";
-      if (e.text == "e") return "M_E";
-      if (e.text == "true") return "1.0";
-      if (e.text == "false") return "0.0";
+      if (const BuiltinConstant* b = builtinConstant(e.text)) return b->cpp;
       return names(e.text);
     case ast::Expr::Unary:
       return "(" + e.op + exprCpp(*e.args[0], names) + ")";

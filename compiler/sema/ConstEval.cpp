@@ -1,5 +1,6 @@
 // Compile-time values of declarative expressions (sema/ConstEval.h).
 #include "sema/ConstEval.h"
+#include "sema/Sema.h"
 
 #include <cmath>
 #include <vector>
@@ -16,10 +17,7 @@ std::optional<double> ConstEval::operator()(const ast::Expr& e, int depth) const
   switch (e.kind) {
     case ast::Expr::Number: return e.number;
     case ast::Expr::Name: {
-      if (e.text == "pi") return M_PI;
-      if (e.text == "e") return M_E;
-      if (e.text == "true") return 1.0;
-      if (e.text == "false") return 0.0;
+      if (const BuiltinConstant* b = builtinConstant(e.text)) return b->value;
       if (auto f = fixed_.find(e.text); f != fixed_.end()) return f->second;
       auto it = decls_.find(e.text);
       if (it == decls_.end() || !it->second) return std::nullopt;

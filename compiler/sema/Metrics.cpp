@@ -71,7 +71,7 @@ bool MetricsBuilder::particleExpr(const ast::ExprPtr& e, int a, const std::strin
   std::set<std::string> names;
   namesOf(*e, names);
   for (const auto& n : names) {
-    if (n == "t" || n == "pi" || n == "e" || n == "true" || n == "false") continue;
+    if (n == "t" || builtinConstant(n)) continue;
     if (isParam_(n) && !declared(n) && !isCoordinate(n)) continue;
     if (n == "z" && plan_.dim < 3) continue;  // 0 in 1D and 2D
     if (n == "y" && plan_.dim < 2) continue;

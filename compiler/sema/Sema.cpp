@@ -122,6 +122,16 @@ int mathFunctionArity(const std::string& name) {
   return it == arity.end() ? -1 : it->second;
 }
 
+const BuiltinConstant* builtinConstant(const std::string& name) {
+  static const BuiltinConstant table[] = {{"pi", M_PI, "M_PI", true},
+                                          {"e", M_E, "M_E", true},
+                                          {"true", 1.0, "1.0", false},
+                                          {"false", 0.0, "0.0", false}};
+  for (const BuiltinConstant& b : table)
+    if (name == b.name) return &b;
+  return nullptr;
+}
+
 bool checkExpr(const ast::Expr& e, const std::function<bool(const std::string&)>& isKnown,
                const std::string& what, DiagnosticEngine& diags) {
   bool ok = true;
@@ -129,7 +139,7 @@ bool checkExpr(const ast::Expr& e, const std::function<bool(const std::string&)>
     case ast::Expr::Number:
       break;
     case ast::Expr::Name:
-      if (e.text == "pi" || e.text == "e" || e.text == "true" || e.text == "false") break;
+      if (builtinConstant(e.text)) break;
       if (!isKnown(e.text)) {
         diags.error(e.loc, "unknown name '" + e.text + "' in " + what);
         ok = false;

@@ -38,4 +38,14 @@ bool checkExpr(const ast::Expr& e, const std::function<bool(const std::string&)>
 // The math functions allowed in declarative expressions, with their arity.
 int mathFunctionArity(const std::string& name);  // -1 if unknown
 
+// The names every declarative expression knows without a declaration: the numbers pi and e,
+// the booleans true and false; their value and how generated C++ spells them.
+struct BuiltinConstant {
+  const char* name;
+  double value;
+  const char* cpp;
+  bool number;  // pi, e (not a boolean)
+};
+const BuiltinConstant* builtinConstant(const std::string& name);  // nullptr if none
+
 }  // namespace sphc

@@ -194,8 +194,7 @@ std::optional<double> literalValue(const ast::Expr& e) {
   switch (e.kind) {
     case ast::Expr::Number: return e.number;
     case ast::Expr::Name:
-      if (e.text == "pi") return M_PI;
-      if (e.text == "e") return M_E;
+      if (const BuiltinConstant* b = builtinConstant(e.text); b && b->number) return b->value;
       return std::nullopt;
     case ast::Expr::Unary: {
       auto v = literalValue(*e.args[0]);
