@@ -793,11 +793,17 @@ void ScenePrinter::emitClusterTiles(const DestinationWork& w, const NeighbourPas
     if (arrays) {  // (stop 41) from the particles' arrays, the padded cluster from its tails
       scene_ << c1 << "const bool cl_it = static_cast<std::uint32_t>(ci) == cl_tail;\n";
       scene_ << c1 << "const int i0 = cl_it ? 0 : ci * CL_W;  // its first slot (the tails': 0)\n";
+      // (stop 47) each array's source chosen once, not at each of its 16 reads: GCC compiled
+      // the choice in the reads as a compare and a branch each, ~900 instructions an i-cluster
+      // in the own dam break's rates pass (docs/performance-log.md, "The i-clusters' values
+      // (stop 47)")
+      for (const auto& c : copies)
+        scene_ << c1 << "const double* const ci_" << c.first << " = (cl_it ? cl_t_" << c.first
+               << " : cl_" << c.first << ") + i0;\n";
     }
     scene_ << c1 << "for (int l = 0; l < CL_W; ++l) {\n";
     for (const auto& c : copies) {
-      const std::string src = arrays ? "(cl_it ? cl_t_" + c.first + " : cl_" + c.first + ")[i0 + "
-                                     : "cl2_" + c.first + "[CL_LANES * ci + ";
+      const std::string src = arrays ? "ci_" + c.first + "[" : "cl2_" + c.first + "[CL_LANES * ci + ";
       scene_ << c1 << "  ri_" << c.first << "[0][l] = " << src << "0]; ri_" << c.first << "[0][CL_W + l] = "
              << src << "1]; ri_" << c.first << "[1][l] = " << src << "2]; ri_" << c.first
              << "[1][CL_W + l] = " << src << "3];\n";
